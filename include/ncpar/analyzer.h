@@ -1,0 +1,61 @@
+/* Data analyzer: the one sequential stage. Consumes parsed blocks in program
+ * order, applies modal state, parameters, expressions, O-word control flow and the
+ * cutter-compensation decisions, and emits numbered command slots. */
+#ifndef NCPAR_ANALYZER_H
+#define NCPAR_ANALYZER_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "ncpar/canon.h"
+#include "ncpar/diag.h"
+#include "ncpar/feeder.h"
+#include "ncpar/lex.h"
+
+/* Where the analyzer gets blocks in file order. The pipeline serves them from the
+ * parsed ring (pre-lexed in parallel); the serial reference lexes on demand.
+ * next() returns the next block in file order (or NULL at the end of the body)
+ * and keeps it valid until release(). The analyzer re-reads earlier blocks for
+ * loops and calls itself, from src->text, with ncp_source_span + ncp_lex_block,
+ * and returns to next() once it is back at the block after the last one taken. */
+struct ncp_block_feed {
+    void *ctx;
+    const struct ncp_block *(*next)(void *ctx);
+    void (*release)(void *ctx);
+    const struct ncp_source *src;
+};
+
+/* Where command slots go, in cmd_id order. acquire() returns a zeroed slot to fill
+ * (may block while the ring is full; NULL = shut down), publish() hands it on. */
+struct ncp_cmd_sink {
+    void *ctx;
+    struct ncp_cmd *(*acquire)(void *ctx);
+    void (*publish)(void *ctx, struct ncp_cmd *cmd);
+};
+
+struct ncp_tool_entry {
+    int pocket;
+    double z_offset, x_offset, diameter, frontangle, backangle;
+    int orientation;
+};
+
+#define NCP_MAX_TOOLS 1000
+
+struct ncp_analyzer_cfg {
+    const char *tool_table_path; /* NULL: empty table (as rs274 without -t) */
+    uint32_t max_loop_iterations;/* runaway while/do/repeat guard, 0 = default 10,000,000 */
+    uint32_t max_call_depth;     /* O-word call nesting, 0 = default (rs274: 10) */
+};
+
+struct ncp_analyzer;
+
+struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
+                                      struct ncp_diag *d);
+void ncp_analyzer_free(struct ncp_analyzer *a);
+
+/* Run to the end of the program or the first error. Every slot is published, the
+ * last one with NCP_CMD_F_END or NCP_CMD_F_ERROR set (an error is carried by a
+ * slot so that it comes out in program order). Returns NCP_OK, or the error code. */
+int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
+                     const struct ncp_cmd_sink *sink);
+
+#endif

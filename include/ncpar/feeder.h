@@ -1,0 +1,43 @@
+/* Feeder: loads the program text and splits it into blocks (lines).
+ * The split is a pure function of the text so that the analyzer can re-read any
+ * earlier block (loops, subroutine calls) from the same text without the file. */
+#ifndef NCPAR_FEEDER_H
+#define NCPAR_FEEDER_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "ncpar/diag.h"
+
+struct ncp_source {
+    const char *text;   /* whole program text (mmap'd file or heap copy of a pipe) */
+    size_t len;
+    size_t begin, end;  /* program body: after a leading '%' line, before the closing '%' */
+    uint32_t begin_line;/* line number of the first body byte */
+    const char *name;   /* file name for diagnostics ("-" for stdin) */
+    int mapped;         /* 1 if mmap'd */
+    int has_percent;    /* program was delimited by '%' lines */
+};
+
+/* A block's position: text[off .. off+len) excluding the line terminator;
+ * `next` is the offset of the following block. */
+struct ncp_span {
+    uint64_t off;
+    uint32_t len;       /* may exceed NCP_LINE_MAX: the lexer reports it */
+    uint32_t line;
+    uint64_t next;
+};
+
+/* Load a file (mmap) or "-" (stdin, read() into memory). Fills d on failure. */
+int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d);
+/* Wrap an in-memory buffer (fuzzing, tests). The buffer must outlive src. */
+int ncp_source_from_memory(struct ncp_source *src, const char *text, size_t len,
+                           const char *name, struct ncp_diag *d);
+void ncp_source_close(struct ncp_source *src);
+
+/* Split the block starting at `off` (which has line number `line`). Returns 0 and
+ * fills *out, or 1 when off >= src->end (no more blocks). \n, \r\n and \r end a
+ * block. */
+int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
+                    struct ncp_span *out);
+
+#endif

@@ -1,0 +1,138 @@
+/* Lexer: one source block (one line) -> one fixed-size parsed block.
+ * Pure: no shared mutable state, so n lexer threads can run it in parallel.
+ * Expressions that are constant fold to a number; those that read parameters are
+ * compiled to a small stack bytecode evaluated later by the analyzer with
+ * ncp_expr_eval(). Syntax errors are stored in the block (err.code != NCP_OK)
+ * and reported when the analyzer reaches the block. */
+#ifndef NCPAR_LEX_H
+#define NCPAR_LEX_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "ncpar/diag.h"
+
+#define NCP_LINE_MAX 256      /* rs274 rejects longer lines ("Command too long") */
+#define NCP_BLOCK_MAX_WORDS 64
+#define NCP_BLOCK_MAX_ASSIGN 32
+#define NCP_BLOCK_MAX_CODE 256 /* bytecode instructions per block */
+#define NCP_BLOCK_POOL 512     /* names and comment text, NUL-terminated strings */
+#define NCP_OWORD_MAX_ARGS 30
+
+/* Stack bytecode. Every instruction pushes or pops doubles. */
+enum ncp_bc_op {
+    NCP_BC_CONST,   /* push k */
+    NCP_BC_PARAM,   /* pop index, push #index (index rounded as rs274 does) */
+    NCP_BC_NAMED,   /* push #<name>; name = pool + a, length b */
+    NCP_BC_EXISTS,  /* push 1/0: EXISTS[#<name>], name = pool + a, length b */
+    NCP_BC_NEG,     /* unary minus */
+    NCP_BC_NOT,     /* reserved */
+    /* binary: pop rhs, pop lhs, push result */
+    NCP_BC_POW, NCP_BC_MUL, NCP_BC_DIV, NCP_BC_MOD, NCP_BC_ADD, NCP_BC_SUB,
+    NCP_BC_EQ, NCP_BC_NE, NCP_BC_GT, NCP_BC_GE, NCP_BC_LT, NCP_BC_LE,
+    NCP_BC_AND, NCP_BC_OR, NCP_BC_XOR,
+    /* unary functions */
+    NCP_BC_ABS, NCP_BC_ACOS, NCP_BC_ASIN, NCP_BC_ATAN2 /* binary: ATAN[a]/[b] */,
+    NCP_BC_COS, NCP_BC_EXP, NCP_BC_FIX, NCP_BC_FUP, NCP_BC_LN, NCP_BC_ROUND,
+    NCP_BC_SIN, NCP_BC_SQRT, NCP_BC_TAN
+};
+
+struct ncp_bc_ins {
+    uint8_t op;      /* enum ncp_bc_op */
+    uint8_t pad;
+    uint16_t a, b;   /* operands (name offset/length) */
+    uint16_t col;    /* source column, for run-time errors (div by zero, ...) */
+    double k;        /* constant */
+};
+
+/* A value: a folded constant, or code[start .. start+len) of the same block. */
+struct ncp_expr {
+    double value;     /* valid when is_const */
+    uint16_t start, len;
+    uint8_t is_const;
+};
+
+struct ncp_word {
+    char letter;      /* upper-case 'A'..'Z' (never 'O' or '#': those have own fields) */
+    uint16_t col;     /* 1-based column of the letter */
+    struct ncp_expr v;
+};
+
+enum ncp_assign_kind { NCP_ASSIGN_NUMBERED, NCP_ASSIGN_NAMED };
+
+/* #index = value  or  #<name> = value. rs274 evaluates all expressions of a block
+ * with the parameter values from before the block, then assigns in order. */
+struct ncp_assign {
+    uint8_t kind;            /* enum ncp_assign_kind */
+    uint16_t col;
+    struct ncp_expr index;   /* NUMBERED: index expression (#[1+2]=... allowed) */
+    uint16_t name_off, name_len; /* NAMED: name in pool, lower-cased, spaces removed */
+    struct ncp_expr value;
+};
+
+enum ncp_oword_kind {
+    NCP_O_NONE = 0, NCP_O_SUB, NCP_O_ENDSUB, NCP_O_CALL, NCP_O_RETURN,
+    NCP_O_IF, NCP_O_ELSEIF, NCP_O_ELSE, NCP_O_ENDIF,
+    NCP_O_WHILE, NCP_O_ENDWHILE, NCP_O_DO, NCP_O_REPEAT, NCP_O_ENDREPEAT,
+    NCP_O_BREAK, NCP_O_CONTINUE
+};
+
+struct ncp_oword {
+    uint8_t kind;             /* enum ncp_oword_kind */
+    uint8_t nargs;            /* CALL: number of [args] */
+    uint16_t col;
+    /* the O-word's name: numeric ("o100" -> "100", leading zeros stripped) or
+     * named ("o<foo>" -> "foo", lower-cased), always as text in the pool */
+    uint16_t name_off, name_len;
+    struct ncp_expr cond;     /* IF/ELSEIF/WHILE/REPEAT count/RETURN value/ENDSUB value */
+    uint8_t has_cond;
+    struct ncp_expr args[NCP_OWORD_MAX_ARGS];
+};
+
+enum ncp_comment_kind {
+    NCP_CMT_NONE = 0, NCP_CMT_PLAIN, NCP_CMT_MSG, NCP_CMT_DEBUG, NCP_CMT_PRINT,
+    NCP_CMT_LOGOPEN, NCP_CMT_LOGAPPEND, NCP_CMT_LOGCLOSE, NCP_CMT_LOG
+};
+
+struct ncp_block {
+    uint64_t offset;          /* byte offset of the block in the program text */
+    uint32_t line;            /* 1-based source line */
+    uint16_t length;          /* bytes of the block, without the newline */
+    uint8_t block_delete;     /* leading '/' */
+    uint8_t has_n;            /* N word present (value in n_number) */
+    double n_number;
+    struct ncp_diag err;      /* err.code != NCP_OK: syntax error, rest undefined */
+
+    uint16_t n_words, n_assign, n_code, pool_used;
+    struct ncp_word words[NCP_BLOCK_MAX_WORDS]; /* in source order, G/M may repeat */
+    struct ncp_assign assign[NCP_BLOCK_MAX_ASSIGN];
+    struct ncp_oword oword;   /* kind NCP_O_NONE when no O-word */
+
+    /* rs274 keeps the last comment of a line; MSG/DEBUG/PRINT text after the comma */
+    uint8_t comment_kind;     /* enum ncp_comment_kind */
+    uint16_t comment_off, comment_len; /* in pool */
+
+    struct ncp_bc_ins code[NCP_BLOCK_MAX_CODE];
+    char pool[NCP_BLOCK_POOL];
+};
+
+/* Parse text[0..len) (one line, no newline) into *out. Always fills out->err.
+ * Returns out->err.code. Never reads outside text[0..len). */
+int ncp_lex_block(const char *text, size_t len, uint32_t line, uint64_t offset,
+                  struct ncp_block *out);
+
+/* Parameter access for expression evaluation, implemented by the analyzer. */
+struct ncp_param_ops {
+    void *ctx;
+    /* return 0 on success, or fill d and return its code */
+    int (*get_numbered)(void *ctx, int index, double *out, struct ncp_diag *d);
+    int (*get_named)(void *ctx, const char *name, size_t len, double *out,
+                     struct ncp_diag *d);
+    int (*exists_named)(void *ctx, const char *name, size_t len);
+};
+
+/* Evaluate e (of block b). Returns NCP_OK or fills *d (with b->line and the
+ * failing instruction's column) and returns d->code. */
+int ncp_expr_eval(const struct ncp_block *b, const struct ncp_expr *e,
+                  const struct ncp_param_ops *p, double *out, struct ncp_diag *d);
+
+#endif

@@ -1,0 +1,71 @@
+/* The parallel interpreter pipeline (feeder -> n lexers -> analyzer -> m executors
+ * -> in-order output) and its serial reference. Both produce byte-identical
+ * output and identical errors for every configuration. */
+#ifndef NCPAR_PIPELINE_H
+#define NCPAR_PIPELINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "ncpar/analyzer.h"
+#include "ncpar/canon.h"
+#include "ncpar/diag.h"
+#include "ncpar/feeder.h"
+
+#define NCP_MAX_LEXERS 16
+#define NCP_MAX_EXECUTORS 16
+
+enum ncp_thread_mode { NCP_MODE_SERIAL, NCP_MODE_DET, NCP_MODE_ATT };
+
+/* Placement of one thread. cpu < 0: let the OS place it (DET). */
+struct ncp_thread_spec {
+    int cpu;
+    int policy;    /* SCHED_OTHER or SCHED_FIFO */
+    int priority;  /* SCHED_FIFO priority, ignored for SCHED_OTHER */
+};
+
+/* Thread map (rt-config/*.ini): which thread runs where, ring sizes. */
+struct ncp_thread_map {
+    enum ncp_thread_mode mode;
+    int n_lexers, n_executors;
+    int string_rows;  /* g: rows of the string ring (each row = n blocks) */
+    int parsed_rows;  /* h: rows of the parsed ring */
+    int cmd_slots;    /* commands ring capacity per executor */
+    int start_timeout_us; /* lexers start when the string ring is full or after this */
+    struct ncp_thread_spec feeder, analyzer, output;
+    struct ncp_thread_spec lexer[NCP_MAX_LEXERS];
+    struct ncp_thread_spec executor[NCP_MAX_EXECUTORS];
+};
+
+/* Defaults for a mode and thread counts (ATT: feeder on CPU0, others round-robin
+ * over the CPUs present). */
+void ncp_thread_map_default(struct ncp_thread_map *m, enum ncp_thread_mode mode,
+                            int n_lexers, int n_executors);
+/* Load an INI thread map; fills d (file:line) on error. */
+int ncp_thread_map_load(struct ncp_thread_map *m, const char *path, struct ncp_diag *d);
+
+/* Receives completed slots in cmd_id order on the output thread. Return non-zero
+ * to stop the run (e.g. write error). */
+struct ncp_output {
+    void *ctx;
+    int (*emit)(void *ctx, const struct ncp_cmd *cmd);
+};
+
+struct ncp_run_stats {
+    uint64_t blocks;        /* blocks lexed */
+    uint64_t commands;      /* slots emitted */
+    double wall_ms;         /* pipeline start (thread creation incl.) to last slot out */
+    int threads;            /* threads used in total */
+};
+
+/* Run the interpreter over src. The error (if any) is returned in *d in program
+ * order, exactly as the serial reference reports it. Returns NCP_OK or d->code. */
+int ncp_pipeline_run(const struct ncp_source *src, const struct ncp_thread_map *map,
+                     const struct ncp_analyzer_cfg *acfg, const struct ncp_output *out,
+                     struct ncp_run_stats *stats, struct ncp_diag *d);
+
+/* The same stages in the calling thread, no rings. */
+int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *acfg,
+                   const struct ncp_output *out, struct ncp_run_stats *stats,
+                   struct ncp_diag *d);
+
+#endif

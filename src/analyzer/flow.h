@@ -1,0 +1,36 @@
+/* O-word control flow (module-internal header).
+ * Serves the analyzer core the next block to interpret, in execution order:
+ * it handles every O-word block itself (sub/endsub definitions are skipped and
+ * indexed, call/return, if/elseif/else/endif, while/endwhile, do/while,
+ * repeat/endrepeat, break, continue) and re-reads earlier blocks from the source
+ * text (ncp_source_span + ncp_lex_block) when a loop or call goes back; it returns
+ * to the pre-lexed feed when execution reaches the block after the last one the
+ * feed delivered. Subroutines may be defined after their call (it scans forward). */
+#ifndef NCP_ANALYZER_FLOW_H
+#define NCP_ANALYZER_FLOW_H
+
+#include "ncpar/analyzer.h"
+#include "params.h"
+
+struct ncp_flow;
+
+struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed,
+                              struct ncp_params *params,
+                              const struct ncp_analyzer_cfg *cfg);
+void ncp_flow_free(struct ncp_flow *f);
+
+/* Next non-O-word block to interpret. Returns NCP_OK and sets *out (valid until
+ * the next call), NCP_END at the end of the program body, or an error with *d
+ * filled (file order line/col). Blocks with a syntax error are returned as they
+ * are (out->err set) for the core to report, except where rs274 would not read
+ * them. */
+int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out,
+                  struct ncp_diag *d);
+
+/* Current subroutine call depth (0 = main program). */
+int ncp_flow_call_depth(const struct ncp_flow *f);
+
+/* M2/M30 inside a subroutine, or errors: drop all frames. */
+void ncp_flow_reset(struct ncp_flow *f);
+
+#endif

@@ -1,0 +1,49 @@
+/* Parameter store of the analyzer (module-internal header).
+ * Numbered parameters #1..#5602 (all start at 0, #5161.. etc. as rs274), named
+ * globals (#<_name>), named locals (#<name>) scoped per subroutine call level,
+ * and read-only predefined names answered by a hook the analyzer core installs. */
+#ifndef NCP_ANALYZER_PARAMS_H
+#define NCP_ANALYZER_PARAMS_H
+
+#include <stddef.h>
+#include "ncpar/diag.h"
+#include "ncpar/lex.h"
+
+#define NCP_PARAMS_MAX 5602        /* rs274: RS274NGC_MAX_PARAMETERS */
+#define NCP_CALL_ARGS 30           /* #1..#30 are the call arguments */
+
+struct ncp_params;
+
+/* Predefined read-only named parameters (#<_x>, #<_line>, ...): return 1 and set
+ * *out if `name` is one, else 0. */
+typedef int (*ncp_predef_fn)(void *ctx, const char *name, size_t len, double *out);
+
+struct ncp_params *ncp_params_new(void);
+void ncp_params_free(struct ncp_params *p);
+void ncp_params_set_predef(struct ncp_params *p, ncp_predef_fn fn, void *ctx);
+
+/* line/col: where to point errors. Out-of-range index, undefined named parameter
+ * and writes to read-only names are errors with rs274's wording. */
+int ncp_params_get(const struct ncp_params *p, int index, double *out,
+                   struct ncp_diag *d);
+int ncp_params_set(struct ncp_params *p, int index, double v, struct ncp_diag *d);
+/* Raw access for the core to keep #5420.. etc. current (no checks, no errors). */
+double *ncp_params_slot(struct ncp_params *p, int index);
+
+int ncp_params_get_named(const struct ncp_params *p, const char *name, size_t len,
+                         double *out, struct ncp_diag *d);
+int ncp_params_set_named(struct ncp_params *p, const char *name, size_t len,
+                         double v, struct ncp_diag *d);
+int ncp_params_exists(const struct ncp_params *p, const char *name, size_t len);
+
+/* Subroutine call: save #1..#30 and open a new local-name scope, then set
+ * #1..#nargs from args (the rest 0, as rs274). Return restores both. */
+int ncp_params_push_call(struct ncp_params *p, const double *args, int nargs,
+                         struct ncp_diag *d);
+void ncp_params_pop_call(struct ncp_params *p);
+int ncp_params_call_level(const struct ncp_params *p);
+
+/* Adapter for ncp_expr_eval(). */
+struct ncp_param_ops ncp_params_ops(struct ncp_params *p);
+
+#endif

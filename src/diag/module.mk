@@ -1,0 +1,1 @@
+LIB_SRCS += src/diag/diag.c
