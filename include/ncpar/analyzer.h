@@ -24,8 +24,10 @@ struct ncp_block_feed {
     const struct ncp_source *src;
 };
 
-/* Where command slots go, in cmd_id order. acquire() returns a zeroed slot to fill
- * (may block while the ring is full; NULL = shut down), publish() hands it on. */
+/* Where command slots go, in cmd_id order. acquire() returns a slot whose header
+ * (n_ops, flags, diag.code, text_used, out_len) is zeroed; ops are NOT cleared, so
+ * the analyzer writes each op whole (compound literal: unused fields 0). It may
+ * block while the ring is full; NULL = shut down. publish() hands it on. */
 struct ncp_cmd_sink {
     void *ctx;
     struct ncp_cmd *(*acquire)(void *ctx);

@@ -122,4 +122,7 @@ struct ncp_cmd {
     char out[NCP_CMD_OUT_MAX];
 };
 
+/* Clear a slot's header (not its ops) and number it: what acquire() does. */
+void ncp_cmd_reset_header(struct ncp_cmd *cmd, uint64_t id);
+
 #endif

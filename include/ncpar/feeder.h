@@ -15,6 +15,7 @@ struct ncp_source {
     uint32_t begin_line;/* line number of the first body byte */
     const char *name;   /* file name for diagnostics ("-" for stdin) */
     int mapped;         /* 1 if mmap'd */
+    int owned;          /* 1 if text is a heap copy freed by ncp_source_close */
     int has_percent;    /* program was delimited by '%' lines */
 };
 
@@ -35,8 +36,8 @@ int ncp_source_from_memory(struct ncp_source *src, const char *text, size_t len,
 void ncp_source_close(struct ncp_source *src);
 
 /* Split the block starting at `off` (which has line number `line`). Returns 0 and
- * fills *out, or 1 when off >= src->end (no more blocks). \n, \r\n and \r end a
- * block. */
+ * fills *out, or 1 when off >= src->end (no more blocks). \n and \r\n end a
+ * block (a lone \r is left to the lexer, which treats it as a blank). */
 int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
                     struct ncp_span *out);
 

@@ -23,7 +23,7 @@ struct ncp_thread_spec {
     int priority;  /* SCHED_FIFO priority, ignored for SCHED_OTHER */
 };
 
-/* Thread map (rt-config/*.ini): which thread runs where, ring sizes. */
+/* Thread map (an INI in rt-config/): which thread runs where, ring sizes. */
 struct ncp_thread_map {
     enum ncp_thread_mode mode;
     int n_lexers, n_executors;

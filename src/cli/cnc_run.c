@@ -1,0 +1,319 @@
+/* cnc-run: command-line front end of ncpar. */
+#include "ncpar/executor.h"
+#include "ncpar/feeder.h"
+#include "ncpar/lex.h"
+#include "ncpar/pipeline.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_PROGRAM = 2, EXIT_RUNTIME = 3 };
+
+/* Canonical text goes through one large buffer: write() per slot would dominate. */
+struct canon_writer {
+    int fd;
+    int failed;
+    size_t used;
+    char buf[1 << 20];
+};
+
+static int writer_flush(struct canon_writer *w)
+{
+    size_t off = 0;
+    while (off < w->used && !w->failed) {
+        ssize_t n = write(w->fd, w->buf + off, w->used - off);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            w->failed = 1;
+        else
+            off += (size_t)n;
+    }
+    w->used = 0;
+    return w->failed;
+}
+
+static int emit_canon(void *ctx, const struct ncp_cmd *cmd)
+{
+    struct canon_writer *w = ctx;
+    if (!w)
+        return 0;
+    if (w->used + cmd->out_len > sizeof w->buf && writer_flush(w))
+        return 1;
+    memcpy(w->buf + w->used, cmd->out, cmd->out_len);
+    w->used += cmd->out_len;
+    return 0;
+}
+
+static void print_diag(const char *prog, const struct ncp_diag *d)
+{
+    if (d->line)
+        fprintf(stderr, "%s:%u:%u: error: %s\n", prog, d->line, d->col ? d->col : 1, d->msg);
+    else
+        fprintf(stderr, "%s: error: %s\n", prog, d->msg);
+}
+
+static void usage(FILE *f)
+{
+    fputs("usage: cnc-run parse PROG [-j N] [--executors M] [--mode serial|det|att]\n"
+          "                          [--config INI] [--tool-table FILE] [--canon FILE|-]\n"
+          "                          [--stats] [--max-loops N]\n"
+          "       cnc-run check PROG [--tool-table FILE]\n"
+          "\n"
+          "parse  interpret PROG (\"-\" = standard input) with the parallel pipeline and\n"
+          "       write canonical machining calls (rs274 -g format) to --canon.\n"
+          "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
+          "\n"
+          "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault\n",
+          f);
+}
+
+struct parse_opts {
+    const char *prog;
+    const char *canon;
+    const char *config;
+    int lexers, executors;
+    enum ncp_thread_mode mode;
+    int mode_given;
+    int stats;
+    struct ncp_analyzer_cfg acfg;
+};
+
+static int parse_int(const char *s, int lo, int hi, int *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || *end || end == s || v < lo || v > hi)
+        return -1;
+    *out = (int)v;
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, struct parse_opts *o)
+{
+    static const struct option longopts[] = {
+        { "jobs", required_argument, 0, 'j' },
+        { "executors", required_argument, 0, 'e' },
+        { "mode", required_argument, 0, 'm' },
+        { "config", required_argument, 0, 'c' },
+        { "tool-table", required_argument, 0, 't' },
+        { "canon", required_argument, 0, 'o' },
+        { "stats", no_argument, 0, 's' },
+        { "max-loops", required_argument, 0, 'L' },
+        { "help", no_argument, 0, 'h' },
+        { 0, 0, 0, 0 },
+    };
+    int c, v;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "j:e:m:c:t:o:shL:", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'j':
+            if (parse_int(optarg, 1, NCP_MAX_LEXERS, &o->lexers))
+                return fprintf(stderr, "cnc-run: -j wants 1..%d lexer threads\n", NCP_MAX_LEXERS), -1;
+            break;
+        case 'e':
+            if (parse_int(optarg, 1, NCP_MAX_EXECUTORS, &o->executors))
+                return fprintf(stderr, "cnc-run: --executors wants 1..%d\n", NCP_MAX_EXECUTORS), -1;
+            break;
+        case 'm':
+            o->mode_given = 1;
+            if (!strcmp(optarg, "serial"))
+                o->mode = NCP_MODE_SERIAL;
+            else if (!strcmp(optarg, "det"))
+                o->mode = NCP_MODE_DET;
+            else if (!strcmp(optarg, "att"))
+                o->mode = NCP_MODE_ATT;
+            else
+                return fprintf(stderr, "cnc-run: --mode is serial, det or att\n"), -1;
+            break;
+        case 'c': o->config = optarg; break;
+        case 't': o->acfg.tool_table_path = optarg; break;
+        case 'o': o->canon = optarg; break;
+        case 's': o->stats = 1; break;
+        case 'L':
+            if (parse_int(optarg, 1, 2000000000, &v))
+                return fprintf(stderr, "cnc-run: --max-loops wants a positive count\n"), -1;
+            o->acfg.max_loop_iterations = (uint32_t)v;
+            break;
+        case 'h': usage(stdout); exit(EXIT_OK);
+        default: return -1;
+        }
+    }
+    if (optind != argc - 1) {
+        fprintf(stderr, "cnc-run: expected exactly one program file\n");
+        return -1;
+    }
+    o->prog = argv[optind];
+    return 0;
+}
+
+static int open_canon(const char *path, struct canon_writer **w)
+{
+    *w = NULL;
+    if (!path)
+        return 0;
+    struct canon_writer *cw = malloc(sizeof *cw);
+    if (!cw)
+        return -1;
+    cw->used = 0;
+    cw->failed = 0;
+    if (!strcmp(path, "-")) {
+        cw->fd = 1;
+    } else {
+        cw->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (cw->fd < 0) {
+            fprintf(stderr, "cnc-run: cannot write %s: %s\n", path, strerror(errno));
+            free(cw);
+            return -1;
+        }
+    }
+    *w = cw;
+    return 0;
+}
+
+static const char *mode_name(enum ncp_thread_mode m)
+{
+    return m == NCP_MODE_SERIAL ? "serial" : m == NCP_MODE_DET ? "det" : "att";
+}
+
+static int cmd_parse(int argc, char **argv)
+{
+    struct parse_opts o;
+    memset(&o, 0, sizeof o);
+    o.lexers = 2;
+    o.executors = 1;
+    o.mode = NCP_MODE_DET;
+    if (parse_args(argc, argv, &o))
+        return usage(stderr), EXIT_USAGE;
+
+    struct ncp_thread_map map;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (o.config) {
+        if (ncp_thread_map_load(&map, o.config, &d) != NCP_OK) {
+            fprintf(stderr, "%s:%u: error: %s\n", o.config, d.line, d.msg);
+            return EXIT_USAGE;
+        }
+        if (o.mode_given)
+            map.mode = o.mode;
+    } else {
+        ncp_thread_map_default(&map, o.mode, o.lexers, o.executors);
+    }
+
+    struct ncp_source src;
+    if (ncp_source_open(&src, o.prog, &d) != NCP_OK) {
+        print_diag(o.prog, &d);
+        return EXIT_PROGRAM;
+    }
+    struct canon_writer *w;
+    if (open_canon(o.canon, &w)) {
+        ncp_source_close(&src);
+        return EXIT_USAGE;
+    }
+    struct ncp_output out = { w, emit_canon };
+    struct ncp_run_stats st;
+    memset(&st, 0, sizeof st);
+    int rc = map.mode == NCP_MODE_SERIAL
+                 ? ncp_serial_run(&src, &o.acfg, &out, &st, &d)
+                 : ncp_pipeline_run(&src, &map, &o.acfg, &out, &st, &d);
+    int status = EXIT_OK;
+    if (w) {
+        writer_flush(w);
+        if (w->failed) {
+            fprintf(stderr, "cnc-run: error writing canonical output\n");
+            status = EXIT_RUNTIME;
+        }
+        if (w->fd != 1)
+            close(w->fd);
+        free(w);
+    }
+    if (rc != NCP_OK) {
+        print_diag(o.prog, &d);
+        status = EXIT_PROGRAM;
+    }
+    if (o.stats) {
+        double bps = st.wall_ms > 0 ? (double)st.blocks / (st.wall_ms / 1e3) : 0;
+        fprintf(stderr,
+                "cnc-run: %llu blocks, %llu commands, %.3f ms, %.0f blocks/s, %d threads (%s, %d lexers, %d executors)\n",
+                (unsigned long long)st.blocks, (unsigned long long)st.commands, st.wall_ms, bps,
+                st.threads, mode_name(map.mode), map.mode == NCP_MODE_SERIAL ? 0 : map.n_lexers,
+                map.mode == NCP_MODE_SERIAL ? 0 : map.n_executors);
+    }
+    ncp_source_close(&src);
+    return status;
+}
+
+/* Syntax errors are independent of each other, so check reports every one of
+ * them; the interpreter itself stops at its first error, which is reported too
+ * unless it is one of the syntax errors already listed. */
+static int cmd_check(int argc, char **argv)
+{
+    struct parse_opts o;
+    memset(&o, 0, sizeof o);
+    if (parse_args(argc, argv, &o))
+        return usage(stderr), EXIT_USAGE;
+    struct ncp_source src;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (ncp_source_open(&src, o.prog, &d) != NCP_OK) {
+        print_diag(o.prog, &d);
+        return EXIT_PROGRAM;
+    }
+    struct ncp_run_stats st;
+    int rc = ncp_serial_run(&src, &o.acfg, NULL, &st, &d);
+    struct ncp_block *b = malloc(sizeof *b);
+    struct ncp_span sp;
+    uint64_t off = src.begin;
+    uint32_t line = src.begin_line;
+    int errors = 0, printed_run_error = 0;
+    while (b && ncp_source_span(&src, off, line, &sp) == 0) {
+        if (rc != NCP_OK && !printed_run_error && d.line <= sp.line) {
+            print_diag(o.prog, &d);
+            printed_run_error = 1;
+            errors++;
+            if (d.line == sp.line) {
+                off = sp.next;
+                line++;
+                continue;
+            }
+        }
+        if (ncp_lex_block(src.text + sp.off, sp.len, sp.line, sp.off, b) != NCP_OK) {
+            print_diag(o.prog, &b->err);
+            errors++;
+        }
+        off = sp.next;
+        line++;
+    }
+    if (rc != NCP_OK && !printed_run_error) {
+        print_diag(o.prog, &d);
+        errors++;
+    }
+    free(b);
+    ncp_source_close(&src);
+    return errors ? EXIT_PROGRAM : EXIT_OK;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    if (!strcmp(argv[1], "parse"))
+        return cmd_parse(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "check"))
+        return cmd_check(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+        usage(stdout);
+        return EXIT_OK;
+    }
+    fprintf(stderr, "cnc-run: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return EXIT_USAGE;
+}

@@ -1,0 +1,192 @@
+/* Program text loading and block splitting. The split is a pure function of the
+ * text so the analyzer can re-read earlier blocks (loops, calls) without the file. */
+#include "ncpar/feeder.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* A '%' line: '%' possibly surrounded by blanks, nothing else that matters. */
+static int is_percent_line(const char *s, size_t n)
+{
+    size_t i = 0;
+    while (i < n && (s[i] == ' ' || s[i] == '\t'))
+        i++;
+    return i < n && s[i] == '%';
+}
+
+static int is_blank_line(const char *s, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (s[i] != ' ' && s[i] != '\t' && s[i] != '\r')
+            return 0;
+    return 1;
+}
+
+/* rs274: if the first non-blank line is '%', the program ends at the next '%'
+ * line; otherwise it runs to the end of the file. */
+static void find_body(struct ncp_source *src)
+{
+    struct ncp_span sp;
+    uint64_t off = 0;
+    uint32_t line = 1;
+    src->begin = 0;
+    src->end = src->len;
+    src->begin_line = 1;
+    src->has_percent = 0;
+    while (ncp_source_span(src, off, line, &sp) == 0) {
+        const char *s = src->text + sp.off;
+        if (is_blank_line(s, sp.len)) {
+            off = sp.next;
+            line++;
+            continue;
+        }
+        if (!is_percent_line(s, sp.len))
+            return;
+        src->has_percent = 1;
+        src->begin = sp.next;
+        src->begin_line = line + 1;
+        break;
+    }
+    if (!src->has_percent)
+        return;
+    off = src->begin;
+    line = src->begin_line;
+    while (ncp_source_span(src, off, line, &sp) == 0) {
+        if (is_percent_line(src->text + sp.off, sp.len)) {
+            src->end = sp.off;
+            return;
+        }
+        off = sp.next;
+        line++;
+    }
+}
+
+int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
+                    struct ncp_span *out)
+{
+    if (off >= src->end)
+        return 1;
+    const char *start = src->text + off;
+    size_t avail = src->end - off;
+    const char *nl = memchr(start, '\n', avail);
+    size_t len = nl ? (size_t)(nl - start) : avail;
+    out->off = off;
+    out->line = line;
+    out->next = off + len + (nl ? 1 : 0);
+    if (len > 0 && start[len - 1] == '\r')
+        len--;
+    out->len = (uint32_t)(len > UINT32_MAX ? UINT32_MAX : len);
+    return 0;
+}
+
+int ncp_source_from_memory(struct ncp_source *src, const char *text, size_t len,
+                           const char *name, struct ncp_diag *d)
+{
+    (void)d;
+    memset(src, 0, sizeof *src);
+    src->text = text;
+    src->len = len;
+    src->name = name;
+    src->end = len;
+    find_body(src);
+    return NCP_OK;
+}
+
+static int read_all(int fd, char **buf, size_t *len)
+{
+    size_t cap = 1 << 16, n = 0;
+    char *p = malloc(cap);
+    if (!p)
+        return -1;
+    for (;;) {
+        if (n == cap) {
+            char *q = realloc(p, cap * 2);
+            if (!q) {
+                free(p);
+                return -1;
+            }
+            p = q;
+            cap *= 2;
+        }
+        ssize_t r = read(fd, p + n, cap - n);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r < 0) {
+            free(p);
+            return -1;
+        }
+        if (r == 0)
+            break;
+        n += (size_t)r;
+    }
+    *buf = p;
+    *len = n;
+    return 0;
+}
+
+int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d)
+{
+    memset(src, 0, sizeof *src);
+    src->name = path;
+    if (strcmp(path, "-") == 0) {
+        char *buf;
+        size_t n;
+        if (read_all(0, &buf, &n) != 0)
+            return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read standard input: %s",
+                                strerror(errno));
+        ncp_source_from_memory(src, buf, n, path, d);
+        src->owned = 1;
+        return NCP_OK;
+    }
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot open program: %s",
+                            strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        /* not a regular file (a FIFO, a device): read it like a pipe */
+        char *buf;
+        size_t n;
+        int rc = read_all(fd, &buf, &n);
+        close(fd);
+        if (rc != 0)
+            return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read program: %s",
+                                strerror(errno));
+        ncp_source_from_memory(src, buf, n, path, d);
+        src->owned = 1;
+        return NCP_OK;
+    }
+    size_t size = (size_t)st.st_size;
+    const char *text = "";
+    if (size > 0) {
+        void *m = mmap(NULL, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+        if (m == MAP_FAILED) {
+            close(fd);
+            return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot map program: %s",
+                                strerror(errno));
+        }
+        madvise(m, size, MADV_SEQUENTIAL);
+        text = m;
+        src->mapped = 1;
+    }
+    close(fd);
+    src->text = text;
+    src->len = size;
+    src->end = size;
+    find_body(src);
+    return NCP_OK;
+}
+
+void ncp_source_close(struct ncp_source *src)
+{
+    if (src->mapped)
+        munmap((void *)src->text, src->len);
+    else if (src->owned)
+        free((void *)src->text);
+    memset(src, 0, sizeof *src);
+}

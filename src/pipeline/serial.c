@@ -1,0 +1,150 @@
+/* The serial reference: the very same stage code as the parallel pipeline, called
+ * in one thread without rings. Every parallel configuration must equal it. */
+#include "ncpar/executor.h"
+#include "ncpar/lex.h"
+#include "ncpar/pipeline.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+struct serial_feed {
+    const struct ncp_source *src;
+    uint64_t off;
+    uint32_t line;
+    uint64_t blocks;
+    struct ncp_block block;
+};
+
+static const struct ncp_block *serial_next(void *ctx)
+{
+    struct serial_feed *f = ctx;
+    struct ncp_span sp;
+    if (ncp_source_span(f->src, f->off, f->line, &sp) != 0)
+        return NULL;
+    ncp_lex_block(f->src->text + sp.off, sp.len, sp.line, sp.off, &f->block);
+    f->off = sp.next;
+    f->line++;
+    f->blocks++;
+    return &f->block;
+}
+
+static void serial_release(void *ctx)
+{
+    (void)ctx;
+}
+
+struct serial_sink {
+    const struct ncp_output *out;
+    uint64_t next_id;
+    uint64_t emitted;
+    int stopped;       /* an error/end slot went out, or emit() asked to stop */
+    int emit_failed;
+    struct ncp_diag err;
+    struct ncp_cmd cmd;
+};
+
+/* Only the header is cleared: ops are written whole by the analyzer. */
+void ncp_cmd_reset_header(struct ncp_cmd *cmd, uint64_t id)
+{
+    cmd->cmd_id = id;
+    cmd->line = 0;
+    cmd->n_ops = 0;
+    cmd->flags = 0;
+    cmd->diag.code = NCP_OK;
+    cmd->diag.line = 0;
+    cmd->diag.col = 0;
+    cmd->diag.msg[0] = '\0';
+    cmd->text_used = 0;
+    cmd->out_len = 0;
+}
+
+static struct ncp_cmd *serial_acquire(void *ctx)
+{
+    struct serial_sink *s = ctx;
+    if (s->stopped)
+        return NULL;
+    ncp_cmd_reset_header(&s->cmd, s->next_id++);
+    return &s->cmd;
+}
+
+static void serial_publish(void *ctx, struct ncp_cmd *cmd)
+{
+    struct serial_sink *s = ctx;
+    ncp_exec_cmd(cmd);
+    s->emitted++;
+    if (s->out && s->out->emit(s->out->ctx, cmd) != 0) {
+        s->stopped = 1;
+        s->emit_failed = 1;
+    }
+    if (cmd->flags & NCP_CMD_F_ERROR) {
+        s->err = cmd->diag;
+        s->stopped = 1;
+    }
+    if (cmd->flags & NCP_CMD_F_END)
+        s->stopped = 1;
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *acfg,
+                   const struct ncp_output *out, struct ncp_run_stats *stats,
+                   struct ncp_diag *d)
+{
+    double t0 = now_ms();
+    struct serial_feed *feed = malloc(sizeof *feed);
+    struct serial_sink *sink = malloc(sizeof *sink);
+    struct ncp_analyzer *an = NULL;
+    int rc;
+
+    memset(d, 0, sizeof *d);
+    if (!feed || !sink) {
+        rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
+        goto done;
+    }
+    feed->src = src;
+    feed->off = src->begin;
+    feed->line = src->begin_line;
+    feed->blocks = 0;
+    sink->out = out;
+    sink->next_id = 0;
+    sink->emitted = 0;
+    sink->stopped = 0;
+    sink->emit_failed = 0;
+    sink->err.code = NCP_OK;
+
+    an = ncp_analyzer_new(acfg, d);
+    if (!an) {
+        rc = d->code ? d->code : NCP_ERR_IO;
+        goto done;
+    }
+    struct ncp_block_feed bf = { feed, serial_next, serial_release, src };
+    struct ncp_cmd_sink cs = { sink, serial_acquire, serial_publish };
+    rc = ncp_analyzer_run(an, &bf, &cs);
+    if (sink->err.code != NCP_OK) {
+        *d = sink->err;
+        rc = d->code;
+    } else if (sink->emit_failed) {
+        rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot write output");
+    } else if (rc != NCP_OK && rc != NCP_END) {
+        ncp_diag_set(d, (enum ncp_status)rc, 0, 0, "interpreter stopped without a diagnostic");
+    } else {
+        rc = NCP_OK;
+    }
+done:
+    if (stats) {
+        stats->blocks = feed ? feed->blocks : 0;
+        stats->commands = sink ? sink->emitted : 0;
+        stats->wall_ms = now_ms() - t0;
+        stats->threads = 1;
+    }
+    ncp_analyzer_free(an);
+    free(feed);
+    free(sink);
+    return rc;
+}
