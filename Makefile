@@ -71,3 +71,36 @@ clean:
 	rm -rf $(BUILD)
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
+
+# ---- sanitizers, fuzzing, benchmarks --------------------------------------
+SAN_FLAGS = -O1 -g -fno-omit-frame-pointer
+# ASan+UBSan over the whole test suite; TSan over the parallel equivalence tests.
+sanitize:
+	$(MAKE) BUILD=build-asan CC=clang CXX=clang++ \
+	    CFLAGS="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
+	    CXXFLAGS="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
+	    LDLIBS="-lm -linih -pthread -fsanitize=address,undefined" test
+	$(MAKE) BUILD=build-tsan CC=clang CXX=clang++ \
+	    CFLAGS="$(SAN_FLAGS) -fsanitize=thread" CXXFLAGS="$(SAN_FLAGS) -fsanitize=thread" \
+	    LDLIBS="-lm -linih -pthread -fsanitize=thread" all
+	TSAN_OPTIONS=halt_on_error=1 tests/tools/equivalence --bin build-tsan/cnc-run ncprograms/*.ngc
+
+FUZZ_SECONDS ?= 600
+FUZZ_FLAGS = -O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all
+$(BUILD)-fuzz/fuzz_pipeline: tests/fuzz/fuzz_pipeline.c FORCE
+	$(MAKE) BUILD=$(BUILD)-fuzz CC=clang CXX=clang++ \
+	    CFLAGS="$(FUZZ_FLAGS) -fsanitize=fuzzer-no-link" \
+	    CXXFLAGS="$(FUZZ_FLAGS) -fsanitize=fuzzer-no-link" $(BUILD)-fuzz/libncpar.a
+	clang $(CPPFLAGS) -std=c11 $(FUZZ_FLAGS) -fsanitize=fuzzer -pthread -o $@ $< \
+	    $(BUILD)-fuzz/libncpar.a -lm -linih -lstdc++
+fuzz: $(BUILD)-fuzz/fuzz_pipeline
+	mkdir -p $(BUILD)-fuzz/corpus
+	cp ncprograms/*.ngc tests/bad/*.ngc $(BUILD)-fuzz/corpus/ 2>/dev/null || true
+	$< -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=10 -rss_limit_mb=2048 \
+	    $(BUILD)-fuzz/corpus
+
+bench-parse: all
+	bench/bench-parse $(BUILD)
+
+.PHONY: FORCE
+FORCE:
