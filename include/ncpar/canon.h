@@ -30,8 +30,15 @@ enum ncp_canon_kind {
     NCP_C_STRAIGHT_TRAVERSE,     /* d[0..5] x y z a b c (program coordinates) */
     NCP_C_STRAIGHT_FEED,         /* d[0..5] */
     NCP_C_STRAIGHT_PROBE,        /* d[0..5] */
-    NCP_C_SET_FEED_RATE,         /* d[0] */
-    NCP_C_SET_FEED_MODE,         /* i[0] spindle, i[1] mode (0 units/min, 1 inverse time, 2 units/rev) */
+    NCP_C_SET_FEED_RATE,         /* d[0]. With flags NCP_FEED_F_INVERSE_ARC and directly
+                                    before an ARC_REQUEST (G93 arc): d[0] = the F word,
+                                    d[1] = the arc's axis (helix) start; the executor
+                                    replaces d[0] by rs274's max(0.1, arc length * F) and
+                                    drops this op too if the arc fails. */
+    NCP_C_SET_FEED_MODE,         /* i[0] spindle, i[1] mode (0 units/min, 1 inverse time, 2 units/rev)
+                                    NB printed verbatim, and rs274 calls SET_FEED_MODE(0, 0)
+                                    for G93 and G94 alike, SET_FEED_MODE(spindle, 1) for G95:
+                                    put those numbers in i[0]/i[1] to match its text. */
     NCP_C_SET_TRAVERSE_RATE,     /* d[0] */
     NCP_C_ARC_FEED,              /* d[0] first_end d[1] second_end d[2] first_axis(centre)
                                     d[3] second_axis(centre) i[0] rotation d[4] axis_end
@@ -47,7 +54,18 @@ enum ncp_canon_kind {
                                     i[3] plane (0 XY, 1 YZ, 2 XZ) for error messages
                                     d[10] tolerance for radius difference (program units)
                                     d[11] relative tolerance used by rs274 (fraction)
-                                    flags bit 0: inches (for messages) */
+                                    flags bit 0: inches (for messages)
+                                    Tolerances, as rs274 (interp_internal.hh) uses them:
+                                    d[10] = CENTER_ARC_RADIUS_TOLERANCE_INCH/_MM of the INI
+                                      [RS274NGC] section, default 2*0.001*sqrt(2) in
+                                      (0.0028284) and 2*0.01*sqrt(2) mm (0.028284);
+                                    d[11] = SPIRAL_RELATIVE_TOLERANCE 0.001 (fixed);
+                                    zero in either means that default. IJK arcs fail when
+                                    |r2-r1| > 100*d[10], or when |r2-r1| > d[10] and
+                                    |r2-r1|/max(r1,r2) > d[11]. RADIUS_TOLERANCE 0.00005 in /
+                                    0.00127 mm (fixed, picked by flags bit 0) is the zero-
+                                    radius limit (IJK) and the reach slack (R form).
+                                    i[2] = 0 is taken as 1. Errors carry col 0. */
     NCP_C_DWELL,                 /* d[0] seconds */
     NCP_C_SELECT_PLANE,          /* i[0]: 0 XY, 1 YZ, 2 XZ (printed CANON_PLANE_XY|YZ|XZ) */
     NCP_C_SET_MOTION_CONTROL_MODE, /* i[0]: 0 EXACT_STOP, 1 EXACT_PATH, 2 CONTINUOUS; d[0] tolerance */
@@ -86,6 +104,9 @@ enum ncp_canon_kind {
     NCP_C_RAW_TEXT,              /* text printed verbatim (for calls not modelled above) */
     NCP_C__COUNT
 };
+
+/* ncp_canon.flags of SET_FEED_RATE (see above) */
+#define NCP_FEED_F_INVERSE_ARC 1u
 
 #define NCP_CANON_NI 4
 #define NCP_CANON_ND 12

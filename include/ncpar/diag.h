@@ -5,7 +5,7 @@
 
 #include <stdint.h>
 
-#define NCP_DIAG_MSG_MAX 160
+#define NCP_DIAG_MSG_MAX 256
 
 enum ncp_status {
     NCP_OK = 0,

@@ -13,14 +13,57 @@
 int ncp_exec_resolve(struct ncp_cmd *cmd);
 
 /* Format cmd->ops as rs274 -g lines (without counter and N column), each ending in
- * '\n', into cmd->out / cmd->out_len. */
+ * '\n', into cmd->out / cmd->out_len. Lines are never cut: if the next line does
+ * not fit NCP_CMD_OUT_MAX (only absurd magnitudes or pool-sized texts can do that)
+ * n_ops is truncated before it, NCP_CMD_F_ERROR set and diag (if still NCP_OK)
+ * gets NCP_ERR_LIMIT. NONE and unresolved requests print nothing. */
 void ncp_exec_format(struct ncp_cmd *cmd);
 
 /* Both, as an executor thread does. */
 int ncp_exec_cmd(struct ncp_cmd *cmd);
 
-/* Fast fixed-point "%.4f": writes into buf (>= 32 bytes), returns length.
- * Byte-identical to printf's %.4f for every finite double. */
+/* Longest "%.4f" text of any double (DBL_MAX has 309 integer digits) + NUL. */
+#define NCP_FMT_FIXED4_MAX 328
+
+/* Fast fixed-point "%.4f": writes into buf, returns length (NUL written too).
+ * Byte-identical to printf's %.4f for every double (NaN and inf included).
+ * buf must hold NCP_FMT_FIXED4_MAX bytes; 32 suffice when |v| < 1e14. */
 size_t ncp_fmt_fixed4(char *buf, double v);
+
+/* ---- Design, not implemented: cutter-compensation requests --------------
+ *
+ * rs274 compensates with a one-move delay: a compensated move's end point is
+ * only final once the next move is known (corner arc, inside-corner retreat,
+ * arc/line intersection), and it then rewrites the queued previous move. In
+ * convert_straight_comp2 the compensated start it works from is the offset end
+ * of the previous programmed move, so each compensated output move is a
+ * function of a window of three PROGRAMMED moves (k-2, k-1, k) plus side and
+ * radius (to be confirmed for the arc_comp paths before implementing): start of
+ * k-1 from the (k-2, k-1) corner, end of k-1 and any corner arc from the
+ * (k-1, k) corner. That keeps slots independent:
+ *
+ *   NCP_C_COMP_REQUEST, three consecutive ops, i[0] = role:
+ *     0 "before" (k-2), 1 "emit" (k-1), 2 "after" (k; absent at G40 / end)
+ *   per op: d[0..1] programmed end in the plane, d[2..3] arc centre,
+ *           d[4] axis end, d[5..7] a b c, d[8] tool radius (> 0),
+ *           i[1] motion (0 G0, 1 G1, 2 arc), i[2] arc turn (signed),
+ *           i[3] side (1 left, 2 right) | entry flag (first move after G41/G42,
+ *           rs274's comp1: offset from the uncompensated start),
+ *           flags bit 0 inches (tolerances as for ARC_REQUEST).
+ *   The executor replaces the three ops by the output of move k-1: an optional
+ *   corner ARC_FEED (or STRAIGHT_TRAVERSE for G0, as rs274 does) and the
+ *   compensated STRAIGHT_FEED / STRAIGHT_TRAVERSE / ARC_FEED; compaction keeps
+ *   ops after the request in order. Errors use rs274's messages ("... can't fit
+ *   in without gouging", "Zero degree inside corner ...", "Cutter gouging with
+ *   cutter radius comp") and col 0.
+ *
+ * The analyzer's share stays sequential and cheap: keep the last two programmed
+ * moves, emit move k-1's request when move k is parsed (so its slot carries
+ * k-1's output), and hold non-motion calls issued between them (rs274 queues
+ * SET_FEED_RATE, COMMENT, spindle/coolant calls) so they come out after k-1,
+ * in the same slot. Geometry (atan2 with long double quarter turns, hypot,
+ * concave test against TOLERANCE_CONCAVE_CORNER) follows interp_convert.cc's
+ * convert_straight_comp1/2 and convert_arc_comp1/2, and lives in
+ * src/executor/comp_geom.cpp next to arc_geom.cpp. */
 
 #endif

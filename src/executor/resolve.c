@@ -1,0 +1,145 @@
+/* Turns requests in a slot into printable calls. Only arcs need it today: the
+ * analyzer knows the end point and the centre word or R, the executor finds
+ * the centre, checks it the way rs274 does and reports its errors in rs274's
+ * words. */
+#include "arc_geom.h"
+#include "ncpar/executor.h"
+
+#include <math.h>
+
+/* rs274 (interp_internal.hh) defaults, used when the analyzer leaves d[10] or
+ * d[11] zero. RADIUS_TOLERANCE_* is not configurable in rs274, so it is not
+ * carried by the op either. */
+#define NCP_RADIUS_TOL_INCH 0.00005
+#define NCP_RADIUS_TOL_MM (NCP_RADIUS_TOL_INCH * 25.4)
+#define NCP_SPIRAL_ABS_TOL_INCH (2 * 0.001 * M_SQRT2)
+#define NCP_SPIRAL_ABS_TOL_MM (2 * 0.01 * M_SQRT2)
+#define NCP_SPIRAL_REL_TOL 0.001
+
+#define NCP_ARC_F_INCHES 1u
+
+static void ncp_arc_in_from_op(const struct ncp_canon *op, struct ncp_arc_in *in)
+{
+    int inches = (op->flags & NCP_ARC_F_INCHES) != 0;
+    in->start[0] = op->d[0];
+    in->start[1] = op->d[1];
+    in->end[0] = op->d[2];
+    in->end[1] = op->d[3];
+    in->radius_form = op->i[1] != 0;
+    in->centre[0] = in->radius_form ? 0.0 : op->d[8];
+    in->centre[1] = in->radius_form ? 0.0 : op->d[9];
+    in->radius = in->radius_form ? op->d[8] : 0.0;
+    in->ccw = op->i[0] > 0;
+    in->turns = op->i[2] >= 1 ? op->i[2] : 1; /* zero means "no P word" */
+    in->radius_tol = inches ? NCP_RADIUS_TOL_INCH : NCP_RADIUS_TOL_MM;
+    in->spiral_abs_tol = op->d[10] > 0 ? op->d[10]
+                       : inches ? NCP_SPIRAL_ABS_TOL_INCH : NCP_SPIRAL_ABS_TOL_MM;
+    in->spiral_rel_tol = op->d[11] > 0 ? op->d[11] : NCP_SPIRAL_REL_TOL;
+}
+
+/* rs274 names the in-plane axes in its messages: XY, then YZ, then XZ as Z,X. */
+static void ncp_plane_axes(int plane, char *a, char *b)
+{
+    static const char first[] = "XYZ", second[] = "YZX";
+    int p = plane >= 0 && plane <= 2 ? plane : 0;
+    *a = first[p];
+    *b = second[p];
+}
+
+static int ncp_arc_error(struct ncp_cmd *cmd, const struct ncp_canon *op, int status,
+                         const struct ncp_arc_out *out)
+{
+    char a, b;
+    ncp_plane_axes(op->i[3], &a, &b);
+    const double *d = op->d;
+    struct ncp_diag *g = &cmd->diag;
+    switch (status) {
+    case NCP_ARC_SAME_POINT:
+        return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
+                            "Current point same as end point of arc");
+    case NCP_ARC_R_TOO_SMALL:
+        return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
+                            "Arc radius too small to reach end point");
+    case NCP_ARC_ZERO_RADIUS:
+        return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
+                            "Zero-radius arc: start=(%c%.4f,%c%.4f) center=(%c%.4f,%c%.4f) "
+                            "end=(%c%.4f,%c%.4f) r1=%.4f r2=%.4f",
+                            a, d[0], b, d[1], a, out->centre[0], b, out->centre[1],
+                            a, d[2], b, d[3], out->r1, out->r2);
+    default:
+        return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
+                            "Radius to end of arc differs from radius to start: "
+                            "start=(%c%.4f,%c%.4f) center=(%c%.4f,%c%.4f) "
+                            "end=(%c%.4f,%c%.4f) r1=%.4f r2=%.4f abs_err=%.4g rel_err=%.4f%%",
+                            a, d[0], b, d[1], a, out->centre[0], b, out->centre[1],
+                            a, d[2], b, d[3], out->r1, out->r2,
+                            out->abs_err, out->rel_err * 100);
+    }
+}
+
+/* A G93 arc's feed rate op, filled in from the arc's length. */
+static struct ncp_canon *ncp_inverse_feed_before(struct ncp_cmd *cmd, unsigned k)
+{
+    struct ncp_canon *prev = k > 0 ? &cmd->ops[k - 1] : NULL;
+    if (prev && prev->kind == NCP_C_SET_FEED_RATE && (prev->flags & NCP_FEED_F_INVERSE_ARC))
+        return prev;
+    return NULL;
+}
+
+/* ARC_REQUEST fields -> ARC_FEED fields, in place. */
+static int ncp_resolve_arc(struct ncp_cmd *cmd, struct ncp_canon *op, struct ncp_canon *feed_op)
+{
+    struct ncp_arc_in in;
+    struct ncp_arc_out out;
+    ncp_arc_in_from_op(op, &in);
+    int status = ncp_arc_solve(&in, &out);
+    if (status != NCP_ARC_OK)
+        return ncp_arc_error(cmd, op, status, &out);
+
+    double axis_end = op->d[4], a = op->d[5], b = op->d[6], c = op->d[7];
+    if (feed_op) {
+        double rate = ncp_arc_length(&in, &out, feed_op->d[1], axis_end) * feed_op->d[0];
+        feed_op->d[0] = rate > 0.1 ? rate : 0.1;
+        feed_op->d[1] = 0.0;
+        feed_op->flags &= (uint16_t)~NCP_FEED_F_INVERSE_ARC;
+    }
+    struct ncp_canon feed = {.kind = NCP_C_ARC_FEED};
+    feed.d[0] = in.end[0];
+    feed.d[1] = in.end[1];
+    feed.d[2] = out.centre[0];
+    feed.d[3] = out.centre[1];
+    feed.i[0] = out.rotation;
+    feed.d[4] = axis_end;
+    feed.d[5] = a;
+    feed.d[6] = b;
+    feed.d[7] = c;
+    *op = feed;
+    return NCP_OK;
+}
+
+int ncp_exec_resolve(struct ncp_cmd *cmd)
+{
+    unsigned n_ops = cmd->n_ops;
+    if (n_ops > NCP_CMD_MAX_OPS)
+        n_ops = NCP_CMD_MAX_OPS;
+    for (unsigned k = 0; k < n_ops; k++) {
+        struct ncp_canon *op = &cmd->ops[k];
+        if (op->kind != NCP_C_ARC_REQUEST)
+            continue;
+        struct ncp_canon *feed_op = ncp_inverse_feed_before(cmd, k);
+        if (ncp_resolve_arc(cmd, op, feed_op) != NCP_OK) {
+            /* rs274 sets the G93 rate only once the arc is known good */
+            cmd->n_ops = (uint16_t)(feed_op ? k - 1 : k);
+            cmd->flags |= NCP_CMD_F_ERROR;
+            break;
+        }
+    }
+    return cmd->diag.code;
+}
+
+int ncp_exec_cmd(struct ncp_cmd *cmd)
+{
+    ncp_exec_resolve(cmd);
+    ncp_exec_format(cmd);
+    return cmd->diag.code;
+}
