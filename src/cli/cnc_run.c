@@ -3,6 +3,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
+#include "run.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -64,10 +65,14 @@ static void usage(FILE *f)
           "                          [--config INI] [--tool-table FILE] [--canon FILE|-]\n"
           "                          [--stats] [--max-loops N]\n"
           "       cnc-run check PROG [--tool-table FILE]\n"
+          "       cnc-run run PROG [--config INI] [--trace CSV] [--for SECONDS]\n"
+          "                        [--feed-override PCT] [--clock real|virtual]\n"
           "\n"
           "parse  interpret PROG (\"-\" = standard input) with the parallel pipeline and\n"
           "       write canonical machining calls (rs274 -g format) to --canon.\n"
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
+          "run    run PROG on the machine: planner, interpolator, position loop, backend\n"
+          "       (the simulated servo by default); `cnc-run run --help` for details.\n"
           "\n"
           "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault\n",
           f);
@@ -309,6 +314,8 @@ int main(int argc, char **argv)
         return cmd_parse(argc - 1, argv + 1);
     if (!strcmp(argv[1], "check"))
         return cmd_check(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "run"))
+        return ncp_cli_run(argc - 1, argv + 1);
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
         usage(stdout);
         return EXIT_OK;

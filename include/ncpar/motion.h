@@ -1,0 +1,148 @@
+/* Motion: machine configuration, canonical calls -> machine-space segments,
+ * look-ahead planner and the interpolator that samples it every servo period.
+ * All lengths in mm, times in s, velocities in mm/s, machine coordinates. */
+#ifndef NCPAR_MOTION_H
+#define NCPAR_MOTION_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "ncpar/canon.h"
+#include "ncpar/diag.h"
+
+#define NCP_AXES 3  /* X Y Z; the canon stream's A B C are carried but not moved */
+
+enum ncp_profile { NCP_PROFILE_TRAPEZOID, NCP_PROFILE_SCURVE };
+
+struct ncp_axis_cfg {
+    double min_limit, max_limit;  /* soft limits, mm */
+    double max_vel, max_acc, max_jerk;
+    double ferror;                /* following-error fault limit, mm */
+};
+
+/* One thread's placement: cpu < 0 lets the OS place it; priority 0 = SCHED_OTHER. */
+struct ncp_rt_place {
+    int cpu;
+    int priority;
+};
+
+struct ncp_machine_cfg {
+    double servo_period;          /* s ([EMCMOT] SERVO_PERIOD is in ns) */
+    double max_linear_vel;        /* [TRAJ] MAX_LINEAR_VELOCITY */
+    double default_linear_acc;    /* [TRAJ] DEFAULT_LINEAR_ACCELERATION, 0 = axis limits */
+    struct ncp_axis_cfg axis[NCP_AXES];
+    int lookahead;                /* [PLANNER] LOOKAHEAD, segments */
+    enum ncp_profile profile;     /* [PLANNER] PROFILE */
+    int setpoint_ring;            /* [PLANNER] SETPOINT_RING, servo cycles buffered (1024) */
+    /* [SIM]: PID of the simulated plant plus feed-forward (LinuxCNC pid naming):
+     * u = KP e + KI int(e) + KD de/dt + FF1 v_cmd + FF2 a_cmd */
+    double kp, ki, kd, ff1, ff2;
+    struct ncp_rt_place position, planner, interp; /* [RT] */
+};
+
+void ncp_machine_cfg_default(struct ncp_machine_cfg *c);
+/* Loads an INI over the defaults. On error d->msg names file, section and key,
+ * d->line is the INI line. Returns NCP_OK or NCP_ERR_IO / NCP_ERR_SEMANTIC. */
+int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp_diag *d);
+
+/* ---- segments -------------------------------------------------------------- */
+
+enum ncp_seg_kind { NCP_SEG_LINE, NCP_SEG_ARC, NCP_SEG_DWELL };
+
+enum ncp_seg_term { NCP_TERM_STOP, NCP_TERM_EXACT_PATH, NCP_TERM_CONTINUOUS };
+
+struct ncp_seg {
+    uint8_t kind;          /* enum ncp_seg_kind */
+    uint8_t term;          /* enum ncp_seg_term: how this segment ends */
+    uint8_t traverse;      /* G0: runs at the machine's maximum velocity */
+    uint32_t line;         /* source line */
+    double start[NCP_AXES], end[NCP_AXES];
+    double length;         /* path length (0 for dwell) */
+    double feed;           /* requested path velocity (override applied), mm/s */
+    double tolerance;      /* G64 P, mm (0 = none) */
+    double dwell;          /* s, NCP_SEG_DWELL only */
+    /* arcs and helices: p(l) = c + r(l)(cos(A l) u + sin(A l) w) + n h l, l in [0,1] */
+    double center[3], normal[3], u[3], w[3];
+    double r0, r1, angle, axial;
+};
+
+/* Position at path distance s (0..length) and the unit tangent there (may be NULL). */
+void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
+                  double tangent[NCP_AXES]);
+
+/* ---- canonical calls -> segments ------------------------------------------- */
+
+struct ncp_canon_map {
+    const struct ncp_machine_cfg *cfg;
+    double scale;           /* mm per program unit */
+    double g5x[6], g92[6], tool[6]; /* mm */
+    double rotation;        /* XY rotation, degrees */
+    int plane;              /* 0 XY, 1 YZ, 2 XZ */
+    double feed;            /* program units per minute */
+    double feed_override;   /* 1.0 = 100 % */
+    int term;               /* enum ncp_seg_term */
+    double tolerance;       /* mm */
+    double pos[NCP_AXES];   /* machine position at the end of the last segment */
+};
+
+void ncp_canon_map_init(struct ncp_canon_map *m, const struct ncp_machine_cfg *cfg,
+                        const double start[NCP_AXES], double feed_override);
+/* Feeds one canonical call. Returns 1 and fills *seg when it makes motion (or a
+ * dwell), 0 when it only changes state, or minus an error code with d filled
+ * (soft-limit violations: -NCP_ERR_LIMIT, d->line = the block's line). */
+int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
+                     struct ncp_seg *seg, struct ncp_diag *d);
+
+/* ---- planner + interpolator ------------------------------------------------ */
+
+struct ncp_setpoint {
+    double pos[NCP_AXES];   /* commanded machine position, mm */
+    double v;               /* path velocity, mm/s */
+    double dir[NCP_AXES];   /* unit tangent (for contour error), 0 at rest */
+    uint32_t line;
+    uint32_t flags;         /* enum ncp_sp_flags */
+};
+
+enum ncp_sp_flags { NCP_SP_END = 1u, NCP_SP_STARVED = 2u };
+
+struct ncp_planner;
+
+struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
+                                    const double start[NCP_AXES]);
+void ncp_planner_free(struct ncp_planner *p);
+/* Room for another segment in the look-ahead window? */
+int ncp_planner_full(const struct ncp_planner *p);
+size_t ncp_planner_queued(const struct ncp_planner *p);
+/* No segment is executing: the machine is at rest (or about to start). */
+int ncp_planner_idle(const struct ncp_planner *p);
+/* Appends a segment and re-plans backwards until a velocity no longer changes. */
+void ncp_planner_push(struct ncp_planner *p, const struct ncp_seg *s);
+/* No more segments will come: the queue may be run to its end. */
+void ncp_planner_finish(struct ncp_planner *p);
+/* Advances the interpolator by one servo period and writes the setpoint.
+ * Returns 1 while moving or waiting for segments, 0 once everything has run
+ * after ncp_planner_finish(). */
+int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out);
+
+struct ncp_planner_stats {
+    uint64_t segments;      /* segments pushed */
+    uint64_t replans;       /* segment entry velocities revised by backward passes */
+    uint64_t starved;       /* cycles spent at rest waiting for segments */
+    double path_length;     /* mm executed */
+};
+void ncp_planner_get_stats(const struct ncp_planner *p, struct ncp_planner_stats *st);
+
+/* Trapezoid over a distance L from v0 to v1 with cruise cap vmax and accel a
+ * (|v1^2 - v0^2| <= 2aL is assumed). Times of the three phases. */
+struct ncp_trap {
+    double v0, vp, v1, a;
+    double t1, t2, t3;      /* accelerate, cruise, decelerate */
+    double d1, d2;          /* distance at the end of phase 1 and 2 */
+    double length;
+};
+void ncp_trap_plan(struct ncp_trap *tp, double len, double v0, double v1, double vmax,
+                   double a);
+double ncp_trap_duration(const struct ncp_trap *tp);
+/* Distance and velocity at time t (clamped to the duration). */
+double ncp_trap_eval(const struct ncp_trap *tp, double t, double *v);
+
+#endif

@@ -1,0 +1,144 @@
+/* Real-time support: a lock-free single-producer/single-consumer ring, and a
+ * periodic thread (SCHED_FIFO, absolute clock_nanosleep schedule, mlockall,
+ * prefaulted stack) that measures its own wake-up latency like cyclictest.
+ * The same loop runs on a virtual clock for tests and previews. */
+#ifndef NCPAR_RT_H
+#define NCPAR_RT_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include "ncpar/diag.h"
+
+/* ---- SPSC ring ------------------------------------------------------------- */
+
+struct ncp_spsc {
+    _Alignas(64) _Atomic size_t head;   /* written by the consumer */
+    _Alignas(64) _Atomic size_t tail;   /* written by the producer */
+    _Alignas(64) size_t mask, elem;
+    unsigned char *buf;
+};
+
+/* capacity is rounded up to a power of two; storage is allocated and touched
+ * here, never on the real-time path. */
+int ncp_spsc_init(struct ncp_spsc *r, size_t elem_size, size_t capacity);
+void ncp_spsc_destroy(struct ncp_spsc *r);
+int ncp_spsc_push(struct ncp_spsc *r, const void *item);   /* 0 ok, -1 full */
+int ncp_spsc_pop(struct ncp_spsc *r, void *item);          /* 0 ok, -1 empty */
+size_t ncp_spsc_count(struct ncp_spsc *r);
+size_t ncp_spsc_capacity(const struct ncp_spsc *r);
+
+/* Starts a thread with the given placement: priority 1..99 asks for SCHED_FIFO
+ * (falling back to SCHED_OTHER when refused, *fifo tells which), cpu >= 0 pins
+ * it. Returns 0 or the pthread_create error. */
+int ncp_rt_spawn(pthread_t *t, void *(*fn)(void *), void *arg, int priority, int cpu,
+                 int *fifo);
+
+/* ---- latency statistics ----------------------------------------------------- */
+
+#define NCP_RT_HIST_BINS 1000    /* 1 us bins; later wake-ups land in overflow */
+
+struct ncp_rt_stats {
+    uint64_t cycles;
+    uint64_t misses;             /* wake-ups later than one period: skipped periods */
+    uint64_t skipped;            /* periods skipped because of misses */
+    int64_t lat_min_ns, lat_max_ns;
+    double lat_sum_ns;
+    uint64_t hist[NCP_RT_HIST_BINS];
+    uint64_t overflow;
+};
+
+void ncp_rt_stats_reset(struct ncp_rt_stats *s);
+void ncp_rt_stats_add(struct ncp_rt_stats *s, int64_t latency_ns);
+/* Prints min/avg/max and the non-empty histogram rows. */
+void ncp_rt_stats_print(const struct ncp_rt_stats *s, FILE *f);
+
+/* ---- periodic thread ---------------------------------------------------------- */
+
+enum ncp_rt_cycle_result {
+    NCP_RT_CONTINUE = 0,   /* next period */
+    NCP_RT_STOP = 1,       /* leave the loop */
+    NCP_RT_RETRY = 2       /* virtual clock only: nothing to do yet, same instant again */
+};
+
+struct ncp_rt_loop_cfg {
+    int64_t period_ns;
+    int priority;          /* 1..99 SCHED_FIFO, 0 SCHED_OTHER */
+    int cpu;               /* < 0: any */
+    int virtual_clock;     /* simulated time, as fast as the CPU allows */
+};
+
+struct ncp_rt_loop {
+    struct ncp_rt_loop_cfg cfg;
+    /* called once per period with the cycle's scheduled time (ns since start) */
+    int (*cycle)(void *ctx, int64_t now_ns);
+    void *ctx;
+    struct ncp_rt_stats stats;    /* written by the loop thread only */
+    _Atomic int stop;             /* request from outside */
+    _Atomic int running;
+    int fifo;                     /* the thread really runs SCHED_FIFO */
+    int memlocked;
+    int dma_fd;                   /* /dev/cpu_dma_latency held open, or -1 */
+    char warning[200];            /* set when the RT set-up had to degrade */
+    pthread_t thread;
+    _Atomic int64_t vnow_ns;      /* virtual clock */
+};
+
+/* Starts the loop thread; degrades to SCHED_OTHER with a warning when the
+ * process may not use SCHED_FIFO. Returns 0 or an errno value. */
+int ncp_rt_loop_start(struct ncp_rt_loop *l);
+void ncp_rt_loop_join(struct ncp_rt_loop *l);
+
+/* ---- the NCK runtime ------------------------------------------------------------
+ * interpreter thread -> canon map -> planner/interpolator thread -> position loop
+ * (this periodic thread, on the sim backend) -> trace/statistics (caller's thread),
+ * joined by SPSC rings. On the real clock the position loop never waits for a
+ * slower stage; the virtual clock waits instead, so runs are deterministic. */
+
+struct ncp_output;
+struct ncp_machine_cfg;
+
+struct ncp_nck_opts {
+    const struct ncp_machine_cfg *cfg;
+    /* Runs the program, handing command slots to out in program order
+     * (ncp_serial_run / ncp_pipeline_run). Called twice: once for the soft-limit
+     * check before any motion, once for the run. Returns NCP_OK or d->code. */
+    int (*interpret)(void *ctx, const struct ncp_output *out, struct ncp_diag *d);
+    void *interp_ctx;
+    int virtual_clock;
+    double for_s;            /* feed hold after this much machine time, 0 = whole program */
+    double feed_override;    /* 1.0 = 100 % (0.01 .. 2.0) */
+    FILE *trace;             /* per-cycle CSV or NULL */
+    FILE *progress;          /* live progress line (a terminal) or NULL */
+    uint32_t total_lines;    /* for the progress line */
+};
+
+enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };
+
+struct ncp_nck_result {
+    int status;              /* enum ncp_nck_status */
+    int limit_violation;     /* soft limit found before motion (diag says where) */
+    int fault;               /* following-error fault */
+    int fault_axis;
+    double fault_err;
+    uint32_t fault_line;
+    struct ncp_diag diag;    /* program error or soft-limit violation */
+    int for_expired;
+    double program_time, path_length;
+    double ferr_max, ferr_avg, ferr_axis_max[3];
+    double contour_max, contour_avg;
+    uint64_t segments, starved, trace_dropped, replans;
+    uint64_t underruns;      /* setpoint ring ran low: slowed down along the path */
+    uint64_t dry;            /* cycles it ran empty in motion anyway (held position) */
+    int fifo;
+    char warning[200];
+    struct ncp_rt_stats lat;
+};
+
+/* Runs the whole chain. Returns res->status. */
+int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res);
+void ncp_nck_print_summary(const struct ncp_nck_result *res, const char *prog, FILE *f);
+
+#endif

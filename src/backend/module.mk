@@ -1,0 +1,2 @@
+# sources of src/backend, appended by the module
+LIB_SRCS += $(wildcard src/backend/*.c)

@@ -1,0 +1,226 @@
+/* cnc-run run: the full NCK (interpreter -> planner -> interpolator -> position
+ * loop) on the simulated machine. Option parsing, loading and reporting; the
+ * runtime itself is ncp_nck_run (src/rt/). */
+#include "run.h"
+
+#include "ncpar/feeder.h"
+#include "ncpar/motion.h"
+#include "ncpar/pipeline.h"
+#include "ncpar/rt.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+enum { RUN_OK = 0, RUN_USAGE = 1, RUN_PROGRAM = 2, RUN_FAULT = 3 };
+
+struct run_opts {
+    const char *prog, *config, *trace;
+    double for_s;               /* 0 = whole program */
+    double feed_override;       /* 1.0 = 100 % */
+    int virtual_clock;
+    enum ncp_thread_mode mode;
+};
+
+struct interp_ctx {
+    const struct ncp_source *src;
+    struct ncp_analyzer_cfg acfg;
+    enum ncp_thread_mode mode;
+};
+
+static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
+{
+    struct interp_ctx *ic = ctx;
+    struct ncp_run_stats st;
+    memset(&st, 0, sizeof st);
+    if (ic->mode == NCP_MODE_SERIAL)
+        return ncp_serial_run(ic->src, &ic->acfg, out, &st, d);
+    struct ncp_thread_map map;
+    ncp_thread_map_default(&map, ic->mode, 2, 1);
+    return ncp_pipeline_run(ic->src, &map, &ic->acfg, out, &st, d);
+}
+
+static void usage(FILE *f)
+{
+    fputs("usage: cnc-run run PROG [--config INI] [--trace CSV] [--for SECONDS]\n"
+          "                        [--feed-override PCT] [--clock real|virtual]\n"
+          "                        [--mode serial|det|att]\n"
+          "Runs PROG on the simulated machine: interpreter -> look-ahead planner ->\n"
+          "interpolator -> position loop (SCHED_FIFO when permitted).\n"
+          "  --config INI        machine INI (default: built-in 3-axis mill)\n"
+          "  --trace CSV         per-cycle trace: t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v\n"
+          "  --for SECONDS       stop after this much machine time\n"
+          "  --feed-override PCT 1..200 (default 100)\n"
+          "  --clock virtual     simulated clock, as fast as the CPU allows\n"
+          "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault / soft limit\n",
+          f);
+}
+
+static int parse_num(const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !(v >= lo && v <= hi))
+        return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_opts(int argc, char **argv, struct run_opts *o)
+{
+    static const struct option longopts[] = {
+        { "config", required_argument, 0, 'c' },
+        { "trace", required_argument, 0, 't' },
+        { "for", required_argument, 0, 'f' },
+        { "feed-override", required_argument, 0, 'o' },
+        { "clock", required_argument, 0, 'k' },
+        { "mode", required_argument, 0, 'm' },
+        { "help", no_argument, 0, 'h' },
+        { 0, 0, 0, 0 },
+    };
+    double pct;
+    int c;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "c:t:f:o:k:m:h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'c': o->config = optarg; break;
+        case 't': o->trace = optarg; break;
+        case 'f':
+            if (parse_num(optarg, 1e-6, 1e9, &o->for_s))
+                return fprintf(stderr, "cnc-run run: --for wants a positive number of seconds\n"), -1;
+            break;
+        case 'o':
+            /* 0 % would never finish: a static override starts at 1 % */
+            if (parse_num(optarg, 1, 200, &pct))
+                return fprintf(stderr, "cnc-run run: --feed-override wants 1..200 (%%)\n"), -1;
+            o->feed_override = pct / 100.0;
+            break;
+        case 'k':
+            if (!strcmp(optarg, "real") || !strcmp(optarg, "virtual"))
+                o->virtual_clock = !strcmp(optarg, "virtual");
+            else
+                return fprintf(stderr, "cnc-run run: --clock is real or virtual\n"), -1;
+            break;
+        case 'm':
+            if (!strcmp(optarg, "serial"))
+                o->mode = NCP_MODE_SERIAL;
+            else if (!strcmp(optarg, "det"))
+                o->mode = NCP_MODE_DET;
+            else if (!strcmp(optarg, "att"))
+                o->mode = NCP_MODE_ATT;
+            else
+                return fprintf(stderr, "cnc-run run: --mode is serial, det or att\n"), -1;
+            break;
+        case 'h': usage(stdout); exit(RUN_OK);
+        default: return -1;
+        }
+    }
+    if (optind != argc - 1)
+        return fprintf(stderr, "cnc-run run: expected exactly one program file\n"), -1;
+    o->prog = argv[optind];
+    return 0;
+}
+
+static uint32_t count_lines(const struct ncp_source *src)
+{
+    uint32_t n = 1;
+    for (const char *p = src->text, *e = src->text + src->len;
+         p < e && (p = memchr(p, '\n', (size_t)(e - p))) != NULL; p++)
+        n++;
+    return n;
+}
+
+static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
+                  const struct ncp_nck_result *res)
+{
+    if (res->limit_violation) {
+        fprintf(stderr, "%s:%u: error: %s (checked before motion: nothing moved)\n", o->prog,
+                res->diag.line, res->diag.msg);
+        return RUN_FAULT;
+    }
+    ncp_nck_print_summary(res, o->prog, stderr);
+    if (res->fault) {
+        fprintf(stderr,
+                "%s:%u: error: following error on %c: %.4f mm exceeds FERROR %.4f mm; servo stopped\n",
+                o->prog, res->fault_line, "XYZ"[res->fault_axis], res->fault_err,
+                cfg->axis[res->fault_axis].ferror);
+    } else if (res->status != RUN_OK && res->diag.line) {
+        fprintf(stderr, "%s:%u:%u: error: %s (motion stopped after the last good block)\n",
+                o->prog, res->diag.line, res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
+    } else if (res->status != RUN_OK) {
+        fprintf(stderr, "%s: error: %s\n", o->prog, res->diag.msg);
+    }
+    return res->status;
+}
+
+static int load_config(const struct run_opts *o, struct ncp_machine_cfg *cfg)
+{
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    ncp_machine_cfg_default(cfg);
+    if (!o->config || ncp_machine_cfg_load(cfg, o->config, &d) == NCP_OK)
+        return 0;
+    if (d.line)
+        fprintf(stderr, "%s:%u: error: %s\n", o->config, d.line, d.msg);
+    else
+        fprintf(stderr, "error: %s\n", d.msg);
+    return -1;
+}
+
+static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
+                       const struct ncp_source *src, FILE *trace)
+{
+    struct interp_ctx ic = { src, { 0 }, o->mode };
+    struct ncp_nck_opts no = {
+        .cfg = cfg, .interpret = interpret, .interp_ctx = &ic,
+        .virtual_clock = o->virtual_clock, .for_s = o->for_s,
+        .feed_override = o->feed_override, .trace = trace,
+        .progress = isatty(2) && !o->virtual_clock ? stderr : NULL,
+        .total_lines = count_lines(src),
+    };
+    struct ncp_nck_result *res = malloc(sizeof *res);
+    if (!res)
+        return RUN_FAULT;
+    ncp_nck_run(&no, res);
+    if (res->warning[0] && !no.progress)
+        fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
+    int rc = report(o, cfg, res);
+    free(res);
+    return rc;
+}
+
+int ncp_cli_run(int argc, char **argv)
+{
+    struct run_opts o = { 0 };
+    o.feed_override = 1.0;
+    o.mode = NCP_MODE_SERIAL;
+    if (parse_opts(argc, argv, &o))
+        return usage(stderr), RUN_USAGE;
+    struct ncp_machine_cfg cfg;
+    if (load_config(&o, &cfg))
+        return RUN_USAGE;
+    struct ncp_source src;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (ncp_source_open(&src, o.prog, &d) != NCP_OK) {
+        fprintf(stderr, "%s: error: %s\n", o.prog, d.msg);
+        return RUN_PROGRAM;
+    }
+    FILE *trace = NULL;
+    if (o.trace && !(trace = fopen(o.trace, "w"))) {
+        fprintf(stderr, "cnc-run run: cannot write %s: %s\n", o.trace, strerror(errno));
+        ncp_source_close(&src);
+        return RUN_USAGE;
+    }
+    int rc = run_program(&o, &cfg, &src, trace);
+    if (trace && fclose(trace) != 0) {
+        fprintf(stderr, "cnc-run run: error writing %s\n", o.trace);
+        rc = rc ? rc : RUN_FAULT;
+    }
+    ncp_source_close(&src);
+    return rc;
+}

@@ -1,0 +1,266 @@
+/* Canonical calls (program coordinates and units) -> machine-space segments (mm).
+ * machine = rotate_xy(program * scale + g92) + g5x + tool, offsets converted to mm
+ * with the units in force when they were issued (as LinuxCNC's canon layer). */
+#include "ncpar/motion.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void ncp_canon_map_init(struct ncp_canon_map *m, const struct ncp_machine_cfg *cfg,
+                        const double start[NCP_AXES], double feed_override)
+{
+    memset(m, 0, sizeof *m);
+    m->cfg = cfg;
+    m->scale = 1.0;
+    m->feed_override = feed_override > 0 ? feed_override : 1.0;
+    m->term = NCP_TERM_CONTINUOUS;   /* LinuxCNC starts in G64 */
+    for (int i = 0; i < NCP_AXES; i++)
+        m->pos[i] = start ? start[i] : 0;
+}
+
+static void to_machine(const struct ncp_canon_map *m, const double p[3], double out[3])
+{
+    double q[3];
+    for (int i = 0; i < 3; i++)
+        q[i] = p[i] * m->scale + m->g92[i];
+    double th = m->rotation * (M_PI / 180.0);
+    double c = cos(th), s = sin(th);
+    double x = q[0] * c - q[1] * s, y = q[0] * s + q[1] * c;
+    q[0] = x;
+    q[1] = y;
+    for (int i = 0; i < 3; i++)
+        out[i] = q[i] + m->g5x[i] + m->tool[i];
+}
+
+static double dot(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross(const double a[3], const double b[3], double o[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static int check_point(const struct ncp_canon_map *m, const double p[NCP_AXES],
+                       uint32_t line, struct ncp_diag *d)
+{
+    for (int i = 0; i < NCP_AXES; i++) {
+        const struct ncp_axis_cfg *a = &m->cfg->axis[i];
+        /* a nanometre of slack: arc extremes are computed, not given */
+        if (p[i] < a->min_limit - 1e-6)
+            return ncp_diag_set(d, NCP_ERR_LIMIT, line, 0,
+                                "soft limit: %c would go to %.4f mm, below its minimum %.4f mm",
+                                "XYZ"[i], p[i], a->min_limit);
+        if (p[i] > a->max_limit + 1e-6)
+            return ncp_diag_set(d, NCP_ERR_LIMIT, line, 0,
+                                "soft limit: %c would go to %.4f mm, above its maximum %.4f mm",
+                                "XYZ"[i], p[i], a->max_limit);
+    }
+    return NCP_OK;
+}
+
+/* A box is convex, so a line is inside if its ends are; an arc also needs the
+ * points where each axis has its extremes. */
+static int check_arc(const struct ncp_canon_map *m, const struct ncp_seg *s, struct ncp_diag *d)
+{
+    double lo = fmin(0, s->angle), hi = fmax(0, s->angle);
+    for (int i = 0; i < NCP_AXES; i++) {
+        double base = atan2(s->w[i], s->u[i]);
+        for (int half = 0; half < 2; half++) {
+            double b = base + half * M_PI;
+            /* radius and height change linearly with the angle, so of all the
+             * turns only the first and the last can hold an extreme */
+            double first = b + 2 * M_PI * ceil((lo - b) / (2 * M_PI));
+            double turns = floor((hi - first) / (2 * M_PI));
+            for (int k = 0; k < 2 && turns >= 0; k++) {
+                double phi = first + 2 * M_PI * (k ? turns : 0), p[NCP_AXES];
+                ncp_seg_eval(s, s->length * (phi / s->angle), p, NULL);
+                int r = check_point(m, p, s->line, d);
+                if (r)
+                    return r;
+            }
+        }
+    }
+    return check_point(m, s->end, s->line, d);
+}
+
+static void seg_common(const struct ncp_canon_map *m, struct ncp_seg *s, uint32_t line)
+{
+    memset(s, 0, sizeof *s);
+    s->line = line;
+    s->term = (uint8_t)m->term;
+    s->tolerance = m->tolerance;
+    s->feed = m->feed * m->feed_override;
+    memcpy(s->start, m->pos, sizeof s->start);
+}
+
+static int finite3(const double *v, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+static int straight(struct ncp_canon_map *m, const struct ncp_canon *op, int traverse,
+                    uint32_t line, struct ncp_seg *s, struct ncp_diag *d)
+{
+    seg_common(m, s, line);
+    s->kind = NCP_SEG_LINE;
+    s->traverse = (uint8_t)traverse;
+    to_machine(m, op->d, s->end);
+    if (!finite3(s->end, NCP_AXES))
+        return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "move to a non-finite position");
+    double l2 = 0;
+    for (int i = 0; i < NCP_AXES; i++)
+        l2 += (s->end[i] - s->start[i]) * (s->end[i] - s->start[i]);
+    s->length = sqrt(l2);
+    if (s->length < 1e-9)
+        return 0;  /* A/B/C-only or null move: nothing for a 3-axis machine to do */
+    if (traverse)
+        s->feed = m->cfg->max_linear_vel;
+    else if (s->feed <= 0)
+        return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "feed move with zero feed rate");
+    int r = check_point(m, s->end, line, d);
+    if (r)
+        return -r;
+    memcpy(m->pos, s->end, sizeof m->pos);
+    return 1;
+}
+
+/* Axis indices (machine X=0 Y=1 Z=2) of first, second and normal per plane. */
+static const int plane_axes[3][3] = { { 0, 1, 2 }, { 1, 2, 0 }, { 2, 0, 1 } };
+
+static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
+               struct ncp_seg *s, struct ncp_diag *d)
+{
+    seg_common(m, s, line);
+    s->kind = NCP_SEG_ARC;
+    const int *ax = plane_axes[m->plane];
+    double pe[3] = { 0, 0, 0 }, pc[3] = { 0, 0, 0 };
+    pe[ax[0]] = op->d[0];
+    pe[ax[1]] = op->d[1];
+    pe[ax[2]] = op->d[4];
+    pc[ax[0]] = op->d[2];
+    pc[ax[1]] = op->d[3];
+    pc[ax[2]] = op->d[4];
+    double c[3], n[3] = { 0, 0, 0 }, origin[3] = { 0, 0, 0 }, nm[3];
+    to_machine(m, pe, s->end);
+    to_machine(m, pc, c);
+    if (!finite3(s->end, NCP_AXES) || !finite3(c, 3) || abs(op->i[0]) > 100000)
+        return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "arc with a non-finite end or centre, or too many turns");
+    /* the plane normal turns with the XY rotation like any direction does */
+    n[ax[2]] = 1.0;
+    to_machine(m, n, nm);
+    to_machine(m, origin, n);
+    for (int i = 0; i < 3; i++)
+        nm[i] -= n[i];
+    double nl = sqrt(dot(nm, nm));
+    for (int i = 0; i < 3; i++)
+        s->normal[i] = nm[i] / nl;
+    double rs[3], re[3];
+    for (int i = 0; i < 3; i++) {
+        rs[i] = s->start[i] - c[i];
+        re[i] = s->end[i] - c[i];
+    }
+    double hs = dot(rs, s->normal), he = dot(re, s->normal);
+    for (int i = 0; i < 3; i++) {
+        rs[i] -= hs * s->normal[i];
+        re[i] -= he * s->normal[i];
+        s->center[i] = c[i] + hs * s->normal[i];
+    }
+    s->axial = he - hs;
+    s->r0 = sqrt(dot(rs, rs));
+    s->r1 = sqrt(dot(re, re));
+    if (s->r0 < 1e-9 || s->r1 < 1e-9)
+        return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "arc with zero radius");
+    for (int i = 0; i < 3; i++)
+        s->u[i] = rs[i] / s->r0;
+    cross(s->normal, s->u, s->w);
+    double a = atan2(dot(re, s->w), dot(re, s->u));
+    int rot = op->i[0];
+    if (rot > 0 && a <= 1e-12)
+        a += 2 * M_PI;
+    else if (rot < 0 && a >= -1e-12)
+        a -= 2 * M_PI;
+    int turns = rot > 0 ? rot - 1 : rot < 0 ? -rot - 1 : 0;
+    a += (a > 0 ? 1 : -1) * 2 * M_PI * turns;
+    s->angle = a;
+    double arc_len = fabs(a) * 0.5 * (s->r0 + s->r1);
+    s->length = sqrt(arc_len * arc_len + s->axial * s->axial);
+    if (s->feed <= 0)
+        return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "arc move with zero feed rate");
+    int r = check_arc(m, s, d);
+    if (r)
+        return -r;
+    memcpy(m->pos, s->end, sizeof m->pos);
+    return 1;
+}
+
+static void set6(double dst[6], const double src[6], double scale)
+{
+    for (int i = 0; i < 6; i++)
+        dst[i] = src[i] * scale;
+}
+
+static int state_op(struct ncp_canon_map *m, const struct ncp_canon *op)
+{
+    switch (op->kind) {
+    case NCP_C_USE_LENGTH_UNITS:
+        m->scale = op->i[0] == 0 ? 25.4 : 1.0;
+        break;
+    case NCP_C_SET_G5X_OFFSET:
+        set6(m->g5x, op->d, m->scale);
+        break;
+    case NCP_C_SET_G92_OFFSET:
+        set6(m->g92, op->d, m->scale);
+        break;
+    case NCP_C_USE_TOOL_LENGTH_OFFSET:
+        set6(m->tool, op->d, m->scale);
+        break;
+    case NCP_C_SET_XY_ROTATION:
+        m->rotation = op->d[0];
+        break;
+    case NCP_C_SELECT_PLANE:
+        m->plane = op->i[0] >= 0 && op->i[0] <= 2 ? op->i[0] : 0;
+        break;
+    case NCP_C_SET_FEED_RATE:
+        m->feed = op->d[0] * m->scale / 60.0;
+        break;
+    case NCP_C_SET_MOTION_CONTROL_MODE:
+        m->term = op->i[0] == 0 ? NCP_TERM_STOP
+                  : op->i[0] == 1 ? NCP_TERM_EXACT_PATH : NCP_TERM_CONTINUOUS;
+        m->tolerance = op->d[0] * m->scale;
+        break;
+    default:
+        break;
+    }
+    return 0;
+}
+
+int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
+                     struct ncp_seg *seg, struct ncp_diag *d)
+{
+    switch (op->kind) {
+    case NCP_C_STRAIGHT_TRAVERSE:
+        return straight(m, op, 1, line, seg, d);
+    case NCP_C_STRAIGHT_FEED:
+    case NCP_C_STRAIGHT_PROBE:
+        return straight(m, op, 0, line, seg, d);
+    case NCP_C_ARC_FEED:
+        return arc(m, op, line, seg, d);
+    case NCP_C_DWELL:
+        seg_common(m, seg, line);
+        seg->kind = NCP_SEG_DWELL;
+        seg->term = NCP_TERM_STOP;
+        seg->dwell = op->d[0] > 0 ? op->d[0] : 0;
+        memcpy(seg->end, m->pos, sizeof seg->end);
+        return 1;
+    default:
+        return state_op(m, op);
+    }
+}

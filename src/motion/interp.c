@@ -1,0 +1,93 @@
+/* Interpolator: samples the planned profile once per servo period. A segment's
+ * profile is frozen when it starts (the lazy forward pass); time left over at
+ * its end carries into the next segment so the path speed has no gaps, except
+ * at a stop, where the end point itself is the sample (exact stop). */
+#include "planner_int.h"
+
+#include <math.h>
+#include <string.h>
+
+static void start_head(struct ncp_planner *p)
+{
+    struct plan_seg *ps = plan_at(p, 0);
+    double v0 = p->v_now;
+    if (ps->s.kind == NCP_SEG_DWELL) {
+        memset(&p->trap, 0, sizeof p->trap);
+        p->dur = ps->s.dwell;
+    } else {
+        double next = p->count > 1 ? plan_at(p, 1)->v_in : 0;
+        double reach = sqrt(v0 * v0 + 2 * ps->acc * ps->s.length);
+        ncp_trap_plan(&p->trap, ps->s.length, v0, fmin(next, reach), fmax(ps->vmax, v0),
+                      ps->acc);
+        p->dur = ncp_trap_duration(&p->trap);
+    }
+    p->active = 1;
+    p->line = ps->s.line;
+}
+
+static void sample(struct ncp_planner *p, struct ncp_setpoint *out)
+{
+    const struct plan_seg *ps = plan_at(p, 0);
+    double v = 0;
+    if (ps->s.kind == NCP_SEG_DWELL) {
+        memcpy(p->pos, ps->s.end, sizeof p->pos);
+        memset(out->dir, 0, sizeof out->dir);
+    } else {
+        double s = ncp_trap_eval(&p->trap, p->t, &v);
+        ncp_seg_eval(&ps->s, s, p->pos, out->dir);
+    }
+    p->v_now = v;
+    out->v = v;
+}
+
+static void hold(struct ncp_planner *p, struct ncp_setpoint *out)
+{
+    memset(out->dir, 0, sizeof out->dir);
+    out->v = 0;
+    p->v_now = 0;
+}
+
+int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out)
+{
+    int stopped_at_end = 0;
+    out->flags = 0;
+    if (!p->active) {
+        if (p->count == 0) {
+            hold(p, out);
+            memcpy(out->pos, p->pos, sizeof out->pos);
+            out->line = p->line;
+            if (p->finished) {
+                out->flags = NCP_SP_END;
+                return 0;
+            }
+            out->flags = NCP_SP_STARVED;
+            p->st.starved++;
+            return 1;
+        }
+        start_head(p);
+        p->t = 0;
+    }
+    p->t += p->cfg.servo_period;
+    while (p->t >= p->dur) {
+        if (p->trap.v1 <= 1e-9 || p->count < 2) {
+            p->t = p->dur;
+            stopped_at_end = 1;
+            break;
+        }
+        double left = p->t - p->dur;
+        p->v_now = p->trap.v1;
+        ncp_planner_pop(p);
+        start_head(p);
+        p->t = left;
+    }
+    sample(p, out);
+    memcpy(out->pos, p->pos, sizeof out->pos);
+    out->line = p->line;
+    if (stopped_at_end) {
+        ncp_planner_pop(p);
+        p->active = 0;
+        p->v_now = 0;
+        out->v = 0;
+    }
+    return 1;
+}

@@ -1,0 +1,290 @@
+/* Look-ahead: per-segment speed and acceleration caps from the axis limits,
+ * junction caps, and a backward pass that keeps every queued segment able to
+ * stop at the end of the queue. The forward pass is done lazily, one segment at
+ * a time, when the interpolator starts a segment (interp.c). */
+#include "planner_int.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
+                                    const double start[NCP_AXES])
+{
+    struct ncp_planner *p = calloc(1, sizeof *p);
+    if (!p)
+        return NULL;
+    p->cfg = *cfg;
+    /* room for a blend arc per programmed segment: the window is LOOKAHEAD blocks */
+    p->cap = 2 * (size_t)(cfg->lookahead > 1 ? cfg->lookahead : 1) + 2;
+    p->q = calloc(p->cap, sizeof *p->q);
+    if (!p->q) {
+        free(p);
+        return NULL;
+    }
+    for (int i = 0; i < NCP_AXES; i++)
+        p->pos[i] = start ? start[i] : 0;
+    return p;
+}
+
+void ncp_planner_free(struct ncp_planner *p)
+{
+    if (!p)
+        return;
+    free(p->q);
+    free(p);
+}
+
+int ncp_planner_full(const struct ncp_planner *p)
+{
+    /* a push may add a blend arc too; blends do not count against the window */
+    return p->programmed >= (size_t)p->cfg.lookahead || p->count + 2 > p->cap;
+}
+
+size_t ncp_planner_queued(const struct ncp_planner *p)
+{
+    return p->count;
+}
+
+int ncp_planner_idle(const struct ncp_planner *p)
+{
+    return !p->active;
+}
+
+void ncp_planner_finish(struct ncp_planner *p)
+{
+    p->finished = 1;
+}
+
+void ncp_planner_get_stats(const struct ncp_planner *p, struct ncp_planner_stats *st)
+{
+    *st = p->st;
+}
+
+void ncp_planner_pop(struct ncp_planner *p)
+{
+    p->st.path_length += p->q[p->head].s.length;
+    if (!p->q[p->head].blend)
+        p->programmed--;
+    p->head = (p->head + 1) % p->cap;
+    p->count--;
+}
+
+static void line_limits(const struct ncp_planner *p, struct plan_seg *ps)
+{
+    const struct ncp_seg *s = &ps->s;
+    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY;
+    for (int j = 0; j < NCP_AXES; j++) {
+        double u = fabs(s->end[j] - s->start[j]) / s->length;
+        if (u < 1e-12)
+            continue;
+        vmax = fmin(vmax, p->cfg.axis[j].max_vel / u);
+        acc = fmin(acc, p->cfg.axis[j].max_acc / u);
+    }
+    ps->vmax = vmax;
+    ps->acc = acc;
+}
+
+/* Along a helix every axis sees at most its share of the tangential
+ * acceleration plus its share of the centripetal one; half of each axis's limit
+ * goes to either, so their sum never exceeds it. */
+static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
+{
+    const struct ncp_seg *s = &ps->s;
+    double r = 0.5 * (s->r0 + s->r1);
+    double f_plane = fabs(s->angle) * r / s->length, f_axis = fabs(s->axial) / s->length;
+    double pitch = s->axial / fabs(s->angle);
+    double kappa = r / (r * r + pitch * pitch);
+    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY;
+    for (int j = 0; j < NCP_AXES; j++) {
+        double m = sqrt(s->u[j] * s->u[j] + s->w[j] * s->w[j]);
+        double share = f_plane * m + f_axis * fabs(s->normal[j]);
+        if (share < 1e-12)
+            continue;
+        const struct ncp_axis_cfg *a = &p->cfg.axis[j];
+        vmax = fmin(vmax, a->max_vel / share);
+        acc = fmin(acc, 0.5 * a->max_acc / share);
+        if (m > 1e-12)
+            vmax = fmin(vmax, sqrt(0.5 * a->max_acc / (kappa * m)));
+    }
+    ps->vmax = vmax;
+    ps->acc = acc;
+}
+
+/* A corner (kink) turns the velocity vector within one servo period. A servo
+ * sample's second difference is a weighted mean of the continuous acceleration
+ * plus the kink's velocity jump over one period, so the kink gets a share beta
+ * of each axis's limit and the segments on both sides keep their continuous
+ * acceleration within 1 - beta (halved: lines 0.5, arcs 0.5 normal + 0.25). */
+static double kink_share(const struct ncp_seg *a, const struct ncp_seg *b)
+{
+    return a->kind == NCP_SEG_ARC || b->kind == NCP_SEG_ARC ? 0.25 : 0.5;
+}
+
+static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
+                       const struct plan_seg *cur, int *kink)
+{
+    *kink = 0;
+    if (prev->kind == NCP_SEG_DWELL || cur->s.kind == NCP_SEG_DWELL ||
+        prev->term == NCP_TERM_STOP)
+        return 0;
+    double pos[NCP_AXES], t1[NCP_AXES], t2[NCP_AXES], dmax = 0, v = cur->vmax;
+    double beta = kink_share(prev, &cur->s);
+    ncp_seg_eval(prev, prev->length, pos, t1);
+    ncp_seg_eval(&cur->s, 0, pos, t2);
+    for (int j = 0; j < NCP_AXES; j++) {
+        double dj = fabs(t2[j] - t1[j]);
+        dmax = fmax(dmax, dj);
+        if (dj > 1e-9)
+            v = fmin(v, beta * p->cfg.axis[j].max_acc * p->cfg.servo_period / dj);
+    }
+    if (dmax <= 1e-9)
+        return v;
+    if (prev->term == NCP_TERM_EXACT_PATH)
+        return 0;
+    *kink = 1;
+    return v;
+}
+
+/* Would lowering the tail's entry speed to v_tail (with the backward pass
+ * carrying it towards the head) take an entry below the speed the executing
+ * segment's frozen profile ends with? Stops as soon as a speed stays put. */
+static int lowering_safe(const struct ncp_planner *p, double v_tail)
+{
+    if (!p->active || p->count < 2)
+        return p->count >= 1 && !(p->active && p->count == 1);
+    size_t k = p->count - 1;
+    double v = v_tail;
+    for (;;) {
+        const struct plan_seg *ps = &p->q[(p->head + k) % p->cap];
+        if (v >= ps->v_in)
+            return 1;
+        if (k == 1)
+            return v >= p->trap.v1;
+        k--;
+        ps = &p->q[(p->head + k) % p->cap];
+        v = fmin(ps->vjunc, sqrt(v * v + 2 * ps->acc * ps->s.length));
+    }
+}
+
+static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
+{
+    if (ps->s.kind == NCP_SEG_DWELL) {
+        ps->vmax = 0;
+        ps->acc = 1;
+    } else if (ps->s.kind == NCP_SEG_ARC) {
+        arc_limits(p, ps);
+    } else {
+        line_limits(p, ps);
+    }
+    if (p->cfg.default_linear_acc > 0)
+        ps->acc = fmin(ps->acc, p->cfg.default_linear_acc);
+    ps->acc_full = ps->acc;
+    ps->vjunc = 0;
+    if (!p->have_last)
+        return;
+    int kink;
+    /* a junction belongs to both segments: neither's cruise cap may be exceeded */
+    double v = fmin(fmin(ps->vmax, p->last_vmax), junction(p, &p->last_pushed, ps, &kink));
+    if (kink) {
+        /* The previous segment gives up acceleration for the kink, unless that
+         * would cut into a profile already frozen: then stop at the corner. */
+        struct plan_seg *prev = p->count ? plan_at(p, p->count - 1) : NULL;
+        double a_half = prev ? 0.5 * prev->acc_full : 0;
+        double exit_lb = fmin(v, sqrt(2 * 0.5 * ps->acc_full * ps->s.length));
+        if (!prev || !lowering_safe(p, fmin(prev->vjunc, sqrt(exit_lb * exit_lb +
+                                                                 2 * a_half * prev->s.length)))) {
+            v = 0;
+        } else {
+            prev->acc = a_half;
+            ps->acc = 0.5 * ps->acc_full;
+        }
+    }
+    ps->vjunc = v;
+}
+
+/* Raise entry speeds from the tail backwards until one does not change: the
+ * segments before it were limited by their own caps, not by what follows. */
+static void backward_pass(struct ncp_planner *p)
+{
+    size_t first = p->active ? 1 : 0;
+    double exit_v = 0;
+    for (size_t k = p->count; k-- > first;) {
+        struct plan_seg *ps = plan_at(p, k);
+        double v = fmin(ps->vjunc, sqrt(exit_v * exit_v + 2 * ps->acc * ps->s.length));
+        if (k + 1 < p->count && v == ps->v_in)
+            break;
+        if (k + 1 < p->count)
+            p->st.replans++;
+        ps->v_in = v;
+        exit_v = v;
+    }
+}
+
+static void push_one(struct ncp_planner *p, const struct ncp_seg *s, int blend)
+{
+    struct plan_seg *ps = &p->q[(p->head + p->count) % p->cap];
+    memset(ps, 0, sizeof *ps);
+    ps->s = *s;
+    ps->blend = blend;
+    seg_limits(p, ps);
+    p->count++;
+    p->programmed += !blend;
+    p->last_pushed = *s;
+    p->last_vmax = ps->vmax;
+    p->have_last = 1;
+    p->st.segments++;
+    backward_pass(p);
+}
+
+/* A corner so slight that its kink speed does not slow the motion is left
+ * sharp: the path stays exact and nothing is lost. */
+static int kink_harmless(const struct ncp_planner *p, const struct ncp_seg *a,
+                         const struct ncp_seg *b, double vmax)
+{
+    double pos[NCP_AXES], t1[NCP_AXES], t2[NCP_AXES];
+    ncp_seg_eval(a, a->length, pos, t1);
+    ncp_seg_eval(b, 0, pos, t2);
+    for (int j = 0; j < NCP_AXES; j++) {
+        double dj = fabs(t2[j] - t1[j]);
+        if (dj > 1e-9 && kink_share(a, b) * p->cfg.axis[j].max_acc * p->cfg.servo_period / dj < vmax)
+            return 0;
+    }
+    return 1;
+}
+
+/* Blends the corner between the queued tail and s when the tail may still
+ * change: not executing, and not lowering speeds a frozen profile counts on. */
+static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
+{
+    if (!p->count || (p->active && p->count == 1))
+        return 0;
+    struct plan_seg *prev = plan_at(p, p->count - 1);
+    struct plan_seg arc;
+    double d;
+    memset(&arc, 0, sizeof arc);
+    if (kink_harmless(p, &prev->s, s, prev->vmax) || !ncp_blend_corner(&prev->s, s, &arc.s, &d))
+        return 0;
+    arc_limits(p, &arc);
+    double exit_lb = fmin(arc.vmax, sqrt(2 * arc.acc * arc.s.length));
+    double vin = fmin(prev->vjunc, sqrt(exit_lb * exit_lb + 2 * prev->acc * (prev->s.length - d)));
+    if (!lowering_safe(p, vin))
+        return 0;
+    prev->s.length -= d;
+    memcpy(prev->s.end, arc.s.start, sizeof prev->s.end);
+    p->last_pushed = prev->s;
+    push_one(p, &arc.s, 1);
+    s->length -= d;
+    memcpy(s->start, arc.s.end, sizeof s->start);
+    p->st.segments--;  /* the arc is not a programmed segment */
+    return 1;
+}
+
+void ncp_planner_push(struct ncp_planner *p, const struct ncp_seg *s)
+{
+    if (ncp_planner_full(p))
+        return;
+    struct ncp_seg cur = *s;
+    try_blend(p, &cur);
+    push_one(p, &cur, 0);
+}

@@ -1,0 +1,50 @@
+/* Planner state shared by the look-ahead (planner.c) and the interpolator
+ * (interp.c). Not part of the public contract. */
+#ifndef NCPAR_MOTION_PLANNER_INT_H
+#define NCPAR_MOTION_PLANNER_INT_H
+
+#include "ncpar/motion.h"
+
+struct plan_seg {
+    struct ncp_seg s;
+    double vmax;    /* cruise cap: feed and per-axis velocity / centripetal limits */
+    double acc;     /* path acceleration that keeps every axis within its limit */
+    double acc_full;/* the same before a corner (kink) took its share */
+    double vjunc;   /* entry speed cap from the junction with the previous segment */
+    double v_in;    /* planned entry speed (backward pass: can still stop at the end) */
+    int blend;      /* a G64 corner arc, not a programmed segment */
+};
+
+struct ncp_planner {
+    struct ncp_machine_cfg cfg;
+    size_t cap;              /* look-ahead window */
+    struct plan_seg *q;      /* ring of cap entries */
+    size_t head, count;
+    size_t programmed;       /* queued segments that are not blend arcs */
+    int active;              /* q[head] is executing with a frozen profile */
+    int finished;
+    struct ncp_trap trap;    /* profile of q[head] */
+    double dur;              /* its duration */
+    double t;                /* time into it */
+    double v_now;            /* path speed at the end of the last sample */
+    double pos[NCP_AXES];
+    uint32_t line;
+    int have_last;           /* last_pushed valid: junctions need the previous segment */
+    struct ncp_seg last_pushed;
+    double last_vmax;        /* its cruise cap */
+    struct ncp_planner_stats st;
+};
+
+static inline struct plan_seg *plan_at(struct ncp_planner *p, size_t k)
+{
+    return &p->q[(p->head + k) % p->cap];
+}
+
+void ncp_planner_pop(struct ncp_planner *p);
+
+/* blend.c: the arc joining prev's end to cur's start within prev's G64 P, and
+ * the length trimmed off both lines. Returns 0 when the corner is not blended. */
+int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, struct ncp_seg *arc,
+                     double *trim);
+
+#endif

@@ -1,0 +1,164 @@
+/* The consumer of the position loop's cycles: trace rows, following and
+ * contour error, the live progress line and the final summary. Runs on the
+ * caller's thread, never on the real-time one. */
+#include "nck_int.h"
+
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+static double dist_to_seg(const double p[NCP_AXES], const double a[NCP_AXES],
+                          const double b[NCP_AXES])
+{
+    double ab2 = 0, ap_ab = 0, d2 = 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        ab2 += (b[j] - a[j]) * (b[j] - a[j]);
+        ap_ab += (p[j] - a[j]) * (b[j] - a[j]);
+    }
+    double f = ab2 > 0 ? fmin(1, fmax(0, ap_ab / ab2)) : 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        double q = a[j] + f * (b[j] - a[j]) - p[j];
+        d2 += q * q;
+    }
+    return sqrt(d2);
+}
+
+/* Distance from the actual point to the commanded path, taken as the polyline
+ * of the recent commanded samples (its chord error is v^2 T^2 / 8r). */
+static double contour_error(struct nck_summary *s, const struct nck_fb *fb)
+{
+    memcpy(s->hist[s->hist_at], fb->cmd, sizeof s->hist[0]);
+    s->hist_at = (s->hist_at + 1) % NCK_CONTOUR_HISTORY;
+    if (s->hist_n < NCK_CONTOUR_HISTORY)
+        s->hist_n++;
+    if (s->hist_n < 2)
+        return dist_to_seg(fb->act, fb->cmd, fb->cmd);
+    double best = INFINITY;
+    for (size_t k = 1; k < s->hist_n; k++) {
+        size_t i = (s->hist_at + NCK_CONTOUR_HISTORY - k) % NCK_CONTOUR_HISTORY;
+        size_t i0 = (i + NCK_CONTOUR_HISTORY - 1) % NCK_CONTOUR_HISTORY;
+        best = fmin(best, dist_to_seg(fb->act, s->hist[i0], s->hist[i]));
+    }
+    return best;
+}
+
+void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
+{
+    double e2 = 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        double e = fb->cmd[j] - fb->act[j];
+        e2 += e * e;
+        s->ferr_axis_max[j] = fmax(s->ferr_axis_max[j], fabs(e));
+    }
+    double e = sqrt(e2), c = contour_error(s, fb), step = 0;
+    for (int j = 0; j < NCP_AXES && s->rows; j++)
+        step += (fb->cmd[j] - s->last[j]) * (fb->cmd[j] - s->last[j]);
+    s->path += sqrt(step);
+    memcpy(s->last, fb->cmd, sizeof s->last);
+    s->rows++;
+    s->ferr_max = fmax(s->ferr_max, e);
+    s->contour_max = fmax(s->contour_max, c);
+    if (fb->v > 0) {
+        s->moving++;
+        s->ferr_sum += e;
+        s->contour_sum += c;
+    }
+    s->line = fb->line;
+    s->t = fb->t;
+    s->v = fb->v;
+    if (trace)
+        fprintf(trace, "%.6f,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f\n", fb->t, fb->line,
+                fb->cmd[0], fb->cmd[1], fb->cmd[2], fb->act[0], fb->act[1], fb->act[2], fb->v);
+}
+
+static int64_t mono_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+static void progress(const struct nck *n, const struct nck_summary *s)
+{
+    uint32_t total = n->o->total_lines;
+    /* lat_max_ns is written by the loop thread; a torn read only blurs a display */
+    fprintf(n->o->progress,
+            "\r  line %u/%u (%3.0f%%)  t %.2f s  feed %.0f mm/min  max latency %.1f us  ",
+            s->line, total, total ? 100.0 * s->line / total : 0.0, s->t, s->v * 60,
+            (double)n->loop.stats.lat_max_ns / 1e3);
+    fflush(n->o->progress);
+}
+
+void nck_drain(struct nck *n, struct nck_summary *s)
+{
+    int64_t last_print = 0;
+    struct nck_fb fb;
+    FILE *tty = n->o->progress;
+    if (n->o->trace)
+        fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v\n", n->o->trace);
+    for (;;) {
+        int got = 0;
+        while (ncp_spsc_pop(&n->fbs, &fb) == 0) {
+            nck_account(s, &fb, n->o->trace);
+            got = 1;
+        }
+        if (!got && !atomic_load(&n->loop.running) && ncp_spsc_count(&n->fbs) == 0)
+            break;
+        if (tty && mono_ns() - last_print > 200000000) {
+            last_print = mono_ns();
+            progress(n, s);
+        }
+        if (!got) {
+            struct timespec ts = { 0, n->o->virtual_clock ? 50000 : 1000000 };
+            nanosleep(&ts, NULL);
+        }
+    }
+    if (tty && last_print)
+        fputc('\n', tty);
+}
+
+/* cyclictest-like histogram, folded into a few readable buckets for a terminal. */
+static void print_latency(const struct ncp_rt_stats *st, FILE *f)
+{
+    static const int edges[] = { 5, 10, 20, 50, 100, 200, 500, NCP_RT_HIST_BINS };
+    if (!st->cycles) {
+        fprintf(f, "  loop latency: no cycles\n");
+        return;
+    }
+    fprintf(f, "  loop latency: min %.1f us, avg %.1f us, max %.1f us over %llu cycles\n",
+            (double)st->lat_min_ns / 1e3, st->lat_sum_ns / (double)st->cycles / 1e3,
+            (double)st->lat_max_ns / 1e3, (unsigned long long)st->cycles);
+    fprintf(f, "  latency histogram:");
+    int lo = 0;
+    for (size_t e = 0; e < sizeof edges / sizeof edges[0]; e++) {
+        uint64_t n = 0;
+        for (int i = lo; i < edges[e]; i++)
+            n += st->hist[i];
+        fprintf(f, " %d-%dus %llu%s", lo, edges[e], (unsigned long long)n, ",");
+        lo = edges[e];
+    }
+    fprintf(f, " >=%dus %llu\n", NCP_RT_HIST_BINS, (unsigned long long)st->overflow);
+}
+
+void ncp_nck_print_summary(const struct ncp_nck_result *r, const char *prog, FILE *f)
+{
+    fprintf(f, "%s: position loop %s%s\n", prog, r->fifo ? "SCHED_FIFO" : "SCHED_OTHER",
+            r->warning[0] ? " (no real-time permission)" : "");
+    fprintf(f, "  program time %.3f s%s, path length %.3f mm, %llu segments\n",
+            r->program_time, r->for_expired ? " (--for: feed hold, braked along the path)" : "", r->path_length,
+            (unsigned long long)r->segments);
+    fprintf(f, "  following error: max %.4f mm (X %.4f, Y %.4f, Z %.4f), avg %.4f mm in motion\n",
+            r->ferr_max, r->ferr_axis_max[0], r->ferr_axis_max[1], r->ferr_axis_max[2],
+            r->ferr_avg);
+    fprintf(f, "  contour error: max %.4f mm, avg %.4f mm in motion\n", r->contour_max,
+            r->contour_avg);
+    print_latency(&r->lat, f);
+    fprintf(f, "  deadline misses %llu (periods skipped %llu), underruns %llu (slowed along the path; "
+               "%llu cycles held empty), planner waited %llu cycles\n",
+            (unsigned long long)r->lat.misses, (unsigned long long)r->lat.skipped,
+            (unsigned long long)r->underruns, (unsigned long long)r->dry,
+            (unsigned long long)r->starved);
+    if (r->trace_dropped)
+        fprintf(f, "  trace: %llu cycles dropped (the writer fell behind)\n",
+                (unsigned long long)r->trace_dropped);
+}

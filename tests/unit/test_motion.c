@@ -1,0 +1,481 @@
+/* Motion: config, canonical calls -> segments, planner and interpolator, checked
+ * on the sampled trajectory with tolerances derived from the servo period. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "ncpar/motion.h"
+
+/* ---- helpers ------------------------------------------------------------- */
+
+static struct ncp_canon op6(int kind, double x, double y, double z)
+{
+    struct ncp_canon c;
+    memset(&c, 0, sizeof c);
+    c.kind = (uint16_t)kind;
+    c.d[0] = x;
+    c.d[1] = y;
+    c.d[2] = z;
+    return c;
+}
+
+static struct ncp_canon op_feed(double f)
+{
+    return op6(NCP_C_SET_FEED_RATE, f, 0, 0);
+}
+
+static struct ncp_canon op_mode(int mode)
+{
+    struct ncp_canon c = op6(NCP_C_SET_MOTION_CONTROL_MODE, 0, 0, 0);
+    c.i[0] = mode;
+    return c;
+}
+
+/* ARC_FEED in the XY plane */
+static struct ncp_canon op_arc(double x, double y, double cx, double cy, int rot, double z)
+{
+    struct ncp_canon c = op6(NCP_C_ARC_FEED, x, y, cx);
+    c.d[3] = cy;
+    c.d[4] = z;
+    c.i[0] = rot;
+    return c;
+}
+
+struct trace {
+    size_t n, cap;
+    struct ncp_setpoint *sp;
+};
+
+static void trace_add(struct trace *t, const struct ncp_setpoint *s)
+{
+    if (t->n == t->cap) {
+        t->cap = t->cap ? 2 * t->cap : 4096;
+        t->sp = realloc(t->sp, t->cap * sizeof *t->sp);
+        assert_non_null(t->sp);
+    }
+    t->sp[t->n++] = *s;
+}
+
+/* Runs ops through canon map + planner like the runtime does (window filled
+ * before each start), collecting every setpoint. Segment ends go to ends[]. */
+static struct trace run_ops(const struct ncp_machine_cfg *cfg, const struct ncp_canon *ops,
+                            size_t n, double ends[][NCP_AXES], size_t *n_ends)
+{
+    struct ncp_canon_map m;
+    double zero[NCP_AXES] = { 0 };
+    ncp_canon_map_init(&m, cfg, zero, 1.0);
+    struct ncp_planner *p = ncp_planner_new(cfg, zero);
+    assert_non_null(p);
+    struct trace t = { 0 };
+    size_t i = 0, ne = 0;
+    for (;;) {
+        while (i < n && !ncp_planner_full(p)) {
+            struct ncp_seg s;
+            struct ncp_diag d;
+            int r = ncp_canon_map_op(&m, &ops[i], (uint32_t)(i + 1), &s, &d);
+            assert_true(r == 0 || r == 1);
+            if (r == 1) {
+                ncp_planner_push(p, &s);
+                if (ends)
+                    memcpy(ends[ne], s.end, sizeof ends[ne]);
+                ne++;
+            }
+            i++;
+        }
+        if (i == n)
+            ncp_planner_finish(p);
+        struct ncp_setpoint sp;
+        if (!ncp_planner_step(p, &sp))
+            break;
+        trace_add(&t, &sp);
+        assert_true(t.n < 50000000);
+    }
+    if (n_ends)
+        *n_ends = ne;
+    ncp_planner_free(p);
+    return t;
+}
+
+/* Velocity and acceleration of every axis from first and second differences.
+ * A difference of samples is a weighted mean of the continuous quantity, so
+ * the limits hold for it exactly; 1e-6 relative slack covers rounding. */
+static void check_limits(const struct ncp_machine_cfg *cfg, const struct trace *t)
+{
+    double T = cfg->servo_period;
+    for (size_t k = 1; k < t->n; k++) {
+        for (int j = 0; j < NCP_AXES; j++) {
+            double v = (t->sp[k].pos[j] - t->sp[k - 1].pos[j]) / T;
+            if (fabs(v) > cfg->axis[j].max_vel * (1 + 1e-6) + 1e-9) {
+                fail_msg("axis %d velocity %.6f > %.6f at sample %zu", j, v,
+                         cfg->axis[j].max_vel, k);
+            }
+            if (k < 2)
+                continue;
+            double a = (t->sp[k].pos[j] - 2 * t->sp[k - 1].pos[j] + t->sp[k - 2].pos[j]) / (T * T);
+            if (fabs(a) > cfg->axis[j].max_acc * (1 + 1e-6) + 1e-6) {
+                fail_msg("axis %d acceleration %.3f > %.3f at sample %zu (line %u)", j, a,
+                         cfg->axis[j].max_acc, k, t->sp[k].line);
+            }
+        }
+    }
+}
+
+static struct ncp_machine_cfg test_cfg(void)
+{
+    struct ncp_machine_cfg c;
+    ncp_machine_cfg_default(&c);
+    return c;
+}
+
+/* ---- config -------------------------------------------------------------- */
+
+static char *write_tmp(const char *text)
+{
+    static char path[64];
+    snprintf(path, sizeof path, "/tmp/ncp_test_motion_%d.ini", (int)getpid());
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+static void test_config_shipped(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c;
+    struct ncp_diag d;
+    ncp_machine_cfg_default(&c);
+    assert_int_equal(ncp_machine_cfg_load(&c, "rt-config/sim-3axis.ini", &d), NCP_OK);
+    assert_true(fabs(c.servo_period - 1e-3) < 1e-12);
+    assert_true(c.axis[2].min_limit == -250 && c.axis[2].max_limit == 50);
+    assert_true(c.axis[0].min_limit == -500 && c.axis[1].max_limit == 500);
+    assert_int_equal(c.lookahead, 200);
+    assert_int_equal(c.position.priority, 90);
+}
+
+static void test_config_errors(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c;
+    struct ncp_diag d;
+    ncp_machine_cfg_default(&c);
+    char *p = write_tmp("[AXIS_X]\nMAX_VELOCITY = 10\nMAX_VELOCTY = 3\n");
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_int_equal(d.line, 3);
+    assert_non_null(strstr(d.msg, "AXIS_X"));
+    assert_non_null(strstr(d.msg, "MAX_VELOCTY"));
+    assert_non_null(strstr(d.msg, p));
+
+    p = write_tmp("[EMCMOT]\nSERVO_PERIOD = fast\n");
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "SERVO_PERIOD"));
+    assert_non_null(strstr(d.msg, "EMCMOT"));
+
+    p = write_tmp("[AXIS_Q]\nMAX_VELOCITY = 1\n");
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "AXIS_Q"));
+
+    ncp_machine_cfg_default(&c);
+    p = write_tmp("[PLANNER]\nSETPOINT_RING = 16\n");
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "SETPOINT_RING"));
+
+    p = write_tmp("[PLANNER]\nPROFILE = wobbly\n");
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "PROFILE"));
+    unlink(p);
+}
+
+/* ---- trapezoid ------------------------------------------------------------ */
+
+static void test_trap_long_line_time(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    /* 400 mm along X at F6000 (100 mm/s), a = 2000: T = L/v + v/a */
+    struct ncp_canon ops[] = { op_feed(6000), op6(NCP_C_STRAIGHT_FEED, 400, 0, 0) };
+    struct trace t = run_ops(&c, ops, 2, NULL, NULL);
+    double expect = 400.0 / 100.0 + 100.0 / 2000.0;
+    double got = (double)t.n * c.servo_period;
+    assert_true(fabs(got - expect) / expect < 0.01);
+    assert_true(fabs(got - expect) <= 2 * c.servo_period);
+    assert_true(t.sp[t.n - 1].pos[0] == 400.0);
+    check_limits(&c, &t);
+    free(t.sp);
+}
+
+static void test_trap_short_triangle(void **state)
+{
+    (void)state;
+    struct ncp_trap tp;
+    ncp_trap_plan(&tp, 1.0, 0, 0, 100, 1000);
+    /* never reaches 100: peak sqrt(a L) */
+    assert_true(fabs(tp.vp - sqrt(1000.0)) < 1e-9);
+    double v;
+    assert_true(fabs(ncp_trap_eval(&tp, ncp_trap_duration(&tp), &v) - 1.0) < 1e-12);
+    assert_true(fabs(ncp_trap_eval(&tp, tp.t1, &v) - 0.5) < 1e-9);
+}
+
+/* ---- corners, exact stop, arcs ------------------------------------------- */
+
+static const double square[][2] = { { 50, 0 }, { 50, 30 }, { 0, 30 }, { 0, 0 }, { 20, 5 } };
+
+static void test_g61_exact_stop_ends(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon ops[16];
+    size_t n = 0;
+    ops[n++] = op_mode(0);
+    ops[n++] = op_feed(3000);
+    for (size_t i = 0; i < sizeof square / sizeof square[0]; i++)
+        ops[n++] = op6(NCP_C_STRAIGHT_FEED, square[i][0], square[i][1], 0);
+    double ends[16][NCP_AXES];
+    size_t ne;
+    struct trace t = run_ops(&c, ops, n, ends, &ne);
+    assert_int_equal(ne, 5);
+    for (size_t e = 0; e < ne; e++) {
+        int hit = 0;
+        for (size_t k = 0; k < t.n && !hit; k++)
+            hit = !memcmp(t.sp[k].pos, ends[e], sizeof ends[e]) && t.sp[k].v == 0;
+        if (!hit)
+            fail_msg("segment end %zu (%.3f, %.3f) never reached at rest", e, ends[e][0],
+                     ends[e][1]);
+    }
+    check_limits(&c, &t);
+    free(t.sp);
+}
+
+static void test_g64_corners_within_limits(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon ops[64];
+    size_t n = 0;
+    ops[n++] = op_mode(2);
+    ops[n++] = op_feed(9000);
+    for (size_t i = 0; i < sizeof square / sizeof square[0]; i++)
+        ops[n++] = op6(NCP_C_STRAIGHT_FEED, square[i][0], square[i][1], -1.0 * (double)i);
+    /* a polyline with small turns: the corners must not force stops */
+    for (int i = 1; i <= 40; i++)
+        ops[n++] = op6(NCP_C_STRAIGHT_FEED, 20 + 20 * sin(i * 0.05), 5 + 20 * (1 - cos(i * 0.05)), -4);
+    ops[n++] = op_arc(60, 25, 40, 25, 1, -4);  /* tangent-ish arc after the polyline */
+    ops[n++] = op6(NCP_C_STRAIGHT_TRAVERSE, 0, 0, 10);
+    struct trace t = run_ops(&c, ops, n, NULL, NULL);
+    check_limits(&c, &t);
+    size_t stops = 0;
+    for (size_t k = 1; k + 1 < t.n; k++)
+        stops += t.sp[k].v == 0;
+    /* only the polyline start, the arc corner and the traverse may stop */
+    assert_true(stops < 10);
+    free(t.sp);
+}
+
+static double dist_point_seg(const double p[2], const double a[2], const double b[2])
+{
+    const double ab[2] = { b[0] - a[0], b[1] - a[1] }, ap[2] = { p[0] - a[0], p[1] - a[1] };
+    double f = (ap[0] * ab[0] + ap[1] * ab[1]) / (ab[0] * ab[0] + ab[1] * ab[1]);
+    f = f < 0 ? 0 : f > 1 ? 1 : f;
+    return hypot(a[0] + f * ab[0] - p[0], a[1] + f * ab[1] - p[1]);
+}
+
+/* G64 P: corners are rounded, at speed, never further than P from the
+ * programmed path. */
+static void test_g64_p_tolerance(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    static const double pts[][2] = { { 0, 0 }, { 50, 0 }, { 50, 30 }, { 0, 30 }, { 20, 5 }, { 25, 60 } };
+    const size_t np = sizeof pts / sizeof pts[0];
+    const double tol = 0.05;
+    struct ncp_canon ops[16];
+    size_t n = 0;
+    ops[n] = op_mode(2);
+    ops[n++].d[0] = tol;
+    ops[n++] = op_feed(9000);
+    for (size_t i = 1; i < np; i++)
+        ops[n++] = op6(NCP_C_STRAIGHT_FEED, pts[i][0], pts[i][1], 0);
+    struct trace t = run_ops(&c, ops, n, NULL, NULL);
+    check_limits(&c, &t);
+    double worst = 0;
+    for (size_t k = 0; k < t.n; k++) {
+        double best = INFINITY;
+        for (size_t i = 1; i < np; i++)
+            best = fmin(best, dist_point_seg(t.sp[k].pos, pts[i - 1], pts[i]));
+        worst = fmax(worst, best);
+    }
+    assert_true(worst <= tol * (1 + 1e-9));
+    assert_true(worst > 0.5 * tol);  /* the corners really were rounded */
+    for (size_t k = 1; k + 1 < t.n; k++)
+        assert_true(t.sp[k].v > 0);   /* and taken without stopping */
+    free(t.sp);
+}
+
+static void test_arc_radius_and_helix(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon ops[] = {
+        op_feed(12000),
+        op6(NCP_C_STRAIGHT_FEED, 30, 0, 0),
+        op_arc(30, 0, 0, 0, 2, -5),   /* two full turns of helix, r = 30, 5 mm down */
+        op_arc(-30, 0, 0, 0, -1, -5), /* half circle clockwise */
+    };
+    struct trace t = run_ops(&c, ops, 4, NULL, NULL);
+    check_limits(&c, &t);
+    size_t on_arc = 0;
+    double zmin = 0;
+    for (size_t k = 0; k < t.n; k++) {
+        if (t.sp[k].line < 3)
+            continue;
+        double r = hypot(t.sp[k].pos[0], t.sp[k].pos[1]);
+        if (fabs(r - 30) > 1e-6)
+            fail_msg("radius %.9f at sample %zu", r, k);
+        on_arc++;
+        zmin = fmin(zmin, t.sp[k].pos[2]);
+    }
+    assert_true(on_arc > 100);
+    assert_true(fabs(zmin + 5) < 1e-9);
+    assert_true(fabs(t.sp[t.n - 1].pos[0] + 30) < 1e-9);
+    free(t.sp);
+}
+
+static void test_arc_centripetal_cap(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    /* r = 2 mm at F12000: v^2/r must stay below the acceleration limit */
+    struct ncp_canon ops[] = { op_feed(12000), op6(NCP_C_STRAIGHT_FEED, 2, 0, 0),
+                               op_arc(2, 0, 0, 0, 3, 0) };
+    struct trace t = run_ops(&c, ops, 3, NULL, NULL);
+    check_limits(&c, &t);
+    double vmax = 0;
+    for (size_t k = 0; k < t.n; k++)
+        vmax = fmax(vmax, t.sp[k].v);
+    assert_true(vmax * vmax / 2.0 <= 0.5 * c.axis[0].max_acc * 1.000001);
+    free(t.sp);
+}
+
+/* ---- canon mapping -------------------------------------------------------- */
+
+static void test_canon_units_offsets(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon_map m;
+    ncp_canon_map_init(&m, &c, NULL, 1.0);
+    struct ncp_seg s;
+    struct ncp_diag d;
+    struct ncp_canon u = op6(NCP_C_USE_LENGTH_UNITS, 0, 0, 0);
+    u.i[0] = 0; /* inches */
+    assert_int_equal(ncp_canon_map_op(&m, &u, 1, &s, &d), 0);
+    struct ncp_canon g5x = op6(NCP_C_SET_G5X_OFFSET, 1, 0, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &g5x, 2, &s, &d), 0);
+    struct ncp_canon mm = u;
+    mm.i[0] = 1;
+    assert_int_equal(ncp_canon_map_op(&m, &mm, 3, &s, &d), 0);
+    struct ncp_canon g92 = op6(NCP_C_SET_G92_OFFSET, 0, 2, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &g92, 4, &s, &d), 0);
+    struct ncp_canon tlo = op6(NCP_C_USE_TOOL_LENGTH_OFFSET, 0, 0, 3);
+    assert_int_equal(ncp_canon_map_op(&m, &tlo, 5, &s, &d), 0);
+    struct ncp_canon tr = op6(NCP_C_STRAIGHT_TRAVERSE, 10, 10, 10);
+    assert_int_equal(ncp_canon_map_op(&m, &tr, 6, &s, &d), 1);
+    /* G5X offset given in inches stays 25.4 mm after the switch to mm */
+    assert_true(fabs(s.end[0] - 35.4) < 1e-12);
+    assert_true(fabs(s.end[1] - 12.0) < 1e-12);
+    assert_true(fabs(s.end[2] - 13.0) < 1e-12);
+    assert_int_equal(s.line, 6);
+}
+
+static void test_soft_limit(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon_map m;
+    ncp_canon_map_init(&m, &c, NULL, 1.0);
+    struct ncp_seg s;
+    struct ncp_diag d;
+    struct ncp_canon f = op_feed(100);
+    ncp_canon_map_op(&m, &f, 1, &s, &d);
+    struct ncp_canon z = op6(NCP_C_STRAIGHT_FEED, 0, 0, 60);
+    assert_int_equal(ncp_canon_map_op(&m, &z, 7, &s, &d), -NCP_ERR_LIMIT);
+    assert_int_equal(d.line, 7);
+    assert_non_null(strstr(d.msg, "Z"));
+    /* an arc whose end is inside but whose bulge leaves the travel */
+    struct ncp_canon l = op6(NCP_C_STRAIGHT_FEED, 480, 0, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &l, 8, &s, &d), 1);
+    struct ncp_canon a = op_arc(480, 10, 480, 5, 1, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &a, 9, &s, &d), 1);
+    /* from (480,10): clockwise r 20 about (480,-10) bulges to x = 500 exactly */
+    struct ncp_canon b = op_arc(480, -30, 480, -10, -1, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &b, 10, &s, &d), 1);
+    /* counter-clockwise r 25 bulges to x = 455 */
+    struct ncp_canon e = op_arc(480, -80, 480, -55, 1, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &e, 11, &s, &d), 1);
+    /* clockwise r 25 bulges to x = 505: beyond +500 */
+    struct ncp_canon h = op_arc(480, -130, 480, -105, -1, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &h, 13, &s, &d), -NCP_ERR_LIMIT);
+    assert_int_equal(d.line, 13);
+}
+
+/* ---- amortised cost --------------------------------------------------------- */
+
+static void test_replan_cost_bounded(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    double zero[NCP_AXES] = { 0 };
+    struct ncp_planner *p = ncp_planner_new(&c, zero);
+    struct ncp_seg s;
+    memset(&s, 0, sizeof s);
+    s.kind = NCP_SEG_LINE;
+    s.term = NCP_TERM_CONTINUOUS;
+    s.feed = 100;
+    s.length = 0.05;
+    struct ncp_setpoint sp;
+    size_t pushed = 0;
+    for (int i = 0; i < 20000; i++) {
+        s.start[0] = 0.05 * i;
+        s.end[0] = 0.05 * (i + 1);
+        if (ncp_planner_full(p))
+            ncp_planner_step(p, &sp);
+        if (!ncp_planner_full(p)) {
+            ncp_planner_push(p, &s);
+            pushed++;
+        }
+    }
+    struct ncp_planner_stats st;
+    ncp_planner_get_stats(p, &st);
+    /* stopping distance v^2/2a = 2.5 mm = 50 segments: the pass is bounded by it,
+     * not by the window (200) or the program length */
+    assert_true(st.replans <= pushed * 60);
+    ncp_planner_free(p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_config_shipped),
+        cmocka_unit_test(test_config_errors),
+        cmocka_unit_test(test_trap_long_line_time),
+        cmocka_unit_test(test_trap_short_triangle),
+        cmocka_unit_test(test_g61_exact_stop_ends),
+        cmocka_unit_test(test_g64_corners_within_limits),
+        cmocka_unit_test(test_g64_p_tolerance),
+        cmocka_unit_test(test_arc_radius_and_helix),
+        cmocka_unit_test(test_arc_centripetal_cap),
+        cmocka_unit_test(test_canon_units_offsets),
+        cmocka_unit_test(test_soft_limit),
+        cmocka_unit_test(test_replan_cost_bounded),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
