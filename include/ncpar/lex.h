@@ -90,7 +90,8 @@ struct ncp_oword {
 
 enum ncp_comment_kind {
     NCP_CMT_NONE = 0, NCP_CMT_PLAIN, NCP_CMT_MSG, NCP_CMT_DEBUG, NCP_CMT_PRINT,
-    NCP_CMT_LOGOPEN, NCP_CMT_LOGAPPEND, NCP_CMT_LOGCLOSE, NCP_CMT_LOG
+    NCP_CMT_LOGOPEN, NCP_CMT_LOGAPPEND, NCP_CMT_LOGCLOSE, NCP_CMT_LOG,
+    NCP_CMT_ABORT             /* (ABORT,text): rs274 stops with text as the error */
 };
 
 struct ncp_block {

@@ -1,0 +1,61 @@
+/* Lexer internals: the state of one ncp_lex_block() call and the readers
+ * that share it. Module-private. */
+#ifndef NCP_LEX_INTERNAL_H
+#define NCP_LEX_INTERNAL_H
+
+#include <stdint.h>
+#include "ncpar/lex.h"
+
+/* rs274 reads lines with fgets(buf, 255): a line of 253 characters or more
+ * (254 with its newline) is "Command too long". */
+#define NCP_LEX_TOO_LONG 253
+#define NCP_LEX_PAD 8
+/* Nesting bound for values inside values, so a lexer thread's stack use is
+ * bounded (about 20 KB); rs274 has none, real programs nest a few levels. */
+#define NCP_LEX_MAX_DEPTH 40
+
+/* The line as rs274's reader sees it: blanks removed and letters lower-cased
+ * outside comments, NUL-terminated, with the source column of every byte. */
+struct ncp_lexer {
+    struct ncp_block *b;
+    int pos;               /* read position in buf */
+    int n;                 /* length of buf */
+    int depth;             /* nesting of values being read */
+    int cmt_pos, cmt_len;  /* last (...) comment seen, inside buf; cmt_pos < 0: none */
+    char buf[NCP_LEX_TOO_LONG + NCP_LEX_PAD];
+    uint8_t col[NCP_LEX_TOO_LONG + NCP_LEX_PAD]; /* 1-based source column */
+};
+
+/* A value being compiled: a constant, or code[start .. b->n_code). */
+struct ncp_lex_val {
+    double k;
+    uint16_t start;
+    uint8_t is_const;
+};
+
+/* Stores a syntax error at buf position pos; returns NCP_ERR_SYNTAX. */
+int ncp_lex_fail(struct ncp_lexer *lx, int pos, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* lex_text.c: close_and_downcase + line checks */
+int ncp_lex_squeeze(struct ncp_lexer *lx, const char *text, size_t len);
+
+/* lex_number.c: decimal literal at lx->pos (rs274 read_real_number) */
+int ncp_lex_number(struct ncp_lexer *lx, double *out);
+
+/* lex_expr.c */
+int ncp_lex_real_value(struct ncp_lexer *lx, struct ncp_lex_val *v);
+int ncp_lex_expression(struct ncp_lexer *lx, struct ncp_lex_val *v);
+int ncp_lex_integer_value(struct ncp_lexer *lx, struct ncp_lex_val *v);
+int ncp_lex_read_name(struct ncp_lexer *lx, uint16_t *off, uint16_t *len);
+void ncp_lex_to_expr(const struct ncp_lexer *lx, const struct ncp_lex_val *v,
+                     struct ncp_expr *e);
+
+/* lex_comment.c */
+int ncp_lex_comment(struct ncp_lexer *lx);
+void ncp_lex_store_comment(struct ncp_lexer *lx);
+
+/* lex_oword.c */
+int ncp_lex_oword(struct ncp_lexer *lx);
+
+#endif

@@ -1,0 +1,761 @@
+/* Lexer: rs274's reading rules (squeezing, numbers, words, comments, O-words,
+ * parameter settings), expression compilation and constant folding, run-time
+ * evaluation, and every error path. Expected messages and values were checked
+ * against LinuxCNC's rs274 (2.9) on the same lines. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ncpar/lex.h"
+
+static struct ncp_block blk;
+
+static int lex(const char *s)
+{
+    return ncp_lex_block(s, strlen(s), 42, 100, &blk);
+}
+
+/* ---- parameters seen by the evaluator: #n = n/2, #<x> = 1.5, #<zero> = 0 */
+
+static int get_num(void *ctx, int index, double *out, struct ncp_diag *d)
+{
+    (void)ctx;
+    (void)d;
+    *out = index / 2.0;
+    return 0;
+}
+
+static int get_named(void *ctx, const char *name, size_t len, double *out,
+                     struct ncp_diag *d)
+{
+    (void)ctx;
+    if (len == 1 && name[0] == 'x') {
+        *out = 1.5;
+        return 0;
+    }
+    if (len == 4 && memcmp(name, "zero", 4) == 0) {
+        *out = 0.0;
+        return 0;
+    }
+    return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0, "Named parameter #<%.*s> not defined",
+                        (int)len, name);
+}
+
+static int exists_named(void *ctx, const char *name, size_t len)
+{
+    (void)ctx;
+    return len == 1 && name[0] == 'x';
+}
+
+static const struct ncp_param_ops ops = { 0, get_num, get_named, exists_named };
+
+static double eval_ok(const struct ncp_expr *e)
+{
+    struct ncp_diag d;
+    double v = -12345.0;
+    int rc = ncp_expr_eval(&blk, e, &ops, &v, &d);
+    if (rc)
+        fail_msg("eval failed: %s", d.msg);
+    return v;
+}
+
+/* value of the single word of `line` */
+static double word_value(const char *line)
+{
+    if (lex(line) != NCP_OK)
+        fail_msg("'%s': %s", line, blk.err.msg);
+    assert_int_equal(blk.n_words, 1);
+    return eval_ok(&blk.words[0].v);
+}
+
+static void expect_word(const char *line, double v)
+{
+    double got = word_value(line);
+    if (!(got == v || (isnan(v) && isnan(got))))
+        fail_msg("'%s': got %.17g, want %.17g", line, got, v);
+}
+
+static void expect_error(const char *line, const char *msg, int col)
+{
+    int rc = lex(line);
+    if (rc == NCP_OK)
+        fail_msg("'%s': no error, want '%s'", line, msg);
+    assert_int_equal(rc, NCP_ERR_SYNTAX);
+    assert_int_equal(blk.err.code, NCP_ERR_SYNTAX);
+    assert_int_equal(blk.err.line, 42);
+    if (strcmp(blk.err.msg, msg) != 0)
+        fail_msg("'%s': got '%s', want '%s'", line, blk.err.msg, msg);
+    if (col >= 0 && blk.err.col != col)
+        fail_msg("'%s': col %d, want %d", line, blk.err.col, col);
+}
+
+static void expect_eval_error(const char *line, const char *msg, int col)
+{
+    struct ncp_diag d;
+    double v;
+    if (lex(line) != NCP_OK)
+        fail_msg("'%s': %s", line, blk.err.msg);
+    assert_int_equal(blk.n_words, 2);
+    assert_false(blk.words[1].v.is_const);
+    assert_int_not_equal(ncp_expr_eval(&blk, &blk.words[1].v, &ops, &v, &d), NCP_OK);
+    assert_int_equal(d.line, 42);
+    if (strcmp(d.msg, msg) != 0)
+        fail_msg("'%s': got '%s', want '%s'", line, d.msg, msg);
+    if (col >= 0 && d.col != col)
+        fail_msg("'%s': col %d, want %d", line, d.col, col);
+}
+
+/* ---------------------------------------------------------------- numbers */
+
+static void test_numbers(void **state)
+{
+    static const char *const nums[] = {
+        "1", "1.", ".5", "+1", "-.5", "-0", "00.5", "12.345", "-6.789", "0.1",
+        "123456789012345", "0.000000000000000000001", "3.14159265358979323846",
+        "99999999999999999999999", "1234567890.0987654321", "0.30000000000000004",
+        "9007199254740993", "4.35", "1.0000000000000002",
+    };
+    size_t i;
+    char line[80];
+    (void)state;
+    for (i = 0; i < sizeof nums / sizeof nums[0]; i++) {
+        snprintf(line, sizeof line, "X%s", nums[i]);
+        expect_word(line, strtod(nums[i], 0));
+    }
+    assert_true(signbit(word_value("X-0")));
+    expect_word("X+-1", -1.0);
+    expect_word("X--1", 1.0);
+    expect_word("X-+1", -1.0);
+    expect_word("X - - 1", 1.0);
+    expect_word("X 1 . 5", 1.5);
+    expect_word("x1 2", 12.0);
+    assert_true(blk.words[0].v.is_const);
+}
+
+static void test_number_errors(void **state)
+{
+    (void)state;
+    expect_error("G1 X. F1", "bad number format (conversion failed) parsing '.'", 5);
+    expect_error("G1 X1.2.3", "bad number format (trailing characters) parsing '1.2.3'", 5);
+    expect_error("G1 X..", "bad number format (conversion failed) parsing '..'", 5);
+    expect_error("G1 X.1.", "bad number format (trailing characters) parsing '.1.'", 5);
+    expect_error("G1 X+.", "bad number format (conversion failed) parsing '+.'", 5);
+    expect_error("G1 F1 X-", "bad number format (conversion failed) parsing '-'", 8);
+    expect_error("G1 X] F1", "bad number format (conversion failed) parsing ''", 5);
+    expect_error("G1 X; F1", "bad number format (conversion failed) parsing ''", 5);
+    expect_error("G1 F1 X", "No characters found in reading real value", 8);
+    expect_error("G1 X- F1", "Unknown word starting with f", 7);
+    expect_error("G1 X1- F1", "Bad character '-' used", 6);
+}
+
+/* ------------------------------------------------------------- words, N, / */
+
+static void test_words(void **state)
+{
+    (void)state;
+    assert_int_equal(lex("G1 X12.345 Y-6.789 Z0.5 F1200"), NCP_OK);
+    assert_int_equal(blk.n_words, 5);
+    assert_int_equal(blk.words[0].letter, 'G');
+    assert_int_equal(blk.words[1].letter, 'X');
+    assert_int_equal(blk.words[1].col, 4);
+    assert_int_equal(blk.words[4].letter, 'F');
+    assert_true(blk.words[2].v.is_const);
+    assert_true(blk.words[2].v.value == -6.789);
+    assert_int_equal(blk.n_code, 0);
+    assert_int_equal(blk.line, 42);
+    assert_int_equal(blk.offset, 100);
+    assert_int_equal(blk.length, 29);
+    assert_int_equal(blk.err.code, NCP_OK);
+
+    assert_int_equal(lex("g 0 1\tx 1"), NCP_OK);
+    assert_int_equal(blk.words[0].letter, 'G');
+    assert_true(blk.words[0].v.value == 1.0);
+    assert_int_equal(blk.words[1].col, 7);
+
+    /* G and M may repeat (the analyzer checks modal groups) */
+    assert_int_equal(lex("G1 G90 M3 M8 S100"), NCP_OK);
+    assert_int_equal(blk.n_words, 5);
+    /* $ @ ^ are rs274 words too */
+    assert_int_equal(lex("M3 $1 S100 @1 ^2"), NCP_OK);
+    assert_int_equal(blk.words[1].letter, '$');
+    assert_int_equal(blk.words[3].letter, '@');
+    /* empty and blank lines */
+    assert_int_equal(lex(""), NCP_OK);
+    assert_int_equal(blk.n_words, 0);
+    assert_int_equal(lex("  \t \r"), NCP_OK);
+    assert_int_equal(blk.n_words, 0);
+    assert_int_equal(lex("G1 X1\r"), NCP_OK);
+    assert_int_equal(blk.n_words, 2);
+}
+
+static void test_line_number_and_delete(void **state)
+{
+    (void)state;
+    assert_int_equal(lex("/N10.5 G1 X1"), NCP_OK);
+    assert_true(blk.block_delete);
+    assert_true(blk.has_n);
+    assert_true(blk.n_number == 10.0);
+    assert_int_equal(blk.n_words, 2);
+    assert_int_equal(lex(" / g1"), NCP_OK);
+    assert_true(blk.block_delete);
+    assert_false(blk.has_n);
+    assert_int_equal(lex("N 1 0 G1"), NCP_OK);
+    assert_true(blk.n_number == 10.0);
+    expect_error("G1 N10 X1", "Bad character 'n' used", 4);
+    expect_error("N-1 G1", "Bad format unsigned integer", 2);
+    expect_error("N10.X", "Bad format unsigned integer", 5);
+    expect_error("N10 /G1", "Bad character '/' used", 5);
+    expect_error("//G1", "Bad character '/' used", 2);
+    expect_error("G1 X1 O", "Bad character 'o' used", 7);
+}
+
+static void test_duplicates(void **state)
+{
+    (void)state;
+    expect_error("G1 X1 Y2 X3", "Multiple x words on one line", 10);
+    expect_error("G1 F1 S1 S2", "Multiple s words on one line", 10);
+    expect_error("M3 $1 $2", "Multiple spindle choice ($) words on one line", 7);
+    expect_error("G4 P1 P2", "Multiple p words on one line", 7);
+    expect_error("G1 U1 U2", "Multiple U words on one line", 7);
+    assert_int_equal(lex("G1 @1 @2"), NCP_OK);
+}
+
+static void test_bad_characters(void **state)
+{
+    (void)state;
+    expect_error("G1 X1 &", "Bad character '&' used", 7);
+    expect_error("G1 X1 {", "Bad character '\\173' used", 7);
+    expect_error("G1 X1 \x01", "Bad character '\\001' used", 7);
+    expect_error("G1 X1 \xe9", "Bad character '\\351' used", 7);
+    expect_error("G1 X1 )", "Bad character ')' used", 7);
+    expect_error("G1 X1 %", "Bad character '%' used", 7);
+    expect_error("G1 X1]", "Bad character ']' used", 6);
+    expect_error("G1 X1 \x0b Y1", "Bad character '\\013' used", 7);
+}
+
+/* --------------------------------------------------------------- comments */
+
+static const char *comment(void)
+{
+    return blk.pool + blk.comment_off;
+}
+
+static void test_comments(void **state)
+{
+    (void)state;
+    assert_int_equal(lex("G1 X1 (first) Y2 (second)"), NCP_OK);
+    assert_int_equal(blk.n_words, 3);
+    assert_int_equal(blk.comment_kind, NCP_CMT_PLAIN);
+    assert_string_equal(comment(), "second");
+    assert_int_equal(lex("(MSG, hi)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_MSG);
+    assert_string_equal(comment(), " hi");
+    assert_int_equal(lex("( msg,Hi There )"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_MSG);
+    assert_string_equal(comment(), "Hi There ");
+    assert_int_equal(lex("(MSG hi)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_PLAIN);
+    assert_string_equal(comment(), "MSG hi");
+    assert_int_equal(lex("(MSG,b)(a)"), NCP_OK);
+    assert_string_equal(comment(), "a");
+    assert_int_equal(lex("(Debug,x=#1)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_DEBUG);
+    assert_string_equal(comment(), "x=#1");
+    assert_int_equal(lex("(PRINT,p)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_PRINT);
+    assert_int_equal(lex("(LOG,l)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_LOG);
+    assert_int_equal(lex("(LOGOPEN,f.txt)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_LOGOPEN);
+    assert_string_equal(comment(), "f.txt");
+    assert_int_equal(lex("(logappend,f.txt)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_LOGAPPEND);
+    assert_int_equal(lex("( LOGCLOSE)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_LOGCLOSE);
+    assert_int_equal(lex("(logclose )"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_PLAIN);
+    assert_int_equal(lex("(ABORT,stop here)"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_ABORT);
+    assert_string_equal(comment(), "stop here");
+    assert_int_equal(lex("(a)()"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_NONE);
+    assert_int_equal(lex("(   )"), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_PLAIN);
+    assert_string_equal(comment(), "");
+    assert_int_equal(lex("(MSG,a;b) ; (MSG,c"), NCP_OK);
+    assert_string_equal(comment(), "a;b");
+    assert_int_equal(lex("G1 X1 ; (MSG,x) G2 %%"), NCP_OK);
+    assert_int_equal(blk.n_words, 2);
+    assert_int_equal(blk.comment_kind, NCP_CMT_NONE);
+    /* blanks inside comments are kept */
+    assert_int_equal(lex("G1 (MSG, A  B)"), NCP_OK);
+    assert_string_equal(comment(), " A  B");
+    expect_error("(a(b))", "Nested comment found", 3);
+    expect_error("G1 (abc", "Unclosed comment found", 4);
+    expect_error("G1 X1 (MSG,a)(", "Unclosed comment found", 14);
+    expect_error("G1 X(a)1", "bad number format (conversion failed) parsing ''", 5);
+}
+
+/* ------------------------------------------------------------ expressions */
+
+static void test_operators(void **state)
+{
+    (void)state;
+    expect_word("X[1+2*3]", 7.0);
+    expect_word("X[2 - 3 - 4]", -5.0);
+    expect_word("X[2**3**2]", 64.0);
+    expect_word("X[8/2/2]", 2.0);
+    expect_word("X[2*3**2]", 18.0);
+    expect_word("X[-7 mod 3]", 2.0);
+    expect_word("X[7 mod -3]", 1.0);
+    expect_word("X[-7 mod -3]", 2.0);
+    expect_word("X[7.5 mod 2]", 1.5);
+    expect_word("X[-2**2]", 4.0);
+    expect_word("X[1 eq 1.00009]", 1.0);
+    expect_word("X[1 eq 1.0002]", 0.0);
+    expect_word("X[1 ne 1.00009]", 0.0);
+    expect_word("X[1 ne 2]", 1.0);
+    expect_word("X[1 gt 0.99999]", 1.0);
+    expect_word("X[1 ge 1.00001]", 0.0);
+    expect_word("X[1 lt 1.00001]", 1.0);
+    expect_word("X[1 le 0.99999]", 0.0);
+    expect_word("X[2 ge 2]", 1.0);
+    expect_word("X[2 le 2]", 1.0);
+    expect_word("X[1 and 0]", 0.0);
+    expect_word("X[1 and 2]", 1.0);
+    expect_word("X[0 or 0]", 0.0);
+    expect_word("X[0 or 3]", 1.0);
+    expect_word("X[1 xor 1]", 0.0);
+    expect_word("X[1 xor 0]", 1.0);
+    /* precedence: ** > * / mod > + - > relational > logical */
+    expect_word("X[1 + 1 gt 1]", 1.0);
+    expect_word("X[1 gt 0 and 0 lt 1]", 1.0);
+    expect_word("X[1 lt 2 eq 1]", 1.0);
+    expect_word("X[0 le 1 eq 0]", 0.0);
+    expect_word("X[1 eq 2 + 3]", 0.0);
+    expect_word("X[2 lt 3 gt 0 + 1]", 0.0);
+    expect_word("X[1 or 0 and 0]", 0.0);
+    expect_word("X[9+8*7/6+5-4*3**2+1]", 9.0 + 8.0 * 7.0 / 6.0 + 5.0 - 36.0 + 1.0);
+    expect_word("X[1 * * 2]", 1.0);
+    expect_word("X[1 2]", 12.0);
+    expect_word("X-[2]", -2.0);
+    expect_word("X+[2]", 2.0);
+    expect_word("X[1+-2]", -1.0);
+    expect_word("X[1--2]", 3.0);
+    expect_word("X[[[[1]]]]", 1.0);
+    /* an overflowing intermediate is fine until a "real value" ends */
+    expect_word("X[1/10**400]", 0.0);
+    expect_word("X[10**400 gt 0]", 1.0);
+}
+
+static void test_functions(void **state)
+{
+    (void)state;
+    expect_word("X[abs[-2]]", 2.0);
+    assert_true(signbit(word_value("X[abs[-0]]")));
+    expect_word("X[sqrt[16]]", 4.0);
+    expect_word("X[fix[-1.5]]", -2.0);
+    expect_word("X[fup[-1.5]]", -1.0);
+    expect_word("X[round[2.5]]", 3.0);
+    expect_word("X[round[-2.5]]", -3.0);
+    expect_word("X[round[3000000000]]", -2147483648.0);
+    expect_word("X[exp[0]]", 1.0);
+    expect_word("X[ln[1]]", 0.0);
+    expect_word("Xatan[1]/[1]", 45.0);
+    expect_word("X[atan[0]/[-1]]", 180.0);
+    expect_word("X[acos[1]]", 0.0);
+    expect_word("X[asin[1]]", 90.0);
+    expect_word("X[exists[#5]]", 1.0);
+    expect_word("X[exists[#0]]", 0.0);
+    expect_word("X[exists[#<x>]]", 1.0);
+    expect_word("X[exists[#<y>]]", 0.0);
+    assert_true(fabs(word_value("X[sin[30]]") - 0.5) < 1e-15);
+    assert_true(fabs(word_value("X[cos[60]]") - 0.5) < 1e-15);
+    assert_true(fabs(word_value("X[tan[45]]") - 1.0) < 1e-15);
+    assert_true(fabs(word_value("X[cos[sin[10]]]") - cos(sin(M_PI / 18) * M_PI / 180)) < 1e-15);
+}
+
+/* A folded constant and the same expression computed by the bytecode at
+ * run time must agree to the bit. #2 evaluates to 1.0 here. */
+static void test_fold_matches_eval(void **state)
+{
+    static const char *const exprs[] = {
+        "sin[%s*33.3]", "cos[%s*71.9]", "tan[%s*12.1]", "acos[%s*0.3]", "asin[%s*-0.7]",
+        "atan[%s*3]/[7]", "exp[%s*1.7]", "ln[%s*7.7]", "sqrt[%s*2]", "[%s*0.1+0.2]",
+        "[%s*10 mod 3.3]", "[%s*2**0.5]", "round[%s*-7.5]", "fix[%s*1.25]", "fup[%s*1.25]",
+        "[%s/3]", "[%s*1.1 - 1.1]", "[%s*5 eq 5.00001]", "abs[%s*-3.3]",
+    };
+    size_t i;
+    char line[120], expr[100];
+    (void)state;
+    for (i = 0; i < sizeof exprs / sizeof exprs[0]; i++) {
+        double folded, run;
+        snprintf(expr, sizeof expr, exprs[i], "1");
+        snprintf(line, sizeof line, "X%s", expr);
+        folded = word_value(line);
+        assert_true(blk.words[0].v.is_const);
+        snprintf(expr, sizeof expr, exprs[i], "#2");
+        snprintf(line, sizeof line, "X%s", expr);
+        run = word_value(line);
+        assert_false(blk.words[0].v.is_const);
+        if (memcmp(&folded, &run, sizeof run) != 0)
+            fail_msg("%s: folded %.17g, run %.17g", exprs[i], folded, run);
+    }
+}
+
+static void test_expression_errors(void **state)
+{
+    (void)state;
+    expect_error("G1 X[1", "Unclosed expression", 5);
+    expect_error("G1 X[[1]", "Unclosed expression", 5);
+    expect_error("G1 X[1+", "No characters found in reading real value", 8);
+    expect_error("G1 X[1+]", "bad number format (conversion failed) parsing ''", 8);
+    expect_error("G1 X[]", "bad number format (conversion failed) parsing ''", 6);
+    expect_error("G1 X[1 foo 2]", "Unknown operation", 8);
+    expect_error("G1 X[1(a)+2]", "Unknown operation", 7);
+    expect_error("G1 X[1 a 2]", "Unknown operation name starting with a", 8);
+    expect_error("G1 X[1 m 2]", "Unknown operation name starting with m", 8);
+    expect_error("G1 X[1 o 2]", "Unknown operation name starting with o", 8);
+    expect_error("G1 X[1 x 2]", "Unknown operation name starting with x", 8);
+    expect_error("G1 X[1 e 2]", "Unknown operation name starting with e", 8);
+    expect_error("G1 X[1 n 2]", "Unknown operation name starting with n", 8);
+    expect_error("G1 X[1 g 2]", "Unknown operation name starting with g", 8);
+    expect_error("G1 X[1 l 2]", "Unknown operation name starting with l", 8);
+    expect_error("G1 X[foo[1]]", "Unknown word starting with f", 6);
+    expect_error("G1 X[abc[1]]", "Unknown word starting with a", 6);
+    expect_error("G1 X[ex[1]]", "Unknown word starting with e", 6);
+    expect_error("G1 X[cz[1]]", "Unknown word starting with c", 6);
+    expect_error("G1 X[lx[1]]", "Unknown word starting with l", 6);
+    expect_error("G1 X[rx[1]]", "Unknown word starting with r", 6);
+    expect_error("G1 X[sx[1]]", "Unknown word starting with s", 6);
+    expect_error("G1 X[tx[1]]", "Unknown word starting with t", 6);
+    expect_error("G1 X[zz[1]]", "Unknown word where unary operation could be", 6);
+    expect_error("G1 X[cosx[1]]", "Left bracket missing after unary operation name", 9);
+    expect_error("G1 X[sin 1]", "Left bracket missing after unary operation name", 10);
+    expect_error("G1 X[atan[1]]", "Slash missing after first atan argument", 13);
+    expect_error("G1 X[atan[1]/1]", "Left bracket missing after slash with atan", 14);
+    expect_error("G1 X-[2]**2", "Bad character '*' used", 9);
+    expect_error("G1 X[1/0]", "Attempt to divide by zero", 7);
+    expect_error("G1 X[1 mod 0]", "Calculation resulted in 'not a number'", 5);
+    expect_error("G1 X[1/[10**400]]", "Calculation resulted in 'infinity'", 8);
+    expect_error("G1 X[[10**400] gt 0]", "Calculation resulted in 'infinity'", 6);
+    expect_error("G1 X[exp[1000]]", "Calculation resulted in 'infinity'", 6);
+    expect_error("G1 X[-2**0.5]", "Attempt to raise negative to non integer power", 8);
+    expect_error("G1 X[sqrt[-1]]", "Negative argument to sqrt", 6);
+    expect_error("G1 X[ln[0]]", "Zero or negative argument to ln", 6);
+    expect_error("G1 X[acos[2]]", "Argument to acos out of range", 6);
+    expect_error("G1 X[asin[-2]]", "Argument to asin out of range", 6);
+    expect_error("G1 X[round[1e10]]", "Unknown operation name starting with e", 13);
+    expect_error("G1 X[exists[5]]", "Expected # reading parameter", 13);
+    expect_error("G1 X[exists[#<x>+1]]", "Expected ] reading bracketed parameter", 17);
+}
+
+/* ------------------------------------------------------------- parameters */
+
+static void test_parameters(void **state)
+{
+    (void)state;
+    expect_word("X#3", 1.5);
+    expect_word("X-#3", -1.5);
+    expect_word("X##4", 1.0);
+    expect_word("X#[1+3]", 2.0);
+    expect_word("X#5.00001", 2.5);
+    expect_word("X#4.99999", 2.5);
+    expect_word("X#<x>", 1.5);
+    expect_word("X#< X >", 1.5);
+    expect_word("X[#<x> * 2 + #2]", 4.0);
+    expect_word("X[1 + #<x>]", 2.5);
+    expect_word("X[#<x> + 1]", 2.5);
+    expect_word("X[2 ** #2 ** 3]", 8.0);
+    expect_word("Xsin[#<zero>]", 0.0);
+    expect_word("Xatan[#<zero>]/[#2]", 0.0);
+    expect_word("X[exists[#<x>] + exists[#<nope>]]", 1.0);
+    assert_false(blk.words[0].v.is_const);
+    expect_error("G1 X#1.5", "Non integer value for integer", 6);
+    expect_error("G1 X#-1", "Parameter number out of range", 5);
+    expect_error("G1 X#0", "Parameter number out of range", 5);
+    expect_error("G1 X#5602", "Parameter number out of range", 5);
+    expect_error("G1 X#<abc", "Named parameter not terminated", 6);
+    expect_error("G1 X## F1", "Unknown word starting with f", 8);
+    expect_error("G1 X#(a)1", "bad number format (conversion failed) parsing ''", 6);
+}
+
+static void test_eval_errors(void **state)
+{
+    (void)state;
+    expect_eval_error("G1 X[#2/0]", "Attempt to divide by zero", 8);
+    expect_eval_error("G1 X[#<zero>/#<zero>]", "Attempt to divide by zero", 13);
+    expect_eval_error("G1 X[sqrt[-#2]]", "Negative argument to sqrt", 6);
+    expect_eval_error("G1 X[ln[#<zero>]]", "Zero or negative argument to ln", 6);
+    expect_eval_error("G1 X[acos[#4]]", "Argument to acos out of range", 6);
+    expect_eval_error("G1 X[asin[#4]]", "Argument to asin out of range", 6);
+    expect_eval_error("G1 X[-#2**0.5]", "Attempt to raise negative to non integer power", 9);
+    expect_eval_error("G1 X[#2 mod 0]", "Calculation resulted in 'not a number'", 9);
+    expect_eval_error("G1 X[#2 * 10**400]", "Calculation resulted in 'infinity'", 9);
+    expect_eval_error("G1 X#[#2/3]", "Non integer value for integer", 5);
+    expect_eval_error("G1 X#[#2*0]", "Parameter number out of range", 5);
+    expect_eval_error("G1 X#[#2*-7]", "Parameter number out of range", 5);
+    expect_eval_error("G1 X[1+#<y>]", "Named parameter #<y> not defined", 8);
+}
+
+static void test_assignments(void **state)
+{
+    (void)state;
+    assert_int_equal(lex("#1=5 #<A b>=[#1+1] #[1+#2]=3 #<_g>=#<x>"), NCP_OK);
+    assert_int_equal(blk.n_assign, 4);
+    assert_int_equal(blk.n_words, 0);
+    assert_int_equal(blk.assign[0].kind, NCP_ASSIGN_NUMBERED);
+    assert_true(blk.assign[0].index.is_const);
+    assert_true(blk.assign[0].index.value == 1.0);
+    assert_true(eval_ok(&blk.assign[0].value) == 5.0);
+    assert_int_equal(blk.assign[0].col, 1);
+    assert_int_equal(blk.assign[1].kind, NCP_ASSIGN_NAMED);
+    assert_int_equal(blk.assign[1].name_len, 2);
+    assert_string_equal(blk.pool + blk.assign[1].name_off, "ab");
+    assert_true(eval_ok(&blk.assign[1].value) == 1.5);
+    assert_false(blk.assign[2].index.is_const);
+    assert_true(eval_ok(&blk.assign[2].index) == 2.0);
+    assert_string_equal(blk.pool + blk.assign[3].name_off, "_g");
+    assert_true(eval_ok(&blk.assign[3].value) == 1.5);
+    assert_int_equal(lex("#1.00001=2 G1 X#1"), NCP_OK);
+    assert_true(blk.assign[0].index.value == 1.0);
+    assert_int_equal(lex("#<>=1"), NCP_OK);
+    assert_int_equal(blk.assign[0].name_len, 0);
+    expect_error("#1 5", "Equal sign missing in parameter setting", 5);
+    expect_error("#<x>5", "Equal sign missing in parameter setting", 5);
+    expect_error("G1 X#1#2", "Equal sign missing in parameter setting", 9);
+    expect_error("#0=1", "Parameter number out of range", 1);
+    expect_error("#1.5=1", "Non integer value for integer", 2);
+    expect_error("#1=", "No characters found in reading real value", 4);
+    expect_error("#1=[2", "Unclosed expression", 4);
+    expect_error("G1 X[#1=2]", "Unknown operation", 8);
+}
+
+/* ---------------------------------------------------------------- O-words */
+
+static const char *oname(void)
+{
+    return blk.pool + blk.oword.name_off;
+}
+
+static void test_owords(void **state)
+{
+    (void)state;
+    assert_int_equal(lex("o0100 sub"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_SUB);
+    assert_string_equal(oname(), "100");
+    assert_int_equal(blk.oword.col, 1);
+    assert_int_equal(lex("O<Foo Bar> CALL [1] (x) [2+#3]"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_CALL);
+    assert_string_equal(oname(), "foobar");
+    assert_int_equal(blk.oword.nargs, 2);
+    assert_true(eval_ok(&blk.oword.args[0]) == 1.0);
+    assert_true(eval_ok(&blk.oword.args[1]) == 3.5);
+    assert_int_equal(blk.comment_kind, NCP_CMT_NONE);
+    assert_int_equal(lex("N5 o100 if [#2 gt 0] (MSG,not shown)"), NCP_OK);
+    assert_true(blk.has_n);
+    assert_int_equal(blk.oword.kind, NCP_O_IF);
+    assert_true(blk.oword.has_cond);
+    assert_true(eval_ok(&blk.oword.cond) == 1.0);
+    assert_int_equal(blk.comment_kind, NCP_CMT_NONE);
+    assert_int_equal(lex("o100elseif[1]"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_ELSEIF);
+    assert_int_equal(lex("o100 else"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_ELSE);
+    assert_int_equal(lex("o100 endif ; done"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_ENDIF);
+    assert_int_equal(lex("o[50*2] while [#1 lt 3]"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_WHILE);
+    assert_string_equal(oname(), "100");
+    assert_int_equal(lex("o100 endwhile"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_ENDWHILE);
+    assert_int_equal(lex("o100 do"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_DO);
+    assert_int_equal(lex("o-5 repeat [3]"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_REPEAT);
+    assert_string_equal(oname(), "-5");
+    assert_true(blk.oword.cond.is_const && blk.oword.cond.value == 3.0);
+    assert_int_equal(lex("o100 endrepeat"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_ENDREPEAT);
+    assert_int_equal(lex("o100 break"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_BREAK);
+    assert_int_equal(lex("o100 continue"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_CONTINUE);
+    assert_int_equal(lex("o100 return [#2*3]"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_RETURN);
+    assert_true(blk.oword.has_cond && eval_ok(&blk.oword.cond) == 3.0);
+    assert_int_equal(lex("o100 return"), NCP_OK);
+    assert_false(blk.oword.has_cond);
+    assert_int_equal(lex("o100 endsub [2]"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_ENDSUB);
+    assert_true(blk.oword.has_cond);
+    assert_int_equal(lex("o100 call"), NCP_OK);
+    assert_int_equal(blk.oword.nargs, 0);
+    /* O-line conditions are not "real values": no finite check (as rs274) */
+    assert_int_equal(lex("o1 if [10**400]"), NCP_OK);
+}
+
+static void test_oword_errors(void **state)
+{
+    char line[200];
+    int i, n = 0;
+    (void)state;
+    expect_error("o100 foo", "Unknown control command in o word", 6);
+    expect_error("o100 if 1", "Left bracket missing after 'if'", 9);
+    expect_error("o100 elseif 1", "Left bracket missing after 'elseif'", 13);
+    expect_error("o100 while 1", "Left bracket missing after 'while'", 12);
+    expect_error("o100 repeat 1", "Left bracket missing after 'repeat'", 13);
+    expect_error("o100 if (a) [1]", "Left bracket missing after 'if'", 9);
+    expect_error("o1.5 if [1]", "Non integer value for integer", 2);
+    expect_error("o100 if [1] [2]", "Unexpected character after O-word", 13);
+    expect_error("o100 if [1] G1", "Unexpected character after O-word", 13);
+    expect_error("o100 (a) if [1]", "Unexpected character after O-word", 10);
+    expect_error("o#1 sub", "O-word number must not depend on parameters", 2);
+    expect_error("o<abc sub", "Named parameter not terminated", 2);
+    expect_error("o100", "O-word without a command (Fanuc-style subroutine) is not supported", 1);
+    /* the kind is known even when the condition is bad */
+    expect_error("o7 while [1/0]", "Attempt to divide by zero", 12);
+    assert_int_equal(blk.oword.kind, NCP_O_WHILE);
+    n += snprintf(line + n, sizeof line - (size_t)n, "o1 call");
+    for (i = 0; i < 31; i++)
+        n += snprintf(line + n, sizeof line - (size_t)n, "[%d]", i);
+    expect_error(line, "Too many subroutine parameters", -1);
+}
+
+/* ------------------------------------------------------- limits, garbage */
+
+static void test_long_lines(void **state)
+{
+    char line[600];
+    (void)state;
+    memset(line, 'a', sizeof line);
+    memcpy(line, "G1 X1 (", 7);
+    line[251] = ')';
+    assert_int_equal(ncp_lex_block(line, 252, 1, 0, &blk), NCP_OK);
+    assert_int_equal(blk.comment_kind, NCP_CMT_PLAIN);
+    line[252] = ')';
+    assert_int_equal(ncp_lex_block(line, 253, 1, 0, &blk), NCP_ERR_SYNTAX);
+    assert_string_equal(blk.err.msg, "Command too long");
+    assert_int_equal(ncp_lex_block(line, sizeof line, 1, 0, &blk), NCP_ERR_SYNTAX);
+    assert_string_equal(blk.err.msg, "Command too long");
+    /* more words than a block holds */
+    memset(line, 0, sizeof line);
+    for (int i = 0; i < 70; i++)
+        memcpy(line + 2 * i, "g1", 2);
+    assert_int_equal(lex(line), NCP_ERR_SYNTAX);
+    /* nesting is bounded (stack use), long operator chains fit the block */
+    memset(line, 0, sizeof line);
+    strcpy(line, "X");
+    for (int i = 0; i < 38; i++)
+        strcat(line, "[");
+    strcat(line, "#1");
+    for (int i = 0; i < 38; i++)
+        strcat(line, "]");
+    expect_word(line, 0.5);
+    memset(line, 0, sizeof line);
+    strcpy(line, "X");
+    for (int i = 0; i < 60; i++)
+        strcat(line, "-[");
+    strcat(line, "1");
+    for (int i = 0; i < 60; i++)
+        strcat(line, "]");
+    expect_error(line, "Expression nested too deeply (more than 40 levels)", -1);
+    memset(line, 0, sizeof line);
+    strcpy(line, "X[#1");
+    for (int i = 0; i < 80; i++)
+        strcat(line, "+#1");
+    strcat(line, "]");
+    expect_word(line, 40.5);
+    memset(line, 0, sizeof line);
+    /* the code array holds any line: at most one instruction per character */
+    strcpy(line, "X[#1");
+    for (int i = 0; i < 41; i++)
+        strcat(line, "*#1+#1");
+    strcat(line, "]");
+    expect_word(line, 41 * 0.25 + 0.5);
+    assert_true(blk.n_code <= 252);
+}
+
+static void test_nul_and_garbage(void **state)
+{
+    static const char with_nul[] = "G1 X1\0Y2";
+    unsigned seed = 12345;
+    char line[300];
+    int round, i;
+    (void)state;
+    assert_int_equal(ncp_lex_block(with_nul, sizeof with_nul - 1, 3, 0, &blk), NCP_ERR_SYNTAX);
+    assert_string_equal(blk.err.msg, "Bad character '\\000' used");
+    assert_int_equal(blk.err.col, 6);
+    assert_int_equal(ncp_lex_block("(a\0b)", 5, 3, 0, &blk), NCP_ERR_SYNTAX);
+    assert_int_equal(ncp_lex_block("G1;\0", 4, 3, 0, &blk), NCP_ERR_SYNTAX);
+    /* random bytes, and random mixes of G-code tokens: never crash, and every
+     * error has a message and a column inside the line */
+    for (round = 0; round < 20000; round++) {
+        static const char *const tok[] = {
+            "G1", "X", "[", "]", "#", "<a>", "1", ".", "-", "+", "*", "**", "/", "sin",
+            "atan", "exists", "(", ")", ";", "o1", "if", "call", "=", " ", "mod",
+            "eq", "#<x>", "#2", "n", "abs", "e", "2.5", "\xff", "\t", "$", "@"
+        };
+        int len = (int)((seed = seed * 1103515245u + 12345u) >> 16) % 280;
+        if (round & 1) {
+            for (i = 0; i < len; i++)
+                line[i] = (char)((seed = seed * 1103515245u + 12345u) >> 16);
+        } else {
+            int n = 0;
+            while (n < len) {
+                const char *t = tok[((seed = seed * 1103515245u + 12345u) >> 16) %
+                                    (sizeof tok / sizeof tok[0])];
+                size_t tl = strlen(t);
+                if (n + (int)tl > len)
+                    break;
+                memcpy(line + n, t, tl);
+                n += (int)tl;
+            }
+            len = n;
+        }
+        if (ncp_lex_block(line, (size_t)len, 9, 0, &blk) != NCP_OK) {
+            assert_int_equal(blk.err.code, NCP_ERR_SYNTAX);
+            assert_true(blk.err.msg[0] != '\0');
+            assert_true(blk.err.col <= len + 1);
+        } else {
+            double v;
+            struct ncp_diag d;
+            for (i = 0; i < blk.n_words; i++)
+                ncp_expr_eval(&blk, &blk.words[i].v, &ops, &v, &d);
+            for (i = 0; i < blk.n_assign; i++)
+                ncp_expr_eval(&blk, &blk.assign[i].value, &ops, &v, &d);
+        }
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_numbers),
+        cmocka_unit_test(test_number_errors),
+        cmocka_unit_test(test_words),
+        cmocka_unit_test(test_line_number_and_delete),
+        cmocka_unit_test(test_duplicates),
+        cmocka_unit_test(test_bad_characters),
+        cmocka_unit_test(test_comments),
+        cmocka_unit_test(test_operators),
+        cmocka_unit_test(test_functions),
+        cmocka_unit_test(test_fold_matches_eval),
+        cmocka_unit_test(test_expression_errors),
+        cmocka_unit_test(test_parameters),
+        cmocka_unit_test(test_eval_errors),
+        cmocka_unit_test(test_assignments),
+        cmocka_unit_test(test_owords),
+        cmocka_unit_test(test_oword_errors),
+        cmocka_unit_test(test_long_lines),
+        cmocka_unit_test(test_nul_and_garbage),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
