@@ -62,13 +62,16 @@ deps:
 	apt-get update -qq
 	DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
 	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev linuxcnc-uspace \
-	    python3 valgrind
+	    python3 python3-matplotlib valgrind cppcheck clang-tidy
+	tools/rtvm/install-deps
 
-test: all unit
+test: all unit test-can-host
 	$(Q)tests/run-tests $(BUILD)
 
 clean:
 	rm -rf $(BUILD)
+
+include tools/rtvm/rtvm.mk
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 
@@ -104,3 +107,11 @@ bench-parse: all
 
 .PHONY: FORCE
 FORCE:
+
+# Static analysis: both must stay quiet on our sources.
+lint:
+	cppcheck --quiet --error-exitcode=1 --enable=warning,style,performance,portability \
+	    --inline-suppr --suppress=missingIncludeSystem -Iinclude -D_GNU_SOURCE \
+	    --std=c11 src tests/unit
+	clang-tidy --quiet $(LIB_SRCS) $(CLI_SRCS) -- $(CPPFLAGS) -std=c11 -I/usr/include/eigen3
+.PHONY: lint

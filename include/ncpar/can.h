@@ -1,0 +1,171 @@
+/* A small CANopen master over raw SocketCAN for CiA 402 drives: bus access,
+ * NMT, SYNC, expedited SDO, PDO 1 encode/decode, EMCY and heartbeat decoding,
+ * the CiA 402 state machine. No CANopen library: every frame is built here. */
+#ifndef NCPAR_CAN_H
+#define NCPAR_CAN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ncpar/diag.h"
+
+/* Function codes of the pre-defined connection set (add the node id). */
+#define NCP_COB_NMT       0x000u
+#define NCP_COB_SYNC      0x080u
+#define NCP_COB_EMCY      0x080u
+#define NCP_COB_TPDO1     0x180u
+#define NCP_COB_RPDO1     0x200u
+#define NCP_COB_SDO_TX    0x580u /* server (drive) -> client (master) */
+#define NCP_COB_SDO_RX    0x600u /* client -> server */
+#define NCP_COB_HEARTBEAT 0x700u
+
+#define NCP_CAN_NODE_MAX 127
+
+struct ncp_can_frame {
+    uint32_t id;   /* 11-bit identifier */
+    uint8_t len;   /* 0..8 */
+    uint8_t rtr;
+    uint8_t data[8];
+};
+
+struct ncp_can_bus {
+    int fd;
+    char ifname[16];
+};
+
+/* ---- raw bus --------------------------------------------------------- */
+int ncp_can_open(struct ncp_can_bus *bus, const char *ifname, struct ncp_diag *d);
+void ncp_can_close(struct ncp_can_bus *bus);
+/* Kernel receive filter: only these exact identifiers pass (n == 0: all). */
+int ncp_can_filter(struct ncp_can_bus *bus, const uint32_t *ids, size_t n,
+                   struct ncp_diag *d);
+int ncp_can_send(struct ncp_can_bus *bus, const struct ncp_can_frame *f,
+                 struct ncp_diag *d);
+/* 1: frame read; 0: nothing within timeout_ms; -1: error (in d). */
+int ncp_can_recv(struct ncp_can_bus *bus, struct ncp_can_frame *f, int timeout_ms,
+                 struct ncp_diag *d);
+
+/* ---- NMT, SYNC ------------------------------------------------------- */
+enum ncp_nmt_cmd {
+    NCP_NMT_START = 0x01,
+    NCP_NMT_STOP = 0x02,
+    NCP_NMT_PRE_OPERATIONAL = 0x80,
+    NCP_NMT_RESET_NODE = 0x81,
+    NCP_NMT_RESET_COMM = 0x82,
+};
+/* node 0 addresses every node. */
+void ncp_nmt_frame(struct ncp_can_frame *f, enum ncp_nmt_cmd cmd, uint8_t node);
+void ncp_sync_frame(struct ncp_can_frame *f);
+
+/* ---- heartbeat ------------------------------------------------------- */
+enum ncp_nmt_state {
+    NCP_NMT_BOOTUP = 0x00,
+    NCP_NMT_STOPPED = 0x04,
+    NCP_NMT_OPERATIONAL = 0x05,
+    NCP_NMT_PREOP = 0x7F,
+};
+void ncp_heartbeat_frame(struct ncp_can_frame *f, uint8_t node, enum ncp_nmt_state s);
+const char *ncp_nmt_state_name(unsigned state);
+
+/* ---- expedited SDO --------------------------------------------------- */
+/* Frames of the protocol, for the client here and for simulated servers. */
+void ncp_sdo_upload_req(struct ncp_can_frame *f, uint8_t node, uint16_t index,
+                        uint8_t sub);
+/* size 1, 2 or 4 bytes. */
+void ncp_sdo_download_req(struct ncp_can_frame *f, uint8_t node, uint16_t index,
+                          uint8_t sub, uint32_t value, unsigned size);
+void ncp_sdo_upload_resp(struct ncp_can_frame *f, uint8_t node, uint16_t index,
+                         uint8_t sub, uint32_t value, unsigned size);
+void ncp_sdo_download_resp(struct ncp_can_frame *f, uint8_t node, uint16_t index,
+                           uint8_t sub);
+void ncp_sdo_abort_frame(struct ncp_can_frame *f, uint32_t cob, uint16_t index,
+                         uint8_t sub, uint32_t code);
+/* Text of an SDO abort code (CiA 301), "unknown abort code" if not listed. */
+const char *ncp_sdo_abort_text(uint32_t code);
+
+/* Blocking client calls. Frames other than the awaited answer are skipped, so
+ * give the SDO its own bus (filtered to 0x580 + node) while PDOs run. On error
+ * d->msg names node, object and cause ("node 2: SDO write 0x6060:00: ..."),
+ * *abort (may be NULL) gets the abort code or 0. */
+int ncp_sdo_read(struct ncp_can_bus *bus, uint8_t node, uint16_t index, uint8_t sub,
+                 uint32_t *value, int timeout_ms, uint32_t *abort, struct ncp_diag *d);
+int ncp_sdo_write(struct ncp_can_bus *bus, uint8_t node, uint16_t index, uint8_t sub,
+                  uint32_t value, unsigned size, int timeout_ms, uint32_t *abort,
+                  struct ncp_diag *d);
+
+/* ---- PDO 1 of a CSP drive: controlword + target, statusword + actual -- */
+void ncp_rpdo1_frame(struct ncp_can_frame *f, uint8_t node, uint16_t controlword,
+                     int32_t target);
+int ncp_rpdo1_decode(const struct ncp_can_frame *f, uint16_t *controlword,
+                     int32_t *target);
+void ncp_tpdo1_frame(struct ncp_can_frame *f, uint8_t node, uint16_t statusword,
+                     int32_t actual);
+int ncp_tpdo1_decode(const struct ncp_can_frame *f, uint16_t *statusword,
+                     int32_t *actual);
+
+/* ---- EMCY ------------------------------------------------------------ */
+struct ncp_emcy {
+    uint16_t code;     /* error code, 0x0000 = error reset */
+    uint8_t reg;       /* error register 0x1001 */
+    uint8_t vendor[5];
+};
+void ncp_emcy_frame(struct ncp_can_frame *f, uint8_t node, const struct ncp_emcy *e);
+int ncp_emcy_decode(const struct ncp_can_frame *f, struct ncp_emcy *e);
+/* "0x8611 following error; register 0x21: generic, device profile" */
+void ncp_emcy_describe(const struct ncp_emcy *e, char *buf, size_t len);
+
+/* ---- CiA 402 device control ------------------------------------------ */
+enum ncp_cia402_state {
+    NCP_402_NOT_READY,
+    NCP_402_SWITCH_ON_DISABLED,
+    NCP_402_READY_TO_SWITCH_ON,
+    NCP_402_SWITCHED_ON,
+    NCP_402_OPERATION_ENABLED,
+    NCP_402_QUICK_STOP_ACTIVE,
+    NCP_402_FAULT_REACTION_ACTIVE,
+    NCP_402_FAULT,
+};
+#define NCP_402_CW_SHUTDOWN     0x0006u
+#define NCP_402_CW_SWITCH_ON    0x0007u
+#define NCP_402_CW_ENABLE       0x000Fu
+#define NCP_402_CW_DISABLE      0x0000u
+#define NCP_402_CW_QUICK_STOP   0x0002u
+#define NCP_402_CW_FAULT_RESET  0x0080u
+
+enum ncp_cia402_state ncp_cia402_state(uint16_t statusword);
+const char *ncp_cia402_state_name(enum ncp_cia402_state s);
+/* Controlword for one step towards Operation enabled. prev_cw is the last one
+ * sent: fault reset acts on a rising edge of bit 7, so it alternates. */
+uint16_t ncp_cia402_step(enum ncp_cia402_state s, uint16_t prev_cw);
+/* Statusword a drive in state s reports (for simulated drives). */
+uint16_t ncp_cia402_statusword(enum ncp_cia402_state s);
+/* Next state of a drive in state s receiving controlword cw. */
+enum ncp_cia402_state ncp_cia402_apply(enum ncp_cia402_state s, uint16_t cw,
+                                       uint16_t prev_cw);
+
+/* ---- what the master knows of each drive --------------------------- */
+struct ncp_co_node {
+    uint8_t id;
+    uint16_t statusword;
+    int32_t actual;
+    uint32_t tpdos;       /* TPDO1 frames received */
+    int64_t last_hb_ms;   /* -1: no heartbeat yet */
+    uint8_t hb_state;     /* enum ncp_nmt_state */
+    uint32_t emcys;       /* EMCY frames received; the last one in emcy */
+    struct ncp_emcy emcy;
+};
+enum ncp_co_event { NCP_CO_NONE, NCP_CO_TPDO, NCP_CO_HEARTBEAT, NCP_CO_EMCY };
+
+void ncp_co_node_init(struct ncp_co_node *node, uint8_t id);
+/* The COB-IDs a master listens to for these nodes (4 per node); returns count. */
+size_t ncp_co_filter_ids(const struct ncp_co_node *nodes, size_t n, uint32_t *ids,
+                         size_t max);
+/* Updates the node the frame comes from; returns what the frame was. */
+enum ncp_co_event ncp_co_track(struct ncp_co_node *nodes, size_t n,
+                               const struct ncp_can_frame *f, int64_t now_ms);
+/* NCP_OK while the node's last heartbeat is younger than timeout_ms (counted
+ * from since_ms when none came yet); else the loss, described in d. */
+int ncp_co_check_heartbeat(const struct ncp_co_node *node, int64_t now_ms,
+                           int64_t since_ms, int timeout_ms, struct ncp_diag *d);
+
+#endif

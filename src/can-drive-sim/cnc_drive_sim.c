@@ -1,0 +1,136 @@
+/* cnc-drive-sim IFACE --node N [switches]: a simulated CiA 402 servo drive
+ * on a (v)CAN interface, with switches that inject the faults a real drive
+ * can show, so the master's reactions can be tested without hardware. */
+#include <getopt.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "drive.h"
+
+static volatile sig_atomic_t stop;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop = 1;
+}
+
+static void usage(FILE *f)
+{
+    fputs("usage: cnc-drive-sim IFACE --node N [options]\n"
+          "  --fault-at-start          start in Fault (needs a fault reset)\n"
+          "  --fault-after K           enter Fault after K SYNCs in Operation enabled\n"
+          "  --emcy-after K            send EMCY 0x8611 (following error) and enter Fault\n"
+          "  --heartbeat-stop-after K  stop producing heartbeats\n"
+          "  --slow-sdo MS             answer every SDO MS milliseconds late\n"
+          "  --sdo-abort INDEX         abort every SDO access to object INDEX (0x6060...)\n"
+          "  --drop-every K            drop every K-th TPDO\n"
+          "  --max-step COUNTS         plant slew limit per SYNC (default 1000000)\n"
+          "  --verbose                 log state changes on stderr\n"
+          "Answers NMT, SDO (expedited), SYNC and RPDO1/TPDO1 (controlword+target,\n"
+          "statusword+actual); heartbeat period from object 0x1017 (default 100 ms).\n",
+          f);
+}
+
+static long num(const char *s, const char *opt, long lo, long hi)
+{
+    char *end;
+    long v = strtol(s, &end, 0);
+    if (*s == '\0' || *end != '\0' || v < lo || v > hi) {
+        fprintf(stderr, "cnc-drive-sim: %s wants a number in %ld..%ld, not '%s'\n", opt, lo,
+                hi, s);
+        exit(1);
+    }
+    return v;
+}
+
+static const char *parse(int argc, char **argv, struct drive_opts *o)
+{
+    static const struct option lo[] = {
+        {"node", required_argument, 0, 'n'},         {"fault-at-start", no_argument, 0, 'F'},
+        {"fault-after", required_argument, 0, 'f'},  {"emcy-after", required_argument, 0, 'e'},
+        {"heartbeat-stop-after", required_argument, 0, 'H'},
+        {"slow-sdo", required_argument, 0, 's'},     {"sdo-abort", required_argument, 0, 'a'},
+        {"drop-every", required_argument, 0, 'd'},   {"max-step", required_argument, 0, 'm'},
+        {"verbose", no_argument, 0, 'v'},            {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    *o = (struct drive_opts){.node = 0, .fault_after = -1, .emcy_after = -1,
+                             .hb_stop_after = -1, .abort_index = -1, .max_step = 1000000};
+    int c;
+    while ((c = getopt_long(argc, argv, "n:v", lo, NULL)) != -1) {
+        switch (c) {
+        case 'n': o->node = (uint8_t)num(optarg, "--node", 1, NCP_CAN_NODE_MAX); break;
+        case 'F': o->fault_at_start = 1; break;
+        case 'f': o->fault_after = num(optarg, "--fault-after", 1, 1L << 30); break;
+        case 'e': o->emcy_after = num(optarg, "--emcy-after", 1, 1L << 30); break;
+        case 'H': o->hb_stop_after = num(optarg, "--heartbeat-stop-after", 1, 1L << 30); break;
+        case 's': o->slow_sdo_ms = (int)num(optarg, "--slow-sdo", 0, 60000); break;
+        case 'a': o->abort_index = (int)num(optarg, "--sdo-abort", 0, 0xFFFF); break;
+        case 'd': o->drop_every = num(optarg, "--drop-every", 1, 1L << 30); break;
+        case 'm': o->max_step = (int32_t)num(optarg, "--max-step", 1, 1L << 30); break;
+        case 'v': o->verbose = 1; break;
+        case 'h': usage(stdout); exit(0);
+        default: usage(stderr); exit(1);
+        }
+    }
+    if (optind != argc - 1 || o->node == 0) {
+        usage(stderr);
+        exit(1);
+    }
+    return argv[optind];
+}
+
+static long long now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+int main(int argc, char **argv)
+{
+    static struct drive dv;
+    const char *ifname = parse(argc, argv, &dv.o);
+    struct ncp_diag d;
+    if (ncp_can_open(&dv.bus, ifname, &d) != NCP_OK) {
+        fprintf(stderr, "cnc-drive-sim: %s\n", d.msg);
+        return 1;
+    }
+    uint8_t n = dv.o.node;
+    const uint32_t ids[] = {NCP_COB_NMT, NCP_COB_SYNC, NCP_COB_SDO_RX + n, NCP_COB_RPDO1 + n};
+    if (ncp_can_filter(&dv.bus, ids, sizeof ids / sizeof ids[0], &d) != NCP_OK) {
+        fprintf(stderr, "cnc-drive-sim: %s\n", d.msg);
+        return 1;
+    }
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    drive_boot(&dv);
+    long long next_hb = now_ms();
+    int rc = 0;
+    while (!stop) {
+        long long t = now_ms();
+        uint32_t period = od_get(&dv.od, 0x1017, 0);
+        if (period > 0 && t >= next_hb) {
+            if (drive_send_heartbeat(&dv) < 0)
+                break;
+            next_hb = t + period;
+        }
+        int wait = period > 0 ? (int)(next_hb - t) : 100;
+        struct ncp_can_frame f;
+        int r = ncp_can_recv(&dv.bus, &f, wait > 100 ? 100 : (wait < 0 ? 0 : wait), &d);
+        if (r < 0) {
+            fprintf(stderr, "cnc-drive-sim node %u: %s\n", n, d.msg);
+            rc = 1;
+            break;
+        }
+        if (r > 0 && drive_on_frame(&dv, &f) < 0) {
+            rc = 1;
+            break;
+        }
+    }
+    ncp_can_close(&dv.bus);
+    return rc;
+}

@@ -1,0 +1,96 @@
+#!/usr/bin/python3
+"""Checks a `candump -L` capture of can-master-test's start-up of NODES:
+per node the SDO configuration in order, each request answered before the
+next; then NMT start; then the CiA 402 walk (0x06, 0x07, 0x0F) in RPDO 1;
+then the cyclic rhythm: every SYNC preceded by one RPDO per node and
+followed by one TPDO per node. Usage: check-startup.py CAPTURE NODE..."""
+import sys
+
+SDO_SEQUENCE = [  # (command byte, index, sub, value) the master sends
+    (0x40, 0x1000, 0, None),
+    (0x2F, 0x6060, 0, 8),
+    (0x2F, 0x60C2, 1, 1), (0x2F, 0x60C2, 2, 0xFD),
+    (0x2F, 0x1600, 0, 0), (0x23, 0x1600, 1, 0x60400010), (0x23, 0x1600, 2, 0x607A0020),
+    (0x2F, 0x1600, 0, 2),
+    (0x2F, 0x1A00, 0, 0), (0x23, 0x1A00, 1, 0x60410010), (0x23, 0x1A00, 2, 0x60640020),
+    (0x2F, 0x1A00, 0, 2),
+    (0x2B, 0x1017, 0, 50),
+    (0x40, 0x6061, 0, None),
+]
+
+
+def frames(path):
+    for line in open(path):
+        parts = line.split()
+        if len(parts) != 3 or "#" not in parts[2]:
+            continue
+        ident, data = parts[2].split("#", 1)
+        yield int(ident, 16), bytes.fromhex(data) if data and data[0] != "R" else b""
+
+
+def sdo_request(data):
+    value = int.from_bytes(data[4:8], "little") if data[0] != 0x40 else None
+    return (data[0], int.from_bytes(data[1:3], "little"), data[3], value)
+
+
+def check(path, nodes):
+    errors = []
+    log = list(frames(path))
+    nmt = [i for i, (ident, data) in enumerate(log) if ident == 0 and data == b"\x01\x00"]
+    if not nmt:
+        return ["no NMT start (000#0100)"]
+    start = nmt[0]
+    for n in nodes:
+        reqs = [(i, sdo_request(d)) for i, (ident, d) in enumerate(log[:start])
+                if ident == 0x600 + n]
+        got = [r for _, r in reqs]
+        if got != SDO_SEQUENCE:
+            errors.append(f"node {n}: SDO requests {got} != expected {SDO_SEQUENCE}")
+        for (i, req), nxt in zip(reqs, [j for j, _ in reqs[1:]] + [start]):
+            answered = any(ident == 0x580 + n and d[1:4] == log[i][1][1:4]
+                           for ident, d in log[i + 1:nxt])
+            if not answered:
+                errors.append(f"node {n}: SDO 0x{req[1]:04X}:{req[2]:02X} unanswered")
+                break
+        cws = []
+        for ident, d in log[start:]:
+            if ident == 0x200 + n and (not cws or cws[-1] != d[0]):
+                cws.append(d[0])
+        walk = [c for c in cws if c in (0x06, 0x07, 0x0F)]
+        if walk[:3] != [0x06, 0x07, 0x0F]:
+            errors.append(f"node {n}: controlwords {[hex(c) for c in cws]} lack 0x06, 0x07, 0x0F")
+    syncs = [i for i, (ident, _) in enumerate(log) if ident == 0x080 and i > start]
+    if len(syncs) < 200:
+        errors.append(f"only {len(syncs)} SYNCs after NMT start")
+    # Each SYNC is preceded by exactly one RPDO per node; each drive answers
+    # every SYNC with one TPDO, at most one SYNC late (the guest's scheduler).
+    prev, tpdos = start, {n: 0 for n in nodes}
+    for k, s in enumerate(syncs + [len(log)]):
+        window = [ident for ident, _ in log[prev + 1:s]]
+        for n in nodes:
+            tpdos[n] += window.count(0x180 + n)
+            if tpdos[n] > k or tpdos[n] < k - 1:
+                errors.append(f"after SYNC #{k}: {tpdos[n]} TPDOs of node {n}")
+            if s < len(log) and window.count(0x200 + n) != 1:
+                errors.append(f"SYNC #{k + 1}: {window.count(0x200 + n)} RPDOs of node {n} before it")
+        prev = s
+        if len(errors) > 10:
+            break
+    for n in nodes:
+        if not any(ident == 0x700 + n and d == b"\x05" for ident, d in log[start:]):
+            errors.append(f"node {n}: no operational heartbeat after NMT start")
+    return errors
+
+
+def main():
+    path, nodes = sys.argv[1], [int(a) for a in sys.argv[2:]]
+    errors = check(path, nodes)
+    for e in errors[:12]:
+        print("startup capture:", e)
+    n = sum(1 for _ in frames(path))
+    print(f"startup capture: {n} frames, sequence {'ok' if not errors else 'WRONG'}")
+    return 1 if errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
