@@ -64,6 +64,13 @@ size_t ncp_fmt_fixed4(char *buf, double v);
  * in the same slot. Geometry (atan2 with long double quarter turns, hypot,
  * concave test against TOLERANCE_CONCAVE_CORNER) follows interp_convert.cc's
  * convert_straight_comp1/2 and convert_arc_comp1/2, and lives in
- * src/executor/comp_geom.cpp next to arc_geom.cpp. */
+ * src/executor/comp_geom.cpp next to arc_geom.cpp.
+ *
+ * As built: the window is not bounded by three moves (Z-only moves and queued
+ * calls ride along, inside corners rewrite every queued move, gouge checks use
+ * the start of the previous compensated move, entry arcs shift their centre,
+ * G20/G21 rescale the queue), so no COMP_REQUEST exists: the analyzer runs
+ * rs274's queue itself (src/analyzer/cutcomp.h, a few atan2/hypot per move)
+ * and the per-move geometry lives in src/executor/comp_geom.cpp. */
 
 #endif

@@ -138,10 +138,19 @@ struct ncp_trap {
     double t1, t2, t3;      /* accelerate, cruise, decelerate */
     double d1, d2;          /* distance at the end of phase 1 and 2 */
     double length;
+    double j;               /* path jerk: > 0 makes the ramps jerk-limited (S-curve) */
 };
 void ncp_trap_plan(struct ncp_trap *tp, double len, double v0, double v1, double vmax,
                    double a);
 double ncp_trap_duration(const struct ncp_trap *tp);
+/* The same with jerk-limited ramps (acceleration 0 at both ends of each ramp):
+ * PROFILE = scurve. Reuses struct ncp_trap with j > 0; ncp_trap_eval serves both. */
+void ncp_scurve_plan(struct ncp_trap *tp, double len, double v0, double v1, double vmax,
+                     double a, double j);
+/* Distance a jerk-limited change between speeds va and vb takes. */
+double ncp_scurve_dist(double va, double vb, double a, double j);
+/* Highest speed reachable from v (or: from which v is reachable) within len. */
+double ncp_scurve_reach(double v, double len, double a, double j);
 /* Distance and velocity at time t (clamped to the duration). */
 double ncp_trap_eval(const struct ncp_trap *tp, double t, double *v);
 

@@ -50,12 +50,35 @@ struct ncp_output {
     int (*emit)(void *ctx, const struct ncp_cmd *cmd);
 };
 
+/* Per-stage counters, each written by its own thread only (read after join). */
+struct ncp_stage_stats {
+    uint64_t items;       /* blocks fed / lexed / analyzed, slots executed / emitted */
+    uint64_t full_waits;  /* times the output ring was full when the stage wanted to write */
+    uint64_t empty_waits; /* times the input ring was empty when the stage wanted to read */
+    uint64_t sleeps;      /* futex sleeps (a wait that outlasted the short spin) */
+};
+
+/* ncp_run_stats.warnings bits: the run went on with a weaker setting. */
+enum ncp_run_warning {
+    NCP_WARN_NO_FIFO = 1u << 0, /* SCHED_FIFO not permitted: ran SCHED_OTHER */
+    NCP_WARN_NO_CPU = 1u << 1   /* a map's cpu is not available: placed on another */
+};
+
 struct ncp_run_stats {
     uint64_t blocks;        /* blocks lexed */
     uint64_t commands;      /* slots emitted */
     double wall_ms;         /* pipeline start (thread creation incl.) to last slot out */
     int threads;            /* threads used in total */
+    /* additive (pipeline): filled by ncp_pipeline_run only */
+    uint32_t warnings;      /* enum ncp_run_warning bits */
+    struct ncp_stage_stats feeder, analyzer, output;
+    struct ncp_stage_stats lexer[NCP_MAX_LEXERS];
+    struct ncp_stage_stats executor[NCP_MAX_EXECUTORS];
 };
+
+/* One line of text per warning bit set in w (for the CLI to print once), or NULL
+ * when no bit is set; *w loses the bit returned. */
+const char *ncp_run_warning_next(uint32_t *w);
 
 /* Run the interpreter over src. The error (if any) is returned in *d in program
  * order, exactly as the serial reference reports it. Returns NCP_OK or d->code. */

@@ -100,6 +100,25 @@ void ncp_rt_loop_join(struct ncp_rt_loop *l);
 struct ncp_output;
 struct ncp_machine_cfg;
 
+/* Live controls of a running NCK, safe to use from any thread. */
+struct ncp_nck_ctl {
+    _Atomic int override_permille;  /* feed override, 0..2000 (1000 = 100 %) */
+    _Atomic int hold;               /* feed hold: brake along the path and wait */
+    _Atomic int64_t now_ns;         /* machine time of the last position cycle */
+    /* Virtual clock only: time stands still at this instant (before its cycle
+     * runs) until it is moved on, so a script can act at an exact machine
+     * time. INT64_MAX (the default) never pauses. */
+    _Atomic int64_t pause_at_ns;
+};
+
+void ncp_nck_ctl_init(struct ncp_nck_ctl *c, double feed_override);
+/* 0.0 .. 2.0. Applied by the position loop at run time by rescaling the planned
+ * setpoint stream in time, ramped so that no axis exceeds its acceleration
+ * limit. The plan itself is made at opts.feed_override: a live value above it
+ * runs at it (start with --feed-override 200 for the full range). */
+void ncp_nck_set_feed_override(struct ncp_nck_ctl *c, double ov);
+void ncp_nck_feed_hold(struct ncp_nck_ctl *c, int hold);
+
 struct ncp_nck_opts {
     const struct ncp_machine_cfg *cfg;
     /* Runs the program, handing command slots to out in program order
@@ -113,6 +132,7 @@ struct ncp_nck_opts {
     FILE *trace;             /* per-cycle CSV or NULL */
     FILE *progress;          /* live progress line (a terminal) or NULL */
     uint32_t total_lines;    /* for the progress line */
+    struct ncp_nck_ctl *ctl; /* live override / hold, or NULL */
 };
 
 enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };

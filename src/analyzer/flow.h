@@ -21,9 +21,9 @@ void ncp_flow_free(struct ncp_flow *f);
 
 /* Next non-O-word block to interpret. Returns NCP_OK and sets *out (valid until
  * the next call), NCP_END at the end of the program body, or an error with *d
- * filled (file order line/col). Blocks with a syntax error are returned as they
- * are (out->err set) for the core to report, except where rs274 would not read
- * them. */
+ * filled (file order line/col). A block with a syntax error comes back as that
+ * error in *d (its err), except where rs274 would not read it (skipped text).
+ * Block delete ('/') is off, as in rs274 -g: such blocks are served as usual. */
 int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out,
                   struct ncp_diag *d);
 

@@ -35,6 +35,17 @@ int ncp_params_get_named(const struct ncp_params *p, const char *name, size_t le
 int ncp_params_set_named(struct ncp_params *p, const char *name, size_t len,
                          double v, struct ncp_diag *d);
 int ncp_params_exists(const struct ncp_params *p, const char *name, size_t len);
+/* rs274 creates the target of `#<name> = ...` (value 0, in the scope the name
+ * belongs to) as it reads the assignment, before it evaluates the value or
+ * anything after it on the line: `#<y>=[#<y>+1]` on an unknown y gives 1, and
+ * `#<y>=1 #<z>=[#<y>+1]` gives z = 1. The core calls this for each named
+ * assignment target in line order. Existing or predefined names are left alone. */
+int ncp_params_declare_named(struct ncp_params *p, const char *name, size_t len,
+                             struct ncp_diag *d);
+
+/* #<_value> / #<_value_returned> (read-only to programs): set by the O-word
+ * flow on return/endsub, with returned = 0 when no value was given. */
+void ncp_params_set_return(struct ncp_params *p, double value, int returned);
 
 /* Subroutine call: save #1..#30 and open a new local-name scope, then set
  * #1..#nargs from args (the rest 0, as rs274). Return restores both. */

@@ -1,0 +1,341 @@
+/* The analyzer's run loop and its output: one slot per block that produces
+ * calls, consecutive cmd_ids, errors carried in program order. */
+#include "state.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
+                                      struct ncp_diag *d)
+{
+    struct ncp_analyzer *a = calloc(1, sizeof *a);
+    if (!a) {
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
+        return NULL;
+    }
+    if (cfg)
+        a->cfg = *cfg;
+    a->params = ncp_params_new();
+    if (!a->params) {
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
+        free(a);
+        return NULL;
+    }
+    ncp_params_set_predef(a->params, ncp_predef_lookup, a);
+    a->pops = ncp_params_ops(a->params);
+    if (ncp_tools_load(a, a->cfg.tool_table_path, d) != NCP_OK) {
+        ncp_analyzer_free(a);
+        return NULL;
+    }
+    ncp_state_init(a);
+    ncp_cutcomp_init(&a->comp, NULL);
+    return a;
+}
+
+void ncp_analyzer_free(struct ncp_analyzer *a)
+{
+    if (!a)
+        return;
+    if (a->flow)
+        ncp_flow_free(a->flow);
+    ncp_params_free(a->params);
+    free(a);
+}
+
+static void ncp_an_publish(struct ncp_analyzer *a)
+{
+    if (a->cmd) {
+        a->sink->publish(a->sink->ctx, a->cmd);
+        a->cmd = NULL;
+    }
+}
+
+/* The block's current slot, opening one (or a continuation) when needed. */
+static struct ncp_cmd *ncp_an_slot(struct ncp_analyzer *a, size_t text_need)
+{
+    uint16_t cont = 0;
+    if (a->cmd && a->cmd->n_ops < NCP_CMD_MAX_OPS &&
+        a->cmd->text_used + text_need <= NCP_CMD_TEXT_POOL)
+        return a->cmd;
+    if (a->cmd) {
+        cont = NCP_CMD_F_CONT;
+        ncp_an_publish(a);
+    }
+    if (a->stopped)
+        return NULL;
+    struct ncp_cmd *c = a->sink->acquire(a->sink->ctx);
+    if (!c) {
+        a->stopped = 1;
+        return NULL;
+    }
+    c->cmd_id = a->next_id++;
+    c->line = a->line;
+    c->flags = cont;
+    a->cmd = c;
+    return c;
+}
+
+/* Ops go to a scratch op when the sink has shut down, so callers need no
+ * NULL checks on the hot path. */
+static struct ncp_canon ncp_an_scratch;
+
+/* Append a finished op (and its text) to the block's slot. */
+static int ncp_an_append(void *ctx, const struct ncp_canon *src, const char *text, size_t len)
+{
+    struct ncp_analyzer *a = ctx;
+    if (len > NCP_CMD_TEXT_POOL)
+        len = NCP_CMD_TEXT_POOL;
+    struct ncp_cmd *c = ncp_an_slot(a, len);
+    if (!c)
+        return NCP_OK;
+    struct ncp_canon *op = &c->ops[c->n_ops++];
+    *op = *src;
+    ncp_sai_op(a, op);
+    op->text_off = 0;
+    op->text_len = 0;
+    if (len) {
+        memcpy(c->text + c->text_used, text, len);
+        op->text_off = c->text_used;
+        op->text_len = (uint16_t)len;
+        c->text_used = (uint16_t)(c->text_used + len);
+    }
+    return NCP_OK;
+}
+
+struct ncp_comp_sink ncp_an_comp_sink(struct ncp_analyzer *a)
+{
+    struct ncp_comp_sink s = {a, ncp_an_append};
+    return s;
+}
+
+/* While compensation holds a queued move, ops are staged and then offered to
+ * its queue, which keeps some of them behind the move as rs274 does. */
+int ncp_an_commit(struct ncp_analyzer *a)
+{
+    struct ncp_staged *st = &a->staged;
+    if (!st->pending)
+        return NCP_OK;
+    st->pending = 0;
+    struct ncp_comp_sink sink = ncp_an_comp_sink(a);
+    int rc = ncp_cutcomp_other(&a->comp, &st->op, st->text, st->len, &sink, &a->err, a->line);
+    if (rc != NCP_OK && a->err.code == NCP_OK)
+        a->err.code = (uint16_t)rc;
+    return rc;
+}
+
+static struct ncp_canon *ncp_an_stage(struct ncp_analyzer *a, enum ncp_canon_kind kind,
+                                      const char *text, size_t len)
+{
+    ncp_an_commit(a);
+    struct ncp_staged *st = &a->staged;
+    memset(&st->op, 0, sizeof st->op);
+    st->op.kind = (uint16_t)kind;
+    if (len > sizeof st->text)
+        len = sizeof st->text;
+    if (len)
+        memcpy(st->text, text, len);
+    st->len = len;
+    st->pending = 1;
+    return &st->op;
+}
+
+struct ncp_canon *ncp_an_emit(struct ncp_analyzer *a, enum ncp_canon_kind kind)
+{
+    if (a->comp.n != 0 || a->staged.pending)
+        return ncp_an_stage(a, kind, NULL, 0);
+    struct ncp_cmd *c = ncp_an_slot(a, 0);
+    struct ncp_canon *op = c ? &c->ops[c->n_ops++] : &ncp_an_scratch;
+    memset(op, 0, sizeof *op);
+    op->kind = (uint16_t)kind;
+    return op;
+}
+
+struct ncp_canon *ncp_an_emit_text(struct ncp_analyzer *a, enum ncp_canon_kind kind,
+                                   const char *text, size_t len)
+{
+    if (a->comp.n != 0 || a->staged.pending)
+        return ncp_an_stage(a, kind, text, len);
+    if (len > NCP_CMD_TEXT_POOL)
+        len = NCP_CMD_TEXT_POOL;
+    struct ncp_cmd *c = ncp_an_slot(a, len);
+    struct ncp_canon *op = c ? &c->ops[c->n_ops++] : &ncp_an_scratch;
+    memset(op, 0, sizeof *op);
+    op->kind = (uint16_t)kind;
+    if (c) {
+        memcpy(c->text + c->text_used, text, len);
+        op->text_off = c->text_used;
+        op->text_len = (uint16_t)len;
+        c->text_used = (uint16_t)(c->text_used + len);
+    }
+    return op;
+}
+
+void ncp_an_emit6(struct ncp_analyzer *a, enum ncp_canon_kind kind, const double *p)
+{
+    struct ncp_canon *op = ncp_an_emit(a, kind);
+    memcpy(op->d, p, 6 * sizeof(double));
+    if (kind == NCP_C_SET_G92_OFFSET)
+        ncp_sai_g92(a, p);
+    else
+        ncp_sai_move(a, p);
+}
+
+int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    a->err.code = NCP_ERR_SEMANTIC;
+    a->err.line = a->line;
+    a->err.col = col;
+    vsnprintf(a->err.msg, sizeof a->err.msg, fmt, ap);
+    va_end(ap);
+    return NCP_ERR_SEMANTIC;
+}
+
+static void ncp_an_preamble(struct ncp_analyzer *a)
+{
+    static const double zero[6];
+    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->i[0] = 1;
+    struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
+    op->i[0] = 1;
+    ncp_an_emit6(a, NCP_C_SET_G92_OFFSET, zero);
+    ncp_an_emit(a, NCP_C_SET_XY_ROTATION);
+    ncp_an_emit(a, NCP_C_SET_FEED_REFERENCE)->i[0] = 1;
+    ncp_an_emit(a, NCP_C_ON_RESET);
+}
+
+/* rs274's driver resets the canon twice when it exits, whatever the outcome. */
+static void ncp_an_finish(struct ncp_analyzer *a, uint16_t flag)
+{
+    if (flag & NCP_CMD_F_ERROR)
+        a->staged.pending = 0;
+    else
+        ncp_an_commit(a);
+    /* whatever compensation still holds is never output, as in rs274 */
+    ncp_cutcomp_reset(&a->comp);
+    ncp_an_emit(a, NCP_C_ON_RESET);
+    ncp_an_emit(a, NCP_C_ON_RESET);
+    struct ncp_cmd *c = ncp_an_slot(a, 0);
+    if (c) {
+        c->flags |= flag;
+        if (flag & NCP_CMD_F_ERROR)
+            c->diag = a->err;
+    }
+    ncp_an_publish(a);
+}
+
+/* rs274 at the end of the text without M2/M30: a closing '%' ends the program
+ * (FINISH), anything else is an error. */
+/* rs274 names the last line it read. */
+static uint32_t ncp_an_last_line(const struct ncp_source *src)
+{
+    uint32_t line = src->begin_line;
+    size_t end = src->end;
+    if (end > src->begin && src->text[end - 1] == '\n')
+        end--;
+    for (size_t k = src->begin; k < end; k++)
+        line += src->text[k] == '\n';
+    return line;
+}
+
+static int ncp_an_eof(struct ncp_analyzer *a, const struct ncp_source *src)
+{
+    if (src)
+        a->line = ncp_an_last_line(src);
+    if (src && src->has_percent && src->end < src->len) {
+        ncp_an_emit_text(a, NCP_C_RAW_TEXT, "FINISH()", 8);
+        return NCP_END;
+    }
+    if (src && src->has_percent)
+        return ncp_an_error(a, 0, "File ended with no percent sign");
+    return ncp_an_error(a, 0, "File ended with no percent sign or program end");
+}
+
+static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
+{
+    a->blk = b;
+    a->line = b->line;
+    if (b->err.code != NCP_OK) {
+        a->err = b->err;
+        return b->err.code;
+    }
+    /* rs274 -g runs with the block delete switch off: '/' lines execute */
+    ncp_sai_resync(a);
+    int rc = ncp_words_collect(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_words_assign(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_modal_check(a);
+    if (rc == NCP_OK)
+        rc = ncp_exec_block(a);
+    if (rc == NCP_OK || rc == NCP_END) {
+        int c = ncp_an_commit(a);
+        if (c != NCP_OK)
+            rc = c;
+    }
+    return rc;
+}
+
+int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
+                     const struct ncp_cmd_sink *sink)
+{
+    a->sink = sink;
+    a->src = feed->src;
+    a->cmd = NULL;
+    a->next_id = 0;
+    a->stopped = 0;
+    a->line = 0;
+    memset(&a->err, 0, sizeof a->err);
+    if (a->flow)
+        ncp_flow_free(a->flow);
+    a->flow = ncp_flow_new(feed, a->params, &a->cfg);
+    if (!a->flow) {
+        ncp_diag_set(&a->err, NCP_ERR_IO, 0, 0, "out of memory");
+        ncp_an_finish(a, NCP_CMD_F_ERROR);
+        return NCP_ERR_IO;
+    }
+    ncp_cutcomp_init(&a->comp, NULL);
+    a->staged.pending = 0;
+    ncp_an_preamble(a);
+    ncp_an_publish(a);
+
+    uint32_t last_line = 0;
+    int rc;
+    for (;;) {
+        const struct ncp_block *b = NULL;
+        struct ncp_diag d; /* filled by flow only on errors: no per-block memset */
+        d.code = NCP_OK;
+        d.line = 0;
+        d.col = 0;
+        d.msg[0] = '\0';
+        rc = ncp_flow_next(a->flow, &b, &d);
+        if (rc == NCP_END) {
+            a->line = last_line;
+            rc = ncp_an_eof(a, feed->src);
+            break;
+        }
+        if (rc != NCP_OK) {
+            a->err = d;
+            break;
+        }
+        last_line = b->line;
+        rc = ncp_an_block(a, b);
+        if (rc != NCP_OK)
+            break;
+        ncp_an_publish(a);
+        if (a->stopped)
+            break;
+    }
+    if (rc == NCP_END) {
+        ncp_an_finish(a, NCP_CMD_F_END);
+        return NCP_END;
+    }
+    if (a->err.code == NCP_OK)
+        ncp_diag_set(&a->err, rc ? (enum ncp_status)rc : NCP_ERR_SEMANTIC, a->line, 0,
+                     "internal error");
+    ncp_flow_reset(a->flow);
+    ncp_an_finish(a, NCP_CMD_F_ERROR);
+    return a->err.code;
+}

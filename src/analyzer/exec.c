@@ -1,0 +1,288 @@
+/* One block in rs274's execution order: comment, feed mode, F, S, T, M codes
+ * by group, then G codes by group, motion, and the stop codes last. Each step
+ * is a small function; the order lives in ncp_exec_block only. */
+#include "state.h"
+
+#include <math.h>
+
+#define W(a, c) ((a)->w.v[NCP_LETTER(c)])
+
+static int ncp_exec_feed_mode(struct ncp_analyzer *a, int g)
+{
+    static const char *const msg[] = {
+        "interpreter: feed mode set to units per minute",
+        "interpreter: feed mode set to inverse time",
+        "interpreter: feed mode set to units per revolution",
+    };
+    int mode = g == 930 ? 1 : g == 940 ? 0 : 2;
+    const char *m = msg[mode];
+    size_t n = 0;
+    while (m[n])
+        n++;
+    ncp_an_emit_text(a, NCP_C_COMMENT, m, n);
+    a->st.m.feed_mode = mode;
+    struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_FEED_MODE);
+    op->i[1] = mode == 2 ? 1 : 0;
+    if (mode != 1) {
+        a->st.feed = 0.0;
+        ncp_an_emit(a, NCP_C_SET_FEED_RATE);
+    }
+    return NCP_OK;
+}
+
+static void ncp_exec_comment_lit(struct ncp_analyzer *a, const char *m)
+{
+    size_t n = 0;
+    while (m[n])
+        n++;
+    ncp_an_emit_text(a, NCP_C_COMMENT, m, n);
+}
+
+static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
+{
+    if (m == 3) {
+        ncp_an_emit(a, NCP_C_START_SPINDLE_CLOCKWISE);
+        a->st.m.spindle_dir = 1;
+    } else if (m == 4) {
+        ncp_an_emit(a, NCP_C_START_SPINDLE_COUNTERCLOCKWISE);
+        a->st.m.spindle_dir = -1;
+    } else if (m == 5) {
+        ncp_an_emit(a, NCP_C_STOP_SPINDLE_TURNING);
+        a->st.m.spindle_dir = 0;
+    } else {
+        struct ncp_canon *op = ncp_an_emit(a, NCP_C_ORIENT_SPINDLE);
+        op->d[0] = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
+        op->i[1] = NCP_HAS(&a->w, 'P') ? (int)lround(W(a, 'P')) : 0;
+    }
+    return NCP_OK;
+}
+
+static int ncp_exec_coolant(struct ncp_analyzer *a, int m)
+{
+    if (m == 7) {
+        ncp_an_emit(a, NCP_C_MIST_ON);
+        a->st.m.mist = 1;
+    } else if (m == 8) {
+        ncp_an_emit(a, NCP_C_FLOOD_ON);
+        a->st.m.flood = 1;
+    } else {
+        ncp_an_emit(a, NCP_C_MIST_OFF);
+        ncp_an_emit(a, NCP_C_FLOOD_OFF);
+        a->st.m.mist = a->st.m.flood = 0;
+    }
+    return NCP_OK;
+}
+
+static int ncp_exec_override(struct ncp_analyzer *a, int m)
+{
+    int on = !NCP_HAS(&a->w, 'P') || W(a, 'P') != 0.0;
+    switch (m) {
+    case 48:
+        ncp_an_emit(a, NCP_C_ENABLE_FEED_OVERRIDE);
+        ncp_an_emit(a, NCP_C_ENABLE_SPEED_OVERRIDE);
+        a->st.m.feed_override = a->st.m.speed_override = 1;
+        break;
+    case 49:
+        ncp_an_emit(a, NCP_C_DISABLE_FEED_OVERRIDE);
+        ncp_an_emit(a, NCP_C_DISABLE_SPEED_OVERRIDE);
+        a->st.m.feed_override = a->st.m.speed_override = 0;
+        break;
+    case 50:
+        ncp_an_emit(a, on ? NCP_C_ENABLE_FEED_OVERRIDE : NCP_C_DISABLE_FEED_OVERRIDE);
+        a->st.m.feed_override = on;
+        break;
+    case 51:
+        ncp_an_emit(a, on ? NCP_C_ENABLE_SPEED_OVERRIDE : NCP_C_DISABLE_SPEED_OVERRIDE);
+        a->st.m.speed_override = on;
+        break;
+    case 52:
+        ncp_an_emit(a, on ? NCP_C_ENABLE_ADAPTIVE_FEED : NCP_C_DISABLE_ADAPTIVE_FEED);
+        a->st.m.adaptive = on;
+        break;
+    default:
+        ncp_an_emit(a, on ? NCP_C_ENABLE_FEED_HOLD : NCP_C_DISABLE_FEED_HOLD);
+        a->st.m.feed_hold = on;
+        break;
+    }
+    return NCP_OK;
+}
+
+static int ncp_exec_io(struct ncp_analyzer *a, int m)
+{
+    static const enum ncp_canon_kind bits[] = {
+        NCP_C_SET_MOTION_OUTPUT_BIT, NCP_C_CLEAR_MOTION_OUTPUT_BIT,
+        NCP_C_SET_AUX_OUTPUT_BIT, NCP_C_CLEAR_AUX_OUTPUT_BIT,
+    };
+    if (m >= 62 && m <= 65) {
+        if (!NCP_HAS(&a->w, 'P'))
+            return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "No valid P word with M%d", m);
+        ncp_an_emit(a, bits[m - 62])->i[0] = (int)lround(W(a, 'P'));
+        return NCP_OK;
+    }
+    if (m == 67 || m == 68) {
+        if (!NCP_HAS(&a->w, 'E') || lround(W(a, 'E')) < 0)
+            return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "Invalid analog index with M%d", m);
+        struct ncp_canon *op = ncp_an_emit(a, m == 67 ? NCP_C_SET_MOTION_OUTPUT_VALUE
+                                                      : NCP_C_SET_AUX_OUTPUT_VALUE);
+        op->i[0] = (int)lround(W(a, 'E'));
+        op->d[0] = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
+        return NCP_OK;
+    }
+    return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "M%d is not supported", m);
+}
+
+static int ncp_exec_plane(struct ncp_analyzer *a, int g)
+{
+    if (g != 170 && g != 180 && g != 190)
+        return ncp_an_error(a, a->w.gcol[NCP_GG_PLANE], "G%d.1 planes are not supported", g / 10);
+    int p = g == 170 ? 0 : g == 190 ? 1 : 2;
+    ncp_an_emit(a, NCP_C_SELECT_PLANE)->i[0] = p;
+    a->st.m.plane = p;
+    return NCP_OK;
+}
+
+static int ncp_exec_comp(struct ncp_analyzer *a, int g)
+{
+    return ncp_comp_gcode(a, g);
+}
+
+static int ncp_exec_control(struct ncp_analyzer *a, int g)
+{
+    struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_MOTION_CONTROL_MODE);
+    /* the canon keeps the naivecam tolerance across G61/G61.1 */
+    if (g == 610) {
+        op->i[0] = 1;
+        a->st.m.control = 1;
+        a->st.m.p_tol = 0.0;
+    } else if (g == 611) {
+        op->i[0] = 0;
+        a->st.m.control = 0;
+        a->st.m.p_tol = 0.0;
+    } else {
+        double p = NCP_HAS(&a->w, 'P') ? W(a, 'P') : 0.0;
+        double q = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : p;
+        op->i[0] = 2;
+        op->d[0] = p;
+        a->st.m.control = 2;
+        a->st.m.p_tol = p;
+        a->st.m.q_tol = q;
+        ncp_an_emit(a, NCP_C_SET_NAIVECAM_TOLERANCE)->d[0] = q;
+    }
+    return NCP_OK;
+}
+
+static void ncp_exec_distance(struct ncp_analyzer *a, int g)
+{
+    int inc = g == 910;
+    if (inc != a->st.m.incremental)
+        ncp_exec_comment_lit(a, inc ? "interpreter: distance mode changed to incremental"
+                                    : "interpreter: distance mode changed to absolute");
+    a->st.m.incremental = inc;
+}
+
+static void ncp_exec_arc_distance(struct ncp_analyzer *a, int g)
+{
+    int inc = g == 911;
+    if (inc != a->st.m.arc_incremental)
+        ncp_exec_comment_lit(a, inc ? "interpreter: IJK distance mode changed to incremental"
+                                    : "interpreter: IJK distance mode changed to absolute");
+    a->st.m.arc_incremental = inc;
+}
+
+static void ncp_exec_retract(struct ncp_analyzer *a, int g)
+{
+    a->st.m.retract_r = g == 990;
+    ncp_exec_comment_lit(a, g == 990 ? "interpreter: retract mode set to r_plane"
+                                     : "interpreter: retract mode set to old_z");
+}
+
+static int ncp_exec_m_codes(struct ncp_analyzer *a)
+{
+    const struct ncp_words *w = &a->w;
+    int rc = NCP_OK;
+    if (w->m[NCP_MG_IO] != -1)
+        rc = ncp_exec_io(a, w->m[NCP_MG_IO]);
+    if (rc == NCP_OK && w->m[NCP_MG_TOOL] != -1)
+        rc = ncp_tools_change(a);
+    if (rc == NCP_OK && w->m[NCP_MG_SPINDLE] != -1)
+        rc = ncp_exec_spindle(a, w->m[NCP_MG_SPINDLE]);
+    if (rc == NCP_OK && w->m[NCP_MG_COOLANT] != -1)
+        rc = ncp_exec_coolant(a, w->m[NCP_MG_COOLANT]);
+    if (rc == NCP_OK && w->m[NCP_MG_OVERRIDE] != -1)
+        rc = ncp_exec_override(a, w->m[NCP_MG_OVERRIDE]);
+    return rc;
+}
+
+static int ncp_exec_g_codes(struct ncp_analyzer *a)
+{
+    const struct ncp_words *w = &a->w;
+    int rc = NCP_OK;
+    if (w->g[NCP_GG_NONMODAL] == 40)
+        ncp_an_emit(a, NCP_C_DWELL)->d[0] = W(a, 'P');
+    if (w->g[NCP_GG_PLANE] != -1)
+        rc = ncp_exec_plane(a, w->g[NCP_GG_PLANE]);
+    if (rc == NCP_OK && w->g[NCP_GG_UNITS] != -1)
+        rc = ncp_offsets_units(a, w->g[NCP_GG_UNITS] == 200);
+    if (rc == NCP_OK && w->g[NCP_GG_LATHE] != -1)
+        rc = ncp_an_error(a, w->gcol[NCP_GG_LATHE], "lathe diameter mode is not supported");
+    if (rc == NCP_OK && w->g[NCP_GG_COMP] != -1)
+        rc = ncp_exec_comp(a, w->g[NCP_GG_COMP]);
+    if (rc == NCP_OK && w->g[NCP_GG_TLO] != -1)
+        rc = ncp_offsets_tlo(a, w->g[NCP_GG_TLO]);
+    if (rc == NCP_OK && w->g[NCP_GG_COORD] != -1)
+        rc = ncp_offsets_coord(a, 1 + (w->g[NCP_GG_COORD] >= 590
+                                       ? 5 + w->g[NCP_GG_COORD] - 590
+                                       : (w->g[NCP_GG_COORD] - 540) / 10));
+    if (rc == NCP_OK && w->g[NCP_GG_CONTROL] != -1)
+        rc = ncp_exec_control(a, w->g[NCP_GG_CONTROL]);
+    if (rc != NCP_OK)
+        return rc;
+    if (w->g[NCP_GG_DIST] != -1)
+        ncp_exec_distance(a, w->g[NCP_GG_DIST]);
+    if (w->g[NCP_GG_ARCDIST] != -1)
+        ncp_exec_arc_distance(a, w->g[NCP_GG_ARCDIST]);
+    if (w->g[NCP_GG_RETRACT] != -1)
+        ncp_exec_retract(a, w->g[NCP_GG_RETRACT]);
+    if (w->g[NCP_GG_NONMODAL] != -1 && w->g[NCP_GG_NONMODAL] != 40 &&
+        w->g[NCP_GG_NONMODAL] != 530)
+        rc = ncp_offsets_modal0(a, w->g[NCP_GG_NONMODAL]);
+    if (rc == NCP_OK && w->motion_to_be != -1)
+        rc = ncp_motion_run(a, w->motion_to_be);
+    return rc;
+}
+
+int ncp_exec_block(struct ncp_analyzer *a)
+{
+    const struct ncp_words *w = &a->w;
+    int rc = NCP_OK;
+    if (a->blk->comment_kind != NCP_CMT_NONE)
+        rc = ncp_comment_run(a);
+    if (rc == NCP_OK && w->g[NCP_GG_SPINDLE] != -1) {
+        /* G96 without D: rs274 passes 1e30 as "no limit" */
+        struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_SPINDLE_MODE);
+        if (w->g[NCP_GG_SPINDLE] == 960)
+            op->d[0] = NCP_HAS(w, 'D') ? W(a, 'D') : 1e30;
+    }
+    if (rc == NCP_OK && w->g[NCP_GG_FEEDMODE] != -1)
+        rc = ncp_exec_feed_mode(a, w->g[NCP_GG_FEEDMODE]);
+    if (rc != NCP_OK)
+        return rc;
+    if (NCP_HAS(w, 'F') && a->st.m.feed_mode != 1) {
+        a->st.feed = W(a, 'F');
+        ncp_an_emit(a, NCP_C_SET_FEED_RATE)->d[0] = a->st.feed;
+    }
+    if (NCP_HAS(w, 'S')) {
+        a->st.speed = W(a, 'S');
+        ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->d[0] = a->st.speed;
+    }
+    if (NCP_HAS(w, 'T'))
+        rc = ncp_tools_select(a);
+    if (rc == NCP_OK)
+        rc = ncp_exec_m_codes(a);
+    if (rc == NCP_OK)
+        rc = ncp_exec_g_codes(a);
+    if (rc == NCP_OK && w->m[NCP_MG_STOP] != -1)
+        rc = ncp_stop_run(a, w->m[NCP_MG_STOP]);
+    ncp_offsets_sync_params(a);
+    return rc;
+}

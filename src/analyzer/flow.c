@@ -1,0 +1,956 @@
+/* O-word control flow, modelled on rs274's own: one table of O-word labels
+ * (subroutine names, and loop/if labels scoped by the subroutine they are in),
+ * a "skip forward to label L" state, and jumps back to a label's recorded block.
+ * Following that model rather than a structured parser keeps rs274's results,
+ * including its error messages and its corner cases, for any program.
+ *
+ * Blocks come from the pre-lexed feed while execution moves forward through new
+ * text; a jump back re-reads the text from the jump target (with a small cache
+ * of lexed blocks for loop bodies) until it is back at the feed's position. */
+#include "flow.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* rs274 -g runs with the block delete switch off: '/' blocks are executed. */
+#define FLOW_BLOCK_DELETE 0
+#define FLOW_DEFAULT_MAX_LOOPS 10000000u
+#define FLOW_DEFAULT_MAX_DEPTH 10u    /* rs274: INTERP_SUB_ROUTINE_LEVELS */
+#define FLOW_CACHE_BITS 8
+#define FLOW_CACHE_SLOTS (1u << FLOW_CACHE_BITS) /* re-read blocks kept lexed (~2 MB) */
+#define FLOW_NAME_MAX NCP_BLOCK_POOL
+#define FLOW_LABEL_MAX (2 * FLOW_NAME_MAX + 2)
+
+struct flow_pos {
+    uint64_t off;
+    uint32_t line;
+};
+
+/* One entry of the label table: where a sub, loop or if was first seen. */
+struct flow_label {
+    uint32_t hash, key_off, key_len;  /* key_len 0: empty slot */
+    uint8_t type;                     /* enum ncp_oword_kind that defined it */
+    int32_t repeat_count;             /* -1: not counting */
+    uint32_t line;
+    uint64_t off;
+    uint64_t iterations;              /* of the current run of the loop */
+};
+
+struct flow_labels {
+    struct flow_label *slots;
+    uint32_t cap, count;
+    char *arena;
+    size_t used, acap;
+};
+
+struct flow_frame {
+    struct flow_pos ret;              /* block after the call */
+    uint16_t name_len;
+    char name[FLOW_NAME_MAX];         /* the called sub: scope of its labels */
+};
+
+struct flow_cached {
+    struct ncp_block blk;
+    uint64_t next;
+    int valid;
+};
+
+/* Text-valued state ("skip to label", "seeking sub", "defining sub"). */
+struct flow_name {
+    int on;
+    uint16_t len;
+    char s[FLOW_LABEL_MAX];
+};
+
+struct ncp_flow {
+    struct ncp_block_feed feed;
+    const struct ncp_source *src;
+    struct ncp_params *params;
+    struct ncp_param_ops pops;
+    uint32_t max_loops, max_depth;
+
+    struct flow_pos cur;              /* next block to execute */
+    struct flow_pos feed_pos;         /* next block the feed will deliver */
+    int feed_done, feed_held;
+    struct flow_cached *cache;
+
+    struct flow_labels labels;
+    struct flow_frame *frames;        /* [1 .. level] */
+    int frames_cap, level;
+
+    struct flow_name skip;            /* skipping forward to this label */
+    struct flow_name seek_sub;        /* ... looking for this sub's definition */
+    struct flow_name defining;        /* inside this sub's definition (level 0) */
+    /* rs274 accepts a stray return at level 0 once any call has returned there
+     * (its "current sub" is then an empty name, no longer none) */
+    int in_sub_context;
+    uint32_t skip_start;
+    int executed_if, doing_break, doing_continue;
+    uint64_t jump_target;             /* offset of the block a loop jumped to */
+    int by_jump;                      /* the current block was reached that way */
+    double test_value;
+    double args[NCP_OWORD_MAX_ARGS];
+    int nargs;
+
+    char label[FLOW_LABEL_MAX];       /* label of the block being run */
+    size_t label_len;
+};
+
+static void name_set(struct flow_name *n, const char *s, size_t len)
+{
+    if (len >= sizeof n->s)
+        len = sizeof n->s - 1;
+    memcpy(n->s, s, len);
+    n->s[len] = '\0';
+    n->len = (uint16_t)len;
+    n->on = 1;
+}
+
+static int name_eq(const struct flow_name *n, const char *s, size_t len)
+{
+    return n->on && n->len == len && memcmp(n->s, s, len) == 0;
+}
+
+/* ======================================================================
+ * Label table
+ * ====================================================================== */
+
+static uint32_t flow_hash(const char *s, size_t n)
+{
+    uint32_t h = 2166136261u;
+    for (size_t i = 0; i < n; i++) {
+        h ^= (unsigned char)s[i];
+        h *= 16777619u;
+    }
+    return h;
+}
+
+static struct flow_label *labels_find(const struct flow_labels *t, const char *k,
+                                      size_t len)
+{
+    if (!t->cap)
+        return NULL;
+    uint32_t h = flow_hash(k, len), mask = t->cap - 1;
+    for (uint32_t i = h & mask;; i = (i + 1) & mask) {
+        struct flow_label *e = &t->slots[i];
+        if (!e->key_len)
+            return NULL;
+        if (e->hash == h && e->key_len == len && memcmp(t->arena + e->key_off, k, len) == 0)
+            return e;
+    }
+}
+
+static int labels_grow(struct flow_labels *t)
+{
+    uint32_t ncap = t->cap ? t->cap * 2 : 64;
+    struct flow_label *ns = calloc(ncap, sizeof *ns);
+    if (!ns)
+        return -1;
+    for (uint32_t i = 0; i < t->cap; i++) {
+        if (!t->slots[i].key_len)
+            continue;
+        uint32_t j = t->slots[i].hash & (ncap - 1);
+        while (ns[j].key_len)
+            j = (j + 1) & (ncap - 1);
+        ns[j] = t->slots[i];
+    }
+    free(t->slots);
+    t->slots = ns;
+    t->cap = ncap;
+    return 0;
+}
+
+/* Add a new key (the caller checked it is absent). NULL when out of memory. */
+static struct flow_label *labels_add(struct flow_labels *t, const char *k, size_t len)
+{
+    if ((t->count + 1) * 2 > t->cap && labels_grow(t) != 0)
+        return NULL;
+    if (t->used + len > t->acap) {
+        size_t ncap = t->acap ? t->acap : 1024;
+        while (ncap < t->used + len)
+            ncap *= 2;
+        char *na = realloc(t->arena, ncap);
+        if (!na)
+            return NULL;
+        t->arena = na;
+        t->acap = ncap;
+    }
+    memcpy(t->arena + t->used, k, len);
+    uint32_t h = flow_hash(k, len), mask = t->cap - 1, i = h & mask;
+    while (t->slots[i].key_len)
+        i = (i + 1) & mask;
+    struct flow_label *e = &t->slots[i];
+    *e = (struct flow_label){ .hash = h, .key_off = (uint32_t)t->used,
+                              .key_len = (uint32_t)len, .repeat_count = -1 };
+    t->used += len;
+    t->count++;
+    return e;
+}
+
+static void labels_clear(struct flow_labels *t)
+{
+    if (t->count)
+        memset(t->slots, 0, t->cap * sizeof *t->slots);
+    t->count = 0;
+    t->used = 0;
+}
+
+/* ======================================================================
+ * Block source: the feed, or re-reading the text behind it
+ * ====================================================================== */
+
+static void release_feed(struct ncp_flow *f)
+{
+    if (f->feed_held) {
+        f->feed_held = 0;
+        if (f->feed.release)
+            f->feed.release(f->feed.ctx);
+    }
+}
+
+static int may_be_oword(const char *s, size_t n)
+{
+    return memchr(s, 'o', n) || memchr(s, 'O', n);
+}
+
+static int from_feed(struct ncp_flow *f, const struct ncp_block **out)
+{
+    if (f->feed_done)
+        return NCP_END;
+    const struct ncp_block *b = f->feed.next(f->feed.ctx);
+    if (!b) {
+        f->feed_done = 1;
+        return NCP_END;
+    }
+    f->feed_held = 1;
+    struct ncp_span sp;
+    uint64_t next = f->src->end;
+    if (ncp_source_span(f->src, b->offset, b->line, &sp) == 0)
+        next = sp.next;
+    f->feed_pos.off = next;
+    f->feed_pos.line = b->line + 1;
+    f->cur = f->feed_pos;
+    *out = b;
+    return NCP_OK;
+}
+
+/* Sets *out to NULL for a block skipped without lexing it (skipping, and its
+ * text cannot hold an O-word). */
+static int from_text(struct ncp_flow *f, int skipping, const struct ncp_block **out,
+                     struct ncp_diag *d)
+{
+    if (!f->cache) {
+        f->cache = calloc(FLOW_CACHE_SLOTS, sizeof *f->cache);
+        if (!f->cache)
+            return ncp_diag_set(d, NCP_ERR_IO, f->cur.line, 0, "out of memory");
+    }
+    struct flow_cached *c =
+        &f->cache[(f->cur.off * 0x9E3779B97F4A7C15ull) >> (64 - FLOW_CACHE_BITS)];
+    if (c->valid && c->blk.offset == f->cur.off) {
+        f->cur.off = c->next;
+        f->cur.line = c->blk.line + 1;
+        *out = &c->blk;
+        return NCP_OK;
+    }
+    struct ncp_span sp;
+    if (ncp_source_span(f->src, f->cur.off, f->cur.line, &sp) != 0)
+        return NCP_END;
+    f->cur.off = sp.next;
+    f->cur.line = sp.line + 1;
+    const char *text = f->src->text + sp.off;
+    if (skipping && !may_be_oword(text, sp.len)) {
+        *out = NULL;
+        return NCP_OK;
+    }
+    ncp_lex_block(text, sp.len, sp.line, sp.off, &c->blk);
+    c->next = sp.next;
+    c->valid = 1;
+    *out = &c->blk;
+    return NCP_OK;
+}
+
+static int fetch(struct ncp_flow *f, int skipping, const struct ncp_block **out,
+                 struct ncp_diag *d)
+{
+    release_feed(f);
+    if (f->cur.off >= f->feed_pos.off)
+        return from_feed(f, out);
+    return from_text(f, skipping, out, d);
+}
+
+/* ======================================================================
+ * Messages
+ * ====================================================================== */
+
+static const char *kind_name(int kind)
+{
+    static const char *const names[] = {
+        [NCP_O_NONE] = "none", [NCP_O_SUB] = "sub", [NCP_O_ENDSUB] = "endsub",
+        [NCP_O_CALL] = "call", [NCP_O_RETURN] = "return", [NCP_O_IF] = "if",
+        [NCP_O_ELSEIF] = "elseif", [NCP_O_ELSE] = "else", [NCP_O_ENDIF] = "endif",
+        [NCP_O_WHILE] = "while", [NCP_O_ENDWHILE] = "endwhile", [NCP_O_DO] = "do",
+        [NCP_O_REPEAT] = "repeat", [NCP_O_ENDREPEAT] = "endrepeat",
+        [NCP_O_BREAK] = "break", [NCP_O_CONTINUE] = "continue",
+    };
+    if (kind < 0 || kind >= (int)(sizeof names / sizeof names[0]) || !names[kind])
+        return "?";
+    return names[kind];
+}
+
+/* The block's text as rs274 quotes it: trailing blanks cut, kept short. */
+static int line_text(const struct ncp_flow *f, const struct ncp_block *b,
+                     const char **s)
+{
+    size_t n = b->length;
+    if (b->offset > f->src->len || n > f->src->len - b->offset)
+        n = 0;
+    *s = f->src->text + (n ? b->offset : 0);
+    while (n > 0 && ((*s)[n - 1] == ' ' || (*s)[n - 1] == '\t' || (*s)[n - 1] == '\r'))
+        n--;
+    return n > 80 ? 80 : (int)n;
+}
+
+static int oword_error(const struct ncp_block *b, const char *what,
+                       struct ncp_diag *d)
+{
+    return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col, "%s", what);
+}
+
+static int err_undefined(struct ncp_flow *f, const struct ncp_block *b,
+                         struct ncp_diag *d)
+{
+    const char *s;
+    int n = line_text(f, b, &s);
+    return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                        "undefined O-word label: '%.*s'", n, s);
+}
+
+/* "found 'while' in line 3" */
+static int err_mismatch(struct ncp_flow *f, const struct ncp_block *b,
+                        const char *what, const struct flow_label *op,
+                        struct ncp_diag *d)
+{
+    const char *s;
+    int n = line_text(f, b, &s);
+    return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                        "%s: '%.*s' (found '%s' in line %u)", what, n, s,
+                        kind_name(op->type), op->line);
+}
+
+/* How a user wrote the O-word: o100 or o<name>. */
+static void display_name(const struct ncp_block *b, char *buf, size_t cap)
+{
+    const char *s = b->pool + b->oword.name_off;
+    size_t n = b->oword.name_len, i = 0;
+    if (n > 60)
+        n = 60;
+    while (i < n && s[i] >= '0' && s[i] <= '9')
+        i++;
+    if (n > 0 && i == n)
+        snprintf(buf, cap, "o%.*s", (int)n, s);
+    else
+        snprintf(buf, cap, "o<%.*s>", (int)n, s);
+}
+
+/* ======================================================================
+ * The O-word state machine
+ * ====================================================================== */
+
+static int is_global_kind(int kind)
+{
+    return kind == NCP_O_SUB || kind == NCP_O_ENDSUB || kind == NCP_O_CALL ||
+           kind == NCP_O_RETURN;
+}
+
+/* Subroutine names are global; other labels belong to the subroutine they are
+ * written in (the called one, or the one being defined), as "sub#label". */
+static void make_label(struct ncp_flow *f, const struct ncp_block *b)
+{
+    const char *name = b->pool + b->oword.name_off;
+    size_t len = b->oword.name_len, n = 0;
+    if (len > FLOW_NAME_MAX)
+        len = FLOW_NAME_MAX;
+    if (!is_global_kind(b->oword.kind)) {
+        if (f->level > 0) {
+            memcpy(f->label, f->frames[f->level].name, f->frames[f->level].name_len);
+            n = f->frames[f->level].name_len;
+        } else if (f->defining.on) {
+            memcpy(f->label, f->defining.s, f->defining.len);
+            n = f->defining.len;
+        }
+        f->label[n++] = '#';
+    }
+    memcpy(f->label + n, name, len);
+    f->label_len = n + len;
+    f->label[f->label_len] = '\0';
+}
+
+static int skipping_other(const struct ncp_flow *f)
+{
+    return f->skip.on && !name_eq(&f->skip, f->label, f->label_len);
+}
+
+static void skip_to_label(struct ncp_flow *f, const struct ncp_block *b)
+{
+    name_set(&f->skip, f->label, f->label_len);
+    f->skip_start = b->line;
+}
+
+static int eval(struct ncp_flow *f, const struct ncp_block *b, const struct ncp_expr *e,
+                double *v, struct ncp_diag *d)
+{
+    if (e->is_const) {
+        *v = e->value;
+        return NCP_OK;
+    }
+    return ncp_expr_eval(b, e, &f->pops, v, d);
+}
+
+static struct flow_label *find_label(struct ncp_flow *f)
+{
+    return labels_find(&f->labels, f->label, f->label_len);
+}
+
+static int save_label(struct ncp_flow *f, const struct ncp_block *b,
+                      struct flow_label **out, struct ncp_diag *d)
+{
+    const struct flow_label *old = find_label(f);
+    if (old) {
+        const char *file = f->src->name ? f->src->name : "";
+        if (old->line == b->line)
+            return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                                "File:%s line:%u sub: o|%s| found in illegal location",
+                                file, b->line, f->label);
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                            "File:%s line:%u redefining sub: o|%s| already defined in "
+                            "file:%s", file, b->line, f->label, file);
+    }
+    struct flow_label *e = labels_add(&f->labels, f->label, f->label_len);
+    if (!e)
+        return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
+    e->type = b->oword.kind;
+    e->line = b->line;
+    e->off = b->offset;
+    if (out)
+        *out = e;
+    return NCP_OK;
+}
+
+static void jump_to(struct ncp_flow *f, const struct flow_label *op)
+{
+    f->cur.off = op->off;
+    f->cur.line = op->line;
+    f->jump_target = op->off;
+}
+
+/* Runaway guard, per run of a loop. A run starts when its first line is
+ * reached by falling into it, not by a jump back: so a loop left by return
+ * starts afresh next time, while rs274's leftover continue flag, which can
+ * send an exhausted loop back to its start for ever, keeps counting. */
+static void loop_entered(const struct ncp_flow *f, struct flow_label *op)
+{
+    if (!f->by_jump)
+        op->iterations = 0;
+}
+
+static int count_iteration(struct ncp_flow *f, const struct ncp_block *b,
+                           struct flow_label *op, struct ncp_diag *d)
+{
+    if (++op->iterations <= f->max_loops)
+        return NCP_OK;
+    char name[80];
+    display_name(b, name, sizeof name);
+    return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
+                        "loop %s at line %u repeated more than %u times: runaway loop? "
+                        "(raise max_loop_iterations if intended)",
+                        name, op->line, f->max_loops);
+}
+
+/* What rs274 does while reading an O-word line: evaluate its expressions unless
+ * it is being skipped. *ignore = 1 when the block has no effect at all. */
+static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore,
+                      struct ncp_diag *d)
+{
+    const struct ncp_oword *o = &b->oword;
+    double v;
+    int rc;
+    *ignore = 0;
+    switch (o->kind) {
+    case NCP_O_SUB:
+        if (f->defining.on)
+            return oword_error(b, "Nested subroutine definition", d);
+        return NCP_OK;
+    case NCP_O_ENDSUB:
+    case NCP_O_RETURN:
+        if (skipping_other(f)) {
+            *ignore = 1;
+            return NCP_OK;
+        }
+        if (!o->has_cond) {
+            ncp_params_set_return(f->params, 0.0, 0);
+            return NCP_OK;
+        }
+        rc = eval(f, b, &o->cond, &v, d);
+        if (rc == NCP_OK)
+            ncp_params_set_return(f->params, v, 1);
+        return rc;
+    default:
+        break;
+    }
+    if (f->defining.on) {
+        *ignore = 1;
+        return NCP_OK;
+    }
+    switch (o->kind) {
+    case NCP_O_CALL:
+        if (f->skip.on) {
+            *ignore = 1;
+            return NCP_OK;
+        }
+        f->nargs = o->nargs > NCP_OWORD_MAX_ARGS ? NCP_OWORD_MAX_ARGS : o->nargs;
+        for (int i = 0; i < f->nargs; i++) {
+            rc = eval(f, b, &o->args[i], &f->args[i], d);
+            if (rc != NCP_OK)
+                return rc;
+        }
+        return NCP_OK;
+    case NCP_O_WHILE:
+    case NCP_O_REPEAT:
+    case NCP_O_IF:
+    case NCP_O_ELSEIF:
+        if (skipping_other(f)) {
+            *ignore = 1;
+            return NCP_OK;
+        }
+        if (!o->has_cond) {
+            char msg[64];
+            snprintf(msg, sizeof msg, "Left bracket missing after '%s'", kind_name(o->kind));
+            return oword_error(b, msg, d);
+        }
+        return eval(f, b, &o->cond, &f->test_value, d);
+    default:
+        return NCP_OK;
+    }
+}
+
+static int do_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    if (f->skip.on) {
+        /* found the sub a call was seeking: it is defined from now on */
+        int rc = save_label(f, b, NULL, d);
+        if (rc != NCP_OK)
+            return rc;
+        f->skip.on = 0;
+    }
+    f->seek_sub.on = 0;
+    if (f->level > 0)
+        return NCP_OK;           /* the called sub's own first line */
+    int rc = save_label(f, b, NULL, d);
+    if (rc != NCP_OK)
+        return rc;
+    skip_to_label(f, b);
+    name_set(&f->defining, f->label, f->label_len);
+    f->in_sub_context = 1;
+    return NCP_OK;
+}
+
+static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    if (f->level == 0 && !f->in_sub_context) {
+        const char *s;
+        int n = line_text(f, b, &s);
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                            "not in a subroutine definition: '%.*s'", n, s);
+    }
+    if (f->skip.on && b->oword.kind == NCP_O_ENDSUB)
+        f->skip.on = 0;
+    if (f->level > 0) {
+        ncp_params_pop_call(f->params);
+        f->cur = f->frames[f->level].ret;
+        f->level--;
+        if (f->level == 0)
+            f->in_sub_context = 1;
+    } else if (b->oword.kind == NCP_O_ENDSUB) {
+        if (!f->defining.on)
+            return oword_error(b, "Not in subroutine definition", d);
+        f->skip.on = 0;
+        f->defining.on = 0;
+        f->in_sub_context = 0;
+    }
+    return NCP_OK;
+}
+
+static int grow_frames(struct ncp_flow *f)
+{
+    if (f->level + 1 < f->frames_cap)
+        return 0;
+    int ncap = f->frames_cap ? f->frames_cap * 2 : 16;
+    struct flow_frame *nf = realloc(f->frames, (size_t)ncap * sizeof *nf);
+    if (!nf)
+        return -1;
+    f->frames = nf;
+    f->frames_cap = ncap;
+    return 0;
+}
+
+static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    if ((uint32_t)f->level + 1 >= f->max_depth)
+        return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, b->oword.col,
+                            "Too many subroutine levels");
+    if (grow_frames(f) != 0)
+        return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
+    int rc = ncp_params_push_call(f->params, f->args, f->nargs, d);
+    if (rc != NCP_OK)
+        return rc;
+    struct flow_frame *fr = &f->frames[++f->level];
+    fr->ret = f->cur;
+    size_t n = f->label_len < FLOW_NAME_MAX ? f->label_len : FLOW_NAME_MAX;
+    memcpy(fr->name, f->label, n);
+    fr->name_len = (uint16_t)n;
+    f->skip.on = 0;
+    const struct flow_label *op = find_label(f);
+    if (op) {
+        jump_to(f, op);
+        return NCP_OK;
+    }
+    /* not seen yet: read on until its definition, as rs274 does */
+    skip_to_label(f, b);
+    name_set(&f->seek_sub, f->label, f->label_len);
+    return NCP_OK;
+}
+
+static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    struct flow_label *op = find_label(f);
+    if (op && op->line != b->line) {
+        const char *s;
+        int n = line_text(f, b, &s);
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                            "duplicate O-word label: '%.*s' - defined in line %u", n, s,
+                            op->line);
+    }
+    if (!op) {
+        int rc = save_label(f, b, &op, d);
+        if (rc != NCP_OK)
+            return rc;
+    }
+    f->skip.on = 0;
+    if (op->type != NCP_O_REPEAT)
+        return NCP_OK;
+    if (op->repeat_count == -1) {
+        double r = floor(f->test_value + 0.5);
+        op->repeat_count = r > INT32_MAX ? INT32_MAX : r < 0 ? 0 : (int32_t)r;
+    }
+    if (op->repeat_count > 0) {
+        op->repeat_count--;
+        loop_entered(f, op);
+        return count_iteration(f, b, op, d);
+    }
+    skip_to_label(f, b);
+    op->repeat_count = -1;
+    return NCP_OK;
+}
+
+static int do_while(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    struct flow_label *op = find_label(f);
+    if (op && op->type != NCP_O_DO && op->line != b->line) {
+        const char *s;
+        int n = line_text(f, b, &s);
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                            "duplicate O-word label: '%.*s' - defined in line %u", n, s,
+                            op->line);
+    }
+    if (!op) {
+        int rc = save_label(f, b, &op, d);
+        if (rc != NCP_OK)
+            return rc;
+    }
+    f->skip.on = 0;
+    if (op->type == NCP_O_WHILE) {
+        loop_entered(f, op);
+        if (f->test_value != 0.0)
+            return count_iteration(f, b, op, d);
+        skip_to_label(f, b);
+        return NCP_OK;
+    }
+    /* the closing line of a do/while loop */
+    if (f->test_value != 0.0 && !f->doing_break) {
+        int rc = count_iteration(f, b, op, d);
+        if (rc == NCP_OK)
+            jump_to(f, op);
+        return rc;
+    }
+    f->doing_break = 0;
+    return NCP_OK;
+}
+
+static int do_do(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    struct flow_label *op = find_label(f);
+    f->skip.on = 0;
+    if (!op)
+        return save_label(f, b, NULL, d);
+    loop_entered(f, op);
+    return NCP_OK;
+}
+
+static int do_if(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    const struct flow_label *op = find_label(f);
+    if (op && op->line != b->line) {
+        const char *s;
+        int n = line_text(f, b, &s);
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                            "duplicate O-word label - already defined in line %u: '%.*s'",
+                            op->line, n, s);
+    }
+    if (!op) {
+        int rc = save_label(f, b, NULL, d);
+        if (rc != NCP_OK)
+            return rc;
+    }
+    if (f->test_value != 0.0) {
+        f->skip.on = 0;
+        f->executed_if = 1;
+    } else {
+        skip_to_label(f, b);
+        f->executed_if = 0;
+    }
+    return NCP_OK;
+}
+
+/* elseif / else: the label must be an if's. */
+static int do_else(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    const struct flow_label *op = find_label(f);
+    if (!op)
+        return err_undefined(f, b, d);
+    if (op->type != NCP_O_IF)
+        return err_mismatch(f, b, "no matching 'if' label", op, d);
+    if (f->executed_if) {
+        skip_to_label(f, b);
+        return NCP_OK;
+    }
+    if (b->oword.kind == NCP_O_ELSEIF) {
+        if (f->test_value != 0.0) {
+            f->skip.on = 0;
+            f->executed_if = 1;
+        }
+    } else if (name_eq(&f->skip, f->label, f->label_len)) {
+        f->executed_if = 1;
+        f->skip.on = 0;
+    }
+    return NCP_OK;
+}
+
+static int do_endif(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    const struct flow_label *op = find_label(f);
+    if (!op)
+        return err_undefined(f, b, d);
+    if (op->type != NCP_O_IF) {
+        const char *s;
+        int n = line_text(f, b, &s);
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
+                            "no matching label: '%s' (found '%s' in line %u): '%.*s'",
+                            f->label, kind_name(op->type), op->line, n, s);
+    }
+    f->skip.on = 0;
+    f->executed_if = 1;
+    return NCP_OK;
+}
+
+/* break / continue: the label must be a while's or a do's. */
+static int do_break(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    const struct flow_label *op = find_label(f);
+    if (!op)
+        return err_undefined(f, b, d);
+    if (op->type != NCP_O_WHILE && op->type != NCP_O_DO)
+        return err_mismatch(f, b, "no matching while/do label", op, d);
+    if (b->oword.kind == NCP_O_BREAK) {
+        f->doing_break = 1;
+    } else {
+        if (name_eq(&f->skip, f->label, f->label_len))
+            return NCP_OK;
+        f->doing_continue = 1;
+    }
+    skip_to_label(f, b);
+    return NCP_OK;
+}
+
+static int do_endloop(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    struct flow_label *op = find_label(f);
+    if (!op)
+        return err_undefined(f, b, d);
+    int want = b->oword.kind == NCP_O_ENDREPEAT ? NCP_O_REPEAT : NCP_O_WHILE;
+    if (op->type != want)
+        return err_mismatch(f, b, "no matching label", op, d);
+    if (name_eq(&f->skip, f->label, f->label_len)) {
+        f->skip.on = 0;
+        if (!f->doing_continue)
+            return NCP_OK;
+        f->doing_continue = 0;
+    }
+    jump_to(f, op);
+    return NCP_OK;
+}
+
+static int run_oword(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    int ignore;
+    make_label(f, b);
+    int rc = read_oword(f, b, &ignore, d);
+    if (rc != NCP_OK || ignore || skipping_other(f))
+        return rc;
+    if (f->seek_sub.on && b->oword.kind != NCP_O_SUB)
+        return NCP_OK;
+    switch (b->oword.kind) {
+    case NCP_O_SUB:
+        return do_sub(f, b, d);
+    case NCP_O_ENDSUB:
+    case NCP_O_RETURN:
+        return do_return(f, b, d);
+    case NCP_O_CALL:
+        return do_call(f, b, d);
+    case NCP_O_DO:
+        return do_do(f, b, d);
+    case NCP_O_REPEAT:
+        return do_repeat(f, b, d);
+    case NCP_O_WHILE:
+        return do_while(f, b, d);
+    case NCP_O_IF:
+        return do_if(f, b, d);
+    case NCP_O_ELSEIF:
+    case NCP_O_ELSE:
+        return do_else(f, b, d);
+    case NCP_O_ENDIF:
+        return do_endif(f, b, d);
+    case NCP_O_BREAK:
+    case NCP_O_CONTINUE:
+        return do_break(f, b, d);
+    case NCP_O_ENDWHILE:
+    case NCP_O_ENDREPEAT:
+        return do_endloop(f, b, d);
+    default:
+        return oword_error(b, "Unknown command in O-word line", d);
+    }
+}
+
+/* End of the program body while still looking for a label. */
+static int at_end(struct ncp_flow *f, struct ncp_diag *d)
+{
+    if (f->skip.on && f->src->has_percent)
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->cur.line, 0,
+                            "Failed to find sub 'O%s' before EOF", f->skip.s);
+    if (f->seek_sub.on)
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->skip_start, 0,
+                            "EOF in file:%s seeking o-word: o<%s> from line: %u",
+                            f->src->name ? f->src->name : "", f->seek_sub.s, f->skip_start);
+    return NCP_END;
+}
+
+static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
+                     struct ncp_diag *d)
+{
+    for (;;) {
+        int skipping = f->skip.on;
+        const struct ncp_block *b = NULL;
+        uint64_t target = f->jump_target;
+        f->jump_target = UINT64_MAX;
+        int rc = fetch(f, skipping, &b, d);
+        if (rc == NCP_END)
+            return at_end(f, d);
+        if (rc != NCP_OK)
+            return rc;
+        if (!b || (FLOW_BLOCK_DELETE && b->block_delete))
+            continue;
+        f->by_jump = b->offset == target;
+        if (b->err.code != NCP_OK) {
+            /* rs274 does not parse the lines it skips */
+            if (skipping)
+                continue;
+            *d = b->err;
+            return b->err.code;
+        }
+        if (b->oword.kind == NCP_O_NONE) {
+            if (skipping)
+                continue;
+            *out = b;
+            return NCP_OK;
+        }
+        rc = run_oword(f, b, d);
+        if (rc != NCP_OK)
+            return rc;
+    }
+}
+
+int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out, struct ncp_diag *d)
+{
+    int rc = flow_step(f, out, d);
+    /* no block goes out with an end or an error: hand the last one back now,
+     * while the feed surely still exists */
+    if (rc != NCP_OK)
+        release_feed(f);
+    return rc;
+}
+
+/* ======================================================================
+ * Life cycle
+ * ====================================================================== */
+
+struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_params *params,
+                              const struct ncp_analyzer_cfg *cfg)
+{
+    struct ncp_flow *f = calloc(1, sizeof *f);
+    if (!f)
+        return NULL;
+    f->feed = *feed;
+    f->src = feed->src;
+    f->params = params;
+    f->pops = ncp_params_ops(params);
+    f->max_loops = cfg && cfg->max_loop_iterations ? cfg->max_loop_iterations
+                                                   : FLOW_DEFAULT_MAX_LOOPS;
+    f->max_depth = cfg && cfg->max_call_depth ? cfg->max_call_depth : FLOW_DEFAULT_MAX_DEPTH;
+    f->cur.off = f->src->begin;
+    f->cur.line = f->src->begin_line;
+    f->feed_pos = f->cur;
+    f->jump_target = UINT64_MAX;
+    return f;
+}
+
+void ncp_flow_free(struct ncp_flow *f)
+{
+    if (!f)
+        return;
+    release_feed(f);
+    free(f->cache);
+    free(f->labels.slots);
+    free(f->labels.arena);
+    free(f->frames);
+    free(f);
+}
+
+int ncp_flow_call_depth(const struct ncp_flow *f)
+{
+    return f->level;
+}
+
+void ncp_flow_reset(struct ncp_flow *f)
+{
+    while (f->level > 0) {
+        ncp_params_pop_call(f->params);
+        f->level--;
+    }
+    f->skip.on = 0;
+    f->seek_sub.on = 0;
+    f->defining.on = 0;
+    f->in_sub_context = 0;
+    labels_clear(&f->labels);
+}

@@ -1,0 +1,172 @@
+/* Whole-block consistency checks, done once per block on the word bitmask:
+ * which motion the block performs, axis words without a user, words without a
+ * G/M code that uses them (rs274's enhance_block and check_* rules). */
+#include "state.h"
+
+#include <math.h>
+
+#define BIT(c) (1u << NCP_LETTER(c))
+
+static int ncp_first_axis_col(const struct ncp_words *w)
+{
+    static const char ax[] = "XYZABCUVW";
+    int best = 0;
+    for (const char *p = ax; *p; p++)
+        if (NCP_HAS(w, *p) && (best == 0 || w->col[NCP_LETTER(*p)] < best))
+            best = w->col[NCP_LETTER(*p)];
+    return best;
+}
+
+static int ncp_motion_to_be(struct ncp_analyzer *a)
+{
+    struct ncp_words *w = &a->w;
+    int axis = (w->has & (NCP_AXIS_LETTERS | NCP_POLAR_BITS)) != 0;
+    int ijk = (w->has & (BIT('I') | BIT('J') | BIT('K'))) != 0;
+    int m0 = w->g[NCP_GG_NONMODAL], m1 = w->g[NCP_GG_MOTION];
+    int covets = m0 == 100 || m0 == 280 || m0 == 300 || m0 == 520 || m0 == 920;
+    int tlo = w->g[NCP_GG_TLO];
+    w->motion_to_be = -1;
+    if (m1 != -1) {
+        uint16_t col = w->gcol[NCP_GG_MOTION];
+        if (m1 == 800) {
+            if (axis && !covets)
+                return ncp_an_error(a, col, "Cannot use axis values with g80");
+            if (!axis && (m0 == 520 || m0 == 920))
+                return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
+                                    "All axes missing with g52 or g92");
+        } else {
+            if (covets)
+                return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
+                                    "Cannot use two g codes that both use axis values");
+            if (!axis && m1 != 0 && m1 != 10 && m1 != 20 && m1 != 30)
+                return ncp_an_error(a, col, "All axes missing with motion code");
+        }
+        w->motion_to_be = m1;
+    } else if (covets) {
+        if (!axis && (m0 == 520 || m0 == 920))
+            return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
+                                "All axes missing with g52 or g92");
+    } else if (axis) {
+        int mm = a->st.m.motion;
+        if ((mm == -1 || mm == 800) && tlo != 431 && tlo != 432)
+            return ncp_an_error(a, ncp_first_axis_col(w),
+                                "Cannot use axis values without a g code that uses them");
+        if (tlo != 431)
+            w->motion_to_be = mm;
+    } else if (ijk && (a->st.m.motion == 20 || a->st.m.motion == 30)) {
+        w->motion_to_be = a->st.m.motion;
+    }
+    return NCP_OK;
+}
+
+static int ncp_check_g(struct ncp_analyzer *a)
+{
+    const struct ncp_words *w = &a->w;
+    int m0 = w->g[NCP_GG_NONMODAL], m1 = w->g[NCP_GG_MOTION];
+    uint16_t col = w->gcol[NCP_GG_NONMODAL];
+    if (m0 == 40) {
+        if (!NCP_HAS(w, 'P'))
+            return ncp_an_error(a, col, "Dwell time missing with g4");
+        if (m1 == 20 || m1 == 30)
+            return ncp_an_error(a, col, "G4 not allowed with G2 or G3 because they both use P");
+    } else if (m0 == 100) {
+        double p = NCP_HAS(w, 'P') ? w->v[NCP_LETTER('P')] : -1.0;
+        int l = NCP_HAS(w, 'L') ? (int)lround(w->v[NCP_LETTER('L')]) : -1;
+        int pi = p >= 0 ? (int)(p + 0.5) : (int)(p - 0.5);
+        if (l != 0 && l != 1 && l != 2 && l != 10 && l != 11 && l != 20)
+            return ncp_an_error(a, col, "Line with G10 does not have L0, L1, L10, L11, L2, or L20");
+        if (p + 0.0001 - pi > 0.0002)
+            return ncp_an_error(a, col, "P value not an integer with G10");
+        if ((l == 2 || l == 20) && (pi < 0 || pi > 9))
+            return ncp_an_error(a, col, "P value out of range (0-9) with G10 L%d", l);
+        if ((l == 1 || l == 10 || l == 11) && pi < 1)
+            return ncp_an_error(a, col, "P value out of range with G10 L%d", l);
+    } else if (m0 == 530) {
+        int mt = w->motion_to_be;
+        if (mt != 0 && mt != 10)
+            return ncp_an_error(a, col, "Must use g0 or g1 with g53");
+        if (w->g[NCP_GG_DIST] == 910 || (w->g[NCP_GG_DIST] != 900 && a->st.m.incremental))
+            return ncp_an_error(a, col, "Cannot use g53 incremental");
+    }
+    return NCP_OK;
+}
+
+static int ncp_is_cycle(int m)
+{
+    return m == 730 || (m >= 810 && m <= 890);
+}
+
+/* Words that need a code to use them. */
+static int ncp_check_other(struct ncp_analyzer *a)
+{
+    const struct ncp_words *w = &a->w;
+    int mt = w->motion_to_be;
+    int m0 = w->g[NCP_GG_NONMODAL];
+    int comp = w->g[NCP_GG_COMP];
+    int tlo = w->g[NCP_GG_TLO];
+    int ctl = w->g[NCP_GG_CONTROL];
+    int g10 = m0 == 100;
+    int comp_on = comp == 410 || comp == 420 || comp == 411 || comp == 421;
+#define COL(c) w->col[NCP_LETTER(c)]
+    if (NCP_HAS(w, 'A') && ncp_is_cycle(mt))
+        return ncp_an_error(a, COL('A'), "Cannot put an a in canned cycle");
+    if (NCP_HAS(w, 'B') && ncp_is_cycle(mt))
+        return ncp_an_error(a, COL('B'), "Cannot put a b in canned cycle");
+    if (NCP_HAS(w, 'C') && ncp_is_cycle(mt))
+        return ncp_an_error(a, COL('C'), "Cannot put a c in canned cycle");
+    if (NCP_HAS(w, 'D') && !comp_on && w->g[NCP_GG_SPINDLE] != 960)
+        return ncp_an_error(a, COL('D'), "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
+    if (NCP_HAS(w, 'E') && mt != 760 && mt != 330 && mt != 331 && w->m[NCP_MG_IO] != 66 &&
+        w->m[NCP_MG_IO] != 67 && w->m[NCP_MG_IO] != 68)
+        return ncp_an_error(a, COL('E'), "E word with no G70, G76, M66, M67 or M68 to use it");
+    if (NCP_HAS(w, 'H') && tlo != 430 && mt != 760 && tlo != 432)
+        return ncp_an_error(a, COL('H'), "H word with no G43 or G76 to use it");
+    if (NCP_HAS(w, 'I') && mt != 20 && mt != 30 && mt != 50 && mt != 51 && mt != 760 &&
+        mt != 870 && mt != 331 && !g10)
+        return ncp_an_error(a, COL('I'), "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
+    if (NCP_HAS(w, 'J') && mt != 20 && mt != 30 && mt != 50 && mt != 51 && mt != 760 &&
+        mt != 870 && !g10)
+        return ncp_an_error(a, COL('J'), "J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it");
+    if (NCP_HAS(w, 'K') && mt != 20 && mt != 30 && mt != 330 && mt != 331 && mt != 760 &&
+        mt != 870)
+        return ncp_an_error(a, COL('K'), "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
+    if (NCP_HAS(w, 'L') && (mt < 810 || mt > 890) && mt != 760 && mt != 52 && mt != 730 &&
+        !g10 && !comp_on && w->m[NCP_MG_IO] != 66)
+        return ncp_an_error(a, COL('L'), "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or NURBS code");
+    if (NCP_HAS(w, 'P')) {
+        int mo = w->m[NCP_MG_OVERRIDE], mi = w->m[NCP_MG_IO];
+        if (!g10 && m0 != 40 && ctl != 640 && mt != 760 && mt != 820 && mt != 860 &&
+            mt != 880 && mt != 890 && mt != 50 && mt != 52 && mt != 20 && mt != 30 &&
+            mt != 840 && (mo < 50 || mo > 53) && (mi < 62 || mi > 66) &&
+            w->m[NCP_MG_SPINDLE] != 19)
+            return ncp_an_error(a, COL('P'), "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 M63 M64 M65 M66 M98 or user M code to use it");
+        double p = w->v[NCP_LETTER('P')];
+        int pv = (int)lround(p);
+        int arc = mt == 20 || mt == 30;
+        if ((arc || w->m[NCP_MG_SPINDLE] == 19) && fabs(pv - p) > 0.001)
+            return ncp_an_error(a, COL('P'), "P value not an integer with M19 G2 or G3");
+        if (arc && pv < 1)
+            return ncp_an_error(a, COL('P'), "P value should be 1 or greater with G2 or G3");
+    }
+    if (NCP_HAS(w, 'Q') && mt != 830 && mt != 730 && mt != 50 && mt != 760 &&
+        w->m[NCP_MG_IO] != 66 && w->m[NCP_MG_IO] != 67 && w->m[NCP_MG_IO] != 68 && !g10 &&
+        w->m[NCP_MG_TOOL] != 61 && ctl != 640 && w->m[NCP_MG_SPINDLE] != 19)
+        return ncp_an_error(a, COL('Q'), "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it");
+    if (NCP_HAS(w, 'R') && mt != 20 && mt != 30 && mt != 760 && (mt < 810 || mt > 890) &&
+        mt != 730 && comp != 411 && comp != 421 && !g10 && w->m[NCP_MG_SPINDLE] != 19)
+        return ncp_an_error(a, COL('R'), "R word with no g code that uses it");
+    if (!NCP_HAS(w, 'S') && w->g[NCP_GG_SPINDLE] == 960)
+        return ncp_an_error(a, w->gcol[NCP_GG_SPINDLE], "S word missing with g96");
+#undef COL
+    return NCP_OK;
+}
+
+int ncp_modal_check(struct ncp_analyzer *a)
+{
+    int rc = ncp_motion_to_be(a);
+    if (rc == NCP_OK)
+        rc = ncp_check_g(a);
+    if (rc == NCP_OK)
+        rc = ncp_check_other(a);
+    return rc;
+}

@@ -1,0 +1,291 @@
+/* G0/G1 (and G53), G2/G3 arc requests, G80 and the dispatch to canned cycles.
+ * End points are in program coordinates; arcs are resolved by the executor. */
+#include "state.h"
+
+#include <math.h>
+#include <string.h>
+
+static const char ncp_letters[NCP_NAX] = {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'};
+
+/* Polar words (@ radius, ^ angle in degrees) replace X/Y in the XY plane. */
+static int ncp_motion_polar(struct ncp_analyzer *a, double *end)
+{
+    const struct ncp_words *w = &a->w;
+    const struct ncp_state *s = &a->st;
+    int hr = NCP_HAS(w, '@'), ht = NCP_HAS(w, '^');
+    uint16_t col = w->col[NCP_LETTER(hr ? '@' : '^')];
+    double r = w->v[NCP_LETTER('@')], t = w->v[NCP_LETTER('^')] * M_PI / 180.0;
+    double x = end[NCP_X], y = end[NCP_Y];
+    if (NCP_HAS(w, 'X'))
+        return ncp_an_error(a, w->col[NCP_LETTER('X')], "Cannot specify both polar coordinate and X word");
+    if (NCP_HAS(w, 'Y'))
+        return ncp_an_error(a, w->col[NCP_LETTER('Y')], "Cannot specify both polar coordinate and Y word");
+    if (!s->m.incremental) {
+        if (hr && !ht) {
+            if (x == 0.0 && y == 0.0)
+                return ncp_an_error(a, col, "Must specify angle in polar coordinate if at the origin");
+            t = atan2(y, x);
+        } else if (!hr) {
+            r = hypot(y, x);
+        }
+    } else {
+        if (x == 0.0 && y == 0.0)
+            return ncp_an_error(a, col, hr ? "Incremental motion with polar coordinates is indeterminate when at the origin"
+                                           : "G91 motion with polar coordinates is indeterminate when at the origin");
+        /* two separate steps, as rs274 rounds them */
+        if (hr) {
+            double th = atan2(y, x), rad = hypot(y, x) + r;
+            x = rad * cos(th);
+            y = rad * sin(th);
+        }
+        if (ht) {
+            double th = atan2(y, x) + t, rad = hypot(y, x);
+            x = rad * cos(th);
+            y = rad * sin(th);
+        }
+        end[NCP_X] = x;
+        end[NCP_Y] = y;
+        return NCP_OK;
+    }
+    end[NCP_X] = r * cos(t);
+    end[NCP_Y] = r * sin(t);
+    return NCP_OK;
+}
+
+/* The block's end point: absolute, incremental, or G53 machine coordinates. */
+int ncp_motion_ends(struct ncp_analyzer *a, int g53, double *end)
+{
+    const struct ncp_state *s = &a->st;
+    const struct ncp_words *w = &a->w;
+    for (int ax = 0; ax < NCP_NAX; ax++) {
+        int l = NCP_LETTER(ncp_letters[ax]);
+        if (!((w->has >> l) & 1u)) {
+            end[ax] = s->pos[ax];
+        } else if (g53) {
+            double tl = (ax >= NCP_A && ax <= NCP_C) ? 0.0 : s->tlo[ax];
+            end[ax] = w->v[l] - s->g5x[ax] - s->g92[ax] - tl;
+        } else if (s->m.incremental) {
+            end[ax] = s->pos[ax] + w->v[l];
+        } else {
+            end[ax] = w->v[l];
+        }
+    }
+    if (w->has & NCP_POLAR_BITS) {
+        if (g53)
+            return ncp_an_error(a, w->line_col, "Cannot use polar coordinates with G53");
+        return ncp_motion_polar(a, end);
+    }
+    return NCP_OK;
+}
+
+static double ncp_straight_length(const double *p, const double *q)
+{
+    double l = 0.0, r = 0.0;
+    for (int ax = 0; ax < NCP_NAX; ax++) {
+        double d = q[ax] - p[ax];
+        if (ax >= NCP_A && ax <= NCP_C)
+            r += d * d;
+        else
+            l += d * d;
+    }
+    return l > 0.0 ? sqrt(l) : sqrt(r);
+}
+
+static int ncp_straight(struct ncp_analyzer *a, int motion)
+{
+    struct ncp_state *s = &a->st;
+    const struct ncp_words *w = &a->w;
+    double end[NCP_NAX];
+    int g53 = w->g[NCP_GG_NONMODAL] == 530;
+    int rc = ncp_cutcomp_check_motion(&a->comp, 0, &a->err, a->line);
+    if (rc == NCP_OK)
+        rc = ncp_motion_ends(a, g53, end);
+    if (rc != NCP_OK)
+        return rc;
+    if (motion == 0) {
+        if (ncp_cutcomp_engaged(&a->comp))
+            rc = ncp_comp_move_straight(a, motion, end, g53);
+        else
+            ncp_an_emit6(a, NCP_C_STRAIGHT_TRAVERSE, end);
+    } else {
+        if (s->m.feed_mode == 1) {
+            if (!NCP_HAS(w, 'F'))
+                return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION]
+                                                              : w->line_col,
+                                    "F word missing with inverse time g1 move");
+            double rate = ncp_straight_length(s->pos, end) * w->v[NCP_LETTER('F')];
+            s->feed = rate < 0.1 ? 0.1 : rate; /* what #<_feed> reads afterwards */
+            ncp_an_emit(a, NCP_C_SET_FEED_RATE)->d[0] = s->feed;
+        } else if (s->feed == 0.0) {
+            return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION]
+                                                          : w->line_col,
+                                "Cannot do g1 with zero feed rate");
+        }
+        if (ncp_cutcomp_engaged(&a->comp))
+            rc = ncp_comp_move_straight(a, motion, end, g53);
+        else
+            ncp_an_emit6(a, NCP_C_STRAIGHT_FEED, end);
+    }
+    if (rc != NCP_OK)
+        return rc;
+    memcpy(s->pos, end, sizeof end);
+    s->m.motion = motion;
+    return NCP_OK;
+}
+
+/* Plane -> (first, second, helix) axes and the centre-offset letters. */
+static const int ncp_plane_axes[3][3] = {
+    {NCP_X, NCP_Y, NCP_Z}, {NCP_Y, NCP_Z, NCP_X}, {NCP_Z, NCP_X, NCP_Y}};
+static const char ncp_plane_ijk[3][2] = {{'I', 'J'}, {'J', 'K'}, {'K', 'I'}};
+static const char *const ncp_plane_missing[3] = {
+    "X and y words missing for arc in xy plane",
+    "Y and z words missing for arc in yz plane",
+    "X and z words missing for arc in xz plane"};
+
+/* Only for #<_feed> after a G93 arc (the executor computes the printed
+ * rate): arc length as rs274 measures it, centre from IJK or R. */
+static double ncp_arc_length(const struct ncp_canon *q)
+{
+    double x1 = q->d[0], y1 = q->d[1], x2 = q->d[2], y2 = q->d[3], cx, cy;
+    int ccw = q->i[0] > 0;
+    if (q->i[1]) {
+        double r = q->d[8], ar = fabs(r);
+        double mx = (x1 + x2) / 2, my = (y1 + y2) / 2;
+        double half = hypot(mx - x2, my - y2);
+        if (ar == 0.0)
+            return 0.0;
+        if (half / ar > 1 - 1e-12)
+            half = ar;
+        double th = atan2(y2 - y1, x2 - x1) + ((!ccw && r > 0) || (ccw && r < 0) ? -M_PI_2 : M_PI_2);
+        double off = ar * cos(asin(half / ar));
+        cx = mx + off * cos(th);
+        cy = my + off * sin(th);
+    } else {
+        cx = q->d[8];
+        cy = q->d[9];
+    }
+    int turn = (q->i[2] > 0 ? q->i[2] : 1) * (ccw ? 1 : -1);
+    double alpha = atan2(y1 - cy, x1 - cx), beta = atan2(y2 - cy, x2 - cx), theta;
+    if (turn > 0) {
+        if (beta <= alpha)
+            beta += 2 * M_PI;
+        theta = beta - alpha + (turn - 1) * 2 * M_PI;
+    } else {
+        if (alpha <= beta)
+            alpha += 2 * M_PI;
+        theta = beta - alpha + (turn + 1) * 2 * M_PI;
+    }
+    double rad = hypot(cx - x1, cy - y1);
+    return fabs(rad * theta);
+}
+
+int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
+{
+    struct ncp_state *s = &a->st;
+    const struct ncp_words *w = &a->w;
+    int pl = s->m.plane;
+    const int *ax = ncp_plane_axes[pl];
+    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    int crc = ncp_cutcomp_check_motion(&a->comp, 1, &a->err, a->line);
+    if (crc != NCP_OK)
+        return crc;
+    int has_ijk = (w->has & ((1u << NCP_LETTER('I')) | (1u << NCP_LETTER('J')) |
+                             (1u << NCP_LETTER('K')))) != 0;
+    int has_r = NCP_HAS(w, 'R');
+    if (!NCP_HAS(w, ncp_letters[ax[0]]) && !NCP_HAS(w, ncp_letters[ax[1]]) && has_r)
+        return ncp_an_error(a, col, "%s", ncp_plane_missing[pl]);
+    if (!has_r && !has_ijk)
+        return ncp_an_error(a, col, "R i j k words all missing for arc");
+    if (has_r && has_ijk)
+        return ncp_an_error(a, col, "Mixed radius ijk format for arc");
+    if (s->m.feed_mode == 1) {
+        if (!NCP_HAS(w, 'F'))
+            return ncp_an_error(a, col, "F word missing with inverse time arc move");
+    } else if (s->feed == 0.0) {
+        return ncp_an_error(a, col, "Cannot make arc with zero feed rate");
+    }
+    if (s->m.feed_mode == 1) {
+        struct ncp_canon *f = ncp_an_emit(a, NCP_C_SET_FEED_RATE);
+        f->flags = NCP_FEED_F_INVERSE_ARC;
+        f->d[0] = w->v[NCP_LETTER('F')];
+        f->d[1] = s->pos[ax[2]];
+    }
+    struct ncp_canon req = {.kind = NCP_C_ARC_REQUEST};
+    struct ncp_canon *op = &req;
+    op->d[0] = s->pos[ax[0]];
+    op->d[1] = s->pos[ax[1]];
+    op->d[2] = end[ax[0]];
+    op->d[3] = end[ax[1]];
+    op->d[4] = end[ax[2]];
+    op->d[5] = end[NCP_A];
+    op->d[6] = end[NCP_B];
+    op->d[7] = end[NCP_C];
+    if (has_r) {
+        op->d[8] = w->v[NCP_LETTER('R')];
+        op->i[1] = 1;
+    } else {
+        double o1 = NCP_HAS(w, ncp_plane_ijk[pl][0]) ? w->v[NCP_LETTER(ncp_plane_ijk[pl][0])] : 0;
+        double o2 = NCP_HAS(w, ncp_plane_ijk[pl][1]) ? w->v[NCP_LETTER(ncp_plane_ijk[pl][1])] : 0;
+        if (s->m.arc_incremental) {
+            o1 += s->pos[ax[0]];
+            o2 += s->pos[ax[1]];
+        }
+        op->d[8] = o1;
+        op->d[9] = o2;
+    }
+    op->i[0] = motion == 30 ? 1 : -1;
+    op->i[2] = NCP_HAS(w, 'P') ? (int)lround(w->v[NCP_LETTER('P')]) : 1;
+    op->i[3] = pl;
+    op->flags = s->m.inches ? 1 : 0;
+    if (s->m.feed_mode == 1) {
+        double len = ncp_arc_length(op), dz = end[ax[2]] - s->pos[ax[2]];
+        if (dz != 0.0)
+            len = hypot(len, dz);
+        double rate = len * w->v[NCP_LETTER('F')];
+        s->feed = rate < 0.1 ? 0.1 : rate;
+    }
+    if (ncp_cutcomp_engaged(&a->comp)) {
+        int rc = ncp_comp_move_arc(a, op, end);
+        if (rc != NCP_OK)
+            return rc;
+    } else {
+        *ncp_an_emit(a, NCP_C_ARC_REQUEST) = req;
+        ncp_sai_move(a, end);
+    }
+    memcpy(s->pos, end, NCP_NAX * sizeof(double));
+    s->m.motion = motion;
+    return NCP_OK;
+}
+
+static int ncp_arc(struct ncp_analyzer *a, int motion)
+{
+    double end[NCP_NAX];
+    int rc = ncp_motion_ends(a, 0, end);
+    if (rc != NCP_OK)
+        return rc;
+    return ncp_arc_run(a, motion, end);
+}
+
+int ncp_motion_run(struct ncp_analyzer *a, int motion)
+{
+    if (motion != 730 && (motion < 810 || motion > 890))
+        a->st.cycle_il_flag = 0;
+    switch (motion) {
+    case 0: case 10:
+        return ncp_straight(a, motion);
+    case 20: case 30:
+        return ncp_arc(a, motion);
+    case 800:
+        a->st.m.motion = 800;
+        ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
+                         sizeof "interpreter: motion mode set to none" - 1);
+        return NCP_OK;
+    case 730: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
+    case 890:
+        return ncp_canned_run(a, motion);
+    default:
+        return ncp_an_error(a, a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION]
+                                                        : a->w.line_col,
+                            "G%d.%d is not supported", motion / 10, motion % 10);
+    }
+}

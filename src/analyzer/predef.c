@@ -1,0 +1,90 @@
+/* Read-only predefined named parameters (#<_x>, #<_metric>, ...) answered
+ * from the analyzer state, installed as the params module's hook. */
+#include "state.h"
+
+#include <string.h>
+
+enum ncp_predef {
+    P_X, P_Y, P_Z, P_A, P_B, P_C, P_U, P_V, P_W,
+    P_LINE, P_MOTION, P_PLANE, P_CCOMP, P_METRIC, P_IMPERIAL, P_ABSOLUTE, P_INCREMENTAL,
+    P_INVERSE, P_UPM, P_UPR, P_COORD, P_TOOL_OFFSET, P_RETRACT_R, P_RETRACT_OLD,
+    P_IJK_ABS, P_SPINDLE_ON, P_SPINDLE_CW, P_MIST, P_FLOOD, P_SPEED_OVR, P_FEED_OVR,
+    P_ADAPTIVE, P_FEED_HOLD, P_FEED, P_RPM, P_CUR_TOOL, P_CUR_POCKET, P_SEL_TOOL,
+    P_SEL_POCKET, P_RPM_MODE, P_CSS_MODE, P_LATHE_DIA, P_LATHE_RAD, P_CALL_LEVEL,
+    P_VMAJOR, P_VMINOR, P_TASK, P__N
+};
+
+static const char *const ncp_predef_names[P__N] = {
+    "_x", "_y", "_z", "_a", "_b", "_c", "_u", "_v", "_w",
+    "_line", "_motion_mode", "_plane", "_ccomp", "_metric", "_imperial", "_absolute",
+    "_incremental", "_inverse_time", "_units_per_minute", "_units_per_rev",
+    "_coord_system", "_tool_offset", "_retract_r_plane", "_retract_old_z",
+    "_ijk_absolute_mode", "_spindle_on", "_spindle_cw", "_mist", "_flood",
+    "_speed_override", "_feed_override", "_adaptive_feed", "_feed_hold", "_feed", "_rpm",
+    "_current_tool", "_current_pocket", "_selected_tool", "_selected_pocket",
+    "_spindle_rpm_mode", "_spindle_css_mode", "_lathe_diameter_mode",
+    "_lathe_radius_mode", "_call_level", "_vmajor", "_vminor", "_task",
+};
+
+static double ncp_predef_value(const struct ncp_analyzer *a, int k)
+{
+    const struct ncp_state *s = &a->st;
+    const struct ncp_modal *m = &s->m;
+    if (k <= P_W)
+        return s->pos[k];
+    switch (k) {
+    case P_LINE: return a->line;
+    case P_MOTION: return m->motion < 0 ? 800 : m->motion;
+    case P_PLANE: return m->plane == 0 ? 170 : m->plane == 1 ? 190 : 180;
+    case P_CCOMP: return m->comp_side == 0 ? 400 : m->comp_side == 1 ? 410 : 420;
+    case P_METRIC: return !m->inches;
+    case P_IMPERIAL: return m->inches;
+    case P_ABSOLUTE: return !m->incremental;
+    case P_INCREMENTAL: return m->incremental;
+    case P_INVERSE: return m->feed_mode == 1;
+    case P_UPM: return m->feed_mode == 0;
+    case P_UPR: return m->feed_mode == 2;
+    case P_COORD: return m->origin <= 6 ? 530 + 10 * m->origin : 590 + (m->origin - 6);
+    case P_TOOL_OFFSET: return s->tlo[NCP_Z] != 0.0 || s->tlo[NCP_X] != 0.0;
+    case P_RETRACT_R: return m->retract_r;
+    case P_RETRACT_OLD: return !m->retract_r;
+    case P_IJK_ABS: return !m->arc_incremental;
+    case P_SPINDLE_ON: return m->spindle_dir != 0;
+    case P_SPINDLE_CW: return m->spindle_dir == 1;
+    case P_MIST: return m->mist;
+    case P_FLOOD: return m->flood;
+    case P_SPEED_OVR: return m->speed_override;
+    case P_FEED_OVR: return m->feed_override;
+    case P_ADAPTIVE: return m->adaptive;
+    case P_FEED_HOLD: return m->feed_hold;
+    case P_FEED: return s->feed;
+    case P_RPM: return s->speed;
+    case P_CUR_TOOL: return s->current_tool;
+    case P_CUR_POCKET: return s->current_pocket;
+    case P_SEL_TOOL: return s->selected_tool;
+    case P_SEL_POCKET: return s->selected_pocket;
+    case P_RPM_MODE: return 1;
+    case P_CSS_MODE: return 0;
+    case P_LATHE_DIA: return 0;
+    case P_LATHE_RAD: return 1;
+    case P_CALL_LEVEL: return a->flow ? ncp_flow_call_depth(a->flow) : 0;
+    case P_VMAJOR: return 2.9;
+    case P_VMINOR: return 0;
+    default: return 0;
+    }
+}
+
+int ncp_predef_lookup(void *ctx, const char *name, size_t len, double *out)
+{
+    const struct ncp_analyzer *a = ctx;
+    if (len < 2 || name[0] != '_')
+        return 0;
+    for (int k = 0; k < P__N; k++) {
+        const char *n = ncp_predef_names[k];
+        if (strlen(n) == len && memcmp(n, name, len) == 0) {
+            *out = ncp_predef_value(a, k);
+            return 1;
+        }
+    }
+    return 0;
+}

@@ -1,0 +1,197 @@
+/* The analyzer core's own state (module-internal): modal state, positions and
+ * offsets per axis, the tool table, the per-block word scratch and the slot
+ * being filled. One struct owned by one ncp_analyzer, passed explicitly. */
+#ifndef NCP_ANALYZER_STATE_H
+#define NCP_ANALYZER_STATE_H
+
+#include <stdint.h>
+#include "ncpar/analyzer.h"
+#include "cutcomp.h"
+#include "flow.h"
+#include "params.h"
+
+enum ncp_axis { NCP_X, NCP_Y, NCP_Z, NCP_A, NCP_B, NCP_C, NCP_U, NCP_V, NCP_W, NCP_NAX };
+
+/* rs274's standalone "user" length unit (parameters, tool table) is the inch. */
+#define NCP_MM_PER_INCH 25.4
+
+/* Modal group slots of the per-block G-code record. */
+enum ncp_ggroup {
+    NCP_GG_NONMODAL, NCP_GG_MOTION, NCP_GG_PLANE, NCP_GG_DIST, NCP_GG_ARCDIST,
+    NCP_GG_FEEDMODE, NCP_GG_UNITS, NCP_GG_COMP, NCP_GG_TLO, NCP_GG_RETRACT,
+    NCP_GG_COORD, NCP_GG_CONTROL, NCP_GG_SPINDLE, NCP_GG_LATHE, NCP_GG__N
+};
+
+enum ncp_mgroup {
+    NCP_MG_STOP, NCP_MG_TOOL, NCP_MG_SPINDLE, NCP_MG_COOLANT, NCP_MG_OVERRIDE,
+    NCP_MG_IO, NCP_MG__N
+};
+
+/* letters A..Z, then the polar radius '@', angle '^' and spindle '$' words */
+#define NCP_LETTER(c) ((c) == '@' ? 26 : (c) == '^' ? 27 : (c) == '$' ? 28 : (c) - 'A')
+#define NCP_WORD_SLOTS 29
+#define NCP_POLAR_BITS ((1u << 26) | (1u << 27))
+#define NCP_HAS(w, c) (((w)->has >> NCP_LETTER(c)) & 1u)
+#define NCP_AXIS_LETTERS ((1u << NCP_LETTER('X')) | (1u << NCP_LETTER('Y')) | \
+    (1u << NCP_LETTER('Z')) | (1u << NCP_LETTER('A')) | (1u << NCP_LETTER('B')) | \
+    (1u << NCP_LETTER('C')) | (1u << NCP_LETTER('U')) | (1u << NCP_LETTER('V')) | \
+    (1u << NCP_LETTER('W')))
+
+/* One block's words after evaluation. G/M codes are stored as code*10
+ * (G38.2 -> 382); -1 = none in that group. */
+struct ncp_words {
+    uint32_t has;                 /* bit per NCP_LETTER slot (not G, M) */
+    double v[NCP_WORD_SLOTS];
+    uint16_t col[NCP_WORD_SLOTS];
+    int16_t g[NCP_GG__N];
+    uint16_t gcol[NCP_GG__N];
+    int16_t m[NCP_MG__N];
+    uint16_t mcol[NCP_MG__N];
+    int n_m;
+    uint16_t line_col;            /* col of the first word, for block-level errors */
+    int motion_to_be;             /* motion this block performs (x10), -1 none */
+};
+
+struct ncp_modal {
+    int motion;                   /* G code*10 of the active motion mode, -1 none (G80) */
+    int plane;                    /* 0 XY, 1 YZ, 2 XZ */
+    int incremental, arc_incremental;
+    int feed_mode;                /* 0 units/min, 1 inverse time, 2 units/rev */
+    int inches;
+    int retract_r;                /* G99 */
+    int control;                  /* 0 exact stop, 1 exact path, 2 continuous */
+    double p_tol, q_tol;
+    int origin;                   /* 1..9 (G54..G59.3) */
+    int comp_side;                /* 0 off, 1 left, 2 right */
+    double comp_radius;
+    int spindle_dir;              /* 0 stop, 1 cw, -1 ccw */
+    int flood, mist;
+    int feed_override, speed_override, adaptive, feed_hold;
+    int g92_enabled;
+};
+
+struct ncp_state {
+    double pos[NCP_NAX];          /* current point, program coordinates/units */
+    double g5x[NCP_NAX];          /* active origin (program units) */
+    double g92[NCP_NAX];          /* axis offsets (program units) */
+    double tlo[NCP_NAX];          /* tool length offset (program units) */
+    double rotation;
+    double feed, speed;
+    struct ncp_modal m;
+    int selected_tool, selected_pocket, current_tool, current_pocket;
+    int toolchange_flag;
+    /* canned cycle sticky values */
+    double cycle_r, cycle_cc, cycle_p, cycle_q, cycle_il, cycle_ijk[3];
+    int cycle_l, cycle_il_flag;
+};
+
+/* The canon side's view of the position (see sai.c). */
+struct ncp_sai {
+    double pos[6], g5x[6], g92[6];
+    int inches;
+};
+
+/* An op held back while cutter compensation has a move queued: it is handed
+ * to the comp queue once the caller has filled it (see analyzer.c). */
+struct ncp_staged {
+    int pending;
+    struct ncp_canon op;
+    size_t len;
+    char text[NCP_CMD_TEXT_POOL];
+};
+
+struct ncp_analyzer {
+    struct ncp_analyzer_cfg cfg;
+    struct ncp_sai sai;
+    struct ncp_cutcomp comp;
+    struct ncp_staged staged;
+    struct ncp_params *params;
+    struct ncp_flow *flow;
+    struct ncp_state st;
+    struct ncp_words w;
+    const struct ncp_block *blk;
+    const struct ncp_source *src;
+    struct ncp_param_ops pops;
+    double *par_pos[NCP_NAX], *par_tool, *par_origin; /* #5420.., #5400, #5220 */
+    /* tool table: entry[i] for pocket-ordered tools as rs274 loads them */
+    int n_tools;
+    int tool_no[NCP_MAX_TOOLS];
+    struct ncp_tool_entry tools[NCP_MAX_TOOLS];
+    /* output */
+    const struct ncp_cmd_sink *sink;
+    struct ncp_cmd *cmd;
+    uint64_t next_id;
+    uint32_t line;
+    int stopped;
+    struct ncp_diag err;
+};
+
+/* analyzer.c: append one op to the block's slot (opens/continues slots). */
+struct ncp_canon *ncp_an_emit(struct ncp_analyzer *a, enum ncp_canon_kind kind);
+struct ncp_canon *ncp_an_emit_text(struct ncp_analyzer *a, enum ncp_canon_kind kind,
+                                   const char *text, size_t len);
+void ncp_an_emit6(struct ncp_analyzer *a, enum ncp_canon_kind kind, const double *p);
+int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* analyzer.c: hand a staged op on (to the comp queue); the comp module's sink */
+int ncp_an_commit(struct ncp_analyzer *a);
+struct ncp_comp_sink ncp_an_comp_sink(struct ncp_analyzer *a);
+
+/* comp.c: the analyzer side of cutter compensation */
+int ncp_comp_gcode(struct ncp_analyzer *a, int g);
+int ncp_comp_move_straight(struct ncp_analyzer *a, int motion, const double *end, int g53);
+int ncp_comp_move_arc(struct ncp_analyzer *a, const struct ncp_canon *req, const double *end);
+int ncp_comp_stop(struct ncp_analyzer *a, int reset);
+
+/* words.c */
+int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
+int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b);
+
+/* modal.c */
+int ncp_modal_check(struct ncp_analyzer *a);
+
+/* exec.c: the whole block in rs274's order */
+int ncp_exec_block(struct ncp_analyzer *a);
+
+/* motion.c / arcs.c / canned.c */
+int ncp_motion_run(struct ncp_analyzer *a, int motion);
+int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end);
+int ncp_canned_run(struct ncp_analyzer *a, int motion);
+int ncp_motion_ends(struct ncp_analyzer *a, int absolute53, double *end);
+
+/* offsets.c */
+int ncp_offsets_units(struct ncp_analyzer *a, int inches);
+int ncp_offsets_coord(struct ncp_analyzer *a, int origin);
+int ncp_offsets_tlo(struct ncp_analyzer *a, int g);
+int ncp_offsets_modal0(struct ncp_analyzer *a, int g);
+void ncp_offsets_sync_params(struct ncp_analyzer *a);
+double ncp_user_len(const struct ncp_analyzer *a, double user);
+double ncp_to_user_len(const struct ncp_analyzer *a, double prog);
+double ncp_tool_len(const struct ncp_analyzer *a, double user);
+
+/* tools.c */
+int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d);
+int ncp_tools_find(const struct ncp_analyzer *a, int tool);
+int ncp_tools_select(struct ncp_analyzer *a);
+int ncp_tools_change(struct ncp_analyzer *a);
+
+/* comments.c */
+int ncp_comment_run(struct ncp_analyzer *a);
+
+/* predef.c */
+int ncp_predef_lookup(void *ctx, const char *name, size_t len, double *out);
+
+/* sai.c */
+void ncp_sai_move(struct ncp_analyzer *a, const double *end);
+void ncp_sai_g5x(struct ncp_analyzer *a, const double *v);
+void ncp_sai_g92(struct ncp_analyzer *a, const double *v);
+void ncp_sai_units(struct ncp_analyzer *a, int inches);
+void ncp_sai_resync(struct ncp_analyzer *a);
+void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op);
+
+/* stop.c */
+int ncp_stop_run(struct ncp_analyzer *a, int m);
+void ncp_state_init(struct ncp_analyzer *a);
+
+#endif

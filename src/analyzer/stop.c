@@ -1,0 +1,114 @@
+/* Start-up state and the stop codes M0 M1 M60 M2 M30 (the end-of-program
+ * reset rs274 performs: back to G54, XY plane, G90, G94, F0, spindle off,
+ * coolant off, feed override on). */
+#include "state.h"
+
+#include <string.h>
+
+void ncp_state_init(struct ncp_analyzer *a)
+{
+    struct ncp_state *s = &a->st;
+    memset(s, 0, sizeof *s);
+    s->m.motion = 800;
+    s->m.origin = 1;
+    s->m.control = 2;
+    s->m.retract_r = 1;
+    s->m.arc_incremental = 1;
+    s->m.feed_override = 1;
+    s->m.speed_override = 1;
+    s->m.feed_hold = 1;
+    s->selected_pocket = 0;
+    s->selected_tool = -1;
+    s->current_pocket = 1; /* rs274 -g starts with pocket 1 as the current one */
+    s->current_tool = 0;
+    double *p = ncp_params_slot(a->params, 5599);
+    if (p)
+        *p = 1.0;
+    p = ncp_params_slot(a->params, 5220);
+    if (p)
+        *p = 1.0;
+}
+
+static void ncp_stop_reset_origin(struct ncp_analyzer *a)
+{
+    struct ncp_state *s = &a->st;
+    for (int ax = 0; ax < NCP_NAX; ax++) {
+        double *p = ncp_params_slot(a->params, 5221 + ax);
+        double v = p ? *p : 0.0;
+        if (ax < NCP_A || ax > NCP_C)
+            v = ncp_user_len(a, v);
+        s->pos[ax] += s->g5x[ax] - v;
+        s->g5x[ax] = v;
+    }
+    double *r = ncp_params_slot(a->params, 5230);
+    s->rotation = r ? *r : 0.0;
+    s->m.origin = 1;
+    struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
+    op->i[0] = 1;
+    memcpy(op->d, s->g5x, 6 * sizeof(double));
+    ncp_sai_g5x(a, s->g5x);
+    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->d[0] = s->rotation;
+}
+
+static int ncp_stop_end(struct ncp_analyzer *a, int m)
+{
+    struct ncp_state *s = &a->st;
+    ncp_stop_reset_origin(a);
+    if (s->m.plane != 0) {
+        ncp_an_emit(a, NCP_C_SELECT_PLANE);
+        s->m.plane = 0;
+    }
+    s->m.incremental = 0;
+    s->m.feed_mode = 0;
+    ncp_an_emit(a, NCP_C_SET_FEED_MODE);
+    s->feed = NCP_HAS(&a->w, 'F') ? a->w.v[NCP_LETTER('F')] : 0.0;
+    ncp_an_emit(a, NCP_C_SET_FEED_RATE);
+    if (!s->m.feed_override) {
+        ncp_an_emit(a, NCP_C_ENABLE_FEED_OVERRIDE);
+        s->m.feed_override = 1;
+    }
+    s->m.comp_side = 0;
+    ncp_an_emit(a, NCP_C_STOP_SPINDLE_TURNING);
+    s->m.spindle_dir = 0;
+    s->m.speed_override = 1;
+    ncp_an_emit(a, NCP_C_SET_SPINDLE_MODE);
+    s->m.motion = 10;
+    if (s->m.mist) {
+        ncp_an_emit(a, NCP_C_MIST_OFF);
+        s->m.mist = 0;
+    }
+    if (s->m.flood) {
+        ncp_an_emit(a, NCP_C_FLOOD_OFF);
+        s->m.flood = 0;
+    }
+    if (m == 30)
+        ncp_an_emit(a, NCP_C_PALLET_SHUTTLE);
+    ncp_an_emit(a, NCP_C_PROGRAM_END);
+    if (a->src && a->src->has_percent && a->src->end >= a->src->len)
+        ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: percent sign missing from end of file",
+                         sizeof "interpreter: percent sign missing from end of file" - 1);
+    ncp_offsets_sync_params(a);
+    ncp_flow_reset(a->flow);
+    return NCP_END;
+}
+
+int ncp_stop_run(struct ncp_analyzer *a, int m)
+{
+    int rc = ncp_comp_stop(a, m == 2 || m == 30);
+    if (rc != NCP_OK)
+        return rc;
+    switch (m) {
+    case 0:
+        ncp_an_emit(a, NCP_C_PROGRAM_STOP);
+        return NCP_OK;
+    case 1:
+        ncp_an_emit(a, NCP_C_OPTIONAL_PROGRAM_STOP);
+        return NCP_OK;
+    case 60:
+        ncp_an_emit(a, NCP_C_PALLET_SHUTTLE);
+        ncp_an_emit(a, NCP_C_PROGRAM_STOP);
+        return NCP_OK;
+    default:
+        return ncp_stop_end(a, m);
+    }
+}

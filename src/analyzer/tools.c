@@ -1,0 +1,174 @@
+/* Tool table (LinuxCNC .tbl format), T selection, M6 and M61. Entries keep
+ * rs274's indexing: 0 is the spindle, 1..n the table lines in file order, and
+ * offsets stay in the table's unit (inch), converted when used. */
+#include "state.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* What rs274 loads when started without -t (LinuxCNC's sample tool.tbl). */
+static const char ncp_default_table[] =
+    "T1 P1 D0.125000 Z+0.511000\n"
+    "T2 P2 D0.062500 Z+0.100000\n"
+    "T3 P3 D0.201000 Z+1.273000\n"
+    "T99999 P123 Z+0.100000\n";
+
+static void ncp_tool_field(struct ncp_tool_entry *t, int *toolno, char c, double v)
+{
+    switch (c) {
+    case 'T': *toolno = (int)v; break;
+    case 'P': t->pocket = (int)v; break;
+    case 'X': t->x_offset = v; break;
+    case 'Z': t->z_offset = v; break;
+    case 'D': t->diameter = v; break;
+    case 'I': t->frontangle = v; break;
+    case 'J': t->backangle = v; break;
+    case 'Q': t->orientation = (int)v; break;
+    default: break;
+    }
+}
+
+/* One line "T1 P1 Z0.5 D0.25 ;comment" -> entry; 0 if the line has no T. */
+static int ncp_tool_line(const char *s, const char *end, struct ncp_tool_entry *t, int *toolno)
+{
+    memset(t, 0, sizeof *t);
+    *toolno = -1;
+    while (s < end && *s != ';') {
+        char c = (char)(*s >= 'a' && *s <= 'z' ? *s - 32 : *s);
+        if (c >= 'A' && c <= 'Z') {
+            char buf[64];
+            size_t n = 0;
+            s++;
+            while (s < end && n < sizeof buf - 1 &&
+                   (strchr("+-.0123456789eE", *s) != NULL))
+                buf[n++] = *s++;
+            buf[n] = '\0';
+            ncp_tool_field(t, toolno, c, strtod(buf, NULL));
+        } else {
+            s++;
+        }
+    }
+    return *toolno >= 0;
+}
+
+static void ncp_tools_parse(struct ncp_analyzer *a, const char *text, size_t len)
+{
+    const char *p = text, *end = text + len;
+    a->n_tools = 1;
+    memset(&a->tools[0], 0, sizeof a->tools[0]);
+    a->tool_no[0] = 0;
+    while (p < end && a->n_tools < NCP_MAX_TOOLS) {
+        const char *nl = memchr(p, '\n', (size_t)(end - p));
+        const char *le = nl ? nl : end;
+        int no;
+        if (ncp_tool_line(p, le, &a->tools[a->n_tools], &no))
+            a->tool_no[a->n_tools++] = no;
+        p = nl ? nl + 1 : end;
+    }
+}
+
+int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d)
+{
+    if (!path) {
+        ncp_tools_parse(a, ncp_default_table, sizeof ncp_default_table - 1);
+        return NCP_OK;
+    }
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot open tool table %s: %s", path,
+                            strerror(errno));
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
+    while (buf) {
+        size_t n = fread(buf + len, 1, cap - len, f);
+        len += n;
+        if (len < cap)
+            break;
+        char *nb = realloc(buf, cap * 2);
+        if (!nb) {
+            free(buf);
+            buf = NULL;
+            break;
+        }
+        buf = nb;
+        cap *= 2;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (!buf || bad) {
+        free(buf);
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read tool table %s", path);
+    }
+    ncp_tools_parse(a, buf, len);
+    free(buf);
+    return NCP_OK;
+}
+
+/* Index of tool number `tool` (0 = the spindle entry), -1 when not in the table. */
+int ncp_tools_find(const struct ncp_analyzer *a, int tool)
+{
+    if (tool == 0)
+        return 0;
+    for (int k = 1; k < a->n_tools; k++)
+        if (a->tool_no[k] == tool)
+            return k;
+    return -1;
+}
+
+int ncp_tools_select(struct ncp_analyzer *a)
+{
+    const struct ncp_words *w = &a->w;
+    int t = (int)lround(w->v[NCP_LETTER('T')]);
+    int idx = ncp_tools_find(a, t);
+    if (idx < 0)
+        return ncp_an_error(a, w->col[NCP_LETTER('T')],
+                            "Requested tool %d not found in the tool table", t);
+    ncp_an_emit(a, NCP_C_SELECT_TOOL)->i[0] = t;
+    a->st.selected_pocket = idx;
+    a->st.selected_tool = t;
+    return NCP_OK;
+}
+
+static int ncp_tools_m61(struct ncp_analyzer *a)
+{
+    const struct ncp_words *w = &a->w;
+    uint16_t col = w->mcol[NCP_MG_TOOL];
+    int t = NCP_HAS(w, 'Q') ? (int)lround(w->v[NCP_LETTER('Q')]) : -1;
+    if (t < 0)
+        return ncp_an_error(a, col, "Need non-negative Q-word to specify tool number with M61");
+    int idx = ncp_tools_find(a, t);
+    if (idx < 0)
+        return ncp_an_error(a, col, "Requested tool %d not found in the tool table", t);
+    a->st.current_pocket = idx;
+    a->st.current_tool = t;
+    a->st.toolchange_flag = 1;
+    ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER)->i[0] = idx;
+    return NCP_OK;
+}
+
+int ncp_tools_change(struct ncp_analyzer *a)
+{
+    struct ncp_state *s = &a->st;
+    if (a->w.m[NCP_MG_TOOL] == 61)
+        return ncp_tools_m61(a);
+    if (s->selected_pocket < 0)
+        return ncp_an_error(a, a->w.mcol[NCP_MG_TOOL], "Need tool prepared -Txx- for toolchange");
+    if (s->m.comp_side != 0)
+        return ncp_an_error(a, a->w.mcol[NCP_MG_TOOL],
+                            "Cannot change tools with cutter radius compensation on");
+    ncp_an_emit(a, NCP_C_START_CHANGE);
+    ncp_an_emit(a, NCP_C_STOP_SPINDLE_TURNING);
+    s->m.spindle_dir = 0;
+    ncp_an_emit(a, NCP_C_CHANGE_TOOL)->i[0] = s->selected_pocket;
+    if (s->selected_pocket > 0) {
+        a->tools[0] = a->tools[s->selected_pocket];
+        a->tool_no[0] = a->tool_no[s->selected_pocket];
+    }
+    s->current_pocket = s->selected_pocket;
+    s->current_tool = s->selected_tool;
+    s->toolchange_flag = 1;
+    return NCP_OK;
+}

@@ -1,0 +1,211 @@
+/* A block's words -> evaluated values, a letter bitmask and G/M codes sorted
+ * into their modal groups; parameter assignments with pre-block values. */
+#include "state.h"
+
+#include <math.h>
+#include <string.h>
+
+/* G code (x10) -> modal group; -1 unknown. Built once. */
+static int8_t ncp_g_group[1000];
+static int ncp_g_group_ready;
+
+static void ncp_g_table_init(void)
+{
+    static const struct { int16_t code; int8_t group; } tab[] = {
+        {40, NCP_GG_NONMODAL}, {100, NCP_GG_NONMODAL}, {280, NCP_GG_NONMODAL},
+        {281, NCP_GG_NONMODAL}, {300, NCP_GG_NONMODAL}, {301, NCP_GG_NONMODAL},
+        {520, NCP_GG_NONMODAL}, {530, NCP_GG_NONMODAL}, {920, NCP_GG_NONMODAL},
+        {921, NCP_GG_NONMODAL}, {922, NCP_GG_NONMODAL}, {923, NCP_GG_NONMODAL},
+        {0, NCP_GG_MOTION}, {10, NCP_GG_MOTION}, {20, NCP_GG_MOTION}, {30, NCP_GG_MOTION},
+        {382, NCP_GG_MOTION}, {383, NCP_GG_MOTION}, {384, NCP_GG_MOTION},
+        {385, NCP_GG_MOTION}, {730, NCP_GG_MOTION}, {800, NCP_GG_MOTION},
+        {810, NCP_GG_MOTION}, {820, NCP_GG_MOTION}, {830, NCP_GG_MOTION},
+        {840, NCP_GG_MOTION}, {850, NCP_GG_MOTION}, {860, NCP_GG_MOTION},
+        {870, NCP_GG_MOTION}, {880, NCP_GG_MOTION}, {890, NCP_GG_MOTION},
+        {330, NCP_GG_MOTION}, {331, NCP_GG_MOTION}, {760, NCP_GG_MOTION},
+        {50, NCP_GG_MOTION}, {51, NCP_GG_MOTION}, {52, NCP_GG_MOTION},
+        {170, NCP_GG_PLANE}, {180, NCP_GG_PLANE}, {190, NCP_GG_PLANE},
+        {171, NCP_GG_PLANE}, {181, NCP_GG_PLANE}, {191, NCP_GG_PLANE},
+        {900, NCP_GG_DIST}, {910, NCP_GG_DIST}, {901, NCP_GG_ARCDIST}, {911, NCP_GG_ARCDIST},
+        {930, NCP_GG_FEEDMODE}, {940, NCP_GG_FEEDMODE}, {950, NCP_GG_FEEDMODE},
+        {200, NCP_GG_UNITS}, {210, NCP_GG_UNITS},
+        {400, NCP_GG_COMP}, {410, NCP_GG_COMP}, {411, NCP_GG_COMP}, {420, NCP_GG_COMP},
+        {421, NCP_GG_COMP},
+        {430, NCP_GG_TLO}, {431, NCP_GG_TLO}, {432, NCP_GG_TLO}, {490, NCP_GG_TLO},
+        {980, NCP_GG_RETRACT}, {990, NCP_GG_RETRACT},
+        {540, NCP_GG_COORD}, {550, NCP_GG_COORD}, {560, NCP_GG_COORD},
+        {570, NCP_GG_COORD}, {580, NCP_GG_COORD}, {590, NCP_GG_COORD},
+        {591, NCP_GG_COORD}, {592, NCP_GG_COORD}, {593, NCP_GG_COORD},
+        {610, NCP_GG_CONTROL}, {611, NCP_GG_CONTROL}, {640, NCP_GG_CONTROL},
+        {960, NCP_GG_SPINDLE}, {970, NCP_GG_SPINDLE}, {70, NCP_GG_LATHE}, {80, NCP_GG_LATHE},
+    };
+    memset(ncp_g_group, -1, sizeof ncp_g_group);
+    for (size_t k = 0; k < sizeof tab / sizeof tab[0]; k++)
+        ncp_g_group[tab[k].code] = tab[k].group;
+    ncp_g_group_ready = 1;
+}
+
+static int ncp_m_group(int m)
+{
+    switch (m) {
+    case 0: case 1: case 2: case 30: case 60: return NCP_MG_STOP;
+    case 6: case 61: return NCP_MG_TOOL;
+    case 3: case 4: case 5: case 19: return NCP_MG_SPINDLE;
+    case 7: case 8: case 9: return NCP_MG_COOLANT;
+    case 48: case 49: case 50: case 51: case 52: case 53: return NCP_MG_OVERRIDE;
+    case 62: case 63: case 64: case 65: case 66: case 67: case 68: return NCP_MG_IO;
+    default: return -1;
+    }
+}
+
+static int ncp_eval(struct ncp_analyzer *a, const struct ncp_block *b,
+                    const struct ncp_expr *e, double *out)
+{
+    if (e->is_const) {
+        *out = e->value;
+        return NCP_OK;
+    }
+    return ncp_expr_eval(b, e, &a->pops, out, &a->err);
+}
+
+static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
+{
+    struct ncp_words *w = &a->w;
+    double t = v * 10.0;
+    int code = (int)floor(t);
+    if (t - code > 0.999)
+        code = (int)ceil(t);
+    else if (t - code > 0.001)
+        return ncp_an_error(a, col, "G-code out of range");
+    if (code > 999)
+        return ncp_an_error(a, col, "G-code out of range");
+    if (code < 0)
+        return ncp_an_error(a, col, "Negative g code used");
+    int g = ncp_g_group[code];
+    if (g < 0)
+        return ncp_an_error(a, col, "Unknown g code used");
+    if (code == 800 && w->g[g] != -1)
+        return NCP_OK;
+    if (w->g[g] != -1 && w->g[g] != 800)
+        return ncp_an_error(a, col, "Two g codes used from same modal group");
+    w->g[g] = (int16_t)code;
+    w->gcol[g] = col;
+    return NCP_OK;
+}
+
+static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
+{
+    struct ncp_words *w = &a->w;
+    int m = (int)lround(v);
+    if (m < 0)
+        return ncp_an_error(a, col, "Negative m code used");
+    if (m > 199)
+        return ncp_an_error(a, col, "M-code greater than 199: M%d", m);
+    int g = ncp_m_group(m);
+    if (g < 0)
+        return ncp_an_error(a, col, "Unknown m code used: M%d", m);
+    if (w->m[g] != -1)
+        return ncp_an_error(a, col, "Two m codes used from same modal group");
+    w->m[g] = (int16_t)m;
+    w->mcol[g] = col;
+    w->n_m++;
+    return NCP_OK;
+}
+
+/* Reader-level value checks rs274 makes while reading each word. */
+static int ncp_word_check(struct ncp_analyzer *a, char c, double v, uint16_t col)
+{
+    if (v >= 0.0)
+        return NCP_OK;
+    switch (c) {
+    case 'F': return ncp_an_error(a, col, "Negative f word used");
+    case 'S': return ncp_an_error(a, col, "Negative spindle speed used");
+    case 'T': return ncp_an_error(a, col, "Negative tool id (tool not found)");
+    case 'H': return ncp_an_error(a, col, "Negative h word used");
+    /* a negative D is legal with G41.1/G42.1 (it swaps the side): cutcomp checks it */
+    case 'L': return ncp_an_error(a, col, "Negative l word used");
+    case 'P': return ncp_an_error(a, col, "Negative p word used");
+    default: return NCP_OK;
+    }
+}
+
+int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b)
+{
+    struct ncp_words *w = &a->w;
+    if (!ncp_g_group_ready)
+        ncp_g_table_init();
+    w->has = 0;
+    w->n_m = 0;
+    w->line_col = b->n_words ? b->words[0].col : 1;
+    memset(w->g, 0xff, sizeof w->g);
+    memset(w->m, 0xff, sizeof w->m);
+    unsigned n = b->n_words;
+    if (n > NCP_BLOCK_MAX_WORDS)
+        n = NCP_BLOCK_MAX_WORDS;
+    for (unsigned k = 0; k < n; k++) {
+        const struct ncp_word *wd = &b->words[k];
+        double v;
+        int rc = ncp_eval(a, b, &wd->v, &v);
+        if (rc != NCP_OK)
+            return rc;
+        if (wd->letter == 'G') {
+            rc = ncp_add_g(a, v, wd->col);
+        } else if (wd->letter == 'M') {
+            rc = ncp_add_m(a, v, wd->col);
+        } else if ((wd->letter >= 'A' && wd->letter <= 'Z') || wd->letter == '@' ||
+                   wd->letter == '^' || wd->letter == '$') {
+            int i = NCP_LETTER(wd->letter);
+            w->has |= 1u << i;
+            w->v[i] = v;
+            w->col[i] = wd->col;
+            rc = ncp_word_check(a, wd->letter, v, wd->col);
+        }
+        if (rc != NCP_OK)
+            return rc;
+    }
+    if (w->n_m > 5)
+        return ncp_an_error(a, w->line_col, "Too many m codes on line");
+    return NCP_OK;
+}
+
+/* All values first (pre-block parameters), then the writes in order. */
+int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b)
+{
+    if (b->n_assign == 0)
+        return NCP_OK;
+    double val[NCP_BLOCK_MAX_ASSIGN];
+    int idx[NCP_BLOCK_MAX_ASSIGN];
+    unsigned n = b->n_assign;
+    if (n > NCP_BLOCK_MAX_ASSIGN)
+        n = NCP_BLOCK_MAX_ASSIGN;
+    for (unsigned k = 0; k < n; k++) {
+        const struct ncp_assign *as = &b->assign[k];
+        int rc = ncp_eval(a, b, &as->value, &val[k]);
+        if (rc == NCP_OK && as->kind == NCP_ASSIGN_NUMBERED) {
+            double iv;
+            rc = ncp_eval(a, b, &as->index, &iv);
+            idx[k] = (int)lround(iv);
+        }
+        if (rc != NCP_OK)
+            return rc;
+    }
+    for (unsigned k = 0; k < n; k++) {
+        const struct ncp_assign *as = &b->assign[k];
+        int rc;
+        a->err.line = b->line;
+        if (as->kind == NCP_ASSIGN_NUMBERED) {
+            rc = ncp_params_set(a->params, idx[k], val[k], &a->err);
+        } else {
+            size_t off = as->name_off < NCP_BLOCK_POOL ? as->name_off : NCP_BLOCK_POOL;
+            size_t len = as->name_len <= NCP_BLOCK_POOL - off ? as->name_len : 0;
+            rc = ncp_params_set_named(a->params, b->pool + off, len, val[k], &a->err);
+        }
+        if (rc != NCP_OK) {
+            a->err.line = b->line;
+            if (a->err.col == 0)
+                a->err.col = as->col;
+            return rc;
+        }
+    }
+    return NCP_OK;
+}

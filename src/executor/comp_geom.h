@@ -1,0 +1,87 @@
+/* Cutter radius compensation geometry with rs274's exact floating-point
+ * recipe (interp_convert.cc comp1/comp2 paths), so offset points agree with
+ * rs274 to the last printed digit. Pure functions, C interface to C++/Eigen:
+ * no exceptions, no allocation cross it. Coordinates are in the comp plane:
+ * XY as x,y and XZ as z,x (rs274's "first", "second"). Side: 1 left, 2 right. */
+#ifndef NCPAR_EXECUTOR_COMP_GEOM_H
+#define NCPAR_EXECUTOR_COMP_GEOM_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define NCP_COMP_LEFT 1
+#define NCP_COMP_RIGHT 2
+
+enum ncp_comp_status {
+    NCP_COMP_OK = 0,
+    NCP_COMP_E_ENTRY_SHORT,      /* straight entry move not longer than the radius */
+    NCP_COMP_E_ENTRY_ARC_SHORT,  /* entry arc chord not longer than the radius */
+    NCP_COMP_E_TOOL_TOO_BIG,     /* tool does not fit inside the arc */
+    NCP_COMP_E_BUG,              /* rs274's own consistency check failed */
+    NCP_COMP_E_ZERO_CORNER,      /* 0-degree inside corner */
+    NCP_COMP_E_ARC_LINE_GOUGE,
+    NCP_COMP_E_LINE_ARC_GOUGE,   /* also: arc end moved beyond its sweep */
+    NCP_COMP_E_ARC_ARC_CENTRE,
+    NCP_COMP_E_ARC_ARC_GOUGE,
+    NCP_COMP_E_FEED_GOUGE,
+    NCP_COMP_E_TRAVERSE_GOUGE,
+    NCP_COMP_E_ARC_MISMATCH      /* moved arc end no longer on its circle */
+};
+
+/* rs274's message for a status (never NULL). */
+const char *ncp_comp_strerror(int status);
+
+/* The move at the front of the compensation queue, already compensated: the
+ * corner decisions look at its kind, turn, centre and end. */
+struct ncp_comp_prev {
+    int valid;               /* 0: queue empty */
+    int is_arc;
+    int turn;
+    double centre[2], end[2];
+};
+
+/* First straight move after G41/G42 (comp1): end point and the "direction"
+ * rs274 records for the later gouge check. */
+int ncp_comp_line_entry(int side, double r, const double cur[2], const double p[2],
+                        double end[2], double dir[2]);
+
+/* First arc after G41/G42 (comp1). centre/turn: the programmed arc from cur.
+ * Gives the offset end and the shifted centre of the compensated arc. */
+int ncp_comp_arc_entry(int side, double r, const double cur[2], const double end[2],
+                       const double centre[2], int turn, double spiral_abs_tol,
+                       double new_end[2], double new_centre[2]);
+
+enum ncp_comp_corner {
+    NCP_CORNER_STRAIGHT = 0, /* tangent or collinear: nothing added */
+    NCP_CORNER_CONVEX,       /* extra arc (G0: traverse) to mid */
+    NCP_CORNER_CONVEX2,      /* arc move: extra arc around op to mid */
+    NCP_CORNER_CONCAVE       /* queued moves end at mid instead */
+};
+
+struct ncp_comp_corner_out {
+    int corner;              /* enum ncp_comp_corner */
+    double mid[2];
+    double end[2];           /* offset end of the new move */
+};
+
+/* Straight move after the first (comp2) with XY motion. cur: compensated
+ * current point, op: programmed current point, p: programmed end. */
+int ncp_comp_line_next(int side, double r, const double cur[2], const double op[2],
+                       const double p[2], const struct ncp_comp_prev *front,
+                       struct ncp_comp_corner_out *out);
+
+/* Arc move after the first (comp2): centre and turn of the programmed arc
+ * from op to end, ccw 1 for G3. */
+int ncp_comp_arc_next(int side, double r, const double cur[2], const double op[2],
+                      const double end[2], const double centre[2], int ccw, int turn,
+                      const struct ncp_comp_prev *front, struct ncp_comp_corner_out *out);
+
+/* Signed swept angle of an arc from p1 to p2 about c (rs274's find_turn). */
+double ncp_comp_find_turn(const double p1[2], const double c[2], int turn, const double p2[2]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

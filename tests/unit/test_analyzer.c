@@ -1,0 +1,355 @@
+/* The analyzer core driven through its public contract: an in-memory program
+ * lexed on demand, slots collected by a test sink, ops checked field by field.
+ * Expected values come from LinuxCNC rs274 -g on the same programs. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "ncpar/analyzer.h"
+#include "ncpar/feeder.h"
+#include "ncpar/lex.h"
+
+struct mem_feed {
+    struct ncp_source src;
+    uint64_t off;
+    uint32_t line;
+    struct ncp_block block;
+};
+
+static const struct ncp_block *mf_next(void *ctx)
+{
+    struct mem_feed *f = ctx;
+    struct ncp_span sp;
+    if (ncp_source_span(&f->src, f->off, f->line, &sp) != 0)
+        return NULL;
+    ncp_lex_block(f->src.text + sp.off, sp.len, sp.line, sp.off, &f->block);
+    f->off = sp.next;
+    f->line++;
+    return &f->block;
+}
+
+static void mf_release(void *ctx)
+{
+    (void)ctx;
+}
+
+#define MAX_SLOTS 4096
+
+/* Every published slot, plus a flat list of all ops in order. */
+struct collect {
+    unsigned n_slots;
+    struct ncp_cmd *slots;
+    struct ncp_cmd cur;
+    unsigned n_ops;
+    struct ncp_canon *ops;
+    uint64_t next_id;
+    int keep;                 /* 0: count only (benchmark) */
+};
+
+static struct ncp_cmd *c_acquire(void *ctx)
+{
+    struct collect *c = ctx;
+    ncp_cmd_reset_header(&c->cur, c->next_id++);
+    return &c->cur;
+}
+
+static void c_publish(void *ctx, struct ncp_cmd *cmd)
+{
+    struct collect *c = ctx;
+    if (!c->keep) {
+        c->n_slots++;
+        return;
+    }
+    assert_true(c->n_slots < MAX_SLOTS);
+    c->slots[c->n_slots++] = *cmd;
+    for (unsigned k = 0; k < cmd->n_ops; k++)
+        c->ops[c->n_ops++] = cmd->ops[k];
+}
+
+struct run {
+    struct collect c;
+    int rc;
+    const struct ncp_cmd *last;
+};
+
+static void run_program(struct run *r, const char *text, int keep)
+{
+    static struct mem_feed feed;
+    struct ncp_diag d;
+    memset(r, 0, sizeof *r);
+    r->c.keep = keep;
+    if (keep) {
+        r->c.slots = calloc(MAX_SLOTS, sizeof *r->c.slots);
+        r->c.ops = calloc(MAX_SLOTS * NCP_CMD_MAX_OPS, sizeof *r->c.ops);
+        assert_non_null(r->c.slots);
+        assert_non_null(r->c.ops);
+    }
+    memset(&feed, 0, sizeof feed);
+    assert_int_equal(ncp_source_from_memory(&feed.src, text, strlen(text), "t.ngc", &d), 0);
+    feed.off = feed.src.begin;
+    feed.line = feed.src.begin_line;
+    struct ncp_analyzer_cfg cfg = {0};
+    struct ncp_analyzer *a = ncp_analyzer_new(&cfg, &d);
+    assert_non_null(a);
+    struct ncp_block_feed bf = {&feed, mf_next, mf_release, &feed.src};
+    struct ncp_cmd_sink sink = {&r->c, c_acquire, c_publish};
+    r->rc = ncp_analyzer_run(a, &bf, &sink);
+    ncp_analyzer_free(a);
+    if (keep && r->c.n_slots)
+        r->last = &r->c.slots[r->c.n_slots - 1];
+}
+
+static void run_free(struct run *r)
+{
+    free(r->c.slots);
+    free(r->c.ops);
+}
+
+/* ops after the 6-call preamble */
+static const struct ncp_canon *body_op(const struct run *r, unsigned k)
+{
+    assert_true(6 + k < r->c.n_ops);
+    return &r->c.ops[6 + k];
+}
+
+static void test_preamble_and_end(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "M2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    static const int want[] = {
+        NCP_C_USE_LENGTH_UNITS, NCP_C_SET_G5X_OFFSET, NCP_C_SET_G92_OFFSET,
+        NCP_C_SET_XY_ROTATION, NCP_C_SET_FEED_REFERENCE, NCP_C_ON_RESET,
+        NCP_C_SET_G5X_OFFSET, NCP_C_SET_XY_ROTATION, NCP_C_SET_FEED_MODE,
+        NCP_C_SET_FEED_RATE, NCP_C_STOP_SPINDLE_TURNING, NCP_C_SET_SPINDLE_MODE,
+        NCP_C_PROGRAM_END, NCP_C_ON_RESET, NCP_C_ON_RESET,
+    };
+    assert_int_equal(r.c.n_ops, sizeof want / sizeof want[0]);
+    for (unsigned k = 0; k < r.c.n_ops; k++)
+        assert_int_equal(r.c.ops[k].kind, want[k]);
+    assert_int_equal(r.c.ops[0].i[0], 1); /* mm */
+    assert_true(r.last->flags & NCP_CMD_F_END);
+    for (unsigned k = 0; k < r.c.n_slots; k++)
+        assert_int_equal(r.c.slots[k].cmd_id, k);
+    run_free(&r);
+}
+
+static void test_straight_feed(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G1 X1.234 Y5.678 Z-1 F100\nG91 X1\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    const struct ncp_canon *f = body_op(&r, 0);
+    assert_int_equal(f->kind, NCP_C_SET_FEED_RATE);
+    assert_true(f->d[0] == 100.0);
+    const struct ncp_canon *m = body_op(&r, 1);
+    assert_int_equal(m->kind, NCP_C_STRAIGHT_FEED);
+    assert_true(m->d[0] == 1.234 && m->d[1] == 5.678 && m->d[2] == -1.0);
+    assert_int_equal(body_op(&r, 2)->kind, NCP_C_COMMENT); /* distance mode comment */
+    m = body_op(&r, 3);
+    assert_int_equal(m->kind, NCP_C_STRAIGHT_FEED);
+    assert_true(fabs(m->d[0] - 2.234) < 1e-12);
+    run_free(&r);
+}
+
+static void test_error_slot(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G0 X1\nS100 G1 X2\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_ERR_SEMANTIC);
+    assert_true(r.last->flags & NCP_CMD_F_ERROR);
+    assert_int_equal(r.last->diag.line, 2);
+    assert_int_equal(r.last->diag.col, 6);
+    assert_string_equal(r.last->diag.msg, "Cannot do g1 with zero feed rate");
+    /* the spindle speed went out before the error, as rs274 printed it */
+    assert_int_equal(r.last->ops[0].kind, NCP_C_SET_SPINDLE_SPEED);
+    run_free(&r);
+}
+
+static void test_eof_without_end(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G0 X1\n", 1);
+    assert_int_equal(r.rc, NCP_ERR_SEMANTIC);
+    assert_string_equal(r.last->diag.msg, "File ended with no percent sign or program end");
+    run_free(&r);
+}
+
+static void test_arc_request(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G0 X1 Y0\nG18 G3 X0 Z1 I-1 K0 F10\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    const struct ncp_canon *a = NULL;
+    for (unsigned k = 0; k < r.c.n_ops; k++)
+        if (r.c.ops[k].kind == NCP_C_ARC_REQUEST)
+            a = &r.c.ops[k];
+    assert_non_null(a);
+    /* XZ plane: first axis Z, second X, helix Y; IJK incremental by default */
+    assert_true(a->d[0] == 0.0 && a->d[1] == 1.0);
+    assert_true(a->d[2] == 1.0 && a->d[3] == 0.0);
+    assert_true(a->d[8] == 0.0 && a->d[9] == 0.0);
+    assert_int_equal(a->i[0], 1);
+    assert_int_equal(a->i[1], 0);
+    assert_int_equal(a->i[3], 2);
+    run_free(&r);
+}
+
+static void test_params_pre_block(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "#1=1\n#1=2 #2=#1\nG0 X#2 Y#1\nM2\n", 1);
+    const struct ncp_canon *m = body_op(&r, 0);
+    assert_int_equal(m->kind, NCP_C_STRAIGHT_TRAVERSE);
+    assert_true(m->d[0] == 1.0 && m->d[1] == 2.0);
+    run_free(&r);
+}
+
+static void test_slot_continuation(void **state)
+{
+    (void)state;
+    struct run r;
+    /* G91 L6 canned cycle: far more than one slot's worth of calls */
+    run_program(&r, "G0 Z5\nG91 F10 G81 X1 Z-2 R-1 L6\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    unsigned cont = 0;
+    for (unsigned k = 0; k < r.c.n_slots; k++) {
+        if (r.c.slots[k].flags & NCP_CMD_F_CONT) {
+            cont++;
+            assert_int_equal(r.c.slots[k].line, r.c.slots[k - 1].line);
+        }
+        assert_int_equal(r.c.slots[k].cmd_id, k);
+    }
+    assert_true(cont >= 2);
+    unsigned feeds = 0;
+    for (unsigned k = 0; k < r.c.n_ops; k++)
+        feeds += r.c.ops[k].kind == NCP_C_STRAIGHT_FEED;
+    assert_int_equal(feeds, 6);
+    run_free(&r);
+}
+
+static void test_g92_and_coords(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G0 X5\nG92 X0\nG0 X1\nG10 L2 P2 X10\nG55 G0 X0\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    const struct ncp_canon *g92 = body_op(&r, 1);
+    assert_int_equal(g92->kind, NCP_C_SET_G92_OFFSET);
+    assert_true(g92->d[0] == 5.0);
+    const struct ncp_canon *g5x = NULL;
+    for (unsigned k = 6; k < r.c.n_ops; k++)
+        if (r.c.ops[k].kind == NCP_C_SET_G5X_OFFSET && r.c.ops[k].i[0] == 2)
+            g5x = &r.c.ops[k];
+    assert_non_null(g5x);
+    assert_true(g5x->d[0] == 10.0);
+    run_free(&r);
+}
+
+/* The sequential bottleneck: a plain G1 block must stay well under 1 us. */
+static void test_speed(void **state)
+{
+    (void)state;
+    enum { N = 200000 };
+    size_t cap = (size_t)N * 32 + 64;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    size_t n = 0;
+    n += (size_t)snprintf(text + n, cap - n, "F100\n");
+    for (int k = 0; k < N; k++)
+        n += (size_t)snprintf(text + n, cap - n, "G1 X%d.234 Y5.678 Z-1\n", k % 100);
+    snprintf(text + n, cap - n, "M2\n");
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    struct run r;
+    run_program(&r, text, 0);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    assert_int_equal(r.rc, NCP_END);
+    double ns = ((double)(t1.tv_sec - t0.tv_sec) * 1e9 + (double)(t1.tv_nsec - t0.tv_nsec)) / N;
+    print_message("analyzer incl. lexing: %.0f ns per block\n", ns);
+    assert_true(ns < 5000.0); /* generous: shared CI machines */
+    free(text);
+}
+
+/* Analyzer alone: the feed replays pre-lexed blocks, as the pipeline does. */
+#define REPLAY 64
+struct replay_feed {
+    struct ncp_block *blocks;
+    unsigned n, total;
+};
+
+static const struct ncp_block *rf_next(void *ctx)
+{
+    struct replay_feed *f = ctx;
+    if (f->n >= f->total)
+        return NULL;
+    struct ncp_block *b = &f->blocks[f->n % REPLAY];
+    b->line = f->n + 1;
+    f->n++;
+    return b;
+}
+
+static void test_speed_analyzer_only(void **state)
+{
+    (void)state;
+    enum { N = 1000000 };
+    struct replay_feed f = {calloc(REPLAY + 2, sizeof(struct ncp_block)), 0, N};
+    assert_non_null(f.blocks);
+    char line[64];
+    for (int k = 0; k < REPLAY; k++) {
+        int len = snprintf(line, sizeof line, k == 0 ? "G1 X1 F100" : "G1 X%d.234 Y5.678 Z-1", k);
+        ncp_lex_block(line, (size_t)len, 1, 0, &f.blocks[k]);
+    }
+    static const char text[] = "M2\n";
+    struct ncp_source src;
+    struct ncp_diag d;
+    assert_int_equal(ncp_source_from_memory(&src, text, sizeof text - 1, "t", &d), 0);
+    struct collect c = {0};
+    struct ncp_analyzer_cfg cfg = {0};
+    struct ncp_analyzer *a = ncp_analyzer_new(&cfg, &d);
+    assert_non_null(a);
+    struct ncp_block_feed bf = {&f, rf_next, mf_release, &src};
+    struct ncp_cmd_sink sink = {&c, c_acquire, c_publish};
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    int rc = ncp_analyzer_run(a, &bf, &sink);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    ncp_analyzer_free(a);
+    /* the replayed body has no M2: rs274's end-of-file error closes it */
+    assert_int_equal(rc, NCP_ERR_SEMANTIC);
+    double ns = ((double)(t1.tv_sec - t0.tv_sec) * 1e9 + (double)(t1.tv_nsec - t0.tv_nsec)) / N;
+    print_message("analyzer alone: %.0f ns per G1 block\n", ns);
+    assert_true(ns < 2000.0);
+    free(f.blocks);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_preamble_and_end),
+        cmocka_unit_test(test_straight_feed),
+        cmocka_unit_test(test_error_slot),
+        cmocka_unit_test(test_eof_without_end),
+        cmocka_unit_test(test_arc_request),
+        cmocka_unit_test(test_params_pre_block),
+        cmocka_unit_test(test_slot_continuation),
+        cmocka_unit_test(test_g92_and_coords),
+        cmocka_unit_test(test_speed),
+        cmocka_unit_test(test_speed_analyzer_only),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

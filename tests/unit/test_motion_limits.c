@@ -1,0 +1,394 @@
+/* Limits the motion runtime must keep, checked from the --trace CSV of whole
+ * virtual-clock runs: velocity, acceleration and (S-curve) jerk per axis from
+ * the first, second and third differences of the commanded positions; live
+ * feed override and feed hold; slowing down for an underrun. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdio.h>
+#include <time.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ncpar/feeder.h"
+#include "ncpar/motion.h"
+#include "ncpar/pipeline.h"
+#include "ncpar/rt.h"
+#include "../../src/rt/nck_int.h"
+
+/* The trace prints positions with 6 decimals: a k-th difference may be off by
+ * 2^k half-units of the last digit, divided by T^k. */
+#define PRINT_Q 0.5e-6
+
+struct row {
+    double t, cmd[3], v;
+    unsigned line;
+};
+
+static struct row *read_trace(FILE *f, size_t *n)
+{
+    char buf[512];
+    rewind(f);
+    assert_non_null(fgets(buf, sizeof buf, f));
+    size_t cap = 4096;
+    struct row *r = malloc(cap * sizeof *r);
+    assert_non_null(r);
+    *n = 0;
+    while (fgets(buf, sizeof buf, f)) {
+        if (*n == cap) {
+            struct row *bigger = realloc(r, (cap *= 2) * sizeof *r);
+            assert_non_null(bigger);
+            r = bigger;
+        }
+        struct row *x = &r[(*n)++];
+        double act[3];
+        assert_int_equal(sscanf(buf, "%lf,%u,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x->t, &x->line,
+                                &x->cmd[0], &x->cmd[1], &x->cmd[2], &act[0], &act[1], &act[2],
+                                &x->v),
+                         9);
+    }
+    return r;
+}
+
+/* Worst ratio of |k-th difference| / limit over all axes (1 = at the limit). */
+struct worst {
+    double vel, acc, jerk;
+    unsigned jerk_line;
+};
+
+static struct worst check_limits(const struct row *r, size_t n, const struct ncp_machine_cfg *c)
+{
+    const double T = c->servo_period;
+    struct worst w = { 0, 0, 0, 0 };
+    for (size_t k = 3; k < n; k++) {
+        assert_true(fabs(r[k].t - r[k - 1].t - T) < 1e-7);  /* one row per period */
+        for (int j = 0; j < NCP_AXES; j++) {
+            const struct ncp_axis_cfg *a = &c->axis[j];
+            double p0 = r[k - 3].cmd[j], p1 = r[k - 2].cmd[j], p2 = r[k - 1].cmd[j],
+                   p3 = r[k].cmd[j];
+            double v = fabs(p3 - p2) / T, acc = fabs(p3 - 2 * p2 + p1) / (T * T);
+            double jerk = fabs(p3 - 3 * p2 + 3 * p1 - p0) / (T * T * T);
+            w.vel = fmax(w.vel, (v - 2 * PRINT_Q / T) / a->max_vel);
+            w.acc = fmax(w.acc, (acc - 4 * PRINT_Q / (T * T)) / a->max_acc);
+            double rj = (jerk - 8 * PRINT_Q / (T * T * T)) / a->max_jerk;
+            if (rj > w.jerk) {
+                w.jerk = rj;
+                w.jerk_line = r[k].line;
+            }
+        }
+    }
+    return w;
+}
+
+struct gcode_ctx {
+    struct ncp_source src;
+    struct ncp_analyzer_cfg acfg;
+};
+
+static int gcode_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
+{
+    struct gcode_ctx *g = ctx;
+    struct ncp_run_stats st;
+    return ncp_serial_run(&g->src, &g->acfg, out, &st, d);
+}
+
+static struct row *run_text(const char *text, const struct ncp_machine_cfg *cfg, size_t *n,
+                            struct ncp_nck_result *res)
+{
+    struct gcode_ctx g;
+    struct ncp_diag d;
+    memset(&g, 0, sizeof g);
+    assert_int_equal(ncp_source_from_memory(&g.src, text, strlen(text), "t.ngc", &d), NCP_OK);
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    struct ncp_nck_opts o = { .cfg = cfg, .interpret = gcode_run, .interp_ctx = &g,
+                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
+    assert_int_equal(ncp_nck_run(&o, res), 0);
+    struct row *r = read_trace(f, n);
+    fclose(f);
+    ncp_source_close(&g.src);
+    return r;
+}
+
+static const char corners_prog[] =
+    "G21 G90 G17 G64 P0.05\n"
+    "G0 X0 Y0 Z5\n"
+    "G1 Z-1 F600\n"
+    "G1 X40 F4000\n"
+    "G1 X60 Y20\n"
+    "G3 X60 Y60 I0 J20\n"
+    "G2 X40 Y80 I-20 J0\n"
+    "G1 X0 Y80\n"
+    "G61 G1 X0 Y40\n"
+    "G1 X-10 Y30\n"
+    "G64 P0.2 G1 X-10 Y0\n"
+    "G2 X-10 Y0 Z-4 I10 J0 F2000\n"
+    "G0 Z5\n"
+    "M2\n";
+
+static void scurve_cfg(struct ncp_machine_cfg *c)
+{
+    ncp_machine_cfg_default(c);
+    c->profile = NCP_PROFILE_SCURVE;
+    c->axis[2].max_vel = 100;
+    c->axis[2].max_acc = 1000;
+    c->axis[2].max_jerk = 50000;
+}
+
+static void test_scurve_trace_within_jerk(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    scurve_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(corners_prog, &cfg, &n, &res);
+    struct worst w = check_limits(r, n, &cfg);
+    if (w.vel > 1 + 1e-9 || w.acc > 1 + 1e-9 || w.jerk > 1 + 1e-9)
+        fail_msg("vel %.4f acc %.4f jerk %.4f (line %u) of the limits", w.vel, w.acc, w.jerk,
+                 w.jerk_line);
+    /* it really is jerk-limited motion that uses the machine, not a crawl */
+    assert_true(w.acc > 0.3 && w.jerk > 0.3);
+    assert_true(r[n - 1].cmd[2] == 5 && r[n - 1].v == 0);
+    free(r);
+}
+
+/* The same program as a trapezoid breaks the jerk limit (which is what the
+ * S-curve is for) but keeps velocity and acceleration. */
+static void test_trapezoid_is_not_jerk_limited(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    scurve_cfg(&cfg);
+    cfg.profile = NCP_PROFILE_TRAPEZOID;
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(corners_prog, &cfg, &n, &res);
+    struct worst w = check_limits(r, n, &cfg);
+    assert_true(w.vel <= 1 + 1e-9 && w.acc <= 1 + 1e-9);
+    assert_true(w.jerk > 2);
+    free(r);
+}
+
+/* A long line takes the analytical S-curve time: two ramps of v/a + a/j. */
+static void test_scurve_long_line_time(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    scurve_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text("G21 G90 G1 X300 F6000\nM2\n", &cfg, &n, &res);
+    double v = 100, a = 2000, j = 0.5 * 100000;  /* half the jerk: corners keep the rest */
+    double ramp = v / a + a / j, expect = 300 / v + ramp;
+    assert_true(fabs(res.program_time - expect) / expect < 0.01);
+    assert_true(r[n - 1].cmd[0] == 300);
+    free(r);
+}
+
+static void test_scurve_programs(void **state)
+{
+    (void)state;
+    static const char *const progs[] = { "ncprograms/demo.ngc", "ncprograms/helical-bore.ngc" };
+    struct ncp_machine_cfg cfg;
+    scurve_cfg(&cfg);
+    for (size_t i = 0; i < sizeof progs / sizeof progs[0]; i++) {
+        struct gcode_ctx g;
+        struct ncp_diag d;
+        memset(&g, 0, sizeof g);
+        if (ncp_source_open(&g.src, progs[i], &d) != NCP_OK) {
+            print_message("skipping %s (run from the source tree)\n", progs[i]);
+            continue;
+        }
+        FILE *f = tmpfile();
+        struct ncp_nck_opts o = { .cfg = &cfg, .interpret = gcode_run, .interp_ctx = &g,
+                                  .virtual_clock = 1, .feed_override = 1.0, .trace = f };
+        struct ncp_nck_result res;
+        int rc = ncp_nck_run(&o, &res);
+        size_t n;
+        struct row *r = read_trace(f, &n);
+        struct worst w = check_limits(r, n, &cfg);
+        if (rc != 0 || w.vel > 1 + 1e-9 || w.acc > 1 + 1e-9 || w.jerk > 1 + 1e-9)
+            fail_msg("%s: rc %d vel %.4f acc %.4f jerk %.4f (line %u)", progs[i], rc, w.vel,
+                     w.acc, w.jerk, w.jerk_line);
+        free(r);
+        fclose(f);
+        ncp_source_close(&g.src);
+    }
+}
+
+
+/* ---- live feed override and feed hold ------------------------------------------ */
+
+struct live {
+    struct ncp_nck_ctl ctl;
+    double at_s[3];        /* machine times of the actions */
+    int action[3];         /* 0 override 30 %, 1 override 100 %, 2 hold, 3 resume */
+    int n;
+    double done_at[3];     /* machine time just after each action was issued */
+};
+
+static void *live_driver(void *arg)
+{
+    struct live *l = arg;
+    for (int i = 0; i < l->n; i++) {
+        /* the virtual clock stands still at at_s until the action is done */
+        while (atomic_load(&l->ctl.now_ns) < atomic_load(&l->ctl.pause_at_ns)) {
+            struct timespec ts = { 0, 20000 };
+            nanosleep(&ts, NULL);
+        }
+        switch (l->action[i]) {
+        case 0: ncp_nck_set_feed_override(&l->ctl, 0.3); break;
+        case 1: ncp_nck_set_feed_override(&l->ctl, 1.0); break;
+        case 2: ncp_nck_feed_hold(&l->ctl, 1); break;
+        default: ncp_nck_feed_hold(&l->ctl, 0); break;
+        }
+        l->done_at[i] = (double)atomic_load(&l->ctl.now_ns) * 1e-9;
+        atomic_store(&l->ctl.pause_at_ns,
+                     i + 1 < l->n ? (int64_t)llround(l->at_s[i + 1] * 1e9) : INT64_MAX);
+    }
+    return NULL;
+}
+
+static struct row *run_live(const char *text, const struct ncp_machine_cfg *cfg, struct live *l,
+                            size_t *n)
+{
+    struct gcode_ctx g;
+    struct ncp_diag d;
+    memset(&g, 0, sizeof g);
+    assert_int_equal(ncp_source_from_memory(&g.src, text, strlen(text), "t.ngc", &d), NCP_OK);
+    FILE *f = tmpfile();
+    ncp_nck_ctl_init(&l->ctl, 1.0);
+    atomic_store(&l->ctl.pause_at_ns, (int64_t)llround(l->at_s[0] * 1e9));
+    struct ncp_nck_opts o = { .cfg = cfg, .interpret = gcode_run, .interp_ctx = &g,
+                              .virtual_clock = 1, .feed_override = 1.0, .trace = f,
+                              .ctl = &l->ctl };
+    pthread_t th;
+    assert_int_equal(pthread_create(&th, NULL, live_driver, l), 0);
+    struct ncp_nck_result res;
+    assert_int_equal(ncp_nck_run(&o, &res), 0);
+    pthread_join(th, NULL);
+    struct row *r = read_trace(f, n);
+    fclose(f);
+    ncp_source_close(&g.src);
+    return r;
+}
+
+static void test_live_override_keeps_limits(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    ncp_machine_cfg_default(&cfg);
+    struct live l = { .at_s = { 0.9, 1.6 }, .action = { 0, 1 }, .n = 2 };
+    size_t n;
+    struct row *r = run_live(corners_prog, &cfg, &l, &n);
+    struct worst w = check_limits(r, n, &cfg);
+    if (w.vel > 1 + 1e-9 || w.acc > 1 + 1e-9)
+        fail_msg("vel %.4f acc %.4f of the limits", w.vel, w.acc);
+    /* between the two calls the feed really was 30 % of the planned one */
+    double vmax = 0;
+    for (size_t k = 0; k < n; k++)
+        if (r[k].t > l.done_at[0] + 0.1 && r[k].t < l.at_s[1] && r[k].line == 4)
+            vmax = fmax(vmax, r[k].v);
+    assert_true(vmax > 0.9 * 0.3 * 4000 / 60.0 && vmax <= 0.3 * 4000 / 60.0 + 1e-6);
+    assert_true(r[n - 1].cmd[2] == 5);  /* and the program ran to its end */
+    free(r);
+}
+
+static void test_live_hold_stops_within_braking_distance(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    ncp_machine_cfg_default(&cfg);
+    struct live l = { .at_s = { 0.5, 1.5 }, .action = { 2, 3 }, .n = 2 };
+    size_t n;
+    struct row *r = run_live("G21 G90 G1 X300 F6000\nM2\n", &cfg, &l, &n);
+    struct worst w = check_limits(r, n, &cfg);
+    assert_true(w.vel <= 1 + 1e-9 && w.acc <= 1 + 1e-9);
+    /* the hold took effect by done_at[0]: from there to the stop at most the
+     * braking distance at the position loop's deceleration (half the weakest
+     * axis) plus a period of travel */
+    size_t k0 = 0, k1;
+    while (k0 < n && r[k0].t < l.done_at[0])
+        k0++;
+    assert_true(k0 < n && l.done_at[0] < l.at_s[1]);
+    for (k1 = k0; k1 < n && r[k1].v > 0; k1++)
+        ;
+    assert_true(k1 < n && r[k1].t < l.at_s[1]);
+    double v = 100, brake = v * v / (2 * 0.5 * cfg.axis[0].max_acc);
+    assert_true(r[k1].cmd[0] - r[k0].cmd[0] <= brake + v * cfg.servo_period);
+    /* it stays put until the resume, then finishes the line */
+    for (size_t k = k1; k < n && r[k].t < l.at_s[1]; k++)
+        assert_true(r[k].cmd[0] == r[k1].cmd[0]);
+    assert_true(r[n - 1].cmd[0] == 300);
+    free(r);
+}
+
+/* ---- underrun: braking along the path keeps the acceleration limit ------------------ */
+
+/* A stream along X that cruises at 100 mm/s and then brakes at the axis's full
+ * limit; the scaler is told to stop (an underrun in the making) right when the
+ * stream starts braking. Returns the worst |second difference| / T^2. */
+static double underrun_worst_acc(int governed)
+{
+    const double T = 1e-3, v = 100, a = 2000;
+    struct ncp_spsc ring;
+    assert_int_equal(ncp_spsc_init(&ring, sizeof(struct ncp_setpoint), 1024), 0);
+    double zero[NCP_AXES] = { 0 }, x = 0, vel = v;
+    struct nck_scaler s;
+    nck_scaler_init(&s, zero, 0.5 * a, T);
+    if (governed)
+        for (int j = 0; j < NCP_AXES; j++)
+            s.amax[j] = a;
+    for (int k = 0; k < 400; k++) {
+        struct ncp_setpoint sp;
+        memset(&sp, 0, sizeof sp);
+        if (k >= 100)
+            vel = fmax(0, vel - a * T);
+        x += vel * T;
+        sp.pos[0] = x;
+        sp.v = vel;
+        assert_int_equal(ncp_spsc_push(&ring, &sp), 0);
+    }
+    double p[3] = { 0, 0, 0 }, worst = 0;
+    for (int k = 0; k < 600; k++) {
+        struct ncp_setpoint out;
+        nck_scaler_step(&s, k < 100 ? 1.0 : 0.0, &ring, &out);
+        p[0] = p[1];
+        p[1] = p[2];
+        p[2] = out.pos[0];
+        if (k >= 2)
+            worst = fmax(worst, fabs(p[2] - 2 * p[1] + p[0]) / (T * T));
+        assert_true(out.pos[0] <= x + 1e-12);
+    }
+    ncp_spsc_destroy(&ring);
+    return worst;
+}
+
+static void test_underrun_braking_keeps_accel_limit(void **state)
+{
+    (void)state;
+    /* without the per-axis check the two decelerations add up (the flaw) */
+    assert_true(underrun_worst_acc(0) > 1.3 * 2000);
+    assert_true(underrun_worst_acc(1) <= 2000 * (1 + 1e-9));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_scurve_trace_within_jerk),
+        cmocka_unit_test(test_trapezoid_is_not_jerk_limited),
+        cmocka_unit_test(test_scurve_long_line_time),
+        cmocka_unit_test(test_scurve_programs),
+        cmocka_unit_test(test_live_override_keeps_limits),
+        cmocka_unit_test(test_live_hold_stops_within_braking_distance),
+        cmocka_unit_test(test_underrun_braking_keeps_accel_limit),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
