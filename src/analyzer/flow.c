@@ -409,6 +409,32 @@ static int eval(struct ncp_flow *f, const struct ncp_block *b, const struct ncp_
     return ncp_expr_eval(b, e, &f->pops, v, d);
 }
 
+/* While rs274 skips over a subroutine definition it still evaluates the
+ * endsub/return value, but an undefined named parameter reads as 0 there. */
+static int lenient_get_named(void *ctx, const char *name, size_t len, double *out,
+                             struct ncp_diag *d)
+{
+    const struct ncp_params *p = ctx;
+    if (!ncp_params_exists(p, name, len)) {
+        *out = 0.0;
+        return NCP_OK;
+    }
+    return ncp_params_get_named(p, name, len, out, d);
+}
+
+static int eval_lenient(struct ncp_flow *f, const struct ncp_block *b,
+                        const struct ncp_expr *e, double *v, struct ncp_diag *d)
+{
+    if (e->is_const) {
+        *v = e->value;
+        return NCP_OK;
+    }
+    struct ncp_param_ops ops = f->pops;
+    ops.ctx = f->params;
+    ops.get_named = lenient_get_named;
+    return ncp_expr_eval(b, e, &ops, v, d);
+}
+
 static struct flow_label *find_label(struct ncp_flow *f)
 {
     return labels_find(&f->labels, f->label, f->label_len);
@@ -493,7 +519,8 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
             ncp_params_set_return(f->params, 0.0, 0);
             return NCP_OK;
         }
-        rc = eval(f, b, &o->cond, &v, d);
+        rc = f->defining.on && f->level == 0 ? eval_lenient(f, b, &o->cond, &v, d)
+                                              : eval(f, b, &o->cond, &v, d);
         if (rc == NCP_OK)
             ncp_params_set_return(f->params, v, 1);
         return rc;

@@ -129,6 +129,30 @@ static int ncp_word_check(struct ncp_analyzer *a, char c, double v, uint16_t col
     }
 }
 
+/* rs274 creates a named assignment target (value 0) the moment it reads it, so
+ * an expression to its right on the same line may already read it. Declare the
+ * targets standing left of `col`; declaring an existing name does nothing. */
+static int ncp_declare_targets_before(struct ncp_analyzer *a, const struct ncp_block *b,
+                                      uint16_t col)
+{
+    unsigned n = b->n_assign < NCP_BLOCK_MAX_ASSIGN ? b->n_assign : NCP_BLOCK_MAX_ASSIGN;
+    for (unsigned k = 0; k < n; k++) {
+        const struct ncp_assign *as = &b->assign[k];
+        if (as->kind != NCP_ASSIGN_NAMED || as->col >= col)
+            continue;
+        size_t off = as->name_off < NCP_BLOCK_POOL ? as->name_off : NCP_BLOCK_POOL;
+        size_t len = as->name_len <= NCP_BLOCK_POOL - off ? as->name_len : 0;
+        int rc = ncp_params_declare_named(a->params, b->pool + off, len, &a->err);
+        if (rc != NCP_OK) {
+            a->err.line = b->line;
+            if (a->err.col == 0)
+                a->err.col = as->col;
+            return rc;
+        }
+    }
+    return NCP_OK;
+}
+
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b)
 {
     struct ncp_words *w = &a->w;
@@ -145,7 +169,9 @@ int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b)
     for (unsigned k = 0; k < n; k++) {
         const struct ncp_word *wd = &b->words[k];
         double v;
-        int rc = ncp_eval(a, b, &wd->v, &v);
+        int rc = b->n_assign ? ncp_declare_targets_before(a, b, wd->col) : NCP_OK;
+        if (rc == NCP_OK)
+            rc = ncp_eval(a, b, &wd->v, &v);
         if (rc != NCP_OK)
             return rc;
         if (wd->letter == 'G') {
@@ -180,7 +206,9 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b)
         n = NCP_BLOCK_MAX_ASSIGN;
     for (unsigned k = 0; k < n; k++) {
         const struct ncp_assign *as = &b->assign[k];
-        int rc = ncp_eval(a, b, &as->value, &val[k]);
+        int rc = ncp_declare_targets_before(a, b, (uint16_t)(as->col + 1));
+        if (rc == NCP_OK)
+            rc = ncp_eval(a, b, &as->value, &val[k]);
         if (rc == NCP_OK && as->kind == NCP_ASSIGN_NUMBERED) {
             double iv;
             rc = ncp_eval(a, b, &as->index, &iv);

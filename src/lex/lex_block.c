@@ -170,7 +170,9 @@ static int items(struct ncp_lexer *lx)
     while (lx->pos < lx->n) {
         unsigned char c = (unsigned char)lx->buf[lx->pos];
         if (c >= 'a' && c <= 'z') {
-            if (c == 'n' || c == 'o')
+            /* canonical output carries XYZABC only, as rs274 -g: U V W are
+             * rejected there the same way */
+            if (c == 'n' || c == 'o' || (c >= 'u' && c <= 'w'))
                 return bad_character(lx, c);
             rc = word(lx, (char)c, &seen);
         } else if (c == '#') {
