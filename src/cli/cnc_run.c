@@ -228,6 +228,10 @@ static int cmd_parse(int argc, char **argv)
                  ? ncp_serial_run(&src, &o.acfg, &out, &st, &d)
                  : ncp_pipeline_run(&src, &map, &o.acfg, &out, &st, &d);
     int status = EXIT_OK;
+    uint32_t warnings = st.warnings;
+    const char *warning;
+    while ((warning = ncp_run_warning_next(&warnings)) != NULL)
+        fprintf(stderr, "cnc-run: warning: %s\n", warning);
     if (w) {
         writer_flush(w);
         if (w->failed) {

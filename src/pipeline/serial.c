@@ -103,6 +103,10 @@ int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *
     int rc;
 
     memset(d, 0, sizeof *d);
+    if (feed)
+        feed->blocks = 0;
+    if (sink)
+        sink->emitted = 0;
     if (!feed || !sink) {
         rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
         goto done;

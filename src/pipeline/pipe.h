@@ -1,0 +1,70 @@
+/* One run of the parallel pipeline: rings and per-thread state shared by the
+ * stage threads (module-internal header). */
+#ifndef NCP_PIPELINE_PIPE_H
+#define NCP_PIPELINE_PIPE_H
+
+#include <stdalign.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include "ncpar/pipeline.h"
+#include "ring.h"
+
+/* Stages of an executor's command ring: analyzer fills, executor completes in
+ * place, output emits and hands the slot back. */
+enum { NCP_CMD_STAGE_ANALYZER, NCP_CMD_STAGE_EXECUTOR, NCP_CMD_STAGE_OUTPUT,
+       NCP_CMD_STAGES };
+
+struct ncp_pipe;
+
+/* Own cache line each: counters are bumped per item by their thread. */
+struct ncp_pipe_worker {
+    alignas(64) struct ncp_pipe *p;
+    int index;
+    uint64_t items;              /* written by this worker's thread only */
+};
+
+struct ncp_pipe {
+    const struct ncp_source *src;
+    const struct ncp_thread_map *map;
+    const struct ncp_analyzer_cfg *acfg;
+    const struct ncp_output *out;
+    int n, m;                    /* lexers, executors */
+
+    struct ncp_ring *strings;    /* n: feeder -> LEX_i, struct ncp_span */
+    struct ncp_ring *parsed;     /* n: LEX_i -> analyzer, struct ncp_block */
+    struct ncp_ring *cmds;       /* m: analyzer -> EXEC_j -> output, struct ncp_cmd */
+
+    /* Lexers start once the string ring is full, or at EOF, or on timeout. */
+    _Atomic uint32_t gate;
+    uint64_t string_fill;        /* spans that fill the whole string ring */
+
+    struct ncp_pipe_worker feeder, analyzer, output;
+    struct ncp_pipe_worker lexer[NCP_MAX_LEXERS], executor[NCP_MAX_EXECUTORS];
+
+    /* analyzer thread only, read after join */
+    alignas(64) uint64_t taken, released;    /* blocks handed to / given back by the analyzer */
+    uint32_t held[NCP_MAX_LEXERS];
+    uint64_t next_id;
+    int an_rc;
+    struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
+
+    /* output thread only, read after join */
+    alignas(64) struct ncp_diag err; /* first error slot, in program order */
+    int emit_failed;
+    double end_ms;               /* last slot out */
+};
+
+void *ncp_pipe_feeder(void *arg);
+void *ncp_pipe_lexer(void *arg);
+void *ncp_pipe_analyzer(void *arg);
+void *ncp_pipe_executor(void *arg);
+void *ncp_pipe_output(void *arg);
+
+/* Shut every ring down: blocked stages return, running ones stop at their next
+ * ring operation. Safe from any thread, more than once. */
+void ncp_pipe_abort(struct ncp_pipe *p);
+void ncp_pipe_open_gate(struct ncp_pipe *p);
+
+double ncp_pipe_now_ms(void);
+
+#endif

@@ -1,0 +1,253 @@
+/* ncp_pipeline_run: sets up the rings, starts the stage threads in the paper's
+ * order (feeder first, the rest once the string ring is full, at EOF or after
+ * the start timeout), joins them and reports exactly what the serial reference
+ * would. */
+#include "pipe.h"
+
+#include "futex.h"
+#include "threads.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static struct ncp_ring *rings_new(int count)
+{
+    struct ncp_ring *r = aligned_alloc(64, sizeof *r * (size_t)count);
+    if (r)
+        memset(r, 0, sizeof *r * (size_t)count);
+    return r;
+}
+
+static void rings_free(struct ncp_ring *r, int count)
+{
+    if (!r)
+        return;
+    for (int i = 0; i < count; i++)
+        ncp_ring_destroy(&r[i]);
+    free(r);
+}
+
+static void pipe_free(struct ncp_pipe *p)
+{
+    if (!p)
+        return;
+    rings_free(p->strings, p->n);
+    rings_free(p->parsed, p->n);
+    rings_free(p->cmds, p->m);
+    free(p);
+}
+
+static int clamp(int v, int lo, int hi)
+{
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
+static struct ncp_pipe *pipe_new(const struct ncp_source *src,
+                                 const struct ncp_thread_map *map)
+{
+    struct ncp_pipe *p = aligned_alloc(64, (sizeof *p + 63) / 64 * 64);
+    if (!p)
+        return NULL;
+    memset(p, 0, sizeof *p);
+    p->src = src;
+    p->map = map;
+    p->n = clamp(map->n_lexers, 1, NCP_MAX_LEXERS);
+    p->m = clamp(map->n_executors, 1, NCP_MAX_EXECUTORS);
+    atomic_init(&p->gate, 0);
+    p->strings = rings_new(p->n);
+    p->parsed = rings_new(p->n);
+    p->cmds = rings_new(p->m);
+    if (!p->strings || !p->parsed || !p->cmds) {
+        pipe_free(p);
+        return NULL;
+    }
+    uint32_t g = (uint32_t)clamp(map->string_rows, 1, NCP_RING_MAX_CAPACITY);
+    uint32_t h = (uint32_t)clamp(map->parsed_rows, 1, NCP_RING_MAX_CAPACITY);
+    uint32_t s = (uint32_t)clamp(map->cmd_slots, 1, NCP_RING_MAX_CAPACITY);
+    int bad = 0;
+    for (int i = 0; i < p->n; i++) {
+        bad |= ncp_ring_init(&p->strings[i], sizeof(struct ncp_span), g);
+        bad |= ncp_ring_init(&p->parsed[i], sizeof(struct ncp_block), h);
+    }
+    for (int j = 0; j < p->m; j++)
+        bad |= ncp_ring_init_staged(&p->cmds[j], sizeof(struct ncp_cmd), s, NCP_CMD_STAGES);
+    if (bad) {
+        pipe_free(p);
+        return NULL;
+    }
+    p->string_fill = (uint64_t)ncp_ring_cap(&p->strings[0]) * (uint64_t)p->n;
+    for (int i = 0; i < NCP_MAX_LEXERS; i++)
+        p->lexer[i] = (struct ncp_pipe_worker){ p, i, 0 };
+    for (int j = 0; j < NCP_MAX_EXECUTORS; j++)
+        p->executor[j] = (struct ncp_pipe_worker){ p, j, 0 };
+    p->feeder = (struct ncp_pipe_worker){ p, 0, 0 };
+    p->analyzer = (struct ncp_pipe_worker){ p, 0, 0 };
+    p->output = (struct ncp_pipe_worker){ p, 0, 0 };
+    return p;
+}
+
+/* The paper's start rule: the lexers wait for a full string ring, EOF, or
+ * the start timeout, whichever comes first. */
+static void wait_gate(struct ncp_pipe *p, int timeout_us)
+{
+    double deadline = ncp_pipe_now_ms() + timeout_us / 1e3;
+    while (atomic_load(&p->gate) == 0) {
+        double left = deadline - ncp_pipe_now_ms();
+        if (left <= 0)
+            return;
+        long long ns = (long long)(left * 1e6);
+        struct timespec ts = { (time_t)(ns / 1000000000LL), (long)(ns % 1000000000LL) };
+        ncp_futex_wait(&p->gate, 0, &ts);
+    }
+}
+
+struct ncp_starter {
+    struct ncp_pipe *p;
+    pthread_t tid[NCP_MAX_LEXERS + NCP_MAX_EXECUTORS + 3];
+    int started;
+    int failed;
+    uint32_t warnings;
+};
+
+static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
+                  void *(*fn)(void *), struct ncp_pipe_worker *w)
+{
+    if (s->failed)
+        return;
+    int pin = s->p->map->mode == NCP_MODE_ATT;
+    if (ncp_thread_start(&s->tid[s->started], spec, pin, fn, w, &s->warnings) != 0) {
+        s->failed = 1;
+        ncp_pipe_abort(s->p);
+        return;
+    }
+    s->started++;
+}
+
+static void start_all(struct ncp_starter *s)
+{
+    struct ncp_pipe *p = s->p;
+    const struct ncp_thread_map *map = p->map;
+    start(s, &map->feeder, ncp_pipe_feeder, &p->feeder);
+    if (!s->failed)
+        wait_gate(p, map->start_timeout_us);
+    for (int i = 0; i < p->n; i++)
+        start(s, &map->lexer[i], ncp_pipe_lexer, &p->lexer[i]);
+    start(s, &map->analyzer, ncp_pipe_analyzer, &p->analyzer);
+    for (int j = 0; j < p->m; j++)
+        start(s, &map->executor[j], ncp_pipe_executor, &p->executor[j]);
+    start(s, &map->output, ncp_pipe_output, &p->output);
+}
+
+static void stage_stats(struct ncp_stage_stats *st, uint64_t items)
+{
+    memset(st, 0, sizeof *st);
+    st->items = items;
+}
+
+static void add_waits(struct ncp_stage_stats *st, const struct ncp_ring *r, unsigned s,
+                      int full)
+{
+    if (full)
+        st->full_waits += ncp_ring_waits(r, s);
+    else
+        st->empty_waits += ncp_ring_waits(r, s);
+    st->sleeps += ncp_ring_sleeps(r, s);
+}
+
+static void fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, double t0,
+                       struct ncp_run_stats *st)
+{
+    st->blocks = 0;
+    st->commands = p->output.items;
+    st->wall_ms = (p->end_ms > 0 ? p->end_ms : ncp_pipe_now_ms()) - t0;
+    st->threads = s->started;
+    st->warnings = s->warnings;
+    stage_stats(&st->feeder, p->feeder.items);
+    stage_stats(&st->analyzer, p->taken);
+    stage_stats(&st->output, p->output.items);
+    for (int i = 0; i < NCP_MAX_LEXERS; i++)
+        stage_stats(&st->lexer[i], i < p->n ? p->lexer[i].items : 0);
+    for (int j = 0; j < NCP_MAX_EXECUTORS; j++)
+        stage_stats(&st->executor[j], j < p->m ? p->executor[j].items : 0);
+    for (int i = 0; i < p->n; i++) {
+        st->blocks += p->lexer[i].items;
+        add_waits(&st->feeder, &p->strings[i], 0, 1);
+        add_waits(&st->lexer[i], &p->strings[i], 1, 0);
+        add_waits(&st->lexer[i], &p->parsed[i], 0, 1);
+        add_waits(&st->analyzer, &p->parsed[i], 1, 0);
+    }
+    for (int j = 0; j < p->m; j++) {
+        add_waits(&st->analyzer, &p->cmds[j], NCP_CMD_STAGE_ANALYZER, 1);
+        add_waits(&st->executor[j], &p->cmds[j], NCP_CMD_STAGE_EXECUTOR, 0);
+        add_waits(&st->output, &p->cmds[j], NCP_CMD_STAGE_OUTPUT, 0);
+    }
+}
+
+/* Same precedence as the serial reference: the first error slot, then a failed
+ * write, then an analyzer that stopped without a diagnostic. */
+static int result(const struct ncp_pipe *p, const struct ncp_starter *s,
+                  struct ncp_diag *d)
+{
+    if (p->err.code != NCP_OK) {
+        *d = p->err;
+        return d->code;
+    }
+    if (p->emit_failed)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot write output");
+    if (s->failed)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the pipeline threads");
+    if (p->an_diag.code != NCP_OK) {
+        *d = p->an_diag;
+        return d->code;
+    }
+    if (p->an_rc != NCP_OK && p->an_rc != NCP_END) {
+        ncp_diag_set(d, (enum ncp_status)p->an_rc, 0, 0,
+                     "interpreter stopped without a diagnostic");
+        return p->an_rc;
+    }
+    return NCP_OK;
+}
+
+int ncp_pipeline_run(const struct ncp_source *src, const struct ncp_thread_map *map,
+                     const struct ncp_analyzer_cfg *acfg, const struct ncp_output *out,
+                     struct ncp_run_stats *stats, struct ncp_diag *d)
+{
+    if (map->mode == NCP_MODE_SERIAL)
+        return ncp_serial_run(src, acfg, out, stats, d);
+    double t0 = ncp_pipe_now_ms();
+    memset(d, 0, sizeof *d);
+    struct ncp_pipe *p = pipe_new(src, map);
+    if (!p)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the pipeline rings");
+    p->acfg = acfg;
+    p->out = out;
+
+    struct ncp_starter s;
+    memset(&s, 0, sizeof s);
+    s.p = p;
+    start_all(&s);
+    for (int t = 0; t < s.started; t++)
+        pthread_join(s.tid[t], NULL);
+
+    int rc = result(p, &s, d);
+    if (stats)
+        fill_stats(p, &s, t0, stats);
+    pipe_free(p);
+    return rc;
+}
+
+const char *ncp_run_warning_next(uint32_t *w)
+{
+    if (*w & NCP_WARN_NO_FIFO) {
+        *w &= ~(uint32_t)NCP_WARN_NO_FIFO;
+        return "SCHED_FIFO not permitted (needs root or CAP_SYS_NICE): threads ran "
+               "SCHED_OTHER";
+    }
+    if (*w & NCP_WARN_NO_CPU) {
+        *w &= ~(uint32_t)NCP_WARN_NO_CPU;
+        return "a CPU of the thread map is not available here: its thread was pinned "
+               "to another CPU";
+    }
+    *w = 0;
+    return NULL;
+}

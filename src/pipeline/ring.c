@@ -1,0 +1,294 @@
+/* Staged lock-free ring (see ring.h). Each position is written by its own stage
+ * only, with release stores; the other stages read it with acquire loads, which
+ * is what hands the slot contents over. Sleeping uses an event count per
+ * position: a waiter announces itself in `sleepers`, reads `event`, re-checks
+ * its condition and sleeps only if `event` is unchanged; a stage that moves its
+ * position and sees a sleeper bumps `event` and wakes it. The seq_cst fence on
+ * one side and seq_cst accesses on the other make a lost wake-up impossible. */
+#include "ring.h"
+
+#include "futex.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+enum { NCP_RING_EOF = 1u, NCP_RING_ABORT = 2u };
+
+/* Short: the machine may have fewer cores than pipeline threads, and a spinning
+ * thread then steals the CPU from the one it waits for. */
+#define NCP_RING_SPIN 128
+
+uint32_t ncp_ring_capacity(uint32_t want)
+{
+    uint32_t c = 1;
+    while (c < want && c < NCP_RING_MAX_CAPACITY)
+        c <<= 1;
+    return c;
+}
+
+int ncp_ring_init_staged(struct ncp_ring *r, size_t elem_size, uint32_t capacity,
+                         unsigned n_stages)
+{
+    memset(r, 0, sizeof *r);
+    if (n_stages < 2 || n_stages > NCP_RING_MAX_STAGES || elem_size == 0)
+        return -1;
+    uint32_t cap = ncp_ring_capacity(capacity);
+    /* Large slots get their own cache lines so neighbouring stages do not
+     * share one; small ones are packed. */
+    size_t align = elem_size >= 64 ? 64 : 8;
+    size_t stride = (elem_size + align - 1) / align * align;
+    size_t bytes = ((size_t)cap * stride + 63) / 64 * 64;
+    r->slots = aligned_alloc(64, bytes);
+    if (!r->slots)
+        return -1;
+    r->n_stages = n_stages;
+    r->mask = cap - 1;
+    r->stride = stride;
+    for (unsigned s = 0; s < NCP_RING_MAX_STAGES; s++) {
+        atomic_init(&r->stage[s].pos, 0);
+        atomic_init(&r->stage[s].sleepers, 0);
+        atomic_init(&r->stage[s].event, 0);
+        atomic_init(&r->stage[s].wake_at, 0);
+    }
+    atomic_init(&r->state, 0);
+    return 0;
+}
+
+int ncp_ring_init(struct ncp_ring *r, size_t elem_size, uint32_t capacity)
+{
+    return ncp_ring_init_staged(r, elem_size, capacity, 2);
+}
+
+void ncp_ring_destroy(struct ncp_ring *r)
+{
+    free(r->slots);
+    r->slots = NULL;
+}
+
+uint32_t ncp_ring_cap(const struct ncp_ring *r)
+{
+    return r->mask + 1;
+}
+
+static void *slot_at(const struct ncp_ring *r, uint32_t pos)
+{
+    return r->slots + (size_t)(pos & r->mask) * r->stride;
+}
+
+static unsigned awaited_stage(const struct ncp_ring *r, unsigned s)
+{
+    return s == 0 ? r->n_stages - 1 : s - 1;
+}
+
+/* 1: stage s may proceed to its k-th element, 0: must wait, -1: never will. */
+static int ready(struct ncp_ring *r, unsigned s, uint32_t k, memory_order mo)
+{
+    struct ncp_ring_stage *st = &r->stage[s];
+    uint32_t own = atomic_load_explicit(&st->pos, memory_order_relaxed);
+    uint32_t state = atomic_load_explicit(&r->state, mo);
+    if (state & NCP_RING_ABORT)
+        return -1;
+    if (s == 0) {
+        if (state & NCP_RING_EOF)
+            return -1;
+        st->seen = atomic_load_explicit(&r->stage[r->n_stages - 1].pos, mo);
+        return own - st->seen <= r->mask ? 1 : 0;
+    }
+    st->seen = atomic_load_explicit(&r->stage[s - 1].pos, mo);
+    if (st->seen - own > k)
+        return 1;
+    if (!(state & NCP_RING_EOF))
+        return 0;
+    /* EOF was published after the producer's last commit, so pos[0] is final
+     * here; the data ended for us once the stage before has passed it all. */
+    return st->seen == atomic_load_explicit(&r->stage[0].pos, mo) ? -1 : 0;
+}
+
+/* Sleepers not yet worth waking (below their wake_at), owed a wake-up by this
+ * thread before it waits itself: without that, two stages could each sleep
+ * waiting for the other's next batch. */
+#define NCP_RING_MAX_OWED 32
+static _Thread_local struct ncp_ring_stage *owed[NCP_RING_MAX_OWED];
+static _Thread_local int n_owed;
+
+static void wake(struct ncp_ring_stage *st)
+{
+    atomic_fetch_add(&st->event, 1);
+    ncp_futex_wake_all(&st->event);
+}
+
+/* Each position has at most one sleeper (its one awaiting stage), and taking
+ * its flag makes sure a batch of advances costs a single wake syscall. */
+static void wake_sleeper(struct ncp_ring_stage *st)
+{
+    if (atomic_exchange(&st->sleepers, 0) != 0)
+        wake(st);
+}
+
+static void pay_owed(void)
+{
+    for (int i = 0; i < n_owed; i++)
+        wake_sleeper(owed[i]);
+    n_owed = 0;
+}
+
+void ncp_ring_wake_owed(void)
+{
+    pay_owed();
+}
+
+static void owe(struct ncp_ring_stage *st)
+{
+    for (int i = 0; i < n_owed; i++)
+        if (owed[i] == st)
+            return;
+    if (n_owed == NCP_RING_MAX_OWED)
+        wake_sleeper(st);
+    else
+        owed[n_owed++] = st;
+}
+
+/* The awaited position at which stage s wants waking: enough for its k-th
+ * element plus up to half a ring more, so one wake-up serves a batch. */
+static uint32_t wake_target(const struct ncp_ring *r, unsigned s, uint32_t k)
+{
+    uint32_t own = atomic_load_explicit(&r->stage[s].pos, memory_order_relaxed);
+    uint32_t cap = r->mask + 1;
+    uint32_t batch = cap / 2 > 0 ? cap / 2 - 1 : 0;
+    if (s == 0)
+        return own - r->mask + batch;
+    if (batch > r->mask - k)
+        batch = r->mask - k;
+    return own + k + 1 + batch;
+}
+
+static int wait_ready(struct ncp_ring *r, unsigned s, uint32_t k)
+{
+    struct ncp_ring_stage *st = &r->stage[s];
+    struct ncp_ring_stage *aw = &r->stage[awaited_stage(r, s)];
+    int rc = ready(r, s, k, memory_order_acquire);
+    if (rc > 0)
+        return rc;
+    pay_owed();
+    if (rc < 0)
+        return rc;
+    st->waits++;
+    for (int i = 0; i < NCP_RING_SPIN; i++) {
+        ncp_cpu_relax();
+        rc = ready(r, s, k, memory_order_acquire);
+        if (rc != 0)
+            return rc;
+    }
+    for (;;) {
+        atomic_store_explicit(&aw->wake_at, wake_target(r, s, k), memory_order_relaxed);
+        atomic_store(&aw->sleepers, 1);
+        uint32_t key = atomic_load(&aw->event);
+        rc = ready(r, s, k, memory_order_seq_cst);
+        if (rc == 0) {
+            st->sleeps++;
+            ncp_futex_wait(&aw->event, key, NULL);
+            rc = ready(r, s, k, memory_order_acquire);
+        }
+        atomic_store_explicit(&aw->sleepers, 0, memory_order_relaxed);
+        if (rc != 0)
+            return rc;
+    }
+}
+
+/* Publish stage s's next position and wake whoever sleeps on it, once its
+ * batch is complete. */
+static void advance(struct ncp_ring *r, unsigned s)
+{
+    struct ncp_ring_stage *st = &r->stage[s];
+    uint32_t p = atomic_load_explicit(&st->pos, memory_order_relaxed) + 1;
+    atomic_store_explicit(&st->pos, p, memory_order_release);
+    atomic_thread_fence(memory_order_seq_cst);
+    /* acquire: the sleeper's wake_at was stored before its flag */
+    if (atomic_load_explicit(&st->sleepers, memory_order_acquire) == 0)
+        return;
+    if ((int32_t)(p - atomic_load_explicit(&st->wake_at, memory_order_relaxed)) >= 0)
+        wake_sleeper(st);
+    else
+        owe(st);
+}
+
+void *ncp_ring_reserve(struct ncp_ring *r)
+{
+    struct ncp_ring_stage *st = &r->stage[0];
+    uint32_t own = atomic_load_explicit(&st->pos, memory_order_relaxed);
+    /* Fast path: room known from the cached consumer position. */
+    if (own - st->seen <= r->mask &&
+        !atomic_load_explicit(&r->state, memory_order_relaxed))
+        return slot_at(r, own);
+    if (wait_ready(r, 0, 0) < 0)
+        return NULL;
+    return slot_at(r, own);
+}
+
+void ncp_ring_commit(struct ncp_ring *r)
+{
+    advance(r, 0);
+}
+
+void *ncp_ring_stage_peek(struct ncp_ring *r, unsigned s, uint32_t k)
+{
+    struct ncp_ring_stage *st = &r->stage[s];
+    uint32_t own = atomic_load_explicit(&st->pos, memory_order_relaxed);
+    if (k > r->mask)
+        return NULL;
+    /* Fast path: the element is known to be there from the cached position;
+     * the acquire load that cached it already ordered its contents. */
+    if (st->seen - own > k && !atomic_load_explicit(&r->state, memory_order_relaxed))
+        return slot_at(r, own + k);
+    if (wait_ready(r, s, k) < 0)
+        return NULL;
+    return slot_at(r, own + k);
+}
+
+void ncp_ring_stage_release(struct ncp_ring *r, unsigned s)
+{
+    advance(r, s);
+}
+
+void *ncp_ring_peek(struct ncp_ring *r)
+{
+    return ncp_ring_stage_peek(r, r->n_stages - 1, 0);
+}
+
+void ncp_ring_release(struct ncp_ring *r)
+{
+    advance(r, r->n_stages - 1);
+}
+
+static void set_state(struct ncp_ring *r, uint32_t bit)
+{
+    atomic_fetch_or(&r->state, bit);
+    for (unsigned s = 0; s < r->n_stages; s++)
+        wake(&r->stage[s]);
+}
+
+void ncp_ring_close(struct ncp_ring *r)
+{
+    set_state(r, NCP_RING_EOF);
+}
+
+void ncp_ring_abort(struct ncp_ring *r)
+{
+    set_state(r, NCP_RING_ABORT);
+}
+
+int ncp_ring_aborted(const struct ncp_ring *r)
+{
+    return (atomic_load_explicit(&((struct ncp_ring *)r)->state, memory_order_acquire) &
+            NCP_RING_ABORT) != 0;
+}
+
+uint64_t ncp_ring_waits(const struct ncp_ring *r, unsigned s)
+{
+    return r->stage[s].waits;
+}
+
+uint64_t ncp_ring_sleeps(const struct ncp_ring *r, unsigned s)
+{
+    return r->stage[s].sleeps;
+}

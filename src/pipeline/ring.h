@@ -1,0 +1,91 @@
+/* Bounded lock-free ring of fixed-size elements, written and read in place
+ * (module-internal header).
+ *
+ * A ring has 2 or more stages. Stage 0 is the producer (reserve/commit); every
+ * later stage takes the elements in order after the stage before it has
+ * released them (peek/release), and the last stage hands the slots back to the
+ * producer. With 2 stages it is a plain SPSC ring; 3 stages let the executor
+ * complete a slot in place and pass it on to the output without a copy.
+ *
+ * Each stage is one thread. Positions are 32-bit counters on their own cache
+ * lines (acquire/release); a stage that must wait spins briefly, then sleeps on
+ * a futex, and the other side only makes the wake syscall when a sleeper has
+ * announced itself, and only once half a ring of work is ready for it (or when
+ * the poster itself has to wait: a stalled pipeline always wakes up). */
+#ifndef NCP_PIPELINE_RING_H
+#define NCP_PIPELINE_RING_H
+
+#include <stdalign.h>
+#include <stdatomic.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define NCP_RING_MAX_STAGES 3
+#define NCP_RING_MAX_CAPACITY (1u << 24)
+
+/* Owned by one stage: its position and what it last saw of the stage it
+ * waits for (so the fast path rarely touches the other side's line). */
+struct ncp_ring_stage {
+    alignas(64) _Atomic uint32_t pos;    /* elements this stage has passed on */
+    _Atomic uint32_t sleepers;           /* 1: the awaiting stage sleeps until pos moves */
+    _Atomic uint32_t event;              /* futex word, bumped to wake them */
+    _Atomic uint32_t wake_at;            /* the sleeper wants waking at this pos */
+    uint32_t seen;                       /* owner-private cache of the awaited pos */
+    uint64_t waits;                      /* owner-private: waits that found no room/data */
+    uint64_t sleeps;                     /* owner-private: waits that slept */
+};
+
+struct ncp_ring {
+    struct ncp_ring_stage stage[NCP_RING_MAX_STAGES];
+    alignas(64) _Atomic uint32_t state;  /* NCP_RING_EOF | NCP_RING_ABORT */
+    unsigned n_stages;
+    uint32_t mask;                       /* capacity - 1 */
+    size_t stride;
+    unsigned char *slots;
+};
+
+/* Round up to a power of two within [1, NCP_RING_MAX_CAPACITY]. */
+uint32_t ncp_ring_capacity(uint32_t want);
+
+/* Plain SPSC ring. capacity is rounded up to a power of two. 0 or -1 (ENOMEM). */
+int ncp_ring_init(struct ncp_ring *r, size_t elem_size, uint32_t capacity);
+/* A ring of n_stages (2..NCP_RING_MAX_STAGES) stages. */
+int ncp_ring_init_staged(struct ncp_ring *r, size_t elem_size, uint32_t capacity,
+                         unsigned n_stages);
+void ncp_ring_destroy(struct ncp_ring *r);
+
+uint32_t ncp_ring_cap(const struct ncp_ring *r);
+
+/* Producer: the next free slot (waits while the ring is full), NULL once
+ * closed or aborted. Write it, then commit. */
+void *ncp_ring_reserve(struct ncp_ring *r);
+void ncp_ring_commit(struct ncp_ring *r);
+
+/* Last stage (SPSC consumer): the oldest element not yet released, waiting for
+ * it; NULL when the producer closed the ring and everything was taken, or on
+ * abort. Valid until release. */
+void *ncp_ring_peek(struct ncp_ring *r);
+void ncp_ring_release(struct ncp_ring *r);
+
+/* Stage s >= 1: the k-th element after the last one it released (k < capacity),
+ * waiting for it; NULL at the end of the data or on abort. Releases go in
+ * order, one element each. */
+void *ncp_ring_stage_peek(struct ncp_ring *r, unsigned s, uint32_t k);
+void ncp_ring_stage_release(struct ncp_ring *r, unsigned s);
+
+/* Producer: no more data. Later stages drain what is there, then get NULL. */
+void ncp_ring_close(struct ncp_ring *r);
+/* Anyone: shut down now. Every waiting or later call returns NULL. The slots
+ * stay allocated until ncp_ring_destroy, so a stage still writing one is safe. */
+void ncp_ring_abort(struct ncp_ring *r);
+int ncp_ring_aborted(const struct ncp_ring *r);
+
+/* Wake every sleeper this thread deferred (waiting for a batch). Ring calls
+ * that wait or end do it; a stage thread calls it before it exits. */
+void ncp_ring_wake_owed(void);
+
+/* Owner-side counters of stage s; read them once its thread was joined. */
+uint64_t ncp_ring_waits(const struct ncp_ring *r, unsigned s);
+uint64_t ncp_ring_sleeps(const struct ncp_ring *r, unsigned s);
+
+#endif
