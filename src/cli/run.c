@@ -13,12 +13,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 enum { RUN_OK = 0, RUN_USAGE = 1, RUN_PROGRAM = 2, RUN_FAULT = 3 };
 
 struct run_opts {
-    const char *prog, *config, *trace;
+    const char *prog, *config, *trace, *plot;
     double for_s;               /* 0 = whole program */
     double feed_override;       /* 1.0 = 100 % */
     int virtual_clock;
@@ -45,13 +46,15 @@ static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d
 
 static void usage(FILE *f)
 {
-    fputs("usage: cnc-run run PROG [--config INI] [--trace CSV] [--for SECONDS]\n"
+    fputs("usage: cnc-run run PROG [--config INI] [--trace CSV] [--plot PNG] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
           "                        [--mode serial|det|att]\n"
           "Runs PROG on the simulated machine: interpreter -> look-ahead planner ->\n"
           "interpolator -> position loop (SCHED_FIFO when permitted).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill)\n"
           "  --trace CSV         per-cycle trace: t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v\n"
+          "  --plot PNG          picture of the run (tools/plot-trace.py, python3-matplotlib):\n"
+          "                      XY toolpath, velocity/acceleration, latency histogram\n"
           "  --for SECONDS       stop after this much machine time\n"
           "  --feed-override PCT 1..200 (default 100)\n"
           "  --clock virtual     simulated clock, as fast as the CPU allows\n"
@@ -75,6 +78,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     static const struct option longopts[] = {
         { "config", required_argument, 0, 'c' },
         { "trace", required_argument, 0, 't' },
+        { "plot", required_argument, 0, 'p' },
         { "for", required_argument, 0, 'f' },
         { "feed-override", required_argument, 0, 'o' },
         { "clock", required_argument, 0, 'k' },
@@ -85,10 +89,11 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     double pct;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:t:f:o:k:m:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:h", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': o->config = optarg; break;
         case 't': o->trace = optarg; break;
+        case 'p': o->plot = optarg; break;
         case 'f':
             if (parse_num(optarg, 1e-6, 1e9, &o->for_s))
                 return fprintf(stderr, "cnc-run run: --for wants a positive number of seconds\n"), -1;
@@ -171,8 +176,82 @@ static int load_config(const struct run_opts *o, struct ncp_machine_cfg *cfg)
     return -1;
 }
 
+
+/* ---- --plot: the trace and a latency sidecar handed to tools/plot-trace.py ---- */
+
+/* The script sits in tools/ of the source tree the binary was built in
+ * (build/cnc-run -> ../tools); NCPAR_PLOT_SCRIPT overrides that. */
+static int find_plot_script(char *buf, size_t n)
+{
+    const char *env = getenv("NCPAR_PLOT_SCRIPT");
+    if (env && *env)
+        return snprintf(buf, n, "%s", env) < (int)n ? 0 : -1;
+    char exe[4096];
+    ssize_t k = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (k <= 0)
+        return -1;
+    exe[k] = 0;
+    char *slash = strrchr(exe, '/');
+    if (!slash)
+        return -1;
+    *slash = 0;
+    static const char *const rel[] = { "/../tools/plot-trace.py", "/../../tools/plot-trace.py",
+                                       "/tools/plot-trace.py" };
+    for (size_t i = 0; i < sizeof rel / sizeof rel[0]; i++) {
+        if (snprintf(buf, n, "%s%s", exe, rel[i]) < (int)n && access(buf, R_OK) == 0)
+            return 0;
+    }
+    return -1;
+}
+
+/* Sidecar format (documented in tools/plot-trace.py): "latency_us,cycles",
+ * one row per non-empty 1 us bin, then ">=1000,N" when anything overflowed. */
+static int write_latency(const char *path, const struct ncp_rt_stats *st)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    fputs("latency_us,cycles\n", f);
+    for (int i = 0; i < NCP_RT_HIST_BINS; i++)
+        if (st->hist[i])
+            fprintf(f, "%d,%llu\n", i, (unsigned long long)st->hist[i]);
+    if (st->overflow)
+        fprintf(f, ">=%d,%llu\n", NCP_RT_HIST_BINS, (unsigned long long)st->overflow);
+    return fclose(f) ? -1 : 0;
+}
+
+static int draw_plot(const struct run_opts *o, const char *trace, const struct ncp_rt_stats *lat)
+{
+    char script[4200], side[4200];
+    if (find_plot_script(script, sizeof script)) {
+        fprintf(stderr, "cnc-run run: cannot find tools/plot-trace.py (set NCPAR_PLOT_SCRIPT)\n");
+        return -1;
+    }
+    if (snprintf(side, sizeof side, "%s.latency.csv", trace) >= (int)sizeof side ||
+        write_latency(side, lat)) {
+        fprintf(stderr, "cnc-run run: cannot write the latency sidecar %s\n", side);
+        return -1;
+    }
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        execl("/usr/bin/python3", "python3", script, trace, o->plot, side, "--title", o->prog,
+              (char *)NULL);
+        _exit(127);
+    }
+    int st = 0;
+    if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "cnc-run run: plotting failed (needs /usr/bin/python3 with matplotlib)\n");
+        return -1;
+    }
+    if (!o->trace)
+        unlink(side);
+    fprintf(stderr, "cnc-run run: wrote %s\n", o->plot);
+    return 0;
+}
+
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
-                       const struct ncp_source *src, FILE *trace)
+                       const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
 {
     struct interp_ctx ic = { src, { 0 }, o->mode };
     struct ncp_nck_opts no = {
@@ -189,6 +268,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
     if (res->warning[0] && !no.progress)
         fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
     int rc = report(o, cfg, res);
+    *lat = res->lat;
     free(res);
     return rc;
 }
@@ -210,17 +290,33 @@ int ncp_cli_run(int argc, char **argv)
         fprintf(stderr, "%s: error: %s\n", o.prog, d.msg);
         return RUN_PROGRAM;
     }
+    /* --plot alone still needs a trace: a temporary one, removed afterwards */
+    char tmp_trace[] = "/tmp/cnc-run-trace-XXXXXX";
+    const char *trace_path = o.trace;
     FILE *trace = NULL;
-    if (o.trace && !(trace = fopen(o.trace, "w"))) {
-        fprintf(stderr, "cnc-run run: cannot write %s: %s\n", o.trace, strerror(errno));
+    if (!o.trace && o.plot) {
+        int fd = mkstemp(tmp_trace);
+        trace = fd >= 0 ? fdopen(fd, "w") : NULL;
+        trace_path = tmp_trace;
+    } else if (o.trace) {
+        trace = fopen(o.trace, "w");
+    }
+    if (trace_path && !trace) {
+        fprintf(stderr, "cnc-run run: cannot write %s: %s\n", trace_path, strerror(errno));
         ncp_source_close(&src);
         return RUN_USAGE;
     }
-    int rc = run_program(&o, &cfg, &src, trace);
+    struct ncp_rt_stats *lat = calloc(1, sizeof *lat);
+    int rc = lat ? run_program(&o, &cfg, &src, trace, lat) : RUN_FAULT;
     if (trace && fclose(trace) != 0) {
-        fprintf(stderr, "cnc-run run: error writing %s\n", o.trace);
+        fprintf(stderr, "cnc-run run: error writing %s\n", trace_path);
         rc = rc ? rc : RUN_FAULT;
     }
+    if (lat && o.plot && draw_plot(&o, trace_path, lat) != 0)
+        rc = rc ? rc : RUN_FAULT;
+    if (!o.trace && o.plot)
+        unlink(tmp_trace);
+    free(lat);
     ncp_source_close(&src);
     return rc;
 }

@@ -16,7 +16,7 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->servo_period = 1e-3;
     c->max_linear_vel = 200.0;
     for (int i = 0; i < NCP_AXES; i++) {
-        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 0.0, 1.0 };
+        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 100000.0, 1.0 };
     }
     c->axis[2].min_limit = -250.0;
     c->axis[2].max_limit = 50.0;
@@ -108,8 +108,10 @@ static int planner_key(struct ncp_machine_cfg *c, const char *k, const char *v)
     if (!strcasecmp(k, "PROFILE")) {
         if (!strcasecmp(v, "trapezoid"))
             c->profile = NCP_PROFILE_TRAPEZOID;
+        else if (!strcasecmp(v, "scurve"))
+            c->profile = NCP_PROFILE_SCURVE;
         else
-            return -1;  /* scurve: not implemented yet, refused rather than faked */
+            return -1;
         return 1;
     }
     return 0;

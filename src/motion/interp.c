@@ -16,9 +16,13 @@ static void start_head(struct ncp_planner *p)
         p->dur = ps->s.dwell;
     } else {
         double next = p->count > 1 ? plan_at(p, 1)->v_in : 0;
-        double reach = sqrt(v0 * v0 + 2 * ps->acc * ps->s.length);
-        ncp_trap_plan(&p->trap, ps->s.length, v0, fmin(next, reach), fmax(ps->vmax, v0),
-                      ps->acc);
+        double reach = plan_reach(p, ps->acc, ps->jerk, v0, ps->s.length);
+        if (plan_scurve(p) && ps->jerk > 0 && isfinite(ps->jerk))
+            ncp_scurve_plan(&p->trap, ps->s.length, v0, fmin(next, reach), fmax(ps->vmax, v0),
+                            ps->acc, ps->jerk);
+        else
+            ncp_trap_plan(&p->trap, ps->s.length, v0, fmin(next, reach), fmax(ps->vmax, v0),
+                          ps->acc);
         p->dur = ncp_trap_duration(&p->trap);
     }
     p->active = 1;

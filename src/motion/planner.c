@@ -73,16 +73,34 @@ void ncp_planner_pop(struct ncp_planner *p)
 static void line_limits(const struct ncp_planner *p, struct plan_seg *ps)
 {
     const struct ncp_seg *s = &ps->s;
-    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY;
+    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY, jerk = INFINITY;
     for (int j = 0; j < NCP_AXES; j++) {
         double u = fabs(s->end[j] - s->start[j]) / s->length;
         if (u < 1e-12)
             continue;
         vmax = fmin(vmax, p->cfg.axis[j].max_vel / u);
         acc = fmin(acc, p->cfg.axis[j].max_acc / u);
+        /* half: the other half is for the jerk a corner or a curvature step adds */
+        if (p->cfg.axis[j].max_jerk > 0)
+            jerk = fmin(jerk, 0.5 * p->cfg.axis[j].max_jerk / u);
     }
     ps->vmax = vmax;
     ps->acc = acc;
+    ps->jerk = jerk;
+}
+
+/* S-curve on an arc, per axis, half of the jerk limit for the arc's own motion
+ * (a sixth each for tangential jerk, the turning centripetal acceleration
+ * v^3 k^2 and the turning tangential acceleration 3 v a k) and half for the
+ * step of centripetal acceleration v^2 k at its ends, felt within one period. */
+static void scurve_arc_caps(const struct ncp_planner *p, double jmax, double share, double km,
+                            double *vmax, double *jerk)
+{
+    *jerk = fmin(*jerk, jmax / (6 * share));
+    if (km > 1e-12) {
+        *vmax = fmin(*vmax, cbrt(jmax / (6 * km * km)));
+        *vmax = fmin(*vmax, sqrt(0.5 * jmax * p->cfg.servo_period / km));
+    }
 }
 
 /* Along a helix every axis sees at most its share of the tangential
@@ -95,7 +113,7 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
     double f_plane = fabs(s->angle) * r / s->length, f_axis = fabs(s->axial) / s->length;
     double pitch = s->axial / fabs(s->angle);
     double kappa = r / (r * r + pitch * pitch);
-    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY;
+    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY, jerk = INFINITY;
     for (int j = 0; j < NCP_AXES; j++) {
         double m = sqrt(s->u[j] * s->u[j] + s->w[j] * s->w[j]);
         double share = f_plane * m + f_axis * fabs(s->normal[j]);
@@ -106,9 +124,18 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
         acc = fmin(acc, 0.5 * a->max_acc / share);
         if (m > 1e-12)
             vmax = fmin(vmax, sqrt(0.5 * a->max_acc / (kappa * m)));
+        if (plan_scurve(p) && a->max_jerk > 0)
+            scurve_arc_caps(p, a->max_jerk, share, kappa * m, &vmax, &jerk);
     }
     ps->vmax = vmax;
     ps->acc = acc;
+    ps->jerk = jerk;
+    /* tangential acceleration turns with the tangent: its jerk is 3 v a kappa */
+    for (int j = 0; j < NCP_AXES && plan_scurve(p); j++) {
+        double m = sqrt(s->u[j] * s->u[j] + s->w[j] * s->w[j]);
+        if (p->cfg.axis[j].max_jerk > 0 && m > 1e-12 && vmax > 0)
+            ps->acc = fmin(ps->acc, p->cfg.axis[j].max_jerk / (6 * 3 * vmax * kappa * m));
+    }
 }
 
 /* A corner (kink) turns the velocity vector within one servo period. A servo
@@ -137,6 +164,11 @@ static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
         dmax = fmax(dmax, dj);
         if (dj > 1e-9)
             v = fmin(v, beta * p->cfg.axis[j].max_acc * p->cfg.servo_period / dj);
+        /* S-curve: the velocity step of the corner, within one period, is a
+         * jerk of dv / T^2: it gets the half the segments leave free */
+        if (dj > 1e-9 && plan_scurve(p) && p->cfg.axis[j].max_jerk > 0)
+            v = fmin(v, 0.5 * p->cfg.axis[j].max_jerk * p->cfg.servo_period *
+                            p->cfg.servo_period / dj);
     }
     if (dmax <= 1e-9)
         return v;
@@ -163,7 +195,7 @@ static int lowering_safe(const struct ncp_planner *p, double v_tail)
             return v >= p->trap.v1;
         k--;
         ps = &p->q[(p->head + k) % p->cap];
-        v = fmin(ps->vjunc, sqrt(v * v + 2 * ps->acc * ps->s.length));
+        v = fmin(ps->vjunc, plan_reach(p, ps->acc, ps->jerk, v, ps->s.length));
     }
 }
 
@@ -191,9 +223,9 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
          * would cut into a profile already frozen: then stop at the corner. */
         struct plan_seg *prev = p->count ? plan_at(p, p->count - 1) : NULL;
         double a_half = prev ? 0.5 * prev->acc_full : 0;
-        double exit_lb = fmin(v, sqrt(2 * 0.5 * ps->acc_full * ps->s.length));
-        if (!prev || !lowering_safe(p, fmin(prev->vjunc, sqrt(exit_lb * exit_lb +
-                                                                 2 * a_half * prev->s.length)))) {
+        double exit_lb = fmin(v, plan_reach(p, 0.5 * ps->acc_full, ps->jerk, 0, ps->s.length));
+        if (!prev || !lowering_safe(p, fmin(prev->vjunc, plan_reach(p, a_half, prev->jerk, exit_lb,
+                                                                    prev->s.length)))) {
             v = 0;
         } else {
             prev->acc = a_half;
@@ -211,7 +243,7 @@ static void backward_pass(struct ncp_planner *p)
     double exit_v = 0;
     for (size_t k = p->count; k-- > first;) {
         struct plan_seg *ps = plan_at(p, k);
-        double v = fmin(ps->vjunc, sqrt(exit_v * exit_v + 2 * ps->acc * ps->s.length));
+        double v = fmin(ps->vjunc, plan_reach(p, ps->acc, ps->jerk, exit_v, ps->s.length));
         if (k + 1 < p->count && v == ps->v_in)
             break;
         if (k + 1 < p->count)
@@ -266,8 +298,8 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     if (kink_harmless(p, &prev->s, s, prev->vmax) || !ncp_blend_corner(&prev->s, s, &arc.s, &d))
         return 0;
     arc_limits(p, &arc);
-    double exit_lb = fmin(arc.vmax, sqrt(2 * arc.acc * arc.s.length));
-    double vin = fmin(prev->vjunc, sqrt(exit_lb * exit_lb + 2 * prev->acc * (prev->s.length - d)));
+    double exit_lb = fmin(arc.vmax, plan_reach(p, arc.acc, arc.jerk, 0, arc.s.length));
+    double vin = fmin(prev->vjunc, plan_reach(p, prev->acc, prev->jerk, exit_lb, prev->s.length - d));
     if (!lowering_safe(p, vin))
         return 0;
     prev->s.length -= d;

@@ -5,11 +5,14 @@
 
 #include "ncpar/motion.h"
 
+#include <math.h>
+
 struct plan_seg {
     struct ncp_seg s;
     double vmax;    /* cruise cap: feed and per-axis velocity / centripetal limits */
     double acc;     /* path acceleration that keeps every axis within its limit */
     double acc_full;/* the same before a corner (kink) took its share */
+    double jerk;    /* path jerk that keeps every axis within its limit (S-curve) */
     double vjunc;   /* entry speed cap from the junction with the previous segment */
     double v_in;    /* planned entry speed (backward pass: can still stop at the end) */
     int blend;      /* a G64 corner arc, not a programmed segment */
@@ -41,6 +44,24 @@ static inline struct plan_seg *plan_at(struct ncp_planner *p, size_t k)
 }
 
 void ncp_planner_pop(struct ncp_planner *p);
+
+/* scurve.c: evaluation of a jerk-limited profile (ncp_trap with j > 0). */
+double ncp_scurve_eval(const struct ncp_trap *tp, double t, double *v);
+
+static inline int plan_scurve(const struct ncp_planner *p)
+{
+    return p->cfg.profile == NCP_PROFILE_SCURVE;
+}
+
+/* Highest speed at one end of ps from which speed v at the other end is
+ * reachable over len, under the profile in use. */
+static inline double plan_reach(const struct ncp_planner *p, double acc, double jerk, double v,
+                                double len)
+{
+    if (plan_scurve(p) && jerk > 0 && isfinite(jerk))
+        return ncp_scurve_reach(v, len, acc, jerk);
+    return sqrt(v * v + 2 * acc * len);
+}
 
 /* blend.c: the arc joining prev's end to cur's start within prev's G64 P, and
  * the length trimmed off both lines. Returns 0 when the corner is not blended. */

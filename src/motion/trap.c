@@ -1,5 +1,5 @@
 /* Trapezoidal velocity profile over a known distance. */
-#include "ncpar/motion.h"
+#include "planner_int.h"
 
 #include <math.h>
 #include <string.h>
@@ -49,6 +49,8 @@ double ncp_trap_duration(const struct ncp_trap *tp)
 
 double ncp_trap_eval(const struct ncp_trap *tp, double t, double *v)
 {
+    if (tp->j > 0)
+        return ncp_scurve_eval(tp, t, v);
     double s, vel;
     if (t <= 0) {
         s = 0;

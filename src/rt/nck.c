@@ -188,12 +188,23 @@ static int check_ferror(struct nck *n, const double act[NCP_AXES])
 /* Real clock: when the ring holds fewer setpoints than a stop along the path
  * needs, slow the stream down (an underrun in the making); speed up again
  * once it has refilled. The virtual clock never needs to: it waits instead. */
+/* Live feed override relative to the override the plan was made at; feed hold
+ * (and --for) bring it to 0. Above the planned override the plan's own caps
+ * hold: a faster stream could exceed the acceleration limits. */
+static double feed_rate(struct nck *n)
+{
+    if (n->for_expired || atomic_load_explicit(&n->ctl->hold, memory_order_relaxed))
+        return 0.0;
+    double ov = atomic_load_explicit(&n->ctl->override_permille, memory_order_relaxed) / 1000.0;
+    double planned = n->o->feed_override > 0 ? n->o->feed_override : 1.0;
+    return fmin(1.0, ov / planned);
+}
+
 static double rate_target(struct nck *n)
 {
-    if (n->for_expired)
-        return 0.0;  /* feed hold: brake along the path */
-    if (n->o->virtual_clock || atomic_load(&n->planner_done))
-        return 1.0;
+    double feed = feed_rate(n);
+    if (feed <= 0 || n->o->virtual_clock || atomic_load(&n->planner_done))
+        return feed;
     /* ramping the rate down to 0 reads half as many samples as cycles pass;
      * a ring too small for that still gets the attempt (see SETPOINT_RING) */
     double cap = (double)ncp_spsc_capacity(&n->sps);
@@ -205,7 +216,7 @@ static double rate_target(struct nck *n)
     } else if (n->slowing && fill >= fmin(2 * need, cap - 1)) {
         n->slowing = 0;
     }
-    return n->slowing ? 0.0 : 1.0;
+    return n->slowing ? 0.0 : feed;
 }
 
 /* The servo sees one setpoint ahead (the command runs one period late), so
@@ -228,6 +239,10 @@ static int take_setpoint(struct nck *n)
 static int position_cycle(void *ctx, int64_t now_ns)
 {
     struct nck *n = ctx;
+    atomic_store_explicit(&n->ctl->now_ns, now_ns, memory_order_release);
+    if (n->o->virtual_clock && now_ns >= atomic_load_explicit(&n->ctl->pause_at_ns,
+                                                              memory_order_acquire))
+        return NCP_RT_RETRY;
     n->now_ns = now_ns;
     if (n->o->virtual_clock && ncp_spsc_count(&n->fbs) >= ncp_spsc_capacity(&n->fbs))
         return NCP_RT_RETRY;
@@ -253,12 +268,37 @@ static int position_cycle(void *ctx, int64_t now_ns)
     return NCP_RT_CONTINUE;
 }
 
+/* ---- live controls ---------------------------------------------------------------- */
+
+void ncp_nck_ctl_init(struct ncp_nck_ctl *c, double feed_override)
+{
+    atomic_store(&c->override_permille, (int)lround(fmin(2.0, fmax(0.0, feed_override)) * 1000));
+    atomic_store(&c->hold, 0);
+    atomic_store(&c->now_ns, 0);
+    atomic_store(&c->pause_at_ns, INT64_MAX);
+}
+
+void ncp_nck_set_feed_override(struct ncp_nck_ctl *c, double ov)
+{
+    atomic_store(&c->override_permille, (int)lround(fmin(2.0, fmax(0.0, ov)) * 1000));
+}
+
+void ncp_nck_feed_hold(struct ncp_nck_ctl *c, int hold)
+{
+    atomic_store(&c->hold, hold != 0);
+}
+
 /* ---- set-up and results ---------------------------------------------------------- */
 
 static int init(struct nck *n, const struct ncp_nck_opts *o, const double start[NCP_AXES])
 {
     n->o = o;
     n->cfg = o->cfg;
+    n->ctl = o->ctl;
+    if (!n->ctl) {
+        ncp_nck_ctl_init(&n->own_ctl, o->feed_override);
+        n->ctl = &n->own_ctl;
+    }
     ncp_canon_map_init(&n->map, o->cfg, start, o->feed_override);
     ncp_sim_init(&n->sim, o->cfg, start);
     memcpy(n->next.pos, start, sizeof n->next.pos);
@@ -267,6 +307,8 @@ static int init(struct nck *n, const struct ncp_nck_opts *o, const double start[
         a_min = fmin(a_min, o->cfg->axis[j].max_acc);
     /* half the weakest axis: the stream may itself be accelerating meanwhile */
     nck_scaler_init(&n->scaler, start, 0.5 * a_min, o->cfg->servo_period);
+    for (int j = 0; j < NCP_AXES; j++)
+        n->scaler.amax[j] = o->cfg->axis[j].max_acc;
     n->planner = ncp_planner_new(o->cfg, start);
     if (!n->planner || ncp_spsc_init(&n->segs, sizeof(struct nck_seg_msg), SEG_RING) ||
         ncp_spsc_init(&n->sps, sizeof(struct ncp_setpoint), (size_t)o->cfg->setpoint_ring) ||

@@ -38,9 +38,16 @@ struct nck_summary {
 /* scaler.c: reads the setpoint stream at a variable rate (see there). */
 struct nck_scaler {
     struct ncp_setpoint a, b;  /* samples around the read position */
+    struct ncp_setpoint c;     /* the sample after b, fetched ahead (have_c) */
+    int have_c;
     double f;                  /* read position between a (0) and b (1) */
     double r;                  /* rate: setpoints per period, 0..1 */
     double decel, period;
+    /* Per-axis acceleration limit the output's second difference must keep
+     * (INFINITY: unchecked); last two outputs for it. */
+    double amax[NCP_AXES];
+    double last[2][NCP_AXES];
+    int nlast;
 };
 
 void nck_scaler_init(struct nck_scaler *s, const double start[NCP_AXES], double decel,
@@ -53,6 +60,8 @@ int nck_scaler_step(struct nck_scaler *s, double target, struct ncp_spsc *ring,
 
 struct nck {
     const struct ncp_nck_opts *o;
+    struct ncp_nck_ctl own_ctl;      /* used when the caller passes none */
+    struct ncp_nck_ctl *ctl;
     const struct ncp_machine_cfg *cfg;
     struct ncp_spsc segs, sps, fbs;
     struct ncp_planner *planner;

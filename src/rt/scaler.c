@@ -3,7 +3,13 @@
  * samples, so it can slow down and stop *along the path* when the ring runs
  * low (a late planner thread) and speed up again when it refills: no jump in
  * position, and the path speed changes at a bounded deceleration. At r = 1 the
- * output is the stream itself, sample for sample. */
+ * output is the stream itself, sample for sample.
+ *
+ * Changing r adds its own acceleration (dr/dt times the stream's velocity) to
+ * the stream's (r^2 times the planned one): when both point the same way an
+ * axis could exceed its limit. Every rate change is therefore checked on the
+ * output's second difference per axis and shortened until it fits. The same
+ * mechanism carries live feed override and feed hold. */
 #include "nck_int.h"
 
 #include <math.h>
@@ -18,6 +24,8 @@ void nck_scaler_init(struct nck_scaler *s, const double start[NCP_AXES], double 
     s->r = 1;
     s->decel = decel;
     s->period = period;
+    for (int j = 0; j < NCP_AXES; j++)
+        s->amax[j] = INFINITY;
 }
 
 /* Cycles needed to bring the path speed to rest at the scaler's deceleration. */
@@ -27,42 +35,102 @@ double nck_scaler_stop_cycles(const struct nck_scaler *s)
     return v / (s->decel * s->period);
 }
 
-static void ramp(struct nck_scaler *s, double target)
+static double ramp(const struct nck_scaler *s, double target)
 {
     double vs = fmax(s->a.v, s->b.v);
     double dr = vs > 1e-9 ? s->decel * s->period / vs : 1.0;
-    if (target > s->r)
-        s->r = fmin(target, s->r + dr);
-    else
-        s->r = fmax(target, s->r - dr);
+    return target > s->r ? fmin(target, s->r + dr) : fmax(target, s->r - dr);
+}
+
+static void lerp(const struct ncp_setpoint *a, const struct ncp_setpoint *b, double f,
+                 double pos[NCP_AXES])
+{
+    for (int j = 0; j < NCP_AXES; j++)
+        pos[j] = f <= 0 ? a->pos[j] : f >= 1 ? b->pos[j] : a->pos[j] + f * (b->pos[j] - a->pos[j]);
+}
+
+/* Output position if this period advances the read position by r; -1 when
+ * that needs a sample the ring has not delivered. */
+static int probe(const struct nck_scaler *s, double r, double pos[NCP_AXES])
+{
+    double f = s->f + r;
+    if (f < 1.0) {
+        lerp(&s->a, &s->b, f, pos);
+        return 0;
+    }
+    if (!s->have_c)
+        return -1;
+    lerp(&s->b, &s->c, f - 1.0, pos);
+    return 0;
+}
+
+/* How far the second difference at rate r exceeds the limit (<= 0: fits). */
+static double excess(const struct nck_scaler *s, double r)
+{
+    double pos[NCP_AXES], worst = -INFINITY;
+    if (s->nlast < 2 || probe(s, r, pos) != 0)
+        return 0;
+    double T2 = s->period * s->period;
+    for (int j = 0; j < NCP_AXES; j++) {
+        double acc = fabs(pos[j] - 2 * s->last[0][j] + s->last[1][j]) / T2;
+        worst = fmax(worst, acc - s->amax[j] * (1 + 1e-9));
+    }
+    return worst;
+}
+
+/* The rate nearest the wanted one whose output keeps every axis's limit;
+ * keeping the current rate is the fallback (it only resamples the stream). */
+static double govern(const struct nck_scaler *s, double want)
+{
+    if (excess(s, want) <= 0)
+        return want;
+    double ok = s->r, bad = want;
+    if (excess(s, ok) > 0)
+        return excess(s, want) < excess(s, ok) ? want : ok;
+    for (int k = 0; k < 30; k++) {
+        double mid = 0.5 * (ok + bad);
+        if (excess(s, mid) <= 0)
+            ok = mid;
+        else
+            bad = mid;
+    }
+    return ok;
+}
+
+static void remember(struct nck_scaler *s, const double pos[NCP_AXES])
+{
+    memcpy(s->last[1], s->last[0], sizeof s->last[0]);
+    memcpy(s->last[0], pos, sizeof s->last[0]);
+    if (s->nlast < 2)
+        s->nlast++;
 }
 
 int nck_scaler_step(struct nck_scaler *s, double target, struct ncp_spsc *ring,
                     struct ncp_setpoint *out)
 {
     int dry = 0;
-    ramp(s, target);
+    if (!s->have_c)
+        s->have_c = ncp_spsc_pop(ring, &s->c) == 0;
+    s->r = govern(s, ramp(s, target));
     s->f += s->r;
-    while (s->f >= 1.0) {
-        struct ncp_setpoint nx;
-        if (ncp_spsc_pop(ring, &nx) != 0) {
+    if (s->f >= 1.0) {
+        if (!s->have_c) {
             s->f = 1.0;
             dry = s->r > 0 && s->b.v > 0;
             s->r = 0;
-            break;
+        } else {
+            s->a = s->b;
+            s->b = s->c;
+            s->f -= 1.0;
+            s->have_c = ncp_spsc_pop(ring, &s->c) == 0;
         }
-        s->a = s->b;
-        s->b = nx;
-        s->f -= 1.0;
     }
     double f = s->f;
-    for (int j = 0; j < NCP_AXES; j++) {
-        out->pos[j] = f <= 0 ? s->a.pos[j] : f >= 1 ? s->b.pos[j]
-                                                     : s->a.pos[j] + f * (s->b.pos[j] - s->a.pos[j]);
-        out->dir[j] = s->b.dir[j];
-    }
+    lerp(&s->a, &s->b, f, out->pos);
+    memcpy(out->dir, s->b.dir, sizeof out->dir);
     out->v = s->r * (s->a.v + f * (s->b.v - s->a.v));
     out->line = f < 0.5 ? s->a.line : s->b.line;
     out->flags = f <= 0 ? s->a.flags : f >= 1 ? s->b.flags : 0;
+    remember(s, out->pos);
     return dry ? -1 : 0;
 }

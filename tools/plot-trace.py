@@ -1,0 +1,158 @@
+#!/usr/bin/python3
+"""Draws a `cnc-run run --trace` CSV as one PNG a machinist can read.
+
+usage: plot-trace.py TRACE.csv OUT.png [LATENCY.csv] [--title TEXT]
+
+TRACE.csv   the per-cycle trace (t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v)
+LATENCY.csv optional sidecar written by `cnc-run run --plot`: the position
+            loop's wake-up latency histogram, one row per non-empty 1 us bin,
+            header "latency_us,cycles" (the last row may be ">=1000" for the
+            overflow bin).
+
+Panels: commanded vs actual XY toolpath (equal aspect), path velocity and
+acceleration over time, loop-latency histogram. Needs python3-matplotlib.
+"""
+import csv
+import sys
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_trace(path):
+    cols = {}
+    with open(path, newline="") as f:
+        rd = csv.reader(f)
+        head = next(rd)
+        for h in head:
+            cols[h] = []
+        for row in rd:
+            if len(row) != len(head):
+                continue
+            for h, v in zip(head, row):
+                cols[h].append(float(v))
+    for need in ("t", "x_cmd", "y_cmd", "x_act", "y_act", "v"):
+        if need not in cols:
+            sys.exit("plot-trace: %s has no column %r" % (path, need))
+    return cols
+
+
+def read_latency(path):
+    bins, counts, overflow = [], [], 0
+    with open(path, newline="") as f:
+        rd = csv.reader(f)
+        next(rd, None)
+        for row in rd:
+            if len(row) != 2:
+                continue
+            if row[0].startswith(">="):
+                overflow = int(row[1])
+            else:
+                bins.append(int(row[0]))
+                counts.append(int(row[1]))
+    return bins, counts, overflow
+
+
+def thin(xs, step):
+    return xs[::step] if step > 1 else xs
+
+
+def path_accel(t, v):
+    """Central differences over a window wide enough to hide sample noise."""
+    n = len(t)
+    a = [0.0] * n
+    for i in range(n):
+        lo, hi = max(0, i - 2), min(n - 1, i + 2)
+        dt = t[hi] - t[lo]
+        a[i] = (v[hi] - v[lo]) / dt if dt > 0 else 0.0
+    return a
+
+
+def plot(trace, out, lat_path, title):
+    c = read_trace(trace)
+    t = c["t"]
+    if not t:
+        sys.exit("plot-trace: %s has no rows" % trace)
+    step = max(1, len(t) // 20000)   # keep the PNG readable and the script fast
+    fig = plt.figure(figsize=(14, 10), dpi=100)
+    gs = fig.add_gridspec(3, 2, width_ratios=[1.25, 1], hspace=0.45, wspace=0.22)
+    fig.suptitle(title, fontsize=13)
+
+    ax = fig.add_subplot(gs[:, 0])
+    ax.plot(thin(c["x_cmd"], step), thin(c["y_cmd"], step), color="tab:blue", lw=1.6,
+            label="commanded")
+    ax.plot(thin(c["x_act"], step), thin(c["y_act"], step), color="tab:red", lw=0.8,
+            ls="--", label="actual (simulated axes)")
+    ferr = max(((xc - xa) ** 2 + (yc - ya) ** 2) ** 0.5 for xc, yc, xa, ya in
+               zip(c["x_cmd"], c["y_cmd"], c["x_act"], c["y_act"]))
+    ax.plot(c["x_cmd"][0], c["y_cmd"][0], "o", color="tab:green", ms=7, label="start")
+    ax.plot(c["x_cmd"][-1], c["y_cmd"][-1], "s", color="black", ms=6, label="end")
+    ax.text(0.02, 0.02, "max XY following error %.4f mm\n(actual lies on commanded at this scale)"
+            % ferr if ferr < 0.05 else "max XY following error %.4f mm" % ferr,
+            transform=ax.transAxes, fontsize=9, va="bottom",
+            bbox=dict(facecolor="white", alpha=0.8, edgecolor="none"))
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("X [mm]")
+    ax.set_ylabel("Y [mm]")
+    ax.set_title("XY toolpath (machine coordinates)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=9)
+
+    v = c["v"]
+    vmin = [x * 60.0 for x in v]
+    axv = fig.add_subplot(gs[0, 1])
+    axv.plot(thin(t, step), thin(vmin, step), color="tab:green", lw=0.9)
+    axv.set_ylabel("feed [mm/min]")
+    axv.set_title("path velocity")
+    axv.grid(True, alpha=0.3)
+
+    a = path_accel(t, v)
+    axa = fig.add_subplot(gs[1, 1], sharex=axv)
+    axa.plot(thin(t, step), thin(a, step), color="tab:purple", lw=0.7)
+    axa.set_ylabel("accel [mm/s²]")
+    axa.set_xlabel("time [s]")
+    axa.set_title("path acceleration (dv/dt)")
+    axa.grid(True, alpha=0.3)
+
+    axh = fig.add_subplot(gs[2, 1])
+    axh.set_title("position-loop wake-up latency")
+    if lat_path:
+        bins, counts, overflow = read_latency(lat_path)
+        if bins:
+            axh.bar(bins, counts, width=1.0, color="tab:orange", align="edge")
+            if max(counts) > 100 * max(1, min(counts)):
+                axh.set_yscale("log")
+            hi = max(bins) + 1
+            axh.set_xlim(0, max(10, hi + 1))
+        total = sum(counts) + overflow
+        note = "%d cycles, max bin %d us" % (total, max(bins) if bins else 0)
+        if overflow:
+            note += ", %d >= 1000 us" % overflow
+        axh.text(0.98, 0.92, note, transform=axh.transAxes, ha="right", va="top",
+                 fontsize=9)
+        axh.set_xlabel("latency [us] (1 us bins)")
+        axh.set_ylabel("cycles")
+    else:
+        axh.text(0.5, 0.5, "no latency histogram given", ha="center", va="center",
+                 transform=axh.transAxes)
+        axh.set_axis_off()
+    fig.savefig(out)
+    plt.close(fig)
+
+
+def main(argv):
+    title = None
+    if "--title" in argv:
+        i = argv.index("--title")
+        if i + 1 >= len(argv):
+            sys.exit(__doc__)
+        title = argv[i + 1]
+        del argv[i:i + 2]
+    if len(argv) not in (3, 4):
+        sys.exit(__doc__)
+    plot(argv[1], argv[2], argv[3] if len(argv) == 4 else None, title or argv[1])
+
+
+if __name__ == "__main__":
+    main(sys.argv)
