@@ -8,6 +8,7 @@
 #define NCPAR_LEX_H
 
 #include <stddef.h>
+#include <math.h>
 #include <stdint.h>
 #include "ncpar/diag.h"
 
@@ -115,6 +116,22 @@ struct ncp_block {
     struct ncp_bc_ins code[NCP_BLOCK_MAX_CODE];
     char pool[NCP_BLOCK_POOL];
 };
+
+/* rs274 converts doubles to int with a 32-bit cvttsd2si: out-of-range values and
+ * NaN become INT_MIN (then "Negative ... used"). C leaves such a cast undefined,
+ * so every double -> int conversion of program values goes through this. */
+static inline int ncp_trunc_int(double t)
+{
+    if (t > -2147483649.0 && t < 2147483648.0)
+        return (int)t;
+    return (-2147483647 - 1);
+}
+
+/* Nearest integer, halves away from zero (lround), INT_MIN when out of range. */
+static inline int ncp_trunc_int_round(double t)
+{
+    return ncp_trunc_int(round(t));
+}
 
 /* Parse text[0..len) (one line, no newline) into *out. Always fills out->err.
  * Returns out->err.code. Never reads outside text[0..len). */

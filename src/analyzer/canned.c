@@ -218,7 +218,7 @@ static int ncp_cyc_checks(struct ncp_analyzer *a, int motion, double *r, int *l)
         *r = s->cycle_r;
     else
         return ncp_an_error(a, col, "R clearance plane unspecified in cycle");
-    *l = NCP_HAS(w, 'L') ? (int)lround(w->v[NCP_LETTER('L')]) : 1;
+    *l = NCP_HAS(w, 'L') ? ncp_trunc_int_round(w->v[NCP_LETTER('L')]) : 1;
     if (NCP_HAS(w, 'L') && *l == 0)
         return ncp_an_error(a, w->col[NCP_LETTER('L')], "Cannot do zero repeats of cycle");
     static const char uvw[] = "UVW";

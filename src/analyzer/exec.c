@@ -52,7 +52,7 @@ static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
     } else {
         struct ncp_canon *op = ncp_an_emit(a, NCP_C_ORIENT_SPINDLE);
         op->d[0] = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
-        op->i[1] = NCP_HAS(&a->w, 'P') ? (int)lround(W(a, 'P')) : 0;
+        op->i[1] = NCP_HAS(&a->w, 'P') ? ncp_trunc_int_round(W(a, 'P')) : 0;
     }
     return NCP_OK;
 }
@@ -116,7 +116,7 @@ static int ncp_exec_io(struct ncp_analyzer *a, int m)
     if (m >= 62 && m <= 65) {
         if (!NCP_HAS(&a->w, 'P'))
             return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "No valid P word with M%d", m);
-        ncp_an_emit(a, bits[m - 62])->i[0] = (int)lround(W(a, 'P'));
+        ncp_an_emit(a, bits[m - 62])->i[0] = ncp_trunc_int_round(W(a, 'P'));
         return NCP_OK;
     }
     if (m == 67 || m == 68) {
@@ -124,7 +124,7 @@ static int ncp_exec_io(struct ncp_analyzer *a, int m)
             return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "Invalid analog index with M%d", m);
         struct ncp_canon *op = ncp_an_emit(a, m == 67 ? NCP_C_SET_MOTION_OUTPUT_VALUE
                                                       : NCP_C_SET_AUX_OUTPUT_VALUE);
-        op->i[0] = (int)lround(W(a, 'E'));
+        op->i[0] = ncp_trunc_int_round(W(a, 'E'));
         op->d[0] = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
         return NCP_OK;
     }

@@ -71,8 +71,8 @@ static int ncp_check_g(struct ncp_analyzer *a)
             return ncp_an_error(a, col, "G4 not allowed with G2 or G3 because they both use P");
     } else if (m0 == 100) {
         double p = NCP_HAS(w, 'P') ? w->v[NCP_LETTER('P')] : -1.0;
-        int l = NCP_HAS(w, 'L') ? (int)lround(w->v[NCP_LETTER('L')]) : -1;
-        int pi = p >= 0 ? (int)(p + 0.5) : (int)(p - 0.5);
+        int l = NCP_HAS(w, 'L') ? ncp_trunc_int_round(w->v[NCP_LETTER('L')]) : -1;
+        int pi = p >= 0 ? ncp_trunc_int(p + 0.5) : ncp_trunc_int(p - 0.5);
         if (l != 0 && l != 1 && l != 2 && l != 10 && l != 11 && l != 20)
             return ncp_an_error(a, col, "Line with G10 does not have L0, L1, L10, L11, L2, or L20");
         if (p + 0.0001 - pi > 0.0002)
@@ -141,7 +141,7 @@ static int ncp_check_other(struct ncp_analyzer *a)
             w->m[NCP_MG_SPINDLE] != 19)
             return ncp_an_error(a, COL('P'), "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 M63 M64 M65 M66 M98 or user M code to use it");
         double p = w->v[NCP_LETTER('P')];
-        int pv = (int)lround(p);
+        int pv = ncp_trunc_int_round(p);
         int arc = mt == 20 || mt == 30;
         if ((arc || w->m[NCP_MG_SPINDLE] == 19) && fabs(pv - p) > 0.001)
             return ncp_an_error(a, COL('P'), "P value not an integer with M19 G2 or G3");

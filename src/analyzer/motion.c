@@ -234,7 +234,7 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
         op->d[9] = o2;
     }
     op->i[0] = motion == 30 ? 1 : -1;
-    op->i[2] = NCP_HAS(w, 'P') ? (int)lround(w->v[NCP_LETTER('P')]) : 1;
+    op->i[2] = NCP_HAS(w, 'P') ? ncp_trunc_int_round(w->v[NCP_LETTER('P')]) : 1;
     op->i[3] = pl;
     op->flags = s->m.inches ? 1 : 0;
     if (s->m.feed_mode == 1) {

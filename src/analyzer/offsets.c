@@ -157,7 +157,7 @@ int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
     if (g == 430) {
         int idx = -1;
         if (NCP_HAS(w, 'H')) {
-            int h = (int)lround(w->v[NCP_LETTER('H')]);
+            int h = ncp_trunc_int_round(w->v[NCP_LETTER('H')]);
             idx = ncp_tools_find(a, h);
             if (idx < 0)
                 return ncp_an_error(a, w->col[NCP_LETTER('H')],
@@ -344,7 +344,7 @@ static int ncp_g10_tool(struct ncp_analyzer *a, int l, int p)
     if (NCP_HAS(w, 'J'))
         t->backangle = w->v[NCP_LETTER('J')];
     if (NCP_HAS(w, 'Q'))
-        t->orientation = (int)lround(w->v[NCP_LETTER('Q')]);
+        t->orientation = ncp_trunc_int_round(w->v[NCP_LETTER('Q')]);
     ncp_emit_tool_entry(a, idx, idx);
     if (idx == a->st.current_pocket) {
         a->tools[0] = *t;
@@ -357,7 +357,7 @@ static int ncp_g10_tool(struct ncp_analyzer *a, int l, int p)
 static int ncp_g10(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
-    int l = (int)lround(w->v[NCP_LETTER('L')]);
+    int l = ncp_trunc_int_round(w->v[NCP_LETTER('L')]);
     int p = (int)w->v[NCP_LETTER('P')]; /* rs274 truncates */
     if (l == 2 || l == 20)
         return ncp_g10_origin(a, l, p);

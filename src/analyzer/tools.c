@@ -19,14 +19,14 @@ static const char ncp_default_table[] =
 static void ncp_tool_field(struct ncp_tool_entry *t, int *toolno, char c, double v)
 {
     switch (c) {
-    case 'T': *toolno = (int)v; break;
-    case 'P': t->pocket = (int)v; break;
+    case 'T': *toolno = ncp_trunc_int(v); break;
+    case 'P': t->pocket = ncp_trunc_int(v); break;
     case 'X': t->x_offset = v; break;
     case 'Z': t->z_offset = v; break;
     case 'D': t->diameter = v; break;
     case 'I': t->frontangle = v; break;
     case 'J': t->backangle = v; break;
-    case 'Q': t->orientation = (int)v; break;
+    case 'Q': t->orientation = ncp_trunc_int(v); break;
     default: break;
     }
 }
@@ -121,7 +121,7 @@ int ncp_tools_find(const struct ncp_analyzer *a, int tool)
 int ncp_tools_select(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
-    int t = (int)lround(w->v[NCP_LETTER('T')]);
+    int t = ncp_trunc_int_round(w->v[NCP_LETTER('T')]);
     int idx = ncp_tools_find(a, t);
     if (idx < 0)
         return ncp_an_error(a, w->col[NCP_LETTER('T')],
@@ -136,7 +136,7 @@ static int ncp_tools_m61(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     uint16_t col = w->mcol[NCP_MG_TOOL];
-    int t = NCP_HAS(w, 'Q') ? (int)lround(w->v[NCP_LETTER('Q')]) : -1;
+    int t = NCP_HAS(w, 'Q') ? ncp_trunc_int_round(w->v[NCP_LETTER('Q')]) : -1;
     if (t < 0)
         return ncp_an_error(a, col, "Need non-negative Q-word to specify tool number with M61");
     int idx = ncp_tools_find(a, t);

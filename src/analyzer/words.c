@@ -72,9 +72,9 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
 {
     struct ncp_words *w = &a->w;
     double t = v * 10.0;
-    int code = (int)floor(t);
+    int code = ncp_trunc_int(floor(t));
     if (t - code > 0.999)
-        code = (int)ceil(t);
+        code = ncp_trunc_int(ceil(t));
     else if (t - code > 0.001)
         return ncp_an_error(a, col, "G-code out of range");
     if (code > 999)
@@ -96,7 +96,7 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
 static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
 {
     struct ncp_words *w = &a->w;
-    int m = (int)lround(v);
+    int m = ncp_trunc_int_round(v);
     if (m < 0)
         return ncp_an_error(a, col, "Negative m code used");
     if (m > 199)
@@ -115,6 +115,9 @@ static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
 /* Reader-level value checks rs274 makes while reading each word. */
 static int ncp_word_check(struct ncp_analyzer *a, char c, double v, uint16_t col)
 {
+    /* rs274 reads T, H and L as integers (x86 conversion) before the sign check */
+    if (c == 'T' || c == 'H' || c == 'L')
+        v = ncp_trunc_int_round(v);
     if (v >= 0.0)
         return NCP_OK;
     switch (c) {
@@ -212,7 +215,7 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b)
         if (rc == NCP_OK && as->kind == NCP_ASSIGN_NUMBERED) {
             double iv;
             rc = ncp_eval(a, b, &as->index, &iv);
-            idx[k] = (int)lround(iv);
+            idx[k] = ncp_trunc_int_round(iv);
         }
         if (rc != NCP_OK)
             return rc;

@@ -26,9 +26,7 @@
  * C leaves that undefined, so spell it out. */
 static inline int ncp_math_trunc_int(double t)
 {
-    if (t > -2147483649.0 && t < 2147483648.0)
-        return (int)t;
-    return INT_MIN;
+    return ncp_trunc_int(t);
 }
 
 /* rs274's "integer value": within 0.0001 of an integer, else an error. */

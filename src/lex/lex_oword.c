@@ -48,7 +48,7 @@ static int read_number_name(struct ncp_lexer *lx, struct ncp_oword *o)
         b->n_code = code_mark;
         return ncp_lex_fail(lx, pos, "O-word number must not depend on parameters");
     }
-    len = snprintf(tmp, sizeof tmp, "%d", (int)v.k);
+    len = snprintf(tmp, sizeof tmp, "%d", ncp_trunc_int(v.k));
     if (b->pool_used + len + 1 > NCP_BLOCK_POOL)
         return ncp_lex_fail(lx, pos, "Line too complex");
     o->name_off = b->pool_used;
