@@ -37,12 +37,19 @@ struct ncp_machine_cfg {
      * u = KP e + KI int(e) + KD de/dt + FF1 v_cmd + FF2 a_cmd */
     double kp, ki, kd, ff1, ff2;
     struct ncp_rt_place position, planner, interp; /* [RT] */
+    /* [TRAJ] PLANNING_PERIOD (ns in the INI): the rough interpolator's period,
+     * an integer multiple of servo_period; the position loop fine-interpolates
+     * between its points. 0 = servo_period (no fine interpolation). */
+    double planning_period;
 };
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c);
 /* Loads an INI over the defaults. On error d->msg names file, section and key,
  * d->line is the INI line. Returns NCP_OK or NCP_ERR_IO / NCP_ERR_SEMANTIC. */
 int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp_diag *d);
+/* Servo periods per planning period (1 when planning_period is 0), or 0 when
+ * planning_period is not a positive integer multiple of servo_period. */
+int ncp_machine_cfg_ipo_ratio(const struct ncp_machine_cfg *c);
 
 /* ---- segments -------------------------------------------------------------- */
 

@@ -143,6 +143,12 @@ static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, c
     if (!strcasecmp(sec, "TRAJ")) {
         if (!strcasecmp(k, "MAX_LINEAR_VELOCITY"))
             return num(v, 1e-6, 1e6, &c->max_linear_vel) ? -1 : 1;
+        if (!strcasecmp(k, "PLANNING_PERIOD")) {
+            if (num(v, 125000, 100000000, &x))
+                return -1;
+            c->planning_period = x * 1e-9;
+            return 1;
+        }
         if (!strcasecmp(k, "DEFAULT_LINEAR_ACCELERATION"))
             return num(v, 0, 1e8, &c->default_linear_acc) ? -1 : 1;
         return 0;
@@ -181,8 +187,26 @@ static int on_key(void *user, const char *sec, const char *k, const char *v)
     return 0;
 }
 
+int ncp_machine_cfg_ipo_ratio(const struct ncp_machine_cfg *c)
+{
+    if (c->planning_period <= 0)
+        return 1;
+    double k = c->planning_period / c->servo_period;
+    long r = lround(k);
+    /* the INI gives whole ns: allow for their rounding only */
+    if (r < 1 || r > 1000 || fabs(k - (double)r) * c->servo_period > 0.5e-9)
+        return 0;
+    return (int)r;
+}
+
 static int check_cfg(const struct ncp_machine_cfg *c, const char *path, struct ncp_diag *d)
 {
+    int ratio = ncp_machine_cfg_ipo_ratio(c);
+    if (ratio == 0)
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
+                            "%s: [TRAJ] PLANNING_PERIOD %.0f ns must be a whole multiple of "
+                            "[EMCMOT] SERVO_PERIOD %.0f ns",
+                            path, c->planning_period * 1e9, c->servo_period * 1e9);
     for (int i = 0; i < NCP_AXES; i++) {
         if (c->axis[i].min_limit >= c->axis[i].max_limit)
             return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
@@ -195,11 +219,11 @@ static int check_cfg(const struct ncp_machine_cfg *c, const char *path, struct n
     double a_min = c->axis[0].max_acc;
     for (int i = 1; i < NCP_AXES; i++)
         a_min = fmin(a_min, c->axis[i].max_acc);
-    double need = c->max_linear_vel / (a_min * c->servo_period) + 8;
+    double need = c->max_linear_vel / (a_min * c->servo_period) / ratio + 8;
     if ((double)c->setpoint_ring < need)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "%s: [PLANNER] SETPOINT_RING %d is too small to stop along the path "
-                            "from MAX_LINEAR_VELOCITY: at least %.0f",
+                            "from MAX_LINEAR_VELOCITY: at least %.0f planning periods",
                             path, c->setpoint_ring, ceil(need));
     return NCP_OK;
 }

@@ -1,4 +1,6 @@
-/* Interpolator: samples the planned profile once per servo period. A segment's
+/* Rough interpolator: samples the planned profile once per planning period
+ * (the servo period unless [TRAJ] PLANNING_PERIOD is longer; the position loop
+ * then fine-interpolates, see src/rt/scaler.c). A segment's
  * profile is frozen when it starts (the lazy forward pass); time left over at
  * its end carries into the next segment so the path speed has no gaps, except
  * at a stop, where the end point itself is the sample (exact stop). */
@@ -71,7 +73,7 @@ int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out)
         start_head(p);
         p->t = 0;
     }
-    p->t += p->cfg.servo_period;
+    p->t += p->cfg.planning_period > 0 ? p->cfg.planning_period : p->cfg.servo_period;
     while (p->t >= p->dur) {
         if (p->trap.v1 <= 1e-9 || p->count < 2) {
             p->t = p->dur;

@@ -8,6 +8,33 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* With fine interpolation (src/rt/scaler.c) the servo cycles between two
+ * rough points follow a cubic through their positions and velocities. Where
+ * the planned acceleration changes inside a planning period the cubic's
+ * acceleration overshoots it, by up to 2/3 when it reverses (a dip into a
+ * junction), so the plan keeps 3/5 of each limit. A corner's velocity step
+ * is spread over the period instead of one servo cycle; the cubic turns a
+ * step dv into at most 4 dv / Tp, which the kink caps below keep within
+ * their share when they take Tp / 4 as the period of the step. Its velocity
+ * strays from the plan by at most da Tp / 12 for an acceleration change da
+ * (<= 2 a) inside the period: the velocity caps keep that much room. */
+static void fine_ipo_margins(struct ncp_machine_cfg *c)
+{
+    int ratio = ncp_machine_cfg_ipo_ratio(c);
+    if (ratio <= 1)
+        return;
+    double room = 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        c->axis[j].max_acc *= 0.6;
+        double dv = 2 * c->axis[j].max_acc * c->planning_period / 12;
+        c->axis[j].max_vel = fmax(0.5 * c->axis[j].max_vel, c->axis[j].max_vel - dv);
+        room = fmax(room, dv);
+    }
+    c->max_linear_vel = fmax(0.5 * c->max_linear_vel, c->max_linear_vel - room);
+    c->default_linear_acc *= 0.6;
+    c->servo_period = c->planning_period / 4;
+}
+
 struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
                                     const double start[NCP_AXES])
 {
@@ -15,6 +42,7 @@ struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
     if (!p)
         return NULL;
     p->cfg = *cfg;
+    fine_ipo_margins(&p->cfg);
     /* room for a blend arc per programmed segment: the window is LOOKAHEAD blocks */
     p->cap = 2 * (size_t)(cfg->lookahead > 1 ? cfg->lookahead : 1) + 2;
     p->q = calloc(p->cap, sizeof *p->q);

@@ -149,7 +149,7 @@ static void *planner_main(void *arg)
     struct nck *n = arg;
     int finished = 0, more = 1;
     int64_t wait_since = 0;
-    long nap = (long)(n->cfg->servo_period * 1e6 / 4) + 1;
+    long nap = (long)(n->cfg->servo_period * ncp_machine_cfg_ipo_ratio(n->cfg) * 1e6 / 4) + 1;
     while (more && !atomic_load(&n->abort)) {
         pull_segments(n, &finished);
         if (ncp_spsc_count(&n->sps) >= ncp_spsc_capacity(&n->sps) ||
@@ -208,7 +208,7 @@ static double rate_target(struct nck *n)
     /* ramping the rate down to 0 reads half as many samples as cycles pass;
      * a ring too small for that still gets the attempt (see SETPOINT_RING) */
     double cap = (double)ncp_spsc_capacity(&n->sps);
-    double need = fmin(0.5 * nck_scaler_stop_cycles(&n->scaler) + 8, 0.75 * cap);
+    double need = fmin(0.5 * nck_scaler_stop_cycles(&n->scaler) / n->scaler.ratio + 8, 0.75 * cap);
     double fill = (double)ncp_spsc_count(&n->sps);
     if (!n->slowing && fill < need) {
         n->slowing = 1;
@@ -307,6 +307,10 @@ static int init(struct nck *n, const struct ncp_nck_opts *o, const double start[
         a_min = fmin(a_min, o->cfg->axis[j].max_acc);
     /* half the weakest axis: the stream may itself be accelerating meanwhile */
     nck_scaler_init(&n->scaler, start, 0.5 * a_min, o->cfg->servo_period);
+    int ratio = ncp_machine_cfg_ipo_ratio(o->cfg);
+    if (ratio < 1)
+        return -1;
+    nck_scaler_set_ratio(&n->scaler, ratio);
     for (int j = 0; j < NCP_AXES; j++)
         n->scaler.amax[j] = o->cfg->axis[j].max_acc;
     n->planner = ncp_planner_new(o->cfg, start);

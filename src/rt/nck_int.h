@@ -48,11 +48,19 @@ struct nck_scaler {
     double amax[NCP_AXES];
     double last[2][NCP_AXES];
     int nlast;
+    /* Fine interpolation: servo periods per stream sample (1: the stream is
+     * at the servo rate and is read linearly, as before), and the stream's
+     * sample period. */
+    int ratio;
+    double tp;
 };
 
 void nck_scaler_init(struct nck_scaler *s, const double start[NCP_AXES], double decel,
                      double period);
 double nck_scaler_stop_cycles(const struct nck_scaler *s);
+/* The stream comes every ratio periods: read it through cubic Hermite
+ * interpolation on the samples' velocities (see scaler.c). */
+void nck_scaler_set_ratio(struct nck_scaler *s, int ratio);
 /* One period at a rate moving towards target. Returns -1 when the stream ran
  * dry in motion (the output holds the last sample), else 0. */
 int nck_scaler_step(struct nck_scaler *s, double target, struct ncp_spsc *ring,

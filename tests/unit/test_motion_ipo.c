@@ -1,0 +1,299 @@
+/* Rough/fine interpolation ([TRAJ] PLANNING_PERIOD = 4 servo periods): the
+ * planner samples its profile every planning period and the position loop
+ * fills in the servo cycles with a cubic Hermite curve. Checked from the
+ * per-servo-cycle --trace of virtual-clock runs, like test_motion_limits. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "ncpar/feeder.h"
+#include "ncpar/motion.h"
+#include "ncpar/pipeline.h"
+#include "ncpar/rt.h"
+
+/* the trace prints 6 decimals: half a unit of the last digit */
+#define PRINT_Q 0.5e-6
+#define RATIO 4
+
+struct row {
+    double t, cmd[3], v;
+    unsigned line;
+};
+
+static struct row *read_trace(FILE *f, size_t *n)
+{
+    char buf[512];
+    rewind(f);
+    assert_non_null(fgets(buf, sizeof buf, f));
+    size_t cap = 4096;
+    struct row *r = malloc(cap * sizeof *r);
+    assert_non_null(r);
+    *n = 0;
+    while (fgets(buf, sizeof buf, f)) {
+        if (*n == cap) {
+            struct row *bigger = realloc(r, (cap *= 2) * sizeof *r);
+            assert_non_null(bigger);
+            r = bigger;
+        }
+        struct row *x = &r[(*n)++];
+        double act[3];
+        assert_int_equal(sscanf(buf, "%lf,%u,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x->t, &x->line,
+                                &x->cmd[0], &x->cmd[1], &x->cmd[2], &act[0], &act[1], &act[2],
+                                &x->v),
+                         9);
+    }
+    return r;
+}
+
+struct gcode_ctx {
+    struct ncp_source src;
+    struct ncp_analyzer_cfg acfg;
+};
+
+static int gcode_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
+{
+    struct gcode_ctx *g = ctx;
+    struct ncp_run_stats st;
+    return ncp_serial_run(&g->src, &g->acfg, out, &st, d);
+}
+
+static struct row *run_text(const char *text, const struct ncp_machine_cfg *cfg, size_t *n,
+                            struct ncp_nck_result *res)
+{
+    struct gcode_ctx g;
+    struct ncp_diag d;
+    memset(&g, 0, sizeof g);
+    assert_int_equal(ncp_source_from_memory(&g.src, text, strlen(text), "t.ngc", &d), NCP_OK);
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    struct ncp_nck_opts o = { .cfg = cfg, .interpret = gcode_run, .interp_ctx = &g,
+                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
+    assert_int_equal(ncp_nck_run(&o, res), 0);
+    struct row *r = read_trace(f, n);
+    fclose(f);
+    ncp_source_close(&g.src);
+    return r;
+}
+
+static void ipo_cfg(struct ncp_machine_cfg *c, enum ncp_profile prof)
+{
+    ncp_machine_cfg_default(c);
+    c->profile = prof;
+    c->axis[2].max_vel = 100;
+    c->axis[2].max_acc = 1000;
+    c->axis[2].max_jerk = 50000;
+    c->planning_period = RATIO * c->servo_period;
+}
+
+/* Worst |k-th difference| / limit over all axes, k = 1, 2 (1 = at the limit),
+ * less what the trace's print rounding can add. Also checks that there is
+ * one row per servo period. */
+static void worst_ratios(const struct row *r, size_t n, const struct ncp_machine_cfg *c,
+                         double *vel, double *acc)
+{
+    const double T = c->servo_period;
+    *vel = *acc = 0;
+    for (size_t k = 2; k < n; k++) {
+        assert_true(fabs(r[k].t - r[k - 1].t - T) < 1e-7);
+        for (int j = 0; j < NCP_AXES; j++) {
+            double p1 = r[k - 2].cmd[j], p2 = r[k - 1].cmd[j], p3 = r[k].cmd[j];
+            double v = fabs(p3 - p2) / T, a = fabs(p3 - 2 * p2 + p1) / (T * T);
+            *vel = fmax(*vel, (v - 2 * PRINT_Q / T) / c->axis[j].max_vel);
+            *acc = fmax(*acc, (a - 4 * PRINT_Q / (T * T)) / c->axis[j].max_acc);
+        }
+    }
+}
+
+static const char corners_prog[] =
+    "G21 G90 G17 G64 P0.05\n"
+    "G0 X0 Y0 Z5\n"
+    "G1 Z-1 F600\n"
+    "G1 X40 F4000\n"
+    "G1 X60 Y20\n"
+    "G3 X60 Y60 I0 J20\n"
+    "G2 X40 Y80 I-20 J0\n"
+    "G1 X0 Y80\n"
+    "G61 G1 X0 Y40\n"
+    "G1 X-10 Y30\n"
+    "G64 P0.2 G1 X-10 Y0\n"
+    "G2 X-10 Y0 Z-4 I10 J0 F2000\n"
+    "G0 Z5\n"
+    "M2\n";
+
+static char *write_tmp(const char *text)
+{
+    static char path[] = "/tmp/ncp_ipo_XXXXXX";
+    strcpy(path, "/tmp/ncp_ipo_XXXXXX");
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, text, strlen(text)), (ssize_t)strlen(text));
+    close(fd);
+    return path;
+}
+
+static void test_ini_planning_period(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c;
+    struct ncp_diag d;
+    ncp_machine_cfg_default(&c);
+    assert_int_equal(ncp_machine_cfg_ipo_ratio(&c), 1);
+    char *p = write_tmp("[EMCMOT]\nSERVO_PERIOD = 250000\n[TRAJ]\nPLANNING_PERIOD = 1000000\n");
+    assert_int_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_int_equal(ncp_machine_cfg_ipo_ratio(&c), 4);
+
+    ncp_machine_cfg_default(&c);
+    p = write_tmp("[EMCMOT]\nSERVO_PERIOD = 1000000\n[TRAJ]\nPLANNING_PERIOD = 2500000\n");
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "PLANNING_PERIOD"));
+    assert_non_null(strstr(d.msg, "multiple"));
+
+    ncp_machine_cfg_default(&c);
+    p = write_tmp("[TRAJ]\nPLANNING_PERIOD = 500000\n");  /* shorter than the servo period */
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "PLANNING_PERIOD"));
+
+    ncp_machine_cfg_default(&c);
+    p = write_tmp("[TRAJ]\nPLANNING_PERIOD = soon\n");
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "TRAJ"));
+    unlink(p);
+}
+
+static void check_corners(enum ncp_profile prof)
+{
+    struct ncp_machine_cfg cfg;
+    ipo_cfg(&cfg, prof);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(corners_prog, &cfg, &n, &res);
+    double vel, acc;
+    worst_ratios(r, n, &cfg, &vel, &acc);
+    if (vel > 1 + 1e-9 || acc > 1 + 1e-9)
+        fail_msg("profile %d: vel %.4f acc %.4f of the limits", prof, vel, acc);
+    assert_true(acc > 0.3);  /* the machine is really used */
+    assert_true(r[n - 1].cmd[2] == 5 && r[n - 1].v == 0);
+    /* the rough stream takes about as long as the servo-rate one */
+    struct ncp_machine_cfg fine = cfg;
+    fine.planning_period = 0;
+    struct ncp_nck_result res1;
+    size_t n1;
+    free(run_text(corners_prog, &fine, &n1, &res1));
+    if (!(res.program_time < 1.3 * res1.program_time && res.program_time > res1.program_time))
+        fail_msg("program time %.4f s with fine interpolation, %.4f s without",
+                 res.program_time, res1.program_time);
+    free(r);
+}
+
+static void test_corners_keep_limits_trapezoid(void **state)
+{
+    (void)state;
+    check_corners(NCP_PROFILE_TRAPEZOID);
+}
+
+static void test_corners_keep_limits_scurve(void **state)
+{
+    (void)state;
+    check_corners(NCP_PROFILE_SCURVE);
+}
+
+/* G61 segment ends are reached exactly (at rest), and the arc keeps its
+ * radius within the fine interpolation's chord error (src/rt/scaler.c):
+ * R theta^4 / 384 at constant speed (theta = v Tp / R), plus 0.0162 da Tp^2
+ * theta where the tangential acceleration changes by da inside a planning
+ * period (da <= 2 MAX_ACCELERATION), plus the trace's print rounding. */
+static void test_g61_ends_and_arc_radius(void **state)
+{
+    (void)state;
+    static const char prog[] = "G21 G90 G17 G61\n"
+                               "G0 X10 Y5 Z2\n"
+                               "G1 Z-1 F600\n"
+                               "G1 X50 F3000\n"
+                               "G2 X60 Y15 I0 J10\n"
+                               "G1 Y40\n"
+                               "G20 G1 X1\n"
+                               "M2\n";
+    struct ncp_machine_cfg cfg;
+    ipo_cfg(&cfg, NCP_PROFILE_TRAPEZOID);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(prog, &cfg, &n, &res);
+    static const double ends[][3] = { { 10, 5, 2 }, { 10, 5, -1 }, { 50, 5, -1 },
+                                      { 60, 15, -1 }, { 60, 40, -1 }, { 25.4, 40, -1 } };
+    for (size_t e = 0; e < sizeof ends / sizeof ends[0]; e++) {
+        int hit = 0;
+        for (size_t k = 0; k < n && !hit; k++)
+            hit = fabs(r[k].cmd[0] - ends[e][0]) < 1e-6 && fabs(r[k].cmd[1] - ends[e][1]) < 1e-6 &&
+                  fabs(r[k].cmd[2] - ends[e][2]) < 1e-6 && r[k].v == 0;
+        if (!hit)
+            fail_msg("end %zu (%g %g %g) not reached at rest", e, ends[e][0], ends[e][1], ends[e][2]);
+    }
+    const double R = 10, v = 3000 / 60.0, theta = v * cfg.planning_period / R;
+    const double Tp = cfg.planning_period, da = 2 * cfg.axis[0].max_acc;
+    const double bound = R * pow(theta, 4) / 384 + 0.0162 * da * Tp * Tp * theta + 2 * PRINT_Q;
+    assert_true(bound < 1e-3 * 0.05);  /* well inside the 1 um the arcs must keep */
+    size_t on = 0;
+    double worst = 0;
+    for (size_t k = 0; k < n; k++) {
+        if (r[k].line != 5)
+            continue;
+        on++;
+        worst = fmax(worst, fabs(hypot(r[k].cmd[0] - 50, r[k].cmd[1] - 15) - R));
+    }
+    assert_true(on > 100);
+    if (worst > bound)
+        fail_msg("arc radius off by %g mm, bound %g", worst, bound);
+    double vel, acc;
+    worst_ratios(r, n, &cfg, &vel, &acc);
+    assert_true(vel <= 1 + 1e-9 && acc <= 1 + 1e-9);
+    free(r);
+}
+
+/* The fine interpolation is smooth: between rough points the servo-rate
+ * velocity does not step (a linear fill would jump by a Tp every Tp). */
+static void test_fine_points_between_rough(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    ipo_cfg(&cfg, NCP_PROFILE_TRAPEZOID);
+    struct ncp_nck_result res;
+    size_t n;
+    /* a rapid: cruises at the axis's velocity limit, decelerates at the end */
+    struct row *r = run_text("G21 G90 G0 X100\nM2\n", &cfg, &n, &res);
+    const double T = cfg.servo_period, a = cfg.axis[0].max_acc;
+    int distinct = 0;
+    for (size_t k = 2; k < n; k++) {
+        double v = fabs(r[k].cmd[0] - r[k - 1].cmd[0]) / T;
+        if (v > cfg.axis[0].max_vel + 2 * PRINT_Q / T)
+            fail_msg("velocity %g at row %zu", v, k);
+        double acc = (r[k].cmd[0] - 2 * r[k - 1].cmd[0] + r[k - 2].cmd[0]) / (T * T);
+        if (fabs(acc) > a + 4 * PRINT_Q / (T * T))
+            fail_msg("acc %g at row %zu t %g x %.6f %.6f %.6f", acc, k, r[k].t, r[k - 2].cmd[0], r[k - 1].cmd[0], r[k].cmd[0]);
+        distinct += r[k].cmd[0] != r[k - 1].cmd[0];
+    }
+    /* every servo cycle in motion gets its own point, not one per rough period */
+    double t_move = res.program_time;
+    assert_true(distinct > 0.9 * t_move / T);
+    assert_true(r[n - 1].cmd[0] == 100);
+    free(r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ini_planning_period),
+        cmocka_unit_test(test_corners_keep_limits_trapezoid),
+        cmocka_unit_test(test_corners_keep_limits_scurve),
+        cmocka_unit_test(test_g61_ends_and_arc_radius),
+        cmocka_unit_test(test_fine_points_between_rough),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
