@@ -17,6 +17,7 @@ enum { NCP_RING_EOF = 1u, NCP_RING_ABORT = 2u };
 /* Short: the machine may have fewer cores than pipeline threads, and a spinning
  * thread then steals the CPU from the one it waits for. */
 #define NCP_RING_SPIN 128
+#define NCP_RING_MAX_BATCH 32u
 
 uint32_t ncp_ring_capacity(uint32_t want)
 {
@@ -44,11 +45,13 @@ int ncp_ring_init_staged(struct ncp_ring *r, size_t elem_size, uint32_t capacity
     r->n_stages = n_stages;
     r->mask = cap - 1;
     r->stride = stride;
+    r->batch = cap / 8 > NCP_RING_MAX_BATCH ? NCP_RING_MAX_BATCH : cap / 8 ? cap / 8 : 1;
     for (unsigned s = 0; s < NCP_RING_MAX_STAGES; s++) {
         atomic_init(&r->stage[s].pos, 0);
         atomic_init(&r->stage[s].sleepers, 0);
         atomic_init(&r->stage[s].event, 0);
         atomic_init(&r->stage[s].wake_at, 0);
+        r->stage[s].next = 0;
     }
     atomic_init(&r->state, 0);
     return 0;
@@ -59,8 +62,11 @@ int ncp_ring_init(struct ncp_ring *r, size_t elem_size, uint32_t capacity)
     return ncp_ring_init_staged(r, elem_size, capacity, 2);
 }
 
+static void forget(const struct ncp_ring *r);
+
 void ncp_ring_destroy(struct ncp_ring *r)
 {
+    forget(r);
     free(r->slots);
     r->slots = NULL;
 }
@@ -84,7 +90,7 @@ static unsigned awaited_stage(const struct ncp_ring *r, unsigned s)
 static int ready(struct ncp_ring *r, unsigned s, uint32_t k, memory_order mo)
 {
     struct ncp_ring_stage *st = &r->stage[s];
-    uint32_t own = atomic_load_explicit(&st->pos, memory_order_relaxed);
+    uint32_t own = st->next;
     uint32_t state = atomic_load_explicit(&r->state, mo);
     if (state & NCP_RING_ABORT)
         return -1;
@@ -125,8 +131,22 @@ static void wake_sleeper(struct ncp_ring_stage *st)
         wake(st);
 }
 
+/* Stages whose position this thread has moved but not yet published. */
+struct ncp_ring_unpublished {
+    struct ncp_ring *r;
+    unsigned s;
+};
+static _Thread_local struct ncp_ring_unpublished unpublished[NCP_RING_MAX_OWED];
+static _Thread_local int n_unpublished;
+
+static void publish(struct ncp_ring *r, unsigned s);
+
 static void pay_owed(void)
 {
+    /* first: publishing may defer more wake-ups */
+    for (int i = 0; i < n_unpublished; i++)
+        publish(unpublished[i].r, unpublished[i].s);
+    n_unpublished = 0;
     for (int i = 0; i < n_owed; i++)
         wake_sleeper(owed[i]);
     n_owed = 0;
@@ -135,6 +155,26 @@ static void pay_owed(void)
 void ncp_ring_wake_owed(void)
 {
     pay_owed();
+}
+
+/* A ring going away must not stay on this thread's lists (the stage threads
+ * emptied theirs before they exited). */
+static void forget(const struct ncp_ring *r)
+{
+    int k = 0;
+    for (int i = 0; i < n_unpublished; i++)
+        if (unpublished[i].r != r)
+            unpublished[k++] = unpublished[i];
+    n_unpublished = k;
+    k = 0;
+    for (int i = 0; i < n_owed; i++) {
+        int mine = 0;
+        for (unsigned s = 0; s < NCP_RING_MAX_STAGES; s++)
+            mine |= owed[i] == &r->stage[s];
+        if (!mine)
+            owed[k++] = owed[i];
+    }
+    n_owed = k;
 }
 
 static void owe(struct ncp_ring_stage *st)
@@ -152,7 +192,7 @@ static void owe(struct ncp_ring_stage *st)
  * element plus up to half a ring more, so one wake-up serves a batch. */
 static uint32_t wake_target(const struct ncp_ring *r, unsigned s, uint32_t k)
 {
-    uint32_t own = atomic_load_explicit(&r->stage[s].pos, memory_order_relaxed);
+    uint32_t own = r->stage[s].next;
     uint32_t cap = r->mask + 1;
     uint32_t batch = cap / 2 > 0 ? cap / 2 - 1 : 0;
     if (s == 0)
@@ -170,7 +210,9 @@ static int wait_ready(struct ncp_ring *r, unsigned s, uint32_t k)
     if (rc > 0)
         return rc;
     pay_owed();
-    if (rc < 0)
+    /* this thread's own unpublished items may have been what was missing */
+    rc = ready(r, s, k, memory_order_acquire);
+    if (rc != 0)
         return rc;
     st->waits++;
     for (int i = 0; i < NCP_RING_SPIN; i++) {
@@ -195,12 +237,14 @@ static int wait_ready(struct ncp_ring *r, unsigned s, uint32_t k)
     }
 }
 
-/* Publish stage s's next position and wake whoever sleeps on it, once its
- * batch is complete. */
-static void advance(struct ncp_ring *r, unsigned s)
+/* Publish stage s's position and wake whoever sleeps on it, once its batch
+ * is complete. */
+static void publish(struct ncp_ring *r, unsigned s)
 {
     struct ncp_ring_stage *st = &r->stage[s];
-    uint32_t p = atomic_load_explicit(&st->pos, memory_order_relaxed) + 1;
+    uint32_t p = st->next;
+    if (atomic_load_explicit(&st->pos, memory_order_relaxed) == p)
+        return;
     atomic_store_explicit(&st->pos, p, memory_order_release);
     atomic_thread_fence(memory_order_seq_cst);
     /* acquire: the sleeper's wake_at was stored before its flag */
@@ -212,10 +256,33 @@ static void advance(struct ncp_ring *r, unsigned s)
         owe(st);
 }
 
+/* Stage s passed one more element on: published at the end of a batch, else
+ * remembered so this thread publishes it before it can wait. */
+static void advance(struct ncp_ring *r, unsigned s)
+{
+    struct ncp_ring_stage *st = &r->stage[s];
+    uint32_t p = ++st->next;
+    uint32_t held = p - atomic_load_explicit(&st->pos, memory_order_relaxed);
+    if (held >= r->batch) {
+        publish(r, s);
+        return;
+    }
+    if (held > 1)
+        return;                          /* listed when its batch began */
+    for (int i = 0; i < n_unpublished; i++)
+        if (unpublished[i].r == r && unpublished[i].s == s)
+            return;
+    if (n_unpublished == NCP_RING_MAX_OWED) {
+        publish(r, s);
+        return;
+    }
+    unpublished[n_unpublished++] = (struct ncp_ring_unpublished){ r, s };
+}
+
 void *ncp_ring_reserve(struct ncp_ring *r)
 {
     struct ncp_ring_stage *st = &r->stage[0];
-    uint32_t own = atomic_load_explicit(&st->pos, memory_order_relaxed);
+    uint32_t own = st->next;
     /* Fast path: room known from the cached consumer position. */
     if (own - st->seen <= r->mask &&
         !atomic_load_explicit(&r->state, memory_order_relaxed))
@@ -233,7 +300,7 @@ void ncp_ring_commit(struct ncp_ring *r)
 void *ncp_ring_stage_peek(struct ncp_ring *r, unsigned s, uint32_t k)
 {
     struct ncp_ring_stage *st = &r->stage[s];
-    uint32_t own = atomic_load_explicit(&st->pos, memory_order_relaxed);
+    uint32_t own = st->next;
     if (k > r->mask)
         return NULL;
     /* Fast path: the element is known to be there from the cached position;
@@ -269,6 +336,8 @@ static void set_state(struct ncp_ring *r, uint32_t bit)
 
 void ncp_ring_close(struct ncp_ring *r)
 {
+    /* the consumers take pos[0] as final once they see EOF */
+    publish(r, 0);
     set_state(r, NCP_RING_EOF);
 }
 

@@ -11,7 +11,14 @@
  * lines (acquire/release); a stage that must wait spins briefly, then sleeps on
  * a futex, and the other side only makes the wake syscall when a sleeper has
  * announced itself, and only once half a ring of work is ready for it (or when
- * the poster itself has to wait: a stalled pipeline always wakes up). */
+ * the poster itself has to wait: a stalled pipeline always wakes up).
+ *
+ * A stage publishes its position once per batch of items (an eighth of the
+ * ring, at most 32), not per item: the store, the fence and the cache-line
+ * transfer are paid once a batch. Whatever a thread has not yet published it
+ * publishes before it waits on any ring, when it closes a ring it produces,
+ * and in ncp_ring_wake_owed (which every stage thread calls before it exits),
+ * so no stage can sleep on an item another stage holds back. */
 #ifndef NCP_PIPELINE_RING_H
 #define NCP_PIPELINE_RING_H
 
@@ -26,19 +33,23 @@
 /* Owned by one stage: its position and what it last saw of the stage it
  * waits for (so the fast path rarely touches the other side's line). */
 struct ncp_ring_stage {
-    alignas(64) _Atomic uint32_t pos;    /* elements this stage has passed on */
+    alignas(64) _Atomic uint32_t pos;    /* elements this stage has published */
     _Atomic uint32_t sleepers;           /* 1: the awaiting stage sleeps until pos moves */
     _Atomic uint32_t event;              /* futex word, bumped to wake them */
     _Atomic uint32_t wake_at;            /* the sleeper wants waking at this pos */
-    uint32_t seen;                       /* owner-private cache of the awaited pos */
-    uint64_t waits;                      /* owner-private: waits that found no room/data */
-    uint64_t sleeps;                     /* owner-private: waits that slept */
+    /* Owner-private, on a line of their own so the per-item bump does not
+     * pull the published line away from the stages polling it. */
+    alignas(64) uint32_t next;           /* elements passed on, published or not */
+    uint32_t seen;                       /* cache of the awaited pos */
+    uint64_t waits;                      /* waits that found no room/data */
+    uint64_t sleeps;                     /* waits that slept */
 };
 
 struct ncp_ring {
     struct ncp_ring_stage stage[NCP_RING_MAX_STAGES];
     alignas(64) _Atomic uint32_t state;  /* NCP_RING_EOF | NCP_RING_ABORT */
     unsigned n_stages;
+    uint32_t batch;                      /* publish a stage's position every batch items */
     uint32_t mask;                       /* capacity - 1 */
     size_t stride;
     unsigned char *slots;
@@ -80,8 +91,10 @@ void ncp_ring_close(struct ncp_ring *r);
 void ncp_ring_abort(struct ncp_ring *r);
 int ncp_ring_aborted(const struct ncp_ring *r);
 
-/* Wake every sleeper this thread deferred (waiting for a batch). Ring calls
- * that wait or end do it; a stage thread calls it before it exits. */
+/* Publish every position this thread holds back (its open batches) and wake
+ * every sleeper it deferred. Ring calls that wait or end do it; a stage thread
+ * calls it before it exits, and a thread handing a ring's slots to anyone
+ * other than a ring stage (e.g. reading them after join) must have done it. */
 void ncp_ring_wake_owed(void);
 
 /* Owner-side counters of stage s; read them once its thread was joined. */
