@@ -19,7 +19,7 @@
 enum { RUN_OK = 0, RUN_USAGE = 1, RUN_PROGRAM = 2, RUN_FAULT = 3 };
 
 struct run_opts {
-    const char *prog, *config, *trace, *plot;
+    const char *prog, *config, *trace, *plot, *tool_table;
     double for_s;               /* 0 = whole program */
     double feed_override;       /* 1.0 = 100 % */
     int virtual_clock;
@@ -48,7 +48,7 @@ static void usage(FILE *f)
 {
     fputs("usage: cnc-run run PROG [--config INI] [--trace CSV] [--plot PNG] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
-          "                        [--mode serial|det|att]\n"
+          "                        [--mode serial|det|att] [--tool-table FILE]\n"
           "Runs PROG on the simulated machine: interpreter -> look-ahead planner ->\n"
           "interpolator -> position loop (SCHED_FIFO when permitted).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill)\n"
@@ -58,6 +58,7 @@ static void usage(FILE *f)
           "  --for SECONDS       stop after this much machine time\n"
           "  --feed-override PCT 1..200 (default 100)\n"
           "  --clock virtual     simulated clock, as fast as the CPU allows\n"
+          "  --tool-table FILE   LinuxCNC tool table (default: rs274's built-in T1-T3)\n"
           "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault / soft limit\n",
           f);
 }
@@ -83,17 +84,19 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "feed-override", required_argument, 0, 'o' },
         { "clock", required_argument, 0, 'k' },
         { "mode", required_argument, 0, 'm' },
+        { "tool-table", required_argument, 0, 'T' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
     double pct;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': o->config = optarg; break;
         case 't': o->trace = optarg; break;
         case 'p': o->plot = optarg; break;
+        case 'T': o->tool_table = optarg; break;
         case 'f':
             if (parse_num(optarg, 1e-6, 1e9, &o->for_s))
                 return fprintf(stderr, "cnc-run run: --for wants a positive number of seconds\n"), -1;
@@ -253,7 +256,7 @@ static int draw_plot(const struct run_opts *o, const char *trace, const struct n
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
 {
-    struct interp_ctx ic = { src, { 0 }, o->mode };
+    struct interp_ctx ic = { src, { .tool_table_path = o->tool_table }, o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
