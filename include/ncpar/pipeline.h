@@ -36,6 +36,11 @@ struct ncp_thread_map {
     struct ncp_thread_spec executor[NCP_MAX_EXECUTORS];
 };
 
+/* "serial", "det" or "att" (any case) -> *mode; returns 0, or -1 if unknown. */
+int ncp_thread_mode_parse(const char *name, enum ncp_thread_mode *mode);
+/* The name ncp_thread_mode_parse() accepts for m. */
+const char *ncp_thread_mode_name(enum ncp_thread_mode m);
+
 /* Defaults for a mode and thread counts (ATT: feeder on CPU0, others round-robin
  * over the CPUs present). */
 void ncp_thread_map_default(struct ncp_thread_map *m, enum ncp_thread_mode mode,

@@ -132,6 +132,15 @@ static int ncp_word_check(struct ncp_analyzer *a, char c, double v, uint16_t col
     }
 }
 
+/* The name of a named assignment, clamped to the block's pool. */
+static const char *ncp_assign_name(const struct ncp_block *b, const struct ncp_assign *as,
+                                   size_t *len)
+{
+    size_t off = as->name_off < NCP_BLOCK_POOL ? as->name_off : NCP_BLOCK_POOL;
+    *len = as->name_len <= NCP_BLOCK_POOL - off ? as->name_len : 0;
+    return b->pool + off;
+}
+
 /* rs274 creates a named assignment target (value 0) the moment it reads it, so
  * an expression to its right on the same line may already read it. Declare the
  * targets standing left of `col`; declaring an existing name does nothing. */
@@ -143,9 +152,9 @@ static int ncp_declare_targets_before(struct ncp_analyzer *a, const struct ncp_b
         const struct ncp_assign *as = &b->assign[k];
         if (as->kind != NCP_ASSIGN_NAMED || as->col >= col)
             continue;
-        size_t off = as->name_off < NCP_BLOCK_POOL ? as->name_off : NCP_BLOCK_POOL;
-        size_t len = as->name_len <= NCP_BLOCK_POOL - off ? as->name_len : 0;
-        int rc = ncp_params_declare_named(a->params, b->pool + off, len, &a->err);
+        size_t len;
+        const char *name = ncp_assign_name(b, as, &len);
+        int rc = ncp_params_declare_named(a->params, name, len, &a->err);
         if (rc != NCP_OK) {
             a->err.line = b->line;
             if (a->err.col == 0)
@@ -227,9 +236,9 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b)
         if (as->kind == NCP_ASSIGN_NUMBERED) {
             rc = ncp_params_set(a->params, idx[k], val[k], &a->err);
         } else {
-            size_t off = as->name_off < NCP_BLOCK_POOL ? as->name_off : NCP_BLOCK_POOL;
-            size_t len = as->name_len <= NCP_BLOCK_POOL - off ? as->name_len : 0;
-            rc = ncp_params_set_named(a->params, b->pool + off, len, val[k], &a->err);
+            size_t len;
+            const char *name = ncp_assign_name(b, as, &len);
+            rc = ncp_params_set_named(a->params, name, len, val[k], &a->err);
         }
         if (rc != NCP_OK) {
             a->err.line = b->line;

@@ -128,13 +128,7 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
             break;
         case 'm':
             o->mode_given = 1;
-            if (!strcmp(optarg, "serial"))
-                o->mode = NCP_MODE_SERIAL;
-            else if (!strcmp(optarg, "det"))
-                o->mode = NCP_MODE_DET;
-            else if (!strcmp(optarg, "att"))
-                o->mode = NCP_MODE_ATT;
-            else
+            if (ncp_thread_mode_parse(optarg, &o->mode))
                 return fprintf(stderr, "cnc-run: --mode is serial, det or att\n"), -1;
             break;
         case 'c': o->config = optarg; break;
@@ -180,11 +174,6 @@ static int open_canon(const char *path, struct canon_writer **w)
     }
     *w = cw;
     return 0;
-}
-
-static const char *mode_name(enum ncp_thread_mode m)
-{
-    return m == NCP_MODE_SERIAL ? "serial" : m == NCP_MODE_DET ? "det" : "att";
 }
 
 static int cmd_parse(int argc, char **argv)
@@ -251,7 +240,7 @@ static int cmd_parse(int argc, char **argv)
         fprintf(stderr,
                 "cnc-run: %llu blocks, %llu commands, %.3f ms, %.0f blocks/s, %d threads (%s, %d lexers, %d executors)\n",
                 (unsigned long long)st.blocks, (unsigned long long)st.commands, st.wall_ms, bps,
-                st.threads, mode_name(map.mode), map.mode == NCP_MODE_SERIAL ? 0 : map.n_lexers,
+                st.threads, ncp_thread_mode_name(map.mode), map.mode == NCP_MODE_SERIAL ? 0 : map.n_lexers,
                 map.mode == NCP_MODE_SERIAL ? 0 : map.n_executors);
     }
     ncp_source_close(&src);

@@ -114,13 +114,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
                 return fprintf(stderr, "cnc-run run: --clock is real or virtual\n"), -1;
             break;
         case 'm':
-            if (!strcmp(optarg, "serial"))
-                o->mode = NCP_MODE_SERIAL;
-            else if (!strcmp(optarg, "det"))
-                o->mode = NCP_MODE_DET;
-            else if (!strcmp(optarg, "att"))
-                o->mode = NCP_MODE_ATT;
-            else
+            if (ncp_thread_mode_parse(optarg, &o->mode))
                 return fprintf(stderr, "cnc-run run: --mode is serial, det or att\n"), -1;
             break;
         case 'h': usage(stdout); exit(RUN_OK);

@@ -127,15 +127,10 @@ static int pipeline_key(struct map_loader *L, const char *name, const char *valu
     int ok = 0;
     switch (k) {
     case 0:
-        ok = 1;
-        if (!strcasecmp(value, "serial"))
-            L->mode = NCP_MODE_SERIAL;
-        else if (!strcasecmp(value, "det"))
-            L->mode = NCP_MODE_DET;
-        else if (!strcasecmp(value, "att"))
-            L->mode = NCP_MODE_ATT;
-        else
-            ok = 0;
+        enum ncp_thread_mode mode;
+        ok = ncp_thread_mode_parse(value, &mode) == 0;
+        if (ok)
+            L->mode = (int)mode;
         if (!ok)
             return fail(L, L->line, "bad value '%s' for %s (serial, det or att)", value,
                         name);
@@ -361,4 +356,24 @@ done:
         fclose(L->f);
     free(L);
     return rc;
+}
+
+static const char *const mode_names[] = {
+    [NCP_MODE_SERIAL] = "serial", [NCP_MODE_DET] = "det", [NCP_MODE_ATT] = "att"
+};
+
+int ncp_thread_mode_parse(const char *name, enum ncp_thread_mode *mode)
+{
+    for (int m = NCP_MODE_SERIAL; m <= NCP_MODE_ATT; m++) {
+        if (!strcasecmp(name, mode_names[m])) {
+            *mode = (enum ncp_thread_mode)m;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+const char *ncp_thread_mode_name(enum ncp_thread_mode m)
+{
+    return (unsigned)m <= NCP_MODE_ATT ? mode_names[m] : "?";
 }
