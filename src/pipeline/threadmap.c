@@ -127,10 +127,12 @@ static int pipeline_key(struct map_loader *L, const char *name, const char *valu
     int ok = 0;
     switch (k) {
     case 0:
-        enum ncp_thread_mode mode;
-        ok = ncp_thread_mode_parse(value, &mode) == 0;
-        if (ok)
-            L->mode = (int)mode;
+        {
+            enum ncp_thread_mode mode;
+            ok = ncp_thread_mode_parse(value, &mode) == 0;
+            if (ok)
+                L->mode = (int)mode;
+        }
         if (!ok)
             return fail(L, L->line, "bad value '%s' for %s (serial, det or att)", value,
                         name);
