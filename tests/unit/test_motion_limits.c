@@ -8,6 +8,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "trace_rows.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <sched.h>
@@ -26,35 +28,6 @@
  * 2^k half-units of the last digit, divided by T^k. */
 #define PRINT_Q 0.5e-6
 
-struct row {
-    double t, cmd[3], v;
-    unsigned line;
-};
-
-static struct row *read_trace(FILE *f, size_t *n)
-{
-    char buf[512];
-    rewind(f);
-    assert_non_null(fgets(buf, sizeof buf, f));
-    size_t cap = 4096;
-    struct row *r = malloc(cap * sizeof *r);
-    assert_non_null(r);
-    *n = 0;
-    while (fgets(buf, sizeof buf, f)) {
-        if (*n == cap) {
-            struct row *bigger = realloc(r, (cap *= 2) * sizeof *r);
-            assert_non_null(bigger);
-            r = bigger;
-        }
-        struct row *x = &r[(*n)++];
-        double act[3];
-        assert_int_equal(sscanf(buf, "%lf,%u,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x->t, &x->line,
-                                &x->cmd[0], &x->cmd[1], &x->cmd[2], &act[0], &act[1], &act[2],
-                                &x->v),
-                         9);
-    }
-    return r;
-}
 
 /* Worst ratio of |k-th difference| / limit over all axes (1 = at the limit). */
 struct worst {

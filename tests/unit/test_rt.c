@@ -7,6 +7,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "trace_rows.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -274,34 +276,6 @@ static void arc(struct ncp_cmd *c, double x, double y, double cx, double cy, int
     o->i[0] = rot;
 }
 
-struct row {
-    double t, cmd[3], act[3], v;
-    unsigned line;
-};
-
-static struct row *read_trace(FILE *f, size_t *n)
-{
-    char buf[512];
-    rewind(f);
-    assert_non_null(fgets(buf, sizeof buf, f));
-    assert_string_equal(buf, "t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v\n");
-    size_t cap = 1024;
-    struct row *r = malloc(cap * sizeof *r);
-    *n = 0;
-    while (fgets(buf, sizeof buf, f)) {
-        if (*n == cap) {
-            struct row *bigger = realloc(r, (cap *= 2) * sizeof *r);
-            assert_non_null(bigger);
-            r = bigger;
-        }
-        struct row *x = &r[(*n)++];
-        assert_int_equal(sscanf(buf, "%lf,%u,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x->t, &x->line,
-                                &x->cmd[0], &x->cmd[1], &x->cmd[2], &x->act[0], &x->act[1],
-                                &x->act[2], &x->v),
-                         9);
-    }
-    return r;
-}
 
 static int run(struct prog *p, struct ncp_machine_cfg *cfg, FILE *trace,
                struct ncp_nck_result *res)
