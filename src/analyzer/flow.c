@@ -650,21 +650,30 @@ static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_dia
     return NCP_OK;
 }
 
-static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+/* The label of a loop's opening line (repeat, while): saved the first time it is
+ * reached; an error when the name already labels another line, except the `do`
+ * that a while line may close (closes_do). */
+static int loop_label(struct ncp_flow *f, const struct ncp_block *b, int closes_do,
+                      struct flow_label **out, struct ncp_diag *d)
 {
     struct flow_label *op = find_label(f);
-    if (op && op->line != b->line) {
+    if (op && !(closes_do && op->type == NCP_O_DO) && op->line != b->line) {
         const char *s;
         int n = line_text(f, b, &s);
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                             "duplicate O-word label: '%.*s' - defined in line %u", n, s,
                             op->line);
     }
-    if (!op) {
-        int rc = save_label(f, b, &op, d);
-        if (rc != NCP_OK)
-            return rc;
-    }
+    *out = op;
+    return op ? NCP_OK : save_label(f, b, out, d);
+}
+
+static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    struct flow_label *op;
+    int rc = loop_label(f, b, 0, &op, d);
+    if (rc != NCP_OK)
+        return rc;
     f->skip.on = 0;
     if (op->type != NCP_O_REPEAT)
         return NCP_OK;
@@ -684,19 +693,10 @@ static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
 
 static int do_while(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    struct flow_label *op = find_label(f);
-    if (op && op->type != NCP_O_DO && op->line != b->line) {
-        const char *s;
-        int n = line_text(f, b, &s);
-        return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
-                            "duplicate O-word label: '%.*s' - defined in line %u", n, s,
-                            op->line);
-    }
-    if (!op) {
-        int rc = save_label(f, b, &op, d);
-        if (rc != NCP_OK)
-            return rc;
-    }
+    struct flow_label *op;
+    int rc = loop_label(f, b, 1, &op, d);
+    if (rc != NCP_OK)
+        return rc;
     f->skip.on = 0;
     if (op->type == NCP_O_WHILE) {
         loop_entered(f, op);
