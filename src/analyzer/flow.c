@@ -707,7 +707,7 @@ static int do_while(struct ncp_flow *f, const struct ncp_block *b, struct ncp_di
     }
     /* the closing line of a do/while loop */
     if (f->test_value != 0.0 && !f->doing_break) {
-        int rc = count_iteration(f, b, op, d);
+        rc = count_iteration(f, b, op, d);
         if (rc == NCP_OK)
             jump_to(f, op);
         return rc;
