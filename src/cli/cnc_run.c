@@ -238,8 +238,8 @@ static int cmd_parse(int argc, char **argv)
     if (o.stats) {
         double bps = st.wall_ms > 0 ? (double)st.blocks / (st.wall_ms / 1e3) : 0;
         fprintf(stderr,
-                "cnc-run: %llu blocks, %llu commands, %.3f ms, %.0f blocks/s, %d threads (%s, %d lexers, %d executors)\n",
-                (unsigned long long)st.blocks, (unsigned long long)st.commands, st.wall_ms, bps,
+                "cnc-run: %llu blocks, %llu commands, %.3f ms (%.3f ms start-up), %.0f blocks/s, %d threads (%s, %d lexers, %d executors)\n",
+                (unsigned long long)st.blocks, (unsigned long long)st.commands, st.wall_ms, st.setup_ms, bps,
                 st.threads, ncp_thread_mode_name(map.mode), map.mode == NCP_MODE_SERIAL ? 0 : map.n_lexers,
                 map.mode == NCP_MODE_SERIAL ? 0 : map.n_executors);
     }

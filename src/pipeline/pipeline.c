@@ -107,6 +107,7 @@ struct ncp_starter {
     int started;
     int failed;
     uint32_t warnings;
+    double setup_ms; /* time spent inside pthread_create and friends */
 };
 
 static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
@@ -115,7 +116,10 @@ static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
     if (s->failed)
         return;
     int pin = s->p->map->mode == NCP_MODE_ATT;
-    if (ncp_thread_start(&s->tid[s->started], spec, pin, fn, w, &s->warnings) != 0) {
+    double t0 = ncp_pipe_now_ms();
+    int rc = ncp_thread_start(&s->tid[s->started], spec, pin, fn, w, &s->warnings);
+    s->setup_ms += ncp_pipe_now_ms() - t0;
+    if (rc != 0) {
         s->failed = 1;
         ncp_pipe_abort(s->p);
         return;
@@ -162,6 +166,7 @@ static void fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, do
     st->wall_ms = (p->end_ms > 0 ? p->end_ms : ncp_pipe_now_ms()) - t0;
     st->threads = s->started;
     st->warnings = s->warnings;
+    st->setup_ms = s->setup_ms + p->alloc_ms;
     stage_stats(&st->feeder, p->feeder.items);
     stage_stats(&st->analyzer, p->taken);
     stage_stats(&st->output, p->output.items);
@@ -219,6 +224,7 @@ int ncp_pipeline_run(const struct ncp_source *src, const struct ncp_thread_map *
     struct ncp_pipe *p = pipe_new(src, map);
     if (!p)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the pipeline rings");
+    p->alloc_ms = ncp_pipe_now_ms() - t0;
     p->acfg = acfg;
     p->out = out;
 
