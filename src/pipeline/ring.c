@@ -11,6 +11,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 enum { NCP_RING_EOF = 1u, NCP_RING_ABORT = 2u };
 
@@ -18,6 +19,21 @@ enum { NCP_RING_EOF = 1u, NCP_RING_ABORT = 2u };
  * thread then steals the CPU from the one it waits for. */
 #define NCP_RING_SPIN 128
 #define NCP_RING_MAX_BATCH 32u
+
+/* Slots come straight from mmap, prefaulted by the kernel in one go
+ * (MAP_POPULATE): the stage threads then never stop for a first-touch page
+ * fault, which costs microseconds each in a virtual machine. No huge pages:
+ * asking for them can stall the start for compaction, and a program of a
+ * thousand blocks is done in a few milliseconds. */
+static unsigned char *slots_alloc(size_t want, size_t *bytes)
+{
+    void *m = mmap(NULL, want, PROT_READ | PROT_WRITE,
+                   MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+    if (m == MAP_FAILED)
+        return NULL;
+    *bytes = want;
+    return m;
+}
 
 uint32_t ncp_ring_capacity(uint32_t want)
 {
@@ -39,7 +55,7 @@ int ncp_ring_init_staged(struct ncp_ring *r, size_t elem_size, uint32_t capacity
     size_t align = elem_size >= 64 ? 64 : 8;
     size_t stride = (elem_size + align - 1) / align * align;
     size_t bytes = ((size_t)cap * stride + 63) / 64 * 64;
-    r->slots = aligned_alloc(64, bytes);
+    r->slots = slots_alloc(bytes, &r->bytes);
     if (!r->slots)
         return -1;
     r->n_stages = n_stages;
@@ -67,7 +83,8 @@ static void forget(const struct ncp_ring *r);
 void ncp_ring_destroy(struct ncp_ring *r)
 {
     forget(r);
-    free(r->slots);
+    if (r->slots)
+        munmap(r->slots, r->bytes);
     r->slots = NULL;
 }
 
@@ -94,11 +111,11 @@ static int ready(struct ncp_ring *r, unsigned s, uint32_t k, memory_order mo)
     uint32_t state = atomic_load_explicit(&r->state, mo);
     if (state & NCP_RING_ABORT)
         return -1;
-    if (s == 0) {
+    if (s == 0) { /* the producer: room for k + 1 elements */
         if (state & NCP_RING_EOF)
             return -1;
         st->seen = atomic_load_explicit(&r->stage[r->n_stages - 1].pos, mo);
-        return own - st->seen <= r->mask ? 1 : 0;
+        return own + k - st->seen <= r->mask ? 1 : 0;
     }
     st->seen = atomic_load_explicit(&r->stage[s - 1].pos, mo);
     if (st->seen - own > k)
@@ -195,8 +212,10 @@ static uint32_t wake_target(const struct ncp_ring *r, unsigned s, uint32_t k)
     uint32_t own = r->stage[s].next;
     uint32_t cap = r->mask + 1;
     uint32_t batch = cap / 2 > 0 ? cap / 2 - 1 : 0;
+    if (batch > r->mask - k)
+        batch = r->mask - k;
     if (s == 0)
-        return own - r->mask + batch;
+        return own + k - r->mask + batch;
     if (batch > r->mask - k)
         batch = r->mask - k;
     return own + k + 1 + batch;
@@ -258,16 +277,17 @@ static void publish(struct ncp_ring *r, unsigned s)
 
 /* Stage s passed one more element on: published at the end of a batch, else
  * remembered so this thread publishes it before it can wait. */
-static void advance(struct ncp_ring *r, unsigned s)
+static void advance_n(struct ncp_ring *r, unsigned s, uint32_t k)
 {
     struct ncp_ring_stage *st = &r->stage[s];
-    uint32_t p = ++st->next;
-    uint32_t held = p - atomic_load_explicit(&st->pos, memory_order_relaxed);
-    if (held >= r->batch) {
+    uint32_t pos = atomic_load_explicit(&st->pos, memory_order_relaxed);
+    uint32_t before = st->next - pos;
+    st->next += k;
+    if (st->next - pos >= r->batch) {
         publish(r, s);
         return;
     }
-    if (held > 1)
+    if (before > 0)
         return;                          /* listed when its batch began */
     for (int i = 0; i < n_unpublished; i++)
         if (unpublished[i].r == r && unpublished[i].s == s)
@@ -277,6 +297,46 @@ static void advance(struct ncp_ring *r, unsigned s)
         return;
     }
     unpublished[n_unpublished++] = (struct ncp_ring_unpublished){ r, s };
+}
+
+static void advance(struct ncp_ring *r, unsigned s)
+{
+    advance_n(r, s, 1);
+}
+
+void *ncp_ring_reserve_n(struct ncp_ring *r, uint32_t k)
+{
+    struct ncp_ring_stage *st = &r->stage[0];
+    uint32_t own = st->next;
+    if (k == 0 || k > r->mask + 1)
+        return NULL;
+    if (own + k - 1 - st->seen <= r->mask &&
+        !atomic_load_explicit(&r->state, memory_order_relaxed))
+        return slot_at(r, own);
+    if (wait_ready(r, 0, k - 1) < 0)
+        return NULL;
+    return slot_at(r, own);
+}
+
+void ncp_ring_commit_n(struct ncp_ring *r, uint32_t k)
+{
+    advance_n(r, 0, k);
+}
+
+void ncp_ring_stage_release_n(struct ncp_ring *r, unsigned s, uint32_t k)
+{
+    advance_n(r, s, k);
+}
+
+uint32_t ncp_ring_to_end(const struct ncp_ring *r, unsigned s)
+{
+    return r->mask + 1 - (r->stage[s].next & r->mask);
+}
+
+void ncp_ring_set_batch(struct ncp_ring *r, uint32_t batch)
+{
+    uint32_t most = (r->mask + 1) / 8 ? (r->mask + 1) / 8 : 1;
+    r->batch = batch == 0 ? 1 : batch > most ? most : batch;
 }
 
 void *ncp_ring_reserve(struct ncp_ring *r)
@@ -310,6 +370,18 @@ void *ncp_ring_stage_peek(struct ncp_ring *r, unsigned s, uint32_t k)
     if (wait_ready(r, s, k) < 0)
         return NULL;
     return slot_at(r, own + k);
+}
+
+const void *ncp_ring_stage_ahead(const struct ncp_ring *r, unsigned s, uint32_t k)
+{
+    const struct ncp_ring_stage *st = &r->stage[s];
+    return k <= r->mask && st->seen - st->next > k ? slot_at(r, st->next + k) : NULL;
+}
+
+void *ncp_ring_reserve_ahead(const struct ncp_ring *r, uint32_t k)
+{
+    const struct ncp_ring_stage *st = &r->stage[0];
+    return k <= r->mask && st->next + k - st->seen <= r->mask ? slot_at(r, st->next + k) : NULL;
 }
 
 void ncp_ring_stage_release(struct ncp_ring *r, unsigned s)

@@ -52,6 +52,7 @@ struct ncp_ring {
     uint32_t batch;                      /* publish a stage's position every batch items */
     uint32_t mask;                       /* capacity - 1 */
     size_t stride;
+    size_t bytes;                        /* mapped for the slots */
     unsigned char *slots;
 };
 
@@ -83,6 +84,29 @@ void ncp_ring_release(struct ncp_ring *r);
  * order, one element each. */
 void *ncp_ring_stage_peek(struct ncp_ring *r, unsigned s, uint32_t k);
 void ncp_ring_stage_release(struct ncp_ring *r, unsigned s);
+
+/* For prefetching, never waiting and touching no shared line: stage s's k-th
+ * element after its next one if the stage before is already known to have
+ * passed it on, else NULL; and the producer's k-th slot after the next one to
+ * reserve if it is known to be free, else NULL. Blocks cross cores through
+ * these rings, and a stage that first touches each slot as it takes it waits
+ * a full cache-to-cache transfer per block. */
+const void *ncp_ring_stage_ahead(const struct ncp_ring *r, unsigned s, uint32_t k);
+void *ncp_ring_reserve_ahead(const struct ncp_ring *r, uint32_t k);
+
+/* Runs of elements (records of several units, e.g. packed blocks): the
+ * producer reserves k elements at once (waiting for room) and commits them
+ * together; a consumer stage waits for its (k-1)-th element with
+ * ncp_ring_stage_peek and releases k at once. The k elements are contiguous in
+ * memory only if k <= ncp_ring_to_end(r, stage): a record must not wrap, so the
+ * producer fills the rest of the ring with padding first. */
+void *ncp_ring_reserve_n(struct ncp_ring *r, uint32_t k);
+void ncp_ring_commit_n(struct ncp_ring *r, uint32_t k);
+void ncp_ring_stage_release_n(struct ncp_ring *r, unsigned s, uint32_t k);
+uint32_t ncp_ring_to_end(const struct ncp_ring *r, unsigned s);
+/* Publish positions every `batch` elements (default: an eighth of the ring, at
+ * most 32): rings of small units want larger batches. */
+void ncp_ring_set_batch(struct ncp_ring *r, uint32_t batch);
 
 /* Producer: no more data. Later stages drain what is there, then get NULL. */
 void ncp_ring_close(struct ncp_ring *r);

@@ -121,6 +121,93 @@ static void test_close_drains_then_ends(void **state)
     ring_free(r);
 }
 
+/* ---- runs of elements: variable-length records across threads ------------ */
+
+#define RUNS_N 200000u
+#define RUN_PAD 0xFFFFFFFFu
+
+/* A record of 1..17 units: its length, then its sequence number repeated. */
+static uint32_t run_len(uint32_t i)
+{
+    return 1 + (i * 7u) % 17u;
+}
+
+static void *runs_producer(void *arg)
+{
+    struct ncp_ring *r = arg;
+    for (uint32_t i = 0; i < RUNS_N; i++) {
+        uint32_t k = run_len(i);
+        uint32_t to_end = ncp_ring_to_end(r, 0);
+        if (k > to_end) {
+            uint32_t *pad = ncp_ring_reserve_n(r, to_end);
+            if (!pad)
+                return NULL;
+            pad[0] = RUN_PAD;
+            ncp_ring_commit_n(r, to_end);
+        }
+        uint32_t *rec = ncp_ring_reserve_n(r, k);
+        if (!rec)
+            return NULL;
+        rec[0] = k;
+        for (uint32_t u = 1; u < k; u++)
+            rec[u] = i;
+        ncp_ring_commit_n(r, k);
+    }
+    ncp_ring_close(r);
+    ncp_ring_wake_owed();
+    return NULL;
+}
+
+static void test_runs_across_threads(void **state)
+{
+    (void)state;
+    struct ncp_ring *r = ring_new(sizeof(uint32_t), 64, 2);
+    ncp_ring_set_batch(r, 8);
+    pthread_t t;
+    assert_int_equal(pthread_create(&t, NULL, runs_producer, r), 0);
+    uint32_t i = 0, bad = 0;
+    for (;;) {
+        const uint32_t *rec = ncp_ring_stage_peek(r, 1, 0);
+        if (!rec)
+            break;
+        if (rec[0] == RUN_PAD) {
+            ncp_ring_stage_release_n(r, 1, ncp_ring_to_end(r, 1));
+            continue;
+        }
+        uint32_t k = rec[0];
+        bad += k != run_len(i);
+        if (k > 1 && !ncp_ring_stage_peek(r, 1, k - 1)) {
+            bad++;
+            break;
+        }
+        /* the whole record lies in one piece of memory */
+        for (uint32_t u = 1; u < k; u++)
+            bad += rec[u] != i;
+        ncp_ring_stage_release_n(r, 1, k);
+        i++;
+    }
+    ncp_ring_wake_owed();
+    pthread_join(t, NULL);
+    assert_int_equal(bad, 0);
+    assert_int_equal(i, RUNS_N);
+    ring_free(r);
+}
+
+static void test_reserve_n_limits(void **state)
+{
+    (void)state;
+    struct ncp_ring *r = ring_new(sizeof(uint32_t), 16, 2);
+    assert_null(ncp_ring_reserve_n(r, 0));
+    assert_null(ncp_ring_reserve_n(r, 17));
+    assert_non_null(ncp_ring_reserve_n(r, 16));
+    ncp_ring_commit_n(r, 10);
+    assert_int_equal(ncp_ring_to_end(r, 0), 6);
+    assert_non_null(ncp_ring_stage_peek(r, 1, 9));
+    ncp_ring_stage_release_n(r, 1, 10);
+    assert_int_equal(ncp_ring_to_end(r, 1), 6);
+    ring_free(r);
+}
+
 /* ---- two threads ---------------------------------------------------------- */
 
 #define STRESS_N 300000u
@@ -336,6 +423,8 @@ int main(void)
         cmocka_unit_test(test_abort_wakes_blocked_producer),
         cmocka_unit_test(test_abort_wakes_blocked_middle_stage),
         cmocka_unit_test(test_release_wakes_sleeping_producer),
+        cmocka_unit_test(test_runs_across_threads),
+        cmocka_unit_test(test_reserve_n_limits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
