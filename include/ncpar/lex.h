@@ -95,6 +95,10 @@ enum ncp_comment_kind {
     NCP_CMT_ABORT             /* (ABORT,text): rs274 stops with text as the error */
 };
 
+/* Laid out for the parallel pipeline, where blocks cross cores in ring slots:
+ * what every block sets or reads (header, counts, the first words) comes first
+ * and is contiguous, the large rarely used arrays last, so a typical block
+ * touches a few cache lines of its slot, not kilobytes. */
 struct ncp_block {
     uint64_t offset;          /* byte offset of the block in the program text */
     uint32_t line;            /* 1-based source line */
@@ -102,17 +106,14 @@ struct ncp_block {
     uint8_t block_delete;     /* leading '/' */
     uint8_t has_n;            /* N word present (value in n_number) */
     double n_number;
-    struct ncp_diag err;      /* err.code != NCP_OK: syntax error, rest undefined */
-
     uint16_t n_words, n_assign, n_code, pool_used;
-    struct ncp_word words[NCP_BLOCK_MAX_WORDS]; /* in source order, G/M may repeat */
-    struct ncp_assign assign[NCP_BLOCK_MAX_ASSIGN];
-    struct ncp_oword oword;   /* kind NCP_O_NONE when no O-word */
-
     /* rs274 keeps the last comment of a line; MSG/DEBUG/PRINT text after the comma */
     uint8_t comment_kind;     /* enum ncp_comment_kind */
     uint16_t comment_off, comment_len; /* in pool */
-
+    struct ncp_oword oword;   /* kind NCP_O_NONE when no O-word (kind is its first byte) */
+    struct ncp_word words[NCP_BLOCK_MAX_WORDS]; /* in source order, G/M may repeat */
+    struct ncp_diag err;      /* err.code != NCP_OK: syntax error, rest undefined */
+    struct ncp_assign assign[NCP_BLOCK_MAX_ASSIGN];
     struct ncp_bc_ins code[NCP_BLOCK_MAX_CODE];
     char pool[NCP_BLOCK_POOL];
 };
@@ -132,6 +133,22 @@ static inline int ncp_trunc_int_round(double t)
 {
     return ncp_trunc_int(round(t));
 }
+
+/* Packed blocks (the parallel pipeline's lexer -> analyzer records): only the
+ * used parts, in whole units of NCP_PACK_UNIT bytes. ncp_block_pack writes
+ * ncp_block_packed_size(b) bytes (at most NCP_BLOCK_PACK_MAX) to dst and
+ * returns that size; ncp_block_unpack restores every field a reader of the
+ * block may use; ncp_block_packed_units reads a record's size from its start. */
+#define NCP_PACK_UNIT 8u
+#define NCP_BLOCK_PACK_MAX (sizeof(struct ncp_block) + 64u)
+size_t ncp_block_packed_size(const struct ncp_block *b);
+size_t ncp_block_pack(const struct ncp_block *b, void *dst);
+size_t ncp_block_packed_units(const void *src);
+void ncp_block_unpack(const void *src, struct ncp_block *b);
+/* A one-unit filler record meaning "nothing more up to the end of the buffer"
+ * (a ring's wrap-around point), and its test. */
+void ncp_block_pack_pad(void *dst);
+int ncp_block_packed_is_pad(const void *src);
 
 /* Parse text[0..len) (one line, no newline) into *out. Always fills out->err.
  * Returns out->err.code. Never reads outside text[0..len). */

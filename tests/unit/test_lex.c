@@ -735,6 +735,95 @@ static void test_nul_and_garbage(void **state)
     }
 }
 
+/* ---- packed blocks: what the parallel pipeline passes between cores ------ */
+
+static void assert_same_block(const struct ncp_block *a, const struct ncp_block *b)
+{
+    assert_int_equal(a->offset, b->offset);
+    assert_int_equal(a->line, b->line);
+    assert_int_equal(a->length, b->length);
+    assert_int_equal(a->block_delete, b->block_delete);
+    assert_int_equal(a->has_n, b->has_n);
+    assert_memory_equal(&a->n_number, &b->n_number, sizeof a->n_number);
+    assert_int_equal(a->n_words, b->n_words);
+    assert_int_equal(a->n_assign, b->n_assign);
+    assert_int_equal(a->n_code, b->n_code);
+    assert_int_equal(a->pool_used, b->pool_used);
+    assert_int_equal(a->comment_kind, b->comment_kind);
+    assert_int_equal(a->comment_off, b->comment_off);
+    assert_int_equal(a->comment_len, b->comment_len);
+    assert_int_equal(a->err.code, b->err.code);
+    assert_int_equal(a->err.line, b->err.line);
+    assert_int_equal(a->err.col, b->err.col);
+    assert_string_equal(a->err.msg, b->err.msg);
+    if (a->n_words)
+        assert_memory_equal(a->words, b->words, a->n_words * sizeof a->words[0]);
+    if (a->n_assign)
+        assert_memory_equal(a->assign, b->assign, a->n_assign * sizeof a->assign[0]);
+    assert_int_equal(a->oword.kind, b->oword.kind);
+    if (a->oword.kind != NCP_O_NONE)
+        assert_memory_equal(&a->oword, &b->oword,
+                            offsetof(struct ncp_oword, args) +
+                                a->oword.nargs * sizeof a->oword.args[0]);
+    if (a->n_code)
+        assert_memory_equal(a->code, b->code, a->n_code * sizeof a->code[0]);
+    if (a->pool_used)
+        assert_memory_equal(a->pool, b->pool, a->pool_used);
+}
+
+static void round_trip(const char *line, size_t len)
+{
+    static struct ncp_block back;
+    static unsigned char buf[NCP_BLOCK_PACK_MAX + 64];
+    ncp_lex_block(line, len, 7, 1234, &blk);
+    size_t want = ncp_block_packed_size(&blk);
+    memset(buf, 0xA5, sizeof buf);
+    assert_int_equal(ncp_block_pack(&blk, buf), want);
+    assert_true(want % NCP_PACK_UNIT == 0 && want <= NCP_BLOCK_PACK_MAX);
+    assert_int_equal(buf[want], 0xA5); /* nothing written past the record */
+    assert_int_equal(ncp_block_packed_units(buf) * NCP_PACK_UNIT, want);
+    assert_false(ncp_block_packed_is_pad(buf));
+    memset(&back, 0x5A, sizeof back);
+    ncp_block_unpack(buf, &back);
+    assert_same_block(&blk, &back);
+}
+
+static void test_pack_round_trip(void **state)
+{
+    (void)state;
+    static const char *const lines[] = {
+        "G1 X1.5 Y-2 Z0.25 F600", "", "(just a comment)", "/N10 G0 X0 (MSG, hello)",
+        "#1 = [#2 + sin[30]] #<name> = 2 #[1+2] = #<_global>",
+        "o<sub> call [1] [#2*3] [exists[#<x>]] [4]", "o100 while [#1 LT 10]",
+        "o100 endsub [#1 ** 2]", "G2 X1 Y1 I[#3/2] J0.5 ;rest of line", "G1 X1 X2",
+        "G1 X[1 +", "(unclosed", "M3 S[1000 * #4] T[#5 MOD 3] (DEBUG, #1 and #<x>)",
+        "o1 if [[#1 EQ 2] AND [#2 NE 3] OR [ATAN[1]/[2] GT 0]]", "%",
+    };
+    for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++)
+        round_trip(lines[i], strlen(lines[i]));
+    /* the largest block: every word slot and a long comment */
+    char big[256];
+    size_t n = 0;
+    while (n + 4 < 250) {
+        memcpy(big + n, "G1X1", 4);
+        n += 4;
+    }
+    round_trip(big, n);
+    /* random text: error blocks carry partial contents, which must survive too */
+    unsigned seed = 7;
+    char line[300];
+    for (int r = 0; r < 5000; r++) {
+        size_t len = ((seed = seed * 1103515245u + 12345u) >> 16) % 280;
+        for (size_t i = 0; i < len; i++)
+            line[i] = "g1xyz#[]+-*/0123456789.<>o=( ),;amnif"[((seed = seed * 1103515245u +
+                                                                12345u) >> 16) % 37];
+        round_trip(line, len);
+    }
+    unsigned char pad[8];
+    ncp_block_pack_pad(pad);
+    assert_true(ncp_block_packed_is_pad(pad));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -756,6 +845,7 @@ int main(void)
         cmocka_unit_test(test_oword_errors),
         cmocka_unit_test(test_long_lines),
         cmocka_unit_test(test_nul_and_garbage),
+        cmocka_unit_test(test_pack_round_trip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,178 @@
+/* Packed blocks: what crosses from a lexer's core to the analyzer's. A parsed
+ * block is a fixed 8 KB struct so that any line fits; a plain "G1 X1 Y2 Z3"
+ * uses about 130 bytes of it, spread over several cache lines. Packed, only
+ * the used parts travel, back to back, so one block costs two or three cache
+ * line transfers instead of five or more, and the lines arrive in sequence
+ * for the hardware prefetcher. Unpacking restores every field the analyzer
+ * may read (arrays up to their counts), so it sees the very block the lexer
+ * produced. */
+#include "ncpar/lex.h"
+
+#include <string.h>
+
+struct packed_head {
+    uint64_t offset;
+    double n_number;
+    uint32_t line;
+    uint16_t units;           /* the record's size in NCP_PACK_UNIT bytes */
+    uint16_t length;
+    uint16_t n_code, pool_used, comment_off, comment_len;
+    uint8_t n_words, n_assign, block_delete, has_n;
+    uint8_t comment_kind, oword_kind, oword_nargs, has_err;
+};
+
+#define ARGS_OFF offsetof(struct ncp_oword, args)
+
+static size_t round_unit(size_t n)
+{
+    return (n + NCP_PACK_UNIT - 1) / NCP_PACK_UNIT * NCP_PACK_UNIT;
+}
+
+static unsigned clampu(unsigned v, unsigned max)
+{
+    return v < max ? v : max;
+}
+
+/* Counts clamped to their arrays: a block with a syntax error may carry
+ * partial counts, and the packer must never read past an array. */
+struct pack_counts {
+    unsigned words, assign, code, pool, nargs, msg;
+};
+
+static struct pack_counts counts_of(const struct ncp_block *b)
+{
+    struct pack_counts c;
+    c.words = clampu(b->n_words, NCP_BLOCK_MAX_WORDS);
+    c.assign = clampu(b->n_assign, NCP_BLOCK_MAX_ASSIGN);
+    c.code = clampu(b->n_code, NCP_BLOCK_MAX_CODE);
+    c.pool = clampu(b->pool_used, NCP_BLOCK_POOL);
+    c.nargs = b->oword.kind != NCP_O_NONE ? clampu(b->oword.nargs, NCP_OWORD_MAX_ARGS) : 0;
+    c.msg = b->err.code != NCP_OK ? (unsigned)strnlen(b->err.msg, NCP_DIAG_MSG_MAX - 1) + 1 : 0;
+    return c;
+}
+
+static size_t bytes_of(const struct ncp_block *b, const struct pack_counts *c)
+{
+    size_t n = sizeof(struct packed_head);
+    if (b->err.code != NCP_OK)
+        n += offsetof(struct ncp_diag, msg) + c->msg;
+    n += c->words * sizeof(struct ncp_word) + c->assign * sizeof(struct ncp_assign);
+    if (b->oword.kind != NCP_O_NONE)
+        n += ARGS_OFF + c->nargs * sizeof(struct ncp_expr);
+    n += c->code * sizeof(struct ncp_bc_ins) + c->pool;
+    return round_unit(n);
+}
+
+size_t ncp_block_packed_size(const struct ncp_block *b)
+{
+    struct pack_counts c = counts_of(b);
+    return bytes_of(b, &c);
+}
+
+static unsigned char *put(unsigned char *p, const void *src, size_t n)
+{
+    memcpy(p, src, n);
+    return p + n;
+}
+
+static const unsigned char *get(const unsigned char *p, void *dst, size_t n)
+{
+    memcpy(dst, p, n);
+    return p + n;
+}
+
+size_t ncp_block_pack(const struct ncp_block *b, void *dst)
+{
+    struct pack_counts c = counts_of(b);
+    size_t total = bytes_of(b, &c);
+    struct packed_head h = {
+        .offset = b->offset, .n_number = b->n_number, .line = b->line,
+        .units = (uint16_t)(total / NCP_PACK_UNIT), .length = b->length,
+        .n_code = (uint16_t)c.code, .pool_used = (uint16_t)c.pool,
+        .comment_off = b->comment_off, .comment_len = b->comment_len,
+        .n_words = (uint8_t)c.words, .n_assign = (uint8_t)c.assign,
+        .block_delete = b->block_delete, .has_n = b->has_n,
+        .comment_kind = b->comment_kind, .oword_kind = b->oword.kind,
+        .oword_nargs = (uint8_t)c.nargs, .has_err = b->err.code != NCP_OK,
+    };
+    unsigned char *p = put(dst, &h, sizeof h);
+    if (h.has_err) {
+        p = put(p, &b->err, offsetof(struct ncp_diag, msg));
+        p = put(p, b->err.msg, c.msg - 1);
+        *p++ = '\0';
+    }
+    p = put(p, b->words, c.words * sizeof b->words[0]);
+    p = put(p, b->assign, c.assign * sizeof b->assign[0]);
+    if (h.oword_kind != NCP_O_NONE) {
+        p = put(p, &b->oword, ARGS_OFF);
+        p = put(p, b->oword.args, c.nargs * sizeof b->oword.args[0]);
+    }
+    p = put(p, b->code, c.code * sizeof b->code[0]);
+    p = put(p, b->pool, c.pool);
+    size_t used = (size_t)(p - (unsigned char *)dst);
+    memset(p, 0, total - used);
+    return total;
+}
+
+size_t ncp_block_packed_units(const void *src)
+{
+    struct packed_head h;
+    memcpy(&h, src, sizeof h);
+    return h.units;
+}
+
+void ncp_block_unpack(const void *src, struct ncp_block *b)
+{
+    struct packed_head h;
+    const unsigned char *p = get(src, &h, sizeof h);
+    b->offset = h.offset;
+    b->line = h.line;
+    b->length = h.length;
+    b->block_delete = h.block_delete;
+    b->has_n = h.has_n;
+    b->n_number = h.n_number;
+    b->n_words = h.n_words;
+    b->n_assign = h.n_assign;
+    b->n_code = h.n_code;
+    b->pool_used = h.pool_used;
+    b->comment_kind = h.comment_kind;
+    b->comment_off = h.comment_off;
+    b->comment_len = h.comment_len;
+    if (h.has_err) {
+        p = get(p, &b->err, offsetof(struct ncp_diag, msg));
+        size_t n = strnlen((const char *)p, NCP_DIAG_MSG_MAX - 1);
+        p = get(p, b->err.msg, n);
+        b->err.msg[n] = '\0';
+        p++;
+    } else {
+        b->err.code = NCP_OK;
+        b->err.line = h.line;
+        b->err.col = 0;
+        b->err.msg[0] = '\0';
+    }
+    p = get(p, b->words, h.n_words * sizeof b->words[0]);
+    p = get(p, b->assign, h.n_assign * sizeof b->assign[0]);
+    if (h.oword_kind != NCP_O_NONE) {
+        p = get(p, &b->oword, ARGS_OFF);
+        p = get(p, b->oword.args, h.oword_nargs * sizeof b->oword.args[0]);
+    } else {
+        b->oword.kind = NCP_O_NONE;
+    }
+    p = get(p, b->code, h.n_code * sizeof b->code[0]);
+    get(p, b->pool, h.pool_used);
+}
+
+/* A record no real block can start with (its offset would be 2^64 - 1). */
+static const uint64_t pad_marker = UINT64_MAX;
+
+void ncp_block_pack_pad(void *dst)
+{
+    memcpy(dst, &pad_marker, sizeof pad_marker);
+}
+
+int ncp_block_packed_is_pad(const void *src)
+{
+    uint64_t v;
+    memcpy(&v, src, sizeof v);
+    return v == pad_marker;
+}
