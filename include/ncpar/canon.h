@@ -129,18 +129,19 @@ enum ncp_cmd_flags {
     NCP_CMD_F_CONT = 1u << 2    /* continues the previous slot's block */
 };
 
+/* The header fields every slot writes share the first cache line (slots cross
+ * cores in the pipeline's rings); the error text and pools follow. */
 struct ncp_cmd {
     uint64_t cmd_id;            /* 0, 1, 2, ... in program order */
     uint32_t line;              /* source line of the block */
     uint16_t n_ops;
     uint16_t flags;             /* enum ncp_cmd_flags */
+    uint16_t text_used;
+    uint32_t out_len;           /* filled by the executor */
     struct ncp_diag diag;       /* error (analyzer or executor), code NCP_OK if none */
     struct ncp_canon ops[NCP_CMD_MAX_OPS];
-    uint16_t text_used;
     char text[NCP_CMD_TEXT_POOL];
-    /* filled by the executor */
-    uint32_t out_len;
-    char out[NCP_CMD_OUT_MAX];
+    char out[NCP_CMD_OUT_MAX];  /* filled by the executor */
 };
 
 /* Clear a slot's header (not its ops) and number it: what acquire() does. */

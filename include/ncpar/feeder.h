@@ -41,4 +41,8 @@ void ncp_source_close(struct ncp_source *src);
 int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
                     struct ncp_span *out);
 
+/* The next of the span at off whose length (ncp_span.len) is len, found from
+ * the line end behind it instead of searching the line again. */
+uint64_t ncp_source_after(const struct ncp_source *src, uint64_t off, size_t len);
+
 #endif

@@ -226,9 +226,11 @@ static int from_feed(struct ncp_flow *f, const struct ncp_block **out)
         return NCP_END;
     }
     f->feed_held = 1;
-    struct ncp_span sp;
     uint64_t next = f->src->end;
-    if (ncp_source_span(f->src, b->offset, b->line, &sp) == 0)
+    struct ncp_span sp;
+    if (b->length < 0xffff) /* length is exact: no second search of the line */
+        next = ncp_source_after(f->src, b->offset, b->length);
+    else if (ncp_source_span(f->src, b->offset, b->line, &sp) == 0)
         next = sp.next;
     f->feed_pos.off = next;
     f->feed_pos.line = b->line + 1;

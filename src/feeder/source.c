@@ -190,3 +190,13 @@ void ncp_source_close(struct ncp_source *src)
         free((void *)src->text);
     memset(src, 0, sizeof *src);
 }
+
+uint64_t ncp_source_after(const struct ncp_source *src, uint64_t off, size_t len)
+{
+    uint64_t pos = off + len;
+    if (pos < src->end && src->text[pos] == '\r')
+        pos++;
+    if (pos < src->end && src->text[pos] == '\n')
+        pos++;
+    return pos < src->end ? pos : src->end;
+}
