@@ -26,7 +26,7 @@ struct ncp_thread_spec {
 /* Thread map (an INI in rt-config/): which thread runs where, ring sizes. */
 struct ncp_thread_map {
     enum ncp_thread_mode mode;
-    int n_lexers, n_executors;
+    int n_lexers, n_executors; /* n_executors 0: the output thread executes */
     int string_rows;  /* g: rows of the string ring (each row = n blocks) */
     int parsed_rows;  /* h: rows of the parsed ring */
     int cmd_slots;    /* commands ring capacity per executor */
@@ -61,6 +61,7 @@ struct ncp_stage_stats {
     uint64_t full_waits;  /* times the output ring was full when the stage wanted to write */
     uint64_t empty_waits; /* times the input ring was empty when the stage wanted to read */
     uint64_t sleeps;      /* futex sleeps (a wait that outlasted the short spin) */
+    double cpu_ms;        /* CPU time of the stage's thread (shows the load balance) */
 };
 
 /* ncp_run_stats.warnings bits: the run went on with a weaker setting. */

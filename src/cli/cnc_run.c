@@ -59,6 +59,29 @@ static void print_diag(const char *prog, const struct ncp_diag *d)
         fprintf(stderr, "%s: error: %s\n", prog, d->msg);
 }
 
+/* One summary line, and for the pipeline the CPU time per stage thread: the
+ * load balance that decides what more cores can gain. */
+static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_map *map)
+{
+    int serial = map->mode == NCP_MODE_SERIAL;
+    double bps = st->wall_ms > 0 ? (double)st->blocks / (st->wall_ms / 1e3) : 0;
+    fprintf(stderr,
+            "cnc-run: %llu blocks, %llu commands, %.3f ms (%.3f ms start-up), %.0f blocks/s, "
+            "%d threads (%s, %d lexers, %d executors)\n",
+            (unsigned long long)st->blocks, (unsigned long long)st->commands, st->wall_ms,
+            st->setup_ms, bps, st->threads, ncp_thread_mode_name(map->mode),
+            serial ? 0 : map->n_lexers, serial ? 0 : map->n_executors);
+    if (serial)
+        return;
+    fprintf(stderr, "cnc-run: cpu ms: feeder %.1f, lexers", st->feeder.cpu_ms);
+    for (int i = 0; i < map->n_lexers && i < NCP_MAX_LEXERS; i++)
+        fprintf(stderr, " %.1f", st->lexer[i].cpu_ms);
+    fprintf(stderr, ", analyzer %.1f, executors", st->analyzer.cpu_ms);
+    for (int j = 0; j < map->n_executors && j < NCP_MAX_EXECUTORS; j++)
+        fprintf(stderr, " %.1f", st->executor[j].cpu_ms);
+    fprintf(stderr, "%s, output %.1f\n", map->n_executors ? "" : " none", st->output.cpu_ms);
+}
+
 static void usage(FILE *f)
 {
     fputs("usage: cnc-run parse PROG [-j N] [--executors M] [--mode serial|det|att]\n"
@@ -123,8 +146,8 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
                 return fprintf(stderr, "cnc-run: -j wants 1..%d lexer threads\n", NCP_MAX_LEXERS), -1;
             break;
         case 'e':
-            if (parse_int(optarg, 1, NCP_MAX_EXECUTORS, &o->executors))
-                return fprintf(stderr, "cnc-run: --executors wants 1..%d\n", NCP_MAX_EXECUTORS), -1;
+            if (parse_int(optarg, 0, NCP_MAX_EXECUTORS, &o->executors))
+                return fprintf(stderr, "cnc-run: --executors wants 0..%d (0: the output thread executes)\n", NCP_MAX_EXECUTORS), -1;
             break;
         case 'm':
             o->mode_given = 1;
@@ -235,14 +258,8 @@ static int cmd_parse(int argc, char **argv)
         print_diag(o.prog, &d);
         status = EXIT_PROGRAM;
     }
-    if (o.stats) {
-        double bps = st.wall_ms > 0 ? (double)st.blocks / (st.wall_ms / 1e3) : 0;
-        fprintf(stderr,
-                "cnc-run: %llu blocks, %llu commands, %.3f ms (%.3f ms start-up), %.0f blocks/s, %d threads (%s, %d lexers, %d executors)\n",
-                (unsigned long long)st.blocks, (unsigned long long)st.commands, st.wall_ms, st.setup_ms, bps,
-                st.threads, ncp_thread_mode_name(map.mode), map.mode == NCP_MODE_SERIAL ? 0 : map.n_lexers,
-                map.mode == NCP_MODE_SERIAL ? 0 : map.n_executors);
-    }
+    if (o.stats)
+        print_stats(&st, &map);
     ncp_source_close(&src);
     return status;
 }

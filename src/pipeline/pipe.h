@@ -21,6 +21,7 @@ struct ncp_pipe_worker {
     alignas(64) struct ncp_pipe *p;
     int index;
     uint64_t items;              /* written by this worker's thread only */
+    double cpu_ms;               /* its thread's CPU time, set as it ends */
 };
 
 struct ncp_pipe {
@@ -28,10 +29,12 @@ struct ncp_pipe {
     const struct ncp_thread_map *map;
     const struct ncp_analyzer_cfg *acfg;
     const struct ncp_output *out;
-    int n, m;                    /* lexers, executors */
+    int n, m;                    /* lexers, command rings (one per executor, >= 1) */
+    int exec_threads;            /* executors; 0: the output thread executes */
+    unsigned out_stage;          /* the output's stage in a command ring */
 
     struct ncp_ring *strings;    /* n: feeder -> LEX_i, struct ncp_span */
-    struct ncp_ring *parsed;     /* n: LEX_i -> analyzer, struct ncp_block */
+    struct ncp_ring *parsed;     /* n: LEX_i -> analyzer, packed blocks in NCP_PACK_UNIT units */
     struct ncp_ring *cmds;       /* m: analyzer -> EXEC_j -> output, struct ncp_cmd */
 
     /* Lexers start once the string ring is full, or at EOF, or on timeout. */
@@ -41,9 +44,12 @@ struct ncp_pipe {
     struct ncp_pipe_worker feeder, analyzer, output;
     struct ncp_pipe_worker lexer[NCP_MAX_LEXERS], executor[NCP_MAX_EXECUTORS];
 
+    /* each lexer's own block, lexed in place before it is packed */
+    struct ncp_lex_scratch { alignas(64) struct ncp_block b; } lex_block[NCP_MAX_LEXERS];
+
     /* analyzer thread only, read after join */
-    alignas(64) uint64_t taken, released;    /* blocks handed to / given back by the analyzer */
-    uint32_t held[NCP_MAX_LEXERS];
+    alignas(64) uint64_t taken;  /* blocks handed to the analyzer */
+    struct ncp_block an_block;   /* the block it holds, unpacked */
     uint64_t next_id;
     int an_rc;
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
@@ -67,5 +73,7 @@ void ncp_pipe_abort(struct ncp_pipe *p);
 void ncp_pipe_open_gate(struct ncp_pipe *p);
 
 double ncp_pipe_now_ms(void);
+/* CPU time of the calling thread so far. */
+double ncp_pipe_thread_cpu_ms(void);
 
 #endif

@@ -42,6 +42,17 @@ static int clamp(int v, int lo, int hi)
     return v < lo ? lo : v > hi ? hi : v;
 }
 
+/* A parsed ring holds packed blocks: h rows of 256 bytes (a plain block packs
+ * to about 130), and never less than four of the largest blocks. */
+static uint32_t parsed_units(uint32_t rows)
+{
+    uint64_t units = (uint64_t)rows * (256 / NCP_PACK_UNIT);
+    uint64_t least = 4 * (NCP_BLOCK_PACK_MAX / NCP_PACK_UNIT + 1);
+    if (units < least)
+        units = least;
+    return units > NCP_RING_MAX_CAPACITY ? NCP_RING_MAX_CAPACITY : (uint32_t)units;
+}
+
 static struct ncp_pipe *pipe_new(const struct ncp_source *src,
                                  const struct ncp_thread_map *map)
 {
@@ -52,7 +63,9 @@ static struct ncp_pipe *pipe_new(const struct ncp_source *src,
     p->src = src;
     p->map = map;
     p->n = clamp(map->n_lexers, 1, NCP_MAX_LEXERS);
-    p->m = clamp(map->n_executors, 1, NCP_MAX_EXECUTORS);
+    p->exec_threads = clamp(map->n_executors, 0, NCP_MAX_EXECUTORS);
+    p->m = p->exec_threads > 0 ? p->exec_threads : 1;
+    p->out_stage = p->exec_threads > 0 ? NCP_CMD_STAGE_OUTPUT : NCP_CMD_STAGE_EXECUTOR;
     atomic_init(&p->gate, 0);
     p->strings = rings_new(p->n);
     p->parsed = rings_new(p->n);
@@ -67,22 +80,24 @@ static struct ncp_pipe *pipe_new(const struct ncp_source *src,
     int bad = 0;
     for (int i = 0; i < p->n; i++) {
         bad |= ncp_ring_init(&p->strings[i], sizeof(struct ncp_span), g);
-        bad |= ncp_ring_init(&p->parsed[i], sizeof(struct ncp_block), h);
+        bad |= ncp_ring_init(&p->parsed[i], NCP_PACK_UNIT, parsed_units(h));
+        if (!bad) /* publish about every 4 KB of records, not every 32 units */
+            ncp_ring_set_batch(&p->parsed[i], 4096 / NCP_PACK_UNIT);
     }
     for (int j = 0; j < p->m; j++)
-        bad |= ncp_ring_init_staged(&p->cmds[j], sizeof(struct ncp_cmd), s, NCP_CMD_STAGES);
+        bad |= ncp_ring_init_staged(&p->cmds[j], sizeof(struct ncp_cmd), s, p->out_stage + 1);
     if (bad) {
         pipe_free(p);
         return NULL;
     }
     p->string_fill = (uint64_t)ncp_ring_cap(&p->strings[0]) * (uint64_t)p->n;
     for (int i = 0; i < NCP_MAX_LEXERS; i++)
-        p->lexer[i] = (struct ncp_pipe_worker){ p, i, 0 };
+        p->lexer[i] = (struct ncp_pipe_worker){ p, i, 0, 0.0 };
     for (int j = 0; j < NCP_MAX_EXECUTORS; j++)
-        p->executor[j] = (struct ncp_pipe_worker){ p, j, 0 };
-    p->feeder = (struct ncp_pipe_worker){ p, 0, 0 };
-    p->analyzer = (struct ncp_pipe_worker){ p, 0, 0 };
-    p->output = (struct ncp_pipe_worker){ p, 0, 0 };
+        p->executor[j] = (struct ncp_pipe_worker){ p, j, 0, 0.0 };
+    p->feeder = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
+    p->analyzer = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
+    p->output = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
     return p;
 }
 
@@ -137,15 +152,18 @@ static void start_all(struct ncp_starter *s)
     for (int i = 0; i < p->n; i++)
         start(s, &map->lexer[i], ncp_pipe_lexer, &p->lexer[i]);
     start(s, &map->analyzer, ncp_pipe_analyzer, &p->analyzer);
-    for (int j = 0; j < p->m; j++)
+    for (int j = 0; j < p->exec_threads; j++)
         start(s, &map->executor[j], ncp_pipe_executor, &p->executor[j]);
     start(s, &map->output, ncp_pipe_output, &p->output);
 }
 
-static void stage_stats(struct ncp_stage_stats *st, uint64_t items)
+static void stage_stats(struct ncp_stage_stats *st, const struct ncp_pipe_worker *w)
 {
     memset(st, 0, sizeof *st);
-    st->items = items;
+    if (w) {
+        st->items = w->items;
+        st->cpu_ms = w->cpu_ms;
+    }
 }
 
 static void add_waits(struct ncp_stage_stats *st, const struct ncp_ring *r, unsigned s,
@@ -167,13 +185,14 @@ static void fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, do
     st->threads = s->started;
     st->warnings = s->warnings;
     st->setup_ms = s->setup_ms + p->alloc_ms;
-    stage_stats(&st->feeder, p->feeder.items);
-    stage_stats(&st->analyzer, p->taken);
-    stage_stats(&st->output, p->output.items);
+    stage_stats(&st->feeder, &p->feeder);
+    stage_stats(&st->analyzer, &p->analyzer);
+    st->analyzer.items = p->taken;
+    stage_stats(&st->output, &p->output);
     for (int i = 0; i < NCP_MAX_LEXERS; i++)
-        stage_stats(&st->lexer[i], i < p->n ? p->lexer[i].items : 0);
+        stage_stats(&st->lexer[i], i < p->n ? &p->lexer[i] : NULL);
     for (int j = 0; j < NCP_MAX_EXECUTORS; j++)
-        stage_stats(&st->executor[j], j < p->m ? p->executor[j].items : 0);
+        stage_stats(&st->executor[j], j < p->exec_threads ? &p->executor[j] : NULL);
     for (int i = 0; i < p->n; i++) {
         st->blocks += p->lexer[i].items;
         add_waits(&st->feeder, &p->strings[i], 0, 1);
@@ -183,8 +202,9 @@ static void fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, do
     }
     for (int j = 0; j < p->m; j++) {
         add_waits(&st->analyzer, &p->cmds[j], NCP_CMD_STAGE_ANALYZER, 1);
-        add_waits(&st->executor[j], &p->cmds[j], NCP_CMD_STAGE_EXECUTOR, 0);
-        add_waits(&st->output, &p->cmds[j], NCP_CMD_STAGE_OUTPUT, 0);
+        if (p->exec_threads > 0)
+            add_waits(&st->executor[j], &p->cmds[j], NCP_CMD_STAGE_EXECUTOR, 0);
+        add_waits(&st->output, &p->cmds[j], p->out_stage, 0);
     }
 }
 

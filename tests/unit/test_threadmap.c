@@ -61,9 +61,13 @@ static void test_default_clamps_counts(void **state)
     ncp_thread_map_default(&m, NCP_MODE_DET, 0, 99);
     assert_int_equal(m.n_lexers, 1);
     assert_int_equal(m.n_executors, NCP_MAX_EXECUTORS);
-    ncp_thread_map_default(&m, NCP_MODE_ATT, -5, 0);
+    ncp_thread_map_default(&m, NCP_MODE_ATT, -5, -1);
     assert_int_equal(m.n_lexers, 1);
-    assert_int_equal(m.n_executors, 1);
+    assert_int_equal(m.n_executors, 0);
+    /* 0 executors: the output thread executes; no executor gets a CPU */
+    ncp_thread_map_default(&m, NCP_MODE_ATT, 1, 0);
+    assert_int_equal(m.n_executors, 0);
+    assert_int_equal(m.executor[0].cpu, -1);
 }
 
 /* The tests run from the top of the tree or from build/tests. */
@@ -190,6 +194,8 @@ static void test_errors(void **state)
     expect_error("[pipeline]\nlexers = 0\n", 2, "lexers");
     expect_error("[pipeline]\nlexers = 17\n", 2, "lexers");
     expect_error("[pipeline]\nexecutors = two\n", 2, "executors");
+    expect_error("[pipeline]\nexecutors = -1\n", 2, "executors");
+    expect_error("[pipeline]\nexecutors = 0\n\n[executor.0]\ncpu = 0\n", 4, "executor.0");
     expect_error("[pipeline]\nstring_rows = -1\n", 2, "string_rows");
     expect_error("[pipeline]\nparsed_rows = 3x\n", 2, "parsed_rows");
     expect_error("[pipeline]\ncmd_slots = 99999999999\n", 2, "cmd_slots");
