@@ -89,6 +89,12 @@ size_t ncp_fmt_fixed4(char *buf, double v)
 {
     uint64_t bits;
     memcpy(&bits, &v, sizeof bits);
+    if ((bits << 1) == 0) { /* +-0: most of a move's nine coordinates */
+        const char *z = bits ? "-0.0000" : "0.0000";
+        size_t n = bits ? 7 : 6;
+        memcpy(buf, z, n + 1);
+        return n;
+    }
     int neg = (int)(bits >> 63);
     int bexp = (int)((bits >> 52) & 0x7ffu);
     if (bexp >= NCP_FMT_FAST_EXP_MAX)
