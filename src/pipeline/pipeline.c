@@ -43,11 +43,12 @@ static int clamp(int v, int lo, int hi)
 }
 
 /* A parsed ring holds packed blocks: h rows of 256 bytes (a plain block packs
- * to about 130), and never less than four of the largest blocks. */
+ * to about 130), and never less than two of the largest blocks (one always
+ * fits after the padding at the wrap point). */
 static uint32_t parsed_units(uint32_t rows)
 {
     uint64_t units = (uint64_t)rows * (256 / NCP_PACK_UNIT);
-    uint64_t least = 4 * (NCP_BLOCK_PACK_MAX / NCP_PACK_UNIT + 1);
+    uint64_t least = 2 * (NCP_BLOCK_PACK_MAX / NCP_PACK_UNIT + 1);
     if (units < least)
         units = least;
     return units > NCP_RING_MAX_CAPACITY ? NCP_RING_MAX_CAPACITY : (uint32_t)units;
