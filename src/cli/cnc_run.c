@@ -54,7 +54,8 @@ static int emit_canon(void *ctx, const struct ncp_cmd *cmd)
 static void print_diag(const char *prog, const struct ncp_diag *d)
 {
     if (d->line)
-        fprintf(stderr, "%s:%u:%u: error: %s\n", prog, d->line, d->col ? d->col : 1, d->msg);
+        fprintf(stderr, "%s:%u:%u: error: %s\n", prog, d->line, d->col ? (unsigned)d->col : 1u,
+                d->msg);
     else
         fprintf(stderr, "%s: error: %s\n", prog, d->msg);
 }
