@@ -72,6 +72,7 @@ clean:
 	rm -rf $(BUILD)
 
 include tools/rtvm/rtvm.mk
+include bench/bench.mk
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 

@@ -1,0 +1,13 @@
+# `make bench`: the benchmark suite of bench/ (not part of `make test`). It
+# reproduces seed 001's Table 3, compares with LinuxCNC's rs274 and measures the
+# position loop's latency beside cyclictest, then rewrites bench/RESULTS.md and the
+# PNGs in bench/. RUNS, RUNS_BIG, LAT_SECONDS, ... scale it down (bench/run-bench).
+.PHONY: bench
+BENCH_BINS = $(BUILD)/bench/table3
+
+$(BUILD)/bench/%: bench/%.c $(LIB)
+	@mkdir -p $(@D)
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -o $@ $< $(LIB) $(LDLIBS) -lstdc++
+
+bench: all $(BENCH_BINS)
+	bench/run-bench $(BUILD)
