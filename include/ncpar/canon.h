@@ -129,8 +129,9 @@ enum ncp_cmd_flags {
     NCP_CMD_F_CONT = 1u << 2    /* continues the previous slot's block */
 };
 
-/* The header fields every slot writes share the first cache line (slots cross
- * cores in the pipeline's rings); the error text and pools follow. */
+/* Slots cross cores in the pipeline's rings: what every slot writes (the
+ * header and its first op) is contiguous from the start; the error, which
+ * only a failing block writes, and the pools follow. */
 struct ncp_cmd {
     uint64_t cmd_id;            /* 0, 1, 2, ... in program order */
     uint32_t line;              /* source line of the block */
@@ -138,13 +139,14 @@ struct ncp_cmd {
     uint16_t flags;             /* enum ncp_cmd_flags */
     uint16_t text_used;
     uint32_t out_len;           /* filled by the executor */
-    struct ncp_diag diag;       /* error (analyzer or executor), code NCP_OK if none */
     struct ncp_canon ops[NCP_CMD_MAX_OPS];
+    struct ncp_diag diag;       /* the error: valid only when flags has NCP_CMD_F_ERROR */
     char text[NCP_CMD_TEXT_POOL];
     char out[NCP_CMD_OUT_MAX];  /* filled by the executor */
 };
 
-/* Clear a slot's header (not its ops) and number it: what acquire() does. */
+/* Clear a slot's header (not its ops, not its diag) and number it: what
+ * acquire() does. Whoever sets diag sets NCP_CMD_F_ERROR with it. */
 void ncp_cmd_reset_header(struct ncp_cmd *cmd, uint64_t id);
 
 #endif

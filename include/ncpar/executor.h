@@ -9,14 +9,15 @@
 
 /* Resolve requests in cmd->ops (ARC_REQUEST -> ARC_FEED, ...). On a geometry error
  * fills cmd->diag, sets NCP_CMD_F_ERROR and truncates n_ops to the ops before the
- * failing one. Returns cmd->diag.code. */
+ * failing one. Returns the slot's error code: diag.code with NCP_CMD_F_ERROR, else
+ * NCP_OK. */
 int ncp_exec_resolve(struct ncp_cmd *cmd);
 
 /* Format cmd->ops as rs274 -g lines (without counter and N column), each ending in
  * '\n', into cmd->out / cmd->out_len. Lines are never cut: if the next line does
  * not fit NCP_CMD_OUT_MAX (only absurd magnitudes or pool-sized texts can do that)
- * n_ops is truncated before it, NCP_CMD_F_ERROR set and diag (if still NCP_OK)
- * gets NCP_ERR_LIMIT. NONE and unresolved requests print nothing. */
+ * n_ops is truncated before it, NCP_CMD_F_ERROR set and diag (unless the slot
+ * already had an error) gets NCP_ERR_LIMIT. NONE and unresolved requests print nothing. */
 void ncp_exec_format(struct ncp_cmd *cmd);
 
 /* Both, as an executor thread does. */

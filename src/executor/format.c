@@ -315,7 +315,7 @@ void ncp_exec_format(struct ncp_cmd *cmd)
              * rather than emit a cut line. */
             o.p = line;
             cmd->n_ops = (uint16_t)k;
-            if (cmd->diag.code == NCP_OK)
+            if (!(cmd->flags & NCP_CMD_F_ERROR))
                 ncp_diag_set(&cmd->diag, NCP_ERR_LIMIT, cmd->line, 0,
                              "canonical output of this block exceeds %d bytes",
                              NCP_CMD_OUT_MAX);

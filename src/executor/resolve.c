@@ -134,12 +134,12 @@ int ncp_exec_resolve(struct ncp_cmd *cmd)
             break;
         }
     }
-    return cmd->diag.code;
+    return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }
 
 int ncp_exec_cmd(struct ncp_cmd *cmd)
 {
     ncp_exec_resolve(cmd);
     ncp_exec_format(cmd);
-    return cmd->diag.code;
+    return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }

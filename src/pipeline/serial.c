@@ -51,10 +51,6 @@ void ncp_cmd_reset_header(struct ncp_cmd *cmd, uint64_t id)
     cmd->line = 0;
     cmd->n_ops = 0;
     cmd->flags = 0;
-    cmd->diag.code = NCP_OK;
-    cmd->diag.line = 0;
-    cmd->diag.col = 0;
-    cmd->diag.msg[0] = '\0';
     cmd->text_used = 0;
     cmd->out_len = 0;
 }
