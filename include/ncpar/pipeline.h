@@ -77,9 +77,10 @@ struct ncp_run_stats {
     int threads;            /* threads used in total */
     /* additive (pipeline): filled by ncp_pipeline_run only */
     uint32_t warnings;      /* enum ncp_run_warning bits */
-    double setup_ms;        /* of wall_ms: ring allocation and thread creation in the
-                               starting thread (0 for serial); wall_ms - setup_ms is
-                               the run as a pre-started pool would see it */
+    double setup_ms;        /* of wall_ms: the starting thread's CPU time for ring
+                               allocation (prefaulted) and thread creation (0 for
+                               serial); wall_ms - setup_ms approximates the run of
+                               a pre-started pool */
     struct ncp_stage_stats feeder, analyzer, output;
     struct ncp_stage_stats lexer[NCP_MAX_LEXERS];
     struct ncp_stage_stats executor[NCP_MAX_EXECUTORS];

@@ -58,7 +58,7 @@ struct ncp_pipe {
     alignas(64) struct ncp_diag err; /* first error slot, in program order */
     int emit_failed;
     double end_ms;               /* last slot out */
-    double alloc_ms;             /* ring allocation, part of the start-up cost */
+    double alloc_ms;             /* ring allocation (CPU time), part of the start-up cost */
 };
 
 void *ncp_pipe_feeder(void *arg);

@@ -123,7 +123,7 @@ struct ncp_starter {
     int started;
     int failed;
     uint32_t warnings;
-    double setup_ms; /* time spent inside pthread_create and friends */
+    double setup_ms; /* CPU time of the starting thread in pthread_create and friends */
 };
 
 static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
@@ -132,9 +132,11 @@ static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
     if (s->failed)
         return;
     int pin = s->p->map->mode == NCP_MODE_ATT;
-    double t0 = ncp_pipe_now_ms();
+    /* CPU time, not wall time: a new thread may preempt its creator, and
+     * that time is the pipeline's work, not start-up. */
+    double t0 = ncp_pipe_thread_cpu_ms();
     int rc = ncp_thread_start(&s->tid[s->started], spec, pin, fn, w, &s->warnings);
-    s->setup_ms += ncp_pipe_now_ms() - t0;
+    s->setup_ms += ncp_pipe_thread_cpu_ms() - t0;
     if (rc != 0) {
         s->failed = 1;
         ncp_pipe_abort(s->p);
@@ -240,12 +242,12 @@ int ncp_pipeline_run(const struct ncp_source *src, const struct ncp_thread_map *
 {
     if (map->mode == NCP_MODE_SERIAL)
         return ncp_serial_run(src, acfg, out, stats, d);
-    double t0 = ncp_pipe_now_ms();
+    double t0 = ncp_pipe_now_ms(), cpu0 = ncp_pipe_thread_cpu_ms();
     memset(d, 0, sizeof *d);
     struct ncp_pipe *p = pipe_new(src, map);
     if (!p)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the pipeline rings");
-    p->alloc_ms = ncp_pipe_now_ms() - t0;
+    p->alloc_ms = ncp_pipe_thread_cpu_ms() - cpu0;
     p->acfg = acfg;
     p->out = out;
 
