@@ -81,6 +81,27 @@ static size_t ncp_fmt_slow(char *buf, const char *fmt, double v)
 /* Below 2^-27 a value prints as (-)0.0000 whatever its bits. */
 #define NCP_FMT_ZERO_SHIFT 80
 
+/* Below 1e8 the product a * 10^4 is within 1.2e-4 of its exact value (half an
+ * ulp of a number below 2^40), so when its fraction is more than 1e-3 away from
+ * one half, rounding the double product rounds the exact one the same way.
+ * Returns 0 (decide exactly) otherwise: near-ties, and the values printf must
+ * settle half-to-even, are left to the integer path below. */
+static int ncp_scaled_round(double a, uint64_t *ipart, unsigned *dec)
+{
+    if (!(a < 1e8))
+        return 0;
+    double t = a * 10000.0;
+    uint64_t q = (uint64_t)t;
+    double f = t - (double)q; /* exact: t < 2^40 */
+    if (f > 0.501)
+        q++;
+    else if (!(f < 0.499))
+        return 0;
+    *ipart = q / 10000u;
+    *dec = (unsigned)(q % 10000u);
+    return 1;
+}
+
 /* The double's exact value is mant * 2^-shift. Splitting it into integer and
  * fraction bits and scaling the fraction by 10^4 in 128-bit integers gives the
  * exact decimal digits and the exact remainder, so the rounding decision is
@@ -102,7 +123,9 @@ size_t ncp_fmt_fixed4(char *buf, double v)
     uint64_t ipart = 0;
     unsigned dec = 0;
     int shift = 1075 - bexp; /* > 0 here */
-    if (bexp != 0 && shift < NCP_FMT_ZERO_SHIFT) {
+    if (ncp_scaled_round(neg ? -v : v, &ipart, &dec)) {
+        /* decided in double arithmetic: far from a rounding boundary */
+    } else if (bexp != 0 && shift < NCP_FMT_ZERO_SHIFT) {
         typedef unsigned __int128 u128;
         uint64_t mant = (bits & ((UINT64_C(1) << 52) - 1u)) | (UINT64_C(1) << 52);
         u128 one = (u128)1 << shift;
