@@ -96,6 +96,22 @@ int ncp_pipeline_run(const struct ncp_source *src, const struct ncp_thread_map *
                      const struct ncp_analyzer_cfg *acfg, const struct ncp_output *out,
                      struct ncp_run_stats *stats, struct ncp_diag *d);
 
+/* A pre-started pipeline: the map's threads are created (and its rings
+ * allocated and prefaulted) once, then run one program after another; each run
+ * behaves exactly like ncp_pipeline_run without the start-up (stats->setup_ms
+ * is 0, stats->wall_ms runs from the start of the run to the last command out).
+ * A serial map keeps no threads: its runs are ncp_serial_run. Runs of one pool
+ * must not overlap. */
+struct ncp_pipeline_pool;
+struct ncp_pipeline_pool *ncp_pipeline_pool_new(const struct ncp_thread_map *map,
+                                                struct ncp_diag *d);
+int ncp_pipeline_pool_run(struct ncp_pipeline_pool *pool, const struct ncp_source *src,
+                          const struct ncp_analyzer_cfg *acfg, const struct ncp_output *out,
+                          struct ncp_run_stats *stats, struct ncp_diag *d);
+/* enum ncp_run_warning bits from starting the pool's threads. */
+uint32_t ncp_pipeline_pool_warnings(const struct ncp_pipeline_pool *pool);
+void ncp_pipeline_pool_free(struct ncp_pipeline_pool *pool);
+
 /* The same stages in the calling thread, no rings. */
 int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *acfg,
                    const struct ncp_output *out, struct ncp_run_stats *stats,

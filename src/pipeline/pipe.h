@@ -5,6 +5,7 @@
 
 #include <stdalign.h>
 #include <stdatomic.h>
+#include <pthread.h>
 #include <stdint.h>
 #include "ncpar/pipeline.h"
 #include "ring.h"
@@ -60,6 +61,33 @@ struct ncp_pipe {
     double end_ms;               /* last slot out */
     double alloc_ms;             /* ring allocation (CPU time), part of the start-up cost */
 };
+
+/* Rings and workers for a map (src, acfg and out are set per run); NULL when
+ * out of memory. */
+struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map);
+void ncp_pipe_free(struct ncp_pipe *p);
+/* Back to the state of a new pipe for another run: only while no stage thread
+ * is inside a stage. */
+void ncp_pipe_reset(struct ncp_pipe *p);
+/* The paper's start rule for the lexers: the string ring full, EOF, or the
+ * start timeout, whichever comes first. */
+void ncp_pipe_wait_gate(struct ncp_pipe *p, int timeout_us);
+
+/* The threads of one run and how their start went. */
+struct ncp_starter {
+    struct ncp_pipe *p;
+    pthread_t tid[NCP_MAX_LEXERS + NCP_MAX_EXECUTORS + 3];
+    int started;
+    int failed;
+    uint32_t warnings;
+    double setup_ms; /* CPU time of the starting thread in pthread_create and friends */
+};
+
+/* The run's result in the serial reference's precedence, and its statistics
+ * (wall time from t0). Both after every stage of the run has ended. */
+int ncp_pipe_result(const struct ncp_pipe *p, const struct ncp_starter *s, struct ncp_diag *d);
+void ncp_pipe_fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, double t0,
+                         struct ncp_run_stats *st);
 
 void *ncp_pipe_feeder(void *arg);
 void *ncp_pipe_lexer(void *arg);

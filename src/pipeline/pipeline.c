@@ -27,7 +27,7 @@ static void rings_free(struct ncp_ring *r, int count)
     free(r);
 }
 
-static void pipe_free(struct ncp_pipe *p)
+void ncp_pipe_free(struct ncp_pipe *p)
 {
     if (!p)
         return;
@@ -54,14 +54,14 @@ static uint32_t parsed_units(uint32_t rows)
     return units > NCP_RING_MAX_CAPACITY ? NCP_RING_MAX_CAPACITY : (uint32_t)units;
 }
 
-static struct ncp_pipe *pipe_new(const struct ncp_source *src,
-                                 const struct ncp_thread_map *map)
+static void workers_reset(struct ncp_pipe *p);
+
+struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
 {
     struct ncp_pipe *p = aligned_alloc(64, (sizeof *p + 63) / 64 * 64);
     if (!p)
         return NULL;
     memset(p, 0, sizeof *p);
-    p->src = src;
     p->map = map;
     p->n = clamp(map->n_lexers, 1, NCP_MAX_LEXERS);
     p->exec_threads = clamp(map->n_executors, 0, NCP_MAX_EXECUTORS);
@@ -72,7 +72,7 @@ static struct ncp_pipe *pipe_new(const struct ncp_source *src,
     p->parsed = rings_new(p->n);
     p->cmds = rings_new(p->m);
     if (!p->strings || !p->parsed || !p->cmds) {
-        pipe_free(p);
+        ncp_pipe_free(p);
         return NULL;
     }
     uint32_t g = (uint32_t)clamp(map->string_rows, 1, NCP_RING_MAX_CAPACITY);
@@ -88,10 +88,16 @@ static struct ncp_pipe *pipe_new(const struct ncp_source *src,
     for (int j = 0; j < p->m; j++)
         bad |= ncp_ring_init_staged(&p->cmds[j], sizeof(struct ncp_cmd), s, p->out_stage + 1);
     if (bad) {
-        pipe_free(p);
+        ncp_pipe_free(p);
         return NULL;
     }
     p->string_fill = (uint64_t)ncp_ring_cap(&p->strings[0]) * (uint64_t)p->n;
+    workers_reset(p);
+    return p;
+}
+
+static void workers_reset(struct ncp_pipe *p)
+{
     for (int i = 0; i < NCP_MAX_LEXERS; i++)
         p->lexer[i] = (struct ncp_pipe_worker){ p, i, 0, 0.0 };
     for (int j = 0; j < NCP_MAX_EXECUTORS; j++)
@@ -99,12 +105,31 @@ static struct ncp_pipe *pipe_new(const struct ncp_source *src,
     p->feeder = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
     p->analyzer = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
     p->output = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
-    return p;
+}
+
+void ncp_pipe_reset(struct ncp_pipe *p)
+{
+    for (int i = 0; i < p->n; i++) {
+        ncp_ring_reset(&p->strings[i]);
+        ncp_ring_reset(&p->parsed[i]);
+    }
+    for (int j = 0; j < p->m; j++)
+        ncp_ring_reset(&p->cmds[j]);
+    atomic_store(&p->gate, 0);
+    workers_reset(p);
+    p->taken = 0;
+    p->next_id = 0;
+    p->an_rc = NCP_OK;
+    memset(&p->an_diag, 0, sizeof p->an_diag);
+    memset(&p->err, 0, sizeof p->err);
+    p->emit_failed = 0;
+    p->end_ms = 0;
+    p->alloc_ms = 0;
 }
 
 /* The paper's start rule: the lexers wait for a full string ring, EOF, or
  * the start timeout, whichever comes first. */
-static void wait_gate(struct ncp_pipe *p, int timeout_us)
+void ncp_pipe_wait_gate(struct ncp_pipe *p, int timeout_us)
 {
     double deadline = ncp_pipe_now_ms() + timeout_us / 1e3;
     while (atomic_load(&p->gate) == 0) {
@@ -116,15 +141,6 @@ static void wait_gate(struct ncp_pipe *p, int timeout_us)
         ncp_futex_wait(&p->gate, 0, &ts);
     }
 }
-
-struct ncp_starter {
-    struct ncp_pipe *p;
-    pthread_t tid[NCP_MAX_LEXERS + NCP_MAX_EXECUTORS + 3];
-    int started;
-    int failed;
-    uint32_t warnings;
-    double setup_ms; /* CPU time of the starting thread in pthread_create and friends */
-};
 
 static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
                   void *(*fn)(void *), struct ncp_pipe_worker *w)
@@ -151,7 +167,7 @@ static void start_all(struct ncp_starter *s)
     const struct ncp_thread_map *map = p->map;
     start(s, &map->feeder, ncp_pipe_feeder, &p->feeder);
     if (!s->failed)
-        wait_gate(p, map->start_timeout_us);
+        ncp_pipe_wait_gate(p, map->start_timeout_us);
     for (int i = 0; i < p->n; i++)
         start(s, &map->lexer[i], ncp_pipe_lexer, &p->lexer[i]);
     start(s, &map->analyzer, ncp_pipe_analyzer, &p->analyzer);
@@ -179,8 +195,8 @@ static void add_waits(struct ncp_stage_stats *st, const struct ncp_ring *r, unsi
     st->sleeps += ncp_ring_sleeps(r, s);
 }
 
-static void fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, double t0,
-                       struct ncp_run_stats *st)
+void ncp_pipe_fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, double t0,
+                         struct ncp_run_stats *st)
 {
     st->blocks = 0;
     st->commands = p->output.items;
@@ -213,8 +229,7 @@ static void fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, do
 
 /* Same precedence as the serial reference: the first error slot, then a failed
  * write, then an analyzer that stopped without a diagnostic. */
-static int result(const struct ncp_pipe *p, const struct ncp_starter *s,
-                  struct ncp_diag *d)
+int ncp_pipe_result(const struct ncp_pipe *p, const struct ncp_starter *s, struct ncp_diag *d)
 {
     if (p->err.code != NCP_OK) {
         *d = p->err;
@@ -244,10 +259,11 @@ int ncp_pipeline_run(const struct ncp_source *src, const struct ncp_thread_map *
         return ncp_serial_run(src, acfg, out, stats, d);
     double t0 = ncp_pipe_now_ms(), cpu0 = ncp_pipe_thread_cpu_ms();
     memset(d, 0, sizeof *d);
-    struct ncp_pipe *p = pipe_new(src, map);
+    struct ncp_pipe *p = ncp_pipe_new(map);
     if (!p)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the pipeline rings");
     p->alloc_ms = ncp_pipe_thread_cpu_ms() - cpu0;
+    p->src = src;
     p->acfg = acfg;
     p->out = out;
 
@@ -258,10 +274,10 @@ int ncp_pipeline_run(const struct ncp_source *src, const struct ncp_thread_map *
     for (int t = 0; t < s.started; t++)
         pthread_join(s.tid[t], NULL);
 
-    int rc = result(p, &s, d);
+    int rc = ncp_pipe_result(p, &s, d);
     if (stats)
-        fill_stats(p, &s, t0, stats);
-    pipe_free(p);
+        ncp_pipe_fill_stats(p, &s, t0, stats);
+    ncp_pipe_free(p);
     return rc;
 }
 

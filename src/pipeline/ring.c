@@ -73,6 +73,23 @@ int ncp_ring_init_staged(struct ncp_ring *r, size_t elem_size, uint32_t capacity
     return 0;
 }
 
+void ncp_ring_reset(struct ncp_ring *r)
+{
+    for (unsigned s = 0; s < NCP_RING_MAX_STAGES; s++) {
+        struct ncp_ring_stage *st = &r->stage[s];
+        atomic_store(&st->pos, 0);
+        atomic_store(&st->sleepers, 0);
+        atomic_store(&st->wake_at, 0);
+        /* event keeps counting: a futex word that went back could match the
+         * key of a waiter from the last run that has not yet gone to sleep */
+        st->next = 0;
+        st->seen = 0;
+        st->waits = 0;
+        st->sleeps = 0;
+    }
+    atomic_store(&r->state, 0);
+}
+
 int ncp_ring_init(struct ncp_ring *r, size_t elem_size, uint32_t capacity)
 {
     return ncp_ring_init_staged(r, elem_size, capacity, 2);

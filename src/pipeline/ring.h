@@ -65,6 +65,10 @@ int ncp_ring_init(struct ncp_ring *r, size_t elem_size, uint32_t capacity);
 int ncp_ring_init_staged(struct ncp_ring *r, size_t elem_size, uint32_t capacity,
                          unsigned n_stages);
 void ncp_ring_destroy(struct ncp_ring *r);
+/* Empty and open again, its slots kept (a pre-started pipeline's next run).
+ * Only while no thread uses the ring and none owes it a publish or a wake
+ * (every stage thread called ncp_ring_wake_owed when it finished). */
+void ncp_ring_reset(struct ncp_ring *r);
 
 uint32_t ncp_ring_cap(const struct ncp_ring *r);
 
