@@ -94,7 +94,7 @@ def parse_driver(text):
         if not f:
             continue
         if f[0] == "run" and len(f) >= 4:
-            out["runs"].append([float(f[2]), float(f[3])])
+            out["runs"].append([float(x) for x in f[2:5]])
         elif f[0] == "hash" and len(f) >= 6:
             out.update(hash=f[1], blocks=int(f[3]), commands=int(f[5]))
         elif f[0] == "warning":
@@ -154,7 +154,7 @@ def table3(build, maps, prog, runs, max_s, chunks, raw):
 
 
 def mean_of(row):
-    return statistics.fmean(w for w, _ in row["runs"]) if row.get("runs") else float("inf")
+    return statistics.fmean(r[0] for r in row["runs"]) if row.get("runs") else float("inf")
 
 
 def best_parallel(rows):

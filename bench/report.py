@@ -44,8 +44,12 @@ def stats(xs):
 
 
 def series(row, pool):
-    """Run times in ms: wall (thread creation incl.) or wall - setup."""
-    return [w - s if pool else w for w, s in row.get("runs", [])]
+    """Run times in ms: wall (thread creation incl.), or the pre-started pool's run
+    of the same program (wall - setup from drivers that had no pool)."""
+    runs = row.get("runs", [])
+    if not pool:
+        return [r[0] for r in runs]
+    return [r[2] if len(r) > 2 else r[0] - r[1] for r in runs]
 
 
 def fmt(x, nd=3):
@@ -106,8 +110,8 @@ def table3_text(rows, pool_rows_note, prog_name):
             % (len(faster), len(g), ", ".join(faster)) if faster
             else "no parallel configuration beats the serial run of its priority"))
     ser = stats(series(rows["serial"], False))
-    share = [statistics.fmean(s for _, s in rows[c]["runs"]) / statistics.fmean(
-        w for w, _ in rows[c]["runs"]) for c in par]
+    share = [statistics.fmean(r[1] for r in rows[c]["runs"]) / statistics.fmean(
+        r[0] for r in rows[c]["runs"]) for c in par]
     lines.append("Our serial reference takes %.3f ms here%s. Ring allocation and thread "
                  "creation (%s threads) are %.0f-%.0f %% of the parallel runs' mean time on "
                  "this program." % (
@@ -313,12 +317,10 @@ def table3_section(data, run_dir):
           "included) to the last canonical command out, as `ncp_run_stats.wall_ms` reports it",
           "(build/bench/table3 does a round's runs of one configuration in one process after",
           "an untimed warm-up run, the program mapped once; output text copied to a buffer,",
-          "not written). *Without thread creation* is W - S, W = wall_ms and S = setup_ms,",
-          "the time the starting thread spent allocating rings and creating threads: an approximation of",
-          "a pre-started pool. It is wall time of the starting thread, so it also holds any",
-          "time the new threads ran on its CPU before it got to create the next one (less",
-          "so in the -fifo runs, where the starting thread has priority 90 too and is not",
-          "preempted by them), and the threads' own start-up after creation stays in W - S.",
+          "not written). *Without thread creation* is measured on a pre-started pool of",
+          "the same map (`ncp_pipeline_pool_run`: the threads created once per process,",
+          "rings reset between runs), each run right after its with-creation twin: from",
+          "the start of the run to the last command out.",
           "Gain = serial mean / configuration mean at the same priority (the paper's",
           "definition); *1st/2nd half* is the same gain from each half of the runs, a",
           "measure of how much it moves within one run. Paper gains are for an Intel i3-2370M",
@@ -343,7 +345,7 @@ def table3_section(data, run_dir):
         if warn:
             L += ["Warnings from the runs: " + "; ".join(warn), ""]
         L += ["With thread creation (the paper's measure):", ""] + table3_md(rows, False)
-        L += ["", "Without thread creation (wall - setup, about a pre-started pool; the paper "
+        L += ["", "Without thread creation (a pre-started pool; the paper "
               "gain column repeats the paper's figures, which include thread creation):", ""]
         L += table3_md(rows, True) + [""]
         L += table3_text(rows, n_threads, name) + [""]

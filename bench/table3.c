@@ -7,7 +7,10 @@
  * timings: the program is mapped once and every run sees the same warm text.
  * Each run is timed by the library itself (ncp_run_stats.wall_ms: pipeline start,
  * thread creation included, to the last command out; setup_ms: the part of it the
- * starting thread spent allocating rings and creating threads).
+ * starting thread spent allocating rings and creating threads), and each is
+ * followed by a run of the same program on a pre-started pool of the same map
+ * (ncp_pipeline_pool_run: threads created once, rings reset between runs): the
+ * time without thread creation, measured rather than estimated.
  *
  * The emitted canonical text is copied into a buffer as `cnc-run parse --canon`
  * does, so the output stage does the same work, but never written. The first
@@ -18,7 +21,8 @@
  * suite keeps its time budget; fewer runs are then reported ("stopped" line).
  *
  * stdout: "warning TEXT" lines, "hash H blocks B commands C", then one line
- * "run I WALL_MS SETUP_MS" per timed run, and "stopped N" if the time ran out.
+ * "run I WALL_MS SETUP_MS POOL_MS" per timed run, and "stopped N" if the time ran
+ * out.
  * Exit 0, 1 usage, 2 program error. */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
@@ -91,6 +95,17 @@ static int run_once(const struct ncp_source *src, const struct ncp_thread_map *m
                                         : ncp_pipeline_run(src, map, acfg, &out, st, d);
 }
 
+static int run_pooled(struct ncp_pipeline_pool *pool, const struct ncp_source *src,
+                      const struct ncp_analyzer_cfg *acfg, struct sink *s,
+                      struct ncp_run_stats *st, struct ncp_diag *d)
+{
+    struct ncp_output out = { s, emit };
+    memset(st, 0, sizeof *st);
+    memset(d, 0, sizeof *d);
+    s->used = 0;
+    return ncp_pipeline_pool_run(pool, src, acfg, &out, st, d);
+}
+
 static void report_warnings(uint32_t *seen, uint32_t w)
 {
     w &= ~*seen;
@@ -145,15 +160,18 @@ static int parse_opts(int argc, char **argv, struct opts *o)
 
 /* Warm-up runs (the first one hashed), then the timed runs. Returns the exit status. */
 static int measure(const struct opts *o, const struct ncp_source *src,
-                   const struct ncp_thread_map *map, struct sink *s)
+                   const struct ncp_thread_map *map, struct sink *s,
+                   struct ncp_pipeline_pool *pool)
 {
-    struct ncp_run_stats st;
+    struct ncp_run_stats st, pst;
     struct ncp_diag d;
     uint32_t seen = 0;
+    report_warnings(&seen, ncp_pipeline_pool_warnings(pool));
     s->hashing = 1;
     s->hash = 14695981039346656037ull;
     for (long i = 0; i < o->warmup; i++) {
-        if (run_once(src, map, &o->acfg, s, &st, &d) != NCP_OK) {
+        if (run_once(src, map, &o->acfg, s, &st, &d) != NCP_OK ||
+            run_pooled(pool, src, &o->acfg, s, &pst, &d) != NCP_OK) {
             fprintf(stderr, "%s:%u:%u: error: %s\n", o->prog, d.line, d.col, d.msg);
             return 2;
         }
@@ -169,12 +187,13 @@ static int measure(const struct opts *o, const struct ncp_source *src,
             printf("stopped %ld\n", i);
             break;
         }
-        if (run_once(src, map, &o->acfg, s, &st, &d) != NCP_OK) {
+        if (run_once(src, map, &o->acfg, s, &st, &d) != NCP_OK ||
+            run_pooled(pool, src, &o->acfg, s, &pst, &d) != NCP_OK) {
             fprintf(stderr, "%s:%u:%u: error: %s\n", o->prog, d.line, d.col, d.msg);
             return 2;
         }
         report_warnings(&seen, st.warnings);
-        printf("run %ld %.6f %.6f\n", i, st.wall_ms, st.setup_ms);
+        printf("run %ld %.6f %.6f %.6f\n", i, st.wall_ms, st.setup_ms, pst.wall_ms);
     }
     return 0;
 }
@@ -197,7 +216,11 @@ int main(int argc, char **argv)
     }
     place_self(&map.feeder, map.mode == NCP_MODE_SERIAL);
     struct sink *s = calloc(1, sizeof *s);
-    int status = s ? measure(&o, &src, &map, s) : 1;
+    struct ncp_pipeline_pool *pool = ncp_pipeline_pool_new(&map, &d);
+    if (!pool)
+        fprintf(stderr, "table3: %s\n", d.msg);
+    int status = s && pool ? measure(&o, &src, &map, s, pool) : 1;
+    ncp_pipeline_pool_free(pool);
     free(s);
     ncp_source_close(&src);
     return status;
