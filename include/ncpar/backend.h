@@ -3,6 +3,10 @@
 #ifndef NCPAR_BACKEND_H
 #define NCPAR_BACKEND_H
 
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
 #include "ncpar/motion.h"
 
 struct ncp_sim_axis {
@@ -28,5 +32,51 @@ void ncp_sim_init(struct ncp_sim *s, const struct ncp_machine_cfg *cfg,
  * of the interval being driven, not the one just past. */
 void ncp_sim_step(struct ncp_sim *s, const double cmd[NCP_AXES], const double next[NCP_AXES],
                   double act[NCP_AXES]);
+
+/* ---- the interface the position loop drives ------------------------------ */
+
+struct ncp_backend;
+
+struct ncp_backend_ops {
+    const char *name;
+    /* Before the real-time loop (may block, allocate, talk SDO): brings the
+     * machine up and reports where its axes are. 0, or -1 with fault(). */
+    int (*start)(struct ncp_backend *b, double pos[NCP_AXES]);
+    /* Real-time, once per servo period: cmd is this period's setpoint, next
+     * the one after (feed-forward, or what a CSP drive gets now and runs at
+     * the next SYNC); act gets the latest actual positions. Non-blocking, no
+     * allocation, no locks. 0, or -1 on a fault (act still filled). */
+    int (*cycle)(struct ncp_backend *b, const double cmd[NCP_AXES], const double next[NCP_AXES],
+                 double act[NCP_AXES]);
+    /* After the loop, fault or not: a controlled stop of every axis. */
+    void (*stop)(struct ncp_backend *b);
+    /* The fault that made start() or cycle() fail, naming node, object and cause. */
+    void (*describe_fault)(const struct ncp_backend *b, char *buf, size_t len);
+    void (*close)(struct ncp_backend *b);
+};
+
+struct ncp_backend {
+    const struct ncp_backend_ops *ops;
+    void *impl;
+    int real_clock_only;   /* real drives: the virtual clock cannot drive them */
+};
+
+/* Opens what cfg->backend names (not started yet). log gets start-up
+ * progress (may be NULL). On error d->msg says what is wrong. */
+int ncp_backend_open(struct ncp_backend *b, const struct ncp_machine_cfg *cfg, FILE *log,
+                     struct ncp_diag *d);
+int ncp_backend_open_sim(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
+                         struct ncp_diag *d);
+int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
+                               FILE *log, struct ncp_diag *d);
+
+/* ---- socketcan: position scaling and configuration checks -------------- */
+
+/* mm -> encoder counts, rounded to nearest; -1 when out of the int32 range. */
+int ncp_mm_to_counts(double mm, double counts_per_mm, int32_t *counts);
+double ncp_counts_to_mm(int32_t counts, double counts_per_mm);
+/* Every axis has a NODE_ID and COUNTS_PER_MM, its soft limits fit in 32-bit
+ * counts, [CAN] INTERFACE is set; else d->msg names section and key. */
+int ncp_socketcan_check_cfg(const struct ncp_machine_cfg *cfg, struct ncp_diag *d);
 
 #endif

@@ -6,6 +6,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "ncpar/diag.h"
 
@@ -44,6 +45,11 @@ int ncp_can_send(struct ncp_can_bus *bus, const struct ncp_can_frame *f,
 /* 1: frame read; 0: nothing within timeout_ms; -1: error (in d). */
 int ncp_can_recv(struct ncp_can_bus *bus, struct ncp_can_frame *f, int timeout_ms,
                  struct ncp_diag *d);
+/* Real-time variants: one non-blocking send()/recv() (MSG_DONTWAIT), no
+ * formatting. try_send: 0 sent, 1 queue full (try next period), -1 error in
+ * errno. try_recv: 1 frame, 0 nothing waiting, -1 error in errno. */
+int ncp_can_try_send(struct ncp_can_bus *bus, const struct ncp_can_frame *f);
+int ncp_can_try_recv(struct ncp_can_bus *bus, struct ncp_can_frame *f);
 
 /* ---- NMT, SYNC ------------------------------------------------------- */
 enum ncp_nmt_cmd {
@@ -167,5 +173,103 @@ enum ncp_co_event ncp_co_track(struct ncp_co_node *nodes, size_t n,
  * from since_ms when none came yet); else the loss, described in d. */
 int ncp_co_check_heartbeat(const struct ncp_co_node *node, int64_t now_ms,
                            int64_t since_ms, int timeout_ms, struct ncp_diag *d);
+
+/* ---- the master of a set of CSP drives ------------------------------ */
+#define NCP_CO_MAX_NODES 8
+
+/* 0x60C2 interpolation time period: value * 10^index s. Picks the coarsest
+ * exact unit for period_us; -1 when none fits a byte. */
+int ncp_co_interp_period(long period_us, uint8_t *value, int8_t *index);
+
+struct ncp_co_master_cfg {
+    long period_us;       /* SYNC period = servo period */
+    int sdo_timeout_ms;
+    int hb_period_ms;     /* heartbeat producer time written to 0x1017 */
+    int hb_timeout_ms;    /* a drive silent this long is lost */
+};
+
+enum ncp_co_fault_kind {
+    NCP_CO_FAULT_NONE,
+    NCP_CO_FAULT_EMCY,      /* an EMCY frame */
+    NCP_CO_FAULT_HEARTBEAT, /* no heartbeat within the timeout */
+    NCP_CO_FAULT_NMT,       /* heartbeat says the node left Operational */
+    NCP_CO_FAULT_STATE,     /* statusword left Operation enabled */
+    NCP_CO_FAULT_BUS,       /* the socket refused frames */
+    NCP_CO_FAULT_START,     /* start-up (SDO, state machine): text says what */
+};
+
+/* What went wrong, recorded on the real-time path as plain values; turned
+ * into text afterwards by ncp_co_fault_describe. */
+struct ncp_co_fault {
+    enum ncp_co_fault_kind kind;
+    uint8_t node;
+    struct ncp_emcy emcy;         /* EMCY */
+    uint16_t statusword;          /* STATE */
+    int32_t error_code;           /* STATE: 0x603F read after the stop, -1 unknown */
+    int64_t hb_age_ms;            /* HEARTBEAT: -1 = none received at all */
+    int hb_timeout_ms;
+    uint8_t hb_state;             /* HEARTBEAT, NMT: the last NMT state reported */
+    uint32_t cob;                 /* BUS: the frame that could not go out */
+    int err;                      /* BUS: errno, 0 = queue full for too long */
+    char text[NCP_DIAG_MSG_MAX];  /* START */
+};
+/* "node 5: EMCY (0x085): error code 0x8611 following error; ..." */
+void ncp_co_fault_describe(const struct ncp_co_fault *f, const char *ifname, char *buf,
+                           size_t len);
+
+struct ncp_co_master {
+    struct ncp_can_bus bus;
+    struct ncp_co_node node[NCP_CO_MAX_NODES];
+    uint16_t cw[NCP_CO_MAX_NODES];      /* controlword sent in RPDO1 */
+    int32_t target[NCP_CO_MAX_NODES];   /* target position sent in RPDO1, counts */
+    uint8_t enabled[NCP_CO_MAX_NODES];  /* reached Operation enabled */
+    size_t n;
+    struct ncp_co_master_cfg cfg;
+    FILE *log;                          /* start-up progress, or NULL */
+    int64_t started_ms;                 /* NMT start: heartbeats counted from here */
+    long cycle;                         /* SYNCs sent */
+    unsigned tx_full;                   /* consecutive periods with a full queue */
+    struct ncp_co_fault fault;
+    /* blocking cycles call this for every TPDO taken in (tests judge them) */
+    void (*on_tpdo)(void *ctx, size_t i);
+    void *on_tpdo_ctx;
+};
+
+/* Opens ifname with receive filters for these nodes' SDO, TPDO1, EMCY and
+ * heartbeat identifiers. */
+int ncp_co_master_open(struct ncp_co_master *m, const char *ifname, const uint8_t *nodes,
+                       size_t n, const struct ncp_co_master_cfg *cfg, struct ncp_diag *d);
+void ncp_co_master_close(struct ncp_co_master *m);
+
+/* ---- start-up and stop: blocking, never on the real-time thread ------- */
+/* SDO configuration of node i: device type, CSP mode (confirmed by 0x6061),
+ * interpolation period, PDO 1 mapping, heartbeat producer. */
+int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *d);
+/* Every node configured, NMT start, then the CiA 402 walk to Operation
+ * enabled (fault reset on the way). targets = actual positions after it. On
+ * failure m->fault.kind != NONE and d->msg names node, object and cause. */
+int ncp_co_master_startup(struct ncp_co_master *m, struct ncp_diag *d);
+int ncp_co_master_enable(struct ncp_co_master *m, struct ncp_diag *d);
+/* One period in blocking style: take in what arrived, RPDOs + SYNC, wait for
+ * every node's TPDO of this SYNC (period + 100 ms at most: a missing one is
+ * not fatal), check for faults, sleep out the period. */
+int ncp_co_master_cycle(struct ncp_co_master *m, struct ncp_diag *d);
+/* Controlled stop: every drive holds for a few periods (after a fault at
+ * its actual position, else at its last target), then shutdown (0x06) and
+ * NMT pre-operational. After a STATE fault it reads
+ * the drive's error code 0x603F into m->fault. */
+void ncp_co_master_stop(struct ncp_co_master *m);
+
+/* ---- real-time path: no allocation, no locks, no blocking ------------ */
+/* Takes in at most max waiting frames. -1 (m->fault set) on an EMCY. */
+int ncp_co_master_poll(struct ncp_co_master *m, int64_t now_ms, int max);
+/* Heartbeats and device states of the enabled drives; -1 with m->fault. */
+int ncp_co_master_check(struct ncp_co_master *m, int64_t now_ms);
+/* RPDO1 of every node, then SYNC. A full transmit queue skips the rest of
+ * the period's frames, SYNC included (the drives take their new targets at
+ * the next SYNC); -1 with m->fault after 50 such periods in a row, or at
+ * once on a socket error. */
+int ncp_co_master_send(struct ncp_co_master *m);
+int64_t ncp_co_now_ms(void);
 
 #endif

@@ -17,6 +17,22 @@ struct ncp_axis_cfg {
     double min_limit, max_limit;  /* soft limits, mm */
     double max_vel, max_acc, max_jerk;
     double ferror;                /* following-error fault limit, mm */
+    /* socketcan backend: the CiA 402 drive of this axis (0 = none) and its
+     * position scaling, encoder counts per mm (0 = not set) */
+    int node_id;
+    double counts_per_mm;
+};
+
+/* What the position loop drives (backend.h): the simulated machine, or CiA 402
+ * drives over SocketCAN. */
+enum ncp_backend_kind { NCP_BACKEND_SIM, NCP_BACKEND_SOCKETCAN };
+
+/* [CAN] */
+struct ncp_can_cfg {
+    char interface[16];           /* INTERFACE, e.g. can0 ("" = not set) */
+    int heartbeat_period_ms;      /* HEARTBEAT_PERIOD_MS: drives' producer time (0x1017) */
+    int heartbeat_timeout_ms;     /* HEARTBEAT_TIMEOUT_MS: later than this = lost */
+    int sdo_timeout_ms;           /* SDO_TIMEOUT_MS: start-up SDO answer deadline */
 };
 
 /* One thread's placement: cpu < 0 lets the OS place it; priority 0 = SCHED_OTHER. */
@@ -41,6 +57,8 @@ struct ncp_machine_cfg {
      * an integer multiple of servo_period; the position loop fine-interpolates
      * between its points. 0 = servo_period (no fine interpolation). */
     double planning_period;
+    enum ncp_backend_kind backend; /* not from the INI: cnc-run run --backend */
+    struct ncp_can_cfg can;
 };
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c);
@@ -110,6 +128,10 @@ struct ncp_setpoint {
 };
 
 enum ncp_sp_flags { NCP_SP_END = 1u, NCP_SP_STARVED = 2u };
+/* What kind of move a setpoint lies on (trace column `motion`, the plot):
+ * neither bit = a feed (G1, a G64 corner blend, a dwell, rest). */
+enum ncp_sp_motion { NCP_SP_RAPID = 4u, NCP_SP_ARC = 8u };
+#define NCP_SP_MOTION_MASK (NCP_SP_RAPID | NCP_SP_ARC)
 
 struct ncp_planner;
 

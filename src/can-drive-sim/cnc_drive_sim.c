@@ -29,6 +29,9 @@ static void usage(FILE *f)
           "  --sdo-abort INDEX         abort every SDO access to object INDEX (0x6060...)\n"
           "  --drop-every K            drop every K-th TPDO\n"
           "  --max-step COUNTS         plant slew limit per SYNC (default 1000000)\n"
+          "  --config INI --axis X|Y|Z the servo plant of cnc-run's sim backend for that\n"
+          "                            axis ([SIM] gains, COUNTS_PER_MM; period from 0x60C2)\n"
+          "                            instead of the slew-limited plant\n"
           "  --verbose                 log state changes on stderr\n"
           "Answers NMT, SDO (expedited), SYNC and RPDO1/TPDO1 (controlword+target,\n"
           "statusword+actual); heartbeat period from object 0x1017 (default 100 ms).\n",
@@ -56,9 +59,11 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         {"slow-sdo", required_argument, 0, 's'},     {"sdo-abort", required_argument, 0, 'a'},
         {"drop-every", required_argument, 0, 'd'},   {"max-step", required_argument, 0, 'm'},
         {"verbose", no_argument, 0, 'v'},            {"help", no_argument, 0, 'h'},
+        {"config", required_argument, 0, 'c'},       {"axis", required_argument, 0, 'x'},
         {0, 0, 0, 0}};
     *o = (struct drive_opts){.node = 0, .fault_after = -1, .emcy_after = -1,
-                             .hb_stop_after = -1, .abort_index = -1, .max_step = 1000000};
+                             .hb_stop_after = -1, .abort_index = -1, .max_step = 1000000,
+                             .axis = -1};
     int c;
     while ((c = getopt_long(argc, argv, "n:v", lo, NULL)) != -1) {
         switch (c) {
@@ -72,6 +77,14 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         case 'd': o->drop_every = num(optarg, "--drop-every", 1, 1L << 30); break;
         case 'm': o->max_step = (int32_t)num(optarg, "--max-step", 1, 1L << 30); break;
         case 'v': o->verbose = 1; break;
+        case 'c': o->config = optarg; break;
+        case 'x':
+            if (!optarg[0] || optarg[1] || !strchr("XYZxyz", optarg[0])) {
+                fprintf(stderr, "cnc-drive-sim: --axis is X, Y or Z\n");
+                exit(1);
+            }
+            o->axis = (int)(strchr("XYZ", optarg[0] & ~0x20) - "XYZ");
+            break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); exit(1);
         }
@@ -94,6 +107,8 @@ int main(int argc, char **argv)
 {
     static struct drive dv;
     const char *ifname = parse(argc, argv, &dv.o);
+    if (drive_servo_load(&dv))
+        return 1;
     struct ncp_diag d;
     if (ncp_can_open(&dv.bus, ifname, &d) != NCP_OK) {
         fprintf(stderr, "cnc-drive-sim: %s\n", d.msg);

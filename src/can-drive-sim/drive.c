@@ -58,8 +58,10 @@ static void apply_controlword(struct drive *dv, uint16_t cw)
     enum ncp_cia402_state next = ncp_cia402_apply(dv->st, cw, dv->prev_cw);
     if (dv->st == NCP_402_FAULT && next != NCP_402_FAULT)
         od_set(&dv->od, 0x603F, 0, 0);
-    if (next == NCP_402_OPERATION_ENABLED && dv->st != next)
+    if (next == NCP_402_OPERATION_ENABLED && dv->st != next) {
         dv->target = dv->actual; /* no jump on enabling */
+        drive_servo_enable(dv);
+    }
     set_state(dv, next);
 }
 
@@ -92,7 +94,8 @@ static int on_sync(struct drive *dv)
         return 0;
     if (dv->st == NCP_402_OPERATION_ENABLED) {
         dv->syncs_enabled++;
-        dv->actual = plant_step(dv->actual, dv->target, dv->o.max_step);
+        dv->actual = dv->servo ? drive_servo_step(dv)
+                               : plant_step(dv->actual, dv->target, dv->o.max_step);
         od_set(&dv->od, 0x6064, 0, (uint32_t)dv->actual);
         if (dv->syncs_enabled == dv->o.emcy_after && go_fault(dv, 0x8611, 1) < 0)
             return -1;

@@ -4,6 +4,7 @@
 
 #include <stdint.h>
 
+#include "ncpar/backend.h"
 #include "ncpar/can.h"
 #include "od.h"
 
@@ -18,6 +19,10 @@ struct drive_opts {
     long drop_every;      /* drop every N-th TPDO; 0 never */
     int32_t max_step;     /* plant slew limit, counts per SYNC */
     int verbose;
+    /* --config INI --axis X|Y|Z: the sim backend's servo plant of that axis
+     * ([SIM] gains, COUNTS_PER_MM) instead of the slew limit */
+    const char *config;
+    int axis;             /* 0..2, -1 = none */
 };
 
 struct drive {
@@ -30,7 +35,19 @@ struct drive {
     int32_t target, actual;
     long syncs_enabled, tpdos;
     int heartbeat_on;
+    /* servo plant (o.config): one axis of the sim backend's machine */
+    int servo;
+    struct ncp_machine_cfg cfg;
+    struct ncp_sim sim;
+    int32_t prev_target;  /* target of the previous SYNC: this period's command */
 };
+
+/* Loads o.config for the servo plant; -1 with a message on stderr. */
+int drive_servo_load(struct drive *dv);
+/* Entering Operation enabled: the plant starts where the drive stands. */
+void drive_servo_enable(struct drive *dv);
+/* One SYNC of the plant; returns the actual position (counts) at the SYNC. */
+int32_t drive_servo_step(struct drive *dv);
 
 void drive_boot(struct drive *dv);
 /* Handles one received frame; returns -1 on a bus error. */

@@ -123,3 +123,46 @@ int ncp_can_recv(struct ncp_can_bus *bus, struct ncp_can_frame *f, int timeout_m
     memcpy(f->data, cf.data, f->len);
     return 1;
 }
+
+/* One send() with MSG_DONTWAIT: the real-time path never waits for the queue. */
+int ncp_can_try_send(struct ncp_can_bus *bus, const struct ncp_can_frame *f)
+{
+    struct can_frame cf;
+    memset(&cf, 0, sizeof cf);
+    cf.can_id = (f->id & CAN_SFF_MASK) | (f->rtr ? CAN_RTR_FLAG : 0);
+    cf.can_dlc = f->len > 8 ? 8 : f->len;
+    memcpy(cf.data, f->data, cf.can_dlc);
+    ssize_t w;
+    do
+        w = send(bus->fd, &cf, sizeof cf, MSG_DONTWAIT);
+    while (w < 0 && errno == EINTR);
+    if (w == (ssize_t)sizeof cf)
+        return 0;
+    if (w < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS))
+        return 1;
+    if (w >= 0)
+        errno = EIO;
+    return -1;
+}
+
+int ncp_can_try_recv(struct ncp_can_bus *bus, struct ncp_can_frame *f)
+{
+    struct can_frame cf;
+    ssize_t n;
+    do
+        n = recv(bus->fd, &cf, sizeof cf, MSG_DONTWAIT);
+    while (n < 0 && errno == EINTR);
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK))
+        return 0;
+    if (n != (ssize_t)sizeof cf) {
+        if (n >= 0)
+            errno = EIO;
+        return -1;
+    }
+    memset(f, 0, sizeof *f);
+    f->id = cf.can_id & CAN_SFF_MASK;
+    f->rtr = (cf.can_id & CAN_RTR_FLAG) != 0;
+    f->len = cf.can_dlc > 8 ? 8 : cf.can_dlc;
+    memcpy(f->data, cf.data, f->len);
+    return 1;
+}

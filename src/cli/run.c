@@ -3,6 +3,7 @@
  * runtime itself is ncp_nck_run (src/rt/). */
 #include "run.h"
 
+#include "ncpar/backend.h"
 #include "ncpar/feeder.h"
 #include "ncpar/motion.h"
 #include "ncpar/pipeline.h"
@@ -24,6 +25,7 @@ struct run_opts {
     double feed_override;       /* 1.0 = 100 % */
     int virtual_clock;
     enum ncp_thread_mode mode;
+    const char *backend;        /* --backend as given, NULL = sim */
 };
 
 struct interp_ctx {
@@ -49,8 +51,9 @@ static void usage(FILE *f)
     fputs("usage: cnc-run run PROG [--config INI] [--trace CSV] [--plot PNG] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
           "                        [--mode serial|det|att] [--tool-table FILE]\n"
-          "Runs PROG on the simulated machine: interpreter -> look-ahead planner ->\n"
-          "interpolator -> position loop (SCHED_FIFO when permitted).\n"
+          "                        [--backend sim|socketcan[:IFACE]]\n"
+          "Runs PROG on the simulated machine (or CiA 402 drives over CAN): interpreter ->\n"
+          "look-ahead planner -> interpolator -> position loop (SCHED_FIFO when permitted).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill)\n"
           "  --trace CSV         per-cycle trace: t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v\n"
           "  --plot PNG          picture of the run (tools/plot-trace.py, python3-matplotlib):\n"
@@ -59,6 +62,14 @@ static void usage(FILE *f)
           "  --feed-override PCT 1..200 (default 100)\n"
           "  --clock virtual     simulated clock, as fast as the CPU allows\n"
           "  --tool-table FILE   LinuxCNC tool table (default: rs274's built-in T1-T3)\n"
+          "  --backend sim       the simulated machine (default)\n"
+          "  --backend socketcan[:IFACE]  CiA 402 drives in CSP mode over SocketCAN on\n"
+          "                      IFACE (default: the INI's [CAN] INTERFACE); each axis\n"
+          "                      needs [AXIS_n] NODE_ID and COUNTS_PER_MM; real clock only.\n"
+          "                      A drive fault (EMCY, heartbeat loss, drive leaving\n"
+          "                      Operation enabled, SDO failure) stops all axes: exit 3.\n"
+          "                      The trace's actual positions are then the drives' TPDOs,\n"
+          "                      one servo period old\n"
           "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault / soft limit\n",
           f);
 }
@@ -85,18 +96,20 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "clock", required_argument, 0, 'k' },
         { "mode", required_argument, 0, 'm' },
         { "tool-table", required_argument, 0, 'T' },
+        { "backend", required_argument, 0, 'b' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
     double pct;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': o->config = optarg; break;
         case 't': o->trace = optarg; break;
         case 'p': o->plot = optarg; break;
         case 'T': o->tool_table = optarg; break;
+        case 'b': o->backend = optarg; break;
         case 'f':
             if (parse_num(optarg, 1e-6, 1e9, &o->for_s))
                 return fprintf(stderr, "cnc-run run: --for wants a positive number of seconds\n"), -1;
@@ -144,8 +157,17 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                 res->diag.line, res->diag.msg);
         return RUN_FAULT;
     }
+    int drive_fault = res->status == RUN_FAULT && res->diag.code == NCP_ERR_IO && !res->fault;
+    if (drive_fault && res->lat.cycles == 0) {
+        fprintf(stderr, "%s: error: drive start-up failed: %s (nothing moved)\n", o->prog,
+                res->diag.msg);
+        return RUN_FAULT;
+    }
     ncp_nck_print_summary(res, o->prog, stderr);
-    if (res->fault) {
+    if (drive_fault) {
+        fprintf(stderr, "%s:%u: error: drive fault: %s; controlled stop of all axes\n", o->prog,
+                res->diag.line, res->diag.msg);
+    } else if (res->fault) {
         fprintf(stderr,
                 "%s:%u: error: following error on %c: %.4f mm exceeds FERROR %.4f mm; servo stopped\n",
                 o->prog, res->fault_line, "XYZ"[res->fault_axis], res->fault_err,
@@ -159,13 +181,43 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
     return res->status;
 }
 
+/* --backend sim | socketcan | socketcan:IFACE, over what the INI said. */
+static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
+{
+    const char *b = o->backend;
+    if (!b || !strcmp(b, "sim")) {
+        cfg->backend = NCP_BACKEND_SIM;
+        return 0;
+    }
+    if (strncmp(b, "socketcan", 9) != 0 || (b[9] != 0 && b[9] != ':'))
+        return fprintf(stderr, "cnc-run run: --backend is sim or socketcan[:IFACE], not '%s'\n",
+                       b), -1;
+    cfg->backend = NCP_BACKEND_SOCKETCAN;
+    if (b[9] == ':') {
+        const char *ifc = b + 10;
+        if (!*ifc || strlen(ifc) >= sizeof cfg->can.interface || strpbrk(ifc, " \t/:"))
+            return fprintf(stderr, "cnc-run run: --backend socketcan: bad interface name '%s'\n",
+                           ifc), -1;
+        snprintf(cfg->can.interface, sizeof cfg->can.interface, "%s", ifc);
+    }
+    if (o->virtual_clock)
+        return fprintf(stderr, "cnc-run run: --backend socketcan drives real hardware: it "
+                               "needs --clock real\n"), -1;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (ncp_socketcan_check_cfg(cfg, &d) != NCP_OK)
+        return fprintf(stderr, "%s: error: %s\n", o->config ? o->config : "cnc-run run", d.msg),
+               -1;
+    return 0;
+}
+
 static int load_config(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 {
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     ncp_machine_cfg_default(cfg);
     if (!o->config || ncp_machine_cfg_load(cfg, o->config, &d) == NCP_OK)
-        return 0;
+        return apply_backend(o, cfg);
     if (d.line)
         fprintf(stderr, "%s:%u: error: %s\n", o->config, d.line, d.msg);
     else

@@ -16,7 +16,7 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->servo_period = 1e-3;
     c->max_linear_vel = 200.0;
     for (int i = 0; i < NCP_AXES; i++) {
-        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 100000.0, 1.0 };
+        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 100000.0, 1.0, 0, 0 };
     }
     c->axis[2].min_limit = -250.0;
     c->axis[2].max_limit = 50.0;
@@ -34,6 +34,12 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->position = (struct ncp_rt_place){ -1, 90 };
     c->planner = (struct ncp_rt_place){ -1, 0 };
     c->interp = (struct ncp_rt_place){ -1, 0 };
+    c->backend = NCP_BACKEND_SIM;
+    /* 10 heartbeats may go missing before the drive counts as lost; SDO
+     * answers come within a few ms from any drive that is there at all */
+    c->can.heartbeat_period_ms = 50;
+    c->can.heartbeat_timeout_ms = 500;
+    c->can.sdo_timeout_ms = 200;
 }
 
 struct load_ctx {
@@ -75,7 +81,10 @@ static int axis_key(struct ncp_axis_cfg *a, const char *k, const char *v)
         { "MAX_ACCELERATION", &a->max_acc, 1e-6, 1e8 },
         { "MAX_JERK", &a->max_jerk, 0, 1e12 },
         { "FERROR", &a->ferror, 1e-9, 1e6 },
+        { "COUNTS_PER_MM", &a->counts_per_mm, 1e-3, 1e9 },
     };
+    if (!strcasecmp(k, "NODE_ID"))
+        return integer(v, 1, 127, &a->node_id) ? -1 : 1;
     for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
         if (!strcasecmp(k, keys[i].name))
             return num(v, keys[i].lo, keys[i].hi, keys[i].dst) ? -1 : 1;
@@ -128,6 +137,27 @@ static int sim_key(struct ncp_machine_cfg *c, const char *k, const char *v)
     return 0;
 }
 
+static int can_key(struct ncp_can_cfg *c, const char *k, const char *v)
+{
+    if (!strcasecmp(k, "INTERFACE")) {
+        /* what the kernel accepts as an interface name (IFNAMSIZ) */
+        size_t n = strlen(v);
+        if (n == 0 || n >= sizeof c->interface || strpbrk(v, " \t/:"))
+            return -1;
+        memcpy(c->interface, v, n + 1);
+        return 1;
+    }
+    const struct { const char *name; int *dst; int lo, hi; } keys[] = {
+        { "HEARTBEAT_PERIOD_MS", &c->heartbeat_period_ms, 1, 65535 },
+        { "HEARTBEAT_TIMEOUT_MS", &c->heartbeat_timeout_ms, 1, 600000 },
+        { "SDO_TIMEOUT_MS", &c->sdo_timeout_ms, 1, 600000 },
+    };
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
+        if (!strcasecmp(k, keys[i].name))
+            return integer(v, keys[i].lo, keys[i].hi, keys[i].dst) ? -1 : 1;
+    return 0;
+}
+
 static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, const char *v)
 {
     double x;
@@ -165,6 +195,8 @@ static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, c
         return sim_key(c, k, v);
     if (!strcasecmp(sec, "RT"))
         return rt_key(c, k, v);
+    if (!strcasecmp(sec, "CAN"))
+        return can_key(&c->can, k, v);
     return -2;
 }
 
@@ -212,7 +244,17 @@ static int check_cfg(const struct ncp_machine_cfg *c, const char *path, struct n
             return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                                 "%s: [AXIS_%c] MIN_LIMIT must be below MAX_LIMIT", path,
                                 "XYZ"[i]);
+        for (int j = 0; j < i; j++)
+            if (c->axis[i].node_id && c->axis[i].node_id == c->axis[j].node_id)
+                return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
+                                    "%s: [AXIS_%c] NODE_ID %d is already the node of [AXIS_%c]",
+                                    path, "XYZ"[i], c->axis[i].node_id, "XYZ"[j]);
     }
+    if (c->can.heartbeat_timeout_ms <= c->can.heartbeat_period_ms)
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
+                            "%s: [CAN] HEARTBEAT_TIMEOUT_MS %d must be longer than "
+                            "HEARTBEAT_PERIOD_MS %d",
+                            path, c->can.heartbeat_timeout_ms, c->can.heartbeat_period_ms);
     /* a late planner thread makes the position loop slow down along the path
      * on what is left in the ring (src/rt/nck.c): half a stop from the top
      * speed at half the weakest axis's acceleration has to fit */

@@ -41,6 +41,11 @@ static void sample(struct ncp_planner *p, struct ncp_setpoint *out)
     } else {
         double s = ncp_trap_eval(&p->trap, p->t, &v);
         ncp_seg_eval(&ps->s, s, p->pos, out->dir);
+        /* a blend arc is part of the feed path around a corner, not a G2/G3 */
+        if (ps->s.traverse)
+            out->flags |= NCP_SP_RAPID;
+        else if (ps->s.kind == NCP_SEG_ARC && !ps->blend)
+            out->flags |= NCP_SP_ARC;
     }
     p->v_now = v;
     out->v = v;

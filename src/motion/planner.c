@@ -9,15 +9,18 @@
 #include <string.h>
 
 /* With fine interpolation (src/rt/scaler.c) the servo cycles between two
- * rough points follow a cubic through their positions and velocities. Where
- * the planned acceleration changes inside a planning period the cubic's
- * acceleration overshoots it, by up to 2/3 when it reverses (a dip into a
- * junction), so the plan keeps 3/5 of each limit. A corner's velocity step
- * is spread over the period instead of one servo cycle; the cubic turns a
- * step dv into at most 4 dv / Tp, which the kink caps below keep within
- * their share when they take Tp / 4 as the period of the step. Its velocity
- * strays from the plan by at most da Tp / 12 for an acceleration change da
- * (<= 2 a) inside the period: the velocity caps keep that much room. */
+ * rough points follow a quintic through their positions, velocities and
+ * accelerations (each point's acceleration that of the cubic through it and
+ * the point before). Where the planned acceleration changes inside a
+ * planning period the curve's acceleration overshoots it (a cubic's by up to
+ * 2/3 when it reverses, a dip into a junction), so the plan keeps 3/5 of
+ * each limit. A corner's velocity step is spread over the period instead of
+ * one servo cycle, at most 4 dv / Tp, which the kink caps below keep within
+ * their share when they take Tp / 4 as the period of the step (with the
+ * S-curve the same caps keep the jerk of that spreading within the limit).
+ * Its velocity strays from the plan by at most da Tp / 12 for an
+ * acceleration change da (<= 2 a) inside the period: the velocity caps keep
+ * that much room. tests/unit/test_motion_ipo.c checks the servo output. */
 static void fine_ipo_margins(struct ncp_machine_cfg *c)
 {
     int ratio = ncp_machine_cfg_ipo_ratio(c);
@@ -42,6 +45,15 @@ struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
     if (!p)
         return NULL;
     p->cfg = *cfg;
+    /* a blend arc's speed keeps its centripetal acceleration a_c below 0.62 of
+     * the largest axis limit a (arc_limits), so a servo step's chord lies at
+     * most a_c T^2 / 8 inside it; read at a fraction of a sample (after a rate
+     * change, src/rt/scaler.c) a step across a sample cuts in up to twice
+     * that again: a T^2 / 4 covers both */
+    double a_max = 0;
+    for (int j = 0; j < NCP_AXES; j++)
+        a_max = fmax(a_max, cfg->axis[j].max_acc);
+    p->chord = a_max * cfg->servo_period * cfg->servo_period / 4;
     fine_ipo_margins(&p->cfg);
     /* room for a blend arc per programmed segment: the window is LOOKAHEAD blocks */
     p->cap = 2 * (size_t)(cfg->lookahead > 1 ? cfg->lookahead : 1) + 2;
@@ -323,7 +335,11 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     struct plan_seg arc;
     double d;
     memset(&arc, 0, sizeof arc);
-    if (kink_harmless(p, &prev->s, s, prev->vmax) || !ncp_blend_corner(&prev->s, s, &arc.s, &d))
+    /* G64 P bounds what the servo gets: its chords across the arc too */
+    struct ncp_seg tol = prev->s;
+    if (tol.tolerance > 0)
+        tol.tolerance = fmax(0.25 * tol.tolerance, tol.tolerance - p->chord);
+    if (kink_harmless(p, &prev->s, s, prev->vmax) || !ncp_blend_corner(&tol, s, &arc.s, &d))
         return 0;
     arc_limits(p, &arc);
     double exit_lb = fmin(arc.vmax, plan_reach(p, arc.acc, arc.jerk, 0, arc.s.length));

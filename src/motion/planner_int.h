@@ -35,6 +35,7 @@ struct ncp_planner {
     int have_last;           /* last_pushed valid: junctions need the previous segment */
     struct ncp_seg last_pushed;
     double last_vmax;        /* its cruise cap */
+    double chord;            /* how far a servo chord of a blend arc cuts inside it, mm */
     struct ncp_planner_stats st;
 };
 

@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <sched.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -223,7 +224,8 @@ static double rate_target(struct nck *n)
  * its feed-forward uses the velocity of the interval it is about to drive. */
 static int take_setpoint(struct nck *n)
 {
-    if (!n->ended && n->o->virtual_clock && ncp_spsc_count(&n->sps) == 0 &&
+    if (!n->ended && n->o->virtual_clock &&
+        ncp_spsc_count(&n->sps) < nck_scaler_wants(&n->scaler, ncp_spsc_capacity(&n->sps)) &&
         !atomic_load(&n->planner_done))
         return NCP_RT_RETRY;
     n->cur = n->next;
@@ -234,6 +236,15 @@ static int take_setpoint(struct nck *n)
         n->end_ns = n->now_ns;
     }
     return NCP_RT_CONTINUE;
+}
+
+/* The line of the setpoint changes when its block's motion is complete. */
+static void track_blocks(struct nck *n)
+{
+    if (n->cur.line != n->line_now) {
+        n->line_done = n->line_now;
+        n->line_now = n->cur.line;
+    }
 }
 
 static int position_cycle(void *ctx, int64_t now_ns)
@@ -249,13 +260,22 @@ static int position_cycle(void *ctx, int64_t now_ns)
     if (take_setpoint(n) == NCP_RT_RETRY)
         return NCP_RT_RETRY;
     struct nck_fb fb;
-    ncp_sim_step(&n->sim, n->cur.pos, n->next.pos, fb.act);
+    int be_rc = n->be->ops->cycle(n->be, n->cur.pos, n->next.pos, fb.act);
+    track_blocks(n);
     fb.t = (double)now_ns * 1e-9;
     fb.v = n->cur.v;
     fb.line = n->cur.line;
+    fb.flags = n->cur.flags;
     memcpy(fb.cmd, n->cur.pos, sizeof fb.cmd);
     if (ncp_spsc_push(&n->fbs, &fb) != 0)
         n->fb_dropped++;
+    /* A drive fault (EMCY, heartbeat, device state, bus) ends the loop; the
+     * backend's stop() then brings every axis to a controlled stop. */
+    if (be_rc != 0) {
+        n->backend_fault = 1;
+        n->fault_line = n->cur.line;
+        return NCP_RT_STOP;
+    }
     /* A following-error fault stops the loop: the servo is disabled where it
      * stands (as LinuxCNC does), and the run reports the commanding line. */
     if (check_ferror(n, fb.act))
@@ -290,9 +310,11 @@ void ncp_nck_feed_hold(struct ncp_nck_ctl *c, int hold)
 
 /* ---- set-up and results ---------------------------------------------------------- */
 
-static int init(struct nck *n, const struct ncp_nck_opts *o, const double start[NCP_AXES])
+static int init(struct nck *n, const struct ncp_nck_opts *o, const double start[NCP_AXES],
+                struct ncp_backend *be)
 {
     n->o = o;
+    n->be = be;
     n->cfg = o->cfg;
     n->ctl = o->ctl;
     if (!n->ctl) {
@@ -300,7 +322,6 @@ static int init(struct nck *n, const struct ncp_nck_opts *o, const double start[
         n->ctl = &n->own_ctl;
     }
     ncp_canon_map_init(&n->map, o->cfg, start, o->feed_override);
-    ncp_sim_init(&n->sim, o->cfg, start);
     memcpy(n->next.pos, start, sizeof n->next.pos);
     double a_min = o->cfg->axis[0].max_acc;
     for (int j = 1; j < NCP_AXES; j++)
@@ -311,8 +332,7 @@ static int init(struct nck *n, const struct ncp_nck_opts *o, const double start[
     if (ratio < 1)
         return -1;
     nck_scaler_set_ratio(&n->scaler, ratio);
-    for (int j = 0; j < NCP_AXES; j++)
-        n->scaler.amax[j] = o->cfg->axis[j].max_acc;
+    nck_scaler_limits(&n->scaler, o->cfg);
     n->planner = ncp_planner_new(o->cfg, start);
     if (!n->planner || ncp_spsc_init(&n->segs, sizeof(struct nck_seg_msg), SEG_RING) ||
         ncp_spsc_init(&n->sps, sizeof(struct ncp_setpoint), (size_t)o->cfg->setpoint_ring) ||
@@ -332,6 +352,20 @@ static void fini(struct nck *n)
     ncp_spsc_destroy(&n->sps);
     ncp_spsc_destroy(&n->fbs);
     ncp_planner_free(n->planner);
+}
+
+/* "node 2: EMCY (0x082): ... (last completed block: line 7)", at the line
+ * of the block in progress. */
+static void backend_diag(const struct nck *n, struct ncp_nck_result *res)
+{
+    char why[NCP_DIAG_MSG_MAX];
+    n->be->ops->describe_fault(n->be, why, sizeof why);
+    char done[48] = "none";
+    if (n->line_done)
+        snprintf(done, sizeof done, "line %u", n->line_done);
+    ncp_diag_set(&res->diag, NCP_ERR_IO, n->fault_line, 0, "%.*s (last completed block: %s)",
+                 (int)(sizeof res->diag.msg - 40), why, done);
+    res->status = NCP_NCK_FAULT;
 }
 
 static void collect(const struct nck *n, const struct nck_summary *s, struct ncp_nck_result *res)
@@ -358,7 +392,9 @@ static void collect(const struct nck *n, const struct nck_summary *s, struct ncp
     memcpy(res->warning, n->loop.warning, sizeof res->warning);
     res->lat = n->loop.stats;
     res->for_expired = n->for_expired;
-    if (n->fault) {
+    if (n->backend_fault) {
+        backend_diag(n, res);
+    } else if (n->fault) {
         res->fault = 1;
         res->fault_axis = n->fault_axis;
         res->fault_err = n->fault_err;
@@ -396,24 +432,60 @@ static int run_threads(struct nck *n, struct nck_summary *s)
     return rc ? -1 : 0;
 }
 
+/* Brings the backend up before anything moves; a failure there (SDO, state
+ * machine, no drive) is a fault with no line: nothing has run. */
+static int start_backend(const struct ncp_nck_opts *o, struct ncp_backend *be,
+                         double start[NCP_AXES], struct ncp_nck_result *res)
+{
+    if (ncp_backend_open(be, o->cfg, o->progress ? o->progress : stderr, &res->diag) != NCP_OK) {
+        res->diag.code = NCP_ERR_IO;
+        return -1;
+    }
+    if (be->real_clock_only && o->virtual_clock) {
+        ncp_diag_set(&res->diag, NCP_ERR_IO, 0, 0,
+                     "the %s backend drives real hardware: it needs the real clock",
+                     be->ops->name);
+        be->ops->close(be);
+        return -1;
+    }
+    if (be->ops->start(be, start) != 0) {
+        char why[NCP_DIAG_MSG_MAX];
+        be->ops->describe_fault(be, why, sizeof why);
+        ncp_diag_set(&res->diag, NCP_ERR_IO, 0, 0, "%s", why);
+        be->ops->stop(be);
+        be->ops->close(be);
+        return -1;
+    }
+    return 0;
+}
+
 int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
 {
     double start[NCP_AXES] = { 0 };
     memset(res, 0, sizeof res[0]);
     ncp_rt_stats_reset(&res->lat);
+    struct ncp_backend be;
+    if (start_backend(o, &be, start, res))
+        return res->status = NCP_NCK_FAULT;
     int lim = precheck_limits(o, start, &res->diag);
     if (lim) {
         res->limit_violation = lim > 0;
+        be.ops->stop(&be);
+        be.ops->close(&be);
         return res->status = NCP_NCK_FAULT;
     }
     struct nck *n = calloc(1, sizeof *n);
     struct nck_summary *s = calloc(1, sizeof *s);
-    if (!n || !s || init(n, o, start) || run_threads(n, s)) {
+    if (!n || !s || init(n, o, start, &be) || run_threads(n, s)) {
         snprintf(res->diag.msg, sizeof res->diag.msg, "cannot set up the runtime");
         res->status = NCP_NCK_FAULT;
+        be.ops->stop(&be);
     } else {
+        /* after the loop, fault or not: the drives stop under control */
+        be.ops->stop(&be);
         collect(n, s, res);
     }
+    be.ops->close(&be);
     if (n)
         fini(n);
     free(n);

@@ -21,6 +21,7 @@ struct nck_fb {
     double t, v;
     double cmd[NCP_AXES], act[NCP_AXES];
     uint32_t line;
+    uint32_t flags;          /* the setpoint's (NCP_SP_RAPID / NCP_SP_ARC for the trace) */
 };
 
 struct nck_summary {
@@ -36,35 +37,7 @@ struct nck_summary {
 };
 
 /* scaler.c: reads the setpoint stream at a variable rate (see there). */
-struct nck_scaler {
-    struct ncp_setpoint a, b;  /* samples around the read position */
-    struct ncp_setpoint c;     /* the sample after b, fetched ahead (have_c) */
-    int have_c;
-    double f;                  /* read position between a (0) and b (1) */
-    double r;                  /* rate: setpoints per period, 0..1 */
-    double decel, period;
-    /* Per-axis acceleration limit the output's second difference must keep
-     * (INFINITY: unchecked); last two outputs for it. */
-    double amax[NCP_AXES];
-    double last[2][NCP_AXES];
-    int nlast;
-    /* Fine interpolation: servo periods per stream sample (1: the stream is
-     * at the servo rate and is read linearly, as before), and the stream's
-     * sample period. */
-    int ratio;
-    double tp;
-};
-
-void nck_scaler_init(struct nck_scaler *s, const double start[NCP_AXES], double decel,
-                     double period);
-double nck_scaler_stop_cycles(const struct nck_scaler *s);
-/* The stream comes every ratio periods: read it through cubic Hermite
- * interpolation on the samples' velocities (see scaler.c). */
-void nck_scaler_set_ratio(struct nck_scaler *s, int ratio);
-/* One period at a rate moving towards target. Returns -1 when the stream ran
- * dry in motion (the output holds the last sample), else 0. */
-int nck_scaler_step(struct nck_scaler *s, double target, struct ncp_spsc *ring,
-                    struct ncp_setpoint *out);
+#include "scaler.h"
 
 struct nck {
     const struct ncp_nck_opts *o;
@@ -74,7 +47,7 @@ struct nck {
     struct ncp_spsc segs, sps, fbs;
     struct ncp_planner *planner;
     struct ncp_canon_map map;
-    struct ncp_sim sim;
+    struct ncp_backend *be;          /* opened and started by ncp_nck_run */
     struct ncp_rt_loop loop;
     _Atomic int abort;
     _Atomic int planner_done;
@@ -91,6 +64,8 @@ struct nck {
     int ended, settle, fault, for_expired, fault_axis;
     double fault_err;
     uint32_t fault_line;
+    int backend_fault;               /* the backend's cycle failed (drive fault) */
+    uint32_t line_now, line_done;    /* block in progress, last completed block */
     int64_t end_ns, now_ns;
 };
 

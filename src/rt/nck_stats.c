@@ -42,6 +42,13 @@ static double contour_error(struct nck_summary *s, const struct nck_fb *fb)
     return best;
 }
 
+/* Trace column `motion`: 0 rapid (G0), 1 feed (G1, corner blends, rest),
+ * 2 arc (G2/G3, helices). */
+static int nck_motion_column(uint32_t flags)
+{
+    return flags & NCP_SP_RAPID ? 0 : flags & NCP_SP_ARC ? 2 : 1;
+}
+
 void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
 {
     double e2 = 0;
@@ -67,8 +74,9 @@ void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
     s->t = fb->t;
     s->v = fb->v;
     if (trace)
-        fprintf(trace, "%.6f,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f\n", fb->t, fb->line,
-                fb->cmd[0], fb->cmd[1], fb->cmd[2], fb->act[0], fb->act[1], fb->act[2], fb->v);
+        fprintf(trace, "%.6f,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%d\n", fb->t, fb->line,
+                fb->cmd[0], fb->cmd[1], fb->cmd[2], fb->act[0], fb->act[1], fb->act[2], fb->v,
+                nck_motion_column(fb->flags));
 }
 
 static int64_t mono_ns(void)
@@ -95,7 +103,7 @@ void nck_drain(struct nck *n, struct nck_summary *s)
     struct nck_fb fb;
     FILE *tty = n->o->progress;
     if (n->o->trace)
-        fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v\n", n->o->trace);
+        fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n", n->o->trace);
     for (;;) {
         int got = 0;
         while (ncp_spsc_pop(&n->fbs, &fb) == 0) {

@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Checks a `candump -L` capture of can-master-test's start-up of NODES:
+"""Checks a `candump -L` capture of a CAN master's start-up of NODES
+(can-master-test, or cnc-run run --backend socketcan):
 per node the SDO configuration in order, each request answered before the
 next; then NMT start; then the CiA 402 walk (0x06, 0x07, 0x0F) in RPDO 1;
 then the cyclic rhythm: every SYNC preceded by one RPDO per node and
@@ -9,16 +10,20 @@ the target of the RPDO before its SYNC once the drive is enabled.
 --lenient: any number of SYNCs late (qemu TCG: the drives' processes are
 scheduled in bursts), but never before its SYNC, and the capture must hold
 a TPDO for nearly every SYNC.
-Usage: check-startup.py [--strict|--lenient] CAPTURE NODE..."""
+--period-ms P: the SYNC period the master runs at (0x60C2:01), default 4.
+--servo: the drives run a servo plant (cnc-drive-sim --config), whose
+actual trails the target: TPDO values are not compared with the targets.
+Usage: check-startup.py [--strict|--lenient] [--period-ms P] CAPTURE NODE..."""
 import sys
 
 OP_ENABLED = 0x27  # statusword & 0x6F in Operation enabled
 MISSING_MAX = 2    # TPDOs of one node the end of the capture may cut off
+COMPARE_VALUES = True  # slew plant: a TPDO's actual is the target before its SYNC
 
 SDO_SEQUENCE = [  # (command byte, index, sub, value) the master sends
     (0x40, 0x1000, 0, None),
     (0x2F, 0x6060, 0, 8),
-    (0x2F, 0x60C2, 1, 1), (0x2F, 0x60C2, 2, 0xFD),
+    (0x2F, 0x60C2, 1, "period"), (0x2F, 0x60C2, 2, 0xFD),
     (0x2F, 0x1600, 0, 0), (0x23, 0x1600, 1, 0x60400010), (0x23, 0x1600, 2, 0x607A0020),
     (0x2F, 0x1600, 0, 2),
     (0x2F, 0x1A00, 0, 0), (0x23, 0x1A00, 1, 0x60410010), (0x23, 0x1A00, 2, 0x60640020),
@@ -42,8 +47,9 @@ def sdo_request(data):
     return (data[0], int.from_bytes(data[1:3], "little"), data[3], value)
 
 
-def check(path, nodes, strict):
+def check(path, nodes, strict, period_ms):
     errors = []
+    expected = [(c, i, s, period_ms if v == "period" else v) for c, i, s, v in SDO_SEQUENCE]
     log = list(frames(path))
     nmt = [i for i, (ident, data) in enumerate(log) if ident == 0 and data == b"\x01\x00"]
     if not nmt:
@@ -53,8 +59,8 @@ def check(path, nodes, strict):
         reqs = [(i, sdo_request(d)) for i, (ident, d) in enumerate(log[:start])
                 if ident == 0x600 + n]
         got = [r for _, r in reqs]
-        if got != SDO_SEQUENCE:
-            errors.append(f"node {n}: SDO requests {got} != expected {SDO_SEQUENCE}")
+        if got != expected:
+            errors.append(f"node {n}: SDO requests {got} != expected {expected}")
         for (i, req), nxt in zip(reqs, [j for j, _ in reqs[1:]] + [start]):
             answered = any(ident == 0x580 + n and d[1:4] == log[i][1][1:4]
                            for ident, d in log[i + 1:nxt])
@@ -126,7 +132,7 @@ def check_tpdo(n, count, k, data, targets):
     status = int.from_bytes(data[0:2], "little")
     actual = int.from_bytes(data[2:6], "little", signed=True)
     want = targets[count - 1]
-    if status & 0x6F == OP_ENABLED and want is not None and actual != want:
+    if COMPARE_VALUES and status & 0x6F == OP_ENABLED and want is not None and actual != want:
         return [f"node {n}: TPDO #{count} actual {actual}, but the RPDO before "
                 f"SYNC #{count} said {want}"]
     return []
@@ -134,13 +140,20 @@ def check_tpdo(n, count, k, data, targets):
 
 def main():
     args = sys.argv[1:]
-    strict = True
-    while args and args[0] in ("--strict", "--lenient"):
-        strict = args.pop(0) == "--strict"
+    strict, period_ms = True, 4
+    while args and args[0] in ("--strict", "--lenient", "--period-ms", "--servo"):
+        opt = args.pop(0)
+        if opt == "--servo":
+            global COMPARE_VALUES
+            COMPARE_VALUES = False
+        elif opt == "--period-ms":
+            period_ms = int(args.pop(0))
+        else:
+            strict = opt == "--strict"
     path, nodes = args[0], [int(a) for a in args[1:]]
     print(f"startup capture: {'strict' if strict else 'lenient'} check "
           f"({'TPDO at most one SYNC late' if strict else 'TPDOs matched to SYNCs by order, any lag'})")
-    errors = check(path, nodes, strict)
+    errors = check(path, nodes, strict, period_ms)
     for e in errors[:12]:
         print("startup capture:", e)
     n = sum(1 for _ in frames(path))

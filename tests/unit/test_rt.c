@@ -188,6 +188,8 @@ static void test_scaler_slows_along_path(void **state)
         sp.pos[0] = 0.6 * v * T * k;
         sp.pos[1] = 0.8 * v * T * k;
         sp.v = v;
+        sp.dir[0] = 0.6;
+        sp.dir[1] = 0.8;
         assert_int_equal(ncp_spsc_push(&ring, &sp), 0);
     }
     double prev[2][2] = { { 0, 0 }, { 0, 0 } };

@@ -1,0 +1,15 @@
+/* Backend selection by the machine configuration. */
+#include "ncpar/backend.h"
+
+#include <string.h>
+
+int ncp_backend_open(struct ncp_backend *b, const struct ncp_machine_cfg *cfg, FILE *log,
+                     struct ncp_diag *d)
+{
+    memset(b, 0, sizeof *b);
+    switch (cfg->backend) {
+    case NCP_BACKEND_SIM: return ncp_backend_open_sim(b, cfg, d);
+    case NCP_BACKEND_SOCKETCAN: return ncp_backend_open_socketcan(b, cfg, log, d);
+    }
+    return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0, "unknown backend %d", (int)cfg->backend);
+}
