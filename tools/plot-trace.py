@@ -3,13 +3,16 @@
 
 usage: plot-trace.py TRACE.csv OUT.png [LATENCY.csv] [--title TEXT]
 
-TRACE.csv   the per-cycle trace (t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v)
+TRACE.csv   the per-cycle trace (t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion;
+            motion: 0 rapid G0, 1 feed G1, 2 arc G2/G3; traces without it
+            are drawn as feeds)
 LATENCY.csv optional sidecar written by `cnc-run run --plot`: the position
             loop's wake-up latency histogram, one row per non-empty 1 us bin,
             header "latency_us,cycles" (the last row may be ">=1000" for the
             overflow bin).
 
-Panels: commanded vs actual XY toolpath (equal aspect), path velocity and
+Panels: commanded vs actual XY toolpath (equal aspect; rapids dashed grey,
+feeds solid blue, arcs solid purple), path velocity (rapids grey) and
 acceleration over time, loop-latency histogram. Needs python3-matplotlib.
 """
 import csv
@@ -58,6 +61,39 @@ def thin(xs, step):
     return xs[::step] if step > 1 else xs
 
 
+# motion column -> how the commanded path is drawn
+STYLES = {0: dict(color="0.4", lw=1.0, ls=(0, (5, 3)), label="rapid (G0)"),
+          1: dict(color="tab:blue", lw=1.6, ls="-", label="feed (G1)"),
+          2: dict(color="tab:purple", lw=1.6, ls="-", label="arc (G2/G3)")}
+
+
+def runs_by_motion(xs, ys, motion, step):
+    """Per motion kind, the points of its stretches with NaN between stretches,
+    each stretch starting at the previous one's last point (no gaps)."""
+    out = {k: ([], []) for k in STYLES}
+    nan = float("nan")
+    n = len(xs)
+    i = 0
+    while i < n:
+        k = int(motion[i]) if int(motion[i]) in STYLES else 1
+        j = i
+        while j + 1 < n and int(motion[j + 1]) == int(motion[i]):
+            j += 1
+        lo = max(0, i - 1)
+        idx = list(range(lo, j + 1, step))
+        if idx[-1] != j:
+            idx.append(j)
+        if j + 1 < n:
+            idx.append(j + 1)
+        px, py = out[k]
+        px.extend(xs[m] for m in idx)
+        py.extend(ys[m] for m in idx)
+        px.append(nan)
+        py.append(nan)
+        i = j + 1
+    return out
+
+
 def path_accel(t, v):
     """Central differences over a window wide enough to hide sample noise."""
     n = len(t)
@@ -79,15 +115,19 @@ def plot(trace, out, lat_path, title):
     gs = fig.add_gridspec(3, 2, width_ratios=[1.25, 1], hspace=0.45, wspace=0.22)
     fig.suptitle(title, fontsize=13)
 
+    motion = c.get("motion") or [1.0] * len(t)
     ax = fig.add_subplot(gs[:, 0])
-    ax.plot(thin(c["x_cmd"], step), thin(c["y_cmd"], step), color="tab:blue", lw=1.6,
-            label="commanded")
-    ax.plot(thin(c["x_act"], step), thin(c["y_act"], step), color="tab:red", lw=0.8,
-            ls="--", label="actual (simulated axes)")
+    runs = runs_by_motion(c["x_cmd"], c["y_cmd"], motion, step)
+    for k in (1, 2, 0):
+        if runs[k][0]:
+            ax.plot(runs[k][0], runs[k][1], zorder=3 if k == 0 else 2, **STYLES[k])
+    # underneath: where it shows, the axes did not follow the command
+    ax.plot(thin(c["x_act"], step), thin(c["y_act"], step), color="tab:red", lw=0.6,
+            alpha=0.35, zorder=1, label="actual (simulated axes)")
     ferr = max(((xc - xa) ** 2 + (yc - ya) ** 2) ** 0.5 for xc, yc, xa, ya in
                zip(c["x_cmd"], c["y_cmd"], c["x_act"], c["y_act"]))
-    ax.plot(c["x_cmd"][0], c["y_cmd"][0], "o", color="tab:green", ms=7, label="start")
-    ax.plot(c["x_cmd"][-1], c["y_cmd"][-1], "s", color="black", ms=6, label="end")
+    ax.plot(c["x_cmd"][0], c["y_cmd"][0], "o", color="tab:green", ms=7, zorder=4, label="start")
+    ax.plot(c["x_cmd"][-1], c["y_cmd"][-1], "s", color="black", ms=6, zorder=4, label="end")
     ax.text(0.02, 0.02, "max XY following error %.4f mm\n(actual lies on commanded at this scale)"
             % ferr if ferr < 0.05 else "max XY following error %.4f mm" % ferr,
             transform=ax.transAxes, fontsize=9, va="bottom",
@@ -102,14 +142,20 @@ def plot(trace, out, lat_path, title):
     v = c["v"]
     vmin = [x * 60.0 for x in v]
     axv = fig.add_subplot(gs[0, 1])
-    axv.plot(thin(t, step), thin(vmin, step), color="tab:green", lw=0.9)
+    vruns = runs_by_motion(t, vmin, motion, step)
+    for k, color, label in ((1, "tab:green", "feed"), (2, "tab:green", None),
+                            (0, "0.55", "rapid")):
+        if vruns[k][0]:
+            axv.plot(vruns[k][0], vruns[k][1], color=color, lw=0.9, label=label)
+    if vruns[0][0]:
+        axv.legend(loc="upper right", fontsize=8)
     axv.set_ylabel("feed [mm/min]")
     axv.set_title("path velocity")
     axv.grid(True, alpha=0.3)
 
     a = path_accel(t, v)
     axa = fig.add_subplot(gs[1, 1], sharex=axv)
-    axa.plot(thin(t, step), thin(a, step), color="tab:purple", lw=0.7)
+    axa.plot(thin(t, step), thin(a, step), color="tab:brown", lw=0.7)
     axa.set_ylabel("accel [mm/s²]")
     axa.set_xlabel("time [s]")
     axa.set_title("path acceleration (dv/dt)")

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""gen-program.py --seed S [--blocks N] [--units mm|in]
+"""gen-program.py --seed S [--blocks N] [--units mm|in] [--motion]
 
 Writes to stdout a random RS274/NGC program of about N lines that LinuxCNC's rs274
 accepts (with simpockets.tbl): every arc is geometrically valid, F is set before
@@ -715,13 +715,169 @@ class Gen:
         return "\n".join(self.out) + "\n"
 
 
+class MotionGen(Gen):
+    """--motion: programs for the motion runtime (`cnc-run run`, the simulated
+    mill of rt-config/sim-3axis.ini: X/Y +-500 mm, Z -250..+50 mm). Only the
+    language that makes or shapes motion: G0/G1/G2/G3 (IJK and R, full circles
+    with P, helices), G17-G19, G61/G61.1/G64 P, G90/G91, G90.1/G91.1, G20/G21,
+    feed changes, dwells, canned cycles, loops and subroutines. Feeds are machine
+    feeds (300-6000 mm/min) and every move stays within a box of about +-100 mm
+    and Z -20..+20 mm (Z 0 of G54 is 100 mm below the machine's): whenever the
+    position is unknown or has wandered off (incremental moves, loops, calls,
+    cycles) the program re-anchors with an absolute rapid. Tool 1 of rt-config/tools.tbl, no tool changes."""
+
+    BOX_XY, BOX_Z = 80.0, (-15.0, 15.0)   # mm: re-anchor beyond this
+
+    def feed(self):
+        return num(self.r.choice([300, 600, 1200, 2000, 3000, 4500, 6000]) * self.s(), 3)
+
+    def st_modal(self):
+        r = self.r
+        c = r.randint(0, 9)
+        if c in (0, 1):
+            self.set_plane(r.choice([17, 18, 19]))
+        elif c == 2:
+            self.set_dist(91 if self.dist == 90 else 90)
+        elif c == 3:
+            self.ijk_abs = not self.ijk_abs
+            self.emit("G90.1" if self.ijk_abs else "G91.1")
+        elif c in (4, 5, 6):
+            self.emit(r.choice(["G61", "G61.1", "G64", "G64 P%s" % self.n(
+                r.choice([0.01, 0.02, 0.05, 0.1, 0.5]) * self.s())]))
+        elif c in (7, 8):
+            self.emit("F" + self.feed())
+        else:
+            self.emit("G4 P%s" % num(r.uniform(0, 0.3), 2))
+
+    def st_straight(self):
+        """G0/G1 within the box; computed words only from values of known size."""
+        r = self.r
+        if self.dist == 91 and any(self.pos[a] is None for a in AXES):
+            self.set_dist(90)
+        g = r.choice(["G0", "G1", "G1", "G1"])
+        words, s = [], self.s()
+        for a in r.sample(AXES, r.randint(1, 3)):
+            if self.dist == 91:
+                d = float(self.n(r.uniform(-15, 15) * s if a != "Z" else r.uniform(-4, 4) * s))
+                words.append(a + self.n(d))
+                self.pos[a] += d
+            elif r.random() < 0.12 and self.geom and self.units == self.home_units:
+                p = r.choice(sorted(self.geom))
+                off = float(self.n(r.uniform(-5, 5) * s))
+                words.append("%s[#%d + %s]" % (a, p, self.n(off)))
+                self.pos[a] = self.geom[p] + off
+            elif r.random() < 0.08 and a != "Z":
+                # a scratch value, within +-10 program units
+                words.append("%s[#%d MOD 10]" % (a, r.choice(SCRATCH)))
+                self.pos[a] = None
+            else:
+                v = float(self.n(r.uniform(-40, 40) * s if a != "Z" else r.uniform(-5, 10) * s))
+                words.append(a + self.n(v))
+                self.pos[a] = v
+        line = " ".join([g] + words)
+        if g == "G1" and r.random() < 0.15:
+            line += " F" + self.feed()
+        self.emit(line)
+
+    def st_arc(self):
+        if self.dist == 91 and any(self.pos[a] is None for a in AXES):
+            self.set_dist(90)
+        return Gen.st_arc(self)
+
+    def absolute_block(self, fn):
+        """Loops, ifs and calls repeat their moves: absolute ones only."""
+        if self.dist != 90:
+            self.set_dist(90)
+        fn()
+
+    def wandered(self):
+        lo, hi = (v * self.s() for v in self.BOX_Z)
+        for a in AXES:
+            v = self.pos[a]
+            if v is None:
+                return True
+            if a == "Z" and not lo <= v <= hi or a != "Z" and abs(v) > self.BOX_XY * self.s():
+                return True
+        return False
+
+    def simple_statement(self, inner=False, in_sub=False):
+        r = self.r
+        c = r.random()
+        if c < 0.34:
+            return self.st_straight()
+        if c < 0.58:
+            return self.st_arc()
+        if c < 0.62:
+            return self.st_assign()
+        if inner:
+            if c < 0.68 and self.depth < 2:
+                return self.st_if()
+            if c < 0.74 and self.depth < 2:
+                return self.st_loop()
+            return self.st_straight()
+        if c < 0.68:
+            return self.st_cycle()
+        if c < 0.82:
+            return self.st_modal()
+        if c < 0.85:
+            return self.st_anchor()
+        if c < 0.88:
+            return self.absolute_block(self.st_if)
+        if c < 0.92:
+            return self.absolute_block(self.st_loop)
+        if c < 0.96:
+            return self.absolute_block(self.st_call)
+        return self.st_units_episode()
+
+    def header(self):
+        r = self.r
+        self.out.append("(gen-program.py --motion seed program, %s)" % self.home_units)
+        self.emit("G%d G17 G90 G94 G40 G49 G80" % (20 if self.home_units == "in" else 21))
+        for name in GLOBAL_NAMES:
+            self.emit("#<%s> = %s" % (name, num(r.uniform(-5, 5), 3)))
+        for p in GEOM_PARAMS:
+            if r.random() < 0.5:
+                v = round(r.uniform(-20, 20) * self.s(), 3)
+                self.geom[p] = v
+                self.emit("#%d = %s" % (p, num(v, 3)))
+        for i in range(r.randint(1, 2)):
+            self.define_sub(i)
+        # Z 0 of the program 100 mm below the machine's: arcs in G18/G19 may
+        # rise some 60 mm above their start, and Z travels -250..+50
+        self.emit("G10 L2 P1 X0 Y0 Z%s" % self.n(-100 * self.s()))
+        self.emit("G54 T1 M6")
+        self.emit("G43")
+        self.emit("S%d M3" % r.choice([1000, 3000, 6000]))
+        self.spindle = 3
+        self.emit("F" + self.feed())
+        self.emit(r.choice(["G64 P%s" % self.n(r.choice([0.01, 0.05, 0.2]) * self.s()),
+                            "G64 P%s" % self.n(0.02 * self.s()), "G61", "G64"]))
+        self.st_anchor()
+
+    def generate(self):
+        self.header()
+        while len(self.out) < self.blocks - 3:
+            self.simple_statement()
+            if self.wandered():
+                if self.dist != 90:
+                    self.set_dist(90)
+                self.st_anchor()
+        self.emit("G80 G90 G94")
+        self.emit("M5 M9")
+        self.emit(self.r.choice(["M30", "M2"]))
+        return "\n".join(self.out) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seed", type=int, required=True)
     ap.add_argument("--blocks", type=int, default=200)
     ap.add_argument("--units", choices=["mm", "in"])
+    ap.add_argument("--motion", action="store_true",
+                    help="a program for cnc-run run on the simulated mill (see MotionGen)")
     a = ap.parse_args()
-    print(Gen(a.seed, a.blocks, a.units).generate(), end="")
+    gen = MotionGen if a.motion else Gen
+    print(gen(a.seed, a.blocks, a.units).generate(), end="")
 
 
 if __name__ == "__main__":

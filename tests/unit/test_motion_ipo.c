@@ -85,6 +85,22 @@ static void worst_ratios(const struct row *r, size_t n, const struct ncp_machine
     }
 }
 
+/* Worst third difference / MAX_JERK over all axes (1 = at the limit). */
+static double worst_jerk(const struct row *r, size_t n, const struct ncp_machine_cfg *c,
+                         unsigned *line, double *t)
+{
+    double vmax[3], amax[3], jmax[3];
+    for (int j = 0; j < 3; j++) {
+        vmax[j] = c->axis[j].max_vel;
+        amax[j] = c->axis[j].max_acc;
+        jmax[j] = c->axis[j].max_jerk;
+    }
+    struct trace_worst w = trace_limits(r, n, c->servo_period, vmax, amax, jmax);
+    *line = w.jerk_line;
+    *t = w.jerk_t;
+    return w.jerk;
+}
+
 static const char corners_prog[] =
     "G21 G90 G17 G64 P0.05\n"
     "G0 X0 Y0 Z5\n"
@@ -153,6 +169,14 @@ static void check_corners(enum ncp_profile prof)
     if (vel > 1 + 1e-9 || acc > 1 + 1e-9)
         fail_msg("profile %d: vel %.4f acc %.4f of the limits", prof, vel, acc);
     assert_true(acc > 0.3);  /* the machine is really used */
+    if (prof == NCP_PROFILE_SCURVE) {
+        unsigned line;
+        double t, jerk = worst_jerk(r, n, &cfg, &line, &t);
+        print_message("fine interpolation, S-curve: jerk %.4f of the limit (line %u, t %.3f)\n",
+                      jerk, line, t);
+        if (jerk > 1 + 1e-9)
+            fail_msg("jerk %.4f of the limit (line %u, t %.3f)", jerk, line, t);
+    }
     assert_true(r[n - 1].cmd[2] == 5 && r[n - 1].v == 0);
     /* the rough stream takes about as long as the servo-rate one */
     struct ncp_machine_cfg fine = cfg;

@@ -220,10 +220,10 @@ static void test_trapezoid_programs(void **state)
 
 struct live {
     struct ncp_nck_ctl ctl;
-    double at_s[3];        /* machine times of the actions */
-    int action[3];         /* 0 override 30 %, 1 override 100 %, 2 hold, 3 resume */
+    double at_s[4];        /* machine times of the actions */
+    int action[4];         /* 0 override 30 %, 1 override 100 %, 2 hold, 3 resume */
     int n;
-    double done_at[3];     /* machine time just after each action was issued */
+    double done_at[4];     /* machine time just after each action was issued */
 };
 
 static void *live_driver(void *arg)
@@ -322,6 +322,113 @@ static void test_live_hold_stops_within_braking_distance(void **state)
     free(r);
 }
 
+/* ---- S-curve: jerk-limited hold, resume and override steps ---------------------------- */
+
+static void assert_within(const struct worst *w, int jerk, const char *what)
+{
+    if (w->vel > 1 + 1e-9 || w->acc > 1 + 1e-9 || (jerk && w->jerk > 1 + 1e-9))
+        fail_msg("%s: vel %.4f acc %.4f jerk %.4f (line %u) of the limits", what, w->vel,
+                 w->acc, w->jerk, w->jerk_line);
+}
+
+/* Distance a jerk-limited stop from v takes at deceleration a and jerk j. */
+static double scurve_brake(double v, double a, double j)
+{
+    return v > a * a / j ? 0.5 * v * (v / a + a / j) : v * sqrt(v / j);
+}
+
+static void test_scurve_hold_resume_keeps_jerk(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    scurve_cfg(&cfg);
+    struct live l = { .at_s = { 0.5, 1.5 }, .action = { 2, 3 }, .n = 2 };
+    size_t n;
+    struct row *r = run_live("G21 G90 G1 X300 F6000\nM2\n", &cfg, &l, &n);
+    struct worst w = check_limits(r, n, &cfg);
+    assert_within(&w, 1, "hold and resume on a line");
+    /* the hold took effect by done_at[0]: from there to the stop at most the
+     * jerk-limited braking distance of the position loop's rate change
+     * (src/rt/scaler.c): path jerk a quarter of the weakest axis's, path
+     * deceleration half the weakest axis's but at most v * rd_cap, rd_cap =
+     * min(MAX_JERK / MAX_ACCELERATION) / 12; plus a period of travel */
+    size_t k0 = 0, k1;
+    while (k0 < n && r[k0].t < l.done_at[0])
+        k0++;
+    for (k1 = k0; k1 < n && r[k1].v > 0; k1++)
+        ;
+    assert_true(k1 < n && r[k1].t < l.at_s[1]);
+    double v = 100, rd_cap = 50000.0 / 1000 / 12;
+    double brake = scurve_brake(v, fmin(0.5 * 1000, rd_cap * v), 0.25 * 50000);
+    double went = r[k1].cmd[0] - r[k0].cmd[0];
+    if (went > brake + v * cfg.servo_period)
+        fail_msg("hold took %.4f mm, the S-curve braking distance is %.4f mm", went, brake);
+    assert_true(went > 0.9 * brake);  /* and it does brake that hard */
+    for (size_t k = k1; k < n && r[k].t < l.at_s[1]; k++)
+        assert_true(r[k].cmd[0] == r[k1].cmd[0]);
+    assert_true(r[n - 1].cmd[0] == 300);
+    free(r);
+}
+
+static void test_scurve_override_steps_keep_jerk(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    scurve_cfg(&cfg);
+    struct live l = { .at_s = { 0.9, 1.6 }, .action = { 0, 1 }, .n = 2 };
+    size_t n;
+    struct row *r = run_live(corners_prog, &cfg, &l, &n);
+    struct worst w = check_limits(r, n, &cfg);
+    assert_within(&w, 1, "override 30 % and back");
+    double vmax = 0;
+    for (size_t k = 0; k < n; k++)
+        if (r[k].t > l.done_at[0] + 0.2 && r[k].t < l.at_s[1] && r[k].line == 4)
+            vmax = fmax(vmax, r[k].v);
+    assert_true(vmax > 0.9 * 0.3 * 4000 / 60.0 && vmax <= 0.3 * 4000 / 60.0 + 1e-6);
+    assert_true(r[n - 1].cmd[2] == 5);
+    free(r);
+}
+
+/* Holds that come while the path turns: in a G64 corner, on an arc, in a helix. */
+static void test_scurve_holds_on_curves_keep_jerk(void **state)
+{
+    (void)state;
+    static const double at[][4] = { { 1.05, 1.6, 2.3, 2.9 }, { 1.9, 2.4, 3.4, 3.9 } };
+    for (size_t i = 0; i < sizeof at / sizeof at[0]; i++) {
+        struct ncp_machine_cfg cfg;
+        scurve_cfg(&cfg);
+        struct live l = { .at_s = { at[i][0], at[i][1], at[i][2], at[i][3] },
+                          .action = { 2, 3, 2, 3 }, .n = 4 };
+        size_t n;
+        struct row *r = run_live(corners_prog, &cfg, &l, &n);
+        struct worst w = check_limits(r, n, &cfg);
+        assert_within(&w, 1, i ? "hold on the arcs" : "hold in the corners");
+        assert_true(r[n - 1].cmd[2] == 5);
+        free(r);
+    }
+}
+
+/* The same with fine interpolation (rough period 4 servo periods): holds and
+ * override steps on the corner program keep velocity, acceleration and jerk. */
+static void test_scurve_fine_ipo_holds_keep_jerk(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    scurve_cfg(&cfg);
+    cfg.planning_period = 4 * cfg.servo_period;
+    struct live l = { .at_s = { 0.6, 1.2, 1.9, 2.6 }, .action = { 2, 3, 0, 1 }, .n = 4 };
+    size_t n;
+    struct row *r = run_live(corners_prog, &cfg, &l, &n);
+    struct worst w = check_limits(r, n, &cfg);
+    assert_within(&w, 1, "fine interpolation, hold, resume, override 30 % and back");
+    int held = 0;
+    for (size_t k = 0; k < n; k++)
+        held |= r[k].t > l.done_at[0] && r[k].t < l.at_s[1] && r[k].v == 0;
+    assert_true(held);
+    assert_true(r[n - 1].cmd[2] == 5);
+    free(r);
+}
+
 /* ---- underrun: braking along the path keeps the acceleration limit ------------------ */
 
 /* A stream along X that cruises at 100 mm/s and then brakes at the axis's full
@@ -346,6 +453,7 @@ static double underrun_worst_acc(int governed)
         x += vel * T;
         sp.pos[0] = x;
         sp.v = vel;
+        sp.dir[0] = 1;
         assert_int_equal(ncp_spsc_push(&ring, &sp), 0);
     }
     double p[3] = { 0, 0, 0 }, worst = 0;
@@ -371,6 +479,86 @@ static void test_underrun_braking_keeps_accel_limit(void **state)
     assert_true(underrun_worst_acc(1) <= 2000 * (1 + 1e-9));
 }
 
+/* The same with the S-curve: a stream that cruises along (3,4)/5 at 100 mm/s and
+ * then brakes jerk-limited (path jerk 25000, deceleration 1000); the scaler,
+ * given the machine's S-curve limits, is told to stop just before the stream
+ * starts braking, and to go on later. Every axis keeps its acceleration and
+ * jerk (second and third differences), and the output stays on the path. */
+static double underrun_scurve_worst(int jerk_limited, double *worst_acc)
+{
+    struct ncp_machine_cfg cfg;
+    scurve_cfg(&cfg);
+    const double T = cfg.servo_period, J = 25000, A = 1000;
+    struct ncp_spsc ring;
+    assert_int_equal(ncp_spsc_init(&ring, sizeof(struct ncp_setpoint), 2048), 0);
+    double zero[NCP_AXES] = { 0 }, s = 0, vel = 100, acc = 0;
+    struct nck_scaler sc;
+    nck_scaler_init(&sc, zero, 0.5 * 1000, T);
+    nck_scaler_limits(&sc, &cfg);
+    if (!jerk_limited) {  /* linear rate ramps, as with the trapezoid */
+        sc.jerk = 0;
+        for (int j = 0; j < NCP_AXES; j++)
+            sc.jmax[j] = INFINITY;
+    }
+    /* jerk -J until the deceleration is A, then hold it, then +J to rest:
+     * each period integrated exactly, as the planner's samples are */
+    const double t_ramp = A / J, t_hold = vel / A - t_ramp;
+    for (int k = 0; k < 1200; k++) {
+        struct ncp_setpoint sp;
+        memset(&sp, 0, sizeof sp);
+        double t = (k - 150) * T, jerk = 0;
+        if (t >= 0 && t < t_ramp)
+            jerk = -J;
+        else if (t >= t_ramp + t_hold && t < 2 * t_ramp + t_hold)
+            jerk = J;
+        s += vel * T + acc * T * T / 2 + jerk * T * T * T / 6;
+        vel = fmax(0, vel + acc * T + jerk * T * T / 2);
+        acc += jerk * T;
+        if (t >= 2 * t_ramp + t_hold)
+            vel = acc = 0;
+        sp.pos[0] = 0.6 * s;
+        sp.pos[1] = 0.8 * s;
+        sp.v = vel;
+        sp.dir[0] = vel > 0 ? 0.6 : 0;
+        sp.dir[1] = vel > 0 ? 0.8 : 0;
+        assert_int_equal(ncp_spsc_push(&ring, &sp), 0);
+    }
+    double p[4][2] = { { 0 } }, wa = 0, wj = 0;
+    int stopped = 0;
+    for (int k = 0; k < 2400; k++) {
+        struct ncp_setpoint out;
+        nck_scaler_step(&sc, k < 120 || k > 700 ? 1.0 : 0.0, &ring, &out);
+        memmove(p[1], p[0], 3 * sizeof p[0]);
+        p[0][0] = out.pos[0];
+        p[0][1] = out.pos[1];
+        assert_true(fabs(out.pos[1] - out.pos[0] * 4.0 / 3.0) < 1e-9);
+        stopped |= k > 120 && k < 700 && out.v == 0;
+        for (int j = 0; j < 2 && k >= 3; j++) {
+            double a2 = fabs(p[0][j] - 2 * p[1][j] + p[2][j]) / (T * T);
+            double j3 = fabs(p[0][j] - 3 * p[1][j] + 3 * p[2][j] - p[3][j]) / (T * T * T);
+            wa = fmax(wa, a2 / cfg.axis[j].max_acc);
+            wj = fmax(wj, j3 / cfg.axis[j].max_jerk);
+        }
+    }
+    assert_true(stopped);
+    assert_true(p[0][0] == 0.6 * s);  /* and then ran the stream to its end */
+    ncp_spsc_destroy(&ring);
+    *worst_acc = wa;
+    return wj;
+}
+
+static void test_underrun_scurve_keeps_jerk(void **state)
+{
+    (void)state;
+    double wa, wj = underrun_scurve_worst(1, &wa);
+    if (wa > 1 + 1e-9 || wj > 1 + 1e-9)
+        fail_msg("acceleration %.4f, jerk %.4f of the limits", wa, wj);
+    /* linear rate ramps step the acceleration: what the S-curve rate avoids */
+    wj = underrun_scurve_worst(0, &wa);
+    if (!(wj > 2))
+        fail_msg("linear ramps: jerk %.4f of the limit", wj);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -382,6 +570,11 @@ int main(void)
         cmocka_unit_test(test_live_override_keeps_limits),
         cmocka_unit_test(test_live_hold_stops_within_braking_distance),
         cmocka_unit_test(test_underrun_braking_keeps_accel_limit),
+        cmocka_unit_test(test_scurve_hold_resume_keeps_jerk),
+        cmocka_unit_test(test_scurve_override_steps_keep_jerk),
+        cmocka_unit_test(test_scurve_holds_on_curves_keep_jerk),
+        cmocka_unit_test(test_scurve_fine_ipo_holds_keep_jerk),
+        cmocka_unit_test(test_underrun_scurve_keeps_jerk),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
