@@ -24,7 +24,7 @@ struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
         return NULL;
     }
     ncp_params_set_predef(a->params, ncp_predef_lookup, a);
-    a->pops = ncp_params_ops(a->params);
+    a->pops = ncp_predef_ops(a);
     if (ncp_tools_load(a, a->cfg.tool_table_path, d) != NCP_OK) {
         ncp_analyzer_free(a);
         return NULL;

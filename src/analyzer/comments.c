@@ -4,6 +4,7 @@
 #include "state.h"
 
 #include <ctype.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -86,7 +87,8 @@ static size_t ncp_param_ref(struct ncp_analyzer *a, const char *s, const char *e
         return 1;
     }
     char val[64];
-    int n = found ? snprintf(val, sizeof val, fmt, v == 0.0 ? 0.0 : v) : -1;
+    /* rs274 prints anything within its equality tolerance of zero as 0 */
+    int n = found ? snprintf(val, sizeof val, fmt, fabs(v) < 0.0001 ? 0.0 : v) : -1;
     if (n < 0 || n >= (int)sizeof val)
         ncp_put(e, "######", 6);
     else

@@ -57,24 +57,31 @@ int ncp_motion_ends(struct ncp_analyzer *a, int g53, double *end)
 {
     const struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
+    if (g53) {
+        if (w->has & NCP_POLAR_BITS)
+            return ncp_an_error(a, w->line_col, "Cannot use polar coordinates with G53");
+        double word[NCP_NAX];
+        uint32_t given = 0;
+        for (int ax = 0; ax < NCP_NAX; ax++) {
+            int l = NCP_LETTER(ncp_letters[ax]);
+            word[ax] = w->v[l];
+            given |= ((w->has >> l) & 1u) << ax;
+        }
+        ncp_frame_g53(a, word, given, end);
+        return NCP_OK;
+    }
     for (int ax = 0; ax < NCP_NAX; ax++) {
         int l = NCP_LETTER(ncp_letters[ax]);
         if (!((w->has >> l) & 1u)) {
             end[ax] = s->pos[ax];
-        } else if (g53) {
-            double tl = (ax >= NCP_A && ax <= NCP_C) ? 0.0 : s->tlo[ax];
-            end[ax] = w->v[l] - s->g5x[ax] - s->g92[ax] - tl;
         } else if (s->m.incremental) {
             end[ax] = s->pos[ax] + w->v[l];
         } else {
             end[ax] = w->v[l];
         }
     }
-    if (w->has & NCP_POLAR_BITS) {
-        if (g53)
-            return ncp_an_error(a, w->line_col, "Cannot use polar coordinates with G53");
+    if (w->has & NCP_POLAR_BITS)
         return ncp_motion_polar(a, end);
-    }
     return NCP_OK;
 }
 

@@ -15,27 +15,26 @@ static int ncp_is_linear(int ax)
     return ax < NCP_A || ax > NCP_C;
 }
 
+/* rs274 -g converts through mm with its canon's inch-per-mm constant, which is
+ * not exactly 1/25.4: these keep its rounding (2 mm -> user unit -> mm is 2.0
+ * there, 1.9999999999999998 with a plain 25.4). */
+#define NCP_USER_PER_MM 0.03937007874016
+
 double ncp_user_len(const struct ncp_analyzer *a, double user)
 {
-    return a->st.m.inches ? user : user * NCP_MM_PER_INCH;
+    double mm = user / NCP_USER_PER_MM;
+    return a->st.m.inches ? mm / NCP_MM_PER_INCH : mm;
 }
 
-/* Tool table lengths go through mm inside rs274, and the round trip's
- * rounding shows in inch programs (0.125 in -> 0.12499999999999999 in). */
+/* Tool table values are user-unit lengths like any other. */
 double ncp_tool_len(const struct ncp_analyzer *a, double user)
 {
-    double mm = user * NCP_MM_PER_INCH;
-    return a->st.m.inches ? mm * (1.0 / NCP_MM_PER_INCH) : mm;
+    return ncp_user_len(a, user);
 }
 
 double ncp_to_user_len(const struct ncp_analyzer *a, double prog)
 {
-    return a->st.m.inches ? prog : prog / NCP_MM_PER_INCH;
-}
-
-static double ncp_from_user(const struct ncp_analyzer *a, int ax, double v)
-{
-    return ncp_is_linear(ax) ? ncp_user_len(a, v) : v;
+    return (a->st.m.inches ? prog * NCP_MM_PER_INCH : prog) * NCP_USER_PER_MM;
 }
 
 static double ncp_to_user(const struct ncp_analyzer *a, int ax, double v)
@@ -48,31 +47,21 @@ static double *ncp_par(struct ncp_analyzer *a, int index)
     return ncp_params_slot(a->params, index);
 }
 
-/* #5420.. current position, #5400 tool, #5220 system: kept after each block. */
+/* #5420.. current position and #5220 system: kept after each block (#5400
+ * follows the spindle's tool table entry, see ncp_tools_sync_params). */
 void ncp_offsets_sync_params(struct ncp_analyzer *a)
 {
     if (!a->par_pos[0]) {
         for (int ax = 0; ax < NCP_NAX; ax++)
             a->par_pos[ax] = ncp_par(a, 5420 + ax);
-        a->par_tool = ncp_par(a, 5400);
         a->par_origin = ncp_par(a, 5220);
-        if (!a->par_pos[0] || !a->par_tool || !a->par_origin)
+        if (!a->par_pos[0] || !a->par_origin)
             return;
     }
     for (int ax = 0; ax < NCP_NAX; ax++)
         if (a->par_pos[ax])
             *a->par_pos[ax] = a->st.pos[ax];
-    *a->par_tool = a->st.current_tool;
     *a->par_origin = a->st.m.origin;
-}
-
-static void ncp_emit_g5x(struct ncp_analyzer *a)
-{
-    struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
-    op->i[0] = a->st.m.origin;
-    memcpy(op->d, a->st.g5x, 6 * sizeof(double));
-    ncp_sai_g5x(a, a->st.g5x);
-    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->d[0] = a->st.rotation;
 }
 
 static void ncp_emit_g92(struct ncp_analyzer *a)
@@ -80,10 +69,10 @@ static void ncp_emit_g92(struct ncp_analyzer *a)
     ncp_an_emit6(a, NCP_C_SET_G92_OFFSET, a->st.g92);
 }
 
-static void ncp_emit_tlo(struct ncp_analyzer *a)
+static void ncp_emit_tlo_values(struct ncp_analyzer *a, const double *v)
 {
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_USE_TOOL_LENGTH_OFFSET);
-    memcpy(op->d, a->st.tlo, NCP_NAX * sizeof(double));
+    memcpy(op->d, v, NCP_NAX * sizeof(double));
 }
 
 int ncp_offsets_units(struct ncp_analyzer *a, int inches)
@@ -100,21 +89,19 @@ int ncp_offsets_units(struct ncp_analyzer *a, int inches)
         s->pos[ax] *= k;
         s->g5x[ax] *= k;
         s->g92[ax] *= k;
-        s->tlo[ax] *= k;
     }
     s->m.comp_radius *= k;
     ncp_cutcomp_scale(&a->comp, k, inches);
-    s->feed *= k;
+    /* rs274 reloads the tool offset and the feed rate from its canon, which
+     * keeps them as last set, unconverted: s->tlo and s->feed already are. */
     s->m.inches = inches;
     return NCP_OK;
 }
 
 static void ncp_load_origin(struct ncp_analyzer *a, int origin, double *out)
 {
-    for (int ax = 0; ax < NCP_NAX; ax++) {
-        double *p = ncp_par(a, 5201 + 20 * origin + ax);
-        out[ax] = ncp_from_user(a, ax, p ? *p : 0.0);
-    }
+    for (int ax = 0; ax < NCP_NAX; ax++)
+        out[ax] = ncp_frame_user(a, ax, 5201 + 20 * origin + ax);
 }
 
 int ncp_offsets_coord(struct ncp_analyzer *a, int origin)
@@ -128,14 +115,11 @@ int ncp_offsets_coord(struct ncp_analyzer *a, int origin)
                          sizeof "interpreter: continuing to use same coordinate system" - 1);
         return NCP_OK;
     }
-    double nw[NCP_NAX];
-    ncp_load_origin(a, origin, nw);
-    for (int ax = 0; ax < NCP_NAX; ax++) {
-        s->pos[ax] += s->g5x[ax] - nw[ax];
-        s->g5x[ax] = nw[ax];
-    }
-    double *r = ncp_par(a, 5210 + 20 * origin);
-    s->rotation = r ? *r : 0.0;
+    double here[NCP_NAX];
+    ncp_frame_current_in(a, origin, 0, here);
+    memcpy(s->pos, here, sizeof here);
+    ncp_load_origin(a, origin, s->g5x);
+    s->rotation = ncp_frame_param(a, 5210 + 20 * origin);
     s->m.origin = origin;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
     op->i[0] = origin;
@@ -167,9 +151,9 @@ int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
         } else {
             idx = 0; /* the spindle's entry */
         }
-        {
-            nw[NCP_X] = ncp_tool_len(a, a->tools[idx].x_offset);
-            nw[NCP_Z] = ncp_tool_len(a, a->tools[idx].z_offset);
+        for (int ax = 0; ax < NCP_NAX; ax++) {
+            double u = ncp_tool_offset(a, idx, ax);
+            nw[ax] = ncp_is_linear(ax) ? ncp_tool_len(a, u) : u;
         }
     } else if (g == 431) {
         memcpy(nw, s->tlo, sizeof nw);
@@ -181,11 +165,15 @@ int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
     } else if (g == 432) {
         return ncp_an_error(a, w->gcol[NCP_GG_TLO], "G43.2 is not supported");
     }
-    for (int ax = 0; ax < NCP_NAX; ax++) {
+    ncp_emit_tlo_values(a, nw);
+    /* the X/Y change of the offset is a machine-frame vector */
+    double dx = s->tlo[NCP_X] - nw[NCP_X], dy = s->tlo[NCP_Y] - nw[NCP_Y];
+    ncp_rotate(&dx, &dy, -s->rotation);
+    s->pos[NCP_X] += dx;
+    s->pos[NCP_Y] += dy;
+    for (int ax = NCP_Z; ax < NCP_NAX; ax++)
         s->pos[ax] += s->tlo[ax] - nw[ax];
-        s->tlo[ax] = nw[ax];
-    }
-    ncp_emit_tlo(a);
+    memcpy(s->tlo, nw, sizeof nw);
     return NCP_OK;
 }
 
@@ -210,160 +198,55 @@ static int ncp_word_axis(const struct ncp_words *w, int ax, double *v)
     return 1;
 }
 
-static void ncp_set_g92(struct ncp_analyzer *a, const double *nw)
+/* G92 sets the point to read as the words; G52 sets the offset itself. */
+static void ncp_g92_words(struct ncp_analyzer *a, int g52)
 {
+    struct ncp_state *s = &a->st;
     for (int ax = 0; ax < NCP_NAX; ax++) {
-        a->st.pos[ax] += a->st.g92[ax] - nw[ax];
-        a->st.g92[ax] = nw[ax];
+        double v;
+        if (!ncp_word_axis(&a->w, ax, &v))
+            continue;
+        if (g52) {
+            s->pos[ax] += s->g92[ax] - v;
+            s->g92[ax] = v;
+        } else {
+            s->g92[ax] = s->pos[ax] + s->g92[ax] - v;
+            s->pos[ax] = v;
+        }
     }
 }
 
 static int ncp_g92(struct ncp_analyzer *a, int g)
 {
     struct ncp_state *s = &a->st;
-    double nw[NCP_NAX];
-    memcpy(nw, s->g92, sizeof nw);
     if (s->m.comp_side != 0)
         return ncp_an_error(a, a->w.gcol[NCP_GG_NONMODAL],
                             "Cannot change axis offsets with cutter radius comp");
-    if (g == 920) {
-        for (int ax = 0; ax < NCP_NAX; ax++) {
-            double v;
-            if (ncp_word_axis(&a->w, ax, &v))
-                nw[ax] = s->pos[ax] + s->g92[ax] - v;
-        }
-        ncp_set_g92(a, nw);
+    if (g == 920 || g == 520) {
+        ncp_g92_words(a, g == 520);
+        ncp_emit_g92(a);
         ncp_store_g92_params(a, 1);
-    } else if (g == 520) {
+        return NCP_OK;
+    }
+    double *applied = ncp_par(a, 5210);
+    if (g == 921 || g == 922) {
         for (int ax = 0; ax < NCP_NAX; ax++) {
-            double v;
-            if (ncp_word_axis(&a->w, ax, &v))
-                nw[ax] = v;
+            s->pos[ax] = s->pos[ax] + s->g92[ax];
+            s->g92[ax] = 0.0;
         }
-        ncp_set_g92(a, nw);
-        ncp_store_g92_params(a, 1);
-    } else if (g == 921 || g == 922) {
-        memset(nw, 0, sizeof nw);
-        ncp_set_g92(a, nw);
         if (g == 921)
             ncp_store_g92_params(a, 0);
-        else if (ncp_par(a, 5210))
-            *ncp_par(a, 5210) = 0;
     } else {
         for (int ax = 0; ax < NCP_NAX; ax++) {
-            double *p = ncp_par(a, 5211 + ax);
-            nw[ax] = ncp_from_user(a, ax, p ? *p : 0.0);
+            double v = ncp_frame_user(a, ax, 5211 + ax);
+            s->pos[ax] = s->pos[ax] + s->g92[ax] - v;
+            s->g92[ax] = v;
         }
-        ncp_set_g92(a, nw);
-        if (ncp_par(a, 5210))
-            *ncp_par(a, 5210) = 1;
     }
+    if (applied)
+        *applied = g == 923;
     ncp_emit_g92(a);
     return NCP_OK;
-}
-
-/* G10 L2 / L20: write a coordinate system; refresh it when it is the active one. */
-static int ncp_g10_origin(struct ncp_analyzer *a, int l, int p)
-{
-    struct ncp_state *s = &a->st;
-    if (p == 0)
-        p = s->m.origin;
-    if (p != s->m.origin)
-        ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: setting coordinate system origin",
-                         sizeof "interpreter: setting coordinate system origin" - 1);
-    double nw[NCP_NAX];
-    ncp_load_origin(a, p, nw);
-    for (int ax = 0; ax < NCP_NAX; ax++) {
-        double v;
-        if (!ncp_word_axis(&a->w, ax, &v))
-            continue;
-        nw[ax] = l == 2 ? v : s->pos[ax] + s->g5x[ax] - v;
-        if (l == 20 && p != s->m.origin)
-            nw[ax] = s->pos[ax] + s->g5x[ax] + s->g92[ax] - s->g92[ax] - v;
-        double *par = ncp_par(a, 5201 + 20 * p + ax);
-        if (par)
-            *par = ncp_to_user(a, ax, nw[ax]);
-    }
-    if (NCP_HAS(&a->w, 'R')) {
-        double *par = ncp_par(a, 5210 + 20 * p);
-        if (par)
-            *par = a->w.v[NCP_LETTER('R')];
-    }
-    if (p == s->m.origin) {
-        for (int ax = 0; ax < NCP_NAX; ax++) {
-            s->pos[ax] += s->g5x[ax] - nw[ax];
-            s->g5x[ax] = nw[ax];
-        }
-        double *r = ncp_par(a, 5210 + 20 * p);
-        s->rotation = r ? *r : 0.0;
-        ncp_emit_g5x(a);
-    }
-    return NCP_OK;
-}
-
-/* rs274 prints this call's offsets in its user unit (inch). */
-static void ncp_emit_tool_entry(struct ncp_analyzer *a, int shown, int idx)
-{
-    const struct ncp_tool_entry *t = &a->tools[idx];
-    char buf[256];
-    int n = snprintf(buf, sizeof buf,
-                     "SET_TOOL_TABLE_ENTRY(%d, %d, %.4f %.4f %.4f %.4f %.4f %.4f %.4f %.4f %.4f, "
-                     "%.4f, %.4f, %d)",
-                     shown, a->tool_no[idx], t->x_offset, 0.0, t->z_offset, 0.0, 0.0, 0.0, 0.0,
-                     0.0, 0.0, t->frontangle, t->backangle, t->orientation);
-    if (n > 0)
-        ncp_an_emit_text(a, NCP_C_RAW_TEXT, buf, (size_t)n < sizeof buf ? (size_t)n : sizeof buf - 1);
-}
-
-static int ncp_g10_tool(struct ncp_analyzer *a, int l, int p)
-{
-    const struct ncp_words *w = &a->w;
-    int idx = ncp_tools_find(a, p);
-    if (idx < 0)
-        return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
-                            "Requested tool %d not found in the tool table", p);
-    struct ncp_tool_entry *t = &a->tools[idx];
-    double v;
-    if (l == 1) {
-        if (ncp_word_axis(w, NCP_Z, &v))
-            t->z_offset = ncp_to_user_len(a, v);
-        if (ncp_word_axis(w, NCP_X, &v))
-            t->x_offset = ncp_to_user_len(a, v);
-    } else {
-        double mz = a->st.pos[NCP_Z] + a->st.g5x[NCP_Z] + a->st.g92[NCP_Z] + a->st.tlo[NCP_Z];
-        double mx = a->st.pos[NCP_X] + a->st.g5x[NCP_X] + a->st.g92[NCP_X] + a->st.tlo[NCP_X];
-        if (ncp_word_axis(w, NCP_Z, &v))
-            t->z_offset = ncp_to_user_len(a, mz - v - a->st.g5x[NCP_Z] - a->st.g92[NCP_Z]);
-        if (ncp_word_axis(w, NCP_X, &v))
-            t->x_offset = ncp_to_user_len(a, mx - v - a->st.g5x[NCP_X] - a->st.g92[NCP_X]);
-    }
-    if (NCP_HAS(w, 'R'))
-        t->diameter = 2.0 * ncp_to_user_len(a, w->v[NCP_LETTER('R')]);
-    if (NCP_HAS(w, 'I'))
-        t->frontangle = w->v[NCP_LETTER('I')];
-    if (NCP_HAS(w, 'J'))
-        t->backangle = w->v[NCP_LETTER('J')];
-    if (NCP_HAS(w, 'Q'))
-        t->orientation = ncp_trunc_int_round(w->v[NCP_LETTER('Q')]);
-    ncp_emit_tool_entry(a, idx, idx);
-    if (idx == a->st.current_pocket) {
-        a->tools[0] = *t;
-        a->tool_no[0] = a->tool_no[idx];
-        ncp_emit_tool_entry(a, 0, idx);
-    }
-    return NCP_OK;
-}
-
-static int ncp_g10(struct ncp_analyzer *a)
-{
-    const struct ncp_words *w = &a->w;
-    int l = ncp_trunc_int_round(w->v[NCP_LETTER('L')]);
-    int p = (int)w->v[NCP_LETTER('P')]; /* rs274 truncates */
-    if (l == 2 || l == 20)
-        return ncp_g10_origin(a, l, p);
-    if (l == 1 || l == 10)
-        return ncp_g10_tool(a, l, p);
-    return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL], "G10 L%d is not supported", l);
 }
 
 /* G28/G30: optional intermediate point, then the stored home, as traverses. */
@@ -371,22 +254,23 @@ static int ncp_home(struct ncp_analyzer *a, int g)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
+    double mid[NCP_NAX], home[NCP_NAX], end[NCP_NAX];
+    int rc = ncp_motion_ends(a, 0, mid);
+    if (rc != NCP_OK)
+        return rc;
     if (s->m.comp_side != 0)
         return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
                             "Cannot use G28 or G30 with cutter radius compensation");
     int base = g == 280 ? 5161 : 5181;
-    double mid[NCP_NAX], end[NCP_NAX];
-    int rc = ncp_motion_ends(a, 0, mid);
-    if (rc != NCP_OK)
-        return rc;
-    int any = (w->has & NCP_AXIS_LETTERS) != 0;
-    for (int ax = 0; ax < NCP_NAX; ax++) {
-        double *p = ncp_par(a, base + ax);
-        double home = ncp_from_user(a, ax, p ? *p : 0.0);
-        double v;
-        end[ax] = home - s->g5x[ax] - s->g92[ax] - s->tlo[ax];
-        if (any && !ncp_word_axis(w, ax, &v))
-            end[ax] = mid[ax];
+    for (int ax = 0; ax < NCP_NAX; ax++)
+        home[ax] = ncp_frame_user(a, ax, base + ax);
+    ncp_frame_relative(a, home, end);
+    if (w->has & NCP_AXIS_LETTERS) {
+        for (int ax = 0; ax < NCP_NAX; ax++) {
+            double v;
+            if (!ncp_word_axis(w, ax, &v))
+                end[ax] = mid[ax];
+        }
     }
     ncp_an_emit6(a, NCP_C_STRAIGHT_TRAVERSE, mid);
     ncp_an_emit6(a, NCP_C_STRAIGHT_TRAVERSE, end);
@@ -394,14 +278,26 @@ static int ncp_home(struct ncp_analyzer *a, int g)
     return NCP_OK;
 }
 
+/* G28.1/G30.1: the current point in machine coordinates. */
 static int ncp_home_store(struct ncp_analyzer *a, int g)
 {
+    const struct ncp_state *s = &a->st;
+    if (s->m.comp_side != 0)
+        return ncp_an_error(a, a->w.gcol[NCP_GG_NONMODAL],
+                            "Cannot set reference point with cutter compensation in effect");
     int base = g == 281 ? 5161 : 5181;
+    double m[NCP_NAX];
+    m[NCP_X] = s->pos[NCP_X] + s->g92[NCP_X];
+    m[NCP_Y] = s->pos[NCP_Y] + s->g92[NCP_Y];
+    ncp_rotate(&m[NCP_X], &m[NCP_Y], s->rotation);
+    m[NCP_X] = m[NCP_X] + s->tlo[NCP_X] + s->g5x[NCP_X];
+    m[NCP_Y] = m[NCP_Y] + s->tlo[NCP_Y] + s->g5x[NCP_Y];
+    for (int ax = NCP_Z; ax < NCP_NAX; ax++)
+        m[ax] = s->pos[ax] + s->tlo[ax] + s->g5x[ax] + s->g92[ax];
     for (int ax = 0; ax < NCP_NAX; ax++) {
         double *p = ncp_par(a, base + ax);
-        double m = a->st.pos[ax] + a->st.g5x[ax] + a->st.g92[ax] + a->st.tlo[ax];
         if (p)
-            *p = ncp_to_user(a, ax, m);
+            *p = ncp_to_user(a, ax, m[ax]);
     }
     return NCP_OK;
 }
@@ -409,7 +305,7 @@ static int ncp_home_store(struct ncp_analyzer *a, int g)
 int ncp_offsets_modal0(struct ncp_analyzer *a, int g)
 {
     switch (g) {
-    case 100: return ncp_g10(a);
+    case 100: return ncp_g10_run(a);
     case 280: case 300: return ncp_home(a, g);
     case 281: case 301: return ncp_home_store(a, g);
     default: return ncp_g92(a, g);

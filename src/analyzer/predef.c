@@ -11,7 +11,7 @@ enum ncp_predef {
     P_IJK_ABS, P_SPINDLE_ON, P_SPINDLE_CW, P_MIST, P_FLOOD, P_SPEED_OVR, P_FEED_OVR,
     P_ADAPTIVE, P_FEED_HOLD, P_FEED, P_RPM, P_CUR_TOOL, P_CUR_POCKET, P_SEL_TOOL,
     P_SEL_POCKET, P_RPM_MODE, P_CSS_MODE, P_LATHE_DIA, P_LATHE_RAD, P_CALL_LEVEL,
-    P_VMAJOR, P_VMINOR, P_TASK, P__N
+    P_VMAJOR, P_VMINOR, P_TASK, P_ABS_X, P_ABS_Y, P_ABS_Z, P_ABS_A, P_ABS_B, P_ABS_C, P__N
 };
 
 static const char *const ncp_predef_names[P__N] = {
@@ -24,6 +24,7 @@ static const char *const ncp_predef_names[P__N] = {
     "_current_tool", "_current_pocket", "_selected_tool", "_selected_pocket",
     "_spindle_rpm_mode", "_spindle_css_mode", "_lathe_diameter_mode",
     "_lathe_radius_mode", "_call_level", "_vmajor", "_vminor", "_task",
+    "_abs_x", "_abs_y", "_abs_z", "_abs_a", "_abs_b", "_abs_c",
 };
 
 static double ncp_predef_value(const struct ncp_analyzer *a, int k)
@@ -32,6 +33,11 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     const struct ncp_modal *m = &s->m;
     if (k <= P_W)
         return s->pos[k];
+    if (k >= P_ABS_X) {
+        double mach[NCP_NAX];
+        ncp_frame_absolute(a, mach);
+        return mach[k - P_ABS_X];
+    }
     switch (k) {
     case P_LINE: return a->line;
     case P_MOTION: return m->motion < 0 ? 800 : m->motion;
@@ -59,7 +65,7 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     case P_FEED_HOLD: return m->feed_hold;
     case P_FEED: return s->feed;
     case P_RPM: return s->speed;
-    case P_CUR_TOOL: return s->current_tool;
+    case P_CUR_TOOL: return ncp_frame_param(a, 5400); /* the spindle entry's tool */
     case P_CUR_POCKET: return s->current_pocket;
     case P_SEL_TOOL: return s->selected_tool;
     case P_SEL_POCKET: return s->selected_pocket;
@@ -87,4 +93,35 @@ int ncp_predef_lookup(void *ctx, const char *name, size_t len, double *out)
         }
     }
     return 0;
+}
+
+/* Numbered reads through the analyzer: rs274 refuses the current position
+ * (#5420..#5428) while cutter compensation is on. */
+static int ncp_predef_get_numbered(void *ctx, int index, double *out, struct ncp_diag *d)
+{
+    const struct ncp_analyzer *a = ctx;
+    if (index >= 5420 && index <= 5428 && a->st.m.comp_side != 0)
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
+                            "Cannot read current position with cutter radius compensation on");
+    return ncp_params_get(a->params, index, out, d);
+}
+
+static int ncp_predef_get_named(void *ctx, const char *name, size_t len, double *out,
+                                struct ncp_diag *d)
+{
+    const struct ncp_analyzer *a = ctx;
+    return ncp_params_get_named(a->params, name, len, out, d);
+}
+
+static int ncp_predef_exists(void *ctx, const char *name, size_t len)
+{
+    const struct ncp_analyzer *a = ctx;
+    return ncp_params_exists(a->params, name, len);
+}
+
+struct ncp_param_ops ncp_predef_ops(struct ncp_analyzer *a)
+{
+    return (struct ncp_param_ops){ .ctx = a, .get_numbered = ncp_predef_get_numbered,
+                                   .get_named = ncp_predef_get_named,
+                                   .exists_named = ncp_predef_exists };
 }

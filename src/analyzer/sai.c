@@ -31,11 +31,16 @@ void ncp_sai_units(struct ncp_analyzer *a, int inches)
 {
     if (inches == a->sai.inches)
         return;
-    double f = inches ? 1.0 / NCP_MM_PER_INCH : NCP_MM_PER_INCH;
     for (int k = 0; k < 3; k++) {
-        a->sai.pos[k] *= f;
-        a->sai.g5x[k] *= f;
-        a->sai.g92[k] *= f;
+        if (inches) {
+            a->sai.pos[k] /= NCP_MM_PER_INCH;
+            a->sai.g5x[k] /= NCP_MM_PER_INCH;
+            a->sai.g92[k] /= NCP_MM_PER_INCH;
+        } else {
+            a->sai.pos[k] *= NCP_MM_PER_INCH;
+            a->sai.g5x[k] *= NCP_MM_PER_INCH;
+            a->sai.g92[k] *= NCP_MM_PER_INCH;
+        }
     }
     a->sai.inches = inches;
 }
@@ -48,6 +53,7 @@ void ncp_sai_resync(struct ncp_analyzer *a)
     a->st.toolchange_flag = 0;
     memcpy(a->st.pos, a->sai.pos, sizeof a->sai.pos);
     ncp_offsets_sync_params(a); /* before this block's expressions read #5420.. */
+    ncp_tools_sync_params(a, 1);
 }
 
 /* A move finished by the comp queue: the canon's point is its end. */

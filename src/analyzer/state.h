@@ -112,11 +112,12 @@ struct ncp_analyzer {
     const struct ncp_block *blk;
     const struct ncp_source *src;
     struct ncp_param_ops pops;
-    double *par_pos[NCP_NAX], *par_tool, *par_origin; /* #5420.., #5400, #5220 */
+    double *par_pos[NCP_NAX], *par_origin; /* #5420.., #5220 */
     /* tool table: entry[i] for pocket-ordered tools as rs274 loads them */
     int n_tools;
     int tool_no[NCP_MAX_TOOLS];
     struct ncp_tool_entry tools[NCP_MAX_TOOLS];
+    double tool_more[NCP_MAX_TOOLS][7]; /* Y A B C U V W offsets (user unit), see tools.c */
     /* output */
     const struct ncp_cmd_sink *sink;
     struct ncp_cmd *cmd;
@@ -170,17 +171,34 @@ double ncp_user_len(const struct ncp_analyzer *a, double user);
 double ncp_to_user_len(const struct ncp_analyzer *a, double prog);
 double ncp_tool_len(const struct ncp_analyzer *a, double user);
 
+/* frames.c: rs274's conversions through the XY rotation */
+void ncp_rotate(double *x, double *y, double deg);
+double ncp_frame_param(const struct ncp_analyzer *a, int index);
+double ncp_frame_user(const struct ncp_analyzer *a, int ax, int index);
+void ncp_frame_current_in(const struct ncp_analyzer *a, int sys, int with_tlo, double *out);
+void ncp_frame_relative(const struct ncp_analyzer *a, const double *abs, double *out);
+void ncp_frame_absolute(const struct ncp_analyzer *a, double *out);
+void ncp_frame_g53(const struct ncp_analyzer *a, const double *word, uint32_t given, double *end);
+
+/* g10.c: G10 L1/L10/L11 (tool table) and L2/L20 (coordinate systems) */
+int ncp_g10_run(struct ncp_analyzer *a);
+
 /* tools.c */
 int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d);
 int ncp_tools_find(const struct ncp_analyzer *a, int tool);
 int ncp_tools_select(struct ncp_analyzer *a);
 int ncp_tools_change(struct ncp_analyzer *a);
+void ncp_tools_sync_params(struct ncp_analyzer *a, int when_empty);
+double ncp_tool_offset(const struct ncp_analyzer *a, int idx, int ax);
+void ncp_tool_set_offset(struct ncp_analyzer *a, int idx, int ax, double user);
+void ncp_tools_copy(struct ncp_analyzer *a, int dst, int src);
 
 /* comments.c */
 int ncp_comment_run(struct ncp_analyzer *a);
 
 /* predef.c */
 int ncp_predef_lookup(void *ctx, const char *name, size_t len, double *out);
+struct ncp_param_ops ncp_predef_ops(struct ncp_analyzer *a);
 
 /* sai.c */
 void ncp_sai_move(struct ncp_analyzer *a, const double *end);

@@ -29,20 +29,23 @@ void ncp_state_init(struct ncp_analyzer *a)
         *p = 1.0;
 }
 
+/* Back to G54 (and its rotation); the current point stays put on the machine. */
 static void ncp_stop_reset_origin(struct ncp_analyzer *a)
 {
     struct ncp_state *s = &a->st;
+    ncp_rotate(&s->pos[NCP_X], &s->pos[NCP_Y], s->rotation);
     for (int ax = 0; ax < NCP_NAX; ax++) {
-        double *p = ncp_params_slot(a->params, 5221 + ax);
-        double v = p ? *p : 0.0;
-        if (ax < NCP_A || ax > NCP_C)
-            v = ncp_user_len(a, v);
-        s->pos[ax] += s->g5x[ax] - v;
-        s->g5x[ax] = v;
+        s->pos[ax] += s->g5x[ax];
+        s->g5x[ax] = ncp_frame_user(a, ax, 5221 + ax);
     }
-    double *r = ncp_params_slot(a->params, 5230);
-    s->rotation = r ? *r : 0.0;
+    s->rotation = ncp_frame_param(a, 5230);
+    for (int ax = 0; ax < NCP_NAX; ax++)
+        s->pos[ax] -= s->g5x[ax];
+    ncp_rotate(&s->pos[NCP_X], &s->pos[NCP_Y], -s->rotation);
     s->m.origin = 1;
+    double *p = ncp_params_slot(a->params, 5220);
+    if (p)
+        *p = 1.0;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
     op->i[0] = 1;
     memcpy(op->d, s->g5x, 6 * sizeof(double));

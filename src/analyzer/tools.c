@@ -16,13 +16,20 @@ static const char ncp_default_table[] =
     "T3 P3 D0.201000 Z+1.273000\n"
     "T99999 P123 Z+0.100000\n";
 
-static void ncp_tool_field(struct ncp_tool_entry *t, int *toolno, char c, double v)
+static void ncp_tool_field(struct ncp_tool_entry *t, double *more, int *toolno, char c, double v)
 {
     switch (c) {
     case 'T': *toolno = ncp_trunc_int(v); break;
     case 'P': t->pocket = ncp_trunc_int(v); break;
     case 'X': t->x_offset = v; break;
+    case 'Y': more[0] = v; break;
     case 'Z': t->z_offset = v; break;
+    case 'A': more[1] = v; break;
+    case 'B': more[2] = v; break;
+    case 'C': more[3] = v; break;
+    case 'U': more[4] = v; break;
+    case 'V': more[5] = v; break;
+    case 'W': more[6] = v; break;
     case 'D': t->diameter = v; break;
     case 'I': t->frontangle = v; break;
     case 'J': t->backangle = v; break;
@@ -32,9 +39,11 @@ static void ncp_tool_field(struct ncp_tool_entry *t, int *toolno, char c, double
 }
 
 /* One line "T1 P1 Z0.5 D0.25 ;comment" -> entry; 0 if the line has no T. */
-static int ncp_tool_line(const char *s, const char *end, struct ncp_tool_entry *t, int *toolno)
+static int ncp_tool_line(const char *s, const char *end, struct ncp_tool_entry *t, double *more,
+                         int *toolno)
 {
     memset(t, 0, sizeof *t);
+    memset(more, 0, 7 * sizeof *more);
     *toolno = -1;
     while (s < end && *s != ';') {
         char c = (char)(*s >= 'a' && *s <= 'z' ? *s - 32 : *s);
@@ -46,7 +55,7 @@ static int ncp_tool_line(const char *s, const char *end, struct ncp_tool_entry *
                    (strchr("+-.0123456789eE", *s) != NULL))
                 buf[n++] = *s++;
             buf[n] = '\0';
-            ncp_tool_field(t, toolno, c, strtod(buf, NULL));
+            ncp_tool_field(t, more, toolno, c, strtod(buf, NULL));
         } else {
             s++;
         }
@@ -60,11 +69,12 @@ static void ncp_tools_parse(struct ncp_analyzer *a, const char *text, size_t len
     a->n_tools = 1;
     memset(&a->tools[0], 0, sizeof a->tools[0]);
     a->tool_no[0] = 0;
+    memset(a->tool_more[0], 0, sizeof a->tool_more[0]);
     while (p < end && a->n_tools < NCP_MAX_TOOLS) {
         const char *nl = memchr(p, '\n', (size_t)(end - p));
         const char *le = nl ? nl : end;
         int no;
-        if (ncp_tool_line(p, le, &a->tools[a->n_tools], &no))
+        if (ncp_tool_line(p, le, &a->tools[a->n_tools], a->tool_more[a->n_tools], &no))
             a->tool_no[a->n_tools++] = no;
         p = nl ? nl + 1 : end;
     }
@@ -163,12 +173,62 @@ int ncp_tools_change(struct ncp_analyzer *a)
     ncp_an_emit(a, NCP_C_STOP_SPINDLE_TURNING);
     s->m.spindle_dir = 0;
     ncp_an_emit(a, NCP_C_CHANGE_TOOL)->i[0] = s->selected_pocket;
-    if (s->selected_pocket > 0) {
-        a->tools[0] = a->tools[s->selected_pocket];
-        a->tool_no[0] = a->tool_no[s->selected_pocket];
-    }
+    if (s->selected_pocket > 0)
+        ncp_tools_copy(a, 0, s->selected_pocket);
     s->current_pocket = s->selected_pocket;
     s->current_tool = s->selected_tool;
     s->toolchange_flag = 1;
     return NCP_OK;
+}
+
+/* #5400..#5413 mirror the spindle's entry (index 0): rs274 refreshes them
+ * after a tool change and on G10 L1/L10/L11; `when_empty` zeroes them when
+ * the spindle holds no tool, as the refresh after a tool change does. */
+void ncp_tools_sync_params(struct ncp_analyzer *a, int when_empty)
+{
+    const struct ncp_tool_entry *t = &a->tools[0];
+    double v[13];
+    for (int ax = 0; ax < NCP_NAX; ax++)
+        v[ax] = ncp_tool_offset(a, 0, ax);
+    v[9] = t->diameter;
+    v[10] = t->frontangle;
+    v[11] = t->backangle;
+    v[12] = t->orientation;
+    int none = when_empty && a->tool_no[0] <= 0;
+    double *no = ncp_params_slot(a->params, 5400);
+    if (no)
+        *no = a->tool_no[0] > 0 ? a->tool_no[0] : 0;
+    for (int k = 0; k < 13; k++) {
+        double *p = ncp_params_slot(a->params, 5401 + k);
+        if (p)
+            *p = none ? 0.0 : v[k];
+    }
+}
+
+/* An entry's offset along axis `ax` (user unit): X and Z live in the public
+ * entry, the other axes beside it. */
+double ncp_tool_offset(const struct ncp_analyzer *a, int idx, int ax)
+{
+    if (ax == NCP_X)
+        return a->tools[idx].x_offset;
+    if (ax == NCP_Z)
+        return a->tools[idx].z_offset;
+    return a->tool_more[idx][ax == NCP_Y ? 0 : ax - 2];
+}
+
+void ncp_tool_set_offset(struct ncp_analyzer *a, int idx, int ax, double user)
+{
+    if (ax == NCP_X)
+        a->tools[idx].x_offset = user;
+    else if (ax == NCP_Z)
+        a->tools[idx].z_offset = user;
+    else
+        a->tool_more[idx][ax == NCP_Y ? 0 : ax - 2] = user;
+}
+
+void ncp_tools_copy(struct ncp_analyzer *a, int dst, int src)
+{
+    a->tools[dst] = a->tools[src];
+    a->tool_no[dst] = a->tool_no[src];
+    memcpy(a->tool_more[dst], a->tool_more[src], sizeof a->tool_more[dst]);
 }

@@ -206,6 +206,12 @@ int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b)
     return NCP_OK;
 }
 
+/* The spindle's tool entry (#5400..#5413) and the current point (#5420..#5428). */
+static int ncp_param_readonly(int index)
+{
+    return (index >= 5400 && index <= 5413) || (index >= 5420 && index <= 5428);
+}
+
 /* All values first (pre-block parameters), then the writes in order. */
 int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b)
 {
@@ -219,13 +225,16 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b)
     for (unsigned k = 0; k < n; k++) {
         const struct ncp_assign *as = &b->assign[k];
         int rc = ncp_declare_targets_before(a, b, (uint16_t)(as->col + 1));
-        if (rc == NCP_OK)
-            rc = ncp_eval(a, b, &as->value, &val[k]);
         if (rc == NCP_OK && as->kind == NCP_ASSIGN_NUMBERED) {
             double iv;
             rc = ncp_eval(a, b, &as->index, &iv);
             idx[k] = ncp_trunc_int_round(iv);
+            /* rs274 refuses these as it reads the target, before the value */
+            if (rc == NCP_OK && ncp_param_readonly(idx[k]))
+                return ncp_an_error(a, as->col, "Parameter is readonly");
         }
+        if (rc == NCP_OK)
+            rc = ncp_eval(a, b, &as->value, &val[k]);
         if (rc != NCP_OK)
             return rc;
     }

@@ -260,6 +260,60 @@ static void test_g92_and_coords(void **state)
     run_free(&r);
 }
 
+/* The last op of `kind` in the run, NULL if none. */
+static const struct ncp_canon *last_op(const struct run *r, int kind)
+{
+    for (unsigned k = r->c.n_ops; k-- > 6;)
+        if ((int)r->c.ops[k].kind == kind)
+            return &r->c.ops[k];
+    return NULL;
+}
+
+/* G53 goes through the XY rotation of the active system (rs274: -11.1603, 0.6699). */
+static void test_rotation_g53(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G21\nG10 L2 P1 X10 Y5 R30\nG0 X10 Y0\nG53 G0 X0 Y0\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    const struct ncp_canon *m = last_op(&r, NCP_C_STRAIGHT_TRAVERSE);
+    assert_non_null(m);
+    assert_true(fabs(m->d[0] - -11.160254037844387) < 1e-12);
+    assert_true(fabs(m->d[1] - 0.6698729810778055) < 1e-12);
+    run_free(&r);
+}
+
+/* Leaving a rotated system and coming back keeps the point; #<_abs_x> and
+ * #<_abs_y> are machine coordinates through the rotation. */
+static void test_rotation_switch_and_abs(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G21\nG10 L2 P1 X10 Y5 R30\nG0 X3 Y4\nG55\nG54\n"
+                    "#1=#<_abs_x> #2=#<_abs_y>\nG0 X#1 Y#2\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    const struct ncp_canon *m = last_op(&r, NCP_C_STRAIGHT_TRAVERSE);
+    assert_non_null(m);
+    double t = 30.0 * M_PI / 180.0;
+    assert_true(fabs(m->d[0] - (3 * cos(t) - 4 * sin(t) + 10)) < 1e-9);
+    assert_true(fabs(m->d[1] - (3 * sin(t) + 4 * cos(t) + 5)) < 1e-9);
+    run_free(&r);
+}
+
+/* G10 L2 R on the active system turns the current point with it. */
+static void test_rotation_change_while_active(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G21\nG0 X10 Y0\nG10 L2 P1 R90\n#1=#5420 #2=#5421\nG0 X#1 Y#2\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    const struct ncp_canon *m = last_op(&r, NCP_C_STRAIGHT_TRAVERSE);
+    assert_non_null(m);
+    assert_true(fabs(m->d[0]) < 1e-12);
+    assert_true(fabs(m->d[1] - -10.0) < 1e-12);
+    run_free(&r);
+}
+
 /* The sequential bottleneck: a plain G1 block must stay well under 1 us. */
 static void test_speed(void **state)
 {
@@ -348,6 +402,9 @@ int main(void)
         cmocka_unit_test(test_params_pre_block),
         cmocka_unit_test(test_slot_continuation),
         cmocka_unit_test(test_g92_and_coords),
+        cmocka_unit_test(test_rotation_g53),
+        cmocka_unit_test(test_rotation_switch_and_abs),
+        cmocka_unit_test(test_rotation_change_while_active),
         cmocka_unit_test(test_speed),
         cmocka_unit_test(test_speed_analyzer_only),
     };
