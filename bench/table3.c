@@ -83,27 +83,19 @@ static void place_self(const struct ncp_thread_spec *spec, int pin)
     }
 }
 
+/* One run: with thread creation (pool NULL) or on the pre-started pool. */
 static int run_once(const struct ncp_source *src, const struct ncp_thread_map *map,
-                    const struct ncp_analyzer_cfg *acfg, struct sink *s,
-                    struct ncp_run_stats *st, struct ncp_diag *d)
+                    struct ncp_pipeline_pool *pool, const struct ncp_analyzer_cfg *acfg,
+                    struct sink *s, struct ncp_run_stats *st, struct ncp_diag *d)
 {
     struct ncp_output out = { s, emit };
     memset(st, 0, sizeof *st);
     memset(d, 0, sizeof *d);
     s->used = 0;
+    if (pool)
+        return ncp_pipeline_pool_run(pool, src, acfg, &out, st, d);
     return map->mode == NCP_MODE_SERIAL ? ncp_serial_run(src, acfg, &out, st, d)
                                         : ncp_pipeline_run(src, map, acfg, &out, st, d);
-}
-
-static int run_pooled(struct ncp_pipeline_pool *pool, const struct ncp_source *src,
-                      const struct ncp_analyzer_cfg *acfg, struct sink *s,
-                      struct ncp_run_stats *st, struct ncp_diag *d)
-{
-    struct ncp_output out = { s, emit };
-    memset(st, 0, sizeof *st);
-    memset(d, 0, sizeof *d);
-    s->used = 0;
-    return ncp_pipeline_pool_run(pool, src, acfg, &out, st, d);
 }
 
 static void report_warnings(uint32_t *seen, uint32_t w)
@@ -170,8 +162,8 @@ static int measure(const struct opts *o, const struct ncp_source *src,
     s->hashing = 1;
     s->hash = 14695981039346656037ull;
     for (long i = 0; i < o->warmup; i++) {
-        if (run_once(src, map, &o->acfg, s, &st, &d) != NCP_OK ||
-            run_pooled(pool, src, &o->acfg, s, &pst, &d) != NCP_OK) {
+        if (run_once(src, map, NULL, &o->acfg, s, &st, &d) != NCP_OK ||
+            run_once(src, map, pool, &o->acfg, s, &pst, &d) != NCP_OK) {
             fprintf(stderr, "%s:%u:%u: error: %s\n", o->prog, d.line, d.col, d.msg);
             return 2;
         }
@@ -187,8 +179,8 @@ static int measure(const struct opts *o, const struct ncp_source *src,
             printf("stopped %ld\n", i);
             break;
         }
-        if (run_once(src, map, &o->acfg, s, &st, &d) != NCP_OK ||
-            run_pooled(pool, src, &o->acfg, s, &pst, &d) != NCP_OK) {
+        if (run_once(src, map, NULL, &o->acfg, s, &st, &d) != NCP_OK ||
+            run_once(src, map, pool, &o->acfg, s, &pst, &d) != NCP_OK) {
             fprintf(stderr, "%s:%u:%u: error: %s\n", o->prog, d.line, d.col, d.msg);
             return 2;
         }

@@ -35,6 +35,7 @@
 #include "ncpar/motion.h"
 #include "ncpar/pipeline.h"
 #include "ncpar/rt.h"
+#include "gcode_src.h"
 
 #define POINT_TOL 2e-6      /* mm: print rounding of a 3-D point (0.87e-6) and some */
 #define RADIUS_TOL 1e-3     /* mm: arcs keep their radius within 1 um */
@@ -81,17 +82,6 @@ static int collect_seg(void *ctx, const struct ncp_cmd *cmd)
     return 0;
 }
 
-struct gcode_ctx {
-    struct ncp_source src;
-    struct ncp_analyzer_cfg acfg;
-};
-
-static int gcode_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
-{
-    struct gcode_ctx *g = ctx;
-    struct ncp_run_stats st;
-    return ncp_serial_run(&g->src, &g->acfg, out, &st, d);
-}
 
 /* ---- --live: the operator's hand on the feed ------------------------------------------ */
 

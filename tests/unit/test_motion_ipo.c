@@ -20,23 +20,13 @@
 #include "ncpar/motion.h"
 #include "ncpar/pipeline.h"
 #include "ncpar/rt.h"
+#include "gcode_src.h"
 
 /* the trace prints 6 decimals: half a unit of the last digit */
 #define PRINT_Q 0.5e-6
 #define RATIO 4
 
 
-struct gcode_ctx {
-    struct ncp_source src;
-    struct ncp_analyzer_cfg acfg;
-};
-
-static int gcode_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
-{
-    struct gcode_ctx *g = ctx;
-    struct ncp_run_stats st;
-    return ncp_serial_run(&g->src, &g->acfg, out, &st, d);
-}
 
 static struct row *run_text(const char *text, const struct ncp_machine_cfg *cfg, size_t *n,
                             struct ncp_nck_result *res)

@@ -23,6 +23,7 @@
 #include "ncpar/pipeline.h"
 #include "ncpar/rt.h"
 #include "../../src/rt/nck_int.h"
+#include "gcode_src.h"
 
 /* The trace prints positions with 6 decimals: a k-th difference may be off by
  * 2^k half-units of the last digit, divided by T^k. */
@@ -59,17 +60,6 @@ static struct worst check_limits(const struct row *r, size_t n, const struct ncp
     return w;
 }
 
-struct gcode_ctx {
-    struct ncp_source src;
-    struct ncp_analyzer_cfg acfg;
-};
-
-static int gcode_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
-{
-    struct gcode_ctx *g = ctx;
-    struct ncp_run_stats st;
-    return ncp_serial_run(&g->src, &g->acfg, out, &st, d);
-}
 
 static struct row *run_text(const char *text, const struct ncp_machine_cfg *cfg, size_t *n,
                             struct ncp_nck_result *res)

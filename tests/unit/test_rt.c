@@ -21,6 +21,7 @@
 #include "ncpar/pipeline.h"
 #include "ncpar/rt.h"
 #include "../../src/rt/nck_int.h"
+#include "gcode_src.h"
 
 /* ---- SPSC ring ----------------------------------------------------------------- */
 
@@ -467,17 +468,6 @@ static void test_run_for_seconds(void **state)
 
 /* ---- through the real interpreter ---------------------------------------------- */
 
-struct gcode_ctx {
-    struct ncp_source src;
-    struct ncp_analyzer_cfg acfg;
-};
-
-static int gcode_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
-{
-    struct gcode_ctx *g = ctx;
-    struct ncp_run_stats st;
-    return ncp_serial_run(&g->src, &g->acfg, out, &st, d);
-}
 
 static void test_run_gcode_g61_corners(void **state)
 {
