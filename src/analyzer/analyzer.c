@@ -296,6 +296,7 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
         ncp_an_finish(a, NCP_CMD_F_ERROR);
         return NCP_ERR_IO;
     }
+    ncp_flow_set_param_ops(a->flow, a->pops);
     ncp_cutcomp_init(&a->comp, NULL);
     a->staged.pending = 0;
     ncp_an_preamble(a);

@@ -431,8 +431,7 @@ static int eval_lenient(struct ncp_flow *f, const struct ncp_block *b,
         *v = e->value;
         return NCP_OK;
     }
-    struct ncp_param_ops ops = f->pops;
-    ops.ctx = f->params;
+    struct ncp_param_ops ops = ncp_params_ops(f->params);
     ops.get_named = lenient_get_named;
     return ncp_expr_eval(b, e, &ops, v, d);
 }
@@ -952,6 +951,11 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
     f->feed_pos = f->cur;
     f->jump_target = UINT64_MAX;
     return f;
+}
+
+void ncp_flow_set_param_ops(struct ncp_flow *f, struct ncp_param_ops ops)
+{
+    f->pops = ops;
 }
 
 void ncp_flow_free(struct ncp_flow *f)

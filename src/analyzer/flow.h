@@ -18,6 +18,10 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed,
                               struct ncp_params *params,
                               const struct ncp_analyzer_cfg *cfg);
 void ncp_flow_free(struct ncp_flow *f);
+/* Parameter reads of O-word conditions, counts and values go through ops (the
+ * analyzer's: it refuses #5420-#5428 under cutter compensation, as rs274 does);
+ * by default they read the parameter table directly. */
+void ncp_flow_set_param_ops(struct ncp_flow *f, struct ncp_param_ops ops);
 
 /* Next non-O-word block to interpret. Returns NCP_OK and sets *out (valid until
  * the next call), NCP_END at the end of the program body, or an error with *d
