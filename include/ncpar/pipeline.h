@@ -41,8 +41,9 @@ int ncp_thread_mode_parse(const char *name, enum ncp_thread_mode *mode);
 /* The name ncp_thread_mode_parse() accepts for m. */
 const char *ncp_thread_mode_name(enum ncp_thread_mode m);
 
-/* Defaults for a mode and thread counts (ATT: feeder on CPU0, others round-robin
- * over the CPUs present). */
+/* Defaults for a mode and thread counts (ATT: feeder on CPU0, lexers, analyzer
+ * and executors round-robin over the CPUs present from CPU1, output beside the
+ * analyzer). */
 void ncp_thread_map_default(struct ncp_thread_map *m, enum ncp_thread_mode mode,
                             int n_lexers, int n_executors);
 /* Load an INI thread map; fills d (file:line) on error. */
