@@ -73,15 +73,34 @@ void ncp_pipe_reset(struct ncp_pipe *p);
  * start timeout, whichever comes first. */
 void ncp_pipe_wait_gate(struct ncp_pipe *p, int timeout_us);
 
+#define NCP_PIPE_MAX_THREADS (NCP_MAX_LEXERS + NCP_MAX_EXECUTORS + 3)
+
+/* One stage thread of a run: where it runs, its code and its worker. */
+struct ncp_pipe_stage {
+    const struct ncp_thread_spec *spec;
+    void *(*fn)(void *);
+    struct ncp_pipe_worker *w;
+    int is_lexer;                /* keeps the paper's start rule (the gate) */
+};
+
+/* The run's stage threads in the paper's start order (feeder, lexers,
+ * analyzer, executors, output); returns how many. */
+int ncp_pipe_stages(struct ncp_pipe *p, struct ncp_pipe_stage out[NCP_PIPE_MAX_THREADS]);
+
 /* The threads of one run and how their start went. */
 struct ncp_starter {
     struct ncp_pipe *p;
-    pthread_t tid[NCP_MAX_LEXERS + NCP_MAX_EXECUTORS + 3];
+    pthread_t tid[NCP_PIPE_MAX_THREADS];
     int started;
     int failed;
     uint32_t warnings;
     double setup_ms; /* CPU time of the starting thread in pthread_create and friends */
 };
+
+/* Start a thread running fn(arg) with spec's placement; its creation counts in
+ * s->setup_ms. On failure s->failed is set and the pipe aborted. */
+void ncp_pipe_start_thread(struct ncp_starter *s, const struct ncp_thread_spec *spec,
+                           void *(*fn)(void *), void *arg);
 
 /* The run's result in the serial reference's precedence, and its statistics
  * (wall time from t0). Both after every stage of the run has ended. */

@@ -142,8 +142,8 @@ void ncp_pipe_wait_gate(struct ncp_pipe *p, int timeout_us)
     }
 }
 
-static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
-                  void *(*fn)(void *), struct ncp_pipe_worker *w)
+void ncp_pipe_start_thread(struct ncp_starter *s, const struct ncp_thread_spec *spec,
+                           void *(*fn)(void *), void *arg)
 {
     if (s->failed)
         return;
@@ -151,7 +151,7 @@ static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
     /* CPU time, not wall time: a new thread may preempt its creator, and
      * that time is the pipeline's work, not start-up. */
     double t0 = ncp_pipe_thread_cpu_ms();
-    int rc = ncp_thread_start(&s->tid[s->started], spec, pin, fn, w, &s->warnings);
+    int rc = ncp_thread_start(&s->tid[s->started], spec, pin, fn, arg, &s->warnings);
     s->setup_ms += ncp_pipe_thread_cpu_ms() - t0;
     if (rc != 0) {
         s->failed = 1;
@@ -161,19 +161,31 @@ static void start(struct ncp_starter *s, const struct ncp_thread_spec *spec,
     s->started++;
 }
 
+int ncp_pipe_stages(struct ncp_pipe *p, struct ncp_pipe_stage out[NCP_PIPE_MAX_THREADS])
+{
+    const struct ncp_thread_map *map = p->map;
+    int k = 0;
+    out[k++] = (struct ncp_pipe_stage){ &map->feeder, ncp_pipe_feeder, &p->feeder, 0 };
+    for (int i = 0; i < p->n; i++)
+        out[k++] = (struct ncp_pipe_stage){ &map->lexer[i], ncp_pipe_lexer, &p->lexer[i], 1 };
+    out[k++] = (struct ncp_pipe_stage){ &map->analyzer, ncp_pipe_analyzer, &p->analyzer, 0 };
+    for (int j = 0; j < p->exec_threads; j++)
+        out[k++] = (struct ncp_pipe_stage){ &map->executor[j], ncp_pipe_executor,
+                                            &p->executor[j], 0 };
+    out[k++] = (struct ncp_pipe_stage){ &map->output, ncp_pipe_output, &p->output, 0 };
+    return k;
+}
+
+/* The paper's order: the feeder first, the rest once the gate opened. */
 static void start_all(struct ncp_starter *s)
 {
-    struct ncp_pipe *p = s->p;
-    const struct ncp_thread_map *map = p->map;
-    start(s, &map->feeder, ncp_pipe_feeder, &p->feeder);
-    if (!s->failed)
-        ncp_pipe_wait_gate(p, map->start_timeout_us);
-    for (int i = 0; i < p->n; i++)
-        start(s, &map->lexer[i], ncp_pipe_lexer, &p->lexer[i]);
-    start(s, &map->analyzer, ncp_pipe_analyzer, &p->analyzer);
-    for (int j = 0; j < p->exec_threads; j++)
-        start(s, &map->executor[j], ncp_pipe_executor, &p->executor[j]);
-    start(s, &map->output, ncp_pipe_output, &p->output);
+    struct ncp_pipe_stage st[NCP_PIPE_MAX_THREADS];
+    int n = ncp_pipe_stages(s->p, st);
+    for (int k = 0; k < n; k++) {
+        if (k == 1 && !s->failed)
+            ncp_pipe_wait_gate(s->p, s->p->map->start_timeout_us);
+        ncp_pipe_start_thread(s, st[k].spec, st[k].fn, st[k].w);
+    }
 }
 
 static void stage_stats(struct ncp_stage_stats *st, const struct ncp_pipe_worker *w)

@@ -23,7 +23,7 @@ struct ncp_pipeline_pool {
     struct ncp_thread_map map;
     struct ncp_pipe *p;
     struct ncp_starter s;
-    struct pool_member member[NCP_MAX_LEXERS + NCP_MAX_EXECUTORS + 3];
+    struct pool_member member[NCP_PIPE_MAX_THREADS];
     _Atomic uint32_t run;         /* bumped to start a run (futex word) */
     _Atomic uint32_t done;        /* members finished with the current run */
     _Atomic int quit;
@@ -49,22 +49,6 @@ static void *member_main(void *arg)
         if (atomic_fetch_add(&pool->done, 1) + 1 == (uint32_t)pool->s.started)
             ncp_futex_wake_all(&pool->done);
     }
-}
-
-static void add(struct ncp_pipeline_pool *pool, const struct ncp_thread_spec *spec,
-                void *(*stage)(void *), struct ncp_pipe_worker *w, int waits_gate)
-{
-    struct ncp_starter *s = &pool->s;
-    if (s->failed)
-        return;
-    struct pool_member *m = &pool->member[s->started];
-    *m = (struct pool_member){ pool, stage, w, waits_gate };
-    int pin = pool->map.mode == NCP_MODE_ATT;
-    if (ncp_thread_start(&s->tid[s->started], spec, pin, member_main, m, &s->warnings) != 0) {
-        s->failed = 1;
-        return;
-    }
-    s->started++;
 }
 
 static void stop_members(struct ncp_pipeline_pool *pool)
@@ -99,15 +83,15 @@ struct ncp_pipeline_pool *ncp_pipeline_pool_new(const struct ncp_thread_map *map
     atomic_init(&pool->done, 0);
     atomic_init(&pool->quit, 0);
     struct ncp_pipe *p = pool->p;
-    const struct ncp_thread_map *m = &pool->map;
     pool->s.p = p;
-    add(pool, &m->feeder, ncp_pipe_feeder, &p->feeder, 0);
-    for (int i = 0; i < p->n; i++)
-        add(pool, &m->lexer[i], ncp_pipe_lexer, &p->lexer[i], 1);
-    add(pool, &m->analyzer, ncp_pipe_analyzer, &p->analyzer, 0);
-    for (int j = 0; j < p->exec_threads; j++)
-        add(pool, &m->executor[j], ncp_pipe_executor, &p->executor[j], 0);
-    add(pool, &m->output, ncp_pipe_output, &p->output, 0);
+    struct ncp_pipe_stage st[NCP_PIPE_MAX_THREADS];
+    int n = ncp_pipe_stages(p, st);
+    for (int k = 0; k < n && !pool->s.failed; k++) {
+        struct pool_member *m = &pool->member[pool->s.started];
+        *m = (struct pool_member){ pool, st[k].fn, st[k].w, st[k].is_lexer };
+        ncp_pipe_start_thread(&pool->s, st[k].spec, member_main, m);
+    }
+    pool->s.setup_ms = 0; /* the runs never pay it */
     if (pool->s.failed) {
         stop_members(pool);
         ncp_pipe_free(p);

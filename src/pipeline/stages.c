@@ -9,11 +9,30 @@
 #include <stddef.h>
 #include <time.h>
 
-double ncp_pipe_now_ms(void)
+static double clock_ms(clockid_t clock)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(clock, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+double ncp_pipe_now_ms(void)
+{
+    return clock_ms(CLOCK_MONOTONIC);
+}
+
+double ncp_pipe_thread_cpu_ms(void)
+{
+    return clock_ms(CLOCK_THREAD_CPUTIME_ID);
+}
+
+/* Every stage thread ends here: nothing it holds back may keep another stage
+ * asleep, and its CPU time goes into the run's statistics. */
+static void *stage_done(void *arg)
+{
+    ncp_ring_wake_owed();
+    ((struct ncp_pipe_worker *)arg)->cpu_ms = ncp_pipe_thread_cpu_ms();
+    return NULL;
 }
 
 /* ---- prefetching -------------------------------------------------------- */
@@ -32,13 +51,6 @@ static void prefetch_cmd(const struct ncp_cmd *cmd)
     __builtin_prefetch(c + offsetof(struct ncp_cmd, ops), 1);
     __builtin_prefetch(c + offsetof(struct ncp_cmd, ops) + 64, 1);
     __builtin_prefetch(c + offsetof(struct ncp_cmd, ops) + 128, 1);
-}
-
-double ncp_pipe_thread_cpu_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
 void ncp_pipe_open_gate(struct ncp_pipe *p)
@@ -81,9 +93,7 @@ void *ncp_pipe_feeder(void *arg)
     for (int i = 0; i < p->n; i++)
         ncp_ring_close(&p->strings[i]);
     ncp_pipe_open_gate(p);
-    ncp_ring_wake_owed();
-    ((struct ncp_pipe_worker *)arg)->cpu_ms = ncp_pipe_thread_cpu_ms();
-    return NULL;
+    return stage_done(arg);
 }
 
 /* LEX_i lexes into a block of its own (hot in its cache) and passes it on
@@ -126,9 +136,7 @@ void *ncp_pipe_lexer(void *arg)
         w->items++;
     }
     ncp_ring_close(out);
-    ncp_ring_wake_owed();
-    ((struct ncp_pipe_worker *)arg)->cpu_ms = ncp_pipe_thread_cpu_ms();
-    return NULL;
+    return stage_done(arg);
 }
 
 /* ---- the analyzer's feed and sink ---------------------------------------- */
@@ -215,9 +223,7 @@ void *ncp_pipe_analyzer(void *arg)
         ncp_ring_abort(&p->strings[i]);
         ncp_ring_abort(&p->parsed[i]);
     }
-    ncp_ring_wake_owed();
-    ((struct ncp_pipe_worker *)arg)->cpu_ms = ncp_pipe_thread_cpu_ms();
-    return NULL;
+    return stage_done(arg);
 }
 
 void *ncp_pipe_executor(void *arg)
@@ -231,9 +237,7 @@ void *ncp_pipe_executor(void *arg)
         ncp_ring_stage_release(r, NCP_CMD_STAGE_EXECUTOR);
         w->items++;
     }
-    ncp_ring_wake_owed();
-    ((struct ncp_pipe_worker *)arg)->cpu_ms = ncp_pipe_thread_cpu_ms();
-    return NULL;
+    return stage_done(arg);
 }
 
 /* Slots in cmd_id order (executed here first when there are no executor
@@ -269,7 +273,5 @@ void *ncp_pipe_output(void *arg)
     }
     p->end_ms = ncp_pipe_now_ms();
     ncp_pipe_abort(p);
-    ncp_ring_wake_owed();
-    ((struct ncp_pipe_worker *)arg)->cpu_ms = ncp_pipe_thread_cpu_ms();
-    return NULL;
+    return stage_done(arg);
 }
