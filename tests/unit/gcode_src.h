@@ -1,22 +1,49 @@
 /* Motion tests that feed the NCK from real G-code: the interpreter callback
- * (serial reference) over a program in memory or on disk. */
+ * (serial reference) over a program in memory or on disk, and a whole run of
+ * a program text on the virtual clock, read back as its trace. Include after
+ * <cmocka.h>. */
 #ifndef NCP_TEST_GCODE_SRC_H
 #define NCP_TEST_GCODE_SRC_H
+
+#include <stdio.h>
+#include <string.h>
 
 #include "ncpar/analyzer.h"
 #include "ncpar/feeder.h"
 #include "ncpar/pipeline.h"
+#include "ncpar/rt.h"
+#include "trace_rows.h"
 
 struct gcode_ctx {
     struct ncp_source src;
     struct ncp_analyzer_cfg acfg;
 };
 
-static int gcode_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
+static inline int gcode_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
 {
     struct gcode_ctx *g = ctx;
     struct ncp_run_stats st;
     return ncp_serial_run(&g->src, &g->acfg, out, &st, d);
+}
+
+/* The trace of PROG run on cfg with the virtual clock (the run must succeed);
+ * caller frees the rows. */
+static inline struct row *run_text(const char *text, const struct ncp_machine_cfg *cfg, size_t *n,
+                            struct ncp_nck_result *res)
+{
+    struct gcode_ctx g;
+    struct ncp_diag d;
+    memset(&g, 0, sizeof g);
+    assert_int_equal(ncp_source_from_memory(&g.src, text, strlen(text), "t.ngc", &d), NCP_OK);
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    struct ncp_nck_opts o = { .cfg = cfg, .interpret = gcode_run, .interp_ctx = &g,
+                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
+    assert_int_equal(ncp_nck_run(&o, res), 0);
+    struct row *r = read_trace(f, n);
+    fclose(f);
+    ncp_source_close(&g.src);
+    return r;
 }
 
 #endif

@@ -82,7 +82,6 @@ static int collect_seg(void *ctx, const struct ncp_cmd *cmd)
     return 0;
 }
 
-
 /* ---- --live: the operator's hand on the feed ------------------------------------------ */
 
 /* Every LIVE_EVERY s of machine time the next of these, over and over: hold,

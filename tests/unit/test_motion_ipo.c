@@ -26,26 +26,6 @@
 #define PRINT_Q 0.5e-6
 #define RATIO 4
 
-
-
-static struct row *run_text(const char *text, const struct ncp_machine_cfg *cfg, size_t *n,
-                            struct ncp_nck_result *res)
-{
-    struct gcode_ctx g;
-    struct ncp_diag d;
-    memset(&g, 0, sizeof g);
-    assert_int_equal(ncp_source_from_memory(&g.src, text, strlen(text), "t.ngc", &d), NCP_OK);
-    FILE *f = tmpfile();
-    assert_non_null(f);
-    struct ncp_nck_opts o = { .cfg = cfg, .interpret = gcode_run, .interp_ctx = &g,
-                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
-    assert_int_equal(ncp_nck_run(&o, res), 0);
-    struct row *r = read_trace(f, n);
-    fclose(f);
-    ncp_source_close(&g.src);
-    return r;
-}
-
 static void ipo_cfg(struct ncp_machine_cfg *c, enum ncp_profile prof)
 {
     ncp_machine_cfg_default(c);

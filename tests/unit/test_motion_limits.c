@@ -29,7 +29,6 @@
  * 2^k half-units of the last digit, divided by T^k. */
 #define PRINT_Q 0.5e-6
 
-
 /* Worst ratio of |k-th difference| / limit over all axes (1 = at the limit). */
 struct worst {
     double vel, acc, jerk;
@@ -58,25 +57,6 @@ static struct worst check_limits(const struct row *r, size_t n, const struct ncp
         }
     }
     return w;
-}
-
-
-static struct row *run_text(const char *text, const struct ncp_machine_cfg *cfg, size_t *n,
-                            struct ncp_nck_result *res)
-{
-    struct gcode_ctx g;
-    struct ncp_diag d;
-    memset(&g, 0, sizeof g);
-    assert_int_equal(ncp_source_from_memory(&g.src, text, strlen(text), "t.ngc", &d), NCP_OK);
-    FILE *f = tmpfile();
-    assert_non_null(f);
-    struct ncp_nck_opts o = { .cfg = cfg, .interpret = gcode_run, .interp_ctx = &g,
-                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
-    assert_int_equal(ncp_nck_run(&o, res), 0);
-    struct row *r = read_trace(f, n);
-    fclose(f);
-    ncp_source_close(&g.src);
-    return r;
 }
 
 static const char corners_prog[] =
@@ -204,7 +184,6 @@ static void test_trapezoid_programs(void **state)
     (void)state;
     check_bundled_programs(NCP_PROFILE_TRAPEZOID);
 }
-
 
 /* ---- live feed override and feed hold ------------------------------------------ */
 

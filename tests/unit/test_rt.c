@@ -279,7 +279,6 @@ static void arc(struct ncp_cmd *c, double x, double y, double cx, double cy, int
     o->i[0] = rot;
 }
 
-
 static int run(struct prog *p, struct ncp_machine_cfg *cfg, FILE *trace,
                struct ncp_nck_result *res)
 {
@@ -468,7 +467,6 @@ static void test_run_for_seconds(void **state)
 
 /* ---- through the real interpreter ---------------------------------------------- */
 
-
 static void test_run_gcode_g61_corners(void **state)
 {
     (void)state;
@@ -480,19 +478,11 @@ static void test_run_gcode_g61_corners(void **state)
                                "G1 Y40\n"
                                "G20 G1 X1\n"
                                "M2\n";
-    struct gcode_ctx g;
-    struct ncp_diag d;
-    memset(&g, 0, sizeof g);
-    assert_int_equal(ncp_source_from_memory(&g.src, prog, sizeof prog - 1, "t.ngc", &d), NCP_OK);
     struct ncp_machine_cfg cfg;
     ncp_machine_cfg_default(&cfg);
-    FILE *f = tmpfile();
-    struct ncp_nck_opts o = { .cfg = &cfg, .interpret = gcode_run, .interp_ctx = &g,
-                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
     struct ncp_nck_result res;
-    assert_int_equal(ncp_nck_run(&o, &res), 0);
     size_t n;
-    struct row *r = read_trace(f, &n);
+    struct row *r = run_text(prog, &cfg, &n, &res);
     static const double ends[][3] = { { 10, 5, 2 }, { 10, 5, -1 }, { 50, 5, -1 },
                                       { 60, 15, -1 }, { 60, 40, -1 }, { 25.4, 40, -1 } };
     for (size_t e = 0; e < sizeof ends / sizeof ends[0]; e++) {
@@ -507,8 +497,6 @@ static void test_run_gcode_g61_corners(void **state)
         if (r[k].line == 5)
             assert_true(fabs(hypot(r[k].cmd[0] - 50, r[k].cmd[1] - 15) - 10) < 2e-6);
     free(r);
-    fclose(f);
-    ncp_source_close(&g.src);
 }
 
 int main(void)
