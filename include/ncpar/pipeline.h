@@ -27,6 +27,12 @@ struct ncp_thread_spec {
 struct ncp_thread_map {
     enum ncp_thread_mode mode;
     int n_lexers, n_executors; /* n_executors 0: the output thread executes */
+    /* 1 (only with n_executors 0): the analyzer executes and writes each
+     * command itself, as the serial reference does: no command ring and no
+     * output thread. On two cores the pipeline is then two busy threads,
+     * feeder + lexer on one core and analyzer on the other, with one
+     * hand-off between them. */
+    int inline_output;
     int string_rows;  /* g: rows of the string ring (each row = n blocks) */
     int parsed_rows;  /* h: rows of the parsed ring */
     int cmd_slots;    /* commands ring capacity per executor */

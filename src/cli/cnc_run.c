@@ -80,20 +80,25 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
     fprintf(stderr, ", analyzer %.1f, executors", st->analyzer.cpu_ms);
     for (int j = 0; j < map->n_executors && j < NCP_MAX_EXECUTORS; j++)
         fprintf(stderr, " %.1f", st->executor[j].cpu_ms);
-    fprintf(stderr, "%s, output %.1f\n", map->n_executors ? "" : " none", st->output.cpu_ms);
+    if (map->inline_output && map->n_executors == 0)
+        fputs(" none, output in the analyzer\n", stderr);
+    else
+        fprintf(stderr, "%s, output %.1f\n", map->n_executors ? "" : " none", st->output.cpu_ms);
 }
 
 static void usage(FILE *f)
 {
     fputs("usage: cnc-run parse PROG [-j N] [--executors M] [--mode serial|det|att]\n"
           "                          [--config INI] [--tool-table FILE] [--canon FILE|-]\n"
-          "                          [--stats] [--max-loops N]\n"
+          "                          [--stats] [--max-loops N] [--inline-output]\n"
           "       cnc-run check PROG [--tool-table FILE]\n"
           "       cnc-run run PROG [--config INI] [--trace CSV] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
           "\n"
           "parse  interpret PROG (\"-\" = standard input) with the parallel pipeline and\n"
           "       write canonical machining calls (rs274 -g format) to --canon.\n"
+          "       --executors 0: the output thread executes; with --inline-output the\n"
+          "       analyzer executes and writes each command itself (no output thread).\n"
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
           "run    run PROG on the machine: planner, interpolator, position loop, backend\n"
           "       (the simulated servo by default); `cnc-run run --help` for details.\n"
@@ -107,6 +112,7 @@ struct parse_opts {
     const char *canon;
     const char *config;
     int lexers, executors;
+    int inline_output;
     enum ncp_thread_mode mode;
     int mode_given;
     int stats;
@@ -134,13 +140,14 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         { "tool-table", required_argument, 0, 't' },
         { "canon", required_argument, 0, 'o' },
         { "stats", no_argument, 0, 's' },
+        { "inline-output", no_argument, 0, 'I' },
         { "max-loops", required_argument, 0, 'L' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
     int c, v;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "j:e:m:c:t:o:shL:", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "j:e:m:c:t:o:shL:I", longopts, NULL)) != -1) {
         switch (c) {
         case 'j':
             if (parse_int(optarg, 1, NCP_MAX_LEXERS, &o->lexers))
@@ -159,6 +166,7 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         case 't': o->acfg.tool_table_path = optarg; break;
         case 'o': o->canon = optarg; break;
         case 's': o->stats = 1; break;
+        case 'I': o->inline_output = 1; break;
         case 'L':
             if (parse_int(optarg, 1, 2000000000, &v))
                 return fprintf(stderr, "cnc-run: --max-loops wants a positive count\n"), -1;
@@ -222,6 +230,13 @@ static int cmd_parse(int argc, char **argv)
             map.mode = o.mode;
     } else {
         ncp_thread_map_default(&map, o.mode, o.lexers, o.executors);
+    }
+    if (o.inline_output) {
+        if (map.n_executors > 0) {
+            fprintf(stderr, "cnc-run: --inline-output needs --executors 0 (the analyzer then executes)\n");
+            return EXIT_USAGE;
+        }
+        map.inline_output = 1;
     }
 
     struct ncp_source src;

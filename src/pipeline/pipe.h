@@ -33,6 +33,7 @@ struct ncp_pipe {
     int n, m;                    /* lexers, command rings (one per executor, >= 1) */
     int exec_threads;            /* executors; 0: the output thread executes */
     unsigned out_stage;          /* the output's stage in a command ring */
+    int inline_out;              /* the analyzer executes and emits (m == 0) */
 
     struct ncp_ring *strings;    /* n: feeder -> LEX_i, struct ncp_span */
     struct ncp_ring *parsed;     /* n: LEX_i -> analyzer, packed blocks in NCP_PACK_UNIT units */
@@ -55,7 +56,11 @@ struct ncp_pipe {
     int an_rc;
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
 
-    /* output thread only, read after join */
+    /* inline output: the analyzer's one command slot, and whether it stopped */
+    struct ncp_cmd *inline_cmd;
+    int inline_stopped;
+
+    /* output thread only (the analyzer's with inline output), read after join */
     alignas(64) struct ncp_diag err; /* first error slot, in program order */
     int emit_failed;
     double end_ms;               /* last slot out */

@@ -34,6 +34,7 @@ void ncp_pipe_free(struct ncp_pipe *p)
     rings_free(p->strings, p->n);
     rings_free(p->parsed, p->n);
     rings_free(p->cmds, p->m);
+    free(p->inline_cmd);
     free(p);
 }
 
@@ -65,13 +66,16 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     p->map = map;
     p->n = clamp(map->n_lexers, 1, NCP_MAX_LEXERS);
     p->exec_threads = clamp(map->n_executors, 0, NCP_MAX_EXECUTORS);
-    p->m = p->exec_threads > 0 ? p->exec_threads : 1;
+    p->inline_out = map->inline_output && p->exec_threads == 0;
+    p->m = p->exec_threads > 0 ? p->exec_threads : p->inline_out ? 0 : 1;
     p->out_stage = p->exec_threads > 0 ? NCP_CMD_STAGE_OUTPUT : NCP_CMD_STAGE_EXECUTOR;
     atomic_init(&p->gate, 0);
     p->strings = rings_new(p->n);
     p->parsed = rings_new(p->n);
-    p->cmds = rings_new(p->m);
-    if (!p->strings || !p->parsed || !p->cmds) {
+    p->cmds = p->m > 0 ? rings_new(p->m) : NULL;
+    p->inline_cmd = p->inline_out ? aligned_alloc(64, sizeof *p->inline_cmd) : NULL;
+    if (!p->strings || !p->parsed || (p->m > 0 && !p->cmds) ||
+        (p->inline_out && !p->inline_cmd)) {
         ncp_pipe_free(p);
         return NULL;
     }
@@ -123,6 +127,7 @@ void ncp_pipe_reset(struct ncp_pipe *p)
     memset(&p->an_diag, 0, sizeof p->an_diag);
     memset(&p->err, 0, sizeof p->err);
     p->emit_failed = 0;
+    p->inline_stopped = 0;
     p->end_ms = 0;
     p->alloc_ms = 0;
 }
@@ -172,7 +177,8 @@ int ncp_pipe_stages(struct ncp_pipe *p, struct ncp_pipe_stage out[NCP_PIPE_MAX_T
     for (int j = 0; j < p->exec_threads; j++)
         out[k++] = (struct ncp_pipe_stage){ &map->executor[j], ncp_pipe_executor,
                                             &p->executor[j], 0 };
-    out[k++] = (struct ncp_pipe_stage){ &map->output, ncp_pipe_output, &p->output, 0 };
+    if (!p->inline_out)
+        out[k++] = (struct ncp_pipe_stage){ &map->output, ncp_pipe_output, &p->output, 0 };
     return k;
 }
 

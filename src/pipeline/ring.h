@@ -129,4 +129,19 @@ void ncp_ring_wake_owed(void);
 uint64_t ncp_ring_waits(const struct ncp_ring *r, unsigned s);
 uint64_t ncp_ring_sleeps(const struct ncp_ring *r, unsigned s);
 
+/* Ask for a line in the state a store needs. A producer writes slots its
+ * consumer on another core read a lap ago: a plain store waits in the store
+ * buffer until that core gave the line up, and a full store buffer stalls the
+ * producer's own work. __builtin_prefetch(p, 1) is a read prefetch unless the
+ * build targets PRFCHW, so x86 gets the instruction itself (a NOP on CPUs
+ * that predate it). */
+static inline void ncp_prefetch_w(const void *p)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __asm__ volatile("prefetchw %0" : : "m"(*(const char *)p));
+#else
+    __builtin_prefetch(p, 1);
+#endif
+}
+
 #endif

@@ -41,17 +41,45 @@ static void *stage_done(void *arg)
  * of cache-to-cache transfers, small against any ring. */
 #define PREFETCH_AHEAD 6u
 
-/* The lines every command slot uses: header with error code, first op. */
+/* The lines the analyzer writes in every command slot: header, first ops. */
 static void prefetch_cmd(const struct ncp_cmd *cmd)
 {
     if (!cmd)
         return;
     const char *c = (const char *)cmd;
-    __builtin_prefetch(c, 1);
-    __builtin_prefetch(c + offsetof(struct ncp_cmd, ops), 1);
-    __builtin_prefetch(c + offsetof(struct ncp_cmd, ops) + 64, 1);
-    __builtin_prefetch(c + offsetof(struct ncp_cmd, ops) + 128, 1);
+    ncp_prefetch_w(c);
+    ncp_prefetch_w(c + offsetof(struct ncp_cmd, ops));
+    ncp_prefetch_w(c + offsetof(struct ncp_cmd, ops) + 64);
+    ncp_prefetch_w(c + offsetof(struct ncp_cmd, ops) + 128);
 }
+
+/* What executing a slot reads (header, ops) and writes (the text). */
+static void prefetch_cmd_exec(const struct ncp_cmd *cmd)
+{
+    if (!cmd)
+        return;
+    const char *c = (const char *)cmd;
+    __builtin_prefetch(c, 0);
+    __builtin_prefetch(c + offsetof(struct ncp_cmd, ops), 0);
+    __builtin_prefetch(c + offsetof(struct ncp_cmd, ops) + 64, 0);
+    ncp_prefetch_w(c + offsetof(struct ncp_cmd, out));
+    ncp_prefetch_w(c + offsetof(struct ncp_cmd, out) + 64);
+}
+
+/* What the output reads of a slot an executor completed. */
+static void prefetch_cmd_out(const struct ncp_cmd *cmd)
+{
+    if (!cmd)
+        return;
+    const char *c = (const char *)cmd;
+    __builtin_prefetch(c, 0);
+    __builtin_prefetch(c + offsetof(struct ncp_cmd, out), 0);
+    __builtin_prefetch(c + offsetof(struct ncp_cmd, out) + 64, 0);
+}
+
+/* How far ahead (8-byte units, a few kB) the lexer claims the lines of the
+ * packed records it is about to write. */
+#define PACK_PREFETCH_UNITS 256u
 
 void ncp_pipe_open_gate(struct ncp_pipe *p)
 {
@@ -70,6 +98,10 @@ void ncp_pipe_abort(struct ncp_pipe *p)
     ncp_pipe_open_gate(p);
 }
 
+/* Spans are 24 bytes: claiming a line this far ahead keeps the feeder's
+ * stores from waiting on a lexer's core. */
+#define SPAN_PREFETCH_SLOTS 64u
+
 /* Block b goes to column b mod n (the paper's i + k*n). */
 void *ncp_pipe_feeder(void *arg)
 {
@@ -79,11 +111,15 @@ void *ncp_pipe_feeder(void *arg)
     uint64_t k = 0;
     struct ncp_span sp;
     while (ncp_source_span(p->src, off, line, &sp) == 0) {
-        struct ncp_span *slot = ncp_ring_reserve(&p->strings[k % (uint64_t)p->n]);
+        struct ncp_ring *r = &p->strings[k % (uint64_t)p->n];
+        struct ncp_span *slot = ncp_ring_reserve(r);
         if (!slot)
             break;
+        const struct ncp_span *later = ncp_ring_reserve_ahead(r, SPAN_PREFETCH_SLOTS);
+        if (later)
+            ncp_prefetch_w(later);
         *slot = sp;
-        ncp_ring_commit(&p->strings[k % (uint64_t)p->n]);
+        ncp_ring_commit(r);
         off = sp.next;
         line++;
         if (++k == p->string_fill)
@@ -112,6 +148,11 @@ static int put_packed(struct ncp_ring *out, const struct ncp_block *b)
     void *dst = ncp_ring_reserve_n(out, units);
     if (!dst)
         return -1;
+    const char *later = ncp_ring_reserve_ahead(out, units + PACK_PREFETCH_UNITS);
+    if (later) { /* a record is 1-3 lines: two a block keep ahead of it */
+        ncp_prefetch_w(later);
+        ncp_prefetch_w(later + 64);
+    }
     ncp_block_pack(b, dst);
     ncp_ring_commit_n(out, units);
     return 0;
@@ -201,6 +242,37 @@ static void sink_publish(void *ctx, struct ncp_cmd *cmd)
     p->analyzer.items++;
 }
 
+/* Inline output: each command executed and written the moment the analyzer
+ * publishes it, stopping where the output thread (and the serial reference)
+ * would stop. */
+static struct ncp_cmd *inline_acquire(void *ctx)
+{
+    struct ncp_pipe *p = ctx;
+    if (p->inline_stopped)
+        return NULL;
+    ncp_cmd_reset_header(p->inline_cmd, p->next_id);
+    return p->inline_cmd;
+}
+
+static void inline_publish(void *ctx, struct ncp_cmd *c)
+{
+    struct ncp_pipe *p = ctx;
+    p->next_id++;
+    p->analyzer.items++;
+    ncp_exec_cmd(c);
+    p->output.items++;
+    if (p->out && p->out->emit(p->out->ctx, c) != 0) {
+        p->emit_failed = 1;
+        p->inline_stopped = 1;
+    }
+    if (c->flags & NCP_CMD_F_ERROR) {
+        p->err = c->diag;
+        p->inline_stopped = 1;
+    }
+    if (c->flags & NCP_CMD_F_END)
+        p->inline_stopped = 1;
+}
+
 void *ncp_pipe_analyzer(void *arg)
 {
     struct ncp_pipe *p = ((struct ncp_pipe_worker *)arg)->p;
@@ -212,9 +284,13 @@ void *ncp_pipe_analyzer(void *arg)
     } else {
         struct ncp_block_feed feed = { p, feed_next, feed_release, p->src };
         struct ncp_cmd_sink sink = { p, sink_acquire, sink_publish };
+        if (p->inline_out)
+            sink = (struct ncp_cmd_sink){ p, inline_acquire, inline_publish };
         p->an_rc = ncp_analyzer_run(an, &feed, &sink);
         ncp_analyzer_free(an);
     }
+    if (p->inline_out)
+        p->end_ms = ncp_pipe_now_ms();
     for (int j = 0; j < p->m; j++)
         ncp_ring_close(&p->cmds[j]);
     /* The program may have ended before the file did (M2, an error): the
@@ -232,7 +308,7 @@ void *ncp_pipe_executor(void *arg)
     struct ncp_ring *r = &w->p->cmds[w->index];
     struct ncp_cmd *c;
     while ((c = ncp_ring_stage_peek(r, NCP_CMD_STAGE_EXECUTOR, 0)) != NULL) {
-        prefetch_cmd(ncp_ring_stage_ahead(r, NCP_CMD_STAGE_EXECUTOR, PREFETCH_AHEAD));
+        prefetch_cmd_exec(ncp_ring_stage_ahead(r, NCP_CMD_STAGE_EXECUTOR, PREFETCH_AHEAD));
         ncp_exec_cmd(c);
         ncp_ring_stage_release(r, NCP_CMD_STAGE_EXECUTOR);
         w->items++;
@@ -252,7 +328,12 @@ void *ncp_pipe_output(void *arg)
         struct ncp_cmd *c = ncp_ring_stage_peek(r, p->out_stage, 0);
         if (!c)
             break;
-        prefetch_cmd(ncp_ring_stage_ahead(r, p->out_stage, PREFETCH_AHEAD / (uint32_t)p->m + 1));
+        const struct ncp_cmd *later =
+            ncp_ring_stage_ahead(r, p->out_stage, PREFETCH_AHEAD / (uint32_t)p->m + 1);
+        if (p->exec_threads == 0)
+            prefetch_cmd_exec(later);
+        else
+            prefetch_cmd_out(later);
         if (p->exec_threads == 0)
             ncp_exec_cmd(c);
         p->output.items++;

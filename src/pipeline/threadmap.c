@@ -88,7 +88,8 @@ struct map_loader {
     struct ncp_diag *d;
     int failed;
     /* [pipeline] */
-    int mode, lexers, executors, string_rows, parsed_rows, cmd_slots, timeout;
+    int mode, lexers, executors, string_rows, parsed_rows, cmd_slots, timeout, inline_out;
+    int inline_line;    /* where inline_output was set */
     unsigned pipe_set;
     struct loaded_spec feeder, analyzer, output;
     struct loaded_spec lexer[NCP_MAX_LEXERS], executor[NCP_MAX_EXECUTORS];
@@ -123,7 +124,8 @@ static int parse_int(const char *s, long lo, long hi, int *out)
 }
 
 static const char *const pipe_keys[] = { "mode", "lexers", "executors", "string_rows",
-                                         "parsed_rows", "cmd_slots", "start_timeout_us" };
+                                         "parsed_rows", "cmd_slots", "start_timeout_us",
+                                         "inline_output" };
 
 static int pipeline_key(struct map_loader *L, const char *name, const char *value)
 {
@@ -162,6 +164,11 @@ static int pipeline_key(struct map_loader *L, const char *name, const char *valu
             return fail(L, L->line, "bad value '%s' for %s (1 to 1048576)", value, name);
         break;
     }
+    case 7:
+        if (parse_int(value, 0, 1, &L->inline_out))
+            return fail(L, L->line, "bad value '%s' for %s (0 or 1)", value, name);
+        L->inline_line = L->line;
+        break;
     default:
         if (parse_int(value, 0, MAX_START_TIMEOUT_US, &L->timeout))
             return fail(L, L->line, "bad value '%s' for %s (0 to 10000000)", value, name);
@@ -309,6 +316,11 @@ static void finish(struct map_loader *L, struct ncp_thread_map *m)
         m->cmd_slots = L->cmd_slots;
     if (L->pipe_set & (1u << 6))
         m->start_timeout_us = L->timeout;
+    if (L->inline_out && m->n_executors > 0)
+        fail(L, L->inline_line, "inline_output = 1 needs executors = 0 (the analyzer then executes)");
+    m->inline_output = L->inline_out;
+    if (L->inline_out && L->output.set)
+        fail(L, L->output.line, "[output] but inline_output = 1: the analyzer writes the output");
     char what[32];
     apply(&m->feeder, &L->feeder);
     check_spec(L, &m->feeder, &L->feeder, "[feeder]");

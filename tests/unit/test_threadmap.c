@@ -186,6 +186,26 @@ static void test_loaded_values_override_defaults(void **state)
     assert_int_equal(m.feeder.cpu, 0); /* ATT default */
 }
 
+/* inline_output: the analyzer executes and writes, so it goes with no
+ * executor threads and no [output] section. */
+static void test_inline_output(void **state)
+{
+    (void)state;
+    struct ncp_diag d;
+    struct ncp_thread_map m;
+    assert_int_equal(load_text("[pipeline]\nexecutors = 0\ninline_output = 1\n", &d, &m), NCP_OK);
+    assert_int_equal(m.inline_output, 1);
+    assert_int_equal(m.n_executors, 0);
+    assert_int_equal(load_text("[pipeline]\nexecutors = 0\n", &d, &m), NCP_OK);
+    assert_int_equal(m.inline_output, 0);
+    ncp_thread_map_default(&m, NCP_MODE_DET, 2, 0);
+    assert_int_equal(m.inline_output, 0);
+    expect_error("[pipeline]\ninline_output = 1\nexecutors = 1\n", 2, "executors = 0");
+    expect_error("[pipeline]\nexecutors = 0\ninline_output = 2\n", 3, "inline_output");
+    expect_error("[pipeline]\nexecutors = 0\ninline_output = 1\n[output]\ncpu = 1\n", 4,
+                 "[output]");
+}
+
 static void test_errors(void **state)
 {
     (void)state;
@@ -245,6 +265,7 @@ int main(void)
         cmocka_unit_test(test_shipped_maps_load),
         cmocka_unit_test(test_paper_att4_and_att8),
         cmocka_unit_test(test_loaded_values_override_defaults),
+        cmocka_unit_test(test_inline_output),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_warning_text),
