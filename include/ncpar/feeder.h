@@ -41,6 +41,18 @@ void ncp_source_close(struct ncp_source *src);
 int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
                     struct ncp_span *out);
 
+/* ncp_source_span for text that ends at `end` (a line end or src->end): the
+ * same spans as ncp_source_span gives for every line that ends before it. */
+int ncp_source_span_until(const struct ncp_source *src, uint64_t off, uint64_t end,
+                          uint32_t line, struct ncp_span *out);
+
+/* Chunks: where a piece of about `want` bytes from off ends, just after a
+ * line end (or at src->end), and how many line ends text[off .. end) holds,
+ * which is how many blocks a chunk that ends after one has. Lets the feeder
+ * hand out the program in pieces of many blocks without splitting it. */
+uint64_t ncp_source_chunk_end(const struct ncp_source *src, uint64_t off, size_t want);
+uint64_t ncp_source_count_newlines(const struct ncp_source *src, uint64_t off, uint64_t end);
+
 /* The next of the span at off whose length (ncp_span.len) is len, found from
  * the line end behind it instead of searching the line again. */
 uint64_t ncp_source_after(const struct ncp_source *src, uint64_t off, size_t len);

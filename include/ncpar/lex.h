@@ -149,6 +149,10 @@ void ncp_block_unpack(const void *src, struct ncp_block *b);
  * (a ring's wrap-around point), and its test. */
 void ncp_block_pack_pad(void *dst);
 int ncp_block_packed_is_pad(const void *src);
+/* A one-unit record meaning "the blocks of this piece of the program end
+ * here" (the pipeline's chunk boundary), and its test. */
+void ncp_block_pack_end_mark(void *dst);
+int ncp_block_packed_is_end_mark(const void *src);
 
 /* Parse text[0..len) (one line, no newline) into *out. Always fills out->err.
  * Returns out->err.code. Never reads outside text[0..len). */

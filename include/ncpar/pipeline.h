@@ -33,7 +33,7 @@ struct ncp_thread_map {
      * feeder + lexer on one core and analyzer on the other, with one
      * hand-off between them. */
     int inline_output;
-    int string_rows;  /* g: rows of the string ring (each row = n blocks) */
+    int string_rows;  /* g: rows of the string ring (each row = n chunks of ~4 KB of text) */
     int parsed_rows;  /* h: rows of the parsed ring */
     int cmd_slots;    /* commands ring capacity per executor */
     int start_timeout_us; /* lexers start when the string ring is full or after this */

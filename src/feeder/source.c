@@ -9,6 +9,9 @@
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* A '%' line: '%' possibly surrounded by blanks, nothing else that matters. */
 static int is_percent_line(const char *s, size_t n)
@@ -69,10 +72,16 @@ static void find_body(struct ncp_source *src)
 int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
                     struct ncp_span *out)
 {
-    if (off >= src->end)
+    return ncp_source_span_until(src, off, src->end, line, out);
+}
+
+int ncp_source_span_until(const struct ncp_source *src, uint64_t off, uint64_t end,
+                          uint32_t line, struct ncp_span *out)
+{
+    if (off >= end)
         return 1;
     const char *start = src->text + off;
-    size_t avail = src->end - off;
+    size_t avail = end - off;
     const char *nl = memchr(start, '\n', avail);
     size_t len = nl ? (size_t)(nl - start) : avail;
     out->off = off;
@@ -82,6 +91,39 @@ int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
         len--;
     out->len = (uint32_t)(len > UINT32_MAX ? UINT32_MAX : len);
     return 0;
+}
+
+uint64_t ncp_source_chunk_end(const struct ncp_source *src, uint64_t off, size_t want)
+{
+    if (off >= src->end || src->end - off <= want)
+        return src->end;
+    const char *from = src->text + off + want - 1; /* a line end right there ends it */
+    const char *nl = memchr(from, '\n', src->end - (off + want - 1));
+    return nl ? (uint64_t)(nl - src->text) + 1 : src->end;
+}
+
+/* 64 bytes a step: compare, collect the bit mask, count its bits. */
+uint64_t ncp_source_count_newlines(const struct ncp_source *src, uint64_t off, uint64_t end)
+{
+    const char *p = src->text + off, *e = src->text + (end < src->end ? end : src->end);
+    uint64_t n = 0;
+#if defined(__SSE2__)
+    const __m128i nl = _mm_set1_epi8('\n');
+    for (; e - p >= 64; p += 64) {
+        uint64_t m0 = (uint16_t)_mm_movemask_epi8(
+            _mm_cmpeq_epi8(_mm_loadu_si128((const __m128i *)(const void *)p), nl));
+        uint64_t m1 = (uint16_t)_mm_movemask_epi8(
+            _mm_cmpeq_epi8(_mm_loadu_si128((const __m128i *)(const void *)(p + 16)), nl));
+        uint64_t m2 = (uint16_t)_mm_movemask_epi8(
+            _mm_cmpeq_epi8(_mm_loadu_si128((const __m128i *)(const void *)(p + 32)), nl));
+        uint64_t m3 = (uint16_t)_mm_movemask_epi8(
+            _mm_cmpeq_epi8(_mm_loadu_si128((const __m128i *)(const void *)(p + 48)), nl));
+        n += (uint64_t)__builtin_popcountll(m0 | m1 << 16 | m2 << 32 | m3 << 48);
+    }
+#endif
+    for (; p < e; p++)
+        n += *p == '\n';
+    return n;
 }
 
 int ncp_source_from_memory(struct ncp_source *src, const char *text, size_t len,

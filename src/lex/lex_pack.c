@@ -162,8 +162,21 @@ void ncp_block_unpack(const void *src, struct ncp_block *b)
     get(p, b->pool, h.pool_used);
 }
 
-/* A record no real block can start with (its offset would be 2^64 - 1). */
+/* Records no real block can start with (its offset would be 2^64 - 1 or - 2). */
 static const uint64_t pad_marker = UINT64_MAX;
+static const uint64_t end_marker = UINT64_MAX - 1;
+
+void ncp_block_pack_end_mark(void *dst)
+{
+    memcpy(dst, &end_marker, sizeof end_marker);
+}
+
+int ncp_block_packed_is_end_mark(const void *src)
+{
+    uint64_t v;
+    memcpy(&v, src, sizeof v);
+    return v == end_marker;
+}
 
 void ncp_block_pack_pad(void *dst)
 {

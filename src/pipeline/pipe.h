@@ -17,6 +17,17 @@ enum { NCP_CMD_STAGE_ANALYZER, NCP_CMD_STAGE_EXECUTOR, NCP_CMD_STAGE_OUTPUT,
 
 struct ncp_pipe;
 
+/* What the feeder hands a lexer: a piece of the program text of about
+ * NCP_CHUNK_BYTES that ends at a line end, and the line number it starts on.
+ * Chunk k goes to LEX_(k mod n), which splits it into blocks itself: the
+ * paper's string buffer with a chunk of blocks per cell instead of one block,
+ * so the feeder's work and every ring hand-off is per chunk, not per block. */
+struct ncp_chunk {
+    uint64_t off, end;
+    uint32_t line;
+};
+#define NCP_CHUNK_BYTES 4096u
+
 /* Own cache line each: counters are bumped per item by their thread. */
 struct ncp_pipe_worker {
     alignas(64) struct ncp_pipe *p;
@@ -35,7 +46,7 @@ struct ncp_pipe {
     unsigned out_stage;          /* the output's stage in a command ring */
     int inline_out;              /* the analyzer executes and emits (m == 0) */
 
-    struct ncp_ring *strings;    /* n: feeder -> LEX_i, struct ncp_span */
+    struct ncp_ring *strings;    /* n: feeder -> LEX_i, struct ncp_chunk */
     struct ncp_ring *parsed;     /* n: LEX_i -> analyzer, packed blocks in NCP_PACK_UNIT units */
     struct ncp_ring *cmds;       /* m: analyzer -> EXEC_j -> output, struct ncp_cmd */
 
@@ -51,6 +62,7 @@ struct ncp_pipe {
 
     /* analyzer thread only, read after join */
     alignas(64) uint64_t taken;  /* blocks handed to the analyzer */
+    uint64_t chunk;              /* the chunk it reads, so ring chunk mod n */
     struct ncp_block an_block;   /* the block it holds, unpacked */
     uint64_t next_id;
     int an_rc;

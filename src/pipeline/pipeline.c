@@ -84,7 +84,7 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     uint32_t s = (uint32_t)clamp(map->cmd_slots, 1, NCP_RING_MAX_CAPACITY);
     int bad = 0;
     for (int i = 0; i < p->n; i++) {
-        bad |= ncp_ring_init(&p->strings[i], sizeof(struct ncp_span), g);
+        bad |= ncp_ring_init(&p->strings[i], sizeof(struct ncp_chunk), g);
         bad |= ncp_ring_init(&p->parsed[i], NCP_PACK_UNIT, parsed_units(h));
         if (!bad) /* publish about every 4 KB of records, not every 32 units */
             ncp_ring_set_batch(&p->parsed[i], 4096 / NCP_PACK_UNIT);
@@ -122,6 +122,7 @@ void ncp_pipe_reset(struct ncp_pipe *p)
     atomic_store(&p->gate, 0);
     workers_reset(p);
     p->taken = 0;
+    p->chunk = 0;
     p->next_id = 0;
     p->an_rc = NCP_OK;
     memset(&p->an_diag, 0, sizeof p->an_diag);

@@ -98,30 +98,29 @@ void ncp_pipe_abort(struct ncp_pipe *p)
     ncp_pipe_open_gate(p);
 }
 
-/* Spans are 24 bytes: claiming a line this far ahead keeps the feeder's
- * stores from waiting on a lexer's core. */
-#define SPAN_PREFETCH_SLOTS 64u
-
-/* Block b goes to column b mod n (the paper's i + k*n). */
+/* Chunk k goes to column k mod n (the paper's i + k*n, a chunk of blocks per
+ * cell). Counting its line ends gives the next chunk's first line number; it
+ * also brings the text into the cache before a lexer reads it. */
 void *ncp_pipe_feeder(void *arg)
 {
     struct ncp_pipe *p = ((struct ncp_pipe_worker *)arg)->p;
-    uint64_t off = p->src->begin;
-    uint32_t line = p->src->begin_line;
+    const struct ncp_source *src = p->src;
+    uint64_t off = src->begin;
+    uint32_t line = src->begin_line;
     uint64_t k = 0;
-    struct ncp_span sp;
-    while (ncp_source_span(p->src, off, line, &sp) == 0) {
-        struct ncp_ring *r = &p->strings[k % (uint64_t)p->n];
-        struct ncp_span *slot = ncp_ring_reserve(r);
+    int col = 0;
+    while (off < src->end) {
+        uint64_t end = ncp_source_chunk_end(src, off, NCP_CHUNK_BYTES);
+        struct ncp_ring *r = &p->strings[col];
+        struct ncp_chunk *slot = ncp_ring_reserve(r);
         if (!slot)
             break;
-        const struct ncp_span *later = ncp_ring_reserve_ahead(r, SPAN_PREFETCH_SLOTS);
-        if (later)
-            ncp_prefetch_w(later);
-        *slot = sp;
+        *slot = (struct ncp_chunk){ off, end, line };
         ncp_ring_commit(r);
-        off = sp.next;
-        line++;
+        line += (uint32_t)ncp_source_count_newlines(src, off, end);
+        off = end;
+        if (++col == p->n)
+            col = 0;
         if (++k == p->string_fill)
             ncp_pipe_open_gate(p);
     }
@@ -158,23 +157,48 @@ static int put_packed(struct ncp_ring *out, const struct ncp_block *b)
     return 0;
 }
 
+/* The analyzer moves on to the next column when it meets this. */
+static int put_end_mark(struct ncp_ring *out)
+{
+    void *dst = ncp_ring_reserve_n(out, 1);
+    if (!dst)
+        return -1;
+    ncp_block_pack_end_mark(dst);
+    ncp_ring_commit_n(out, 1);
+    return 0;
+}
+
+/* Every block of the chunk, in order, then the chunk's end mark. */
+static int lex_chunk(struct ncp_pipe_worker *w, const struct ncp_chunk *c,
+                     struct ncp_ring *out, struct ncp_block *b)
+{
+    const struct ncp_source *src = w->p->src;
+    uint64_t off = c->off;
+    uint32_t line = c->line;
+    struct ncp_span sp;
+    while (ncp_source_span_until(src, off, c->end, line, &sp) == 0) {
+        ncp_lex_block(src->text + sp.off, sp.len, sp.line, sp.off, b);
+        if (put_packed(out, b) != 0)
+            return -1;
+        w->items++;
+        off = sp.next;
+        line++;
+    }
+    return put_end_mark(out);
+}
+
 void *ncp_pipe_lexer(void *arg)
 {
     struct ncp_pipe_worker *w = arg;
     struct ncp_pipe *p = w->p;
     struct ncp_ring *in = &p->strings[w->index], *out = &p->parsed[w->index];
     struct ncp_block *b = &p->lex_block[w->index].b;
-    const struct ncp_span *sp;
-    while ((sp = ncp_ring_peek(in)) != NULL) {
-        /* the feeder has just read this text on its own core */
-        const struct ncp_span *later = ncp_ring_stage_ahead(in, 1, PREFETCH_AHEAD * 2);
-        if (later)
-            __builtin_prefetch(p->src->text + later->off, 0);
-        ncp_lex_block(p->src->text + sp->off, sp->len, sp->line, sp->off, b);
+    const struct ncp_chunk *slot;
+    while ((slot = ncp_ring_peek(in)) != NULL) {
+        struct ncp_chunk c = *slot;
         ncp_ring_release(in);
-        if (put_packed(out, b) != 0)
+        if (lex_chunk(w, &c, out, b) != 0)
             break;
-        w->items++;
     }
     ncp_ring_close(out);
     return stage_done(arg);
@@ -188,13 +212,19 @@ void *ncp_pipe_lexer(void *arg)
 static const struct ncp_block *feed_next(void *ctx)
 {
     struct ncp_pipe *p = ctx;
-    struct ncp_ring *r = &p->parsed[p->taken % (uint64_t)p->n];
+    struct ncp_ring *r = &p->parsed[p->chunk % (uint64_t)p->n];
     for (;;) {
         const void *rec = ncp_ring_stage_peek(r, 1, 0);
         if (!rec)
             return NULL;
         if (ncp_block_packed_is_pad(rec)) {
             ncp_ring_stage_release_n(r, 1, ncp_ring_to_end(r, 1));
+            continue;
+        }
+        if (ncp_block_packed_is_end_mark(rec)) {
+            ncp_ring_stage_release_n(r, 1, 1);
+            p->chunk++;
+            r = &p->parsed[p->chunk % (uint64_t)p->n];
             continue;
         }
         uint32_t units = (uint32_t)ncp_block_packed_units(rec);

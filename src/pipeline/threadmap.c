@@ -11,7 +11,7 @@
 #include <strings.h>
 #include <unistd.h>
 
-#define DEFAULT_STRING_ROWS 1024
+#define DEFAULT_STRING_ROWS 32 /* of n chunks of ~4 KB: 128 KB of text per lexer ahead */
 /* Deep rings: with more threads than cores every stage has to sleep now and
  * then, and a wake-up is paid per half ring, so on a 2-core machine 64/128
  * slots spent most of the run in futex calls (measured: 1M blocks, det -j 2,

@@ -139,6 +139,50 @@ static void test_numbers(void **state)
     assert_true(blk.words[0].v.is_const);
 }
 
+/* The 8-characters-at-a-time reader against strtod, on numbers of every
+ * shape around its limits (0-10 digits each side, signs, a point or not),
+ * followed by what may follow a number on a line. Bit-identical values, and
+ * the next word read from the right place. */
+static void test_numbers_match_strtod(void **state)
+{
+    (void)state;
+    static const char *const after[] = { "", " Y7", "Y7", "(c)", ";x", "\tY7" };
+    uint64_t seed = 0x9E3779B97F4A7C15u;
+    char num[40], line[80];
+    for (int iter = 0; iter < 200000; iter++) {
+        seed = seed * 6364136223846793005u + 1442695040888963407u;
+        uint64_t r = seed >> 11;
+        int n = 0, n_int = (int)(r % 11), n_frac = (int)(r / 11 % 11);
+        int point = (r >> 8) % 4 != 0, sign = (int)((r >> 10) % 3);
+        if (!point)
+            n_frac = 0;
+        if (n_int + n_frac == 0)
+            n_int = 1;
+        if (sign)
+            num[n++] = sign == 1 ? '-' : '+';
+        for (int i = 0; i < n_int; i++)
+            num[n++] = (char)('0' + (r >> (12 + i * 3)) % 10);
+        if (point)
+            num[n++] = '.';
+        for (int i = 0; i < n_frac; i++)
+            num[n++] = (char)('0' + (r >> (20 + i * 3)) % 10);
+        num[n] = '\0';
+        const char *tail = after[(r >> 40) % (sizeof after / sizeof *after)];
+        snprintf(line, sizeof line, "X%s%s", num, tail);
+        if (lex(line) != NCP_OK)
+            fail_msg("'%s': %s", line, blk.err.msg);
+        double want = strtod(num, 0), got = blk.words[0].v.value;
+        if (memcmp(&want, &got, sizeof want) != 0)
+            fail_msg("'%s': %.17g, strtod %.17g", line, got, want);
+        if (tail[0] && strchr(tail, 'Y') && (blk.n_words != 2 || blk.words[1].v.value != 7.0))
+            fail_msg("'%s': the word after the number was not read", line);
+    }
+    /* the characters just outside '0'..'9' end a number */
+    expect_error("X12/", "Bad character '/' used", 4);
+    expect_error("X1.5:", "Bad character ':' used", 5);
+    expect_error("X123456789.12345678/", "Bad character '/' used", 20);
+}
+
 static void test_number_errors(void **state)
 {
     (void)state;
@@ -843,6 +887,7 @@ int main(void)
         cmocka_unit_test(test_assignments),
         cmocka_unit_test(test_owords),
         cmocka_unit_test(test_oword_errors),
+        cmocka_unit_test(test_numbers_match_strtod),
         cmocka_unit_test(test_long_lines),
         cmocka_unit_test(test_nul_and_garbage),
         cmocka_unit_test(test_pack_round_trip),
