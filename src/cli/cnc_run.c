@@ -3,6 +3,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
+#include "canon_writer.h"
 #include "run.h"
 
 #include <errno.h>
@@ -14,42 +15,6 @@
 #include <unistd.h>
 
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_PROGRAM = 2, EXIT_RUNTIME = 3 };
-
-/* Canonical text goes through one large buffer: write() per slot would dominate. */
-struct canon_writer {
-    int fd;
-    int failed;
-    size_t used;
-    char buf[1 << 20];
-};
-
-static int writer_flush(struct canon_writer *w)
-{
-    size_t off = 0;
-    while (off < w->used && !w->failed) {
-        ssize_t n = write(w->fd, w->buf + off, w->used - off);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0)
-            w->failed = 1;
-        else
-            off += (size_t)n;
-    }
-    w->used = 0;
-    return w->failed;
-}
-
-static int emit_canon(void *ctx, const struct ncp_cmd *cmd)
-{
-    struct canon_writer *w = ctx;
-    if (!w)
-        return 0;
-    if (w->used + cmd->out_len > sizeof w->buf && writer_flush(w))
-        return 1;
-    memcpy(w->buf + w->used, cmd->out, cmd->out_len);
-    w->used += cmd->out_len;
-    return 0;
-}
 
 static void print_diag(const char *prog, const struct ncp_diag *d)
 {
@@ -184,30 +149,6 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
     return 0;
 }
 
-static int open_canon(const char *path, struct canon_writer **w)
-{
-    *w = NULL;
-    if (!path)
-        return 0;
-    struct canon_writer *cw = malloc(sizeof *cw);
-    if (!cw)
-        return -1;
-    cw->used = 0;
-    cw->failed = 0;
-    if (!strcmp(path, "-")) {
-        cw->fd = 1;
-    } else {
-        cw->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-        if (cw->fd < 0) {
-            fprintf(stderr, "cnc-run: cannot write %s: %s\n", path, strerror(errno));
-            free(cw);
-            return -1;
-        }
-    }
-    *w = cw;
-    return 0;
-}
-
 static int cmd_parse(int argc, char **argv)
 {
     struct parse_opts o;
@@ -244,12 +185,12 @@ static int cmd_parse(int argc, char **argv)
         print_diag(o.prog, &d);
         return EXIT_PROGRAM;
     }
-    struct canon_writer *w;
-    if (open_canon(o.canon, &w)) {
+    struct canon_writer *w = NULL;
+    if (o.canon && !(w = canon_writer_open(o.canon, map.mode != NCP_MODE_SERIAL))) {
         ncp_source_close(&src);
         return EXIT_USAGE;
     }
-    struct ncp_output out = { w, emit_canon };
+    struct ncp_output out = { w, canon_writer_emit };
     struct ncp_run_stats st;
     memset(&st, 0, sizeof st);
     int rc = map.mode == NCP_MODE_SERIAL
@@ -260,17 +201,14 @@ static int cmd_parse(int argc, char **argv)
     const char *warning;
     while ((warning = ncp_run_warning_next(&warnings)) != NULL)
         fprintf(stderr, "cnc-run: warning: %s\n", warning);
-    if (w) {
-        writer_flush(w);
-        if (w->failed) {
-            fprintf(stderr, "cnc-run: error writing canonical output\n");
-            status = EXIT_RUNTIME;
-        }
-        if (w->fd != 1)
-            close(w->fd);
-        free(w);
+    int write_err = w ? canon_writer_close(w) : 0;
+    if (write_err) {
+        /* the text could not be written (disk full, closed pipe): a fault of
+         * the machine, not of the program, which stopped at that point */
+        fprintf(stderr, "cnc-run: error writing canonical output: %s\n", strerror(write_err));
+        status = EXIT_RUNTIME;
     }
-    if (rc != NCP_OK) {
+    if (rc != NCP_OK && !(write_err && rc == NCP_ERR_IO)) {
         print_diag(o.prog, &d);
         status = EXIT_PROGRAM;
     }

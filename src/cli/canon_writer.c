@@ -1,0 +1,177 @@
+/* Canonical text through 1 MB buffers: a write() per slot would dominate.
+ *
+ * The 1M-block benchmark writes about 65 MB; the write() calls that copy it
+ * into the page cache cost a sixth of the serial run. With the pipeline the
+ * thread that emits is the analyzer (inline output) or the output thread, the
+ * busiest stage, so there the writes go to a thread of their own: the caller
+ * fills one buffer while the writer thread writes the other. Buffers change
+ * hands 65 times in that run, so a mutex and a condition variable cost
+ * nothing that matters. */
+#include "canon_writer.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define WRITER_BUF (1u << 20)
+
+struct canon_writer {
+    int fd;
+    int async;
+    char *fill;                 /* the buffer being filled */
+    size_t used;
+    char *spare;                /* sync: unused; async: the other buffer, owned by whoever holds it */
+    /* async hand-over: the writer thread owns `pending` while it is set */
+    pthread_t thread;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    char *pending;
+    size_t pending_len;
+    int quit;
+    int failed;                 /* errno of the first failed write; under mu when async */
+};
+
+/* 0, or the errno of the failed write. */
+static int write_all(int fd, const char *p, size_t n)
+{
+    size_t off = 0;
+    while (off < n) {
+        ssize_t k = write(fd, p + off, n - off);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0)
+            return k < 0 ? errno : EIO;
+        off += (size_t)k;
+    }
+    return 0;
+}
+
+static void *writer_main(void *arg)
+{
+    struct canon_writer *w = arg;
+    pthread_mutex_lock(&w->mu);
+    for (;;) {
+        while (!w->pending && !w->quit)
+            pthread_cond_wait(&w->cv, &w->mu);
+        if (!w->pending)
+            break;
+        char *buf = w->pending;
+        size_t len = w->pending_len;
+        int failed = w->failed;
+        pthread_mutex_unlock(&w->mu);
+        int err = failed ? 0 : write_all(w->fd, buf, len);
+        pthread_mutex_lock(&w->mu);
+        if (!w->failed)
+            w->failed = err;
+        w->spare = buf;
+        w->pending = NULL;
+        pthread_cond_broadcast(&w->cv);
+    }
+    pthread_mutex_unlock(&w->mu);
+    return NULL;
+}
+
+/* The filled buffer goes out; the caller continues in an empty one. */
+static int hand_over(struct canon_writer *w)
+{
+    if (!w->async) {
+        if (!w->failed)
+            w->failed = write_all(w->fd, w->fill, w->used);
+        w->used = 0;
+        return w->failed;
+    }
+    pthread_mutex_lock(&w->mu);
+    while (w->pending)
+        pthread_cond_wait(&w->cv, &w->mu);
+    w->pending = w->fill;
+    w->pending_len = w->used;
+    w->fill = w->spare;
+    w->spare = NULL;
+    int failed = w->failed;
+    pthread_cond_broadcast(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+    w->used = 0;
+    return failed;
+}
+
+int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd)
+{
+    struct canon_writer *w = ctx;
+    if (!w)
+        return 0;
+    if (w->used + cmd->out_len > WRITER_BUF && hand_over(w))
+        return 1;
+    memcpy(w->fill + w->used, cmd->out, cmd->out_len);
+    w->used += cmd->out_len;
+    return 0;
+}
+
+static void writer_free(struct canon_writer *w)
+{
+    free(w->fill);
+    free(w->spare);
+    free(w);
+}
+
+struct canon_writer *canon_writer_open(const char *path, int async)
+{
+    struct canon_writer *w = calloc(1, sizeof *w);
+    if (!w) {
+        fprintf(stderr, "cnc-run: out of memory for the output buffers\n");
+        return NULL;
+    }
+    w->fill = malloc(WRITER_BUF);
+    w->spare = async ? malloc(WRITER_BUF) : NULL;
+    if (!w->fill || (async && !w->spare)) {
+        fprintf(stderr, "cnc-run: out of memory for the output buffers\n");
+        writer_free(w);
+        return NULL;
+    }
+    if (!strcmp(path, "-")) {
+        w->fd = 1;
+    } else {
+        w->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (w->fd < 0) {
+            fprintf(stderr, "cnc-run: cannot write %s: %s\n", path, strerror(errno));
+            writer_free(w);
+            return NULL;
+        }
+    }
+    if (async) {
+        pthread_mutex_init(&w->mu, NULL);
+        pthread_cond_init(&w->cv, NULL);
+        /* no thread: write in the caller's thread, which is always correct */
+        w->async = pthread_create(&w->thread, NULL, writer_main, w) == 0;
+        if (!w->async) {
+            pthread_mutex_destroy(&w->mu);
+            pthread_cond_destroy(&w->cv);
+        }
+    }
+    return w;
+}
+
+int canon_writer_close(struct canon_writer *w)
+{
+    if (!w)
+        return 0;
+    if (w->used)
+        hand_over(w);
+    if (w->async) {
+        pthread_mutex_lock(&w->mu);
+        w->quit = 1;
+        pthread_cond_broadcast(&w->cv);
+        pthread_mutex_unlock(&w->mu);
+        pthread_join(w->thread, NULL);
+        pthread_mutex_destroy(&w->mu);
+        pthread_cond_destroy(&w->cv);
+    }
+    int failed = w->failed;
+    if (w->fd != 1 && close(w->fd) != 0 && !failed)
+        failed = errno;
+    writer_free(w);
+    return failed;
+}

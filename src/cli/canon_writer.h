@@ -1,0 +1,20 @@
+/* Where `cnc-run parse --canon FILE` puts the canonical text (CLI-internal). */
+#ifndef NCP_CLI_CANON_WRITER_H
+#define NCP_CLI_CANON_WRITER_H
+
+#include "ncpar/canon.h"
+
+struct canon_writer;
+
+/* path "-" is standard output. async: a thread of its own does the write()
+ * calls, one 1 MB buffer at a time, while the caller fills the next (for the
+ * parallel pipeline; the serial reference stays one thread). NULL, with a
+ * message on stderr, when the file cannot be opened or memory is short. */
+struct canon_writer *canon_writer_open(const char *path, int async);
+/* ncp_output.emit: appends a slot's text; non-zero once a write has failed. */
+int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd);
+/* Writes what is left, closes, frees; 0, or the errno of the first write
+ * that failed. */
+int canon_writer_close(struct canon_writer *w);
+
+#endif
