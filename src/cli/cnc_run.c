@@ -64,6 +64,8 @@ static void usage(FILE *f)
           "       write canonical machining calls (rs274 -g format) to --canon.\n"
           "       --executors 0: the output thread executes; with --inline-output the\n"
           "       analyzer executes and writes each command itself (no output thread).\n"
+          "       Default: -j 2 --executors 1; with 2 CPUs or fewer, -j 1 --executors 0\n"
+          "       --inline-output.\n"
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
           "run    run PROG on the machine: planner, interpolator, position loop, backend\n"
           "       (the simulated servo by default); `cnc-run run --help` for details.\n"
@@ -80,6 +82,7 @@ struct parse_opts {
     int inline_output;
     enum ncp_thread_mode mode;
     int mode_given;
+    int counts_given;   /* -j or --executors on the command line */
     int stats;
     struct ncp_analyzer_cfg acfg;
 };
@@ -115,10 +118,12 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
     while ((c = getopt_long(argc, argv, "j:e:m:c:t:o:shL:I", longopts, NULL)) != -1) {
         switch (c) {
         case 'j':
+            o->counts_given = 1;
             if (parse_int(optarg, 1, NCP_MAX_LEXERS, &o->lexers))
                 return fprintf(stderr, "cnc-run: -j wants 1..%d lexer threads\n", NCP_MAX_LEXERS), -1;
             break;
         case 'e':
+            o->counts_given = 1;
             if (parse_int(optarg, 0, NCP_MAX_EXECUTORS, &o->executors))
                 return fprintf(stderr, "cnc-run: --executors wants 0..%d (0: the output thread executes)\n", NCP_MAX_EXECUTORS), -1;
             break;
@@ -170,6 +175,15 @@ static int cmd_parse(int argc, char **argv)
         if (o.mode_given)
             map.mode = o.mode;
     } else {
+        /* Two CPUs or fewer: feeder and lexer on one, the analyzer executing
+         * and writing on the other; more stage threads than cores only adds
+         * hand-offs (bench/RESULTS.md). */
+        long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+        if (!o.counts_given && ncpu > 0 && ncpu <= 2) {
+            o.lexers = 1;
+            o.executors = 0;
+            o.inline_output = 1;
+        }
         ncp_thread_map_default(&map, o.mode, o.lexers, o.executors);
     }
     if (o.inline_output) {
