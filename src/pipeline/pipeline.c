@@ -73,7 +73,10 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     p->strings = rings_new(p->n);
     p->parsed = rings_new(p->n);
     p->cmds = p->m > 0 ? rings_new(p->m) : NULL;
-    p->inline_cmd = p->inline_out ? aligned_alloc(64, sizeof *p->inline_cmd) : NULL;
+    /* aligned_alloc wants a size that is a multiple of the alignment */
+    p->inline_cmd = p->inline_out
+                        ? aligned_alloc(64, (sizeof *p->inline_cmd + 63) / 64 * 64)
+                        : NULL;
     if (!p->strings || !p->parsed || (p->m > 0 && !p->cmds) ||
         (p->inline_out && !p->inline_cmd)) {
         ncp_pipe_free(p);
