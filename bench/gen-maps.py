@@ -45,13 +45,19 @@ def section(name, cpu, fifo):
     return "\n".join(lines) + "\n"
 
 
-def write_map(outdir, name, mode, n_lex, place, fifo, how):
+def write_map(outdir, name, mode, n_lex, place, fifo, how, inline=False):
     label = ("Prio 90. " if fifo else "Non RT. ") + (
         "Serial" if mode == "serial" else "%s %d Threads" % (mode.capitalize(), n_lex + 1))
+    if inline:
+        label += ", the analyzer executing and writing (not in the paper)"
     text = HEADER.format(name=os.path.join(outdir, name), how=how, label=label)
     if fifo:
         text += "# All threads SCHED_FIFO 90: needs root or CAP_SYS_NICE (else a warning).\n"
-    text += "\n[pipeline]\nmode = %s\nlexers = %d\nexecutors = 1\n\n" % (mode, n_lex)
+    if inline:
+        text += "\n[pipeline]\nmode = %s\nlexers = %d\nexecutors = 0\ninline_output = 1\n\n" % (
+            mode, n_lex)
+    else:
+        text += "\n[pipeline]\nmode = %s\nlexers = %d\nexecutors = 1\n\n" % (mode, n_lex)
     feeder, lexers, others = place
     text += section("feeder", feeder, fifo)
     if mode == "serial":
@@ -61,7 +67,8 @@ def write_map(outdir, name, mode, n_lex, place, fifo, how):
         return
     for i, cpu in enumerate(lexers):
         text += "\n" + section("lexer.%d" % i, cpu, fifo)
-    for sec, cpu in zip(("analyzer", "executor.0", "output"), others):
+    for sec, cpu in zip(("analyzer",) if inline else ("analyzer", "executor.0", "output"),
+                        others):
         text += "\n" + section(sec, cpu, fifo)
     with open(os.path.join(outdir, name), "w", encoding="utf-8") as f:
         f.write(text)
@@ -90,6 +97,12 @@ def main():
                       (-1, [-1] * (n - 1), [-1] * 3), fifo, how)
             write_map(o.outdir, "att%d%s.ini" % (n, sfx), "att", n - 1,
                       placement_att(n - 1, ids), fifo, how)
+        # ours, for two cores: feeder + lexer on the first CPU, the analyzer (which
+        # executes and writes: no executor or output thread) on the next
+        write_map(o.outdir, "det2-inline%s.ini" % sfx, "det", 1, (-1, [-1], [-1]), fifo, how,
+                  inline=True)
+        write_map(o.outdir, "att2-inline%s.ini" % sfx, "att", 1,
+                  (ids[0], [ids[0]], [ids[1 % len(ids)]]), fifo, how, inline=True)
 
 
 if __name__ == "__main__":

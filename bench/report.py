@@ -18,7 +18,8 @@ PAPER_GAIN = {"det4": 1.914, "att4": 3.524, "det8": 0.995, "att8": 1.3245,
               "det4-fifo": 4.205, "att4-fifo": 4.225, "det8-fifo": 2.621,
               "att8-fifo": 4.0498}
 PAPER_SERIAL_MS = {"": 9.265, "-fifo": 10.643}
-BASES = ("serial", "det2", "att2", "det4", "att4", "det8", "att8")
+BASES = ("serial", "det2", "att2", "det4", "att4", "det8", "att8", "det2-inline",
+         "att2-inline")
 
 
 def bases(rows):
@@ -33,6 +34,8 @@ def label(cfg):
     pre = "Prio 90." if fifo else "Non RT."
     if base == "serial":
         return pre + " Serial"
+    if base.endswith("-inline"):
+        return "%s %s 2 Threads, inline output (ours)" % (pre, base[:3].capitalize())
     return "%s %s %s Threads" % (pre, base[:3].capitalize(), base[3:])
 
 
