@@ -315,7 +315,10 @@ def table3_section(data, run_dir):
           "ATT4 = feeder + LEX0..2), so DETn/ATTn run n-1 lexers; our pipeline adds the",
           "analyzer, one executor and the output stage (%s threads in all, the starting"
           % n_threads,
-          "thread sleeping as the paper's main thread does). The paper timed feeder + lexers;",
+          "thread sleeping as the paper's main thread does). The rows marked *inline output",
+          "(ours)* are not in the paper: feeder and one lexer, and the analyzer executing and",
+          "writing each command itself (`--inline-output`), 3 threads in all, the layout",
+          "`cnc-run parse` uses by default on 2 CPUs. The paper timed feeder + lexers;",
           "we time the whole interpreter: from the start of `ncp_pipeline_run` (thread creation",
           "included) to the last canonical command out, as `ncp_run_stats.wall_ms` reports it",
           "(build/bench/table3 does a round's runs of one configuration in one process after",
@@ -357,7 +360,8 @@ def table3_section(data, run_dir):
                   "part998" if key == "table3_part998" else "big"), ""]
     L += ["Why ours differs from the paper (known differences of set-up, not separately "
           "measured here): this machine has %d CPUs where the paper had 4 logical CPUs, so "
-          "every configuration runs more threads (n+3, at least 5) than there are CPUs and ATT "
+          "each of the paper's configurations runs more threads (n+3, at least 5) than there "
+          "are CPUs and ATT "
           "stacks several threads on one CPU; the kernel is %s; our pipeline has three "
           "stages more than the paper's feeder + lexers, each a hand-off between threads, and we time up to the "
           "last command out, not the lexers alone; and the program differs (ours: "
