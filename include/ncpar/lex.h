@@ -134,6 +134,13 @@ static inline int ncp_trunc_int_round(double t)
     return ncp_trunc_int(round(t));
 }
 
+/* Parameters a program may read but not set (rs274's readonly_parameters):
+ * the spindle's tool entry #5400-#5413 and the current point #5420-#5428. */
+static inline int ncp_param_readonly(int index)
+{
+    return (index >= 5400 && index <= 5413) || (index >= 5420 && index <= 5428);
+}
+
 /* Packed blocks (the parallel pipeline's lexer -> analyzer records): only the
  * used parts, in whole units of NCP_PACK_UNIT bytes. ncp_block_pack writes
  * ncp_block_packed_size(b) bytes (at most NCP_BLOCK_PACK_MAX) to dst and

@@ -206,12 +206,6 @@ int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b)
     return NCP_OK;
 }
 
-/* The spindle's tool entry (#5400..#5413) and the current point (#5420..#5428). */
-static int ncp_param_readonly(int index)
-{
-    return (index >= 5400 && index <= 5413) || (index >= 5420 && index <= 5428);
-}
-
 /* All values first (pre-block parameters), then the writes in order. */
 int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b)
 {

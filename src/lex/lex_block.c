@@ -147,6 +147,10 @@ static int assignment(struct ncp_lexer *lx)
             return rc;
         if (v.is_const && (v.k < 1.0 || v.k >= NCP_LEX_PARAM_MAX))
             return ncp_lex_fail(lx, pos, "Parameter number out of range");
+        /* rs274 refuses the target as it reads it, before the value, so
+         * #5421=[1/0] is a read-only error, not a division by zero */
+        if (v.is_const && ncp_param_readonly(ncp_trunc_int_round(v.k)))
+            return ncp_lex_fail(lx, pos, "Parameter is readonly");
         ncp_lex_to_expr(lx, &v, &a->index);
     }
     if ((rc = expect_equal(lx)) || (rc = ncp_lex_real_value(lx, &v)))
