@@ -3,6 +3,7 @@
 #include "ncpar/executor.h"
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
+#include "emit.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -69,15 +70,7 @@ static void serial_publish(void *ctx, struct ncp_cmd *cmd)
     struct serial_sink *s = ctx;
     ncp_exec_cmd(cmd);
     s->emitted++;
-    if (s->out && s->out->emit(s->out->ctx, cmd) != 0) {
-        s->stopped = 1;
-        s->emit_failed = 1;
-    }
-    if (cmd->flags & NCP_CMD_F_ERROR) {
-        s->err = cmd->diag;
-        s->stopped = 1;
-    }
-    if (cmd->flags & NCP_CMD_F_END)
+    if (ncp_emit_cmd(cmd, s->out, &s->err, &s->emit_failed))
         s->stopped = 1;
 }
 

@@ -2,6 +2,7 @@
  * stages: each one writes or reads its slot in place in the ring. */
 #include "pipe.h"
 
+#include "emit.h"
 #include "futex.h"
 #include "ncpar/executor.h"
 #include "ncpar/lex.h"
@@ -291,15 +292,7 @@ static void inline_publish(void *ctx, struct ncp_cmd *c)
     p->analyzer.items++;
     ncp_exec_cmd(c);
     p->output.items++;
-    if (p->out && p->out->emit(p->out->ctx, c) != 0) {
-        p->emit_failed = 1;
-        p->inline_stopped = 1;
-    }
-    if (c->flags & NCP_CMD_F_ERROR) {
-        p->err = c->diag;
-        p->inline_stopped = 1;
-    }
-    if (c->flags & NCP_CMD_F_END)
+    if (ncp_emit_cmd(c, p->out, &p->err, &p->emit_failed))
         p->inline_stopped = 1;
 }
 
@@ -367,17 +360,7 @@ void *ncp_pipe_output(void *arg)
         if (p->exec_threads == 0)
             ncp_exec_cmd(c);
         p->output.items++;
-        int stop = 0;
-        if (p->out && p->out->emit(p->out->ctx, c) != 0) {
-            p->emit_failed = 1;
-            stop = 1;
-        }
-        if (c->flags & NCP_CMD_F_ERROR) {
-            p->err = c->diag;
-            stop = 1;
-        }
-        if (c->flags & NCP_CMD_F_END)
-            stop = 1;
+        int stop = ncp_emit_cmd(c, p->out, &p->err, &p->emit_failed);
         ncp_ring_stage_release(r, p->out_stage);
         if (stop)
             break;
