@@ -197,6 +197,13 @@ void ncp_block_unpack(const void *src, struct ncp_block *b)
 static const uint64_t pad_marker = UINT64_MAX;
 static const uint64_t end_marker = UINT64_MAX - 1;
 
+static int starts_with(const void *src, uint64_t marker)
+{
+    uint64_t v;
+    memcpy(&v, src, sizeof v);
+    return v == marker;
+}
+
 void ncp_block_pack_end_mark(void *dst)
 {
     memcpy(dst, &end_marker, sizeof end_marker);
@@ -204,9 +211,7 @@ void ncp_block_pack_end_mark(void *dst)
 
 int ncp_block_packed_is_end_mark(const void *src)
 {
-    uint64_t v;
-    memcpy(&v, src, sizeof v);
-    return v == end_marker;
+    return starts_with(src, end_marker);
 }
 
 void ncp_block_pack_pad(void *dst)
@@ -216,7 +221,5 @@ void ncp_block_pack_pad(void *dst)
 
 int ncp_block_packed_is_pad(const void *src)
 {
-    uint64_t v;
-    memcpy(&v, src, sizeof v);
-    return v == pad_marker;
+    return starts_with(src, pad_marker);
 }
