@@ -196,7 +196,7 @@ static int items(struct ncp_lexer *lx)
     return NCP_OK;
 }
 
-static void init_block(struct ncp_block *b, size_t len, uint32_t line, uint64_t offset)
+void ncp_lex_init_block(struct ncp_block *b, size_t len, uint32_t line, uint64_t offset)
 {
     b->offset = offset;
     b->line = line;
@@ -217,10 +217,18 @@ static void init_block(struct ncp_block *b, size_t len, uint32_t line, uint64_t 
 int ncp_lex_block(const char *text, size_t len, uint32_t line, uint64_t offset,
                   struct ncp_block *out)
 {
+    if (ncp_lex_fast(text, len, line, offset, out))
+        return NCP_OK;
+    return ncp_lex_block_general(text, len, line, offset, out);
+}
+
+int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t offset,
+                          struct ncp_block *out)
+{
     struct ncp_lexer lx;
     int rc;
 
-    init_block(out, len, line, offset);
+    ncp_lex_init_block(out, len, line, offset);
     lx.b = out;
     lx.pos = 0;
     lx.depth = 0;

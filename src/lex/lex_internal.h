@@ -33,6 +33,18 @@ struct ncp_lex_val {
     uint8_t is_const;
 };
 
+/* lex_block.c: a block as it is before anything was read from its line */
+void ncp_lex_init_block(struct ncp_block *b, size_t len, uint32_t line, uint64_t offset);
+/* ncp_lex_block without the fast path (the differential test calls it) */
+int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t offset,
+                          struct ncp_block *out);
+
+/* lex_fast.c: 1 and *out filled exactly as the general reader fills it when
+ * the line is words with plain numbers only (what CAM output mostly is); 0
+ * for anything else, errors included, which the general reader then reads. */
+int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,
+                 struct ncp_block *out);
+
 /* Stores a syntax error at buf position pos; returns NCP_ERR_SYNTAX. */
 int ncp_lex_fail(struct ncp_lexer *lx, int pos, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "ncpar/lex.h"
+#include "../../src/lex/lex_internal.h"
 
 static struct ncp_block blk;
 
@@ -839,6 +840,67 @@ static void round_trip(const char *line, size_t len)
     assert_same_block(&blk, &back);
 }
 
+/* The one-pass reader for plain lines against the general reader: every line
+ * the fast path takes must come out as the very block the general reader
+ * makes of it. Lines from an alphabet close to CAM output with the characters
+ * that must make the fast path give up mixed in. */
+static void expect_fast_like_general(const char *line, size_t len, int *taken)
+{
+    static struct ncp_block fast, general;
+    memset(&fast, 0x5A, sizeof fast);
+    if (!ncp_lex_fast(line, len, 11, 99, &fast))
+        return;
+    (*taken)++;
+    if (ncp_lex_block_general(line, len, 11, 99, &general) != NCP_OK)
+        fail_msg("fast path took '%.*s', the general reader says: %s", (int)len, line,
+                 general.err.msg);
+    assert_same_block(&general, &fast);
+}
+
+static void test_fast_path_is_the_general_reader(void **state)
+{
+    (void)state;
+    static const char *const lines[] = {
+        "G1 X12.253 Y-3.7 Z-0.540 F600", "g0x1y2", "G1\tX1", "  G1 X1  ", "", "   ",
+        "G2 X7.867 Y2.423 I0.000 J2.000", "X.5 Y-.5 Z+.5", "G1 X1.", "M3 S12000",
+        "G1 G0 X1", "M3 M8", "X1.0000000000000000001", "X123456789012345678901",
+        "A1 B2 C3 D4 E5 F6 H7 I8 J9 K10 L11 P12 Q13 R14 S15 T16 X17 Y18 Z19",
+    };
+    int taken = 0;
+    for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++)
+        expect_fast_like_general(lines[i], strlen(lines[i]), &taken);
+    assert_true(taken >= 12);
+    /* and what it must leave alone */
+    static const char *const general_only[] = {
+        "N10 G1 X1", "G1 X1 (c)", "G1 X1 ;c", "/G1 X1", "G1 X#1", "G1 X[1]", "G1 X1 X2",
+        "G1 X1.2.3", "G1 X--1", "G1 X1 2", "G1 X", "o100 sub", "G1 U1", "G1 X1\r",
+        "G1 X1\v", "#1=2", "G1 $1", "G1 X 1",
+    };
+    for (size_t i = 0; i < sizeof general_only / sizeof general_only[0]; i++) {
+        static struct ncp_block b;
+        if (ncp_lex_fast(general_only[i], strlen(general_only[i]), 1, 0, &b))
+            fail_msg("fast path took '%s'", general_only[i]);
+    }
+    static const char alphabet[] = "GgXxYyZzMmFfIiJjNnOoUu0123456789..--+  \t(;#[/\r\v$";
+    uint64_t seed = 99;
+    char line[300];
+    taken = 0;
+    for (int iter = 0; iter < 300000; iter++) {
+        seed = seed * 6364136223846793005u + 1442695040888963407u;
+        size_t len = (size_t)(seed >> 33) % 40;
+        if (iter % 1000 == 0)
+            len = 240 + (size_t)(seed >> 40) % 20; /* around the too-long limit */
+        for (size_t i = 0; i < len; i++) {
+            seed = seed * 6364136223846793005u + 1442695040888963407u;
+            /* mostly letter, digits, point, blank: the shapes the fast path takes */
+            unsigned r = (unsigned)(seed >> 33);
+            line[i] = r % 4 ? "GXYZ0123456789. "[r / 4 % 16] : alphabet[r / 4 % (sizeof alphabet - 1)];
+        }
+        expect_fast_like_general(line, len, &taken);
+    }
+    assert_true(taken > 1000);
+}
+
 static void test_pack_round_trip(void **state)
 {
     (void)state;
@@ -899,6 +961,7 @@ int main(void)
         cmocka_unit_test(test_owords),
         cmocka_unit_test(test_oword_errors),
         cmocka_unit_test(test_numbers_match_strtod),
+        cmocka_unit_test(test_fast_path_is_the_general_reader),
         cmocka_unit_test(test_long_lines),
         cmocka_unit_test(test_nul_and_garbage),
         cmocka_unit_test(test_pack_round_trip),

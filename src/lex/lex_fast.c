@@ -1,0 +1,101 @@
+/* The common line in one pass over the source text: letters followed by plain
+ * numbers ("G1 X12.253 Y-3.7 F600"), blanks between words. The general reader
+ * first copies the line without its blanks and with a column for every byte,
+ * then reads words from the copy; for CAM output that copy and its per-digit
+ * loops were most of the lexing time. Anything this reader does not take
+ * exactly as the general one would (comments, expressions, parameters, N and
+ * O words, blanks inside a number, signs beyond one, errors of any kind) makes
+ * it give up and the general reader reads the line from the start, so both
+ * paths give the same block; tests/unit/test_lex.c checks that they do. */
+#include "lex_internal.h"
+
+#include <stdint.h>
+
+static const double pow10_tab[23] = {
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22
+};
+
+static int is_blank(char c)
+{
+    return c == ' ' || c == '\t';
+}
+
+static int is_digit(char c)
+{
+    return c >= '0' && c <= '9';
+}
+
+/* [sign] digits [. digits] starting at text[*i], converted as ncp_lex_number
+ * converts it (exact mantissa / exact power of ten), or 0 to give up. */
+static int plain_number(const char *text, size_t len, size_t *i, double *out)
+{
+    size_t p = *i;
+    int neg = 0;
+    if (p < len && (text[p] == '+' || text[p] == '-'))
+        neg = text[p++] == '-';
+    uint64_t m = 0;
+    int ndig = 0, frac = 0;
+    for (; p < len && is_digit(text[p]); p++, ndig++)
+        m = m * 10 + (uint64_t)(text[p] - '0');
+    if (p < len && text[p] == '.') {
+        for (p++; p < len && is_digit(text[p]); p++, frac++)
+            m = m * 10 + (uint64_t)(text[p] - '0');
+        ndig += frac;
+    }
+    if (ndig == 0 || ndig > 19 || m >= (UINT64_C(1) << 53) || frac > 22)
+        return 0;
+    if (p < len && text[p] == '.')
+        return 0; /* "1.2.3": the general reader's error */
+    double v = (double)m / pow10_tab[frac];
+    *out = neg ? -v : v;
+    *i = p;
+    return 1;
+}
+
+int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,
+                 struct ncp_block *out)
+{
+    if (len >= NCP_LEX_TOO_LONG)
+        return 0;
+    ncp_lex_init_block(out, len, line, offset);
+    uint32_t seen = 0;
+    size_t i = 0;
+    for (;;) {
+        while (i < len && is_blank(text[i]))
+            i++;
+        if (i == len)
+            return 1;
+        char c = text[i];
+        if (c >= 'A' && c <= 'Z')
+            c = (char)(c + 32);
+        /* n, o: N and O words; u, v, w: not axes here (rs274 -g rejects them) */
+        if (c < 'a' || c > 'z' || c == 'n' || c == 'o' || (c >= 'u' && c <= 'w'))
+            return 0;
+        if (c != 'g' && c != 'm') {
+            uint32_t bit = 1u << (c - 'a');
+            if (seen & bit)
+                return 0; /* "Multiple X words": the general reader's error */
+            seen |= bit;
+        }
+        if (out->n_words >= NCP_BLOCK_MAX_WORDS)
+            return 0;
+        size_t letter = i++;
+        double v;
+        if (!plain_number(text, len, &i, &v))
+            return 0;
+        /* a blank may only be followed by the next word: "X1 2" is X12 */
+        size_t j = i;
+        while (j < len && is_blank(text[j]))
+            j++;
+        if (j < len && !((text[j] >= 'a' && text[j] <= 'z') || (text[j] >= 'A' && text[j] <= 'Z')))
+            return 0;
+        struct ncp_word *w = &out->words[out->n_words++];
+        w->letter = (char)(c - 32);
+        w->col = (uint16_t)(letter + 1);
+        w->v.value = v;
+        w->v.start = w->v.len = 0;
+        w->v.is_const = 1;
+        i = j;
+    }
+}
