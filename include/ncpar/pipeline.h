@@ -26,7 +26,7 @@ struct ncp_thread_spec {
 /* Thread map (an INI in rt-config/): which thread runs where, ring sizes. */
 struct ncp_thread_map {
     enum ncp_thread_mode mode;
-    int n_lexers, n_executors; /* n_executors 0: the output thread executes */
+    int n_lexers, n_executors; /* 0: the analyzer resolves, the output thread formats */
     /* 1 (only with n_executors 0): the analyzer executes and writes each
      * command itself, as the serial reference does: no command ring and no
      * output thread. On two cores the pipeline is then two busy threads,

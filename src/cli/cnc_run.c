@@ -62,7 +62,7 @@ static void usage(FILE *f)
           "\n"
           "parse  interpret PROG (\"-\" = standard input) with the parallel pipeline and\n"
           "       write canonical machining calls (rs274 -g format) to --canon.\n"
-          "       --executors 0: the output thread executes; with --inline-output the\n"
+          "       --executors 0: the output thread formats; with --inline-output the\n"
           "       analyzer executes and writes each command itself (no output thread).\n"
           "       Default: -j 2 --executors 1; with 2 CPUs or fewer, -j 1 --executors 0\n"
           "       --inline-output.\n"

@@ -45,10 +45,12 @@ struct ncp_pipe {
     int exec_threads;            /* executors; 0: the output thread executes */
     unsigned out_stage;          /* the output's stage in a command ring */
     int inline_out;              /* the analyzer executes and emits (m == 0) */
+    int packed_out;              /* no executors: the output thread formats packed commands */
 
     struct ncp_ring *strings;    /* n: feeder -> LEX_i, struct ncp_chunk */
     struct ncp_ring *parsed;     /* n: LEX_i -> analyzer, packed blocks in NCP_PACK_UNIT units */
-    struct ncp_ring *cmds;       /* m: analyzer -> EXEC_j -> output, struct ncp_cmd */
+    struct ncp_ring *cmds;       /* m: analyzer -> EXEC_j -> output, struct ncp_cmd;
+                                  * packed_out: one ring of packed commands, 8-byte units */
 
     /* Lexers start once the string ring is full, or at EOF, or on timeout. */
     _Atomic uint32_t gate;
@@ -68,9 +70,11 @@ struct ncp_pipe {
     int an_rc;
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
 
-    /* inline output: the analyzer's one command slot, and whether it stopped */
+    /* inline and packed output: the analyzer's own command slot, whether the
+     * inline output stopped; the output thread's slot it unpacks into */
     struct ncp_cmd *inline_cmd;
     int inline_stopped;
+    struct ncp_cmd *out_cmd;
 
     /* output thread only (the analyzer's with inline output), read after join */
     alignas(64) struct ncp_diag err; /* first error slot, in program order */

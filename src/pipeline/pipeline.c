@@ -4,6 +4,7 @@
  * would. */
 #include "pipe.h"
 
+#include "cmd_pack.h"
 #include "futex.h"
 #include "threads.h"
 
@@ -35,6 +36,7 @@ void ncp_pipe_free(struct ncp_pipe *p)
     rings_free(p->parsed, p->n);
     rings_free(p->cmds, p->m);
     free(p->inline_cmd);
+    free(p->out_cmd);
     free(p);
 }
 
@@ -55,6 +57,16 @@ static uint32_t parsed_units(uint32_t rows)
     return units > NCP_RING_MAX_CAPACITY ? NCP_RING_MAX_CAPACITY : (uint32_t)units;
 }
 
+/* The packed command ring (no executor threads): 1 KB a command slot. */
+static uint32_t packed_cmd_units(uint32_t slots)
+{
+    uint64_t units = (uint64_t)slots * (1024 / NCP_PACK_UNIT);
+    uint64_t least = 2 * (NCP_CMD_PACK_MAX / NCP_PACK_UNIT + 1);
+    if (units < least)
+        units = least;
+    return units > NCP_RING_MAX_CAPACITY ? NCP_RING_MAX_CAPACITY : (uint32_t)units;
+}
+
 static void workers_reset(struct ncp_pipe *p);
 
 struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
@@ -67,6 +79,7 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     p->n = clamp(map->n_lexers, 1, NCP_MAX_LEXERS);
     p->exec_threads = clamp(map->n_executors, 0, NCP_MAX_EXECUTORS);
     p->inline_out = map->inline_output && p->exec_threads == 0;
+    p->packed_out = p->exec_threads == 0 && !p->inline_out;
     p->m = p->exec_threads > 0 ? p->exec_threads : p->inline_out ? 0 : 1;
     p->out_stage = p->exec_threads > 0 ? NCP_CMD_STAGE_OUTPUT : NCP_CMD_STAGE_EXECUTOR;
     atomic_init(&p->gate, 0);
@@ -74,11 +87,12 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     p->parsed = rings_new(p->n);
     p->cmds = p->m > 0 ? rings_new(p->m) : NULL;
     /* aligned_alloc wants a size that is a multiple of the alignment */
-    p->inline_cmd = p->inline_out
-                        ? aligned_alloc(64, (sizeof *p->inline_cmd + 63) / 64 * 64)
-                        : NULL;
+    size_t cmd_bytes = (sizeof(struct ncp_cmd) + 63) / 64 * 64;
+    p->inline_cmd = p->inline_out || p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
+    p->out_cmd = p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
     if (!p->strings || !p->parsed || (p->m > 0 && !p->cmds) ||
-        (p->inline_out && !p->inline_cmd)) {
+        ((p->inline_out || p->packed_out) && !p->inline_cmd) ||
+        (p->packed_out && !p->out_cmd)) {
         ncp_pipe_free(p);
         return NULL;
     }
@@ -92,8 +106,15 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
         if (!bad) /* publish about every 4 KB of records, not every 32 units */
             ncp_ring_set_batch(&p->parsed[i], 4096 / NCP_PACK_UNIT);
     }
-    for (int j = 0; j < p->m; j++)
-        bad |= ncp_ring_init_staged(&p->cmds[j], sizeof(struct ncp_cmd), s, p->out_stage + 1);
+    if (p->packed_out) { /* cmd_slots of about 1 KB, never less than two of the largest */
+        bad |= ncp_ring_init(&p->cmds[0], NCP_PACK_UNIT, packed_cmd_units(s));
+        if (!bad)
+            ncp_ring_set_batch(&p->cmds[0], 4096 / NCP_PACK_UNIT);
+    } else {
+        for (int j = 0; j < p->m; j++)
+            bad |= ncp_ring_init_staged(&p->cmds[j], sizeof(struct ncp_cmd), s,
+                                        p->out_stage + 1);
+    }
     if (bad) {
         ncp_pipe_free(p);
         return NULL;

@@ -2,6 +2,7 @@
  * stages: each one writes or reads its slot in place in the ring. */
 #include "pipe.h"
 
+#include "cmd_pack.h"
 #include "emit.h"
 #include "futex.h"
 #include "ncpar/executor.h"
@@ -296,6 +297,49 @@ static void inline_publish(void *ctx, struct ncp_cmd *c)
         p->inline_stopped = 1;
 }
 
+/* Packed output (no executor threads): the analyzer resolves each command
+ * (arc geometry: what may still turn it into an error) and hands it to the
+ * output thread packed, which formats and writes it. Formatting is about a
+ * third of the analyzer's work on CAM programs; on two cores it then runs on
+ * the core of the feeder and lexer, which have time to spare. */
+static struct ncp_cmd *packed_acquire(void *ctx)
+{
+    struct ncp_pipe *p = ctx;
+    if (ncp_ring_aborted(&p->cmds[0]))
+        return NULL;
+    ncp_cmd_reset_header(p->inline_cmd, p->next_id);
+    return p->inline_cmd;
+}
+
+static void packed_publish(void *ctx, struct ncp_cmd *c)
+{
+    struct ncp_pipe *p = ctx;
+    struct ncp_ring *r = &p->cmds[0];
+    p->next_id++;
+    p->analyzer.items++;
+    ncp_exec_resolve(c);
+    uint32_t units = (uint32_t)(ncp_cmd_packed_size(c) / NCP_PACK_UNIT);
+    uint32_t to_end = ncp_ring_to_end(r, 0);
+    if (units > to_end) { /* records never wrap: pad to the ring's end */
+        void *pad = ncp_ring_reserve_n(r, to_end);
+        if (!pad)
+            return; /* aborted: the next acquire says so */
+        ncp_cmd_pack_pad(pad);
+        ncp_ring_commit_n(r, to_end);
+    }
+    void *dst = ncp_ring_reserve_n(r, units);
+    if (!dst)
+        return;
+    const char *later = ncp_ring_reserve_ahead(r, units + PACK_PREFETCH_UNITS);
+    if (later) {
+        ncp_prefetch_w(later);
+        ncp_prefetch_w(later + 64);
+        ncp_prefetch_w(later + 128);
+    }
+    ncp_cmd_pack(c, dst);
+    ncp_ring_commit_n(r, units);
+}
+
 void *ncp_pipe_analyzer(void *arg)
 {
     struct ncp_pipe *p = ((struct ncp_pipe_worker *)arg)->p;
@@ -309,6 +353,8 @@ void *ncp_pipe_analyzer(void *arg)
         struct ncp_cmd_sink sink = { p, sink_acquire, sink_publish };
         if (p->inline_out)
             sink = (struct ncp_cmd_sink){ p, inline_acquire, inline_publish };
+        else if (p->packed_out)
+            sink = (struct ncp_cmd_sink){ p, packed_acquire, packed_publish };
         p->an_rc = ncp_analyzer_run(an, &feed, &sink);
         ncp_analyzer_free(an);
     }
@@ -343,9 +389,54 @@ void *ncp_pipe_executor(void *arg)
  * threads: on a machine with few cores a thread per stage only adds hand-offs);
  * the first error, the end of the program or a failed
  * emit stops the run, exactly where the serial reference stops. */
+/* The next packed command, unpacked into the output thread's own slot; NULL
+ * at the end of the data or on abort. */
+static struct ncp_cmd *take_packed(struct ncp_pipe *p)
+{
+    struct ncp_ring *r = &p->cmds[0];
+    for (;;) {
+        const void *rec = ncp_ring_stage_peek(r, 1, 0);
+        if (!rec)
+            return NULL;
+        if (ncp_cmd_packed_is_pad(rec)) {
+            ncp_ring_stage_release_n(r, 1, ncp_ring_to_end(r, 1));
+            continue;
+        }
+        uint32_t units = (uint32_t)ncp_cmd_packed_units(rec);
+        if (units > 1 && !ncp_ring_stage_peek(r, 1, units - 1))
+            return NULL;
+        const char *later = ncp_ring_stage_ahead(r, 1, units + 1024 / NCP_PACK_UNIT);
+        if (later) {
+            __builtin_prefetch(later, 0);
+            __builtin_prefetch(later + 64, 0);
+            __builtin_prefetch(later + 128, 0);
+        }
+        ncp_cmd_unpack(rec, p->out_cmd);
+        ncp_ring_stage_release_n(r, 1, units);
+        return p->out_cmd;
+    }
+}
+
+static void output_packed(struct ncp_pipe *p)
+{
+    struct ncp_cmd *c;
+    while ((c = take_packed(p)) != NULL) {
+        ncp_exec_format(c);
+        p->output.items++;
+        if (ncp_emit_cmd(c, p->out, &p->err, &p->emit_failed))
+            break;
+    }
+}
+
 void *ncp_pipe_output(void *arg)
 {
     struct ncp_pipe *p = ((struct ncp_pipe_worker *)arg)->p;
+    if (p->packed_out) {
+        output_packed(p);
+        p->end_ms = ncp_pipe_now_ms();
+        ncp_pipe_abort(p);
+        return stage_done(arg);
+    }
     for (uint64_t id = 0;; id++) {
         struct ncp_ring *r = &p->cmds[id % (uint64_t)p->m];
         struct ncp_cmd *c = ncp_ring_stage_peek(r, p->out_stage, 0);

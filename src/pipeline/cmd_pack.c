@@ -1,0 +1,113 @@
+/* Packed commands (see cmd_pack.h). */
+#include "cmd_pack.h"
+
+#include <stdint.h>
+#include <string.h>
+
+#define UNIT 8u
+
+struct packed_cmd_head {
+    uint64_t cmd_id;
+    uint32_t line;
+    uint16_t n_ops, flags;
+    uint16_t text_used, units;
+    uint32_t msg_len;          /* with F_ERROR: the diagnostic's text, without NUL */
+};
+
+static const uint64_t pad_id = UINT64_MAX;
+
+static unsigned ops_of(const struct ncp_cmd *c)
+{
+    return c->n_ops < NCP_CMD_MAX_OPS ? c->n_ops : NCP_CMD_MAX_OPS;
+}
+
+static unsigned text_of(const struct ncp_cmd *c)
+{
+    return c->text_used < NCP_CMD_TEXT_POOL ? c->text_used : NCP_CMD_TEXT_POOL;
+}
+
+static size_t msg_of(const struct ncp_cmd *c)
+{
+    return c->flags & NCP_CMD_F_ERROR ? strnlen(c->diag.msg, NCP_DIAG_MSG_MAX - 1) : 0;
+}
+
+static size_t bytes_of(const struct ncp_cmd *c, size_t msg)
+{
+    size_t n = sizeof(struct packed_cmd_head) + ops_of(c) * sizeof c->ops[0] + text_of(c);
+    if (c->flags & NCP_CMD_F_ERROR)
+        n += offsetof(struct ncp_diag, msg) + msg;
+    return (n + UNIT - 1) / UNIT * UNIT;
+}
+
+size_t ncp_cmd_packed_size(const struct ncp_cmd *c)
+{
+    return bytes_of(c, msg_of(c));
+}
+
+size_t ncp_cmd_pack(const struct ncp_cmd *c, void *dst)
+{
+    size_t msg = msg_of(c), total = bytes_of(c, msg);
+    struct packed_cmd_head h = {
+        .cmd_id = c->cmd_id, .line = c->line, .n_ops = (uint16_t)ops_of(c),
+        .flags = c->flags, .text_used = (uint16_t)text_of(c),
+        .units = (uint16_t)(total / UNIT), .msg_len = (uint32_t)msg,
+    };
+    unsigned char *p = dst;
+    memcpy(p, &h, sizeof h);
+    p += sizeof h;
+    memcpy(p, c->ops, h.n_ops * sizeof c->ops[0]);
+    p += h.n_ops * sizeof c->ops[0];
+    if (c->flags & NCP_CMD_F_ERROR) {
+        memcpy(p, &c->diag, offsetof(struct ncp_diag, msg));
+        p += offsetof(struct ncp_diag, msg);
+        memcpy(p, c->diag.msg, msg);
+        p += msg;
+    }
+    memcpy(p, c->text, h.text_used);
+    p += h.text_used;
+    memset(p, 0, total - (size_t)(p - (unsigned char *)dst));
+    return total;
+}
+
+size_t ncp_cmd_packed_units(const void *src)
+{
+    struct packed_cmd_head h;
+    memcpy(&h, src, sizeof h);
+    return h.units;
+}
+
+void ncp_cmd_unpack(const void *src, struct ncp_cmd *c)
+{
+    struct packed_cmd_head h;
+    const unsigned char *p = src;
+    memcpy(&h, p, sizeof h);
+    p += sizeof h;
+    c->cmd_id = h.cmd_id;
+    c->line = h.line;
+    c->n_ops = h.n_ops;
+    c->flags = h.flags;
+    c->text_used = h.text_used;
+    c->out_len = 0;
+    memcpy(c->ops, p, h.n_ops * sizeof c->ops[0]);
+    p += h.n_ops * sizeof c->ops[0];
+    if (h.flags & NCP_CMD_F_ERROR) {
+        memcpy(&c->diag, p, offsetof(struct ncp_diag, msg));
+        p += offsetof(struct ncp_diag, msg);
+        memcpy(c->diag.msg, p, h.msg_len);
+        c->diag.msg[h.msg_len] = '\0';
+        p += h.msg_len;
+    }
+    memcpy(c->text, p, h.text_used);
+}
+
+void ncp_cmd_pack_pad(void *dst)
+{
+    memcpy(dst, &pad_id, sizeof pad_id);
+}
+
+int ncp_cmd_packed_is_pad(const void *src)
+{
+    uint64_t v;
+    memcpy(&v, src, sizeof v);
+    return v == pad_id;
+}

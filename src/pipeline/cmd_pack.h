@@ -1,0 +1,23 @@
+/* Packed commands: what crosses from the analyzer's core to the output
+ * thread's when the output thread formats (executors = 0). A command slot is
+ * about 3.5 KB so that any block's calls fit; a STRAIGHT_FEED uses the header
+ * and one 120-byte call of it. Packed, only those parts travel, in a ring of
+ * 8-byte units published 4 KB at a time (module-internal header). */
+#ifndef NCP_PIPELINE_CMD_PACK_H
+#define NCP_PIPELINE_CMD_PACK_H
+
+#include <stddef.h>
+#include "ncpar/canon.h"
+
+/* Bytes ncp_cmd_pack writes for c (a multiple of 8, at most NCP_CMD_PACK_MAX). */
+size_t ncp_cmd_packed_size(const struct ncp_cmd *c);
+#define NCP_CMD_PACK_MAX (sizeof(struct ncp_cmd) + 64u)
+size_t ncp_cmd_pack(const struct ncp_cmd *c, void *dst);
+size_t ncp_cmd_packed_units(const void *src);
+/* Restores what formatting and emitting read: header, calls, text, error. */
+void ncp_cmd_unpack(const void *src, struct ncp_cmd *c);
+/* A filler up to the end of the ring (no command has the id 2^64 - 1). */
+void ncp_cmd_pack_pad(void *dst);
+int ncp_cmd_packed_is_pad(const void *src);
+
+#endif
