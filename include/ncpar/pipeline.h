@@ -49,7 +49,7 @@ const char *ncp_thread_mode_name(enum ncp_thread_mode m);
 
 /* Defaults for a mode and thread counts (ATT: feeder on CPU0, lexers, analyzer
  * and executors round-robin over the CPUs present from CPU1, output beside the
- * analyzer). */
+ * analyzer, or with no executors on the next CPU). */
 void ncp_thread_map_default(struct ncp_thread_map *m, enum ncp_thread_mode mode,
                             int n_lexers, int n_executors);
 /* Load an INI thread map; fills d (file:line) on error. */

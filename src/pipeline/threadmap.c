@@ -63,10 +63,12 @@ void ncp_thread_map_default(struct ncp_thread_map *m, enum ncp_thread_mode mode,
     m->analyzer = spec_on(PLACE());
     for (int i = 0; i < NCP_MAX_EXECUTORS; i++)
         m->executor[i] = spec_on(i < m->n_executors ? PLACE() : -1);
-    /* The output beside the analyzer: every command crosses from one to the
-     * other, and across cores that hand-off cost the analyzer more than its
-     * own work (bench/RESULTS.md, ATT placements). */
-    m->output = m->analyzer;
+    /* With executor threads the output sits beside the analyzer: command
+     * slots crossing from one to the other cost the analyzer more than its
+     * own work (bench/RESULTS.md, ATT placements). Without them the output
+     * formats packed commands, a third of the work, and takes the next CPU
+     * (on two CPUs: the lexer's, which has time to spare). */
+    m->output = m->n_executors > 0 ? m->analyzer : spec_on(PLACE());
 #undef PLACE
 }
 

@@ -52,6 +52,12 @@ static void test_default_att(void **state)
     assert_int_equal(m.executor[0].cpu, 6 % ncpu);
     assert_int_equal(m.output.cpu, m.analyzer.cpu);
     assert_true(m.analyzer.cpu >= 0 && m.analyzer.cpu < ncpu);
+    /* no executor threads: the output formats, on the next CPU */
+    ncp_thread_map_default(&m, NCP_MODE_ATT, 1, 0);
+    assert_int_equal(m.feeder.cpu, 0);
+    assert_int_equal(m.lexer[0].cpu, 1 % ncpu);
+    assert_int_equal(m.analyzer.cpu, 2 % ncpu);
+    assert_int_equal(m.output.cpu, 3 % ncpu);
 }
 
 static void test_default_clamps_counts(void **state)
