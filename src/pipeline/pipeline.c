@@ -45,23 +45,14 @@ static int clamp(int v, int lo, int hi)
     return v < lo ? lo : v > hi ? hi : v;
 }
 
-/* A parsed ring holds packed blocks: h rows of 256 bytes (a plain block packs
- * to about 130), and never less than two of the largest blocks (one always
- * fits after the padding at the wrap point). */
-static uint32_t parsed_units(uint32_t rows)
+/* A ring of packed records (blocks, commands) in 8-byte units: rows of
+ * row_bytes, and never less than two of the largest records (one always fits
+ * after the padding at the wrap point). A plain block packs to 96 bytes (rows of
+ * 256), a plain command to 144 (rows of 1 KB: a command slot). */
+static uint32_t record_ring_units(uint32_t rows, size_t row_bytes, size_t record_max)
 {
-    uint64_t units = (uint64_t)rows * (256 / NCP_PACK_UNIT);
-    uint64_t least = 2 * (NCP_BLOCK_PACK_MAX / NCP_PACK_UNIT + 1);
-    if (units < least)
-        units = least;
-    return units > NCP_RING_MAX_CAPACITY ? NCP_RING_MAX_CAPACITY : (uint32_t)units;
-}
-
-/* The packed command ring (no executor threads): 1 KB a command slot. */
-static uint32_t packed_cmd_units(uint32_t slots)
-{
-    uint64_t units = (uint64_t)slots * (1024 / NCP_PACK_UNIT);
-    uint64_t least = 2 * (NCP_CMD_PACK_MAX / NCP_PACK_UNIT + 1);
+    uint64_t units = (uint64_t)rows * (row_bytes / NCP_PACK_UNIT);
+    uint64_t least = 2 * (record_max / NCP_PACK_UNIT + 1);
     if (units < least)
         units = least;
     return units > NCP_RING_MAX_CAPACITY ? NCP_RING_MAX_CAPACITY : (uint32_t)units;
@@ -102,12 +93,14 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     int bad = 0;
     for (int i = 0; i < p->n; i++) {
         bad |= ncp_ring_init(&p->strings[i], sizeof(struct ncp_chunk), g);
-        bad |= ncp_ring_init(&p->parsed[i], NCP_PACK_UNIT, parsed_units(h));
+        bad |= ncp_ring_init(&p->parsed[i], NCP_PACK_UNIT,
+                             record_ring_units(h, 256, NCP_BLOCK_PACK_MAX));
         if (!bad) /* publish about every 4 KB of records, not every 32 units */
             ncp_ring_set_batch(&p->parsed[i], 4096 / NCP_PACK_UNIT);
     }
     if (p->packed_out) { /* cmd_slots of about 1 KB, never less than two of the largest */
-        bad |= ncp_ring_init(&p->cmds[0], NCP_PACK_UNIT, packed_cmd_units(s));
+        bad |= ncp_ring_init(&p->cmds[0], NCP_PACK_UNIT,
+                             record_ring_units(s, 1024, NCP_CMD_PACK_MAX));
         if (!bad)
             ncp_ring_set_batch(&p->cmds[0], 4096 / NCP_PACK_UNIT);
     } else {

@@ -43,40 +43,34 @@ static void *stage_done(void *arg)
  * of cache-to-cache transfers, small against any ring. */
 #define PREFETCH_AHEAD 6u
 
-/* The lines the analyzer writes in every command slot: header, first ops. */
-static void prefetch_cmd(const struct ncp_cmd *cmd)
-{
-    if (!cmd)
-        return;
-    const char *c = (const char *)cmd;
-    ncp_prefetch_w(c);
-    ncp_prefetch_w(c + offsetof(struct ncp_cmd, ops));
-    ncp_prefetch_w(c + offsetof(struct ncp_cmd, ops) + 64);
-    ncp_prefetch_w(c + offsetof(struct ncp_cmd, ops) + 128);
-}
+/* The lines of a command slot a stage touches next: the analyzer fills the
+ * header and the first calls, an executing stage reads those and writes the
+ * text, the output reads the text. Written lines are claimed for writing. */
+enum slot_use { SLOT_FILL, SLOT_EXECUTE, SLOT_EMIT };
 
-/* What executing a slot reads (header, ops) and writes (the text). */
-static void prefetch_cmd_exec(const struct ncp_cmd *cmd)
+static void prefetch_slot(const struct ncp_cmd *cmd, enum slot_use use)
 {
     if (!cmd)
         return;
     const char *c = (const char *)cmd;
-    __builtin_prefetch(c, 0);
-    __builtin_prefetch(c + offsetof(struct ncp_cmd, ops), 0);
-    __builtin_prefetch(c + offsetof(struct ncp_cmd, ops) + 64, 0);
-    ncp_prefetch_w(c + offsetof(struct ncp_cmd, out));
-    ncp_prefetch_w(c + offsetof(struct ncp_cmd, out) + 64);
-}
-
-/* What the output reads of a slot an executor completed. */
-static void prefetch_cmd_out(const struct ncp_cmd *cmd)
-{
-    if (!cmd)
+    const char *ops = c + offsetof(struct ncp_cmd, ops), *out = c + offsetof(struct ncp_cmd, out);
+    if (use == SLOT_FILL) {
+        ncp_prefetch_w(c);
+        ncp_prefetch_w(ops);
+        ncp_prefetch_w(ops + 64);
+        ncp_prefetch_w(ops + 128);
         return;
-    const char *c = (const char *)cmd;
+    }
     __builtin_prefetch(c, 0);
-    __builtin_prefetch(c + offsetof(struct ncp_cmd, out), 0);
-    __builtin_prefetch(c + offsetof(struct ncp_cmd, out) + 64, 0);
+    if (use == SLOT_EXECUTE) {
+        __builtin_prefetch(ops, 0);
+        __builtin_prefetch(ops + 64, 0);
+        ncp_prefetch_w(out);
+        ncp_prefetch_w(out + 64);
+    } else {
+        __builtin_prefetch(out, 0);
+        __builtin_prefetch(out + 64, 0);
+    }
 }
 
 /* How far ahead (8-byte units, a few kB) the lexer claims the lines of the
@@ -260,7 +254,7 @@ static struct ncp_cmd *sink_acquire(void *ctx)
     struct ncp_cmd *c = ncp_ring_reserve(r);
     if (!c)
         return NULL;
-    prefetch_cmd(ncp_ring_reserve_ahead(r, PREFETCH_AHEAD / (uint32_t)p->m + 1));
+    prefetch_slot(ncp_ring_reserve_ahead(r, PREFETCH_AHEAD / (uint32_t)p->m + 1), SLOT_FILL);
     ncp_cmd_reset_header(c, p->next_id);
     return c;
 }
@@ -377,7 +371,7 @@ void *ncp_pipe_executor(void *arg)
     struct ncp_ring *r = &w->p->cmds[w->index];
     struct ncp_cmd *c;
     while ((c = ncp_ring_stage_peek(r, NCP_CMD_STAGE_EXECUTOR, 0)) != NULL) {
-        prefetch_cmd_exec(ncp_ring_stage_ahead(r, NCP_CMD_STAGE_EXECUTOR, PREFETCH_AHEAD));
+        prefetch_slot(ncp_ring_stage_ahead(r, NCP_CMD_STAGE_EXECUTOR, PREFETCH_AHEAD), SLOT_EXECUTE);
         ncp_exec_cmd(c);
         ncp_ring_stage_release(r, NCP_CMD_STAGE_EXECUTOR);
         w->items++;
@@ -444,10 +438,7 @@ void *ncp_pipe_output(void *arg)
             break;
         const struct ncp_cmd *later =
             ncp_ring_stage_ahead(r, p->out_stage, PREFETCH_AHEAD / (uint32_t)p->m + 1);
-        if (p->exec_threads == 0)
-            prefetch_cmd_exec(later);
-        else
-            prefetch_cmd_out(later);
+        prefetch_slot(later, p->exec_threads == 0 ? SLOT_EXECUTE : SLOT_EMIT);
         if (p->exec_threads == 0)
             ncp_exec_cmd(c);
         p->output.items++;
