@@ -73,8 +73,8 @@ static void prefetch_slot(const struct ncp_cmd *cmd, enum slot_use use)
     }
 }
 
-/* How far ahead (8-byte units, a few kB) the lexer claims the lines of the
- * packed records it is about to write. */
+/* How far ahead (8-byte units, a few kB) the writer of a ring of packed
+ * records claims the lines of the records it is about to write. */
 #define PACK_PREFETCH_UNITS 256u
 
 void ncp_pipe_open_gate(struct ncp_pipe *p)
@@ -127,27 +127,91 @@ void *ncp_pipe_feeder(void *arg)
     return stage_done(arg);
 }
 
+/* ---- rings of packed records ------------------------------------------- */
+
+/* Blocks (lexer -> analyzer) and, without executor threads, commands
+ * (analyzer -> output) cross in rings of 8-byte units as records of their
+ * own size that never wrap: the writer pads to the ring's end first. What
+ * differs between the two is how a record marks a pad and tells its size. */
+struct record_kind {
+    void (*pad)(void *dst);
+    int (*is_pad)(const void *src);
+    size_t (*units)(const void *src);
+    unsigned prefetch_lines;     /* lines a record of this kind usually takes */
+};
+
+/* A chunk's end mark is one unit, without a block header to read. */
+static size_t block_record_units(const void *src)
+{
+    return ncp_block_packed_is_end_mark(src) ? 1 : ncp_block_packed_units(src);
+}
+
+static const struct record_kind block_records = {
+    ncp_block_pack_pad, ncp_block_packed_is_pad, block_record_units, 2
+};
+static const struct record_kind cmd_records = {
+    ncp_cmd_pack_pad, ncp_cmd_packed_is_pad, ncp_cmd_packed_units, 3
+};
+
+/* Room for a record of `units` (padding to the ring's end first if it would
+ * wrap), the lines of the records to come claimed for writing; NULL once the
+ * ring is closed or aborted. The caller writes it and commits `units`. */
+static void *put_record(struct ncp_ring *r, const struct record_kind *k, uint32_t units)
+{
+    uint32_t to_end = ncp_ring_to_end(r, 0);
+    if (units > to_end) {
+        void *pad = ncp_ring_reserve_n(r, to_end);
+        if (!pad)
+            return NULL;
+        k->pad(pad);
+        ncp_ring_commit_n(r, to_end);
+    }
+    void *dst = ncp_ring_reserve_n(r, units);
+    if (!dst)
+        return NULL;
+    const char *later = ncp_ring_reserve_ahead(r, units + PACK_PREFETCH_UNITS);
+    for (unsigned l = 0; later && l < k->prefetch_lines; l++)
+        ncp_prefetch_w(later + 64 * l);
+    return dst;
+}
+
+/* The next whole record for the ring's reader (stage 1), pads skipped, and
+ * its size in units; NULL at the end of the data or on abort. The caller
+ * releases `units` when done with it. */
+static const void *take_record(struct ncp_ring *r, const struct record_kind *k,
+                               uint32_t *units)
+{
+    for (;;) {
+        const void *rec = ncp_ring_stage_peek(r, 1, 0);
+        if (!rec)
+            return NULL;
+        if (k->is_pad(rec)) {
+            ncp_ring_stage_release_n(r, 1, ncp_ring_to_end(r, 1));
+            continue;
+        }
+        uint32_t n = (uint32_t)k->units(rec);
+        if (n > 1 && !ncp_ring_stage_peek(r, 1, n - 1))
+            return NULL;
+        /* the writer wrote the next records on its core: start their transfer */
+        const char *later = ncp_ring_stage_ahead(r, 1, n + 1024 / NCP_PACK_UNIT);
+        if (later) {
+            __builtin_prefetch(later, 0);
+            __builtin_prefetch(later + 64, 0);
+            __builtin_prefetch(later + 128, 0);
+        }
+        *units = n;
+        return rec;
+    }
+}
+
 /* LEX_i lexes into a block of its own (hot in its cache) and passes it on
  * packed: only the used parts cross to the analyzer's core. */
 static int put_packed(struct ncp_ring *out, const struct ncp_block *b)
 {
     uint32_t units = (uint32_t)(ncp_block_packed_size(b) / NCP_PACK_UNIT);
-    uint32_t to_end = ncp_ring_to_end(out, 0);
-    if (units > to_end) { /* records never wrap: pad to the ring's end */
-        void *pad = ncp_ring_reserve_n(out, to_end);
-        if (!pad)
-            return -1;
-        ncp_block_pack_pad(pad);
-        ncp_ring_commit_n(out, to_end);
-    }
-    void *dst = ncp_ring_reserve_n(out, units);
+    void *dst = put_record(out, &block_records, units);
     if (!dst)
         return -1;
-    const char *later = ncp_ring_reserve_ahead(out, units + PACK_PREFETCH_UNITS);
-    if (later) { /* a record is 1-3 lines: two a block keep ahead of it */
-        ncp_prefetch_w(later);
-        ncp_prefetch_w(later + 64);
-    }
     ncp_block_pack(b, dst);
     ncp_ring_commit_n(out, units);
     return 0;
@@ -156,7 +220,7 @@ static int put_packed(struct ncp_ring *out, const struct ncp_block *b)
 /* The analyzer moves on to the next column when it meets this. */
 static int put_end_mark(struct ncp_ring *out)
 {
-    void *dst = ncp_ring_reserve_n(out, 1);
+    void *dst = put_record(out, &block_records, 1);
     if (!dst)
         return -1;
     ncp_block_pack_end_mark(dst);
@@ -210,28 +274,15 @@ static const struct ncp_block *feed_next(void *ctx)
     struct ncp_pipe *p = ctx;
     struct ncp_ring *r = &p->parsed[p->chunk % (uint64_t)p->n];
     for (;;) {
-        const void *rec = ncp_ring_stage_peek(r, 1, 0);
+        uint32_t units;
+        const void *rec = take_record(r, &block_records, &units);
         if (!rec)
             return NULL;
-        if (ncp_block_packed_is_pad(rec)) {
-            ncp_ring_stage_release_n(r, 1, ncp_ring_to_end(r, 1));
-            continue;
-        }
         if (ncp_block_packed_is_end_mark(rec)) {
             ncp_ring_stage_release_n(r, 1, 1);
             p->chunk++;
             r = &p->parsed[p->chunk % (uint64_t)p->n];
             continue;
-        }
-        uint32_t units = (uint32_t)ncp_block_packed_units(rec);
-        if (units > 1 && !ncp_ring_stage_peek(r, 1, units - 1))
-            return NULL;
-        /* the lexer wrote the next records on its core: start their transfer */
-        const char *later = ncp_ring_stage_ahead(r, 1, units + 1024 / NCP_PACK_UNIT);
-        if (later) {
-            __builtin_prefetch(later, 0);
-            __builtin_prefetch(later + 64, 0);
-            __builtin_prefetch(later + 128, 0);
         }
         ncp_block_unpack(rec, &p->an_block);
         ncp_ring_stage_release_n(r, 1, units);
@@ -313,23 +364,9 @@ static void packed_publish(void *ctx, struct ncp_cmd *c)
     p->analyzer.items++;
     ncp_exec_resolve(c);
     uint32_t units = (uint32_t)(ncp_cmd_packed_size(c) / NCP_PACK_UNIT);
-    uint32_t to_end = ncp_ring_to_end(r, 0);
-    if (units > to_end) { /* records never wrap: pad to the ring's end */
-        void *pad = ncp_ring_reserve_n(r, to_end);
-        if (!pad)
-            return; /* aborted: the next acquire says so */
-        ncp_cmd_pack_pad(pad);
-        ncp_ring_commit_n(r, to_end);
-    }
-    void *dst = ncp_ring_reserve_n(r, units);
+    void *dst = put_record(r, &cmd_records, units);
     if (!dst)
-        return;
-    const char *later = ncp_ring_reserve_ahead(r, units + PACK_PREFETCH_UNITS);
-    if (later) {
-        ncp_prefetch_w(later);
-        ncp_prefetch_w(later + 64);
-        ncp_prefetch_w(later + 128);
-    }
+        return; /* aborted: the next acquire says so */
     ncp_cmd_pack(c, dst);
     ncp_ring_commit_n(r, units);
 }
@@ -388,27 +425,13 @@ void *ncp_pipe_executor(void *arg)
 static struct ncp_cmd *take_packed(struct ncp_pipe *p)
 {
     struct ncp_ring *r = &p->cmds[0];
-    for (;;) {
-        const void *rec = ncp_ring_stage_peek(r, 1, 0);
-        if (!rec)
-            return NULL;
-        if (ncp_cmd_packed_is_pad(rec)) {
-            ncp_ring_stage_release_n(r, 1, ncp_ring_to_end(r, 1));
-            continue;
-        }
-        uint32_t units = (uint32_t)ncp_cmd_packed_units(rec);
-        if (units > 1 && !ncp_ring_stage_peek(r, 1, units - 1))
-            return NULL;
-        const char *later = ncp_ring_stage_ahead(r, 1, units + 1024 / NCP_PACK_UNIT);
-        if (later) {
-            __builtin_prefetch(later, 0);
-            __builtin_prefetch(later + 64, 0);
-            __builtin_prefetch(later + 128, 0);
-        }
-        ncp_cmd_unpack(rec, p->out_cmd);
-        ncp_ring_stage_release_n(r, 1, units);
-        return p->out_cmd;
-    }
+    uint32_t units;
+    const void *rec = take_record(r, &cmd_records, &units);
+    if (!rec)
+        return NULL;
+    ncp_cmd_unpack(rec, p->out_cmd);
+    ncp_ring_stage_release_n(r, 1, units);
+    return p->out_cmd;
 }
 
 static void output_packed(struct ncp_pipe *p)
