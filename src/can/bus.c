@@ -70,14 +70,29 @@ int ncp_can_filter(struct ncp_can_bus *bus, const uint32_t *ids, size_t n,
     return NCP_OK;
 }
 
+/* Our frame <-> the kernel's: 11-bit ids, RTR flag, at most 8 data bytes. */
+static void to_socketcan(const struct ncp_can_frame *f, struct can_frame *cf)
+{
+    memset(cf, 0, sizeof *cf);
+    cf->can_id = (f->id & CAN_SFF_MASK) | (f->rtr ? CAN_RTR_FLAG : 0);
+    cf->can_dlc = f->len > 8 ? 8 : f->len;
+    memcpy(cf->data, f->data, cf->can_dlc);
+}
+
+static void from_socketcan(const struct can_frame *cf, struct ncp_can_frame *f)
+{
+    memset(f, 0, sizeof *f);
+    f->id = cf->can_id & CAN_SFF_MASK;
+    f->rtr = (cf->can_id & CAN_RTR_FLAG) != 0;
+    f->len = cf->can_dlc > 8 ? 8 : cf->can_dlc;
+    memcpy(f->data, cf->data, f->len);
+}
+
 int ncp_can_send(struct ncp_can_bus *bus, const struct ncp_can_frame *f,
                  struct ncp_diag *d)
 {
     struct can_frame cf;
-    memset(&cf, 0, sizeof cf);
-    cf.can_id = (f->id & CAN_SFF_MASK) | (f->rtr ? CAN_RTR_FLAG : 0);
-    cf.can_dlc = f->len > 8 ? 8 : f->len;
-    memcpy(cf.data, f->data, cf.can_dlc);
+    to_socketcan(f, &cf);
     for (int tries = 0; tries < 100; tries++) {
         ssize_t w = write(bus->fd, &cf, sizeof cf);
         if (w == (ssize_t)sizeof cf)
@@ -116,11 +131,7 @@ int ncp_can_recv(struct ncp_can_bus *bus, struct ncp_can_frame *f, int timeout_m
                      n < 0 ? strerror(errno) : "short frame");
         return -1;
     }
-    memset(f, 0, sizeof *f);
-    f->id = cf.can_id & CAN_SFF_MASK;
-    f->rtr = (cf.can_id & CAN_RTR_FLAG) != 0;
-    f->len = cf.can_dlc > 8 ? 8 : cf.can_dlc;
-    memcpy(f->data, cf.data, f->len);
+    from_socketcan(&cf, f);
     return 1;
 }
 
@@ -128,10 +139,7 @@ int ncp_can_recv(struct ncp_can_bus *bus, struct ncp_can_frame *f, int timeout_m
 int ncp_can_try_send(struct ncp_can_bus *bus, const struct ncp_can_frame *f)
 {
     struct can_frame cf;
-    memset(&cf, 0, sizeof cf);
-    cf.can_id = (f->id & CAN_SFF_MASK) | (f->rtr ? CAN_RTR_FLAG : 0);
-    cf.can_dlc = f->len > 8 ? 8 : f->len;
-    memcpy(cf.data, f->data, cf.can_dlc);
+    to_socketcan(f, &cf);
     ssize_t w;
     do
         w = send(bus->fd, &cf, sizeof cf, MSG_DONTWAIT);
@@ -159,10 +167,6 @@ int ncp_can_try_recv(struct ncp_can_bus *bus, struct ncp_can_frame *f)
             errno = EIO;
         return -1;
     }
-    memset(f, 0, sizeof *f);
-    f->id = cf.can_id & CAN_SFF_MASK;
-    f->rtr = (cf.can_id & CAN_RTR_FLAG) != 0;
-    f->len = cf.can_dlc > 8 ? 8 : cf.can_dlc;
-    memcpy(f->data, cf.data, f->len);
+    from_socketcan(&cf, f);
     return 1;
 }
