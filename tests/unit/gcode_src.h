@@ -46,4 +46,23 @@ static inline struct row *run_text(const char *text, const struct ncp_machine_cf
     return r;
 }
 
+/* A program with every kind of corner the planner handles: G64 P blends
+ * between lines and arcs (G2/G3 by centre), G61 exact stops, a G64 P change
+ * and a helix; shared by the motion tests that check limits and tolerances. */
+static const char corners_prog[] =
+    "G21 G90 G17 G64 P0.05\n"
+    "G0 X0 Y0 Z5\n"
+    "G1 Z-1 F600\n"
+    "G1 X40 F4000\n"
+    "G1 X60 Y20\n"
+    "G3 X60 Y60 I0 J20\n"
+    "G2 X40 Y80 I-20 J0\n"
+    "G1 X0 Y80\n"
+    "G61 G1 X0 Y40\n"
+    "G1 X-10 Y30\n"
+    "G64 P0.2 G1 X-10 Y0\n"
+    "G2 X-10 Y0 Z-4 I10 J0 F2000\n"
+    "G0 Z5\n"
+    "M2\n";
+
 #endif

@@ -375,23 +375,17 @@ static void test_fault_messages(void **state)
 static void test_interp_period(void **state)
 {
     (void)state;
-    uint8_t v;
-    int8_t e;
-    assert_int_equal(ncp_co_interp_period(1000, &v, &e), 0);
-    assert_int_equal(v, 1);
-    assert_int_equal(e, -3);
-    assert_int_equal(ncp_co_interp_period(4000, &v, &e), 0);
-    assert_int_equal(v, 4);
-    assert_int_equal(e, -3);
-    assert_int_equal(ncp_co_interp_period(250, &v, &e), 0);
-    assert_int_equal(v, 25);
-    assert_int_equal(e, -5);
-    assert_int_equal(ncp_co_interp_period(125, &v, &e), 0);
-    assert_int_equal(v, 125);
-    assert_int_equal(e, -6);
-    assert_int_equal(ncp_co_interp_period(1500, &v, &e), 0);
-    assert_int_equal(v, 15);
-    assert_int_equal(e, -4);
+    uint8_t v = 0; /* no expected value is 0: an unset result fails */
+    int8_t e = 0;
+    /* period in us -> value x 10^exponent seconds (0x60C2) */
+    static const struct { uint32_t us; uint8_t v; int8_t e; } ok[] = {
+        { 1000, 1, -3 }, { 4000, 4, -3 }, { 250, 25, -5 }, { 125, 125, -6 }, { 1500, 15, -4 },
+    };
+    for (size_t k = 0; k < sizeof ok / sizeof ok[0]; k++) {
+        assert_int_equal(ncp_co_interp_period(ok[k].us, &v, &e), 0);
+        assert_int_equal(v, ok[k].v);
+        assert_int_equal(e, ok[k].e);
+    }
     assert_int_equal(ncp_co_interp_period(300000, &v, &e), -1);
     assert_int_equal(ncp_co_interp_period(0, &v, &e), -1);
 }

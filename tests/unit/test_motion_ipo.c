@@ -71,22 +71,6 @@ static double worst_jerk(const struct row *r, size_t n, const struct ncp_machine
     return w.jerk;
 }
 
-static const char corners_prog[] =
-    "G21 G90 G17 G64 P0.05\n"
-    "G0 X0 Y0 Z5\n"
-    "G1 Z-1 F600\n"
-    "G1 X40 F4000\n"
-    "G1 X60 Y20\n"
-    "G3 X60 Y60 I0 J20\n"
-    "G2 X40 Y80 I-20 J0\n"
-    "G1 X0 Y80\n"
-    "G61 G1 X0 Y40\n"
-    "G1 X-10 Y30\n"
-    "G64 P0.2 G1 X-10 Y0\n"
-    "G2 X-10 Y0 Z-4 I10 J0 F2000\n"
-    "G0 Z5\n"
-    "M2\n";
-
 static char *write_tmp(const char *text)
 {
     static char path[] = "/tmp/ncp_ipo_XXXXXX";

@@ -59,22 +59,6 @@ static struct worst check_limits(const struct row *r, size_t n, const struct ncp
     return w;
 }
 
-static const char corners_prog[] =
-    "G21 G90 G17 G64 P0.05\n"
-    "G0 X0 Y0 Z5\n"
-    "G1 Z-1 F600\n"
-    "G1 X40 F4000\n"
-    "G1 X60 Y20\n"
-    "G3 X60 Y60 I0 J20\n"
-    "G2 X40 Y80 I-20 J0\n"
-    "G1 X0 Y80\n"
-    "G61 G1 X0 Y40\n"
-    "G1 X-10 Y30\n"
-    "G64 P0.2 G1 X-10 Y0\n"
-    "G2 X-10 Y0 Z-4 I10 J0 F2000\n"
-    "G0 Z5\n"
-    "M2\n";
-
 static void scurve_cfg(struct ncp_machine_cfg *c)
 {
     ncp_machine_cfg_default(c);
