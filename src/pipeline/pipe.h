@@ -43,7 +43,8 @@ struct ncp_pipe {
     const struct ncp_output *out;
     int n, m;                    /* lexers, command rings (one per executor, >= 1) */
     int exec_threads;            /* executors; 0: the output thread executes */
-    unsigned out_stage;          /* the output's stage in a command ring */
+    unsigned out_stage;          /* the output's stage: of a slot ring (executors),
+                                  * or the reader (1) of the packed ring */
     int inline_out;              /* the analyzer executes and emits (m == 0) */
     int packed_out;              /* no executors: the output thread formats packed commands */
 
@@ -72,7 +73,7 @@ struct ncp_pipe {
 
     /* inline and packed output: the analyzer's own command slot, whether the
      * inline output stopped; the output thread's slot it unpacks into */
-    struct ncp_cmd *inline_cmd;
+    struct ncp_cmd *an_cmd;
     int inline_stopped;
     struct ncp_cmd *out_cmd;
 

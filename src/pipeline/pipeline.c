@@ -35,7 +35,7 @@ void ncp_pipe_free(struct ncp_pipe *p)
     rings_free(p->strings, p->n);
     rings_free(p->parsed, p->n);
     rings_free(p->cmds, p->m);
-    free(p->inline_cmd);
+    free(p->an_cmd);
     free(p->out_cmd);
     free(p);
 }
@@ -79,10 +79,10 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     p->cmds = p->m > 0 ? rings_new(p->m) : NULL;
     /* aligned_alloc wants a size that is a multiple of the alignment */
     size_t cmd_bytes = (sizeof(struct ncp_cmd) + 63) / 64 * 64;
-    p->inline_cmd = p->inline_out || p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
+    p->an_cmd = p->inline_out || p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
     p->out_cmd = p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
     if (!p->strings || !p->parsed || (p->m > 0 && !p->cmds) ||
-        ((p->inline_out || p->packed_out) && !p->inline_cmd) ||
+        ((p->inline_out || p->packed_out) && !p->an_cmd) ||
         (p->packed_out && !p->out_cmd)) {
         ncp_pipe_free(p);
         return NULL;
@@ -106,7 +106,7 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     } else {
         for (int j = 0; j < p->m; j++)
             bad |= ncp_ring_init_staged(&p->cmds[j], sizeof(struct ncp_cmd), s,
-                                        p->out_stage + 1);
+                                        NCP_CMD_STAGES);
     }
     if (bad) {
         ncp_pipe_free(p);

@@ -327,8 +327,8 @@ static struct ncp_cmd *inline_acquire(void *ctx)
     struct ncp_pipe *p = ctx;
     if (p->inline_stopped)
         return NULL;
-    ncp_cmd_reset_header(p->inline_cmd, p->next_id);
-    return p->inline_cmd;
+    ncp_cmd_reset_header(p->an_cmd, p->next_id);
+    return p->an_cmd;
 }
 
 static void inline_publish(void *ctx, struct ncp_cmd *c)
@@ -352,8 +352,8 @@ static struct ncp_cmd *packed_acquire(void *ctx)
     struct ncp_pipe *p = ctx;
     if (ncp_ring_aborted(&p->cmds[0]))
         return NULL;
-    ncp_cmd_reset_header(p->inline_cmd, p->next_id);
-    return p->inline_cmd;
+    ncp_cmd_reset_header(p->an_cmd, p->next_id);
+    return p->an_cmd;
 }
 
 static void packed_publish(void *ctx, struct ncp_cmd *c)
@@ -416,10 +416,6 @@ void *ncp_pipe_executor(void *arg)
     return stage_done(arg);
 }
 
-/* Slots in cmd_id order (executed here first when there are no executor
- * threads: on a machine with few cores a thread per stage only adds hand-offs);
- * the first error, the end of the program or a failed
- * emit stops the run, exactly where the serial reference stops. */
 /* The next packed command, unpacked into the output thread's own slot; NULL
  * at the end of the data or on abort. */
 static struct ncp_cmd *take_packed(struct ncp_pipe *p)
@@ -434,6 +430,7 @@ static struct ncp_cmd *take_packed(struct ncp_pipe *p)
     return p->out_cmd;
 }
 
+/* Without executor threads: each packed command formatted here. */
 static void output_packed(struct ncp_pipe *p)
 {
     struct ncp_cmd *c;
@@ -445,31 +442,34 @@ static void output_packed(struct ncp_pipe *p)
     }
 }
 
-void *ncp_pipe_output(void *arg)
+/* With executor threads: the slots they completed, round-robin over their
+ * rings, which is cmd_id order. */
+static void output_slots(struct ncp_pipe *p)
 {
-    struct ncp_pipe *p = ((struct ncp_pipe_worker *)arg)->p;
-    if (p->packed_out) {
-        output_packed(p);
-        p->end_ms = ncp_pipe_now_ms();
-        ncp_pipe_abort(p);
-        return stage_done(arg);
-    }
     for (uint64_t id = 0;; id++) {
         struct ncp_ring *r = &p->cmds[id % (uint64_t)p->m];
         struct ncp_cmd *c = ncp_ring_stage_peek(r, p->out_stage, 0);
         if (!c)
             break;
-        const struct ncp_cmd *later =
-            ncp_ring_stage_ahead(r, p->out_stage, PREFETCH_AHEAD / (uint32_t)p->m + 1);
-        prefetch_slot(later, p->exec_threads == 0 ? SLOT_EXECUTE : SLOT_EMIT);
-        if (p->exec_threads == 0)
-            ncp_exec_cmd(c);
+        prefetch_slot(ncp_ring_stage_ahead(r, p->out_stage, PREFETCH_AHEAD / (uint32_t)p->m + 1),
+                      SLOT_EMIT);
         p->output.items++;
         int stop = ncp_emit_cmd(c, p->out, &p->err, &p->emit_failed);
         ncp_ring_stage_release(r, p->out_stage);
         if (stop)
             break;
     }
+}
+
+/* Commands leave in cmd_id order; the first error, the end of the program or a
+ * failed emit stops the run, exactly where the serial reference stops. */
+void *ncp_pipe_output(void *arg)
+{
+    struct ncp_pipe *p = ((struct ncp_pipe_worker *)arg)->p;
+    if (p->packed_out)
+        output_packed(p);
+    else
+        output_slots(p);
     p->end_ms = ncp_pipe_now_ms();
     ncp_pipe_abort(p);
     return stage_done(arg);
