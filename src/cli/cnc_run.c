@@ -125,7 +125,7 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         case 'e':
             o->counts_given = 1;
             if (parse_int(optarg, 0, NCP_MAX_EXECUTORS, &o->executors))
-                return fprintf(stderr, "cnc-run: --executors wants 0..%d (0: the output thread executes)\n", NCP_MAX_EXECUTORS), -1;
+                return fprintf(stderr, "cnc-run: --executors wants 0..%d (0: the output thread formats)\n", NCP_MAX_EXECUTORS), -1;
             break;
         case 'm':
             o->mode_given = 1;

@@ -42,7 +42,7 @@ struct ncp_pipe {
     const struct ncp_analyzer_cfg *acfg;
     const struct ncp_output *out;
     int n, m;                    /* lexers, command rings (one per executor, >= 1) */
-    int exec_threads;            /* executors; 0: the output thread executes */
+    int exec_threads;            /* executors; 0: the output thread (or the analyzer) formats */
     unsigned out_stage;          /* the output's stage: of a slot ring (executors),
                                   * or the reader (1) of the packed ring */
     int inline_out;              /* the analyzer executes and emits (m == 0) */

@@ -77,13 +77,13 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     p->strings = rings_new(p->n);
     p->parsed = rings_new(p->n);
     p->cmds = p->m > 0 ? rings_new(p->m) : NULL;
-    /* aligned_alloc wants a size that is a multiple of the alignment */
+    /* Without executor threads the analyzer fills a slot of its own (inline
+     * or packed output). aligned_alloc wants a multiple of the alignment. */
     size_t cmd_bytes = (sizeof(struct ncp_cmd) + 63) / 64 * 64;
-    p->an_cmd = p->inline_out || p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
+    p->an_cmd = p->exec_threads == 0 ? aligned_alloc(64, cmd_bytes) : NULL;
     p->out_cmd = p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
     if (!p->strings || !p->parsed || (p->m > 0 && !p->cmds) ||
-        ((p->inline_out || p->packed_out) && !p->an_cmd) ||
-        (p->packed_out && !p->out_cmd)) {
+        (p->exec_threads == 0 && !p->an_cmd) || (p->packed_out && !p->out_cmd)) {
         ncp_pipe_free(p);
         return NULL;
     }
