@@ -165,6 +165,13 @@ int ncp_block_packed_is_end_mark(const void *src);
  * Returns out->err.code. Never reads outside text[0..len). */
 int ncp_lex_block(const char *text, size_t len, uint32_t line, uint64_t offset,
                   struct ncp_block *out);
+/* The line at the start of text[0..avail) (the rest of the program or of a
+ * chunk), lexed as ncp_lex_block lexes it, with *next = the bytes up to and
+ * past its line end (as ncp_source_span splits lines: "\n" ends a line, a
+ * "\r" before it or at the very end is not part of it). Splitting and lexing
+ * in one pass: the common line is read once, not searched for its end first. */
+int ncp_lex_line(const char *text, size_t avail, uint32_t line, uint64_t offset,
+                 struct ncp_block *out, size_t *next);
 
 /* Parameter access for expression evaluation, implemented by the analyzer. */
 struct ncp_param_ops {

@@ -5,6 +5,7 @@
  * here; what the words mean is the analyzer's business. */
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 #include "lex_internal.h"
 #include "lex_math.h"
 
@@ -219,6 +220,19 @@ int ncp_lex_block(const char *text, size_t len, uint32_t line, uint64_t offset,
 {
     if (ncp_lex_fast(text, len, line, offset, out))
         return NCP_OK;
+    return ncp_lex_block_general(text, len, line, offset, out);
+}
+
+int ncp_lex_line(const char *text, size_t avail, uint32_t line, uint64_t offset,
+                 struct ncp_block *out, size_t *next)
+{
+    if (ncp_lex_fast_line(text, avail, line, offset, out, next))
+        return NCP_OK;
+    const char *nl = memchr(text, '\n', avail);
+    size_t len = nl ? (size_t)(nl - text) : avail;
+    *next = len + (nl ? 1 : 0);
+    if (len > 0 && text[len - 1] == '\r')
+        len--;
     return ncp_lex_block_general(text, len, line, offset, out);
 }
 

@@ -53,19 +53,54 @@ static int plain_number(const char *text, size_t len, size_t *i, double *out)
     return 1;
 }
 
-int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,
-                 struct ncp_block *out)
+/* Where the line starting at text ends, seen from position i (a blank run
+ * already skipped): 1 with its length and the bytes up to and past its line
+ * end, 0 if text[i] is no line end. As ncp_source_span: "\n" ends it, a "\r"
+ * right before that or at the end of the text is not part of it. */
+static int line_end(const char *text, size_t avail, size_t lim, size_t i, size_t *len,
+                    size_t *next)
 {
-    if (len >= NCP_LEX_TOO_LONG)
-        return 0;
-    ncp_lex_init_block(out, len, line, offset);
+    if (i == lim) {
+        if (lim < avail)
+            return -1; /* too long for this reader: the general one says so */
+        *len = *next = i;
+        return 1;
+    }
+    if (text[i] == '\n') {
+        *len = i;
+        *next = i + 1;
+        return 1;
+    }
+    if (text[i] == '\r' && (i + 1 == avail || text[i + 1] == '\n')) {
+        *len = i;
+        *next = i + 1 + (i + 1 < avail);
+        return 1;
+    }
+    return 0;
+}
+
+static int is_letter(char c)
+{
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
+}
+
+int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t offset,
+                      struct ncp_block *out, size_t *next)
+{
+    /* never further than the general reader's line limit */
+    size_t len = avail < NCP_LEX_TOO_LONG ? avail : NCP_LEX_TOO_LONG;
+    ncp_lex_init_block(out, 0, line, offset);
     uint32_t seen = 0;
     size_t i = 0;
     for (;;) {
         while (i < len && is_blank(text[i]))
             i++;
-        if (i == len)
-            return 1;
+        size_t line_len = 0;
+        int end = line_end(text, avail, len, i, &line_len, next);
+        if (end != 0) {
+            out->length = (uint16_t)line_len;
+            return end > 0;
+        }
         char c = text[i];
         if (c >= 'A' && c <= 'Z')
             c = (char)(c + 32);
@@ -88,7 +123,7 @@ int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,
         size_t j = i;
         while (j < len && is_blank(text[j]))
             j++;
-        if (j < len && !((text[j] >= 'a' && text[j] <= 'z') || (text[j] >= 'A' && text[j] <= 'Z')))
+        if (j < len && !is_letter(text[j]) && text[j] != '\n' && text[j] != '\r')
             return 0;
         struct ncp_word *w = &out->words[out->n_words++];
         w->letter = (char)(c - 32);
@@ -98,4 +133,13 @@ int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,
         w->v.is_const = 1;
         i = j;
     }
+}
+
+int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,
+                 struct ncp_block *out)
+{
+    size_t next;
+    /* the whole of text[0..len) must be the line, as the general reader takes it */
+    return ncp_lex_fast_line(text, len, line, offset, out, &next) && next == len &&
+           out->length == len;
 }

@@ -44,6 +44,10 @@ int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t 
  * for anything else, errors included, which the general reader then reads. */
 int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,
                  struct ncp_block *out);
+/* The same for the line at the start of text[0..avail), found while reading
+ * it: *next = the bytes up to and past its line end. */
+int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t offset,
+                      struct ncp_block *out, size_t *next);
 
 /* Stores a syntax error at buf position pos; returns NCP_ERR_SYNTAX. */
 int ncp_lex_fail(struct ncp_lexer *lx, int pos, const char *fmt, ...)

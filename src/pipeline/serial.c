@@ -20,11 +20,12 @@ struct serial_feed {
 static const struct ncp_block *serial_next(void *ctx)
 {
     struct serial_feed *f = ctx;
-    struct ncp_span sp;
-    if (ncp_source_span(f->src, f->off, f->line, &sp) != 0)
+    if (f->off >= f->src->end)
         return NULL;
-    ncp_lex_block(f->src->text + sp.off, sp.len, sp.line, sp.off, &f->block);
-    f->off = sp.next;
+    size_t next;
+    ncp_lex_line(f->src->text + f->off, f->src->end - f->off, f->line, f->off, &f->block,
+                 &next);
+    f->off += next;
     f->line++;
     f->blocks++;
     return &f->block;

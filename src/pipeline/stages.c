@@ -232,17 +232,15 @@ static int put_end_mark(struct ncp_ring *out)
 static int lex_chunk(struct ncp_pipe_worker *w, const struct ncp_chunk *c,
                      struct ncp_ring *out, struct ncp_block *b)
 {
-    const struct ncp_source *src = w->p->src;
-    uint64_t off = c->off;
+    const char *text = w->p->src->text;
     uint32_t line = c->line;
-    struct ncp_span sp;
-    while (ncp_source_span_until(src, off, c->end, line, &sp) == 0) {
-        ncp_lex_block(src->text + sp.off, sp.len, sp.line, sp.off, b);
+    for (uint64_t off = c->off; off < c->end; line++) {
+        size_t next;
+        ncp_lex_line(text + off, c->end - off, line, off, b, &next);
         if (put_packed(out, b) != 0)
             return -1;
         w->items++;
-        off = sp.next;
-        line++;
+        off += next;
     }
     return put_end_mark(out);
 }

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ncpar/feeder.h"
 #include "ncpar/lex.h"
 #include "../../src/lex/lex_internal.h"
 
@@ -901,6 +902,64 @@ static void test_fast_path_is_the_general_reader(void **state)
     assert_true(taken > 1000);
 }
 
+/* ncp_lex_line finds the line end while it reads: it must split a text exactly
+ * as ncp_source_span does (\n, \r\n, a \r at the very end, blank lines, no
+ * newline at the end, lines past the length limit) and lex every line as
+ * ncp_lex_block lexes the span. */
+static void expect_lines_like_spans(const char *text, size_t len)
+{
+    static struct ncp_block by_line, by_span;
+    struct ncp_source src = {0};
+    src.text = text;
+    src.len = src.end = len;
+    src.begin_line = 1;
+    src.name = "t";
+    uint64_t off = 0;
+    uint32_t line = 1;
+    struct ncp_span sp;
+    while (ncp_source_span(&src, off, line, &sp) == 0) {
+        size_t next = 0;
+        memset(&by_line, 0x5A, sizeof by_line);
+        int rc = ncp_lex_line(text + off, len - off, line, off, &by_line, &next);
+        int want = ncp_lex_block(text + sp.off, sp.len, sp.line, sp.off, &by_span);
+        assert_int_equal(rc, want);
+        assert_int_equal(off + next, sp.next);
+        assert_same_block(&by_span, &by_line);
+        off = sp.next;
+        line++;
+    }
+    assert_int_equal(off, len);
+}
+
+static void test_line_reader_splits_as_spans(void **state)
+{
+    (void)state;
+    static const char *const texts[] = {
+        "G1 X1\nG1 Y2\n", "G1 X1\r\nG1 Y2\r\n", "G1 X1", "G1 X1\r", "\n\n\r\n",
+        "G1 X1\r\r\nG0 Y1", "G1 X1 \n(c)\nG1 X2\t\r\n", "G1 X1\rG1 X2\n", "X1\n\n",
+    };
+    for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++)
+        expect_lines_like_spans(texts[i], strlen(texts[i]));
+    static const char alphabet[] = "GgXxYyZzMmFf0123456789..--  \t(;#[\r\n\n\n";
+    uint64_t seed = 5;
+    static char text[4096];
+    for (int iter = 0; iter < 20000; iter++) {
+        seed = seed * 6364136223846793005u + 1442695040888963407u;
+        size_t len = (size_t)(seed >> 33) % 200;
+        if (iter % 100 == 0)
+            len = 200 + (size_t)(seed >> 40) % 3000; /* lines past the limit too */
+        for (size_t i = 0; i < len; i++) {
+            seed = seed * 6364136223846793005u + 1442695040888963407u;
+            unsigned r = (unsigned)(seed >> 33);
+            text[i] = r % 3 ? "GXYZ0123456789. \n"[r / 4 % 17]
+                            : alphabet[r / 4 % (sizeof alphabet - 1)];
+            if (iter % 100 == 0 && text[i] == '\n' && r % 5)
+                text[i] = '1'; /* long lines */
+        }
+        expect_lines_like_spans(text, len);
+    }
+}
+
 static void test_pack_round_trip(void **state)
 {
     (void)state;
@@ -962,6 +1021,7 @@ int main(void)
         cmocka_unit_test(test_oword_errors),
         cmocka_unit_test(test_numbers_match_strtod),
         cmocka_unit_test(test_fast_path_is_the_general_reader),
+        cmocka_unit_test(test_line_reader_splits_as_spans),
         cmocka_unit_test(test_long_lines),
         cmocka_unit_test(test_nul_and_garbage),
         cmocka_unit_test(test_pack_round_trip),
