@@ -15,9 +15,26 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #define WRITER_BUF (1u << 20)
+
+/* Prefaulted by the kernel in one go (MAP_POPULATE): touched page by page
+ * instead, a buffer costs 256 page faults in the thread that emits, and in a
+ * virtual machine a fault is microseconds (~7 ms per run here). */
+static char *buffer_new(void)
+{
+    void *m = mmap(NULL, WRITER_BUF, PROT_READ | PROT_WRITE,
+                   MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+    return m == MAP_FAILED ? NULL : m;
+}
+
+static void buffer_free(char *b)
+{
+    if (b)
+        munmap(b, WRITER_BUF);
+}
 
 struct canon_writer {
     int fd;
@@ -112,8 +129,8 @@ int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd)
 
 static void writer_free(struct canon_writer *w)
 {
-    free(w->fill);
-    free(w->spare);
+    buffer_free(w->fill);
+    buffer_free(w->spare);
     free(w);
 }
 
@@ -124,8 +141,8 @@ struct canon_writer *canon_writer_open(const char *path, int async)
         fprintf(stderr, "cnc-run: out of memory for the output buffers\n");
         return NULL;
     }
-    w->fill = malloc(WRITER_BUF);
-    w->spare = async ? malloc(WRITER_BUF) : NULL;
+    w->fill = buffer_new();
+    w->spare = async ? buffer_new() : NULL;
     if (!w->fill || (async && !w->spare)) {
         fprintf(stderr, "cnc-run: out of memory for the output buffers\n");
         writer_free(w);
