@@ -25,6 +25,12 @@ static void print_diag(const char *prog, const struct ncp_diag *d)
         fprintf(stderr, "%s: error: %s\n", prog, d->msg);
 }
 
+static void print_waits(const struct ncp_stage_stats *s)
+{
+    fprintf(stderr, " %llu/%llu/%llu", (unsigned long long)s->empty_waits,
+            (unsigned long long)s->full_waits, (unsigned long long)s->sleeps);
+}
+
 /* One summary line, and for the pipeline the CPU time per stage thread: the
  * load balance that decides what more cores can gain. */
 static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_map *map)
@@ -45,10 +51,30 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
     fprintf(stderr, ", analyzer %.1f, executors", st->analyzer.cpu_ms);
     for (int j = 0; j < map->n_executors && j < NCP_MAX_EXECUTORS; j++)
         fprintf(stderr, " %.1f", st->executor[j].cpu_ms);
-    if (map->inline_output && map->n_executors == 0)
+    int inline_out = map->inline_output && map->n_executors == 0;
+    if (inline_out)
         fputs(" none, output in the analyzer\n", stderr);
     else
         fprintf(stderr, "%s, output %.1f\n", map->n_executors ? "" : " none", st->output.cpu_ms);
+    /* who waited for whom: a stage that often finds its input empty is starved,
+     * one that finds its output full is ahead of the next */
+    fputs("cnc-run: waits empty/full/slept: feeder", stderr);
+    print_waits(&st->feeder);
+    fputs(", lexers", stderr);
+    for (int i = 0; i < map->n_lexers && i < NCP_MAX_LEXERS; i++)
+        print_waits(&st->lexer[i]);
+    fputs(", analyzer", stderr);
+    print_waits(&st->analyzer);
+    if (map->n_executors) {
+        fputs(", executors", stderr);
+        for (int j = 0; j < map->n_executors && j < NCP_MAX_EXECUTORS; j++)
+            print_waits(&st->executor[j]);
+    }
+    if (!inline_out) {
+        fputs(", output", stderr);
+        print_waits(&st->output);
+    }
+    fputc('\n', stderr);
 }
 
 static void usage(FILE *f)
