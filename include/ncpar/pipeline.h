@@ -26,7 +26,9 @@ struct ncp_thread_spec {
 /* Thread map (an INI in rt-config/): which thread runs where, ring sizes. */
 struct ncp_thread_map {
     enum ncp_thread_mode mode;
-    int n_lexers, n_executors; /* 0: the analyzer resolves, the output thread formats */
+    /* n_lexers 0: no feeder and lexer threads, the analyzer lexes the text
+     * itself; n_executors 0: the analyzer resolves, the output thread formats */
+    int n_lexers, n_executors;
     /* 1 (only with n_executors 0): the analyzer executes and writes each
      * command itself, as the serial reference does: no command ring and no
      * output thread. On two cores the pipeline is then two busy threads,

@@ -45,7 +45,10 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
             serial ? 0 : map->n_lexers, serial ? 0 : map->n_executors);
     if (serial)
         return;
-    fprintf(stderr, "cnc-run: cpu ms: feeder %.1f, lexers", st->feeder.cpu_ms);
+    if (map->n_lexers == 0)
+        fputs("cnc-run: cpu ms: feeder none, lexers none (the analyzer lexes)", stderr);
+    else
+        fprintf(stderr, "cnc-run: cpu ms: feeder %.1f, lexers", st->feeder.cpu_ms);
     for (int i = 0; i < map->n_lexers && i < NCP_MAX_LEXERS; i++)
         fprintf(stderr, " %.1f", st->lexer[i].cpu_ms);
     fprintf(stderr, ", analyzer %.1f, executors", st->analyzer.cpu_ms);
@@ -58,12 +61,16 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
         fprintf(stderr, "%s, output %.1f\n", map->n_executors ? "" : " none", st->output.cpu_ms);
     /* who waited for whom: a stage that often finds its input empty is starved,
      * one that finds its output full is ahead of the next */
-    fputs("cnc-run: waits empty/full/slept: feeder", stderr);
-    print_waits(&st->feeder);
-    fputs(", lexers", stderr);
-    for (int i = 0; i < map->n_lexers && i < NCP_MAX_LEXERS; i++)
-        print_waits(&st->lexer[i]);
-    fputs(", analyzer", stderr);
+    fputs("cnc-run: waits empty/full/slept:", stderr);
+    if (map->n_lexers > 0) {
+        fputs(" feeder", stderr);
+        print_waits(&st->feeder);
+        fputs(", lexers", stderr);
+        for (int i = 0; i < map->n_lexers && i < NCP_MAX_LEXERS; i++)
+            print_waits(&st->lexer[i]);
+        fputc(',', stderr);
+    }
+    fputs(" analyzer", stderr);
     print_waits(&st->analyzer);
     if (map->n_executors) {
         fputs(", executors", stderr);
@@ -90,8 +97,8 @@ static void usage(FILE *f)
           "       write canonical machining calls (rs274 -g format) to --canon.\n"
           "       --executors 0: the output thread formats; with --inline-output the\n"
           "       analyzer executes and writes each command itself (no output thread).\n"
-          "       Default: -j 2 --executors 1; with 2 CPUs or fewer, -j 1 --executors 0\n"
-          "       --inline-output.\n"
+          "       -j 0: no lexer threads, the analyzer lexes the text itself.\n"
+          "       Default: -j 2 --executors 1; with 2 CPUs or fewer, -j 0 --executors 0.\n"
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
           "run    run PROG on the machine: planner, interpolator, position loop, backend\n"
           "       (the simulated servo by default); `cnc-run run --help` for details.\n"
@@ -145,8 +152,8 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         switch (c) {
         case 'j':
             o->counts_given = 1;
-            if (parse_int(optarg, 1, NCP_MAX_LEXERS, &o->lexers))
-                return fprintf(stderr, "cnc-run: -j wants 1..%d lexer threads\n", NCP_MAX_LEXERS), -1;
+            if (parse_int(optarg, 0, NCP_MAX_LEXERS, &o->lexers))
+                return fprintf(stderr, "cnc-run: -j wants 0..%d lexer threads (0: the analyzer lexes)\n", NCP_MAX_LEXERS), -1;
             break;
         case 'e':
             o->counts_given = 1;
@@ -201,14 +208,15 @@ static int cmd_parse(int argc, char **argv)
         if (o.mode_given)
             map.mode = o.mode;
     } else {
-        /* Two CPUs or fewer: feeder and lexer on one, the analyzer executing
-         * and writing on the other; more stage threads than cores only adds
-         * hand-offs (bench/RESULTS.md). */
+        /* Two CPUs or fewer: two busy threads, the analyzer lexing the text
+         * itself and resolving, the output thread formatting and writing.
+         * More stage threads than cores only adds hand-offs, and a lexer
+         * thread's blocks cost the analyzer about as much to take over from
+         * the other core as to lex them itself (bench/RESULTS.md). */
         long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
         if (!o.counts_given && ncpu > 0 && ncpu <= 2) {
-            o.lexers = 1;
+            o.lexers = 0;
             o.executors = 0;
-            o.inline_output = 1;
         }
         ncp_thread_map_default(&map, o.mode, o.lexers, o.executors);
     }

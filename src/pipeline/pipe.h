@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include "ncpar/pipeline.h"
 #include "ring.h"
+#include "text_feed.h"
 
 /* Stages of an executor's command ring: analyzer fills, executor completes in
  * place, output emits and hands the slot back. */
@@ -67,6 +68,7 @@ struct ncp_pipe {
     alignas(64) uint64_t taken;  /* blocks handed to the analyzer */
     uint64_t chunk;              /* the chunk it reads, so ring chunk mod n */
     struct ncp_block an_block;   /* the block it holds, unpacked */
+    struct ncp_text_feed *text;  /* no lexer threads: the analyzer lexes the text */
     uint64_t next_id;
     int an_rc;
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */

@@ -37,6 +37,7 @@ void ncp_pipe_free(struct ncp_pipe *p)
     rings_free(p->cmds, p->m);
     free(p->an_cmd);
     free(p->out_cmd);
+    free(p->text);
     free(p);
 }
 
@@ -67,22 +68,25 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
         return NULL;
     memset(p, 0, sizeof *p);
     p->map = map;
-    p->n = clamp(map->n_lexers, 1, NCP_MAX_LEXERS);
+    p->n = clamp(map->n_lexers, 0, NCP_MAX_LEXERS);
     p->exec_threads = clamp(map->n_executors, 0, NCP_MAX_EXECUTORS);
     p->inline_out = map->inline_output && p->exec_threads == 0;
     p->packed_out = p->exec_threads == 0 && !p->inline_out;
     p->m = p->exec_threads > 0 ? p->exec_threads : p->inline_out ? 0 : 1;
     p->out_stage = p->exec_threads > 0 ? NCP_CMD_STAGE_OUTPUT : NCP_CMD_STAGE_EXECUTOR;
     atomic_init(&p->gate, 0);
-    p->strings = rings_new(p->n);
-    p->parsed = rings_new(p->n);
+    /* No lexer threads: no feeder either, the analyzer reads the text itself */
+    p->strings = p->n > 0 ? rings_new(p->n) : NULL;
+    p->parsed = p->n > 0 ? rings_new(p->n) : NULL;
+    p->text = p->n > 0 ? NULL : malloc(sizeof *p->text);
     p->cmds = p->m > 0 ? rings_new(p->m) : NULL;
     /* Without executor threads the analyzer fills a slot of its own (inline
      * or packed output). aligned_alloc wants a multiple of the alignment. */
     size_t cmd_bytes = (sizeof(struct ncp_cmd) + 63) / 64 * 64;
     p->an_cmd = p->exec_threads == 0 ? aligned_alloc(64, cmd_bytes) : NULL;
     p->out_cmd = p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
-    if (!p->strings || !p->parsed || (p->m > 0 && !p->cmds) ||
+    if ((p->n > 0 && (!p->strings || !p->parsed)) || (p->n == 0 && !p->text) ||
+        (p->m > 0 && !p->cmds) ||
         (p->exec_threads == 0 && !p->an_cmd) || (p->packed_out && !p->out_cmd)) {
         ncp_pipe_free(p);
         return NULL;
@@ -112,7 +116,7 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
         ncp_pipe_free(p);
         return NULL;
     }
-    p->string_fill = (uint64_t)ncp_ring_cap(&p->strings[0]) * (uint64_t)p->n;
+    p->string_fill = p->n > 0 ? (uint64_t)ncp_ring_cap(&p->strings[0]) * (uint64_t)p->n : 0;
     workers_reset(p);
     return p;
 }
@@ -188,7 +192,8 @@ int ncp_pipe_stages(struct ncp_pipe *p, struct ncp_pipe_stage out[NCP_PIPE_MAX_T
 {
     const struct ncp_thread_map *map = p->map;
     int k = 0;
-    out[k++] = (struct ncp_pipe_stage){ &map->feeder, ncp_pipe_feeder, &p->feeder, 0 };
+    if (p->n > 0)
+        out[k++] = (struct ncp_pipe_stage){ &map->feeder, ncp_pipe_feeder, &p->feeder, 0 };
     for (int i = 0; i < p->n; i++)
         out[k++] = (struct ncp_pipe_stage){ &map->lexer[i], ncp_pipe_lexer, &p->lexer[i], 1 };
     out[k++] = (struct ncp_pipe_stage){ &map->analyzer, ncp_pipe_analyzer, &p->analyzer, 0 };
@@ -206,7 +211,7 @@ static void start_all(struct ncp_starter *s)
     struct ncp_pipe_stage st[NCP_PIPE_MAX_THREADS];
     int n = ncp_pipe_stages(s->p, st);
     for (int k = 0; k < n; k++) {
-        if (k == 1 && !s->failed)
+        if (k == 1 && s->p->n > 0 && !s->failed)
             ncp_pipe_wait_gate(s->p, s->p->map->start_timeout_us);
         ncp_pipe_start_thread(s, st[k].spec, st[k].fn, st[k].w);
     }
@@ -243,6 +248,8 @@ void ncp_pipe_fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, 
     stage_stats(&st->feeder, &p->feeder);
     stage_stats(&st->analyzer, &p->analyzer);
     st->analyzer.items = p->taken;
+    if (p->n == 0)
+        st->blocks = p->taken;
     stage_stats(&st->output, &p->output);
     for (int i = 0; i < NCP_MAX_LEXERS; i++)
         stage_stats(&st->lexer[i], i < p->n ? &p->lexer[i] : NULL);

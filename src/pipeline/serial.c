@@ -4,37 +4,11 @@
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
 #include "emit.h"
+#include "text_feed.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-struct serial_feed {
-    const struct ncp_source *src;
-    uint64_t off;
-    uint32_t line;
-    uint64_t blocks;
-    struct ncp_block block;
-};
-
-static const struct ncp_block *serial_next(void *ctx)
-{
-    struct serial_feed *f = ctx;
-    if (f->off >= f->src->end)
-        return NULL;
-    size_t next;
-    ncp_lex_line(f->src->text + f->off, f->src->end - f->off, f->line, f->off, &f->block,
-                 &next);
-    f->off += next;
-    f->line++;
-    f->blocks++;
-    return &f->block;
-}
-
-static void serial_release(void *ctx)
-{
-    (void)ctx;
-}
 
 struct serial_sink {
     const struct ncp_output *out;
@@ -87,7 +61,7 @@ int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *
                    struct ncp_diag *d)
 {
     double t0 = now_ms();
-    struct serial_feed *feed = malloc(sizeof *feed);
+    struct ncp_text_feed *feed = malloc(sizeof *feed);
     struct serial_sink *sink = malloc(sizeof *sink);
     struct ncp_analyzer *an = NULL;
     int rc;
@@ -101,10 +75,7 @@ int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *
         rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
         goto done;
     }
-    feed->src = src;
-    feed->off = src->begin;
-    feed->line = src->begin_line;
-    feed->blocks = 0;
+    ncp_text_feed_start(feed, src);
     sink->out = out;
     sink->next_id = 0;
     sink->emitted = 0;
@@ -117,7 +88,7 @@ int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *
         rc = d->code ? d->code : NCP_ERR_IO;
         goto done;
     }
-    struct ncp_block_feed bf = { feed, serial_next, serial_release, src };
+    struct ncp_block_feed bf = { feed, ncp_text_feed_next, ncp_text_feed_release, src };
     struct ncp_cmd_sink cs = { sink, serial_acquire, serial_publish };
     rc = ncp_analyzer_run(an, &bf, &cs);
     if (sink->err.code != NCP_OK) {

@@ -379,12 +379,19 @@ void *ncp_pipe_analyzer(void *arg)
         p->an_rc = p->an_diag.code;
     } else {
         struct ncp_block_feed feed = { p, feed_next, feed_release, p->src };
+        if (p->n == 0) {
+            ncp_text_feed_start(p->text, p->src);
+            feed = (struct ncp_block_feed){ p->text, ncp_text_feed_next, ncp_text_feed_release,
+                                            p->src };
+        }
         struct ncp_cmd_sink sink = { p, sink_acquire, sink_publish };
         if (p->inline_out)
             sink = (struct ncp_cmd_sink){ p, inline_acquire, inline_publish };
         else if (p->packed_out)
             sink = (struct ncp_cmd_sink){ p, packed_acquire, packed_publish };
         p->an_rc = ncp_analyzer_run(an, &feed, &sink);
+        if (p->n == 0)
+            p->taken = p->text->blocks;
         ncp_analyzer_free(an);
     }
     if (p->inline_out)

@@ -40,7 +40,7 @@ void ncp_thread_map_default(struct ncp_thread_map *m, enum ncp_thread_mode mode,
 {
     memset(m, 0, sizeof *m);
     m->mode = mode;
-    m->n_lexers = clamp(n_lexers, 1, NCP_MAX_LEXERS);
+    m->n_lexers = clamp(n_lexers, 0, NCP_MAX_LEXERS);
     m->n_executors = clamp(n_executors, 0, NCP_MAX_EXECUTORS);
     m->string_rows = DEFAULT_STRING_ROWS;
     m->parsed_rows = DEFAULT_PARSED_ROWS;
@@ -150,8 +150,9 @@ static int pipeline_key(struct map_loader *L, const char *name, const char *valu
                         name);
         break;
     case 1:
-        if (parse_int(value, 1, NCP_MAX_LEXERS, &L->lexers))
-            return fail(L, L->line, "bad value '%s' for %s (1 to 16)", value, name);
+        if (parse_int(value, 0, NCP_MAX_LEXERS, &L->lexers))
+            return fail(L, L->line, "bad value '%s' for %s (0 to 16; 0: the analyzer lexes)",
+                        value, name);
         break;
     case 2:
         if (parse_int(value, 0, NCP_MAX_EXECUTORS, &L->executors))

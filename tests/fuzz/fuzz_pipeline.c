@@ -45,7 +45,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int rc1 = ncp_serial_run(&src, &cfg, &o1, &st, &d1);
 
     struct ncp_thread_map map;
-    ncp_thread_map_default(&map, NCP_MODE_DET, 1 + (int)(size % 3), (int)(size % 3)); /* 0: output formats */
+    /* lexers 0..2 (0: the analyzer lexes), executors 0..2 (0: the output formats) */
+    ncp_thread_map_default(&map, NCP_MODE_DET, (int)(size / 6 % 3), (int)(size % 3));
     map.inline_output = size % 6 == 3; /* with 0 executors half the time: the analyzer writes */
     /* tiny rings: every input wraps them, and the run stays cheap */
     map.string_rows = 2;

@@ -85,9 +85,10 @@ static void test_runs_equal_serial(void **state)
         big,
         "%\nG0 X1\n%\n",
     };
-    /* the last one: the analyzer writes the output itself */
-    static const int lexers[] = { 1, 2, 3, 2 }, execs[] = { 0, 1, 2, 0 };
-    for (int c = 0; c < 4; c++) {
+    /* the fourth: the analyzer writes the output itself; the fifth: it lexes
+     * the text itself (no feeder, no lexer threads) */
+    static const int lexers[] = { 1, 2, 3, 2, 0 }, execs[] = { 0, 1, 2, 0, 0 };
+    for (int c = 0; c < 5; c++) {
         struct ncp_thread_map map;
         ncp_thread_map_default(&map, c == 1 ? NCP_MODE_ATT : NCP_MODE_DET, lexers[c], execs[c]);
         map.inline_output = c == 3;

@@ -64,11 +64,11 @@ static void test_default_clamps_counts(void **state)
 {
     (void)state;
     struct ncp_thread_map m;
-    ncp_thread_map_default(&m, NCP_MODE_DET, 0, 99);
-    assert_int_equal(m.n_lexers, 1);
+    ncp_thread_map_default(&m, NCP_MODE_DET, 0, 99); /* 0 lexers: the analyzer lexes */
+    assert_int_equal(m.n_lexers, 0);
     assert_int_equal(m.n_executors, NCP_MAX_EXECUTORS);
     ncp_thread_map_default(&m, NCP_MODE_ATT, -5, -1);
-    assert_int_equal(m.n_lexers, 1);
+    assert_int_equal(m.n_lexers, 0);
     assert_int_equal(m.n_executors, 0);
     /* 0 executors: the output thread formats; no executor gets a CPU */
     ncp_thread_map_default(&m, NCP_MODE_ATT, 1, 0);
@@ -192,6 +192,22 @@ static void test_loaded_values_override_defaults(void **state)
     assert_int_equal(m.feeder.cpu, 0); /* ATT default */
 }
 
+/* lexers = 0: the analyzer lexes the text itself; a [lexer.0] section then
+ * names a thread the map does not have. */
+static void test_no_lexer_threads(void **state)
+{
+    (void)state;
+    struct ncp_diag d;
+    struct ncp_thread_map m;
+    assert_int_equal(load_text("[pipeline]\nmode = att\nlexers = 0\nexecutors = 0\n", &d, &m),
+                     NCP_OK);
+    assert_int_equal(m.n_lexers, 0);
+    assert_int_equal(m.n_executors, 0);
+    if (sysconf(_SC_NPROCESSORS_ONLN) >= 2) /* two busy threads, two CPUs */
+        assert_int_not_equal(m.analyzer.cpu, m.output.cpu);
+    expect_error("[pipeline]\nlexers = 0\n[lexer.0]\ncpu = 1\n", 3, "lexer.0");
+}
+
 /* inline_output: the analyzer executes and writes, so it goes with no
  * executor threads and no [output] section. */
 static void test_inline_output(void **state)
@@ -217,7 +233,7 @@ static void test_errors(void **state)
     (void)state;
     expect_error("[pipeline]\nlexers = 2\nthreads = 4\n", 3, "threads");
     expect_error("[pipeline]\nmode = fast\n", 2, "mode");
-    expect_error("[pipeline]\nlexers = 0\n", 2, "lexers");
+    expect_error("[pipeline]\nlexers = -1\n", 2, "lexers");
     expect_error("[pipeline]\nlexers = 17\n", 2, "lexers");
     expect_error("[pipeline]\nexecutors = two\n", 2, "executors");
     expect_error("[pipeline]\nexecutors = -1\n", 2, "executors");
@@ -268,6 +284,7 @@ int main(void)
         cmocka_unit_test(test_default_det),
         cmocka_unit_test(test_default_att),
         cmocka_unit_test(test_default_clamps_counts),
+        cmocka_unit_test(test_no_lexer_threads),
         cmocka_unit_test(test_shipped_maps_load),
         cmocka_unit_test(test_paper_att4_and_att8),
         cmocka_unit_test(test_loaded_values_override_defaults),
