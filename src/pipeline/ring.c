@@ -1,7 +1,7 @@
 /* Staged lock-free ring (see ring.h). Each position is written by its own stage
  * only, with release stores; the other stages read it with acquire loads, which
  * is what hands the slot contents over. Sleeping uses an event count per
- * position: a waiter announces itself in `sleepers`, reads `event`, re-checks
+ * position: a waiter reads `event`, announces itself in `sleepers`, re-checks
  * its condition and sleeps only if `event` is unchanged; a stage that moves its
  * position and sees a sleeper bumps `event` and wakes it. The seq_cst fence on
  * one side and seq_cst accesses on the other make a lost wake-up impossible. */
@@ -258,9 +258,14 @@ static int wait_ready(struct ncp_ring *r, unsigned s, uint32_t k)
             return rc;
     }
     for (;;) {
+        /* The key before the flag: a waker may take the flag the moment it is
+         * set (paying a wake-up it owed from an earlier publish) and bump the
+         * event; read after the flag, the key would already include that bump,
+         * the futex would sleep, and with the flag gone no later publish would
+         * wake it. Read first, the bump makes the futex return at once. */
+        uint32_t key = atomic_load(&aw->event);
         atomic_store_explicit(&aw->wake_at, wake_target(r, s, k), memory_order_relaxed);
         atomic_store(&aw->sleepers, 1);
-        uint32_t key = atomic_load(&aw->event);
         rc = ready(r, s, k, memory_order_seq_cst);
         if (rc == 0) {
             st->sleeps++;
