@@ -46,7 +46,8 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
     if (serial)
         return;
     if (map->n_lexers == 0)
-        fputs("cnc-run: cpu ms: feeder none, lexers none (the analyzer lexes)", stderr);
+        fprintf(stderr, "cnc-run: cpu ms: feeder %.1f (prefaults the text), lexers none "
+                "(the analyzer lexes)", st->feeder.cpu_ms);
     else
         fprintf(stderr, "cnc-run: cpu ms: feeder %.1f, lexers", st->feeder.cpu_ms);
     for (int i = 0; i < map->n_lexers && i < NCP_MAX_LEXERS; i++)

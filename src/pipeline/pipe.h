@@ -69,6 +69,7 @@ struct ncp_pipe {
     uint64_t chunk;              /* the chunk it reads, so ring chunk mod n */
     struct ncp_block an_block;   /* the block it holds, unpacked */
     struct ncp_text_feed *text;  /* no lexer threads: the analyzer lexes the text */
+    unsigned prefault_sum;       /* what the prefaulter read (written by it only) */
     uint64_t next_id;
     int an_rc;
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
@@ -133,6 +134,7 @@ void ncp_pipe_fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, 
                          struct ncp_run_stats *st);
 
 void *ncp_pipe_feeder(void *arg);
+void *ncp_pipe_prefaulter(void *arg);
 void *ncp_pipe_lexer(void *arg);
 void *ncp_pipe_analyzer(void *arg);
 void *ncp_pipe_executor(void *arg);

@@ -192,8 +192,9 @@ int ncp_pipe_stages(struct ncp_pipe *p, struct ncp_pipe_stage out[NCP_PIPE_MAX_T
 {
     const struct ncp_thread_map *map = p->map;
     int k = 0;
-    if (p->n > 0)
-        out[k++] = (struct ncp_pipe_stage){ &map->feeder, ncp_pipe_feeder, &p->feeder, 0 };
+    out[k++] = (struct ncp_pipe_stage){ &map->feeder,
+                                        p->n > 0 ? ncp_pipe_feeder : ncp_pipe_prefaulter,
+                                        &p->feeder, 0 };
     for (int i = 0; i < p->n; i++)
         out[k++] = (struct ncp_pipe_stage){ &map->lexer[i], ncp_pipe_lexer, &p->lexer[i], 1 };
     out[k++] = (struct ncp_pipe_stage){ &map->analyzer, ncp_pipe_analyzer, &p->analyzer, 0 };
