@@ -88,7 +88,9 @@ int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t of
                       struct ncp_block *out, size_t *next)
 {
     /* never further than the general reader's line limit */
-    size_t len = avail < NCP_LEX_TOO_LONG ? avail : NCP_LEX_TOO_LONG;
+    size_t len = avail;
+    if (len > NCP_LEX_TOO_LONG)
+        len = NCP_LEX_TOO_LONG;
     ncp_lex_init_block(out, 0, line, offset);
     uint32_t seen = 0;
     size_t i = 0;

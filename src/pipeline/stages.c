@@ -195,7 +195,7 @@ static void *put_record(struct ncp_ring *r, const struct record_kind *k, uint32_
         return NULL;
     const char *later = ncp_ring_reserve_ahead(r, units + PACK_PREFETCH_UNITS);
     for (unsigned l = 0; later && l < k->prefetch_lines; l++)
-        ncp_prefetch_w(later + 64 * l);
+        ncp_prefetch_w(later + (size_t)64 * l);
     return dst;
 }
 
