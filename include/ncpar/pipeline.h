@@ -27,7 +27,7 @@ struct ncp_thread_spec {
 struct ncp_thread_map {
     enum ncp_thread_mode mode;
     /* n_lexers 0: no feeder and lexer threads, the analyzer lexes the text
-     * itself; n_executors 0: the analyzer resolves, the output thread formats */
+     * itself; n_executors 0: the output thread executes (arcs, text) */
     int n_lexers, n_executors;
     /* 1 (only with n_executors 0): the analyzer executes and writes each
      * command itself, as the serial reference does: no command ring and no

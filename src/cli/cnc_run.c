@@ -96,7 +96,7 @@ static void usage(FILE *f)
           "\n"
           "parse  interpret PROG (\"-\" = standard input) with the parallel pipeline and\n"
           "       write canonical machining calls (rs274 -g format) to --canon.\n"
-          "       --executors 0: the output thread formats; with --inline-output the\n"
+          "       --executors 0: the output thread executes; with --inline-output the\n"
           "       analyzer executes and writes each command itself (no output thread).\n"
           "       -j 0: no lexer threads, the analyzer lexes the text itself.\n"
           "       Default: -j 2 --executors 1; with 2 CPUs or fewer, -j 0 --executors 0.\n"
@@ -159,7 +159,7 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         case 'e':
             o->counts_given = 1;
             if (parse_int(optarg, 0, NCP_MAX_EXECUTORS, &o->executors))
-                return fprintf(stderr, "cnc-run: --executors wants 0..%d (0: the output thread formats)\n", NCP_MAX_EXECUTORS), -1;
+                return fprintf(stderr, "cnc-run: --executors wants 0..%d (0: the output thread executes)\n", NCP_MAX_EXECUTORS), -1;
             break;
         case 'm':
             o->mode_given = 1;

@@ -1,5 +1,5 @@
 /* Packed commands: what crosses from the analyzer's core to the output
- * thread's when the output thread formats (executors = 0). A command slot is
+ * thread's when the output thread executes (executors = 0). A command slot is
  * about 3.5 KB so that any block's calls fit; a STRAIGHT_FEED uses the header
  * and one 120-byte call of it. Packed, only those parts travel, in a ring of
  * 8-byte units published 4 KB at a time (module-internal header). */

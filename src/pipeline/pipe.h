@@ -47,7 +47,7 @@ struct ncp_pipe {
     unsigned out_stage;          /* the output's stage: of a slot ring (executors),
                                   * or the reader (1) of the packed ring */
     int inline_out;              /* the analyzer executes and emits (m == 0) */
-    int packed_out;              /* no executors: the output thread formats packed commands */
+    int packed_out;              /* no executors: the output thread executes packed commands */
 
     struct ncp_ring *strings;    /* n: feeder -> LEX_i, struct ncp_chunk */
     struct ncp_ring *parsed;     /* n: LEX_i -> analyzer, packed blocks in NCP_PACK_UNIT units */

@@ -364,11 +364,12 @@ static void inline_publish(void *ctx, struct ncp_cmd *c)
         p->inline_stopped = 1;
 }
 
-/* Packed output (no executor threads): the analyzer resolves each command
- * (arc geometry: what may still turn it into an error) and hands it to the
- * output thread packed, which formats and writes it. Formatting is about a
- * third of the analyzer's work on CAM programs; on two cores it then runs on
- * the core of the feeder and lexer, which have time to spare. */
+/* Packed output (no executor threads): the analyzer hands each command to
+ * the output thread packed, which executes it (arc geometry, which may still
+ * turn it into an error, then the text) and writes it, as an executor and the
+ * output thread would. Executing is about a third of the analyzer's work on
+ * CAM programs; on two cores it then runs on the other core, which has time
+ * to spare. */
 static struct ncp_cmd *packed_acquire(void *ctx)
 {
     struct ncp_pipe *p = ctx;
@@ -384,7 +385,6 @@ static void packed_publish(void *ctx, struct ncp_cmd *c)
     struct ncp_ring *r = &p->cmds[0];
     p->next_id++;
     p->analyzer.items++;
-    ncp_exec_resolve(c);
     uint32_t units = (uint32_t)(ncp_cmd_packed_size(c) / NCP_PACK_UNIT);
     void *dst = put_record(r, &cmd_records, units);
     if (!dst)
@@ -459,12 +459,12 @@ static struct ncp_cmd *take_packed(struct ncp_pipe *p)
     return p->out_cmd;
 }
 
-/* Without executor threads: each packed command formatted here. */
+/* Without executor threads: each packed command executed here. */
 static void output_packed(struct ncp_pipe *p)
 {
     struct ncp_cmd *c;
     while ((c = take_packed(p)) != NULL) {
-        ncp_exec_format(c);
+        ncp_exec_cmd(c);
         p->output.items++;
         if (ncp_emit_cmd(c, p->out, &p->err, &p->emit_failed))
             break;

@@ -156,7 +156,7 @@ static int pipeline_key(struct map_loader *L, const char *name, const char *valu
         break;
     case 2:
         if (parse_int(value, 0, NCP_MAX_EXECUTORS, &L->executors))
-            return fail(L, L->line, "bad value '%s' for %s (0 to 16; 0: the output thread formats)",
+            return fail(L, L->line, "bad value '%s' for %s (0 to 16; 0: the output thread executes)",
                         value, name);
         break;
     case 3:

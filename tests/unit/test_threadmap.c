@@ -52,7 +52,7 @@ static void test_default_att(void **state)
     assert_int_equal(m.executor[0].cpu, 6 % ncpu);
     assert_int_equal(m.output.cpu, m.analyzer.cpu);
     assert_true(m.analyzer.cpu >= 0 && m.analyzer.cpu < ncpu);
-    /* no executor threads: the output formats, on the next CPU */
+    /* no executor threads: the output executes, on the next CPU */
     ncp_thread_map_default(&m, NCP_MODE_ATT, 1, 0);
     assert_int_equal(m.feeder.cpu, 0);
     assert_int_equal(m.lexer[0].cpu, 1 % ncpu);
@@ -70,7 +70,7 @@ static void test_default_clamps_counts(void **state)
     ncp_thread_map_default(&m, NCP_MODE_ATT, -5, -1);
     assert_int_equal(m.n_lexers, 0);
     assert_int_equal(m.n_executors, 0);
-    /* 0 executors: the output thread formats; no executor gets a CPU */
+    /* 0 executors: the output thread executes; no executor gets a CPU */
     ncp_thread_map_default(&m, NCP_MODE_ATT, 1, 0);
     assert_int_equal(m.n_executors, 0);
     assert_int_equal(m.executor[0].cpu, -1);
