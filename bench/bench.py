@@ -37,7 +37,7 @@ TOOL_TABLE = "rt-config/tools.tbl"
 DEFAULT_TABLE = "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/simpockets.tbl"
 CONFIGS = [b + s for s in ("", "-fifo")
            for b in ("serial", "det2", "att2", "det4", "att4", "det8", "att8",
-                     "det2-inline", "att2-inline")]
+                     "det2-inline", "att2-inline", "det2-j0", "att2-j0")]
 # On a 4-CPU host the paper's own ATT8 map (LEX3 beside the feeder on CPU0, Table 2)
 # differs from the scaled one and runs as an extra row; its ATT4 map is the scaled one.
 PAPER4 = ["paper4-att8", "paper4-att8-fifo"]

@@ -46,10 +46,15 @@ def section(name, cpu, fifo):
 
 
 def write_map(outdir, name, mode, n_lex, place, fifo, how, inline=False):
+    """n_lex 0: no lexer threads, the analyzer lexes and the output thread executes
+    (ours, two busy threads); inline: the analyzer executes and writes (ours)."""
+    threads = 2 if n_lex == 0 else n_lex + 1
     label = ("Prio 90. " if fifo else "Non RT. ") + (
-        "Serial" if mode == "serial" else "%s %d Threads" % (mode.capitalize(), n_lex + 1))
+        "Serial" if mode == "serial" else "%s %d Threads" % (mode.capitalize(), threads))
     if inline:
         label += ", the analyzer executing and writing (not in the paper)"
+    elif n_lex == 0:
+        label += ", the analyzer lexing, the output thread executing (not in the paper)"
     text = HEADER.format(name=os.path.join(outdir, name), how=how, label=label)
     if fifo:
         text += "# All threads SCHED_FIFO 90: needs root or CAP_SYS_NICE (else a warning).\n"
@@ -57,7 +62,8 @@ def write_map(outdir, name, mode, n_lex, place, fifo, how, inline=False):
         text += "\n[pipeline]\nmode = %s\nlexers = %d\nexecutors = 0\ninline_output = 1\n\n" % (
             mode, n_lex)
     else:
-        text += "\n[pipeline]\nmode = %s\nlexers = %d\nexecutors = 1\n\n" % (mode, n_lex)
+        text += "\n[pipeline]\nmode = %s\nlexers = %d\nexecutors = %d\n\n" % (
+            mode, n_lex, 0 if n_lex == 0 else 1)
     feeder, lexers, others = place
     text += section("feeder", feeder, fifo)
     if mode == "serial":
@@ -67,8 +73,9 @@ def write_map(outdir, name, mode, n_lex, place, fifo, how, inline=False):
         return
     for i, cpu in enumerate(lexers):
         text += "\n" + section("lexer.%d" % i, cpu, fifo)
-    for sec, cpu in zip(("analyzer",) if inline else ("analyzer", "executor.0", "output"),
-                        others):
+    secs = (("analyzer",) if inline else ("analyzer", "output") if n_lex == 0
+            else ("analyzer", "executor.0", "output"))
+    for sec, cpu in zip(secs, others):
         text += "\n" + section(sec, cpu, fifo)
     with open(os.path.join(outdir, name), "w", encoding="utf-8") as f:
         f.write(text)
@@ -103,6 +110,12 @@ def main():
                   inline=True)
         write_map(o.outdir, "att2-inline%s.ini" % sfx, "att", 1,
                   (ids[0], [ids[0]], [ids[1 % len(ids)]]), fifo, how, inline=True)
+        # ours, the default on two cores (-j 0 --executors 0): the analyzer lexing
+        # on one CPU, the output thread executing and writing on the other, the
+        # feeder (it only prefaults the text) beside the output, as the ATT default
+        write_map(o.outdir, "det2-j0%s.ini" % sfx, "det", 0, (-1, [], [-1, -1]), fifo, how)
+        write_map(o.outdir, "att2-j0%s.ini" % sfx, "att", 0,
+                  (ids[0], [], [ids[1 % len(ids)], ids[0]]), fifo, how)
 
 
 if __name__ == "__main__":

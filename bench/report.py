@@ -19,7 +19,7 @@ PAPER_GAIN = {"det4": 1.914, "att4": 3.524, "det8": 0.995, "att8": 1.3245,
               "att8-fifo": 4.0498}
 PAPER_SERIAL_MS = {"": 9.265, "-fifo": 10.643}
 BASES = ("serial", "det2", "att2", "det4", "att4", "det8", "att8", "det2-inline",
-         "att2-inline")
+         "att2-inline", "det2-j0", "att2-j0")
 
 
 def bases(rows):
@@ -36,6 +36,8 @@ def label(cfg):
         return pre + " Serial"
     if base.endswith("-inline"):
         return "%s %s 2 Threads, inline output (ours)" % (pre, base[:3].capitalize())
+    if base.endswith("-j0"):
+        return "%s %s 2 Threads, analyzer lexes (ours)" % (pre, base[:3].capitalize())
     return "%s %s %s Threads" % (pre, base[:3].capitalize(), base[3:])
 
 
@@ -315,10 +317,13 @@ def table3_section(data, run_dir):
           "ATT4 = feeder + LEX0..2), so DETn/ATTn run n-1 lexers; our pipeline adds the",
           "analyzer, one executor and the output stage (%s threads in all, the starting"
           % n_threads,
-          "thread sleeping as the paper's main thread does). The rows marked *inline output",
-          "(ours)* are not in the paper: feeder and one lexer, and the analyzer executing and",
-          "writing each command itself (`--inline-output`), 3 threads in all, the layout",
-          "`cnc-run parse` uses by default on 2 CPUs. The paper timed feeder + lexers;",
+          "thread sleeping as the paper's main thread does). The rows marked *(ours)* are not",
+          "in the paper: *inline output*, feeder and one lexer, and the analyzer executing and",
+          "writing each command itself (`--inline-output`), 3 threads in all; *analyzer lexes*",
+          "(`-j 0 --executors 0`, the layout `cnc-run parse` uses by default on 2 CPUs), no",
+          "lexer threads: the analyzer lexes the text itself and the output thread executes and",
+          "writes, two busy threads (the feeder only prefaults the text). The paper timed",
+          "feeder + lexers;",
           "we time the whole interpreter: from the start of `ncp_pipeline_run` (thread creation",
           "included) to the last canonical command out, as `ncp_run_stats.wall_ms` reports it",
           "(build/bench/table3 does a round's runs of one configuration in one process after",
