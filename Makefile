@@ -60,6 +60,13 @@ $(BUILD)/tests/%: tests/unit/%.c $(LIB)
 	@mkdir -p $(@D)
 	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -o $@ $< $(LIB) $(LDLIBS) -lcmocka -lstdc++
 
+# The ring's sleep protocol with a test hook compiled in (see the test's header):
+# its own copy of ring.c, not the library's.
+$(BUILD)/tests/test_ring_race: tests/unit/test_ring_race.c src/pipeline/ring.c $(LIB)
+	@mkdir -p $(@D)
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -DNCP_RING_TEST_HOOKS -o $@ $< src/pipeline/ring.c \
+	    $(LIB) $(LDLIBS) -lcmocka
+
 unit: $(UNIT_BINS)
 
 # Build and test dependencies on Debian 12 (run as root).

@@ -238,6 +238,19 @@ static uint32_t wake_target(const struct ncp_ring *r, unsigned s, uint32_t k)
     return own + k + 1 + batch;
 }
 
+#ifdef NCP_RING_TEST_HOOKS
+/* tests/unit/test_ring_race.c: called the moment a waiter has raised its
+ * sleeper flag, to play a waker that takes it there. Not in the library. */
+void (*ncp_ring_test_flag_raised)(struct ncp_ring_stage *st);
+#define FLAG_RAISED(st)                                                        \
+    do {                                                                       \
+        if (ncp_ring_test_flag_raised)                                         \
+            ncp_ring_test_flag_raised(st);                                     \
+    } while (0)
+#else
+#define FLAG_RAISED(st) ((void)0)
+#endif
+
 static int wait_ready(struct ncp_ring *r, unsigned s, uint32_t k)
 {
     struct ncp_ring_stage *st = &r->stage[s];
@@ -266,6 +279,7 @@ static int wait_ready(struct ncp_ring *r, unsigned s, uint32_t k)
         uint32_t key = atomic_load(&aw->event);
         atomic_store_explicit(&aw->wake_at, wake_target(r, s, k), memory_order_relaxed);
         atomic_store(&aw->sleepers, 1);
+        FLAG_RAISED(aw);
         rc = ready(r, s, k, memory_order_seq_cst);
         if (rc == 0) {
             st->sleeps++;
