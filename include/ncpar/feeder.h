@@ -41,11 +41,6 @@ void ncp_source_close(struct ncp_source *src);
 int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
                     struct ncp_span *out);
 
-/* ncp_source_span for text that ends at `end` (a line end or src->end): the
- * same spans as ncp_source_span gives for every line that ends before it. */
-int ncp_source_span_until(const struct ncp_source *src, uint64_t off, uint64_t end,
-                          uint32_t line, struct ncp_span *out);
-
 /* Chunks: where a piece of about `want` bytes from off ends, just after a
  * line end (or at src->end), and how many line ends text[off .. end) holds,
  * which is how many blocks a chunk that ends after one has. Lets the feeder

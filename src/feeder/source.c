@@ -72,16 +72,10 @@ static void find_body(struct ncp_source *src)
 int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
                     struct ncp_span *out)
 {
-    return ncp_source_span_until(src, off, src->end, line, out);
-}
-
-int ncp_source_span_until(const struct ncp_source *src, uint64_t off, uint64_t end,
-                          uint32_t line, struct ncp_span *out)
-{
-    if (off >= end)
+    if (off >= src->end)
         return 1;
     const char *start = src->text + off;
-    size_t avail = end - off;
+    size_t avail = src->end - off;
     const char *nl = memchr(start, '\n', avail);
     size_t len = nl ? (size_t)(nl - start) : avail;
     out->off = off;

@@ -1,6 +1,6 @@
 /* Block splitting and the feeder's chunks: cutting the program into chunks at
- * line ends and splitting each chunk on its own must give exactly the blocks
- * (offsets, lengths, line numbers) that splitting the whole text gives. */
+ * line ends and reading each chunk's lines on its own must give exactly the
+ * blocks (offsets, lengths, line numbers) that splitting the whole text gives. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "ncpar/feeder.h"
+#include "ncpar/lex.h"
 
 #define MAX_SPANS 4096
 
@@ -28,9 +29,13 @@ static int whole_spans(const struct ncp_source *src, struct ncp_span *out)
 }
 
 /* What the pipeline does: chunks of about `want` bytes, line numbers carried
- * from chunk to chunk by counting line ends, spans inside each chunk. */
+ * from chunk to chunk by counting line ends, and each line of a chunk read by
+ * the lexer, which finds its end itself within the chunk (ncp_lex_line). The
+ * spans come back from the blocks: offset, line, length, and where the next
+ * line starts. */
 static int chunked_spans(const struct ncp_source *src, size_t want, struct ncp_span *out)
 {
+    static struct ncp_block b;
     int n = 0;
     uint64_t off = src->begin;
     uint32_t line = src->begin_line;
@@ -38,13 +43,14 @@ static int chunked_spans(const struct ncp_source *src, size_t want, struct ncp_s
         uint64_t end = ncp_source_chunk_end(src, off, want);
         assert_true(end > off);
         assert_true(end == src->end || src->text[end - 1] == '\n');
-        uint64_t o = off;
         uint32_t l = line;
-        while (n < MAX_SPANS && ncp_source_span_until(src, o, end, l, &out[n]) == 0) {
-            assert_true(out[n].next <= end);
-            o = out[n].next;
-            l++;
-            n++;
+        for (uint64_t o = off; n < MAX_SPANS && o < end; n++, l++) {
+            size_t next;
+            ncp_lex_line(src->text + o, end - o, l, o, &b, &next);
+            /* lines here stay far below the block's 16-bit length */
+            out[n] = (struct ncp_span){ b.offset, b.length, b.line, o + next };
+            assert_true(o + next <= end);
+            o += next;
         }
         line += (uint32_t)ncp_source_count_newlines(src, off, end);
         off = end;
