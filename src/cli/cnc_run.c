@@ -210,7 +210,7 @@ static int cmd_parse(int argc, char **argv)
             map.mode = o.mode;
     } else {
         /* Two CPUs or fewer: two busy threads, the analyzer lexing the text
-         * itself and resolving, the output thread formatting and writing.
+         * itself and interpreting it, the output thread executing and writing.
          * More stage threads than cores only adds hand-offs, and a lexer
          * thread's blocks cost the analyzer about as much to take over from
          * the other core as to lex them itself (bench/RESULTS.md). */

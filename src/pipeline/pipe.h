@@ -69,7 +69,6 @@ struct ncp_pipe {
     uint64_t chunk;              /* the chunk it reads, so ring chunk mod n */
     struct ncp_block an_block;   /* the block it holds, unpacked */
     struct ncp_text_feed *text;  /* no lexer threads: the analyzer lexes the text */
-    unsigned prefault_sum;       /* what the prefaulter read (written by it only) */
     uint64_t next_id;
     int an_rc;
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
