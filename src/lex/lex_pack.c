@@ -93,21 +93,41 @@ static const unsigned char *get(const unsigned char *p, void *dst, size_t n)
     return p + n;
 }
 
+/* Header and words are written field by field straight to their place: built
+ * on the stack and copied whole, their mixed-width stores could not be
+ * forwarded to the wide load of the copy, a stall per block and per word
+ * (most of the packing time, measured). */
+#define PUT_AT(base, type, field, val)                                          \
+    do {                                                                        \
+        __typeof__(((type *)0)->field) v_ = (val);                              \
+        memcpy((base) + offsetof(type, field), &v_, sizeof v_);                 \
+    } while (0)
+
 size_t ncp_block_pack(const struct ncp_block *b, void *dst)
 {
     struct pack_counts c = counts_of(b);
     size_t total = bytes_of(b, &c);
     struct packed_head h = {
-        .offset = b->offset, .line = b->line,
-        .units = (uint16_t)(total / NCP_PACK_UNIT), .length = b->length,
-        .n_code = (uint16_t)c.code, .pool_used = (uint16_t)c.pool,
-        .comment_off = b->comment_off, .comment_len = b->comment_len,
-        .n_words = (uint8_t)c.words, .n_assign = (uint8_t)c.assign,
-        .block_delete = b->block_delete, .has_n = b->has_n,
-        .comment_kind = b->comment_kind, .oword_kind = b->oword.kind,
-        .oword_nargs = (uint8_t)c.nargs, .has_err = b->err.code != NCP_OK,
+        .has_n = b->has_n, .has_err = b->err.code != NCP_OK, .oword_kind = b->oword.kind,
     };
-    unsigned char *p = put(dst, &h, sizeof h);
+    unsigned char *p = dst;
+    PUT_AT(p, struct packed_head, offset, b->offset);
+    PUT_AT(p, struct packed_head, line, b->line);
+    PUT_AT(p, struct packed_head, units, (uint16_t)(total / NCP_PACK_UNIT));
+    PUT_AT(p, struct packed_head, length, b->length);
+    PUT_AT(p, struct packed_head, n_code, (uint16_t)c.code);
+    PUT_AT(p, struct packed_head, pool_used, (uint16_t)c.pool);
+    PUT_AT(p, struct packed_head, comment_off, b->comment_off);
+    PUT_AT(p, struct packed_head, comment_len, b->comment_len);
+    PUT_AT(p, struct packed_head, n_words, (uint8_t)c.words);
+    PUT_AT(p, struct packed_head, n_assign, (uint8_t)c.assign);
+    PUT_AT(p, struct packed_head, block_delete, b->block_delete);
+    PUT_AT(p, struct packed_head, has_n, h.has_n);
+    PUT_AT(p, struct packed_head, comment_kind, b->comment_kind);
+    PUT_AT(p, struct packed_head, oword_kind, h.oword_kind);
+    PUT_AT(p, struct packed_head, oword_nargs, (uint8_t)c.nargs);
+    PUT_AT(p, struct packed_head, has_err, h.has_err);
+    p += sizeof h;
     if (h.has_n)
         p = put(p, &b->n_number, sizeof b->n_number);
     if (h.has_err) {
@@ -115,11 +135,14 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
         p = put(p, b->err.msg, c.msg - 1);
         *p++ = '\0';
     }
-    for (unsigned k = 0; k < c.words; k++) {
+    for (unsigned k = 0; k < c.words; k++, p += sizeof(struct packed_word)) {
         const struct ncp_word *w = &b->words[k];
-        struct packed_word pw = { w->v.value, w->v.start, w->v.len, w->col, w->letter,
-                                  w->v.is_const };
-        p = put(p, &pw, sizeof pw);
+        PUT_AT(p, struct packed_word, value, w->v.value);
+        PUT_AT(p, struct packed_word, start, w->v.start);
+        PUT_AT(p, struct packed_word, len, w->v.len);
+        PUT_AT(p, struct packed_word, col, w->col);
+        PUT_AT(p, struct packed_word, letter, w->letter);
+        PUT_AT(p, struct packed_word, is_const, w->v.is_const);
     }
     p = put(p, b->assign, c.assign * sizeof b->assign[0]);
     if (h.oword_kind != NCP_O_NONE) {

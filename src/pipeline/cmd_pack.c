@@ -44,27 +44,47 @@ size_t ncp_cmd_packed_size(const struct ncp_cmd *c)
     return bytes_of(c, msg_of(c));
 }
 
+/* One call at a time, each a copy of constant size: the compiler makes it a
+ * few vector moves, where one copy of n_ops * size is a `rep movs` whose
+ * start-up costs more than a call's worth of moves (one call is the rule). */
+#define OP_BYTES sizeof(struct ncp_canon)
+static void copy_ops(void *dst, const void *src, unsigned n)
+{
+    unsigned char *d = dst;
+    const unsigned char *s = src;
+    for (unsigned i = 0; i < n; i++)
+        memcpy(d + (size_t)i * OP_BYTES, s + (size_t)i * OP_BYTES, OP_BYTES);
+}
+
 size_t ncp_cmd_pack(const struct ncp_cmd *c, void *dst)
 {
     size_t msg = msg_of(c), total = bytes_of(c, msg);
-    struct packed_cmd_head h = {
-        .cmd_id = c->cmd_id, .line = c->line, .n_ops = (uint16_t)ops_of(c),
-        .flags = c->flags, .text_used = (uint16_t)text_of(c),
-        .units = (uint16_t)(total / UNIT), .msg_len = (uint32_t)msg,
-    };
+    /* The header goes field by field straight to its place: built on the
+     * stack and copied whole, its mixed-width stores could not be forwarded
+     * to the wide load that copies it, a stall on every command. */
+    struct packed_cmd_head h;
     unsigned char *p = dst;
-    memcpy(p, &h, sizeof h);
+    uint16_t n_ops = (uint16_t)ops_of(c), text_used = (uint16_t)text_of(c);
+    uint16_t units = (uint16_t)(total / UNIT);
+    uint32_t msg_len = (uint32_t)msg;
+    memcpy(p + offsetof(struct packed_cmd_head, cmd_id), &c->cmd_id, sizeof h.cmd_id);
+    memcpy(p + offsetof(struct packed_cmd_head, line), &c->line, sizeof h.line);
+    memcpy(p + offsetof(struct packed_cmd_head, n_ops), &n_ops, sizeof h.n_ops);
+    memcpy(p + offsetof(struct packed_cmd_head, flags), &c->flags, sizeof h.flags);
+    memcpy(p + offsetof(struct packed_cmd_head, text_used), &text_used, sizeof h.text_used);
+    memcpy(p + offsetof(struct packed_cmd_head, units), &units, sizeof h.units);
+    memcpy(p + offsetof(struct packed_cmd_head, msg_len), &msg_len, sizeof h.msg_len);
     p += sizeof h;
-    memcpy(p, c->ops, h.n_ops * sizeof c->ops[0]);
-    p += h.n_ops * sizeof c->ops[0];
+    copy_ops(p, c->ops, n_ops);
+    p += n_ops * sizeof c->ops[0];
     if (c->flags & NCP_CMD_F_ERROR) {
         memcpy(p, &c->diag, offsetof(struct ncp_diag, msg));
         p += offsetof(struct ncp_diag, msg);
         memcpy(p, c->diag.msg, msg);
         p += msg;
     }
-    memcpy(p, c->text, h.text_used);
-    p += h.text_used;
+    memcpy(p, c->text, text_used);
+    p += text_used;
     memset(p, 0, total - (size_t)(p - (unsigned char *)dst));
     return total;
 }
@@ -88,7 +108,7 @@ void ncp_cmd_unpack(const void *src, struct ncp_cmd *c)
     c->flags = h.flags;
     c->text_used = h.text_used;
     c->out_len = 0;
-    memcpy(c->ops, p, h.n_ops * sizeof c->ops[0]);
+    copy_ops(c->ops, p, h.n_ops);
     p += h.n_ops * sizeof c->ops[0];
     if (h.flags & NCP_CMD_F_ERROR) {
         memcpy(&c->diag, p, offsetof(struct ncp_diag, msg));
