@@ -39,6 +39,10 @@ struct ncp_thread_map {
     int parsed_rows;  /* h: rows of the parsed ring */
     int cmd_slots;    /* commands ring capacity per executor */
     int start_timeout_us; /* lexers start when the string ring is full or after this */
+    /* n_lexers 0 and n_executors 0: the output thread, when it has no command
+     * to write, lexes chunks of about this many bytes of text ahead of the
+     * analyzer (it balances the two threads); 0: never */
+    int lex_ahead_bytes;
     struct ncp_thread_spec feeder, analyzer, output;
     struct ncp_thread_spec lexer[NCP_MAX_LEXERS];
     struct ncp_thread_spec executor[NCP_MAX_EXECUTORS];
@@ -91,6 +95,7 @@ struct ncp_run_stats {
                                serial); wall_ms - setup_ms approximates the run of
                                a pre-started pool */
     struct ncp_stage_stats feeder, analyzer, output;
+    uint64_t lexed_ahead;   /* blocks the output thread lexed for the analyzer */
     struct ncp_stage_stats lexer[NCP_MAX_LEXERS];
     struct ncp_stage_stats executor[NCP_MAX_EXECUTORS];
 };

@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <getopt.h>
+#include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -59,7 +60,12 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
     if (inline_out)
         fputs(" none, output in the analyzer\n", stderr);
     else
-        fprintf(stderr, "%s, output %.1f\n", map->n_executors ? "" : " none", st->output.cpu_ms);
+        fprintf(stderr, "%s, output %.1f", map->n_executors ? "" : " none", st->output.cpu_ms);
+    if (!inline_out && map->n_lexers == 0 && map->n_executors == 0)
+        fprintf(stderr, " (lexed %" PRIu64 " of the %" PRIu64 " blocks ahead)", st->lexed_ahead,
+                st->blocks);
+    if (!inline_out)
+        fputc('\n', stderr);
     /* who waited for whom: a stage that often finds its input empty is starved,
      * one that finds its output full is ahead of the next */
     fputs("cnc-run: waits empty/full/slept:", stderr);

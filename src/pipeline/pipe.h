@@ -8,6 +8,7 @@
 #include <pthread.h>
 #include <stdint.h>
 #include "ncpar/pipeline.h"
+#include "lex_ahead.h"
 #include "ring.h"
 #include "text_feed.h"
 
@@ -69,6 +70,7 @@ struct ncp_pipe {
     uint64_t chunk;              /* the chunk it reads, so ring chunk mod n */
     struct ncp_block an_block;   /* the block it holds, unpacked */
     struct ncp_text_feed *text;  /* no lexer threads: the analyzer lexes the text */
+    struct ncp_lex_ahead *ahead; /* ... and, with packed output, the output thread helps */
     uint64_t next_id;
     int an_rc;
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
@@ -93,6 +95,10 @@ void ncp_pipe_free(struct ncp_pipe *p);
 /* Back to the state of a new pipe for another run: only while no stage thread
  * is inside a stage. */
 void ncp_pipe_reset(struct ncp_pipe *p);
+/* The program, settings and output of the next run: before its threads start
+ * (or, in a pool, are let go). */
+void ncp_pipe_set_run(struct ncp_pipe *p, const struct ncp_source *src,
+                      const struct ncp_analyzer_cfg *acfg, const struct ncp_output *out);
 /* The paper's start rule for the lexers: the string ring full, EOF, or the
  * start timeout, whichever comes first. */
 void ncp_pipe_wait_gate(struct ncp_pipe *p, int timeout_us);

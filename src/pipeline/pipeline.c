@@ -38,6 +38,9 @@ void ncp_pipe_free(struct ncp_pipe *p)
     free(p->an_cmd);
     free(p->out_cmd);
     free(p->text);
+    if (p->ahead)
+        ncp_lex_ahead_destroy(p->ahead);
+    free(p->ahead);
     free(p);
 }
 
@@ -85,6 +88,19 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     size_t cmd_bytes = (sizeof(struct ncp_cmd) + 63) / 64 * 64;
     p->an_cmd = p->exec_threads == 0 ? aligned_alloc(64, cmd_bytes) : NULL;
     p->out_cmd = p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
+    if (p->n == 0 && p->packed_out && map->lex_ahead_bytes > 0) {
+        size_t ahead_bytes = (sizeof *p->ahead + 63) / 64 * 64;
+        p->ahead = aligned_alloc(64, ahead_bytes);
+        if (p->ahead && ncp_lex_ahead_init(p->ahead, (uint64_t)map->lex_ahead_bytes) != 0) {
+            ncp_lex_ahead_destroy(p->ahead);
+            free(p->ahead);
+            p->ahead = NULL;
+        }
+        if (!p->ahead) {
+            ncp_pipe_free(p);
+            return NULL;
+        }
+    }
     if ((p->n > 0 && (!p->strings || !p->parsed)) || (p->n == 0 && !p->text) ||
         (p->m > 0 && !p->cmds) ||
         (p->exec_threads == 0 && !p->an_cmd) || (p->packed_out && !p->out_cmd)) {
@@ -152,6 +168,18 @@ void ncp_pipe_reset(struct ncp_pipe *p)
     p->inline_stopped = 0;
     p->end_ms = 0;
     p->alloc_ms = 0;
+}
+
+void ncp_pipe_set_run(struct ncp_pipe *p, const struct ncp_source *src,
+                      const struct ncp_analyzer_cfg *acfg, const struct ncp_output *out)
+{
+    p->src = src;
+    p->acfg = acfg;
+    p->out = out;
+    /* here, not in the analyzer: the output thread may look for lexing work
+     * before the analyzer has started */
+    if (p->ahead)
+        ncp_lex_ahead_start(p->ahead, src);
 }
 
 /* The paper's start rule: the lexers wait for a full string ring, EOF, or
@@ -249,6 +277,7 @@ void ncp_pipe_fill_stats(const struct ncp_pipe *p, const struct ncp_starter *s, 
     stage_stats(&st->feeder, &p->feeder);
     stage_stats(&st->analyzer, &p->analyzer);
     st->analyzer.items = p->taken;
+    st->lexed_ahead = p->ahead ? p->ahead->h_blocks : 0;
     if (p->n == 0)
         st->blocks = p->taken;
     stage_stats(&st->output, &p->output);
@@ -307,9 +336,7 @@ int ncp_pipeline_run(const struct ncp_source *src, const struct ncp_thread_map *
     if (!p)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the pipeline rings");
     p->alloc_ms = ncp_pipe_thread_cpu_ms() - cpu0;
-    p->src = src;
-    p->acfg = acfg;
-    p->out = out;
+    ncp_pipe_set_run(p, src, acfg, out);
 
     struct ncp_starter s;
     memset(&s, 0, sizeof s);

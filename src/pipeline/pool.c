@@ -117,9 +117,7 @@ int ncp_pipeline_pool_run(struct ncp_pipeline_pool *pool, const struct ncp_sourc
     struct ncp_pipe *p = pool->p;
     double t0 = ncp_pipe_now_ms();
     ncp_pipe_reset(p);
-    p->src = src;
-    p->acfg = acfg;
-    p->out = out;
+    ncp_pipe_set_run(p, src, acfg, out);
     atomic_store(&pool->done, 0);
     atomic_fetch_add(&pool->run, 1);
     ncp_futex_wake_all(&pool->run);

@@ -408,6 +408,16 @@ void *ncp_ring_stage_peek(struct ncp_ring *r, unsigned s, uint32_t k)
     return slot_at(r, own + k);
 }
 
+int ncp_ring_stage_poll(struct ncp_ring *r, unsigned s, uint32_t k)
+{
+    struct ncp_ring_stage *st = &r->stage[s];
+    if (k > r->mask)
+        return -1;
+    if (st->seen - st->next > k && !atomic_load_explicit(&r->state, memory_order_relaxed))
+        return 1;
+    return ready(r, s, k, memory_order_acquire);
+}
+
 const void *ncp_ring_stage_ahead(const struct ncp_ring *r, unsigned s, uint32_t k)
 {
     const struct ncp_ring_stage *st = &r->stage[s];

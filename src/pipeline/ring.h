@@ -95,6 +95,10 @@ void ncp_ring_stage_release(struct ncp_ring *r, unsigned s);
  * reserve if it is known to be free, else NULL. Blocks cross cores through
  * these rings, and a stage that first touches each slot as it takes it waits
  * a full cache-to-cache transfer per block. */
+/* Stage s (>= 1) without waiting: 1 if its k-th element is there, 0 if it
+ * would have to wait for it, -1 if it never comes (end of data, abort). */
+int ncp_ring_stage_poll(struct ncp_ring *r, unsigned s, uint32_t k);
+
 const void *ncp_ring_stage_ahead(const struct ncp_ring *r, unsigned s, uint32_t k);
 void *ncp_ring_reserve_ahead(const struct ncp_ring *r, uint32_t k);
 

@@ -401,7 +401,10 @@ void *ncp_pipe_analyzer(void *arg)
         p->an_rc = p->an_diag.code;
     } else {
         struct ncp_block_feed feed = { p, feed_next, feed_release, p->src };
-        if (p->n == 0) {
+        if (p->ahead) { /* started with the run (ncp_pipe_set_run) */
+            feed = (struct ncp_block_feed){ p->ahead, ncp_lex_ahead_next, ncp_lex_ahead_release,
+                                            p->src };
+        } else if (p->n == 0) {
             ncp_text_feed_start(p->text, p->src);
             feed = (struct ncp_block_feed){ p->text, ncp_text_feed_next, ncp_text_feed_release,
                                             p->src };
@@ -412,8 +415,12 @@ void *ncp_pipe_analyzer(void *arg)
         else if (p->packed_out)
             sink = (struct ncp_cmd_sink){ p, packed_acquire, packed_publish };
         p->an_rc = ncp_analyzer_run(an, &feed, &sink);
-        if (p->n == 0)
+        if (p->ahead) {
+            ncp_lex_ahead_finish(p->ahead);
+            p->taken = p->ahead->feed.blocks;
+        } else if (p->n == 0) {
             p->taken = p->text->blocks;
+        }
         ncp_analyzer_free(an);
     }
     if (p->inline_out)
@@ -457,11 +464,21 @@ static struct ncp_cmd *take_packed(struct ncp_pipe *p)
     return p->out_cmd;
 }
 
-/* Without executor threads: each packed command executed here. */
+/* Without executor threads: each packed command executed here. With no
+ * command waiting, the thread lexes ahead for the analyzer instead of waiting
+ * (lex_ahead.h), having first published what it has taken, so the analyzer
+ * does not find the ring full while this thread is busy elsewhere. */
 static void output_packed(struct ncp_pipe *p)
 {
     struct ncp_cmd *c;
-    while ((c = take_packed(p)) != NULL) {
+    for (;;) {
+        if (p->ahead && ncp_ring_stage_poll(&p->cmds[0], 1, 0) == 0) {
+            ncp_ring_wake_owed();
+            if (ncp_lex_ahead_help(p->ahead))
+                continue;
+        }
+        if ((c = take_packed(p)) == NULL)
+            break;
         ncp_exec_cmd(c);
         p->output.items++;
         if (ncp_emit_cmd(c, p->out, &p->err, &p->emit_failed))

@@ -21,6 +21,10 @@
  * them keep the start-up of a short program to a few milliseconds. */
 #define DEFAULT_CMD_SLOTS 256
 #define DEFAULT_START_TIMEOUT_US 1000
+/* 8 KB of CAM text is ~280 blocks, ~20 us of lexing: fine enough to balance,
+ * coarse enough that the hand-over costs nothing */
+#define DEFAULT_LEX_AHEAD_BYTES 8192
+#define MAX_LEX_AHEAD_BYTES (1 << 20)
 #define MAX_ROWS (1 << 20)
 #define MAX_START_TIMEOUT_US 10000000
 
@@ -46,6 +50,7 @@ void ncp_thread_map_default(struct ncp_thread_map *m, enum ncp_thread_mode mode,
     m->parsed_rows = DEFAULT_PARSED_ROWS;
     m->cmd_slots = DEFAULT_CMD_SLOTS;
     m->start_timeout_us = DEFAULT_START_TIMEOUT_US;
+    m->lex_ahead_bytes = DEFAULT_LEX_AHEAD_BYTES;
 
     /* ATT: the feeder alone on CPU0 as in the paper's tables, then lexers,
      * analyzer and executors round-robin in data-flow order from CPU1 on, the
@@ -91,6 +96,7 @@ struct map_loader {
     int failed;
     /* [pipeline] */
     int mode, lexers, executors, string_rows, parsed_rows, cmd_slots, timeout, inline_out;
+    int lex_ahead;
     int inline_line;    /* where inline_output was set */
     unsigned pipe_set;
     struct loaded_spec feeder, analyzer, output;
@@ -127,7 +133,7 @@ static int parse_int(const char *s, long lo, long hi, int *out)
 
 static const char *const pipe_keys[] = { "mode", "lexers", "executors", "string_rows",
                                          "parsed_rows", "cmd_slots", "start_timeout_us",
-                                         "inline_output" };
+                                         "inline_output", "lex_ahead_bytes" };
 
 static int pipeline_key(struct map_loader *L, const char *name, const char *value)
 {
@@ -167,6 +173,11 @@ static int pipeline_key(struct map_loader *L, const char *name, const char *valu
             return fail(L, L->line, "bad value '%s' for %s (1 to 1048576)", value, name);
         break;
     }
+    case 8:
+        if (parse_int(value, 0, MAX_LEX_AHEAD_BYTES, &L->lex_ahead))
+            return fail(L, L->line, "bad value '%s' for %s (0 to %d; 0: the output thread never lexes)",
+                        value, name, MAX_LEX_AHEAD_BYTES);
+        break;
     case 7:
         if (parse_int(value, 0, 1, &L->inline_out))
             return fail(L, L->line, "bad value '%s' for %s (0 or 1)", value, name);
@@ -319,6 +330,8 @@ static void finish(struct map_loader *L, struct ncp_thread_map *m)
         m->cmd_slots = L->cmd_slots;
     if (L->pipe_set & (1u << 6))
         m->start_timeout_us = L->timeout;
+    if (L->pipe_set & (1u << 8))
+        m->lex_ahead_bytes = L->lex_ahead;
     if (L->inline_out && m->n_executors > 0)
         fail(L, L->inline_line, "inline_output = 1 needs executors = 0 (the analyzer then executes)");
     m->inline_output = L->inline_out;

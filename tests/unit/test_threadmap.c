@@ -206,6 +206,15 @@ static void test_no_lexer_threads(void **state)
     if (sysconf(_SC_NPROCESSORS_ONLN) >= 2) /* two busy threads, two CPUs */
         assert_int_not_equal(m.analyzer.cpu, m.output.cpu);
     expect_error("[pipeline]\nlexers = 0\n[lexer.0]\ncpu = 1\n", 3, "lexer.0");
+    /* the output thread lexes ahead in 8 KB chunks unless told otherwise */
+    assert_int_equal(m.lex_ahead_bytes, 8192);
+    assert_int_equal(load_text("[pipeline]\nlexers = 0\nexecutors = 0\nlex_ahead_bytes = 0\n",
+                               &d, &m), NCP_OK);
+    assert_int_equal(m.lex_ahead_bytes, 0);
+    assert_int_equal(load_text("[pipeline]\nlex_ahead_bytes = 64\n", &d, &m), NCP_OK);
+    assert_int_equal(m.lex_ahead_bytes, 64);
+    expect_error("[pipeline]\nlexers = 0\nlex_ahead_bytes = -1\n", 3, "lex_ahead_bytes");
+    expect_error("[pipeline]\nlex_ahead_bytes = 2000000\n", 2, "lex_ahead_bytes");
 }
 
 /* inline_output: the analyzer executes and writes, so it goes with no
