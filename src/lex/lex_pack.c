@@ -97,11 +97,22 @@ static const unsigned char *get(const unsigned char *p, void *dst, size_t n)
  * on the stack and copied whole, their mixed-width stores could not be
  * forwarded to the wide load of the copy, a stall per block and per word
  * (most of the packing time, measured). */
-#define PUT_AT(base, type, field, val)                                          \
+/* PUT_AT's ctype must be the field's type: with these sizes and no padding,
+ * a wrong one would overlap its neighbour (and the round-trip tests fail). */
+_Static_assert(sizeof(struct packed_head) == 32, "packed_head: 8+4+6*2+8*1 bytes");
+_Static_assert(sizeof(struct packed_word) == 16, "packed_word: 8+3*2+2*1 bytes");
+
+static void put_at(unsigned char *base, size_t off, const void *v, size_t n)
+{
+    memcpy(base + off, v, n);
+}
+#define PUT_AT(base, type, field, ctype, val)                                   \
     do {                                                                        \
-        __typeof__(((type *)0)->field) v_ = (val);                              \
-        memcpy((base) + offsetof(type, field), &v_, sizeof v_);                 \
+        ctype v_ = (val);                                                       \
+        put_at((base), offsetof(type, field), &v_, sizeof v_);                  \
     } while (0)
+#define HEAD(field, ctype, val) PUT_AT(p, struct packed_head, field, ctype, val)
+#define WORD(field, ctype, val) PUT_AT(p, struct packed_word, field, ctype, val)
 
 size_t ncp_block_pack(const struct ncp_block *b, void *dst)
 {
@@ -111,22 +122,22 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
         .has_n = b->has_n, .has_err = b->err.code != NCP_OK, .oword_kind = b->oword.kind,
     };
     unsigned char *p = dst;
-    PUT_AT(p, struct packed_head, offset, b->offset);
-    PUT_AT(p, struct packed_head, line, b->line);
-    PUT_AT(p, struct packed_head, units, (uint16_t)(total / NCP_PACK_UNIT));
-    PUT_AT(p, struct packed_head, length, b->length);
-    PUT_AT(p, struct packed_head, n_code, (uint16_t)c.code);
-    PUT_AT(p, struct packed_head, pool_used, (uint16_t)c.pool);
-    PUT_AT(p, struct packed_head, comment_off, b->comment_off);
-    PUT_AT(p, struct packed_head, comment_len, b->comment_len);
-    PUT_AT(p, struct packed_head, n_words, (uint8_t)c.words);
-    PUT_AT(p, struct packed_head, n_assign, (uint8_t)c.assign);
-    PUT_AT(p, struct packed_head, block_delete, b->block_delete);
-    PUT_AT(p, struct packed_head, has_n, h.has_n);
-    PUT_AT(p, struct packed_head, comment_kind, b->comment_kind);
-    PUT_AT(p, struct packed_head, oword_kind, h.oword_kind);
-    PUT_AT(p, struct packed_head, oword_nargs, (uint8_t)c.nargs);
-    PUT_AT(p, struct packed_head, has_err, h.has_err);
+    HEAD(offset, uint64_t, b->offset);
+    HEAD(line, uint32_t, b->line);
+    HEAD(units, uint16_t, (uint16_t)(total / NCP_PACK_UNIT));
+    HEAD(length, uint16_t, b->length);
+    HEAD(n_code, uint16_t, (uint16_t)c.code);
+    HEAD(pool_used, uint16_t, (uint16_t)c.pool);
+    HEAD(comment_off, uint16_t, b->comment_off);
+    HEAD(comment_len, uint16_t, b->comment_len);
+    HEAD(n_words, uint8_t, (uint8_t)c.words);
+    HEAD(n_assign, uint8_t, (uint8_t)c.assign);
+    HEAD(block_delete, uint8_t, b->block_delete);
+    HEAD(has_n, uint8_t, h.has_n);
+    HEAD(comment_kind, uint8_t, b->comment_kind);
+    HEAD(oword_kind, uint8_t, h.oword_kind);
+    HEAD(oword_nargs, uint8_t, (uint8_t)c.nargs);
+    HEAD(has_err, uint8_t, h.has_err);
     p += sizeof h;
     if (h.has_n)
         p = put(p, &b->n_number, sizeof b->n_number);
@@ -137,12 +148,12 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
     }
     for (unsigned k = 0; k < c.words; k++, p += sizeof(struct packed_word)) {
         const struct ncp_word *w = &b->words[k];
-        PUT_AT(p, struct packed_word, value, w->v.value);
-        PUT_AT(p, struct packed_word, start, w->v.start);
-        PUT_AT(p, struct packed_word, len, w->v.len);
-        PUT_AT(p, struct packed_word, col, w->col);
-        PUT_AT(p, struct packed_word, letter, w->letter);
-        PUT_AT(p, struct packed_word, is_const, w->v.is_const);
+        WORD(value, double, w->v.value);
+        WORD(start, uint16_t, w->v.start);
+        WORD(len, uint16_t, w->v.len);
+        WORD(col, uint16_t, w->col);
+        WORD(letter, char, w->letter);
+        WORD(is_const, uint8_t, w->v.is_const);
     }
     p = put(p, b->assign, c.assign * sizeof b->assign[0]);
     if (h.oword_kind != NCP_O_NONE) {
