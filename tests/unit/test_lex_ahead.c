@@ -75,14 +75,11 @@ static void assert_same_block(const struct ncp_block *a, const struct ncp_block 
 static struct ncp_text_feed ref;
 static struct ncp_lex_ahead la;
 
-/* The analyzer's feed against the plain one, the helper called `help` times
- * (in the same thread) before each block: 0 = never, more = far ahead. */
-static uint64_t run_against_reference(const struct ncp_source *src, unsigned help_every,
-                                      unsigned seed)
+/* Reads both feeds to their ends, block against block; before each block
+ * the helper is called 0-3 times in this thread, one time in `help_every`
+ * (0: never; the helper may also be another thread). */
+static uint64_t compare_feeds(unsigned help_every)
 {
-    ncp_lex_ahead_start(&la, src);
-    ncp_text_feed_start(&ref, src);
-    srand(seed);
     uint64_t blocks = 0;
     for (;;) {
         if (help_every && (unsigned)rand() % help_every == 0) {
@@ -102,6 +99,17 @@ static uint64_t run_against_reference(const struct ncp_source *src, unsigned hel
     }
     assert_int_equal(la.feed.blocks, ref.blocks);
     ncp_lex_ahead_finish(&la);
+    return blocks;
+}
+
+/* The analyzer's feed against the plain one, the helper in the same thread. */
+static uint64_t run_against_reference(const struct ncp_source *src, unsigned help_every,
+                                      unsigned seed)
+{
+    ncp_lex_ahead_start(&la, src);
+    ncp_text_feed_start(&ref, src);
+    srand(seed);
+    uint64_t blocks = compare_feeds(help_every);
     assert_int_equal(ncp_lex_ahead_help(&la), 0); /* finished: no more help */
     return blocks;
 }
@@ -185,17 +193,7 @@ static void test_two_threads(void **state)
         struct helper_arg h = { &la, 0 };
         pthread_t t;
         assert_int_equal(pthread_create(&t, NULL, helper, &h), 0);
-        for (;;) {
-            const struct ncp_block *want = ncp_text_feed_next(&ref);
-            const struct ncp_block *got = ncp_lex_ahead_next(&la);
-            if (!want) {
-                assert_null(got);
-                break;
-            }
-            assert_non_null(got);
-            assert_same_block(got, want);
-        }
-        ncp_lex_ahead_finish(&la);
+        compare_feeds(0);
         atomic_store(&h.stop, 1);
         pthread_join(t, NULL);
         helped += la.h_blocks;
