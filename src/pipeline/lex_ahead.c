@@ -11,7 +11,6 @@
 enum { AHEAD_OPEN = 0, AHEAD_HELPER = 1, AHEAD_READY = 2, AHEAD_ANALYZER = 3 };
 #define TAG(chunk, state) ((chunk) * 4u + (state))
 #define TAG_CHUNK(tag) ((tag) / 4u)
-#define TAG_STATE(tag) ((unsigned)((tag) % 4u))
 
 /* The analyzer spins this long for a chunk the helper is still lexing
  * (a chunk takes tens of microseconds), then sleeps. */
@@ -97,7 +96,6 @@ void ncp_lex_ahead_start(struct ncp_lex_ahead *la, const struct ncp_source *src)
     ncp_text_feed_start(&la->feed, src);
     la->recs_left = 0;
     la->rec = NULL;
-    la->a_waits = 0;
     enter_chunk(la, 0);
 }
 
@@ -176,7 +174,6 @@ static void wait_ready(struct ncp_lex_ahead *la, struct ncp_ahead_slot *s, uint6
     uint64_t ready = TAG(k, AHEAD_READY);
     if (atomic_load_explicit(&s->tag, memory_order_acquire) == ready)
         return;
-    la->a_waits++;
     for (int i = 0; i < AHEAD_SPIN; i++) {
         ncp_cpu_relax();
         if (atomic_load_explicit(&s->tag, memory_order_acquire) == ready)
@@ -257,11 +254,6 @@ const struct ncp_block *ncp_lex_ahead_next(void *ctx)
         leave_chunk(la);
         enter_chunk(la, la->chunk + 1);
     }
-}
-
-void ncp_lex_ahead_release(void *ctx)
-{
-    (void)ctx; /* the block is overwritten by the next one */
 }
 
 void ncp_lex_ahead_finish(struct ncp_lex_ahead *la)

@@ -67,7 +67,6 @@ struct ncp_lex_ahead {
     const unsigned char *rec;         /* the helper's next packed block */
     uint32_t recs_left;
     uint64_t rec_stop;
-    uint64_t a_waits;
 };
 
 /* Slot buffers for chunks of chunk_bytes (>= 1). 0, or -1 when out of memory. */
@@ -76,10 +75,11 @@ void ncp_lex_ahead_destroy(struct ncp_lex_ahead *la);
 /* Start on src: only while neither side is inside a call below. */
 void ncp_lex_ahead_start(struct ncp_lex_ahead *la, const struct ncp_source *src);
 
-/* The analyzer's side, as struct ncp_block_feed's next() and release(): every
- * block of the text in order, exactly as ncp_text_feed_next gives them. */
+/* The analyzer's side, as struct ncp_block_feed's next() (its release() is
+ * ncp_text_feed_release: the block is the feed's, overwritten by the next
+ * one): every block of the text in order, exactly as ncp_text_feed_next
+ * gives them. */
 const struct ncp_block *ncp_lex_ahead_next(void *ctx);
-void ncp_lex_ahead_release(void *ctx);
 /* The analyzer has stopped: the helper wants no more work. */
 void ncp_lex_ahead_finish(struct ncp_lex_ahead *la);
 

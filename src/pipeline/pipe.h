@@ -69,8 +69,9 @@ struct ncp_pipe {
     alignas(64) uint64_t taken;  /* blocks handed to the analyzer */
     uint64_t chunk;              /* the chunk it reads, so ring chunk mod n */
     struct ncp_block an_block;   /* the block it holds, unpacked */
-    struct ncp_text_feed *text;  /* no lexer threads: the analyzer lexes the text */
-    struct ncp_lex_ahead *ahead; /* ... and, with packed output, the output thread helps */
+    struct ncp_text_feed *text;  /* no lexer threads: the analyzer lexes the text ... */
+    struct ncp_lex_ahead *ahead; /* ... or, with packed output, the output thread helps
+                                  * (then text is NULL: this has a feed of its own) */
     uint64_t next_id;
     int an_rc;
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */

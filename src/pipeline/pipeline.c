@@ -81,14 +81,17 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     /* No lexer threads: no feeder either, the analyzer reads the text itself */
     p->strings = p->n > 0 ? rings_new(p->n) : NULL;
     p->parsed = p->n > 0 ? rings_new(p->n) : NULL;
-    p->text = p->n > 0 ? NULL : malloc(sizeof *p->text);
+    /* no lexer threads: the analyzer's own feed, or with packed output the
+     * lexing-ahead one (which has a feed of its own) */
+    int lex_ahead = p->n == 0 && p->packed_out && map->lex_ahead_bytes > 0;
+    p->text = p->n == 0 && !lex_ahead ? malloc(sizeof *p->text) : NULL;
     p->cmds = p->m > 0 ? rings_new(p->m) : NULL;
     /* Without executor threads the analyzer fills a slot of its own (inline
      * or packed output). aligned_alloc wants a multiple of the alignment. */
     size_t cmd_bytes = (sizeof(struct ncp_cmd) + 63) / 64 * 64;
     p->an_cmd = p->exec_threads == 0 ? aligned_alloc(64, cmd_bytes) : NULL;
     p->out_cmd = p->packed_out ? aligned_alloc(64, cmd_bytes) : NULL;
-    if (p->n == 0 && p->packed_out && map->lex_ahead_bytes > 0) {
+    if (lex_ahead) {
         size_t ahead_bytes = (sizeof *p->ahead + 63) / 64 * 64;
         p->ahead = aligned_alloc(64, ahead_bytes);
         if (p->ahead && ncp_lex_ahead_init(p->ahead, (uint64_t)map->lex_ahead_bytes) != 0) {
@@ -101,7 +104,7 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
             return NULL;
         }
     }
-    if ((p->n > 0 && (!p->strings || !p->parsed)) || (p->n == 0 && !p->text) ||
+    if ((p->n > 0 && (!p->strings || !p->parsed)) || (p->n == 0 && !p->text && !p->ahead) ||
         (p->m > 0 && !p->cmds) ||
         (p->exec_threads == 0 && !p->an_cmd) || (p->packed_out && !p->out_cmd)) {
         ncp_pipe_free(p);

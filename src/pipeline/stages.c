@@ -402,7 +402,7 @@ void *ncp_pipe_analyzer(void *arg)
     } else {
         struct ncp_block_feed feed = { p, feed_next, feed_release, p->src };
         if (p->ahead) { /* started with the run (ncp_pipe_set_run) */
-            feed = (struct ncp_block_feed){ p->ahead, ncp_lex_ahead_next, ncp_lex_ahead_release,
+            feed = (struct ncp_block_feed){ p->ahead, ncp_lex_ahead_next, ncp_text_feed_release,
                                             p->src };
         } else if (p->n == 0) {
             ncp_text_feed_start(p->text, p->src);
