@@ -232,9 +232,10 @@ static int from_feed(struct ncp_flow *f, const struct ncp_block **out)
         next = ncp_source_after(f->src, b->offset, b->length);
     else if (ncp_source_span(f->src, b->offset, b->line, &sp) == 0)
         next = sp.next;
-    f->feed_pos.off = next;
-    f->feed_pos.line = b->line + 1;
-    f->cur = f->feed_pos;
+    /* Field by field: copying feed_pos whole right after these narrow
+     * stores is a wide load the stores cannot forward to, a stall per block. */
+    f->feed_pos.off = f->cur.off = next;
+    f->feed_pos.line = f->cur.line = b->line + 1;
     *out = b;
     return NCP_OK;
 }
