@@ -55,8 +55,16 @@ struct ncp_pipe {
     struct ncp_ring *cmds;       /* m: analyzer -> EXEC_j -> output, struct ncp_cmd;
                                   * packed_out: one ring of packed commands, 8-byte units */
 
+    /* Fixed when the pipe is made; read per item by the analyzer and the
+     * output thread, so nothing either of them writes may share their lines. */
+    struct ncp_text_feed *text;  /* no lexer threads: the analyzer lexes the text ... */
+    struct ncp_lex_ahead *ahead; /* ... or, with packed output, the output thread helps
+                                  * (then text is NULL: this has a feed of its own) */
+    struct ncp_cmd *an_cmd;      /* inline and packed output: the analyzer's own slot */
+    struct ncp_cmd *out_cmd;     /* packed output: the output thread's slot it unpacks into */
+
     /* Lexers start once the string ring is full, or at EOF, or on timeout. */
-    _Atomic uint32_t gate;
+    alignas(64) _Atomic uint32_t gate;
     uint64_t string_fill;        /* spans that fill the whole string ring */
 
     struct ncp_pipe_worker feeder, analyzer, output;
@@ -68,19 +76,11 @@ struct ncp_pipe {
     /* analyzer thread only, read after join */
     alignas(64) uint64_t taken;  /* blocks handed to the analyzer */
     uint64_t chunk;              /* the chunk it reads, so ring chunk mod n */
-    struct ncp_block an_block;   /* the block it holds, unpacked */
-    struct ncp_text_feed *text;  /* no lexer threads: the analyzer lexes the text ... */
-    struct ncp_lex_ahead *ahead; /* ... or, with packed output, the output thread helps
-                                  * (then text is NULL: this has a feed of its own) */
     uint64_t next_id;
     int an_rc;
+    int inline_stopped;          /* the inline output stopped */
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
-
-    /* inline and packed output: the analyzer's own command slot, whether the
-     * inline output stopped; the output thread's slot it unpacks into */
-    struct ncp_cmd *an_cmd;
-    int inline_stopped;
-    struct ncp_cmd *out_cmd;
+    struct ncp_block an_block;   /* the block it holds, unpacked */
 
     /* output thread only (the analyzer's with inline output), read after join */
     alignas(64) struct ncp_diag err; /* first error slot, in program order */

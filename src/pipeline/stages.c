@@ -470,11 +470,13 @@ static struct ncp_cmd *take_packed(struct ncp_pipe *p)
  * does not find the ring full while this thread is busy elsewhere. */
 static void output_packed(struct ncp_pipe *p)
 {
+    struct ncp_lex_ahead *ahead = p->ahead;
+    struct ncp_ring *r = &p->cmds[0];
     struct ncp_cmd *c;
     for (;;) {
-        if (p->ahead && ncp_ring_stage_poll(&p->cmds[0], 1, 0) == 0) {
+        if (ahead && ncp_ring_stage_poll(r, 1, 0) == 0) {
             ncp_ring_wake_owed();
-            if (ncp_lex_ahead_help(p->ahead))
+            if (ncp_lex_ahead_help(ahead))
                 continue;
         }
         if ((c = take_packed(p)) == NULL)
