@@ -1,12 +1,11 @@
-/* Canonical text through 1 MB buffers: a write() per slot would dominate.
+/* Canonical text through a 1 MB buffer: a write() per slot would dominate.
  *
- * The 1M-block benchmark writes about 65 MB; the write() calls that copy it
- * into the page cache cost a sixth of the serial run. With the pipeline the
- * thread that emits is the analyzer (inline output) or the output thread, the
- * busiest stage, so there the writes go to a thread of their own: the caller
- * fills one buffer while the writer thread writes the other. Buffers change
- * hands 65 times in that run, so a mutex and a condition variable cost
- * nothing that matters. */
+ * The 1M-block benchmark writes about 65 MB. The write() calls stay in the
+ * thread that emits. A writer thread of its own (an earlier version) made
+ * the pipeline slower once the output thread could lex ahead when it had
+ * nothing to write: on two CPUs a third busy thread takes time from both, and
+ * the buffers it read crossed cores twice; interleaved runs of the 1M-block
+ * program, det -j 0: 158 ms with the thread, 142 ms without. */
 #include "canon_writer.h"
 
 #include <errno.h>
@@ -40,18 +39,9 @@ static void buffer_free(char *b)
 
 struct canon_writer {
     int fd;
-    int async;
-    char *fill;                 /* the buffer being filled */
+    char *buf;
     size_t used;
-    char *spare;                /* sync: unused; async: the other buffer, owned by whoever holds it */
-    /* async hand-over: the writer thread owns `pending` while it is set */
-    pthread_t thread;
-    pthread_mutex_t mu;
-    pthread_cond_t cv;
-    char *pending;
-    size_t pending_len;
-    int quit;
-    int failed;                 /* errno of the first failed write; under mu when async */
+    int failed;                 /* errno of the first failed write */
 };
 
 /* 0, or the errno of the failed write. */
@@ -69,52 +59,13 @@ static int write_all(int fd, const char *p, size_t n)
     return 0;
 }
 
-static void *writer_main(void *arg)
-{
-    struct canon_writer *w = arg;
-    pthread_mutex_lock(&w->mu);
-    for (;;) {
-        while (!w->pending && !w->quit)
-            pthread_cond_wait(&w->cv, &w->mu);
-        if (!w->pending)
-            break;
-        char *buf = w->pending;
-        size_t len = w->pending_len;
-        int failed = w->failed;
-        pthread_mutex_unlock(&w->mu);
-        int err = failed ? 0 : write_all(w->fd, buf, len);
-        pthread_mutex_lock(&w->mu);
-        if (!w->failed)
-            w->failed = err;
-        w->spare = buf;
-        w->pending = NULL;
-        pthread_cond_broadcast(&w->cv);
-    }
-    pthread_mutex_unlock(&w->mu);
-    return NULL;
-}
-
-/* The filled buffer goes out; the caller continues in an empty one. */
+/* The filled buffer goes out; the caller continues in it, empty. */
 static int hand_over(struct canon_writer *w)
 {
-    if (!w->async) {
-        if (!w->failed)
-            w->failed = write_all(w->fd, w->fill, w->used);
-        w->used = 0;
-        return w->failed;
-    }
-    pthread_mutex_lock(&w->mu);
-    while (w->pending)
-        pthread_cond_wait(&w->cv, &w->mu);
-    w->pending = w->fill;
-    w->pending_len = w->used;
-    w->fill = w->spare;
-    w->spare = NULL;
-    int failed = w->failed;
-    pthread_cond_broadcast(&w->cv);
-    pthread_mutex_unlock(&w->mu);
+    if (!w->failed)
+        w->failed = write_all(w->fd, w->buf, w->used);
     w->used = 0;
-    return failed;
+    return w->failed;
 }
 
 int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd)
@@ -124,15 +75,14 @@ int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd)
         return 0;
     if (w->used + cmd->out_len > WRITER_BUF && hand_over(w))
         return 1;
-    memcpy(w->fill + w->used, cmd->out, cmd->out_len);
+    memcpy(w->buf + w->used, cmd->out, cmd->out_len);
     w->used += cmd->out_len;
     return 0;
 }
 
 static void writer_free(struct canon_writer *w)
 {
-    buffer_free(w->fill);
-    buffer_free(w->spare);
+    buffer_free(w->buf);
     free(w);
 }
 
@@ -153,10 +103,10 @@ static void *close_in_background(void *arg)
  * extended attributes (ACLs, labels), whose mode carries over. Anything else
  * (a symlink, a device, a FIFO, a hard-linked or foreign file) is opened with
  * O_TRUNC as before. The old file's pages are freed when its last descriptor
- * closes: with async, in a short thread of its own, so neither the
- * interpreter nor the writer waits; otherwise right away, in unlink().
+ * closes: with background, in a short thread of its own, so the run does
+ * not wait for it; otherwise right away, in unlink().
  * Returns the new descriptor or -1 (then the caller truncates). */
-static int open_replacing(const char *path, int async)
+static int open_replacing(const char *path, int background)
 {
     struct stat st;
     if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode) || st.st_nlink != 1 ||
@@ -166,7 +116,7 @@ static int open_replacing(const char *path, int async)
     if (xattrs != 0)
         return -1;
     int old = -1;
-    if (async) {
+    if (background) {
         old = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
         struct stat ost;
         if (old < 0 || fstat(old, &ost) != 0 || ost.st_ino != st.st_ino ||
@@ -202,16 +152,15 @@ static int open_replacing(const char *path, int async)
     return fd;
 }
 
-struct canon_writer *canon_writer_open(const char *path, int async)
+struct canon_writer *canon_writer_open(const char *path, int background)
 {
     struct canon_writer *w = calloc(1, sizeof *w);
     if (!w) {
         fprintf(stderr, "cnc-run: out of memory for the output buffers\n");
         return NULL;
     }
-    w->fill = buffer_new();
-    w->spare = async ? buffer_new() : NULL;
-    if (!w->fill || (async && !w->spare)) {
+    w->buf = buffer_new();
+    if (!w->buf) {
         fprintf(stderr, "cnc-run: out of memory for the output buffers\n");
         writer_free(w);
         return NULL;
@@ -219,23 +168,13 @@ struct canon_writer *canon_writer_open(const char *path, int async)
     if (!strcmp(path, "-")) {
         w->fd = 1;
     } else {
-        w->fd = open_replacing(path, async);
+        w->fd = open_replacing(path, background);
         if (w->fd < 0)
             w->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
         if (w->fd < 0) {
             fprintf(stderr, "cnc-run: cannot write %s: %s\n", path, strerror(errno));
             writer_free(w);
             return NULL;
-        }
-    }
-    if (async) {
-        pthread_mutex_init(&w->mu, NULL);
-        pthread_cond_init(&w->cv, NULL);
-        /* no thread: write in the caller's thread, which is always correct */
-        w->async = pthread_create(&w->thread, NULL, writer_main, w) == 0;
-        if (!w->async) {
-            pthread_mutex_destroy(&w->mu);
-            pthread_cond_destroy(&w->cv);
         }
     }
     return w;
@@ -247,15 +186,6 @@ int canon_writer_close(struct canon_writer *w)
         return 0;
     if (w->used)
         hand_over(w);
-    if (w->async) {
-        pthread_mutex_lock(&w->mu);
-        w->quit = 1;
-        pthread_cond_broadcast(&w->cv);
-        pthread_mutex_unlock(&w->mu);
-        pthread_join(w->thread, NULL);
-        pthread_mutex_destroy(&w->mu);
-        pthread_cond_destroy(&w->cv);
-    }
     int failed = w->failed;
     if (w->fd != 1 && close(w->fd) != 0 && !failed)
         failed = errno;

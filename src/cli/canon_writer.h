@@ -6,11 +6,12 @@
 
 struct canon_writer;
 
-/* path "-" is standard output. async: a thread of its own does the write()
- * calls, one 1 MB buffer at a time, while the caller fills the next (for the
- * parallel pipeline; the serial reference stays one thread). NULL, with a
- * message on stderr, when the file cannot be opened or memory is short. */
-struct canon_writer *canon_writer_open(const char *path, int async);
+/* path "-" is standard output. An existing plain file is replaced rather than
+ * truncated (canon_writer.c says why); background: the old file's pages may
+ * be freed by a short thread of its own (the pipeline), not in this call (the
+ * serial reference stays one thread). NULL, with a message on stderr, when
+ * the file cannot be opened or memory is short. */
+struct canon_writer *canon_writer_open(const char *path, int background);
 /* ncp_output.emit: appends a slot's text; non-zero once a write has failed. */
 int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd);
 /* Writes what is left, closes, frees; 0, or the errno of the first write
