@@ -6,6 +6,12 @@
 #include <string.h>
 
 static const char ncp_letters[NCP_NAX] = {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'};
+/* Their word slots, constant: NCP_LETTER of a table entry is computed per
+ * axis at run time, a chain of compares in every move's end point. */
+static const unsigned char ncp_axis_slot[NCP_NAX] = {
+    NCP_LETTER('X'), NCP_LETTER('Y'), NCP_LETTER('Z'), NCP_LETTER('A'), NCP_LETTER('B'),
+    NCP_LETTER('C'), NCP_LETTER('U'), NCP_LETTER('V'), NCP_LETTER('W'),
+};
 
 /* Polar words (@ radius, ^ angle in degrees) replace X/Y in the XY plane. */
 static int ncp_motion_polar(struct ncp_analyzer *a, double *end)
@@ -63,22 +69,22 @@ int ncp_motion_ends(struct ncp_analyzer *a, int g53, double *end)
         double word[NCP_NAX];
         uint32_t given = 0;
         for (int ax = 0; ax < NCP_NAX; ax++) {
-            int l = NCP_LETTER(ncp_letters[ax]);
+            int l = ncp_axis_slot[ax];
             word[ax] = w->v[l];
             given |= ((w->has >> l) & 1u) << ax;
         }
         ncp_frame_g53(a, word, given, end);
         return NCP_OK;
     }
+    int incremental = s->m.incremental;
     for (int ax = 0; ax < NCP_NAX; ax++) {
-        int l = NCP_LETTER(ncp_letters[ax]);
-        if (!((w->has >> l) & 1u)) {
+        int l = ncp_axis_slot[ax];
+        if (!((w->has >> l) & 1u))
             end[ax] = s->pos[ax];
-        } else if (s->m.incremental) {
+        else if (incremental)
             end[ax] = s->pos[ax] + w->v[l];
-        } else {
+        else
             end[ax] = w->v[l];
-        }
     }
     if (w->has & NCP_POLAR_BITS)
         return ncp_motion_polar(a, end);
