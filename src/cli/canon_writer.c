@@ -86,12 +86,30 @@ static void writer_free(struct canon_writer *w)
     free(w);
 }
 
-static void *close_in_background(void *arg)
+static void *close_thread(void *arg)
 {
     int *fd = arg;
     close(*fd);
     free(fd);
     return NULL;
+}
+
+/* close(fd) in a detached thread; here if no thread can be had. */
+static void close_in_background(int fd)
+{
+    pthread_t t;
+    pthread_attr_t attr;
+    int *arg = malloc(sizeof *arg);
+    if (arg && pthread_attr_init(&attr) == 0) {
+        *arg = fd;
+        pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
+        int spawned = pthread_create(&t, &attr, close_thread, arg) == 0;
+        pthread_attr_destroy(&attr);
+        if (spawned)
+            return;
+    }
+    free(arg);
+    close(fd);
 }
 
 /* Rewriting a file that holds the last run's output (65 MB for the 1M-block
@@ -103,10 +121,12 @@ static void *close_in_background(void *arg)
  * extended attributes (ACLs, labels), whose mode carries over. Anything else
  * (a symlink, a device, a FIFO, a hard-linked or foreign file) is opened with
  * O_TRUNC as before. The old file's pages are freed when its last descriptor
- * closes: with background, in a short thread of its own, so the run does
- * not wait for it; otherwise right away, in unlink().
- * Returns the new descriptor or -1 (then the caller truncates). */
-static int open_replacing(const char *path, int background)
+ * closes, in a short thread of its own, so the run does not wait for it (an
+ * unlink() of the last name frees them in the call: 3-30 ms here). The serial
+ * reference gets the same thread: it is file-system housekeeping, not
+ * interpretation, and serial and parallel runs must pay alike for their
+ * output. Returns the new descriptor or -1 (then the caller truncates). */
+static int open_replacing(const char *path)
 {
     struct stat st;
     if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode) || st.st_nlink != 1 ||
@@ -115,44 +135,26 @@ static int open_replacing(const char *path, int background)
     ssize_t xattrs = llistxattr(path, NULL, 0);
     if (xattrs != 0)
         return -1;
-    int old = -1;
-    if (background) {
-        old = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
-        struct stat ost;
-        if (old < 0 || fstat(old, &ost) != 0 || ost.st_ino != st.st_ino ||
-            ost.st_dev != st.st_dev) {
-            if (old >= 0)
-                close(old);
-            return -1;
-        }
+    int old = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    struct stat ost;
+    if (old < 0 || fstat(old, &ost) != 0 || ost.st_ino != st.st_ino || ost.st_dev != st.st_dev) {
+        if (old >= 0)
+            close(old);
+        return -1;
     }
     int fd = -1;
     if (unlink(path) == 0) {
         fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, st.st_mode & 0777);
-        if (fd >= 0 && fchmod(fd, st.st_mode & 0777) != 0) {
-            /* the umask narrowed it; the file is still right to write */
-        }
+        /* the umask may have narrowed the mode; a failure leaves a file as
+         * writable as O_CREAT made it, so the run goes on */
+        if (fd >= 0)
+            (void)fchmod(fd, st.st_mode & 0777);
     }
-    if (old >= 0) {
-        pthread_t t;
-        pthread_attr_t attr;
-        int *arg = malloc(sizeof *arg);
-        int spawned = 0;
-        if (arg && pthread_attr_init(&attr) == 0) {
-            *arg = old;
-            pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
-            spawned = pthread_create(&t, &attr, close_in_background, arg) == 0;
-            pthread_attr_destroy(&attr);
-        }
-        if (!spawned) {
-            free(arg);
-            close(old);
-        }
-    }
+    close_in_background(old);
     return fd;
 }
 
-struct canon_writer *canon_writer_open(const char *path, int background)
+struct canon_writer *canon_writer_open(const char *path)
 {
     struct canon_writer *w = calloc(1, sizeof *w);
     if (!w) {
@@ -168,7 +170,7 @@ struct canon_writer *canon_writer_open(const char *path, int background)
     if (!strcmp(path, "-")) {
         w->fd = 1;
     } else {
-        w->fd = open_replacing(path, background);
+        w->fd = open_replacing(path);
         if (w->fd < 0)
             w->fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
         if (w->fd < 0) {

@@ -7,11 +7,10 @@
 struct canon_writer;
 
 /* path "-" is standard output. An existing plain file is replaced rather than
- * truncated (canon_writer.c says why); background: the old file's pages may
- * be freed by a short thread of its own (the pipeline), not in this call (the
- * serial reference stays one thread). NULL, with a message on stderr, when
- * the file cannot be opened or memory is short. */
-struct canon_writer *canon_writer_open(const char *path, int background);
+ * truncated, its pages freed by a short thread of its own (canon_writer.c
+ * says why). NULL, with a message on stderr, when the file cannot be opened
+ * or memory is short. */
+struct canon_writer *canon_writer_open(const char *path);
 /* ncp_output.emit: appends a slot's text; non-zero once a write has failed. */
 int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd);
 /* Writes what is left, closes, frees; 0, or the errno of the first write

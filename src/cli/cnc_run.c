@@ -241,7 +241,7 @@ static int cmd_parse(int argc, char **argv)
         return EXIT_PROGRAM;
     }
     struct canon_writer *w = NULL;
-    if (o.canon && !(w = canon_writer_open(o.canon, map.mode != NCP_MODE_SERIAL))) {
+    if (o.canon && !(w = canon_writer_open(o.canon))) {
         ncp_source_close(&src);
         return EXIT_USAGE;
     }
