@@ -253,6 +253,28 @@ static int ncp_an_eof(struct ncp_analyzer *a, const struct ncp_source *src)
     return ncp_an_error(a, 0, "File ended with no percent sign or program end");
 }
 
+/* G7 (lathe diameter mode): an X word is a diameter, so the axis moves half
+ * of it, whatever uses X (moves, G10, G92, G28, cycles). rs274 halves X as it
+ * reads the word when the mode is already on, then, if this block's G7 turns
+ * it on, halves it there, or, if its G8 turns it off, doubles it back: done
+ * in that order here, so every value (even a subnormal) comes out as rs274's.
+ * Before any step of the block uses X, after the checks that only look at
+ * whether it is there. */
+static void ncp_lathe_x_word(struct ncp_analyzer *a)
+{
+    struct ncp_words *w = &a->w;
+    if (!NCP_HAS(w, 'X'))
+        return;
+    int before = a->st.m.lathe_diameter, g = w->g[NCP_GG_LATHE];
+    double *x = &w->v[NCP_LETTER('X')];
+    if (before)
+        *x /= 2;
+    if (g == 70 && !before)
+        *x /= 2;
+    else if (g == 80 && before)
+        *x *= 2;
+}
+
 static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
 {
     a->blk = b;
@@ -268,6 +290,8 @@ static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
         rc = ncp_words_assign(a, b);
     if (rc == NCP_OK)
         rc = ncp_modal_check(a);
+    if (rc == NCP_OK)
+        ncp_lathe_x_word(a);
     if (rc == NCP_OK)
         rc = ncp_exec_block(a);
     if (rc == NCP_OK || rc == NCP_END) {

@@ -213,6 +213,17 @@ static int ncp_exec_m_codes(struct ncp_analyzer *a)
     return rc;
 }
 
+/* G7/G8. The block's X word was already scaled (analyzer.c, ncp_lathe_x_word);
+ * rs274 says so only when the mode changes. */
+static void ncp_exec_lathe_mode(struct ncp_analyzer *a, int diameter)
+{
+    if (a->st.m.lathe_diameter == diameter)
+        return;
+    a->st.m.lathe_diameter = diameter;
+    ncp_exec_comment_lit(a, diameter ? "interpreter: Lathe diameter mode changed to diameter"
+                                     : "interpreter: Lathe diameter mode changed to radius");
+}
+
 static int ncp_exec_g_codes(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
@@ -224,7 +235,7 @@ static int ncp_exec_g_codes(struct ncp_analyzer *a)
     if (rc == NCP_OK && w->g[NCP_GG_UNITS] != -1)
         rc = ncp_offsets_units(a, w->g[NCP_GG_UNITS] == 200);
     if (rc == NCP_OK && w->g[NCP_GG_LATHE] != -1)
-        rc = ncp_an_error(a, w->gcol[NCP_GG_LATHE], "lathe diameter mode is not supported");
+        ncp_exec_lathe_mode(a, w->g[NCP_GG_LATHE] == 70);
     if (rc == NCP_OK && w->g[NCP_GG_COMP] != -1)
         rc = ncp_exec_comp(a, w->g[NCP_GG_COMP]);
     if (rc == NCP_OK && w->g[NCP_GG_TLO] != -1)

@@ -71,8 +71,8 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     case P_SEL_POCKET: return s->selected_pocket;
     case P_RPM_MODE: return 1;
     case P_CSS_MODE: return 0;
-    case P_LATHE_DIA: return 0;
-    case P_LATHE_RAD: return 1;
+    case P_LATHE_DIA: return m->lathe_diameter;
+    case P_LATHE_RAD: return !m->lathe_diameter;
     case P_CALL_LEVEL: return a->flow ? ncp_flow_call_depth(a->flow) : 0;
     case P_VMAJOR: return 2.9;
     case P_VMINOR: return 0;

@@ -68,6 +68,7 @@ struct ncp_modal {
     int flood, mist;
     int feed_override, speed_override, adaptive, feed_hold;
     int g92_enabled;
+    int lathe_diameter;           /* G7: X words are diameters (halved); G8: radii */
 };
 
 struct ncp_state {

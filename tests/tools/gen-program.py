@@ -7,7 +7,7 @@ feeds, parameters are defined before they are read, loops terminate. It covers
 G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G4, G10 L2/L20, G17-G19,
 G20/G21, G28/G30, G43/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
-M0-M9 M30 M48/M49, S T M6 F, comments, MSG and DEBUG with parameters, numbered and
+G7/G8 (X words as diameters), M0-M9 M30 M48/M49, S T M6 F, comments, MSG and DEBUG with parameters, numbered and
 named parameters, expressions with every operator and function, O-word subroutines
 with arguments and return values, if/elseif/else, while, do-while, repeat, break and
 continue. The same seed always gives the same program.
@@ -675,7 +675,45 @@ class Gen:
             return self.st_loop()
         if c < 0.97:
             return self.st_call()
-        return self.st_units_episode()
+        if c < 0.985:
+            return self.st_units_episode()
+        return self.st_diameter_episode()
+
+    def st_diameter_episode(self):
+        """G7 lathe diameter mode: a few straight moves whose X words are
+        diameters (the axis moves half), G7 and G8 alone or on a move's line."""
+        r = self.r
+        lines = r.randint(1, 3)
+        prefix = "G7 " if r.random() < 0.5 else ""
+        if not prefix:
+            self.emit("G7")
+        for k in range(lines + 1):
+            last = k == lines
+            if last:
+                if r.random() < 0.5:
+                    self.emit("G8")
+                    return
+                prefix = "G8 "   # this line's X is a radius again
+            g = r.choice(["G0", "G1"])
+            words, scale = [], 1 if last else 2
+            for a in r.sample(AXES, r.randint(1, 3)):
+                if self.dist == 91:
+                    w = self.n(r.uniform(-15, 15) * self.s() * (scale if a == "X" else 1))
+                    words.append(a + w)
+                    if self.pos[a] is not None:
+                        self.pos[a] += float(w) / (scale if a == "X" else 1)
+                else:
+                    v = r.uniform(-40, 40) * self.s() if a != "Z" else r.uniform(-5, 10) * self.s()
+                    w = self.n(v * (scale if a == "X" else 1))
+                    words.append(a + w)
+                    self.pos[a] = float(w) / (scale if a == "X" else 1)
+            if g == "G1":
+                self.ensure_feed_ready()
+            line = prefix + " ".join([g] + words)
+            if g == "G1" and self.feed_mode == 93:
+                line += " F" + self.feed()
+            self.emit(line)
+            prefix = ""
 
     def st_units_episode(self):
         """A few moves in the other unit system, then back."""

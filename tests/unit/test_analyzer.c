@@ -162,6 +162,34 @@ static void test_straight_feed(void **state)
     run_free(&r);
 }
 
+/* G7: X words are diameters, the mode after the line's own G7/G8 decides,
+ * incremental X too; rs274 says when the mode changes, not when it stays. */
+static void test_lathe_diameter_mode(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "G7 G0 X10 Z1\nG0 X3\nG91 G0 X-4\nG90 G8 G0 X3\n"
+                    "G7\nG8 G0 X7\nG7 G0 X8\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    static const double want_x[] = {5.0, 1.5, -0.5, 3.0, 7.0, 4.0};
+    unsigned moves = 0, comments = 0;
+    for (unsigned k = 6; k < r.c.n_ops; k++) {
+        const struct ncp_canon *op = &r.c.ops[k];
+        if (op->kind == NCP_C_COMMENT)
+            comments++;
+        if (op->kind != NCP_C_STRAIGHT_TRAVERSE)
+            continue;
+        assert_true(moves < sizeof want_x / sizeof want_x[0]);
+        if (op->d[0] != want_x[moves])
+            fail_msg("move %u: X %a, want %a", moves, op->d[0], want_x[moves]);
+        moves++;
+    }
+    assert_int_equal(moves, sizeof want_x / sizeof want_x[0]);
+    /* diameter, radius, diameter, radius, diameter; the distance mode twice */
+    assert_int_equal(comments, 7);
+    run_free(&r);
+}
+
 static void test_error_slot(void **state)
 {
     (void)state;
@@ -396,6 +424,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_preamble_and_end),
         cmocka_unit_test(test_straight_feed),
+        cmocka_unit_test(test_lathe_diameter_mode),
         cmocka_unit_test(test_error_slot),
         cmocka_unit_test(test_eof_without_end),
         cmocka_unit_test(test_arc_request),
