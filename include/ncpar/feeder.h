@@ -35,6 +35,9 @@ int ncp_source_from_memory(struct ncp_source *src, const char *text, size_t len,
                            const char *name, struct ncp_diag *d);
 void ncp_source_close(struct ncp_source *src);
 
+/* A tape delimiter line: '%' first after blanks (what follows does not matter). */
+int ncp_source_percent_line(const char *s, size_t n);
+
 /* Split the block starting at `off` (which has line number `line`). Returns 0 and
  * fills *out, or 1 when off >= src->end (no more blocks). \n and \r\n end a
  * block (a lone \r is left to the lexer, which treats it as a blank). */

@@ -307,7 +307,10 @@ static int cmd_check(int argc, char **argv)
                 continue;
             }
         }
-        if (ncp_lex_block(src.text + sp.off, sp.len, sp.line, sp.off, b) != NCP_OK) {
+        /* '%' lines are tape delimiters, not blocks: the customary one after
+         * M2 is never read, one the run does read is its error above */
+        if (!ncp_source_percent_line(src.text + sp.off, sp.len) &&
+            ncp_lex_block(src.text + sp.off, sp.len, sp.line, sp.off, b) != NCP_OK) {
             print_diag(o.prog, &b->err);
             errors++;
         }

@@ -13,8 +13,7 @@
 #include <emmintrin.h>
 #endif
 
-/* A '%' line: '%' possibly surrounded by blanks, nothing else that matters. */
-static int is_percent_line(const char *s, size_t n)
+int ncp_source_percent_line(const char *s, size_t n)
 {
     size_t i = 0;
     while (i < n && (s[i] == ' ' || s[i] == '\t'))
@@ -48,7 +47,7 @@ static void find_body(struct ncp_source *src)
             line++;
             continue;
         }
-        if (!is_percent_line(s, sp.len))
+        if (!ncp_source_percent_line(s, sp.len))
             return;
         src->has_percent = 1;
         src->begin = sp.next;
@@ -60,7 +59,7 @@ static void find_body(struct ncp_source *src)
     off = src->begin;
     line = src->begin_line;
     while (ncp_source_span(src, off, line, &sp) == 0) {
-        if (is_percent_line(src->text + sp.off, sp.len)) {
+        if (ncp_source_percent_line(src->text + sp.off, sp.len)) {
             src->end = sp.off;
             return;
         }
