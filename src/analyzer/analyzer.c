@@ -290,10 +290,10 @@ static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
         rc = ncp_words_assign(a, b);
     if (rc == NCP_OK)
         rc = ncp_modal_check(a);
-    if (rc == NCP_OK)
+    if (rc == NCP_OK) {
         ncp_lathe_x_word(a);
-    if (rc == NCP_OK)
         rc = ncp_exec_block(a);
+    }
     if (rc == NCP_OK || rc == NCP_END) {
         int c = ncp_an_commit(a);
         if (c != NCP_OK)

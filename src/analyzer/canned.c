@@ -48,11 +48,15 @@ static void ncp_cyc_peck(struct ncp_cyc *c, int motion, double x, double y, doub
                          double clear, double bottom, double delta)
 {
     const double clr = ncp_user_len(c->a, NCP_PECK_CLEARANCE_INCH);
-    for (double d = r - delta; d > bottom; d -= delta) {
+    /* Depth by repeated subtraction, as rs274 steps it: r - k * delta would
+     * round differently and end a peck early or late. */
+    double d = r - delta;
+    while (d > bottom) {
         FEED(c, x, y, d);
         if (motion == 830)
             TRAV(c, x, y, r);
         TRAV(c, x, y, d + clr);
+        d -= delta;
     }
     FEED(c, x, y, bottom);
     TRAV(c, x, y, clear);
@@ -311,7 +315,7 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
     double clear = s->m.retract_r ? rr : old_cc;
     ncp_cyc_motion_mode(a, 1);
     rc = ncp_cyc_pq(a, motion, &p, &q);
-    double ijk[3];
+    double ijk[3] = {0}; /* read by G87 only, which sets them */
     if (rc == NCP_OK)
         rc = ncp_cyc_spindle_check(a, motion);
     if (rc == NCP_OK && motion == 870)

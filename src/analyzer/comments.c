@@ -31,11 +31,11 @@ static size_t ncp_fmt_directive(const char *s, const char *end, char *fmt, struc
         return 1;
     }
     if (s[1] == 'd') {
-        strcpy(fmt, "%.0f");
+        memcpy(fmt, "%.0f", sizeof "%.0f");
         return 2;
     }
     if (s[1] == 'f') {
-        strcpy(fmt, "%.4f");
+        memcpy(fmt, "%.4f", sizeof "%.4f");
         return 2;
     }
     if (s[1] == '.') {

@@ -672,9 +672,9 @@ static int loop_label(struct ncp_flow *f, const struct ncp_block *b, int closes_
 
 static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    struct flow_label *op;
+    struct flow_label *op = NULL;
     int rc = loop_label(f, b, 0, &op, d);
-    if (rc != NCP_OK)
+    if (rc != NCP_OK || !op) /* op is set whenever rc is NCP_OK */
         return rc;
     f->skip.on = 0;
     if (op->type != NCP_O_REPEAT)
@@ -695,9 +695,9 @@ static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
 
 static int do_while(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    struct flow_label *op;
+    struct flow_label *op = NULL;
     int rc = loop_label(f, b, 1, &op, d);
-    if (rc != NCP_OK)
+    if (rc != NCP_OK || !op) /* op is set whenever rc is NCP_OK */
         return rc;
     f->skip.on = 0;
     if (op->type == NCP_O_WHILE) {

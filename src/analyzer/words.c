@@ -81,7 +81,7 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
         return ncp_an_error(a, col, "G-code out of range");
     if (code < 0)
         return ncp_an_error(a, col, "Negative g code used");
-    int g = ncp_g_group[code];
+    int g = (int)ncp_g_group[code]; /* -1: no such code */
     if (g < 0)
         return ncp_an_error(a, col, "Unknown g code used");
     if (code == 800 && w->g[g] != -1)
@@ -148,6 +148,9 @@ static int ncp_declare_targets_before(struct ncp_analyzer *a, const struct ncp_b
                                       uint16_t col)
 {
     unsigned n = b->n_assign < NCP_BLOCK_MAX_ASSIGN ? b->n_assign : NCP_BLOCK_MAX_ASSIGN;
+    /* cppcheck follows one caller's block with no assignments and calls the
+     * loop dead; other blocks have them */
+    // cppcheck-suppress knownConditionTrueFalse
     for (unsigned k = 0; k < n; k++) {
         const struct ncp_assign *as = &b->assign[k];
         if (as->kind != NCP_ASSIGN_NAMED || as->col >= col)
@@ -212,7 +215,7 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b)
     if (b->n_assign == 0)
         return NCP_OK;
     double val[NCP_BLOCK_MAX_ASSIGN];
-    int idx[NCP_BLOCK_MAX_ASSIGN];
+    int idx[NCP_BLOCK_MAX_ASSIGN] = {0}; /* set for the numbered targets, read only for them */
     unsigned n = b->n_assign;
     if (n > NCP_BLOCK_MAX_ASSIGN)
         n = NCP_BLOCK_MAX_ASSIGN;
