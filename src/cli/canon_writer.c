@@ -117,10 +117,10 @@ static void close_in_background(int fd)
  * (4-13 ms here), and ext4, seeing a file truncated to zero and written
  * again, starts its writeback when it is closed (12 ms). A new file under the
  * old name has neither. Only a file the user could not tell from the one
- * O_TRUNC would leave is replaced: a regular file of ours, one link, no
- * extended attributes (ACLs, labels), whose mode carries over. Anything else
- * (a symlink, a device, a FIFO, a hard-linked or foreign file) is opened with
- * O_TRUNC as before. The old file's pages are freed when its last descriptor
+ * O_TRUNC would leave is replaced: a regular file of ours that we may write,
+ * one link, no extended attributes (ACLs, labels), whose mode carries over.
+ * Anything else (a symlink, a device, a FIFO, a hard-linked, read-only or
+ * foreign file) is opened with O_TRUNC as before. The old file's pages are freed when its last descriptor
  * closes, in a short thread of its own, so the run does not wait for it (an
  * unlink() of the last name frees them in the call: 3-30 ms here). The serial
  * reference gets the same thread: it is file-system housekeeping, not
@@ -129,8 +129,10 @@ static void close_in_background(int fd)
 static int open_replacing(const char *path)
 {
     struct stat st;
+    /* no write permission: O_TRUNC must refuse it (or, for root, write it) as
+     * it always did, not an unlink the directory would allow */
     if (lstat(path, &st) != 0 || !S_ISREG(st.st_mode) || st.st_nlink != 1 ||
-        st.st_uid != geteuid() || st.st_size == 0)
+        st.st_uid != geteuid() || !(st.st_mode & S_IWUSR) || st.st_size == 0)
         return -1;
     ssize_t xattrs = llistxattr(path, NULL, 0);
     if (xattrs != 0)
