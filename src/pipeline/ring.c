@@ -62,6 +62,7 @@ int ncp_ring_init_staged(struct ncp_ring *r, size_t elem_size, uint32_t capacity
     r->mask = cap - 1;
     r->stride = stride;
     r->batch = cap / 8 > NCP_RING_MAX_BATCH ? NCP_RING_MAX_BATCH : cap / 8 ? cap / 8 : 1;
+    r->spin = NCP_RING_SPIN;
     for (unsigned s = 0; s < NCP_RING_MAX_STAGES; s++) {
         atomic_init(&r->stage[s].pos, 0);
         atomic_init(&r->stage[s].sleepers, 0);
@@ -264,7 +265,7 @@ static int wait_ready(struct ncp_ring *r, unsigned s, uint32_t k)
     if (rc != 0)
         return rc;
     st->waits++;
-    for (int i = 0; i < NCP_RING_SPIN; i++) {
+    for (uint32_t i = 0; i < r->spin; i++) {
         ncp_cpu_relax();
         rc = ready(r, s, k, memory_order_acquire);
         if (rc != 0)
@@ -373,6 +374,11 @@ void ncp_ring_set_batch(struct ncp_ring *r, uint32_t batch)
 {
     uint32_t most = (r->mask + 1) / 8 ? (r->mask + 1) / 8 : 1;
     r->batch = batch == 0 ? 1 : batch > most ? most : batch;
+}
+
+void ncp_ring_set_spin(struct ncp_ring *r, uint32_t spins)
+{
+    r->spin = spins;
 }
 
 void *ncp_ring_reserve(struct ncp_ring *r)

@@ -50,6 +50,7 @@ struct ncp_ring {
     alignas(64) _Atomic uint32_t state;  /* NCP_RING_EOF | NCP_RING_ABORT */
     unsigned n_stages;
     uint32_t batch;                      /* publish a stage's position every batch items */
+    uint32_t spin;                       /* polls before a waiting stage sleeps */
     uint32_t mask;                       /* capacity - 1 */
     size_t stride;
     size_t bytes;                        /* mapped for the slots */
@@ -115,6 +116,10 @@ uint32_t ncp_ring_to_end(const struct ncp_ring *r, unsigned s);
 /* Publish positions every `batch` elements (default: an eighth of the ring, at
  * most 32): rings of small units want larger batches. */
 void ncp_ring_set_batch(struct ncp_ring *r, uint32_t batch);
+/* How long a stage that finds no data or room polls before it sleeps
+ * (NCP_RING_SPIN by default). 0: sleep at once, for when the run has more
+ * threads than CPUs and the one polling would hold up the one it waits for. */
+void ncp_ring_set_spin(struct ncp_ring *r, uint32_t spins);
 
 /* Producer: no more data. Later stages drain what is there, then get NULL. */
 void ncp_ring_close(struct ncp_ring *r);

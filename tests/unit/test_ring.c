@@ -263,6 +263,24 @@ static void test_spsc_stress_two_threads(void **state)
     ring_free(s.r);
 }
 
+/* With no polling (more threads than CPUs) every wait goes straight to the
+ * futex: the same hand-off must still lose and repeat nothing. */
+static void test_spsc_stress_no_spin(void **state)
+{
+    (void)state;
+    struct stress s = { ring_new(2 * sizeof(uint64_t), 16, 2), 0, 0 };
+    ncp_ring_set_spin(s.r, 0);
+    pthread_t p, c;
+    pthread_create(&c, NULL, stress_consumer, &s);
+    pthread_create(&p, NULL, stress_producer, &s);
+    pthread_join(p, NULL);
+    pthread_join(c, NULL);
+    assert_int_equal(s.bad, 0);
+    assert_int_equal(s.got, STRESS_N);
+    assert_true(ncp_ring_sleeps(s.r, 0) + ncp_ring_sleeps(s.r, 1) > 0);
+    ring_free(s.r);
+}
+
 /* producer -> middle (completes in place) -> last (checks, hands back) */
 static void *stage_middle(void *arg)
 {
@@ -418,6 +436,7 @@ int main(void)
         cmocka_unit_test(test_wrap_around_single_thread),
         cmocka_unit_test(test_close_drains_then_ends),
         cmocka_unit_test(test_spsc_stress_two_threads),
+        cmocka_unit_test(test_spsc_stress_no_spin),
         cmocka_unit_test(test_three_stage_stress),
         cmocka_unit_test(test_close_wakes_blocked_consumer),
         cmocka_unit_test(test_abort_wakes_blocked_producer),
