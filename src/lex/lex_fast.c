@@ -3,9 +3,9 @@
  * first copies the line without its blanks and with a column for every byte,
  * then reads words from the copy; for CAM output that copy and its per-digit
  * loops were most of the lexing time. Anything this reader does not take
- * exactly as the general one would (comments, expressions, parameters, N and
- * O words, blanks inside a number, signs beyond one, errors of any kind) makes
- * it give up and the general reader reads the line from the start, so both
+ * exactly as the general one would (comments, expressions, parameters, O
+ * words, an N word with a fraction or not first, blanks inside a number, signs
+ * beyond one, errors of any kind) makes it give up and the general reader reads the line from the start, so both
  * paths give the same block; tests/unit/test_lex.c checks that they do. */
 #include "lex_internal.h"
 
@@ -84,6 +84,30 @@ static int is_letter(char c)
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
 }
 
+/* A leading N word (line number, what many CAM posts put on every line),
+ * read as the general reader reads it: digits accumulated in a double. Returns
+ * where the next word starts, or 0 to give up ("N10.5", "N 10", a comment or
+ * a digit after it). */
+static size_t line_number(const char *text, size_t len, size_t i, struct ncp_block *out)
+{
+    size_t p = i + 1;
+    if (p >= len || !is_digit(text[p]))
+        return 0;
+    double v = 0.0;
+    while (p < len && is_digit(text[p]))
+        v = v * 10.0 + (text[p++] - '0');
+    if (p < len && text[p] == '.')
+        return 0;
+    size_t j = p;
+    while (j < len && is_blank(text[j]))
+        j++;
+    if (j < len && !is_letter(text[j]) && text[j] != '\n' && text[j] != '\r')
+        return 0;
+    out->has_n = 1;
+    out->n_number = v;
+    return j;
+}
+
 int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t offset,
                       struct ncp_block *out, size_t *next)
 {
@@ -94,6 +118,10 @@ int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t of
     ncp_lex_init_block(out, 0, line, offset);
     uint32_t seen = 0;
     size_t i = 0;
+    while (i < len && is_blank(text[i]))
+        i++;
+    if (i < len && (text[i] == 'N' || text[i] == 'n') && (i = line_number(text, len, i, out)) == 0)
+        return 0;
     for (;;) {
         while (i < len && is_blank(text[i]))
             i++;

@@ -866,14 +866,17 @@ static void test_fast_path_is_the_general_reader(void **state)
         "G2 X7.867 Y2.423 I0.000 J2.000", "X.5 Y-.5 Z+.5", "G1 X1.", "M3 S12000",
         "G1 G0 X1", "M3 M8", "X1.0000000000000000001", "X123456789012345678901",
         "A1 B2 C3 D4 E5 F6 H7 I8 J9 K10 L11 P12 Q13 R14 S15 T16 X17 Y18 Z19",
+        "N10 G1 X1", "n20g1x1", "N10", "  N0010 G0 X1 ", "N123456789012345678901 G1 X1",
+        "N7\tM3 S100",
     };
     int taken = 0;
     for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++)
         expect_fast_like_general(lines[i], strlen(lines[i]), &taken);
-    assert_true(taken >= 12);
+    assert_true(taken >= 18);
     /* and what it must leave alone */
     static const char *const general_only[] = {
-        "N10 G1 X1", "G1 X1 (c)", "G1 X1 ;c", "/G1 X1", "G1 X#1", "G1 X[1]", "G1 X1 X2",
+        "N10.5 G1 X1", "N 10 G1", "N10(c)", "N10 ;c", "G1 N10 X1", "N", "NX1", "N10 O100 sub",
+        "N10 N20", "N10 2", "/N10 G1", "G1 X1 (c)", "G1 X1 ;c", "/G1 X1", "G1 X#1", "G1 X[1]", "G1 X1 X2",
         "G1 X1.2.3", "G1 X--1", "G1 X1 2", "G1 X", "o100 sub", "G1 U1", "G1 X1\r",
         "G1 X1\v", "#1=2", "G1 $1", "G1 X 1",
     };
@@ -896,6 +899,11 @@ static void test_fast_path_is_the_general_reader(void **state)
             /* mostly letter, digits, point, blank: the shapes the fast path takes */
             unsigned r = (unsigned)(seed >> 33);
             line[i] = r % 4 ? "GXYZ0123456789. "[r / 4 % 16] : alphabet[r / 4 % (sizeof alphabet - 1)];
+        }
+        if (iter % 3 == 0 && len > 2) { /* a leading N word, now and then a malformed one */
+            line[0] = iter % 2 ? 'N' : 'n';
+            for (size_t i = 1; i < len && i < 1 + (size_t)(seed >> 60); i++)
+                line[i] = (char)('0' + (seed >> (4 * i)) % 10);
         }
         expect_fast_like_general(line, len, &taken);
     }
