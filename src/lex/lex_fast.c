@@ -84,6 +84,17 @@ static int is_letter(char c)
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
 }
 
+/* Where the next word or the line end starts after the word ending at p
+ * (p > 0), past blanks; 0 when something else follows them (a digit: "X1 2"
+ * is X12 to the general reader; a comment), which is not this reader's. */
+static size_t word_ends(const char *text, size_t len, size_t p)
+{
+    size_t k = p;
+    while (k < len && is_blank(text[k]))
+        k++;
+    return k >= len || is_letter(text[k]) || text[k] == '\n' || text[k] == '\r' ? k : 0;
+}
+
 /* A leading N word (line number, what many CAM posts put on every line),
  * read as the general reader reads it: digits accumulated in a double. Returns
  * where the next word starts, or 0 to give up ("N10.5", "N 10", a comment or
@@ -96,12 +107,8 @@ static size_t line_number(const char *text, size_t len, size_t i, struct ncp_blo
     double v = 0.0;
     while (p < len && is_digit(text[p]))
         v = v * 10.0 + (text[p++] - '0');
-    if (p < len && text[p] == '.')
-        return 0;
-    size_t j = p;
-    while (j < len && is_blank(text[j]))
-        j++;
-    if (j < len && !is_letter(text[j]) && text[j] != '\n' && text[j] != '\r')
+    size_t j = p < len && text[p] == '.' ? 0 : word_ends(text, len, p);
+    if (j == 0)
         return 0;
     out->has_n = 1;
     out->n_number = v;
@@ -149,11 +156,8 @@ int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t of
         double v;
         if (!plain_number(text, len, &i, &v))
             return 0;
-        /* a blank may only be followed by the next word: "X1 2" is X12 */
-        size_t j = i;
-        while (j < len && is_blank(text[j]))
-            j++;
-        if (j < len && !is_letter(text[j]) && text[j] != '\n' && text[j] != '\r')
+        size_t j = word_ends(text, len, i);
+        if (j == 0)
             return 0;
         struct ncp_word *w = &out->words[out->n_words++];
         w->letter = (char)(c - 32);
