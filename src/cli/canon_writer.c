@@ -120,12 +120,13 @@ static void close_in_background(int fd)
  * O_TRUNC would leave is replaced: a regular file of ours that we may write,
  * one link, no extended attributes (ACLs, labels), whose mode carries over.
  * Anything else (a symlink, a device, a FIFO, a hard-linked, read-only or
- * foreign file) is opened with O_TRUNC as before. The old file's pages are freed when its last descriptor
- * closes, in a short thread of its own, so the run does not wait for it (an
- * unlink() of the last name frees them in the call: 3-30 ms here). The serial
- * reference gets the same thread: it is file-system housekeeping, not
- * interpretation, and serial and parallel runs must pay alike for their
- * output. Returns the new descriptor or -1 (then the caller truncates). */
+ * foreign file) is opened with O_TRUNC as before. The old file's pages are
+ * freed when its last descriptor closes, in a short thread of its own, so
+ * the run does not wait for it (an unlink() of the last name frees them in
+ * the call: 3-30 ms here). The serial reference gets the same thread: it is
+ * file-system housekeeping, not interpretation, and serial and parallel runs
+ * must pay alike for their output. Returns the new descriptor or -1 (then the
+ * caller truncates). */
 static int open_replacing(const char *path)
 {
     struct stat st;
