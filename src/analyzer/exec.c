@@ -107,6 +107,37 @@ static int ncp_exec_override(struct ncp_analyzer *a, int m)
     return NCP_OK;
 }
 
+/* M66: wait for a digital (P) or analog (E) input, L the wait type, Q the
+ * timeout; rs274's checks in its order. There is no input here, as in
+ * rs274 -g, whose stand-in returns the default: after a digital wait #5399
+ * (the result) becomes 1 if it was not 0, else 0; after an analog one it
+ * keeps its value. Nothing is printed (rs274 -g prints no call for it). */
+static int ncp_exec_wait_input(struct ncp_analyzer *a)
+{
+    const struct ncp_words *w = &a->w;
+    uint16_t col = w->mcol[NCP_MG_IO];
+    int has_p = NCP_HAS(w, 'P'), has_e = NCP_HAS(w, 'E'), has_l = NCP_HAS(w, 'L');
+    double q = NCP_HAS(w, 'Q') ? W(a, 'Q') : -1.0;
+    int l = has_l ? ncp_trunc_int_round(W(a, 'L')) : 0;
+    if (has_p && has_e)
+        return ncp_an_error(a, col, "Invalid to select both a digital and an analog input with M66");
+    if (q <= 0.0 && has_l && l > 0)
+        return ncp_an_error(a, col, "Zero timeout with wait type != immediate return");
+    if (has_e && has_l && l != 0)
+        return ncp_an_error(a, col, "Can't select analog input with wait type != immediate return");
+    if ((has_p && ncp_trunc_int_round(W(a, 'P')) < 0) ||
+        (has_e && ncp_trunc_int_round(W(a, 'E')) < 0) || (!has_p && !has_e))
+        return ncp_an_error(a, col, "Need to have either a valid P or a valid E word with M66");
+    if (a->st.m.comp_side != 0)
+        return ncp_an_error(a, col, has_p ? "Cannot wait for digital input with cutter radius compensation on"
+                                          : "Cannot wait for analog input with cutter radius compensation on");
+    if (has_p) {
+        double *result = ncp_params_slot(a->params, 5399);
+        *result = *result != 0.0 ? 1.0 : 0.0;
+    }
+    return NCP_OK;
+}
+
 static int ncp_exec_io(struct ncp_analyzer *a, int m)
 {
     static const enum ncp_canon_kind bits[] = {
@@ -128,6 +159,8 @@ static int ncp_exec_io(struct ncp_analyzer *a, int m)
         op->d[0] = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
         return NCP_OK;
     }
+    if (m == 66)
+        return ncp_exec_wait_input(a);
     return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "M%d is not supported", m);
 }
 

@@ -7,7 +7,7 @@ feeds, parameters are defined before they are read, loops terminate. It covers
 G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G4, G10 L2/L20, G17-G19,
 G20/G21, G28/G30, G43/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
-G7/G8 (X words as diameters), M0-M9 M30 M48/M49, S T M6 F, comments, MSG and DEBUG with parameters, numbered and
+G7/G8 (X words as diameters), M66 (wait for an input), M0-M9 M30 M48/M49, S T M6 F, comments, MSG and DEBUG with parameters, numbered and
 named parameters, expressions with every operator and function, O-word subroutines
 with arguments and return values, if/elseif/else, while, do-while, repeat, break and
 continue. The same seed always gives the same program.
@@ -431,7 +431,13 @@ class Gen:
         elif c == 10:
             self.emit(r.choice(["M0", "M1"]))
         elif c == 11:
-            self.emit("S%d" % r.choice([500, 1500, 3000]))
+            if r.random() < 0.7:
+                self.emit("S%d" % r.choice([500, 1500, 3000]))
+            else:   # wait for an input; #5399 holds what rs274's stand-in reports
+                self.emit(r.choice(["M66 P%d L0" % r.randint(0, 3), "M66 E%d" % r.randint(0, 3),
+                                    "M66 P%d L%d Q%s" % (r.randint(0, 3), r.randint(1, 4),
+                                                         num(r.uniform(0.5, 3), 1))]))
+                self.emit("(DEBUG, input result #5399)")
         else:
             self.emit("G4 P%s" % num(r.uniform(0, 1.5), 2))
 
