@@ -130,6 +130,41 @@ int ncp_offsets_coord(struct ncp_analyzer *a, int origin)
     return NCP_OK;
 }
 
+/* The tool table entry of tool h for G43 H / G43.2 H. */
+static int ncp_tlo_tool_index(struct ncp_analyzer *a, int h, int *idx)
+{
+    *idx = ncp_tools_find(a, h);
+    if (*idx < 0) {
+        const struct ncp_words *w = &a->w;
+        uint16_t col = NCP_HAS(w, 'H') ? w->col[NCP_LETTER('H')] : w->gcol[NCP_GG_TLO];
+        return ncp_an_error(a, col, "Requested tool %d not found in the tool table", h);
+    }
+    return NCP_OK;
+}
+
+/* G43.2: the current offset plus tool H's, into nw. LinuxCNC 2.9's rs274
+ * (the reference here) checks for H and axis words as later versions do but
+ * has no axis-word form: without H it looks up tool -1 and fails. */
+static int ncp_offsets_tlo_add(struct ncp_analyzer *a, double *nw)
+{
+    const struct ncp_words *w = &a->w;
+    int has_h = NCP_HAS(w, 'H'), axes = (w->has & NCP_AXIS_LETTERS) != 0;
+    if (has_h && axes)
+        return ncp_an_error(a, w->gcol[NCP_GG_TLO], "G43.2: Can not have both H and axis words");
+    if (!has_h && !axes)
+        return ncp_an_error(a, w->gcol[NCP_GG_TLO], "G43.2: No axes specified and H word missing");
+    int idx;
+    int rc = ncp_tlo_tool_index(a, has_h ? ncp_trunc_int_round(w->v[NCP_LETTER('H')]) : -1, &idx);
+    if (rc != NCP_OK)
+        return rc;
+    memcpy(nw, a->st.tlo, NCP_NAX * sizeof *nw);
+    for (int ax = 0; ax < NCP_NAX; ax++) {
+        double u = ncp_tool_offset(a, idx, ax);
+        nw[ax] += ncp_is_linear(ax) ? ncp_tool_len(a, u) : u;
+    }
+    return NCP_OK;
+}
+
 int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
 {
     struct ncp_state *s = &a->st;
@@ -141,11 +176,9 @@ int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
     if (g == 430) {
         int idx = -1;
         if (NCP_HAS(w, 'H')) {
-            int h = ncp_trunc_int_round(w->v[NCP_LETTER('H')]);
-            idx = ncp_tools_find(a, h);
-            if (idx < 0)
-                return ncp_an_error(a, w->col[NCP_LETTER('H')],
-                                    "Requested tool %d not found in the tool table", h);
+            int rc = ncp_tlo_tool_index(a, ncp_trunc_int_round(w->v[NCP_LETTER('H')]), &idx);
+            if (rc != NCP_OK)
+                return rc;
         } else if (s->toolchange_flag) {
             idx = s->current_pocket; /* M6/M61 earlier in this block */
         } else {
@@ -163,7 +196,9 @@ int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
                 nw[ax] = w->v[l];
         }
     } else if (g == 432) {
-        return ncp_an_error(a, w->gcol[NCP_GG_TLO], "G43.2 is not supported");
+        int rc = ncp_offsets_tlo_add(a, nw);
+        if (rc != NCP_OK)
+            return rc;
     }
     ncp_emit_tlo_values(a, nw);
     /* the X/Y change of the offset is a machine-frame vector */

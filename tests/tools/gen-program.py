@@ -5,7 +5,7 @@ Writes to stdout a random RS274/NGC program of about N lines that LinuxCNC's rs2
 accepts (with simpockets.tbl): every arc is geometrically valid, F is set before
 feeds, parameters are defined before they are read, loops terminate. It covers
 G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G4, G10 L2/L20, G17-G19,
-G20/G21, G28/G30, G43/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
+G20/G21, G28/G30, G43/G43.2/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
 G7/G8 (X words as diameters), M66 (wait for an input), M0-M9 M30 M48/M49, S T M6 F, comments, MSG and DEBUG with parameters, numbered and
 named parameters, expressions with every operator and function, O-word subroutines
@@ -507,7 +507,8 @@ class Gen:
             if r.random() < 0.5:
                 self.emit("G43 H%d" % r.choice(TOOLS + [0]))
         elif c == 7:
-            self.emit(r.choice(["G43", "G49", "G43 H%d" % r.choice(TOOLS)]))
+            self.emit(r.choice(["G43", "G49", "G43 H%d" % r.choice(TOOLS),
+                                "G43.2 H%d" % r.choice(TOOLS)]))
         elif c == 8:
             if self.dist == 91:
                 return self.st_straight()
