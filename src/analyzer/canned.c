@@ -8,7 +8,6 @@
 
 static const int ncp_cyc_axes[3][3] = {
     {NCP_X, NCP_Y, NCP_Z}, {NCP_Y, NCP_Z, NCP_X}, {NCP_Z, NCP_X, NCP_Y}};
-static const char ncp_cyc_letter[NCP_NAX] = {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'};
 static const char *const ncp_cyc_no_depth[3] = {
     "Z value unspecified in xy plane canned cycle",
     "X value unspecified in yz plane canned cycle",
@@ -260,7 +259,7 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
     int rc = ncp_cyc_checks(a, motion, &r, &l);
     if (rc != NCP_OK)
         return rc;
-    char nl = ncp_cyc_letter[ax[2]];
+    char nl = ncp_axis_letter[ax[2]];
     int has_n = NCP_HAS(w, nl);
     if (s->m.motion != motion && !has_n)
         return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col,
@@ -273,7 +272,7 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
     }
     double old_cc = s->cycle_il;
     double aa, bb, ai = 0.0, bi = 0.0, cc, rr;
-    char l1 = ncp_cyc_letter[ax[0]], l2 = ncp_cyc_letter[ax[1]];
+    char l1 = ncp_axis_letter[ax[0]], l2 = ncp_axis_letter[ax[1]];
     int polar = pl == 0 && (w->has & NCP_POLAR_BITS) != 0;
     double rad_inc = 0.0, th_inc = 0.0;
     if (!s->m.incremental) {

@@ -7,16 +7,6 @@
 #include <stdio.h>
 #include <string.h>
 
-static const char ncp_g10_letters[NCP_NAX] = {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'};
-
-static int ncp_g10_word(const struct ncp_words *w, int ax, double *v)
-{
-    int l = NCP_LETTER(ncp_g10_letters[ax]);
-    if (!((w->has >> l) & 1u))
-        return 0;
-    *v = w->v[l];
-    return 1;
-}
 
 static double ncp_g10_to_user(const struct ncp_analyzer *a, int ax, double prog)
 {
@@ -41,9 +31,9 @@ static void ncp_g10_l20_xy(struct ncp_analyzer *a, int p, double r, const double
 {
     const struct ncp_words *w = &a->w;
     double ox = cur[NCP_X], oy = cur[NCP_Y], x = cur[NCP_X], y = cur[NCP_Y], v;
-    if (ncp_g10_word(w, NCP_X, &v))
+    if (ncp_axis_word(w, NCP_X, &v))
         x = v;
-    if (ncp_g10_word(w, NCP_Y, &v))
+    if (ncp_axis_word(w, NCP_Y, &v))
         y = v;
     ncp_rotate(&ox, &oy, r);
     ncp_rotate(&x, &y, r);
@@ -108,7 +98,7 @@ static int ncp_g10_origin(struct ncp_analyzer *a, int l)
     }
     for (int ax = first; ax < NCP_NAX; ax++) {
         int index = 5201 + 20 * p + ax;
-        if (ncp_g10_word(w, ax, &v)) {
+        if (ncp_axis_word(w, ax, &v)) {
             nw[ax] = l == 20 ? cur[ax] + ncp_frame_user(a, ax, index) - v : v;
             ncp_g10_store(a, index, ncp_g10_to_user(a, ax, nw[ax]));
         } else {
@@ -166,10 +156,10 @@ static void ncp_g10_tool_measured(struct ncp_analyzer *a, int l, int idx)
         for (int ax = 0; ax < NCP_NAX; ax++)
             t[ax] += ncp_frame_user(a, ax, 5211 + ax);
     double r = ncp_frame_param(a, 5210 + 20 * dest);
-    int hx = ncp_g10_word(w, NCP_X, &v), hy = NCP_HAS(w, 'Y');
+    int hx = ncp_axis_word(w, NCP_X, &v), hy = NCP_HAS(w, 'Y');
     if (hx)
         t[NCP_X] -= v;
-    if (ncp_g10_word(w, NCP_Y, &v))
+    if (ncp_axis_word(w, NCP_Y, &v))
         t[NCP_Y] -= v;
     if (hx && hy) {
         ncp_rotate(&t[NCP_X], &t[NCP_Y], r);
@@ -179,7 +169,7 @@ static void ncp_g10_tool_measured(struct ncp_analyzer *a, int l, int idx)
         ncp_g10_tool_one_axis(a, idx, hx ? 0 : 1, r, t);
     }
     for (int ax = NCP_Z; ax < NCP_NAX; ax++)
-        if (ncp_g10_word(w, ax, &v))
+        if (ncp_axis_word(w, ax, &v))
             ncp_tool_set_offset(a, idx, ax, ncp_g10_to_user(a, ax, t[ax] - v));
 }
 
@@ -199,7 +189,7 @@ static int ncp_g10_tool(struct ncp_analyzer *a, int l)
     double v;
     if (l == 1) {
         for (int ax = 0; ax < NCP_NAX; ax++)
-            if (ncp_g10_word(w, ax, &v))
+            if (ncp_axis_word(w, ax, &v))
                 ncp_tool_set_offset(a, idx, ax, ncp_g10_to_user(a, ax, v));
     } else {
         ncp_g10_tool_measured(a, l, idx);

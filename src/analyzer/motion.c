@@ -5,14 +5,6 @@
 #include <math.h>
 #include <string.h>
 
-static const char ncp_letters[NCP_NAX] = {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'};
-/* Their word slots, constant: NCP_LETTER of a table entry is computed per
- * axis at run time, a chain of compares in every move's end point. */
-static const unsigned char ncp_axis_slot[NCP_NAX] = {
-    NCP_LETTER('X'), NCP_LETTER('Y'), NCP_LETTER('Z'), NCP_LETTER('A'), NCP_LETTER('B'),
-    NCP_LETTER('C'), NCP_LETTER('U'), NCP_LETTER('V'), NCP_LETTER('W'),
-};
-
 /* Polar words (@ radius, ^ angle in degrees) replace X/Y in the XY plane. */
 static int ncp_motion_polar(struct ncp_analyzer *a, double *end)
 {
@@ -205,7 +197,7 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
     int has_ijk = (w->has & ((1u << NCP_LETTER('I')) | (1u << NCP_LETTER('J')) |
                              (1u << NCP_LETTER('K')))) != 0;
     int has_r = NCP_HAS(w, 'R');
-    if (!NCP_HAS(w, ncp_letters[ax[0]]) && !NCP_HAS(w, ncp_letters[ax[1]]) && has_r)
+    if (!NCP_HAS(w, ncp_axis_letter[ax[0]]) && !NCP_HAS(w, ncp_axis_letter[ax[1]]) && has_r)
         return ncp_an_error(a, col, "%s", ncp_plane_missing[pl]);
     if (!has_r && !has_ijk)
         return ncp_an_error(a, col, "R i j k words all missing for arc");

@@ -1,5 +1,5 @@
 /* Coordinate offsets and units: G20/G21, G54..G59.3, G10 L2/L20, G92 family,
- * G52, G43/G43.1/G49, G28/G30 and their .1 forms, and the numbered parameters
+ * G52, G43/G43.1/G43.2/G49, G28/G30 and their .1 forms, and the numbered parameters
  * that mirror them. Parameters hold rs274's user unit (inch); the state holds
  * program units. */
 #include "state.h"
@@ -7,8 +7,6 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-
-static const char ncp_axis_letters[NCP_NAX] = {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'};
 
 static int ncp_is_linear(int ax)
 {
@@ -190,11 +188,8 @@ int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
         }
     } else if (g == 431) {
         memcpy(nw, s->tlo, sizeof nw);
-        for (int ax = 0; ax < NCP_NAX; ax++) {
-            int l = NCP_LETTER(ncp_axis_letters[ax]);
-            if ((w->has >> l) & 1u)
-                nw[ax] = w->v[l];
-        }
+        for (int ax = 0; ax < NCP_NAX; ax++)
+            ncp_axis_word(w, ax, &nw[ax]);
     } else if (g == 432) {
         int rc = ncp_offsets_tlo_add(a, nw);
         if (rc != NCP_OK)
@@ -224,14 +219,6 @@ static void ncp_store_g92_params(struct ncp_analyzer *a, int applied)
         *p = applied;
 }
 
-static int ncp_word_axis(const struct ncp_words *w, int ax, double *v)
-{
-    int l = NCP_LETTER(ncp_axis_letters[ax]);
-    if (!((w->has >> l) & 1u))
-        return 0;
-    *v = w->v[l];
-    return 1;
-}
 
 /* G92 sets the point to read as the words; G52 sets the offset itself. */
 static void ncp_g92_words(struct ncp_analyzer *a, int g52)
@@ -239,7 +226,7 @@ static void ncp_g92_words(struct ncp_analyzer *a, int g52)
     struct ncp_state *s = &a->st;
     for (int ax = 0; ax < NCP_NAX; ax++) {
         double v;
-        if (!ncp_word_axis(&a->w, ax, &v))
+        if (!ncp_axis_word(&a->w, ax, &v))
             continue;
         if (g52) {
             s->pos[ax] += s->g92[ax] - v;
@@ -303,7 +290,7 @@ static int ncp_home(struct ncp_analyzer *a, int g)
     if (w->has & NCP_AXIS_LETTERS) {
         for (int ax = 0; ax < NCP_NAX; ax++) {
             double v;
-            if (!ncp_word_axis(w, ax, &v))
+            if (!ncp_axis_word(w, ax, &v))
                 end[ax] = mid[ax];
         }
     }

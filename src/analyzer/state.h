@@ -148,6 +148,12 @@ int ncp_comp_stop(struct ncp_analyzer *a, int reset);
 
 /* words.c */
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
+/* Axis ax (enum ncp_axis)'s letter, and its slot in struct ncp_words: a table,
+ * since NCP_LETTER of a variable is a chain of compares at run time. */
+extern const char ncp_axis_letter[NCP_NAX];
+extern const unsigned char ncp_axis_slot[NCP_NAX];
+/* 1 and *v when the block has axis ax's word, else 0. */
+int ncp_axis_word(const struct ncp_words *w, int ax, double *v);
 int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b);
 
 /* modal.c */

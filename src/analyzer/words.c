@@ -5,6 +5,21 @@
 #include <math.h>
 #include <string.h>
 
+const char ncp_axis_letter[NCP_NAX] = {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'};
+const unsigned char ncp_axis_slot[NCP_NAX] = {
+    NCP_LETTER('X'), NCP_LETTER('Y'), NCP_LETTER('Z'), NCP_LETTER('A'), NCP_LETTER('B'),
+    NCP_LETTER('C'), NCP_LETTER('U'), NCP_LETTER('V'), NCP_LETTER('W'),
+};
+
+int ncp_axis_word(const struct ncp_words *w, int ax, double *v)
+{
+    int l = ncp_axis_slot[ax];
+    if (!((w->has >> l) & 1u))
+        return 0;
+    *v = w->v[l];
+    return 1;
+}
+
 /* G code (x10) -> modal group; -1 unknown. Built once. */
 static int8_t ncp_g_group[1000];
 static int ncp_g_group_ready;
