@@ -5,8 +5,9 @@
  * loops were most of the lexing time. Anything this reader does not take
  * exactly as the general one would (comments, expressions, parameters, O
  * words, an N word with a fraction or not first, blanks inside a number, signs
- * beyond one, errors of any kind) makes it give up and the general reader reads the line from the start, so both
- * paths give the same block; tests/unit/test_lex.c checks that they do. */
+ * beyond one, errors of any kind) makes it give up and the general reader
+ * reads the line from the start, so both paths give the same block;
+ * tests/unit/test_lex.c checks that they do. */
 #include "lex_internal.h"
 
 #include <stdint.h>

@@ -89,6 +89,9 @@ void ncp_ring_release(struct ncp_ring *r);
  * order, one element each. */
 void *ncp_ring_stage_peek(struct ncp_ring *r, unsigned s, uint32_t k);
 void ncp_ring_stage_release(struct ncp_ring *r, unsigned s);
+/* Stage s (>= 1) without waiting: 1 if its k-th element is there, 0 if it
+ * would have to wait for it, -1 if it never comes (end of data, abort). */
+int ncp_ring_stage_poll(struct ncp_ring *r, unsigned s, uint32_t k);
 
 /* For prefetching, never waiting and touching no shared line: stage s's k-th
  * element after its next one if the stage before is already known to have
@@ -96,10 +99,6 @@ void ncp_ring_stage_release(struct ncp_ring *r, unsigned s);
  * reserve if it is known to be free, else NULL. Blocks cross cores through
  * these rings, and a stage that first touches each slot as it takes it waits
  * a full cache-to-cache transfer per block. */
-/* Stage s (>= 1) without waiting: 1 if its k-th element is there, 0 if it
- * would have to wait for it, -1 if it never comes (end of data, abort). */
-int ncp_ring_stage_poll(struct ncp_ring *r, unsigned s, uint32_t k);
-
 const void *ncp_ring_stage_ahead(const struct ncp_ring *r, unsigned s, uint32_t k);
 void *ncp_ring_reserve_ahead(const struct ncp_ring *r, uint32_t k);
 
