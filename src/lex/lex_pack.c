@@ -118,9 +118,7 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
 {
     struct pack_counts c = counts_of(b);
     size_t total = bytes_of(b, &c);
-    struct packed_head h = {
-        .has_n = b->has_n, .has_err = b->err.code != NCP_OK, .oword_kind = b->oword.kind,
-    };
+    uint8_t has_n = b->has_n, has_err = b->err.code != NCP_OK, oword_kind = b->oword.kind;
     unsigned char *p = dst;
     HEAD(offset, uint64_t, b->offset);
     HEAD(line, uint32_t, b->line);
@@ -133,15 +131,15 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
     HEAD(n_words, uint8_t, (uint8_t)c.words);
     HEAD(n_assign, uint8_t, (uint8_t)c.assign);
     HEAD(block_delete, uint8_t, b->block_delete);
-    HEAD(has_n, uint8_t, h.has_n);
+    HEAD(has_n, uint8_t, has_n);
     HEAD(comment_kind, uint8_t, b->comment_kind);
-    HEAD(oword_kind, uint8_t, h.oword_kind);
+    HEAD(oword_kind, uint8_t, oword_kind);
     HEAD(oword_nargs, uint8_t, (uint8_t)c.nargs);
-    HEAD(has_err, uint8_t, h.has_err);
-    p += sizeof h;
-    if (h.has_n)
+    HEAD(has_err, uint8_t, has_err);
+    p += sizeof(struct packed_head);
+    if (has_n)
         p = put(p, &b->n_number, sizeof b->n_number);
-    if (h.has_err) {
+    if (has_err) {
         p = put(p, &b->err, offsetof(struct ncp_diag, msg));
         p = put(p, b->err.msg, c.msg - 1);
         *p++ = '\0';
@@ -156,7 +154,7 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
         WORD(is_const, uint8_t, w->v.is_const);
     }
     p = put(p, b->assign, c.assign * sizeof b->assign[0]);
-    if (h.oword_kind != NCP_O_NONE) {
+    if (oword_kind != NCP_O_NONE) {
         p = put(p, &b->oword, ARGS_OFF);
         p = put(p, b->oword.args, c.nargs * sizeof b->oword.args[0]);
     }
