@@ -271,6 +271,40 @@ static int ncp_arc(struct ncp_analyzer *a, int motion)
     return ncp_arc_run(a, motion, end);
 }
 
+/* G38.2 (toward, error if no trip), G38.3 (toward), G38.4 (away, error if no
+ * release), G38.5 (away): rs274's checks, then the probe move between the
+ * probe switching calls. rs274 leaves its current point alone here: it reads
+ * the canon's (backed off, see sai.c) at the next block, with the results. */
+static int ncp_probe(struct ncp_analyzer *a, int motion)
+{
+    struct ncp_state *s = &a->st;
+    uint16_t col = a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION] : a->w.line_col;
+    if (s->m.comp_side != 0)
+        return ncp_an_error(a, col, "Cannot probe with cutter radius comp on");
+    if (s->feed == 0.0)
+        return ncp_an_error(a, col, "Cannot probe with zero feed rate");
+    if (s->m.feed_mode == 2)
+        return ncp_an_error(a, col, "Cannot probe with feed per rev mode");
+    double end[NCP_NAX];
+    int rc = ncp_motion_ends(a, 0, end);
+    if (rc != NCP_OK)
+        return rc;
+    int errors_if_missed = (motion - 382) % 2 == 0;
+    if (errors_if_missed) {
+        int same = 1;
+        for (int ax = 0; ax < NCP_NAX; ax++)
+            same &= end[ax] == s->pos[ax];
+        if (same)
+            return ncp_an_error(a, col, "Start point too close to probe point");
+    }
+    ncp_an_emit(a, NCP_C_TURN_PROBE_ON);
+    memcpy(ncp_an_emit(a, NCP_C_STRAIGHT_PROBE)->d, end, 6 * sizeof(double));
+    ncp_sai_probe(a, end);
+    ncp_an_emit(a, NCP_C_TURN_PROBE_OFF);
+    s->m.motion = motion;
+    return NCP_OK;
+}
+
 int ncp_motion_run(struct ncp_analyzer *a, int motion)
 {
     if (motion != 730 && (motion < 810 || motion > 890))
@@ -285,6 +319,8 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
                          sizeof "interpreter: motion mode set to none" - 1);
         return NCP_OK;
+    case 382: case 383: case 384: case 385:
+        return ncp_probe(a, motion);
     case 730: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
     case 890:
         return ncp_canned_run(a, motion);

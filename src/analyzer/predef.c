@@ -96,10 +96,14 @@ int ncp_predef_lookup(void *ctx, const char *name, size_t len, double *out)
 }
 
 /* Numbered reads through the analyzer: rs274 refuses the current position
- * (#5420..#5428) while cutter compensation is on. */
+ * (#5420..#5428) while cutter compensation is on. rs274 reads back a probe's
+ * or a tool change's results as it reads the next line, O-word lines too;
+ * those never reach ncp_an_block, so any read catches up first (nothing in
+ * the probing or changing block itself reads after the move). */
 static int ncp_predef_get_numbered(void *ctx, int index, double *out, struct ncp_diag *d)
 {
-    const struct ncp_analyzer *a = ctx;
+    struct ncp_analyzer *a = ctx;
+    ncp_sai_resync(a);
     if (index >= 5420 && index <= 5428 && a->st.m.comp_side != 0)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "Cannot read current position with cutter radius compensation on");
@@ -109,7 +113,8 @@ static int ncp_predef_get_numbered(void *ctx, int index, double *out, struct ncp
 static int ncp_predef_get_named(void *ctx, const char *name, size_t len, double *out,
                                 struct ncp_diag *d)
 {
-    const struct ncp_analyzer *a = ctx;
+    struct ncp_analyzer *a = ctx;
+    ncp_sai_resync(a);
     return ncp_params_get_named(a->params, name, len, out, d);
 }
 

@@ -90,6 +90,8 @@ struct ncp_state {
 struct ncp_sai {
     double pos[6], g5x[6], g92[6];
     int inches;
+    int probe_flag;               /* a G38.x ran: rs274 reads its results at the next block */
+    double probed[6];             /* where the probe tripped: its programmed end */
 };
 
 /* An op held back while cutter compensation has a move queued: it is handed
@@ -213,6 +215,7 @@ void ncp_sai_g5x(struct ncp_analyzer *a, const double *v);
 void ncp_sai_g92(struct ncp_analyzer *a, const double *v);
 void ncp_sai_units(struct ncp_analyzer *a, int inches);
 void ncp_sai_resync(struct ncp_analyzer *a);
+void ncp_sai_probe(struct ncp_analyzer *a, const double *end);
 void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op);
 
 /* stop.c */

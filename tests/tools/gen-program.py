@@ -7,10 +7,11 @@ feeds, parameters are defined before they are read, loops terminate. It covers
 G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G4, G10 L2/L20, G17-G19,
 G20/G21, G28/G30, G43/G43.2/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
-G7/G8 (X words as diameters), M66 (wait for an input), M0-M9 M30 M48/M49, S T M6 F, comments, MSG and DEBUG with parameters, numbered and
-named parameters, expressions with every operator and function, O-word subroutines
-with arguments and return values, if/elseif/else, while, do-while, repeat, break and
-continue. The same seed always gives the same program.
+G7/G8 (X words as diameters),
+G38.2-G38.5 (probing), M66 (wait for an input), M0-M9 M30 M48/M49, S T M6 F, comments,
+MSG and DEBUG with parameters, numbered and named parameters, expressions with every
+operator and function, O-word subroutines with arguments and return values,
+if/elseif/else, while, do-while, repeat, break and continue. The same seed always gives the same program.
 
 How validity is kept without simulating the interpreter:
   * geometry parameters (#100-#109) are assigned once, at the top level, with
@@ -684,7 +685,38 @@ class Gen:
             return self.st_call()
         if c < 0.985:
             return self.st_units_episode()
-        return self.st_diameter_episode()
+        if c < 0.993:
+            return self.st_diameter_episode()
+        return self.st_probe_episode()
+
+
+    def st_probe_episode(self):
+        """G38.2-G38.5 toward a point away from here, maybe once more in the
+        probe mode, then the results read back: rs274's stand-in trips at the
+        end and backs off 0.254 mm (0.01 in), so the position is then unknown."""
+        r = self.r
+        if self.feed_mode == 95:
+            self.set_feed_mode(94)
+        g = r.choice(["G38.2", "G38.3", "G38.4", "G38.5"])
+        words = []
+        for a in r.sample(AXES, r.randint(1, 3)):
+            if self.dist == 91:
+                words.append(a + self.n(r.choice([-1, 1]) * r.uniform(1, 15) * self.s()))
+            else:
+                here = self.pos[a] if self.pos[a] is not None else 0.0
+                words.append(a + self.n(here + r.choice([-1, 1]) * r.uniform(1, 15) * self.s()))
+        line = g + " " + " ".join(words)
+        if self.feed_mode == 93 or r.random() < 0.3:
+            line += " F" + self.feed()
+        self.emit(line)
+        self.forget_position()
+        if r.random() < 0.3:   # the probe mode is modal: axis words alone probe again
+            self.emit("%s%s" % (r.choice(AXES), self.n(r.uniform(-20, 20) * self.s())) +
+                      (" F" + self.feed() if self.feed_mode == 93 else ""))
+        self.emit("(DEBUG, probed #5061 #5062 #5063 tripped #5070 at #5420 #5421 #5422)")
+        if r.random() < 0.5:
+            self.emit("#<probed_z> = #5063")
+        self.emit("G80")
 
     def st_diameter_episode(self):
         """G7 lathe diameter mode: a few straight moves whose X words are
