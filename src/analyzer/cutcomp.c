@@ -512,6 +512,11 @@ static void ncp_comp_advance(struct ncp_cutcomp *c, const double cur[2], const d
     memcpy(c->prog, prog3, sizeof c->prog);
 }
 
+static int ncp_bug_not_g0_g1(struct ncp_diag *d, uint32_t line)
+{
+    return ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "Bug code not g0 or g1");
+}
+
 static int ncp_line_first(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
                           const struct ncp_comp_sink *sink, struct ncp_diag *d)
 {
@@ -521,6 +526,8 @@ static int ncp_line_first(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
     if (st != NCP_COMP_OK)
         return ncp_comp_fail(d, m->line, st);
     ncp_set_endpoint(c, m->start[0], m->start[1]);
+    if (m->motion == NCP_COMP_SYNCED)
+        return ncp_bug_not_g0_g1(d, m->line);
     int rc = ncp_push_straight(c, m->motion == 0, dir, end[0], end[1], m->end[2], m->abc, d,
                                m->line);
     c->firstmove = 0;
@@ -536,6 +543,8 @@ static int ncp_line_next(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
     double dir[2] = {p[0] - op[0], p[1] - op[1]};
     int traverse = m->motion == 0;
     if (p[0] == op[0] && p[1] == op[1]) { /* no motion in the plane */
+        if (m->motion == NCP_COMP_SYNCED)
+            return ncp_bug_not_g0_g1(d, m->line);
         int rc = ncp_push_straight(c, traverse, dir, cur[0], cur[1], p[2], m->abc, d, m->line);
         ncp_comp_advance(c, cur, p, p[2]);
         return rc;
@@ -548,6 +557,8 @@ static int ncp_line_next(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
     int rc;
     if (out.corner == NCP_CORNER_CONVEX) {
         rc = ncp_move_endpoint_and_flush(c, cur[0], cur[1], sink, d, m->line);
+        if (rc == NCP_OK && m->motion == NCP_COMP_SYNCED)
+            return ncp_bug_not_g0_g1(d, m->line);
         if (rc == NCP_OK && traverse) {
             static const double none[2] = {0.0, 0.0};
             rc = ncp_push_straight(c, 1, none, out.mid[0], out.mid[1], c->cur[2], m->abc, d,
@@ -648,7 +659,7 @@ int ncp_cutcomp_move(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
                      const struct ncp_comp_sink *sink, struct ncp_diag *d)
 {
     c->inches = m->inches;
-    if (m->motion == 0 || m->motion == 1) {
+    if (m->motion == 0 || m->motion == 1 || m->motion == NCP_COMP_SYNCED) {
         c->inv_pending = 0;
         if (m->g53)
             return ncp_diag_set(d, NCP_ERR_SEMANTIC, m->line, 0,

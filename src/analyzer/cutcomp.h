@@ -85,8 +85,13 @@ struct ncp_comp_on_req {
 };
 
 /* A programmed G0/G1/G2/G3 while compensation is engaged. */
+/* G33/G33.1: rs274's compensation knows only G0 and G1. It fails them where it
+ * picks the call by the code (the entry move, a move without motion in the
+ * plane, a convex corner's arc) and makes them plain feeds everywhere else. */
+#define NCP_COMP_SYNCED 33
+
 struct ncp_comp_move {
-    int motion;               /* 0 G0, 1 G1, 2 G2, 3 G3 */
+    int motion;               /* 0 G0, 1 G1, 2 G2, 3 G3, NCP_COMP_SYNCED */
     double start[3];          /* programmed start, plane coords */
     double end[3];            /* programmed end, plane coords */
     double abc[3];            /* end a b c */

@@ -157,6 +157,13 @@ static int ncp_check_other(struct ncp_analyzer *a)
         return ncp_an_error(a, COL('R'), "R word with no g code that uses it");
     if (!NCP_HAS(w, 'S') && w->g[NCP_GG_SPINDLE] == 960)
         return ncp_an_error(a, w->gcol[NCP_GG_SPINDLE], "S word missing with g96");
+    if (mt == 330 || mt == 331) {
+        if (!NCP_HAS(w, 'K'))
+            return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col,
+                                "K word missing with g33/g33.1");
+        if (NCP_HAS(w, 'F'))
+            return ncp_an_error(a, COL('F'), "F word used with a g33/g33.1");
+    }
 #undef COL
     return NCP_OK;
 }

@@ -305,6 +305,41 @@ static int ncp_probe(struct ncp_analyzer *a, int motion)
     return NCP_OK;
 }
 
+/* G33 (a straight feed locked to the spindle, K the distance per turn) and
+ * G33.1 (rigid tapping to the end and back: rs274 keeps its current point).
+ * Under cutter compensation rs274 hands them to its compensation code, which
+ * knows only G0 and G1 (see ncp_cutcomp_move). */
+static int ncp_synced(struct ncp_analyzer *a, int motion)
+{
+    struct ncp_state *s = &a->st;
+    double end[NCP_NAX];
+    int rc = ncp_motion_ends(a, 0, end);
+    if (rc != NCP_OK)
+        return rc;
+    s->m.motion = motion;
+    if (ncp_cutcomp_engaged(&a->comp)) {
+        rc = ncp_comp_move_straight(a, motion, end, 0);
+        if (rc == NCP_OK)
+            memcpy(s->pos, end, sizeof end);
+        return rc;
+    }
+    if (s->m.spindle_dir == 0)
+        return ncp_an_error(a, a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION]
+                                                        : a->w.line_col,
+                            motion == 330 ? "Spindle not turning in G33"
+                                          : "Spindle not turning in G33.1");
+    struct ncp_canon *sync = ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH);
+    sync->d[0] = a->w.v[NCP_LETTER('K')];
+    if (motion == 330) {
+        ncp_an_emit6(a, NCP_C_STRAIGHT_FEED, end);
+        memcpy(s->pos, end, sizeof end);
+    } else {
+        memcpy(ncp_an_emit(a, NCP_C_RIGID_TAP)->d, end, 3 * sizeof(double));
+    }
+    ncp_an_emit(a, NCP_C_STOP_SPEED_FEED_SYNCH);
+    return NCP_OK;
+}
+
 int ncp_motion_run(struct ncp_analyzer *a, int motion)
 {
     if (motion != 730 && (motion < 810 || motion > 890))
@@ -319,6 +354,8 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
                          sizeof "interpreter: motion mode set to none" - 1);
         return NCP_OK;
+    case 330: case 331:
+        return ncp_synced(a, motion);
     case 382: case 383: case 384: case 385:
         return ncp_probe(a, motion);
     case 730: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:

@@ -7,7 +7,7 @@ feeds, parameters are defined before they are read, loops terminate. It covers
 G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G4, G10 L2/L20, G17-G19,
 G20/G21, G28/G30, G43/G43.2/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
-G7/G8 (X words as diameters),
+G7/G8 (X words as diameters), G33/G33.1 (spindle-synchronised feeds, rigid taps),
 G38.2-G38.5 (probing), M66 (wait for an input), M0-M9 M30 M48/M49, S T M6 F, comments,
 MSG and DEBUG with parameters, numbered and named parameters, expressions with every
 operator and function, O-word subroutines with arguments and return values,
@@ -685,10 +685,34 @@ class Gen:
             return self.st_call()
         if c < 0.985:
             return self.st_units_episode()
-        if c < 0.993:
+        if c < 0.99:
             return self.st_diameter_episode()
-        return self.st_probe_episode()
+        if c < 0.995:
+            return self.st_probe_episode()
+        return self.st_sync_episode()
 
+    def st_sync_episode(self):
+        """G33 feeds (K per turn, on every line) and G33.1 taps, which end where
+        they started; both modes are modal, and the spindle must turn."""
+        r = self.r
+        if self.spindle == 0:
+            self.spindle = r.choice([3, 4])
+            self.emit("S%d M%d" % (r.choice([300, 600]), self.spindle))
+        prev = None
+        for _ in range(r.randint(1, 3)):
+            modal = prev is not None and r.random() < 0.3   # axis words and K alone
+            g = prev if modal else ("G33.1" if r.random() < 0.4 else "G33")
+            axes = r.sample(AXES, r.randint(1, 2))
+            scale = 8 if self.dist == 91 else 20
+            words = [a + self.n(r.uniform(-scale, scale) * self.s()) for a in axes]
+            words.append("K" + num(r.choice([0.5, 0.8, 1, 1.25, 1.5]) * self.s(), 4))
+            if g == "G33.1" and r.random() < 0.3:
+                words.append("I%d" % r.randint(1, 3))
+            self.emit(" ".join(([] if modal else [g]) + words))
+            if g == "G33":
+                self.forget_position(axes)
+            prev = g
+        self.emit("G80")
 
     def st_probe_episode(self):
         """G38.2-G38.5 toward a point away from here, maybe once more in the
