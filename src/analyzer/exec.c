@@ -192,8 +192,11 @@ static int ncp_exec_control(struct ncp_analyzer *a, int g)
         a->st.m.control = 0;
         a->st.m.p_tol = 0.0;
     } else {
-        double p = NCP_HAS(&a->w, 'P') ? W(a, 'P') : 0.0;
-        double q = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : p;
+        /* rs274: a negative P or Q (P-1 is "no P") means the default, 0 here */
+        double p_in = NCP_HAS(&a->w, 'P') ? W(a, 'P') : -1.0;
+        double q_in = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
+        double p = p_in >= 0 ? p_in : 0.0;
+        double q = q_in >= 0 ? q_in : p;
         op->i[0] = 2;
         op->d[0] = p;
         a->st.m.control = 2;

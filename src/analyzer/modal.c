@@ -65,7 +65,7 @@ static int ncp_check_g(struct ncp_analyzer *a)
     int m0 = w->g[NCP_GG_NONMODAL], m1 = w->g[NCP_GG_MOTION];
     uint16_t col = w->gcol[NCP_GG_NONMODAL];
     if (m0 == 40) {
-        if (!NCP_HAS(w, 'P'))
+        if (!NCP_HAS(w, 'P') || w->v[NCP_LETTER('P')] == -1.0) /* rs274: P-1 is no P */
             return ncp_an_error(a, col, "Dwell time missing with g4");
         if (m1 == 20 || m1 == 30)
             return ncp_an_error(a, col, "G4 not allowed with G2 or G3 because they both use P");
@@ -145,6 +145,8 @@ static int ncp_check_other(struct ncp_analyzer *a)
         int arc = mt == 20 || mt == 30;
         if ((arc || w->m[NCP_MG_SPINDLE] == 19) && fabs(pv - p) > 0.001)
             return ncp_an_error(a, COL('P'), "P value not an integer with M19 G2 or G3");
+        if (w->m[NCP_MG_SPINDLE] == 19 && (pv > 2 || pv < 0))
+            return ncp_an_error(a, COL('P'), "P value must be 0,1,or 2 with M19");
         if (arc && pv < 1)
             return ncp_an_error(a, COL('P'), "P value should be 1 or greater with G2 or G3");
     }

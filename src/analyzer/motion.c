@@ -340,6 +340,48 @@ static int ncp_synced(struct ncp_analyzer *a, int motion)
     return NCP_OK;
 }
 
+/* G5 (cubic: P Q, I J optional) and G5.1 (quadratic: I J) splines in the XY
+ * plane, with rs274 2.9's checks in its order. rs274 -g prints only
+ * NURBS_FEED(order, ...), no control point. The current point moves to the
+ * end and the motion mode stays what it was; rs274's canon puts its own X
+ * and Y at 0 (what a probe backs off from, or a tool change reads back,
+ * shows it: measured with rs274 2.9 from several start and end points). */
+static int ncp_spline(struct ncp_analyzer *a, int motion)
+{
+    struct ncp_state *s = &a->st;
+    const struct ncp_words *w = &a->w;
+    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    if (s->m.comp_side != 0)
+        return ncp_an_error(a, col, "Cannot convert spline with cutter radius compensation");
+    if (s->m.feed_mode == 0 && s->feed == 0.0)
+        return ncp_an_error(a, col, "Cannot make arc with zero feed rate");
+    if (s->m.feed_mode == 1 && !NCP_HAS(w, 'F'))
+        return ncp_an_error(a, col, "F word missing with inverse time arc move");
+    if (s->m.plane != 0)
+        return ncp_an_error(a, col, "Splines must be in the XY plane");
+    if (NCP_HAS(w, 'Z') || NCP_HAS(w, 'A') || NCP_HAS(w, 'B') || NCP_HAS(w, 'C'))
+        return ncp_an_error(a, col, "Splines may not have motion in Z, A, B, or C");
+    if (motion == 51) {
+        if (!NCP_HAS(w, 'I') || !NCP_HAS(w, 'J'))
+            return ncp_an_error(a, col, "Must specify both I and J with G5.1");
+    } else {
+        if (NCP_HAS(w, 'I') != NCP_HAS(w, 'J'))
+            return ncp_an_error(a, col, "Must specify both I and J, or neither");
+        if (!NCP_HAS(w, 'P') || !NCP_HAS(w, 'Q'))
+            return ncp_an_error(a, col, "Must specify both P and Q with G5");
+    }
+    double end[NCP_NAX];
+    int rc = ncp_motion_ends(a, 0, end);
+    if (rc != NCP_OK)
+        return rc;
+    struct ncp_canon *op = ncp_an_emit(a, NCP_C_NURBS_FEED);
+    op->i[0] = motion == 51 ? 3 : 4;
+    memcpy(op->d, end, 3 * sizeof(double));
+    a->sai.pos[NCP_X] = a->sai.pos[NCP_Y] = 0.0;
+    memcpy(s->pos, end, sizeof end);
+    return NCP_OK;
+}
+
 int ncp_motion_run(struct ncp_analyzer *a, int motion)
 {
     if (motion != 730 && (motion < 810 || motion > 890))
@@ -354,6 +396,8 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
                          sizeof "interpreter: motion mode set to none" - 1);
         return NCP_OK;
+    case 50: case 51:
+        return ncp_spline(a, motion);
     case 330: case 331:
         return ncp_synced(a, motion);
     case 382: case 383: case 384: case 385:

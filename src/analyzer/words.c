@@ -142,7 +142,8 @@ static int ncp_word_check(struct ncp_analyzer *a, char c, double v, uint16_t col
     case 'H': return ncp_an_error(a, col, "Negative h word used");
     /* a negative D is legal with G41.1/G42.1 (it swaps the side): cutcomp checks it */
     case 'L': return ncp_an_error(a, col, "Negative l word used");
-    case 'P': return ncp_an_error(a, col, "Negative p word used");
+    /* P may be negative (rs274 2.9 dropped that check: G5 takes signed P);
+     * its users treat P-1, rs274's "no P" marker, as missing where rs274 does */
     default: return NCP_OK;
     }
 }

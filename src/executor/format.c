@@ -99,6 +99,7 @@ static const struct ncp_kind_fmt ncp_kind_fmts[NCP_C__COUNT] = {
     /* rs274 spells this one without the H and prints the mode as %d of a bool */
     [NCP_C_START_SPEED_FEED_SYNCH] = {{"START_SPEED_FEED_SYNC(%F0,%I1)"}, NULL},
     [NCP_C_STOP_SPEED_FEED_SYNCH] = {{"STOP_SPEED_FEED_SYNCH()"}, NULL},
+    [NCP_C_NURBS_FEED] = {{"NURBS_FEED(%I0, ...)"}, NULL},
     [NCP_C_RIGID_TAP] = {{"RIGID_TAP(%D0, %D1, %D2)"}, NULL},
     [NCP_C_RAW_TEXT] = {{"%T"}, NULL},
 };

@@ -4,8 +4,8 @@
 Writes to stdout a random RS274/NGC program of about N lines that LinuxCNC's rs274
 accepts (with simpockets.tbl): every arc is geometrically valid, F is set before
 feeds, parameters are defined before they are read, loops terminate. It covers
-G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G4, G10 L2/L20, G17-G19,
-G20/G21, G28/G30, G43/G43.2/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
+G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G5/G5.1 splines, G4, G10 L2/L20,
+G17-G19, G20/G21, G28/G30, G43/G43.2/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
 G7/G8 (X words as diameters), G33/G33.1 (spindle-synchronised feeds, rigid taps),
 G38.2-G38.5 (probing), M66 (wait for an input), M0-M9 M30 M48/M49, S T M6 F, comments,
@@ -687,9 +687,43 @@ class Gen:
             return self.st_units_episode()
         if c < 0.99:
             return self.st_diameter_episode()
-        if c < 0.995:
+        if c < 0.994:
             return self.st_probe_episode()
-        return self.st_sync_episode()
+        if c < 0.997:
+            return self.st_sync_episode()
+        return self.st_spline()
+
+    def st_spline(self):
+        """A G5 (cubic, P Q; I J optional) or G5.1 (quadratic, I J) spline in
+        the XY plane; it ends at its end point and leaves the motion mode."""
+        r = self.r
+        self.set_plane(17)
+        self.ensure_feed_ready()
+        s, words = self.s(), []
+        for a in ("X", "Y"):
+            if self.dist == 91:
+                d = r.uniform(-15, 15) * s
+                words.append(a + self.n(d))
+                if self.pos[a] is not None:
+                    self.pos[a] += float(self.n(d))
+            else:
+                v = float(self.n(r.uniform(-40, 40) * s))
+                words.append(a + self.n(v))
+                self.pos[a] = v
+        vec = lambda: [self.n(r.uniform(-10, 10) * s) for _ in range(2)]
+        if r.random() < 0.5:
+            g, i, j = "G5.1", *vec()
+            words += ["I" + i, "J" + j]
+        else:
+            g, (p, q) = "G5", vec()
+            if r.random() < 0.7:
+                i, j = vec()
+                words += ["I" + i, "J" + j]
+            words += ["P" + p, "Q" + q]
+        line = " ".join([g] + words)
+        if self.feed_mode == 93:
+            line += " F" + self.feed()
+        self.emit(line)
 
     def st_sync_episode(self):
         """G33 feeds (K per turn, on every line) and G33.1 taps, which end where

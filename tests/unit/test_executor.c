@@ -209,6 +209,9 @@ static const struct kind_case kind_cases[] = {
     {NCP_C_SET_MOTION_OUTPUT_VALUE, 1, 0, {2.5}, NULL, "SET_MOTION_OUTPUT_VALUE(1,2.500000)"},
     {NCP_C_START_SPEED_FEED_SYNCH, 0, 0, {0.1}, NULL, "START_SPEED_FEED_SYNC(0.100000,0)"},
     {NCP_C_STOP_SPEED_FEED_SYNCH, 0, 0, {0}, NULL, "STOP_SPEED_FEED_SYNCH()"},
+    /* the end point rides along for the motion module; rs274 -g prints the order only */
+    {NCP_C_NURBS_FEED, 3, 0, {10.0, 5.0, -1.0}, NULL, "NURBS_FEED(3, ...)"},
+    {NCP_C_RIGID_TAP, 0, 0, {1.5, -2.0, -8.25}, NULL, "RIGID_TAP(1.5000, -2.0000, -8.2500)"},
     {NCP_C_RAW_TEXT, 0, 0, {0}, "SPINDLE.0.WAIT_ORIENT_COMPLETE(2.0000)",
      "SPINDLE.0.WAIT_ORIENT_COMPLETE(2.0000)"},
 };
