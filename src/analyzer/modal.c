@@ -28,6 +28,12 @@ static int ncp_motion_to_be(struct ncp_analyzer *a)
     w->motion_to_be = -1;
     if (m1 != -1) {
         uint16_t col = w->gcol[NCP_GG_MOTION];
+        if (m1 >= 700 && m1 <= 722) { /* before the word checks, which do not know them */
+            if (m1 % 10)
+                return ncp_an_error(a, col, "G%d.%d (lathe profile cycle) is not supported",
+                                    m1 / 10, m1 % 10);
+            return ncp_an_error(a, col, "G%d (lathe profile cycle) is not supported", m1 / 10);
+        }
         if (m1 == 800) {
             if (axis && !covets)
                 return ncp_an_error(a, col, "Cannot use axis values with g80");

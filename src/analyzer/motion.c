@@ -405,9 +405,11 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
     case 730: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
     case 890:
         return ncp_canned_run(a, motion);
-    default:
-        return ncp_an_error(a, a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION]
-                                                        : a->w.line_col,
-                            "G%d.%d is not supported", motion / 10, motion % 10);
+    default: {
+        uint16_t col = a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION] : a->w.line_col;
+        if (motion % 10)
+            return ncp_an_error(a, col, "G%d.%d is not supported", motion / 10, motion % 10);
+        return ncp_an_error(a, col, "G%d is not supported", motion / 10);
+    }
     }
 }

@@ -39,6 +39,10 @@ static void ncp_g_table_init(void)
         {870, NCP_GG_MOTION}, {880, NCP_GG_MOTION}, {890, NCP_GG_MOTION},
         {330, NCP_GG_MOTION}, {331, NCP_GG_MOTION}, {760, NCP_GG_MOTION},
         {50, NCP_GG_MOTION}, {51, NCP_GG_MOTION}, {52, NCP_GG_MOTION},
+        /* lathe profile cycles: known to rs274, refused as not supported */
+        {700, NCP_GG_MOTION}, {710, NCP_GG_MOTION}, {711, NCP_GG_MOTION},
+        {712, NCP_GG_MOTION}, {720, NCP_GG_MOTION}, {721, NCP_GG_MOTION},
+        {722, NCP_GG_MOTION},
         {170, NCP_GG_PLANE}, {180, NCP_GG_PLANE}, {190, NCP_GG_PLANE},
         {171, NCP_GG_PLANE}, {181, NCP_GG_PLANE}, {191, NCP_GG_PLANE},
         {900, NCP_GG_DIST}, {910, NCP_GG_DIST}, {901, NCP_GG_ARCDIST}, {911, NCP_GG_ARCDIST},
@@ -116,6 +120,8 @@ static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
         return ncp_an_error(a, col, "Negative m code used");
     if (m > 199)
         return ncp_an_error(a, col, "M-code greater than 199: M%d", m);
+    if (m >= 70 && m <= 73)
+        return ncp_an_error(a, col, "M%d (modal state save/restore) is not supported", m);
     int g = ncp_m_group(m);
     if (g < 0)
         return ncp_an_error(a, col, "Unknown m code used: M%d", m);
