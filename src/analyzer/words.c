@@ -112,10 +112,28 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
     return NCP_OK;
 }
 
+/* rs274's read_integer_value (M, T, H, L): the floor, or the ceiling when
+ * within 0.0001 of it (x86 conversions of the floor, as rs274 makes them);
+ * anything further from an integer is an error. */
+static int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out)
+{
+    int i = ncp_trunc_int(floor(v));
+    double d = v - i;
+    if (d > 0.9999)
+        i = ncp_trunc_int(ceil(v));
+    else if (d > 0.0001)
+        return ncp_an_error(a, col, "Non integer value for integer");
+    *out = i;
+    return NCP_OK;
+}
+
 static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
 {
     struct ncp_words *w = &a->w;
-    int m = ncp_trunc_int_round(v);
+    int m;
+    int rc = ncp_integer_word(a, v, col, &m);
+    if (rc != NCP_OK)
+        return rc;
     if (m < 0)
         return ncp_an_error(a, col, "Negative m code used");
     if (m > 199)
@@ -136,10 +154,15 @@ static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
 /* Reader-level value checks rs274 makes while reading each word. */
 static int ncp_word_check(struct ncp_analyzer *a, char c, double v, uint16_t col)
 {
-    /* rs274 reads T, H and L as integers (x86 conversion) before the sign check */
-    if (c == 'T' || c == 'H' || c == 'L')
-        v = ncp_trunc_int_round(v);
-    if (v >= 0.0)
+    /* rs274 reads T, H and L as integers before the sign check */
+    if (c == 'T' || c == 'H' || c == 'L') {
+        int i;
+        int rc = ncp_integer_word(a, v, col, &i);
+        if (rc != NCP_OK)
+            return rc;
+        v = i;
+    }
+    if (v >= 0.0 || (c == 'H' && v == -1.0)) /* rs274 reads H down to -1 */
         return NCP_OK;
     switch (c) {
     case 'F': return ncp_an_error(a, col, "Negative f word used");
