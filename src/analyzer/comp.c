@@ -63,8 +63,9 @@ int ncp_comp_move_straight(struct ncp_analyzer *a, int motion, const double *end
     int rc = ncp_an_commit(a);
     if (rc != NCP_OK)
         return rc;
-    struct ncp_comp_move m = {.motion = motion == 330 || motion == 331 ? NCP_COMP_SYNCED
-                                                                : motion / 10,
+    struct ncp_comp_move m = {.motion = motion == 330 || motion == 331 || motion == 760
+                                            ? NCP_COMP_SYNCED
+                                            : motion / 10,
                               .inches = a->st.m.inches,
                               .g53 = g53, .line = a->line, .turns = 1};
     ncp_comp_plane(a->comp.plane, a->st.pos, m.start);

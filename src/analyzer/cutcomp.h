@@ -85,7 +85,7 @@ struct ncp_comp_on_req {
 };
 
 /* A programmed G0/G1/G2/G3 while compensation is engaged. */
-/* G33/G33.1: rs274's compensation knows only G0 and G1. It fails them where it
+/* G33/G33.1/G76: rs274's compensation knows only G0 and G1. It fails them where it
  * picks the call by the code (the entry move, a move without motion in the
  * plane, a convex corner's arc) and makes them plain feeds everywhere else. */
 #define NCP_COMP_SYNCED 33

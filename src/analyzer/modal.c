@@ -172,6 +172,13 @@ static int ncp_check_other(struct ncp_analyzer *a)
         if (NCP_HAS(w, 'F'))
             return ncp_an_error(a, COL('F'), "F word used with a g33/g33.1");
     }
+    if (mt == 760) {
+        uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+        if (!NCP_HAS(w, 'P') || w->v[NCP_LETTER('P')] == -1.0) /* rs274: P-1 is no P */
+            return ncp_an_error(a, col, "P word missing with G76");
+        if (!NCP_HAS(w, 'I') || !NCP_HAS(w, 'J') || !NCP_HAS(w, 'K'))
+            return ncp_an_error(a, col, "I J or K words missing with G76");
+    }
 #undef COL
     return NCP_OK;
 }

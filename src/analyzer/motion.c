@@ -382,6 +382,31 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
     return NCP_OK;
 }
 
+/* G76 as rs274 dispatches it: the move's checks here, the passes in
+ * thread.c. Under cutter compensation it goes where G33 goes. */
+static int ncp_threading(struct ncp_analyzer *a)
+{
+    struct ncp_state *s = &a->st;
+    double end[NCP_NAX];
+    int rc = ncp_motion_ends(a, 0, end);
+    if (rc != NCP_OK)
+        return rc;
+    s->m.motion = 760;
+    if (ncp_cutcomp_engaged(&a->comp)) {
+        rc = ncp_comp_move_straight(a, 760, end, 0);
+        if (rc == NCP_OK)
+            memcpy(s->pos, end, sizeof end);
+        return rc;
+    }
+    uint16_t col = a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION] : a->w.line_col;
+    if (s->m.spindle_dir == 0)
+        return ncp_an_error(a, col, "Chosen spindle (0) not turning in G76");
+    for (int ax = NCP_A; ax < NCP_NAX; ax++)
+        if (end[ax] != s->pos[ax])
+            return ncp_an_error(a, col, "Cannot move rotary axes with G76");
+    return ncp_thread_cycle(a, end);
+}
+
 int ncp_motion_run(struct ncp_analyzer *a, int motion)
 {
     if (motion != 730 && (motion < 810 || motion > 890))
@@ -400,6 +425,8 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         return ncp_spline(a, motion);
     case 330: case 331:
         return ncp_synced(a, motion);
+    case 760:
+        return ncp_threading(a);
     case 382: case 383: case 384: case 385:
         return ncp_probe(a, motion);
     case 730: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:

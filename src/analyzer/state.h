@@ -168,6 +168,8 @@ int ncp_exec_block(struct ncp_analyzer *a);
 int ncp_motion_run(struct ncp_analyzer *a, int motion);
 int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end);
 int ncp_canned_run(struct ncp_analyzer *a, int motion);
+/* thread.c: G76 from the current point to end (checked by motion.c) */
+int ncp_thread_cycle(struct ncp_analyzer *a, const double *end);
 int ncp_motion_ends(struct ncp_analyzer *a, int absolute53, double *end);
 
 /* offsets.c */

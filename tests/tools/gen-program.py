@@ -7,7 +7,7 @@ feeds, parameters are defined before they are read, loops terminate. It covers
 G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G5/G5.1 splines, G4, G10 L2/L20,
 G17-G19, G20/G21, G28/G30, G43/G43.2/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
-G7/G8 (X words as diameters), G33/G33.1 (spindle-synchronised feeds, rigid taps),
+G7/G8 (X words as diameters), G33/G33.1 (spindle-synchronised feeds, rigid taps), G76,
 G38.2-G38.5 (probing), M66 (wait for an input), M0-M9 M30 M48/M49, S T M6 F, comments,
 MSG and DEBUG with parameters, numbered and named parameters, expressions with every
 operator and function, O-word subroutines with arguments and return values,
@@ -689,9 +689,39 @@ class Gen:
             return self.st_diameter_episode()
         if c < 0.994:
             return self.st_probe_episode()
-        if c < 0.997:
+        if c < 0.996:
             return self.st_sync_episode()
-        return self.st_spline()
+        if c < 0.998:
+            return self.st_spline()
+        return self.st_thread()
+
+    def st_thread(self):
+        """A G76 threading cycle along Z (outside or bored, maybe tapered, with
+        a compound angle, degression and spring passes); the spindle turns."""
+        r = self.r
+        s = self.s()
+        if self.spindle == 0:
+            self.spindle = r.choice([3, 4])
+            self.emit("S%d M%d" % (r.choice([300, 600]), self.spindle))
+        j = r.uniform(0.05, 0.3) * s
+        words = ["P" + self.n(r.choice([0.5, 1, 1.5, 2]) * s),
+                 "Z" + self.n(r.uniform(-20, 20) * s),
+                 "I" + self.n(r.choice([-1, 1]) * r.uniform(0.5, 2) * s),
+                 "J" + self.n(j), "K" + self.n(j * r.uniform(2, 6))]
+        if r.random() < 0.3:
+            words.append("X" + self.n(r.uniform(-20, 20) * s))
+        if r.random() < 0.5:
+            words.append("Q" + num(r.uniform(0, 30), 1))
+        if r.random() < 0.3:
+            words.append("R" + num(r.uniform(1, 2.5), 2))
+        if r.random() < 0.3:
+            words.append("H%d" % r.randint(0, 3))
+        if r.random() < 0.3:
+            words += ["E" + self.n(r.uniform(0.2, 2) * s), "L%d" % r.randint(0, 3)]
+        r.shuffle(words)
+        self.emit("G76 " + " ".join(words))
+        self.forget_position(("X", "Z"))
+        self.emit("G80")
 
     def st_spline(self):
         """A G5 (cubic, P Q; I J optional) or G5.1 (quadratic, I J) spline in
