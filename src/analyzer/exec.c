@@ -4,6 +4,7 @@
 #include "state.h"
 
 #include <math.h>
+#include <stdio.h>
 
 #define W(a, c) ((a)->w.v[NCP_LETTER(c)])
 
@@ -50,9 +51,22 @@ static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
         ncp_an_emit(a, NCP_C_STOP_SPINDLE_TURNING);
         a->st.m.spindle_dir = 0;
     } else {
-        struct ncp_canon *op = ncp_an_emit(a, NCP_C_ORIENT_SPINDLE);
-        op->d[0] = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
-        op->i[1] = NCP_HAS(&a->w, 'P') ? ncp_trunc_int_round(W(a, 'P')) : 0;
+        /* M19: the spindle counts as stopped; the orient call only with R or P */
+        a->st.m.spindle_dir = 0;
+        if (NCP_HAS(&a->w, 'R') || NCP_HAS(&a->w, 'P')) {
+            struct ncp_canon *op = ncp_an_emit(a, NCP_C_ORIENT_SPINDLE);
+            op->d[0] = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
+            op->i[1] = NCP_HAS(&a->w, 'P') ? ncp_trunc_int_round(W(a, 'P')) : 0;
+        }
+        if (NCP_HAS(&a->w, 'Q')) { /* wait for the orientation, Q seconds at most */
+            if (W(a, 'Q') <= 0.0)
+                return ncp_an_error(a, a->w.col[NCP_LETTER('Q')],
+                                    "Q word with M19 requires a value > 0");
+            char buf[64];
+            int n = snprintf(buf, sizeof buf, "SPINDLE.0.WAIT_ORIENT_COMPLETE(%.4f)", W(a, 'Q'));
+            ncp_an_emit_text(a, NCP_C_RAW_TEXT, buf,
+                             n > 0 && (size_t)n < sizeof buf ? (size_t)n : sizeof buf - 1);
+        }
     }
     return NCP_OK;
 }
