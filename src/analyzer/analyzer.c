@@ -31,6 +31,7 @@ struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
     }
     ncp_state_init(a);
     ncp_cutcomp_init(&a->comp, NULL);
+    ncp_m7x_reset(a);
     return a;
 }
 
@@ -40,6 +41,7 @@ void ncp_analyzer_free(struct ncp_analyzer *a)
         return;
     if (a->flow)
         ncp_flow_free(a->flow);
+    ncp_m7x_free(a);
     ncp_params_free(a->params);
     free(a);
 }
@@ -260,7 +262,7 @@ static int ncp_an_eof(struct ncp_analyzer *a, const struct ncp_source *src)
  * in that order here, so every value (even a subnormal) comes out as rs274's.
  * Before any step of the block uses X, after the checks that only look at
  * whether it is there. */
-static void ncp_lathe_x_word(struct ncp_analyzer *a)
+void ncp_lathe_x_word(struct ncp_analyzer *a)
 {
     struct ncp_words *w = &a->w;
     if (!NCP_HAS(w, 'X'))
@@ -284,8 +286,11 @@ static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
         return b->err.code;
     }
     /* rs274 -g runs with the block delete switch off: '/' lines execute */
+    int rc = ncp_m7x_pending(a);
+    if (rc != NCP_OK)
+        return rc;
     ncp_sai_resync(a);
-    int rc = ncp_words_collect(a, b);
+    rc = ncp_words_collect(a, b);
     if (rc == NCP_OK)
         rc = ncp_words_assign(a, b);
     if (rc == NCP_OK)
@@ -321,6 +326,8 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
         return NCP_ERR_IO;
     }
     ncp_flow_set_param_ops(a->flow, a->pops);
+    ncp_flow_set_frame_hooks(a->flow, ncp_m7x_hooks(a));
+    ncp_m7x_reset(a);
     ncp_cutcomp_init(&a->comp, NULL);
     a->staged.pending = 0;
     ncp_an_preamble(a);

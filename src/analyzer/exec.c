@@ -41,6 +41,8 @@ static void ncp_exec_comment_lit(struct ncp_analyzer *a, const char *m)
 
 static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
 {
+    if (m >= 70)
+        return ncp_m7x_run(a, m);
     if (m == 3) {
         ncp_an_emit(a, NCP_C_START_SPINDLE_CLOCKWISE);
         a->st.m.spindle_dir = 1;
@@ -216,6 +218,8 @@ static int ncp_exec_control(struct ncp_analyzer *a, int g)
         a->st.m.control = 2;
         a->st.m.p_tol = p;
         a->st.m.q_tol = q;
+        a->st.m.g64_p = p;
+        a->st.m.g64_q = q;
         ncp_an_emit(a, NCP_C_SET_NAIVECAM_TOLERANCE)->d[0] = q;
     }
     return NCP_OK;
@@ -256,6 +260,8 @@ static int ncp_exec_m_codes(struct ncp_analyzer *a)
         rc = ncp_tools_change(a);
     if (rc == NCP_OK && w->m[NCP_MG_SPINDLE] != -1)
         rc = ncp_exec_spindle(a, w->m[NCP_MG_SPINDLE]);
+    if (a->block_consumed) /* see ncp_exec_block */
+        return rc;
     if (rc == NCP_OK && w->m[NCP_MG_COOLANT] != -1)
         rc = ncp_exec_coolant(a, w->m[NCP_MG_COOLANT]);
     if (rc == NCP_OK && w->m[NCP_MG_OVERRIDE] != -1)
@@ -321,6 +327,7 @@ int ncp_exec_block(struct ncp_analyzer *a)
     if (rc == NCP_OK && w->g[NCP_GG_SPINDLE] != -1) {
         /* G96 without D: rs274 passes 1e30 as "no limit" */
         struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_SPINDLE_MODE);
+        a->st.m.css = w->g[NCP_GG_SPINDLE] == 960;
         if (w->g[NCP_GG_SPINDLE] == 960)
             op->d[0] = NCP_HAS(w, 'D') ? W(a, 'D') : 1e30;
     }
@@ -340,6 +347,11 @@ int ncp_exec_block(struct ncp_analyzer *a)
         rc = ncp_tools_select(a);
     if (rc == NCP_OK)
         rc = ncp_exec_m_codes(a);
+    if (a->block_consumed) { /* M72's restore lines ran in this block's place */
+        a->block_consumed = 0;
+        ncp_offsets_sync_params(a);
+        return rc;
+    }
     if (rc == NCP_OK)
         rc = ncp_exec_g_codes(a);
     if (rc == NCP_OK && w->m[NCP_MG_STOP] != -1)

@@ -70,6 +70,7 @@ struct ncp_flow {
     const struct ncp_source *src;
     struct ncp_params *params;
     struct ncp_param_ops pops;
+    struct ncp_flow_frames hooks;
     uint32_t max_loops, max_depth;
 
     struct flow_pos cur;              /* next block to execute */
@@ -602,6 +603,8 @@ static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
         f->level--;
         if (f->level == 0)
             f->in_sub_context = 1;
+        if (f->hooks.left)
+            f->hooks.left(f->hooks.ctx, f->level + 1);
     } else if (b->oword.kind == NCP_O_ENDSUB) {
         if (!f->defining.on)
             return oword_error(b, "Not in subroutine definition", d);
@@ -636,6 +639,8 @@ static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_dia
     if (rc != NCP_OK)
         return rc;
     struct flow_frame *fr = &f->frames[++f->level];
+    if (f->hooks.entered)
+        f->hooks.entered(f->hooks.ctx, f->level);
     fr->ret = f->cur;
     size_t n = f->label_len < FLOW_NAME_MAX ? f->label_len : FLOW_NAME_MAX;
     memcpy(fr->name, f->label, n);
@@ -957,6 +962,11 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
 void ncp_flow_set_param_ops(struct ncp_flow *f, struct ncp_param_ops ops)
 {
     f->pops = ops;
+}
+
+void ncp_flow_set_frame_hooks(struct ncp_flow *f, struct ncp_flow_frames hooks)
+{
+    f->hooks = hooks;
 }
 
 void ncp_flow_free(struct ncp_flow *f)

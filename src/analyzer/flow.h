@@ -23,6 +23,15 @@ void ncp_flow_free(struct ncp_flow *f);
  * by default they read the parameter table directly. */
 void ncp_flow_set_param_ops(struct ncp_flow *f, struct ncp_param_ops ops);
 
+/* Told when a call opens call level `level` (entered) and when a return or
+ * endsub leaves it (left); M73's auto-restore hangs on the second. */
+struct ncp_flow_frames {
+    void *ctx;
+    void (*entered)(void *ctx, int level);
+    void (*left)(void *ctx, int level);
+};
+void ncp_flow_set_frame_hooks(struct ncp_flow *f, struct ncp_flow_frames hooks);
+
 /* Next non-O-word block to interpret. Returns NCP_OK and sets *out (valid until
  * the next call), NCP_END at the end of the program body, or an error with *d
  * filled (file order line/col). A block with a syntax error comes back as that

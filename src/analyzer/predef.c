@@ -103,6 +103,9 @@ int ncp_predef_lookup(void *ctx, const char *name, size_t len, double *out)
 static int ncp_predef_get_numbered(void *ctx, int index, double *out, struct ncp_diag *d)
 {
     struct ncp_analyzer *a = ctx;
+    int rc = ncp_m7x_pending(a);
+    if (rc != NCP_OK)
+        return ncp_diag_set(d, (enum ncp_status)rc, 0, 0, "%s", a->err.msg);
     ncp_sai_resync(a);
     if (index >= 5420 && index <= 5428 && a->st.m.comp_side != 0)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
@@ -114,6 +117,9 @@ static int ncp_predef_get_named(void *ctx, const char *name, size_t len, double 
                                 struct ncp_diag *d)
 {
     struct ncp_analyzer *a = ctx;
+    int rc = ncp_m7x_pending(a);
+    if (rc != NCP_OK)
+        return ncp_diag_set(d, (enum ncp_status)rc, 0, 0, "%s", a->err.msg);
     ncp_sai_resync(a);
     return ncp_params_get_named(a->params, name, len, out, d);
 }

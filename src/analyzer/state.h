@@ -69,6 +69,8 @@ struct ncp_modal {
     int feed_override, speed_override, adaptive, feed_hold;
     int g92_enabled;
     int lathe_diameter;           /* G7: X words are diameters (halved); G8: radii */
+    int css;                      /* G96 (constant surface speed); G97 */
+    double g64_p, g64_q;          /* rs274's own G64 tolerances (G61 leaves them): M72 */
 };
 
 struct ncp_state {
@@ -128,6 +130,12 @@ struct ncp_analyzer {
     uint32_t line;
     int stopped;
     struct ncp_diag err;
+    /* M70-M73 (m7x.c) */
+    struct ncp_m7x_frame *m7x;    /* saved modal state per call level */
+    int m7x_cap;
+    int m7x_restore_from;         /* a return left an M73 level: restore from it, else -1 */
+    int block_consumed;           /* an M72 ran restore lines in this block's place */
+    struct ncp_block *m7x_block;  /* the restore line being run */
 };
 
 /* analyzer.c: append one op to the block's slot (opens/continues slots). */
@@ -160,6 +168,8 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b);
 
 /* modal.c */
 int ncp_modal_check(struct ncp_analyzer *a);
+/* analyzer.c: G7 halves the block's X word (before any step uses it) */
+void ncp_lathe_x_word(struct ncp_analyzer *a);
 
 /* exec.c: the whole block in rs274's order */
 int ncp_exec_block(struct ncp_analyzer *a);
@@ -170,6 +180,13 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end);
 int ncp_canned_run(struct ncp_analyzer *a, int motion);
 /* thread.c: G76 from the current point to end (checked by motion.c) */
 int ncp_thread_cycle(struct ncp_analyzer *a, const double *end);
+/* m7x.c: M70-M73 (m is 70..73); the flow's frame hooks; a restore a return
+ * left pending (before the next block, or a parameter read); teardown */
+int ncp_m7x_run(struct ncp_analyzer *a, int m);
+struct ncp_flow_frames ncp_m7x_hooks(struct ncp_analyzer *a);
+int ncp_m7x_pending(struct ncp_analyzer *a);
+void ncp_m7x_reset(struct ncp_analyzer *a);
+void ncp_m7x_free(struct ncp_analyzer *a);
 int ncp_motion_ends(struct ncp_analyzer *a, int absolute53, double *end);
 
 /* offsets.c */

@@ -70,6 +70,7 @@ static int ncp_m_group(int m)
     case 0: case 1: case 2: case 30: case 60: return NCP_MG_STOP;
     case 6: case 61: return NCP_MG_TOOL;
     case 3: case 4: case 5: case 19: return NCP_MG_SPINDLE;
+    case 70: case 71: case 72: case 73: return NCP_MG_SPINDLE; /* rs274's group 7 too */
     case 7: case 8: case 9: return NCP_MG_COOLANT;
     case 48: case 49: case 50: case 51: case 52: case 53: return NCP_MG_OVERRIDE;
     case 62: case 63: case 64: case 65: case 66: case 67: case 68: return NCP_MG_IO;
@@ -138,8 +139,6 @@ static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
         return ncp_an_error(a, col, "Negative m code used");
     if (m > 199)
         return ncp_an_error(a, col, "M-code greater than 199: M%d", m);
-    if (m >= 70 && m <= 73)
-        return ncp_an_error(a, col, "M%d (modal state save/restore) is not supported", m);
     int g = ncp_m_group(m);
     if (g < 0)
         return ncp_an_error(a, col, "Unknown m code used: M%d", m);

@@ -8,7 +8,8 @@ G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G5/G5.1 splines, G4, G10 L2
 G17-G19, G20/G21, G28/G30, G43/G43.2/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
 G7/G8 (X words as diameters), G33/G33.1 (spindle-synchronised feeds, rigid taps), G76,
-G38.2-G38.5 (probing), M66 (wait for an input), M0-M9 M30 M48/M49, S T M6 F, comments,
+G38.2-G38.5 (probing), M66 (wait for an input), M70/M72 (modal state save and
+restore), M0-M9 M30 M48/M49, S T M6 F, comments,
 MSG and DEBUG with parameters, numbered and named parameters, expressions with every
 operator and function, O-word subroutines with arguments and return values,
 if/elseif/else, while, do-while, repeat, break and continue. The same seed always gives the same program.
@@ -693,7 +694,24 @@ class Gen:
             return self.st_sync_episode()
         if c < 0.998:
             return self.st_spline()
-        return self.st_thread()
+        if c < 0.999:
+            return self.st_thread()
+        return self.st_state_episode()
+
+    def st_state_episode(self):
+        """M70, some moves in another distance mode or plane, M72: the modes
+        come back (and F, rounded to one decimal, if a move changed it)."""
+        r = self.r
+        dist, plane = self.dist, self.plane
+        self.emit("M70")
+        if r.random() < 0.6:
+            self.set_dist(91 if self.dist == 90 else 90)
+        if r.random() < 0.4:
+            self.set_plane(r.choice([17, 18, 19]))
+        for _ in range(r.randint(1, 3)):
+            self.simple_statement(inner=True)
+        self.emit("M72")
+        self.dist, self.plane = dist, plane
 
     def st_thread(self):
         """A G76 threading cycle along Z (outside or bored, maybe tapered, with

@@ -1,0 +1,287 @@
+/* M70 (save the modal state), M71 (forget it), M72 (restore it) and M73
+ * (save it, restored when the subroutine returns), per call level, as rs274
+ * 2.9 runs them. rs274 restores by writing G-code for whatever differs and
+ * executing it: a G20/G21 line first, then one line of F (%.1f), S (%.0f),
+ * the differing G codes and G64 with its tolerances (%f), with the first
+ * differing M code joined to it and each further M code on a line of its
+ * own. The text, its rounding and its order are what rs274 prints from, so
+ * they are rebuilt here the same way and run through the same reader and
+ * executor as any block. The lines run in place of the M72 block: rs274
+ * reads them into the block it is executing, so what that block had left to
+ * do (its G codes, its motion) is dropped, and so it is here. */
+#include "state.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { M7X_VALID = 1, M7X_RESTORE_ON_RETURN = 2 };
+
+/* rs274's active_g_codes / active_m_codes slots that a restore looks at */
+enum { G_PLANE = 3, G_COMP, G_UNITS, G_DIST, G_FEEDMODE, G_COORD, G_TLO, G_RETRACT,
+       G_CONTROL, G_SPINDLE = 13, G_IJK, G_LATHE, G_SLOTS };
+enum { M_SPINDLE = 2, M_MIST = 4, M_FLOOD, M_OVERRIDE, M_ADAPTIVE, M_HOLD, M_SLOTS };
+
+struct ncp_m7x_state {
+    int g[G_SLOTS], m[M_SLOTS];
+    double feed, speed, tol, naive;
+};
+
+struct ncp_m7x_frame {
+    int status;
+    struct ncp_m7x_state s;
+};
+
+static void ncp_m7x_snapshot(const struct ncp_analyzer *a, struct ncp_m7x_state *o)
+{
+    const struct ncp_modal *m = &a->st.m;
+    for (int i = 0; i < G_SLOTS; i++)
+        o->g[i] = -1;
+    for (int i = 0; i < M_SLOTS; i++)
+        o->m[i] = -1;
+    o->g[G_PLANE] = m->plane == 0 ? 170 : m->plane == 1 ? 190 : 180;
+    o->g[G_COMP] = m->comp_side == 1 ? 410 : m->comp_side == 2 ? 420 : 400;
+    o->g[G_UNITS] = m->inches ? 200 : 210;
+    o->g[G_DIST] = m->incremental ? 910 : 900;
+    o->g[G_FEEDMODE] = m->feed_mode == 1 ? 930 : m->feed_mode == 0 ? 940 : 950;
+    o->g[G_COORD] = m->origin < 7 ? 530 + 10 * m->origin : 584 + m->origin;
+    int tlo = 0;
+    for (int ax = 0; ax < NCP_NAX; ax++)
+        tlo |= a->st.tlo[ax] != 0.0;
+    o->g[G_TLO] = tlo ? 430 : 490;
+    o->g[G_RETRACT] = m->retract_r ? 990 : 980;
+    o->g[G_CONTROL] = m->control == 2 ? 640 : m->control == 1 ? 610 : 611;
+    o->g[G_SPINDLE] = m->css ? 960 : 970;
+    o->g[G_IJK] = m->arc_incremental ? 911 : 901;
+    o->g[G_LATHE] = m->lathe_diameter ? 70 : 80;
+    o->m[M_SPINDLE] = m->spindle_dir == 0 ? 5 : m->spindle_dir == 1 ? 3 : 4;
+    o->m[M_MIST] = m->mist ? 7 : m->flood ? -1 : 9;
+    o->m[M_FLOOD] = m->flood ? 8 : -1;
+    o->m[M_OVERRIDE] = m->feed_override ? 48 : 49; /* 2.9 looks at the feed override only */
+    o->m[M_ADAPTIVE] = m->adaptive ? 52 : -1;
+    o->m[M_HOLD] = m->feed_hold ? 53 : -1;
+    o->feed = a->st.feed;
+    o->speed = a->st.speed;
+    o->tol = m->g64_p;
+    o->naive = m->g64_q;
+}
+
+/* Call level `level`'s frame, the table grown to hold it; NULL (and the
+ * analyzer's error set) when out of memory. */
+static struct ncp_m7x_frame *ncp_m7x_frame_at(struct ncp_analyzer *a, int level)
+{
+    if (level >= a->m7x_cap) {
+        int cap = level + 8;
+        struct ncp_m7x_frame *f = realloc(a->m7x, (size_t)cap * sizeof *f);
+        if (!f) {
+            ncp_an_error(a, 0, "out of memory");
+            return NULL;
+        }
+        memset(f + a->m7x_cap, 0, (size_t)(cap - a->m7x_cap) * sizeof *f);
+        a->m7x = f;
+        a->m7x_cap = cap;
+    }
+    return &a->m7x[level];
+}
+
+/* One line of restore text, read and executed like a block of the program
+ * (the read-back after a probe or tool change included, as rs274's read). */
+static int ncp_m7x_exec_line(struct ncp_analyzer *a, const char *text)
+{
+    if (!a->m7x_block) {
+        a->m7x_block = malloc(sizeof *a->m7x_block);
+        if (!a->m7x_block)
+            return ncp_an_error(a, 0, "out of memory");
+    }
+    struct ncp_block *b = a->m7x_block;
+    size_t next;
+    ncp_lex_line(text, strlen(text), a->line, a->blk ? a->blk->offset : 0, b, &next);
+    if (b->err.code != NCP_OK) {
+        a->err = b->err;
+        return b->err.code;
+    }
+    a->blk = b;
+    ncp_sai_resync(a);
+    int rc = ncp_words_collect(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_words_assign(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_modal_check(a);
+    if (rc == NCP_OK) {
+        ncp_lathe_x_word(a);
+        rc = ncp_exec_block(a);
+    }
+    return rc;
+}
+
+static void ncp_m7x_put(char *buf, size_t cap, size_t *len, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static void ncp_m7x_put(char *buf, size_t cap, size_t *len, const char *fmt, ...)
+{
+    if (*len >= cap)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(buf + *len, cap - *len, fmt, ap);
+    va_end(ap);
+    *len = n < 0 ? *len : *len + (size_t)n < cap ? *len + (size_t)n : cap;
+}
+
+/* rs274's gen_settings + gen_m_codes: the text that brings `cur` to `saved`. */
+static void ncp_m7x_text(const struct ncp_m7x_state *cur, const struct ncp_m7x_state *saved,
+                         char *buf, size_t cap)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    int g64_changed = saved->tol != cur->tol || saved->naive != cur->naive;
+    if (saved->feed != cur->feed)
+        ncp_m7x_put(buf, cap, &len, " F%.1f", saved->feed);
+    if (saved->speed != cur->speed)
+        ncp_m7x_put(buf, cap, &len, " S%.0f", saved->speed);
+    for (int i = G_PLANE; i < G_SLOTS; i++) {
+        int v = saved->g[i];
+        if (i == G_UNITS || v == cur->g[i] || v == -1)
+            continue;
+        if (i == G_CONTROL && v == 640)
+            g64_changed = 1;
+        else if (v % 10)
+            ncp_m7x_put(buf, cap, &len, " G%d.%d", v / 10, v % 10);
+        else
+            ncp_m7x_put(buf, cap, &len, " G%d", v / 10);
+    }
+    if (saved->g[G_CONTROL] == 640 && g64_changed) {
+        if (saved->tol < 0)
+            ncp_m7x_put(buf, cap, &len, " G64");
+        else if (saved->naive < 0)
+            ncp_m7x_put(buf, cap, &len, " G64 P%f", saved->tol);
+        else
+            ncp_m7x_put(buf, cap, &len, " G64 P%f Q%f", saved->tol, saved->naive);
+    }
+    static const int m_slots[] = {M_SPINDLE, M_MIST, M_FLOOD, M_OVERRIDE, M_ADAPTIVE, M_HOLD};
+    for (size_t k = 0; k < sizeof m_slots / sizeof m_slots[0]; k++) {
+        int i = m_slots[k];
+        if (saved->m[i] != cur->m[i] && saved->m[i] != -1)
+            ncp_m7x_put(buf, cap, &len, "M%d\n", saved->m[i]);
+    }
+}
+
+/* rs274's restore_settings from the frame of call level `from`. */
+static int ncp_m7x_restore(struct ncp_analyzer *a, int from)
+{
+    const struct ncp_m7x_frame *fr = ncp_m7x_frame_at(a, from);
+    if (!fr)
+        return a->err.code;
+    struct ncp_m7x_state cur;
+    ncp_m7x_snapshot(a, &cur);
+    int ran = 0; /* the flag is set once all lines ran: each runs as a whole block */
+    if (cur.g[G_UNITS] != fr->s.g[G_UNITS]) {
+        ran = 1;
+        char units[8];
+        snprintf(units, sizeof units, "G%d", fr->s.g[G_UNITS] / 10);
+        if (ncp_m7x_exec_line(a, units) != NCP_OK)
+            return ncp_an_error(a, 0, "M7x: restore_settings G20/G21 failed: ''");
+        ncp_m7x_snapshot(a, &cur);
+    }
+    char text[512];
+    ncp_m7x_text(&cur, &fr->s, text, sizeof text);
+    for (char *line = text; *line;) {
+        char *nl = strchr(line, '\n');
+        if (nl)
+            *nl = '\0';
+        if (*line) {
+            ran = 1;
+            if (ncp_m7x_exec_line(a, line) != NCP_OK) {
+                char why[NCP_DIAG_MSG_MAX];
+                snprintf(why, sizeof why, "%s", a->err.msg);
+                return ncp_an_error(a, 0, "M7x: restore_settings failed executing: '%s': %s",
+                                    line, why);
+            }
+        }
+        if (!nl)
+            break;
+        line = nl + 1;
+    }
+    a->block_consumed = ran;
+    return NCP_OK;
+}
+
+int ncp_m7x_run(struct ncp_analyzer *a, int m)
+{
+    int level = a->flow ? ncp_flow_call_depth(a->flow) : 0;
+    struct ncp_m7x_frame *fr = ncp_m7x_frame_at(a, level);
+    if (!fr)
+        return a->err.code;
+    if (m == 70 || m == 73) {
+        ncp_m7x_snapshot(a, &fr->s);
+        fr->status |= M7X_VALID;
+        if (m == 73 && level > 0) /* at level 0 rs274 only warns: nothing returns there */
+            fr->status |= M7X_RESTORE_ON_RETURN;
+        return NCP_OK;
+    }
+    if (m == 71) {
+        fr->status &= ~M7X_VALID;
+        return NCP_OK;
+    }
+    if (!(fr->status & M7X_VALID))
+        return ncp_an_error(a, a->w.mcol[NCP_MG_SPINDLE],
+                            "Cannot restore context from invalid stack frame - missing M70/M73?");
+    return ncp_m7x_restore(a, level);
+}
+
+static void ncp_m7x_entered(void *ctx, int level)
+{
+    struct ncp_analyzer *a = ctx;
+    struct ncp_m7x_frame *fr = ncp_m7x_frame_at(a, level);
+    if (fr)
+        fr->status = 0;
+}
+
+static void ncp_m7x_left(void *ctx, int level)
+{
+    struct ncp_analyzer *a = ctx;
+    if (level < a->m7x_cap && (a->m7x[level].status & (M7X_VALID | M7X_RESTORE_ON_RETURN)) ==
+                                  (M7X_VALID | M7X_RESTORE_ON_RETURN))
+        a->m7x_restore_from = level;
+}
+
+struct ncp_flow_frames ncp_m7x_hooks(struct ncp_analyzer *a)
+{
+    return (struct ncp_flow_frames){a, ncp_m7x_entered, ncp_m7x_left};
+}
+
+/* The restore a return or endsub left: rs274 runs it on that line, before
+ * anything after it is read, so it runs before the next block or the next
+ * parameter an O-word line reads. */
+int ncp_m7x_pending(struct ncp_analyzer *a)
+{
+    if (a->m7x_restore_from < 0)
+        return NCP_OK;
+    int from = a->m7x_restore_from;
+    a->m7x_restore_from = -1;
+    const struct ncp_block *blk = a->blk;
+    int rc = ncp_m7x_restore(a, from);
+    a->blk = blk;
+    a->block_consumed = 0;
+    if (rc == NCP_OK)
+        rc = ncp_an_commit(a);
+    return rc;
+}
+
+/* A new run: no level holds a saved state, no restore is pending. */
+void ncp_m7x_reset(struct ncp_analyzer *a)
+{
+    if (a->m7x)
+        memset(a->m7x, 0, (size_t)a->m7x_cap * sizeof *a->m7x);
+    a->m7x_restore_from = -1;
+    a->block_consumed = 0;
+}
+
+void ncp_m7x_free(struct ncp_analyzer *a)
+{
+    free(a->m7x);
+    free(a->m7x_block);
+    a->m7x = NULL;
+    a->m7x_block = NULL;
+    a->m7x_cap = 0;
+}
