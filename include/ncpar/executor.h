@@ -19,9 +19,14 @@ int ncp_exec_resolve(struct ncp_cmd *cmd);
  * n_ops is truncated before it, NCP_CMD_F_ERROR set and diag (unless the slot
  * already had an error) gets NCP_ERR_LIMIT. NONE and unresolved requests print nothing. */
 void ncp_exec_format(struct ncp_cmd *cmd);
+/* The same text written to dst (NCP_CMD_OUT_MAX bytes of room) instead of
+ * cmd->out: a thread that formats and writes a command itself can format
+ * into its output buffer. cmd->out_len is set as ncp_exec_format sets it. */
+void ncp_exec_format_into(struct ncp_cmd *cmd, char *dst);
 
-/* Both, as an executor thread does. */
+/* Both, as an executor thread does; and both with the text into dst. */
 int ncp_exec_cmd(struct ncp_cmd *cmd);
+int ncp_exec_cmd_into(struct ncp_cmd *cmd, char *dst);
 
 /* Longest "%.4f" text of any double (DBL_MAX has 309 integer digits) + NUL. */
 #define NCP_FMT_FIXED4_MAX 328

@@ -66,6 +66,13 @@ int ncp_thread_map_load(struct ncp_thread_map *m, const char *path, struct ncp_d
 struct ncp_output {
     void *ctx;
     int (*emit)(void *ctx, const struct ncp_cmd *cmd);
+    /* Optional, both or neither: room for NCP_CMD_OUT_MAX bytes of text
+     * (NULL when there is none, e.g. after a failed write), where the thread
+     * that formats a command (serial, inline or packed output) writes it, and
+     * the call that then takes the command with its cmd->out_len bytes
+     * written there, in place of emit. Spares copying every line. */
+    char *(*reserve)(void *ctx);
+    int (*commit)(void *ctx, const struct ncp_cmd *cmd);
 };
 
 /* Per-stage counters, each written by its own thread only (read after join). */

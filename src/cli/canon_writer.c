@@ -77,7 +77,22 @@ int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd)
         return 1;
     memcpy(w->buf + w->used, cmd->out, cmd->out_len);
     w->used += cmd->out_len;
-    return 0;
+    return w->failed != 0;
+}
+
+char *canon_writer_reserve(void *ctx)
+{
+    struct canon_writer *w = ctx;
+    if (!w || (w->used + NCP_CMD_OUT_MAX > WRITER_BUF && hand_over(w)))
+        return NULL;
+    return w->buf + w->used;
+}
+
+int canon_writer_commit(void *ctx, const struct ncp_cmd *cmd)
+{
+    struct canon_writer *w = ctx;
+    w->used += cmd->out_len;
+    return w->failed != 0;
 }
 
 static void writer_free(struct canon_writer *w)

@@ -13,6 +13,10 @@ struct canon_writer;
 struct canon_writer *canon_writer_open(const char *path);
 /* ncp_output.emit: appends a slot's text; non-zero once a write has failed. */
 int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd);
+/* ncp_output.reserve/commit: the slot's text formatted straight into the
+ * buffer (NULL once a write has failed, then emit is used). */
+char *canon_writer_reserve(void *ctx);
+int canon_writer_commit(void *ctx, const struct ncp_cmd *cmd);
 /* Writes what is left, closes, frees; 0, or the errno of the first write
  * that failed. */
 int canon_writer_close(struct canon_writer *w);

@@ -245,7 +245,7 @@ static int cmd_parse(int argc, char **argv)
         ncp_source_close(&src);
         return EXIT_USAGE;
     }
-    struct ncp_output out = { w, canon_writer_emit };
+    struct ncp_output out = { w, canon_writer_emit, canon_writer_reserve, canon_writer_commit };
     struct ncp_run_stats st;
     memset(&st, 0, sizeof st);
     int rc = map.mode == NCP_MODE_SERIAL

@@ -301,8 +301,13 @@ static int ncp_kind_prints(unsigned kind)
 
 void ncp_exec_format(struct ncp_cmd *cmd)
 {
+    ncp_exec_format_into(cmd, cmd->out);
+}
+
+void ncp_exec_format_into(struct ncp_cmd *cmd, char *dst)
+{
     pthread_once(&ncp_tpls_once, ncp_tpls_build);
-    struct ncp_out o = {cmd->out, cmd->out + NCP_CMD_OUT_MAX, 0};
+    struct ncp_out o = {dst, dst + NCP_CMD_OUT_MAX, 0};
     unsigned n_ops = cmd->n_ops;
     if (n_ops > NCP_CMD_MAX_OPS)
         n_ops = NCP_CMD_MAX_OPS;
@@ -325,5 +330,5 @@ void ncp_exec_format(struct ncp_cmd *cmd)
             break;
         }
     }
-    cmd->out_len = (uint32_t)(o.p - cmd->out);
+    cmd->out_len = (uint32_t)(o.p - dst);
 }

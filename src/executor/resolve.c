@@ -143,3 +143,10 @@ int ncp_exec_cmd(struct ncp_cmd *cmd)
     ncp_exec_format(cmd);
     return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }
+
+int ncp_exec_cmd_into(struct ncp_cmd *cmd, char *dst)
+{
+    ncp_exec_resolve(cmd);
+    ncp_exec_format_into(cmd, dst);
+    return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
+}

@@ -43,9 +43,8 @@ static struct ncp_cmd *serial_acquire(void *ctx)
 static void serial_publish(void *ctx, struct ncp_cmd *cmd)
 {
     struct serial_sink *s = ctx;
-    ncp_exec_cmd(cmd);
     s->emitted++;
-    if (ncp_emit_cmd(cmd, s->out, &s->err, &s->emit_failed))
+    if (ncp_exec_emit_cmd(cmd, s->out, &s->err, &s->emit_failed))
         s->stopped = 1;
 }
 

@@ -356,9 +356,8 @@ static void inline_publish(void *ctx, struct ncp_cmd *c)
     struct ncp_pipe *p = ctx;
     p->next_id++;
     p->analyzer.items++;
-    ncp_exec_cmd(c);
     p->output.items++;
-    if (ncp_emit_cmd(c, p->out, &p->err, &p->emit_failed))
+    if (ncp_exec_emit_cmd(c, p->out, &p->err, &p->emit_failed))
         p->inline_stopped = 1;
 }
 
@@ -481,9 +480,8 @@ static void output_packed(struct ncp_pipe *p)
         }
         if ((c = take_packed(p)) == NULL)
             break;
-        ncp_exec_cmd(c);
         p->output.items++;
-        if (ncp_emit_cmd(c, p->out, &p->err, &p->emit_failed))
+        if (ncp_exec_emit_cmd(c, p->out, &p->err, &p->emit_failed))
             break;
     }
 }

@@ -60,7 +60,7 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
 static void *interp_main(void *arg)
 {
     struct nck *n = arg;
-    struct ncp_output out = { n, emit_segments };
+    struct ncp_output out = { .ctx = n, .emit = emit_segments };
     memset(&n->interp_diag, 0, sizeof n->interp_diag);
     n->interp_rc = n->o->interpret(n->o->interp_ctx, &out, &n->interp_diag);
     struct nck_seg_msg end;
@@ -101,7 +101,7 @@ static int precheck_limits(const struct ncp_nck_opts *o, const double start[NCP_
     if (!pc)
         return -1;
     ncp_canon_map_init(&pc->map, o->cfg, start, o->feed_override);
-    struct ncp_output out = { pc, emit_check };
+    struct ncp_output out = { .ctx = pc, .emit = emit_check };
     struct ncp_diag ignored;
     o->interpret(o->interp_ctx, &out, &ignored);
     int failed = pc->failed;

@@ -37,7 +37,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* small limits keep runaway loops short while still exercising the guard */
     struct ncp_analyzer_cfg cfg = { .max_loop_iterations = 2000 };
     struct capture serial = { 0 }, par = { 0 };
-    struct ncp_output o1 = { &serial, capture_emit }, o2 = { &par, capture_emit };
+    struct ncp_output o1 = { .ctx = &serial, .emit = capture_emit },
+                      o2 = { .ctx = &par, .emit = capture_emit };
 
     memset(&d1, 0, sizeof d1);
     memset(&d2, 0, sizeof d2);

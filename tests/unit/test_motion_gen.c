@@ -331,7 +331,7 @@ static void run_job(void **state)
     assert_non_null(g);
     double start[NCP_AXES] = { 0 };
     ncp_canon_map_init(&g->map, &cfg, start, 1.0);
-    struct ncp_output out = { g, collect_seg };
+    struct ncp_output out = { .ctx = g, .emit = collect_seg };
     struct ncp_diag d;
     int irc = gcode_run(&gc, &out, &d);
     if (irc != NCP_OK || g->failed)
