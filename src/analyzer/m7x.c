@@ -11,7 +11,6 @@
  * do (its G codes, its motion) is dropped, and so it is here. */
 #include "state.h"
 
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -115,18 +114,15 @@ static int ncp_m7x_exec_line(struct ncp_analyzer *a, const char *text)
     return rc;
 }
 
-static void ncp_m7x_put(char *buf, size_t cap, size_t *len, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-static void ncp_m7x_put(char *buf, size_t cap, size_t *len, const char *fmt, ...)
+/* Appends what snprintf wrote (n) to a text of length *len in cap bytes. */
+static void ncp_m7x_grow(size_t *len, size_t cap, int n)
 {
-    if (*len >= cap)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(buf + *len, cap - *len, fmt, ap);
-    va_end(ap);
-    *len = n < 0 ? *len : *len + (size_t)n < cap ? *len + (size_t)n : cap;
+    if (n > 0)
+        *len = *len + (size_t)n < cap ? *len + (size_t)n : cap;
 }
+
+#define M7X_PUT(...) \
+    ncp_m7x_grow(&len, cap, snprintf(buf + len, len < cap ? cap - len : 0, __VA_ARGS__))
 
 /* rs274's gen_settings + gen_m_codes: the text that brings `cur` to `saved`. */
 static void ncp_m7x_text(const struct ncp_m7x_state *cur, const struct ncp_m7x_state *saved,
@@ -136,9 +132,9 @@ static void ncp_m7x_text(const struct ncp_m7x_state *cur, const struct ncp_m7x_s
     buf[0] = '\0';
     int g64_changed = saved->tol != cur->tol || saved->naive != cur->naive;
     if (saved->feed != cur->feed)
-        ncp_m7x_put(buf, cap, &len, " F%.1f", saved->feed);
+        M7X_PUT(" F%.1f", saved->feed);
     if (saved->speed != cur->speed)
-        ncp_m7x_put(buf, cap, &len, " S%.0f", saved->speed);
+        M7X_PUT(" S%.0f", saved->speed);
     for (int i = G_PLANE; i < G_SLOTS; i++) {
         int v = saved->g[i];
         if (i == G_UNITS || v == cur->g[i] || v == -1)
@@ -146,23 +142,23 @@ static void ncp_m7x_text(const struct ncp_m7x_state *cur, const struct ncp_m7x_s
         if (i == G_CONTROL && v == 640)
             g64_changed = 1;
         else if (v % 10)
-            ncp_m7x_put(buf, cap, &len, " G%d.%d", v / 10, v % 10);
+            M7X_PUT(" G%d.%d", v / 10, v % 10);
         else
-            ncp_m7x_put(buf, cap, &len, " G%d", v / 10);
+            M7X_PUT(" G%d", v / 10);
     }
     if (saved->g[G_CONTROL] == 640 && g64_changed) {
         if (saved->tol < 0)
-            ncp_m7x_put(buf, cap, &len, " G64");
+            M7X_PUT(" G64");
         else if (saved->naive < 0)
-            ncp_m7x_put(buf, cap, &len, " G64 P%f", saved->tol);
+            M7X_PUT(" G64 P%f", saved->tol);
         else
-            ncp_m7x_put(buf, cap, &len, " G64 P%f Q%f", saved->tol, saved->naive);
+            M7X_PUT(" G64 P%f Q%f", saved->tol, saved->naive);
     }
     static const int m_slots[] = {M_SPINDLE, M_MIST, M_FLOOD, M_OVERRIDE, M_ADAPTIVE, M_HOLD};
     for (size_t k = 0; k < sizeof m_slots / sizeof m_slots[0]; k++) {
         int i = m_slots[k];
         if (saved->m[i] != cur->m[i] && saved->m[i] != -1)
-            ncp_m7x_put(buf, cap, &len, "M%d\n", saved->m[i]);
+            M7X_PUT("M%d\n", saved->m[i]);
     }
 }
 

@@ -69,8 +69,9 @@ static int ncp_m_group(int m)
     switch (m) {
     case 0: case 1: case 2: case 30: case 60: return NCP_MG_STOP;
     case 6: case 61: return NCP_MG_TOOL;
-    case 3: case 4: case 5: case 19: return NCP_MG_SPINDLE;
-    case 70: case 71: case 72: case 73: return NCP_MG_SPINDLE; /* rs274's group 7 too */
+    case 3: case 4: case 5: case 19:
+    case 70: case 71: case 72: case 73: /* rs274's group 7 holds M70-M73 too */
+        return NCP_MG_SPINDLE;
     case 7: case 8: case 9: return NCP_MG_COOLANT;
     case 48: case 49: case 50: case 51: case 52: case 53: return NCP_MG_OVERRIDE;
     case 62: case 63: case 64: case 65: case 66: case 67: case 68: return NCP_MG_IO;
@@ -131,7 +132,7 @@ static int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int 
 static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
 {
     struct ncp_words *w = &a->w;
-    int m;
+    int m = 0;
     int rc = ncp_integer_word(a, v, col, &m);
     if (rc != NCP_OK)
         return rc;
@@ -155,7 +156,7 @@ static int ncp_word_check(struct ncp_analyzer *a, char c, double v, uint16_t col
 {
     /* rs274 reads T, H and L as integers before the sign check */
     if (c == 'T' || c == 'H' || c == 'L') {
-        int i;
+        int i = 0;
         int rc = ncp_integer_word(a, v, col, &i);
         if (rc != NCP_OK)
             return rc;
