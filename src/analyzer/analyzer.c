@@ -262,7 +262,7 @@ static int ncp_an_eof(struct ncp_analyzer *a, const struct ncp_source *src)
  * in that order here, so every value (even a subnormal) comes out as rs274's.
  * Before any step of the block uses X, after the checks that only look at
  * whether it is there. */
-void ncp_lathe_x_word(struct ncp_analyzer *a)
+static void ncp_lathe_x_word(struct ncp_analyzer *a)
 {
     struct ncp_words *w = &a->w;
     if (!NCP_HAS(w, 'X'))
@@ -277,6 +277,24 @@ void ncp_lathe_x_word(struct ncp_analyzer *a)
         *x *= 2;
 }
 
+/* A block as rs274 reads and executes it: what the canon did since the last
+ * one read back, the words, their checks, then the steps in rs274's order. */
+int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b)
+{
+    a->blk = b;
+    ncp_sai_resync(a);
+    int rc = ncp_words_collect(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_words_assign(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_modal_check(a);
+    if (rc == NCP_OK) {
+        ncp_lathe_x_word(a);
+        rc = ncp_exec_block(a);
+    }
+    return rc;
+}
+
 static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
 {
     a->blk = b;
@@ -287,18 +305,8 @@ static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
     }
     /* rs274 -g runs with the block delete switch off: '/' lines execute */
     int rc = ncp_m7x_pending(a);
-    if (rc != NCP_OK)
-        return rc;
-    ncp_sai_resync(a);
-    rc = ncp_words_collect(a, b);
     if (rc == NCP_OK)
-        rc = ncp_words_assign(a, b);
-    if (rc == NCP_OK)
-        rc = ncp_modal_check(a);
-    if (rc == NCP_OK) {
-        ncp_lathe_x_word(a);
-        rc = ncp_exec_block(a);
-    }
+        rc = ncp_an_execute(a, b);
     if (rc == NCP_OK || rc == NCP_END) {
         int c = ncp_an_commit(a);
         if (c != NCP_OK)

@@ -100,18 +100,7 @@ static int ncp_m7x_exec_line(struct ncp_analyzer *a, const char *text)
         a->err = b->err;
         return b->err.code;
     }
-    a->blk = b;
-    ncp_sai_resync(a);
-    int rc = ncp_words_collect(a, b);
-    if (rc == NCP_OK)
-        rc = ncp_words_assign(a, b);
-    if (rc == NCP_OK)
-        rc = ncp_modal_check(a);
-    if (rc == NCP_OK) {
-        ncp_lathe_x_word(a);
-        rc = ncp_exec_block(a);
-    }
-    return rc;
+    return ncp_an_execute(a, b);
 }
 
 /* Appends what snprintf wrote (n) to a text of length *len in cap bytes. */

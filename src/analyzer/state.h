@@ -168,8 +168,8 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b);
 
 /* modal.c */
 int ncp_modal_check(struct ncp_analyzer *a);
-/* analyzer.c: G7 halves the block's X word (before any step uses it) */
-void ncp_lathe_x_word(struct ncp_analyzer *a);
+/* analyzer.c: read back what the canon did, then read and execute block b */
+int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b);
 
 /* exec.c: the whole block in rs274's order */
 int ncp_exec_block(struct ncp_analyzer *a);
