@@ -98,6 +98,29 @@ static void seg_common(const struct ncp_canon_map *m, struct ncp_seg *s, uint32_
     memcpy(s->start, m->pos, sizeof s->start);
 }
 
+/* The spindle's speed (rpm) with the tool at machine X = x_mm: under G96 the
+ * surface speed (m/min, or ft/min in inches) over the circumference at that
+ * radius, capped at D. */
+static double spindle_rpm(const struct ncp_canon_map *m, double x_mm)
+{
+    if (m->css_max <= 0)
+        return m->speed;
+    double surface = m->speed * (m->scale == 1.0 ? 1000.0 : 304.8); /* mm per minute */
+    double r = fabs(x_mm);
+    double rpm = r > 0 ? surface / (2 * M_PI * r) : m->css_max;
+    return rpm < m->css_max ? rpm : m->css_max;
+}
+
+/* Feed in mm/s of a move ending at machine X = x_mm. A synchronised move
+ * runs at its pitch whatever the override (rs274 turns it off around them). */
+static double feed_at(const struct ncp_canon_map *m, double x_mm)
+{
+    if (m->sync_pitch > 0)
+        return m->sync_pitch * spindle_rpm(m, x_mm) / 60.0;
+    double f = m->per_rev ? m->per_rev_feed * spindle_rpm(m, x_mm) / 60.0 : m->feed;
+    return f * m->feed_override;
+}
+
 static int finite3(const double *v, int n)
 {
     for (int i = 0; i < n; i++)
@@ -123,7 +146,7 @@ static int straight(struct ncp_canon_map *m, const struct ncp_canon *op, int tra
         return 0;  /* A/B/C-only or null move: nothing for a 3-axis machine to do */
     if (traverse)
         s->feed = m->cfg->max_linear_vel;
-    else if (s->feed <= 0)
+    else if ((s->feed = feed_at(m, s->end[0])) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "feed move with zero feed rate");
     int r = check_point(m, s->end, line, d);
     if (r)
@@ -192,7 +215,7 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     s->angle = a;
     double arc_len = fabs(a) * 0.5 * (s->r0 + s->r1);
     s->length = sqrt(arc_len * arc_len + s->axial * s->axial);
-    if (s->feed <= 0)
+    if ((s->feed = feed_at(m, s->end[0])) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "arc move with zero feed rate");
     int r = check_arc(m, s, d);
     if (r)
@@ -230,6 +253,22 @@ static int state_op(struct ncp_canon_map *m, const struct ncp_canon *op)
         break;
     case NCP_C_SET_FEED_RATE:
         m->feed = op->d[0] * m->scale / 60.0;
+        m->per_rev_feed = op->d[0] * m->scale;
+        break;
+    case NCP_C_SET_FEED_MODE:
+        m->per_rev = op->i[1] == 1;
+        break;
+    case NCP_C_SET_SPINDLE_SPEED:
+        m->speed = op->d[0];
+        break;
+    case NCP_C_SET_SPINDLE_MODE:
+        m->css_max = op->d[0] > 0 ? op->d[0] : 0.0;
+        break;
+    case NCP_C_START_SPEED_FEED_SYNCH:
+        m->sync_pitch = op->d[0] * m->scale;
+        break;
+    case NCP_C_STOP_SPEED_FEED_SYNCH:
+        m->sync_pitch = 0.0;
         break;
     case NCP_C_SET_MOTION_CONTROL_MODE:
         m->term = op->i[0] == 0 ? NCP_TERM_STOP

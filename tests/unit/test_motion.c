@@ -396,6 +396,54 @@ static void test_canon_units_offsets(void **state)
     assert_int_equal(s.line, 6);
 }
 
+/* G95 feeds per turn, G96 at the end point's radius capped at D, and the
+ * synchronised moves of G33/G76 at their pitch, whatever the override. */
+static void test_canon_spindle_feeds(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon_map m;
+    ncp_canon_map_init(&m, &c, NULL, 0.5); /* 50 % override */
+    struct ncp_seg s;
+    struct ncp_diag d;
+    struct ncp_canon mode = op6(NCP_C_SET_FEED_MODE, 0, 0, 0);
+    mode.i[1] = 1; /* units per revolution */
+    struct ncp_canon speed = op6(NCP_C_SET_SPINDLE_SPEED, 600, 0, 0);
+    struct ncp_canon f = op_feed(0.2);
+    assert_int_equal(ncp_canon_map_op(&m, &mode, 1, &s, &d), 0);
+    assert_int_equal(ncp_canon_map_op(&m, &speed, 2, &s, &d), 0);
+    assert_int_equal(ncp_canon_map_op(&m, &f, 3, &s, &d), 0);
+    struct ncp_canon mv = op6(NCP_C_STRAIGHT_FEED, 10, 0, -5);
+    assert_int_equal(ncp_canon_map_op(&m, &mv, 4, &s, &d), 1);
+    assert_true(fabs(s.feed - 0.2 * 600 / 60.0 * 0.5) < 1e-12);
+    /* G96 S180 (m/min) D2500: at X 10 mm 180000 / (2 pi 10) = 2864.8 rpm, capped */
+    struct ncp_canon css = op6(NCP_C_SET_SPINDLE_MODE, 2500, 0, 0);
+    struct ncp_canon surface = op6(NCP_C_SET_SPINDLE_SPEED, 180, 0, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &css, 5, &s, &d), 0);
+    assert_int_equal(ncp_canon_map_op(&m, &surface, 6, &s, &d), 0);
+    struct ncp_canon at10 = op6(NCP_C_STRAIGHT_FEED, 10, 0, -10);
+    assert_int_equal(ncp_canon_map_op(&m, &at10, 7, &s, &d), 1);
+    assert_true(fabs(s.feed - 0.2 * 2500 / 60.0 * 0.5) < 1e-12);
+    struct ncp_canon at20 = op6(NCP_C_STRAIGHT_FEED, 20, 0, -10);
+    assert_int_equal(ncp_canon_map_op(&m, &at20, 8, &s, &d), 1);
+    assert_true(fabs(s.feed - 0.2 * (180000 / (2 * M_PI * 20)) / 60.0 * 0.5) < 1e-9);
+    /* synchronised at pitch 1.5 under G97 S400: 10 mm/s, no override */
+    struct ncp_canon rpm = op6(NCP_C_SET_SPINDLE_MODE, 0, 0, 0);
+    struct ncp_canon s400 = op6(NCP_C_SET_SPINDLE_SPEED, 400, 0, 0);
+    struct ncp_canon sync = op6(NCP_C_START_SPEED_FEED_SYNCH, 1.5, 0, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &rpm, 9, &s, &d), 0);
+    assert_int_equal(ncp_canon_map_op(&m, &s400, 10, &s, &d), 0);
+    assert_int_equal(ncp_canon_map_op(&m, &sync, 11, &s, &d), 0);
+    struct ncp_canon thread = op6(NCP_C_STRAIGHT_FEED, 20, 0, -30);
+    assert_int_equal(ncp_canon_map_op(&m, &thread, 12, &s, &d), 1);
+    assert_true(fabs(s.feed - 10.0) < 1e-12);
+    struct ncp_canon stop = op6(NCP_C_STOP_SPEED_FEED_SYNCH, 0, 0, 0);
+    assert_int_equal(ncp_canon_map_op(&m, &stop, 13, &s, &d), 0);
+    struct ncp_canon back = op6(NCP_C_STRAIGHT_FEED, 20, 0, -20);
+    assert_int_equal(ncp_canon_map_op(&m, &back, 14, &s, &d), 1);
+    assert_true(fabs(s.feed - 0.2 * 400 / 60.0 * 0.5) < 1e-12);
+}
+
 static void test_soft_limit(void **state)
 {
     (void)state;
@@ -474,6 +522,7 @@ int main(void)
         cmocka_unit_test(test_arc_radius_and_helix),
         cmocka_unit_test(test_arc_centripetal_cap),
         cmocka_unit_test(test_canon_units_offsets),
+        cmocka_unit_test(test_canon_spindle_feeds),
         cmocka_unit_test(test_soft_limit),
         cmocka_unit_test(test_replan_cost_bounded),
     };
