@@ -101,8 +101,9 @@ enum ncp_canon_kind {
     NCP_C_SET_AUX_OUTPUT_VALUE, NCP_C_SET_MOTION_OUTPUT_VALUE,  /* i[0], d[0] */
     NCP_C_START_SPEED_FEED_SYNCH,/* i[0] spindle, d[0] feed per rev, i[1] velocity mode */
     NCP_C_STOP_SPEED_FEED_SYNCH,
-    NCP_C_NURBS_FEED,            /* i[0] order (3 G5.1, 4 G5); d[0..2] the end x y z (not printed:
-                                    rs274 -g prints no control point) */
+    NCP_C_NURBS_FEED,            /* i[0] order (3 G5.1, 4 G5); d[0..2] the end x y z, d[3..4]
+                                    the start, d[5..6] and (G5) d[7..8] the control points, x y:
+                                    for the NCK only, rs274 -g prints no point */
     NCP_C_RIGID_TAP,             /* d[0..2] x y z of the hole's bottom (G33.1); back at the start after */
     NCP_C_RAW_TEXT,              /* text printed verbatim (for calls not modelled above) */
     NCP_C__COUNT

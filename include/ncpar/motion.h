@@ -113,6 +113,14 @@ struct ncp_canon_map {
     double sync_pitch;      /* mm per turn; 0: not synchronised */
     double speed;           /* S as programmed */
     double css_max;         /* > 0: G96 (constant surface speed), rpm cap */
+    /* A call that makes several segments, what ncp_canon_map_more has left:
+     * RIGID_TAP the way back out; NURBS_FEED the rest of the curve in lines. */
+    int more_left, more_kind, more_steps;
+    uint32_t more_line;
+    double more_back[NCP_AXES];   /* RIGID_TAP: where the tap started, mm */
+    double more_ctrl[4][2];       /* NURBS_FEED: Bezier control points, program X Y */
+    int more_points;              /* 3 (G5.1) or 4 (G5) */
+    double more_z;                /* NURBS_FEED: Z, program units */
     int term;               /* enum ncp_seg_term */
     double tolerance;       /* mm */
     double pos[NCP_AXES];   /* machine position at the end of the last segment */
@@ -125,6 +133,11 @@ void ncp_canon_map_init(struct ncp_canon_map *m, const struct ncp_machine_cfg *c
  * (soft-limit violations: -NCP_ERR_LIMIT, d->line = the block's line). */
 int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
                      struct ncp_seg *seg, struct ncp_diag *d);
+/* After a call that made a segment: the next segment the same call makes
+ * (1), none left (0), or minus an error code. A rigid tap is two segments
+ * (in, back out), a G5/G5.1 spline NCP_SPLINE_STEPS lines along the curve. */
+int ncp_canon_map_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_diag *d);
+#define NCP_SPLINE_STEPS 16
 
 /* ---- planner + interpolator ------------------------------------------------ */
 

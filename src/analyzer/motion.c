@@ -374,9 +374,24 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
     int rc = ncp_motion_ends(a, 0, end);
     if (rc != NCP_OK)
         return rc;
+    /* the control points ride along for the NCK (rs274 -g prints none): start,
+     * start + IJ, [end + PQ,] end; a G5 without I J continues the last G5's
+     * direction (-P, -Q), as LinuxCNC draws it */
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_NURBS_FEED);
     op->i[0] = motion == 51 ? 3 : 4;
     memcpy(op->d, end, 3 * sizeof(double));
+    double i = NCP_HAS(w, 'I') ? w->v[NCP_LETTER('I')] : -s->g5_pq[0];
+    double j = NCP_HAS(w, 'J') ? w->v[NCP_LETTER('J')] : -s->g5_pq[1];
+    op->d[3] = s->pos[NCP_X];
+    op->d[4] = s->pos[NCP_Y];
+    op->d[5] = s->pos[NCP_X] + i;
+    op->d[6] = s->pos[NCP_Y] + j;
+    if (motion == 50) {
+        s->g5_pq[0] = w->v[NCP_LETTER('P')];
+        s->g5_pq[1] = w->v[NCP_LETTER('Q')];
+        op->d[7] = end[NCP_X] + s->g5_pq[0];
+        op->d[8] = end[NCP_Y] + s->g5_pq[1];
+    }
     a->sai.pos[NCP_X] = a->sai.pos[NCP_Y] = 0.0;
     memcpy(s->pos, end, sizeof end);
     return NCP_OK;

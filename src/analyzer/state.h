@@ -83,6 +83,7 @@ struct ncp_state {
     struct ncp_modal m;
     int selected_tool, selected_pocket, current_tool, current_pocket;
     int toolchange_flag;
+    double g5_pq[2];              /* the last G5's P Q: where a G5 without I J starts off */
     /* canned cycle sticky values */
     double cycle_r, cycle_cc, cycle_p, cycle_q, cycle_il, cycle_ijk[3];
     int cycle_l, cycle_il_flag;

@@ -129,13 +129,14 @@ static int finite3(const double *v, int n)
     return 1;
 }
 
-static int straight(struct ncp_canon_map *m, const struct ncp_canon *op, int traverse,
-                    uint32_t line, struct ncp_seg *s, struct ncp_diag *d)
+/* A line from the current machine position to end_mm. */
+static int line_to(struct ncp_canon_map *m, const double end_mm[NCP_AXES], int traverse,
+                   uint32_t line, struct ncp_seg *s, struct ncp_diag *d)
 {
     seg_common(m, s, line);
     s->kind = NCP_SEG_LINE;
     s->traverse = (uint8_t)traverse;
-    to_machine(m, op->d, s->end);
+    memcpy(s->end, end_mm, sizeof s->end);
     if (!finite3(s->end, NCP_AXES))
         return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "move to a non-finite position");
     double l2 = 0;
@@ -153,6 +154,93 @@ static int straight(struct ncp_canon_map *m, const struct ncp_canon *op, int tra
         return -r;
     memcpy(m->pos, s->end, sizeof m->pos);
     return 1;
+}
+
+static int straight(struct ncp_canon_map *m, const struct ncp_canon *op, int traverse,
+                    uint32_t line, struct ncp_seg *s, struct ncp_diag *d)
+{
+    double end[NCP_AXES];
+    to_machine(m, op->d, end);
+    return line_to(m, end, traverse, line, s, d);
+}
+
+/* G33.1: to the hole's bottom now, back to where it started next (more). */
+static int rigid_tap(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
+                     struct ncp_seg *s, struct ncp_diag *d)
+{
+    double end[NCP_AXES];
+    memcpy(m->more_back, m->pos, sizeof m->more_back);
+    to_machine(m, op->d, end);
+    int rc = line_to(m, end, 0, line, s, d);
+    if (rc == 1) {
+        m->more_kind = NCP_C_RIGID_TAP;
+        m->more_left = 1;
+        m->more_line = line;
+    }
+    return rc;
+}
+
+/* The point at t of the spline's Bezier curve (its control points are the
+ * start, start + IJ, [end + PQ,] end: G5.1 quadratic, G5 cubic), machine mm. */
+static void spline_point(const struct ncp_canon_map *m, double t, double out[NCP_AXES])
+{
+    const double (*c)[2] = m->more_ctrl;
+    double u = 1.0 - t, p[3];
+    for (int k = 0; k < 2; k++)
+        p[k] = m->more_points == 3
+                   ? u * u * c[0][k] + 2 * u * t * c[1][k] + t * t * c[2][k]
+                   : u * u * u * c[0][k] + 3 * u * u * t * c[1][k] + 3 * u * t * t * c[2][k] +
+                         t * t * t * c[3][k];
+    p[2] = m->more_z;
+    to_machine(m, p, out);
+}
+
+/* The next line along a spline, or a tap's way out: 1, 0 when done. Lines of
+ * zero length (a degenerate curve) are passed over. */
+int ncp_canon_map_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_diag *d)
+{
+    while (m->more_left > 0) {
+        m->more_left--;
+        double end[NCP_AXES];
+        if (m->more_kind == NCP_C_RIGID_TAP) {
+            memcpy(end, m->more_back, sizeof end);
+        } else {
+            int k = m->more_steps - m->more_left;
+            spline_point(m, (double)k / m->more_steps, end);
+        }
+        int rc = line_to(m, end, 0, m->more_line, seg, d);
+        if (rc != 0) {
+            if (rc < 0)
+                m->more_left = 0;
+            return rc;
+        }
+    }
+    return 0;
+}
+
+/* G5/G5.1: op->d[0..2] the end, d[3..4] the start, d[5..6] the first control
+ * point, d[7..8] the second (G5) - program X Y. The first line now. */
+static int spline(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
+                  struct ncp_seg *s, struct ncp_diag *d)
+{
+    m->more_points = op->i[0] == 4 ? 4 : 3;
+    m->more_ctrl[0][0] = op->d[3];
+    m->more_ctrl[0][1] = op->d[4];
+    m->more_ctrl[1][0] = op->d[5];
+    m->more_ctrl[1][1] = op->d[6];
+    int last = m->more_points - 1;
+    if (last == 3) {
+        m->more_ctrl[2][0] = op->d[7];
+        m->more_ctrl[2][1] = op->d[8];
+    }
+    m->more_ctrl[last][0] = op->d[0];
+    m->more_ctrl[last][1] = op->d[1];
+    m->more_z = op->d[2];
+    m->more_kind = NCP_C_NURBS_FEED;
+    m->more_steps = NCP_SPLINE_STEPS;
+    m->more_left = NCP_SPLINE_STEPS;
+    m->more_line = line;
+    return ncp_canon_map_more(m, s, d);
 }
 
 /* Axis indices (machine X=0 Y=1 Z=2) of first, second and normal per plane. */
@@ -292,6 +380,10 @@ int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
         return straight(m, op, 0, line, seg, d);
     case NCP_C_ARC_FEED:
         return arc(m, op, line, seg, d);
+    case NCP_C_RIGID_TAP:
+        return rigid_tap(m, op, line, seg, d);
+    case NCP_C_NURBS_FEED:
+        return spline(m, op, line, seg, d);
     case NCP_C_DWELL:
         seg_common(m, seg, line);
         seg->kind = NCP_SEG_DWELL;

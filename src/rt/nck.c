@@ -51,8 +51,15 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
             n->map_failed = 1;
             return 1;
         }
-        if (rc == 1 && push_wait(n, &n->segs, &m))
+        while (rc == 1) {
+            if (push_wait(n, &n->segs, &m))
+                return 1;
+            rc = ncp_canon_map_more(&n->map, &m.seg, &n->map_diag);
+        }
+        if (rc < 0) {
+            n->map_failed = 1;
             return 1;
+        }
     }
     return 0;
 }
@@ -83,7 +90,10 @@ static int emit_check(void *ctx, const struct ncp_cmd *cmd)
     struct precheck *pc = ctx;
     struct ncp_seg s;
     for (unsigned i = 0; i < cmd->n_ops; i++) {
-        if (ncp_canon_map_op(&pc->map, &cmd->ops[i], cmd->line, &s, &pc->d) < 0) {
+        int rc = ncp_canon_map_op(&pc->map, &cmd->ops[i], cmd->line, &s, &pc->d);
+        while (rc == 1)
+            rc = ncp_canon_map_more(&pc->map, &s, &pc->d);
+        if (rc < 0) {
             pc->failed = pc->d.code == NCP_ERR_LIMIT;
             return 1;
         }

@@ -444,6 +444,62 @@ static void test_canon_spindle_feeds(void **state)
     assert_true(fabs(s.feed - 0.2 * 400 / 60.0 * 0.5) < 1e-12);
 }
 
+/* A rigid tap goes down and comes back; a spline comes out as lines on the
+ * Bezier curve of its control points. */
+static void test_canon_tap_and_spline(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon_map m;
+    ncp_canon_map_init(&m, &c, NULL, 1.0);
+    struct ncp_seg s;
+    struct ncp_diag d;
+    struct ncp_canon f = op_feed(600);
+    assert_int_equal(ncp_canon_map_op(&m, &f, 1, &s, &d), 0);
+    struct ncp_canon to = op6(NCP_C_STRAIGHT_TRAVERSE, 5, 5, 2);
+    assert_int_equal(ncp_canon_map_op(&m, &to, 2, &s, &d), 1);
+    struct ncp_canon tap = op6(NCP_C_RIGID_TAP, 5, 5, -8);
+    assert_int_equal(ncp_canon_map_op(&m, &tap, 3, &s, &d), 1);
+    assert_true(fabs(s.end[2] + 8.0) < 1e-12 && fabs(s.start[2] - 2.0) < 1e-12);
+    assert_int_equal(ncp_canon_map_more(&m, &s, &d), 1);
+    assert_true(fabs(s.end[2] - 2.0) < 1e-12 && fabs(s.end[0] - 5.0) < 1e-12);
+    assert_int_equal(s.line, 3);
+    assert_int_equal(ncp_canon_map_more(&m, &s, &d), 0);
+    /* G5.1 from (5,5) with control point (15,5) to (15,15): at t = 1/2 the
+     * curve is at (12.5, 7.5) */
+    struct ncp_canon q = op6(NCP_C_NURBS_FEED, 15, 15, 2);
+    q.i[0] = 3;
+    q.d[3] = 5;
+    q.d[4] = 5;
+    q.d[5] = 15;
+    q.d[6] = 5;
+    int n = ncp_canon_map_op(&m, &q, 4, &s, &d);
+    for (int k = 1; n == 1; k++) {
+        if (k == NCP_SPLINE_STEPS / 2)
+            assert_true(fabs(s.end[0] - 12.5) < 1e-12 && fabs(s.end[1] - 7.5) < 1e-12);
+        assert_true(k <= NCP_SPLINE_STEPS);
+        n = ncp_canon_map_more(&m, &s, &d);
+    }
+    assert_int_equal(n, 0);
+    assert_true(fabs(m.pos[0] - 15) < 1e-12 && fabs(m.pos[1] - 15) < 1e-12);
+    /* G5 back to (5,5) through (15,10) and (10,5): at t = 1/2,
+     * (15 + 3*15 + 3*10 + 5) / 8 = 11.875 and (15 + 3*10 + 3*5 + 5) / 8 = 8.125 */
+    struct ncp_canon cu = op6(NCP_C_NURBS_FEED, 5, 5, 2);
+    cu.i[0] = 4;
+    cu.d[3] = 15;
+    cu.d[4] = 15;
+    cu.d[5] = 15;
+    cu.d[6] = 10;
+    cu.d[7] = 10;
+    cu.d[8] = 5;
+    int segs = 0;
+    for (n = ncp_canon_map_op(&m, &cu, 5, &s, &d); n == 1; n = ncp_canon_map_more(&m, &s, &d)) {
+        if (++segs == NCP_SPLINE_STEPS / 2)
+            assert_true(fabs(s.end[0] - 11.875) < 1e-12 && fabs(s.end[1] - 8.125) < 1e-12);
+    }
+    assert_int_equal(segs, NCP_SPLINE_STEPS);
+}
+
 static void test_soft_limit(void **state)
 {
     (void)state;
@@ -523,6 +579,7 @@ int main(void)
         cmocka_unit_test(test_arc_centripetal_cap),
         cmocka_unit_test(test_canon_units_offsets),
         cmocka_unit_test(test_canon_spindle_feeds),
+        cmocka_unit_test(test_canon_tap_and_spline),
         cmocka_unit_test(test_soft_limit),
         cmocka_unit_test(test_replan_cost_bounded),
     };
