@@ -396,52 +396,71 @@ static void test_canon_units_offsets(void **state)
     assert_int_equal(s.line, 6);
 }
 
+/* A canon map on the test machine, and what its calls fill. */
+struct map_fixture {
+    struct ncp_machine_cfg cfg;
+    struct ncp_canon_map m;
+    struct ncp_seg s;
+    struct ncp_diag d;
+};
+
+static void map_fixture_init(struct map_fixture *f, double feed_override)
+{
+    f->cfg = test_cfg();
+    ncp_canon_map_init(&f->m, &f->cfg, NULL, feed_override);
+}
+
+/* Feeds op to the map: what ncp_canon_map_op returns. */
+static int map_op(struct map_fixture *f, struct ncp_canon op, uint32_t line)
+{
+    return ncp_canon_map_op(&f->m, &op, line, &f->s, &f->d);
+}
+
+static int map_more(struct map_fixture *f)
+{
+    return ncp_canon_map_more(&f->m, &f->s, &f->d);
+}
+
 /* G95 feeds per turn, G96 at the end point's radius capped at D, and the
  * synchronised moves of G33/G76 at their pitch, whatever the override. */
 static void test_canon_spindle_feeds(void **state)
 {
     (void)state;
-    struct ncp_machine_cfg c = test_cfg();
-    struct ncp_canon_map m;
-    ncp_canon_map_init(&m, &c, NULL, 0.5); /* 50 % override */
-    struct ncp_seg s;
-    struct ncp_diag d;
+    struct map_fixture f;
+    map_fixture_init(&f, 0.5); /* 50 % override */
     struct ncp_canon mode = op6(NCP_C_SET_FEED_MODE, 0, 0, 0);
     mode.i[1] = 1; /* units per revolution */
-    struct ncp_canon speed = op6(NCP_C_SET_SPINDLE_SPEED, 600, 0, 0);
-    struct ncp_canon f = op_feed(0.2);
-    assert_int_equal(ncp_canon_map_op(&m, &mode, 1, &s, &d), 0);
-    assert_int_equal(ncp_canon_map_op(&m, &speed, 2, &s, &d), 0);
-    assert_int_equal(ncp_canon_map_op(&m, &f, 3, &s, &d), 0);
-    struct ncp_canon mv = op6(NCP_C_STRAIGHT_FEED, 10, 0, -5);
-    assert_int_equal(ncp_canon_map_op(&m, &mv, 4, &s, &d), 1);
-    assert_true(fabs(s.feed - 0.2 * 600 / 60.0 * 0.5) < 1e-12);
+    assert_int_equal(map_op(&f, mode, 1), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_SET_SPINDLE_SPEED, 600, 0, 0), 2), 0);
+    assert_int_equal(map_op(&f, op_feed(0.2), 3), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_STRAIGHT_FEED, 10, 0, -5), 4), 1);
+    assert_true(fabs(f.s.feed - 0.2 * 600 / 60.0 * 0.5) < 1e-12);
     /* G96 S180 (m/min) D2500: at X 10 mm 180000 / (2 pi 10) = 2864.8 rpm, capped */
-    struct ncp_canon css = op6(NCP_C_SET_SPINDLE_MODE, 2500, 0, 0);
-    struct ncp_canon surface = op6(NCP_C_SET_SPINDLE_SPEED, 180, 0, 0);
-    assert_int_equal(ncp_canon_map_op(&m, &css, 5, &s, &d), 0);
-    assert_int_equal(ncp_canon_map_op(&m, &surface, 6, &s, &d), 0);
-    struct ncp_canon at10 = op6(NCP_C_STRAIGHT_FEED, 10, 0, -10);
-    assert_int_equal(ncp_canon_map_op(&m, &at10, 7, &s, &d), 1);
-    assert_true(fabs(s.feed - 0.2 * 2500 / 60.0 * 0.5) < 1e-12);
-    struct ncp_canon at20 = op6(NCP_C_STRAIGHT_FEED, 20, 0, -10);
-    assert_int_equal(ncp_canon_map_op(&m, &at20, 8, &s, &d), 1);
-    assert_true(fabs(s.feed - 0.2 * (180000 / (2 * M_PI * 20)) / 60.0 * 0.5) < 1e-9);
+    assert_int_equal(map_op(&f, op6(NCP_C_SET_SPINDLE_MODE, 2500, 0, 0), 5), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_SET_SPINDLE_SPEED, 180, 0, 0), 6), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_STRAIGHT_FEED, 10, 0, -10), 7), 1);
+    assert_true(fabs(f.s.feed - 0.2 * 2500 / 60.0 * 0.5) < 1e-12);
+    assert_int_equal(map_op(&f, op6(NCP_C_STRAIGHT_FEED, 20, 0, -10), 8), 1);
+    assert_true(fabs(f.s.feed - 0.2 * (180000 / (2 * M_PI * 20)) / 60.0 * 0.5) < 1e-9);
     /* synchronised at pitch 1.5 under G97 S400: 10 mm/s, no override */
-    struct ncp_canon rpm = op6(NCP_C_SET_SPINDLE_MODE, 0, 0, 0);
-    struct ncp_canon s400 = op6(NCP_C_SET_SPINDLE_SPEED, 400, 0, 0);
-    struct ncp_canon sync = op6(NCP_C_START_SPEED_FEED_SYNCH, 1.5, 0, 0);
-    assert_int_equal(ncp_canon_map_op(&m, &rpm, 9, &s, &d), 0);
-    assert_int_equal(ncp_canon_map_op(&m, &s400, 10, &s, &d), 0);
-    assert_int_equal(ncp_canon_map_op(&m, &sync, 11, &s, &d), 0);
-    struct ncp_canon thread = op6(NCP_C_STRAIGHT_FEED, 20, 0, -30);
-    assert_int_equal(ncp_canon_map_op(&m, &thread, 12, &s, &d), 1);
-    assert_true(fabs(s.feed - 10.0) < 1e-12);
-    struct ncp_canon stop = op6(NCP_C_STOP_SPEED_FEED_SYNCH, 0, 0, 0);
-    assert_int_equal(ncp_canon_map_op(&m, &stop, 13, &s, &d), 0);
-    struct ncp_canon back = op6(NCP_C_STRAIGHT_FEED, 20, 0, -20);
-    assert_int_equal(ncp_canon_map_op(&m, &back, 14, &s, &d), 1);
-    assert_true(fabs(s.feed - 0.2 * 400 / 60.0 * 0.5) < 1e-12);
+    assert_int_equal(map_op(&f, op6(NCP_C_SET_SPINDLE_MODE, 0, 0, 0), 9), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_SET_SPINDLE_SPEED, 400, 0, 0), 10), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_START_SPEED_FEED_SYNCH, 1.5, 0, 0), 11), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_STRAIGHT_FEED, 20, 0, -30), 12), 1);
+    assert_true(fabs(f.s.feed - 10.0) < 1e-12);
+    assert_int_equal(map_op(&f, op6(NCP_C_STOP_SPEED_FEED_SYNCH, 0, 0, 0), 13), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_STRAIGHT_FEED, 20, 0, -20), 14), 1);
+    assert_true(fabs(f.s.feed - 0.2 * 400 / 60.0 * 0.5) < 1e-12);
+}
+
+/* A NURBS_FEED op: order 3 (G5.1) or 4 (G5), end, start and control points. */
+static struct ncp_canon op_spline(int order, const double end[2], const double pts[6])
+{
+    struct ncp_canon c = op6(NCP_C_NURBS_FEED, end[0], end[1], 2);
+    c.i[0] = order;
+    for (int k = 0; k < 6; k++)
+        c.d[3 + k] = pts[k];
+    return c;
 }
 
 /* A rigid tap goes down and comes back; a spline comes out as lines on the
@@ -449,53 +468,35 @@ static void test_canon_spindle_feeds(void **state)
 static void test_canon_tap_and_spline(void **state)
 {
     (void)state;
-    struct ncp_machine_cfg c = test_cfg();
-    struct ncp_canon_map m;
-    ncp_canon_map_init(&m, &c, NULL, 1.0);
-    struct ncp_seg s;
-    struct ncp_diag d;
-    struct ncp_canon f = op_feed(600);
-    assert_int_equal(ncp_canon_map_op(&m, &f, 1, &s, &d), 0);
-    struct ncp_canon to = op6(NCP_C_STRAIGHT_TRAVERSE, 5, 5, 2);
-    assert_int_equal(ncp_canon_map_op(&m, &to, 2, &s, &d), 1);
-    struct ncp_canon tap = op6(NCP_C_RIGID_TAP, 5, 5, -8);
-    assert_int_equal(ncp_canon_map_op(&m, &tap, 3, &s, &d), 1);
-    assert_true(fabs(s.end[2] + 8.0) < 1e-12 && fabs(s.start[2] - 2.0) < 1e-12);
-    assert_int_equal(ncp_canon_map_more(&m, &s, &d), 1);
-    assert_true(fabs(s.end[2] - 2.0) < 1e-12 && fabs(s.end[0] - 5.0) < 1e-12);
-    assert_int_equal(s.line, 3);
-    assert_int_equal(ncp_canon_map_more(&m, &s, &d), 0);
+    struct map_fixture f;
+    map_fixture_init(&f, 1.0);
+    assert_int_equal(map_op(&f, op_feed(600), 1), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_STRAIGHT_TRAVERSE, 5, 5, 2), 2), 1);
+    assert_int_equal(map_op(&f, op6(NCP_C_RIGID_TAP, 5, 5, -8), 3), 1);
+    assert_true(fabs(f.s.end[2] + 8.0) < 1e-12 && fabs(f.s.start[2] - 2.0) < 1e-12);
+    assert_int_equal(map_more(&f), 1);
+    assert_true(fabs(f.s.end[2] - 2.0) < 1e-12 && fabs(f.s.end[0] - 5.0) < 1e-12);
+    assert_int_equal(f.s.line, 3);
+    assert_int_equal(map_more(&f), 0);
     /* G5.1 from (5,5) with control point (15,5) to (15,15): at t = 1/2 the
      * curve is at (12.5, 7.5) */
-    struct ncp_canon q = op6(NCP_C_NURBS_FEED, 15, 15, 2);
-    q.i[0] = 3;
-    q.d[3] = 5;
-    q.d[4] = 5;
-    q.d[5] = 15;
-    q.d[6] = 5;
-    int n = ncp_canon_map_op(&m, &q, 4, &s, &d);
+    const double qend[2] = {15, 15}, qpts[6] = {5, 5, 15, 5, 0, 0};
+    int n = map_op(&f, op_spline(3, qend, qpts), 4);
     for (int k = 1; n == 1; k++) {
         if (k == NCP_SPLINE_STEPS / 2)
-            assert_true(fabs(s.end[0] - 12.5) < 1e-12 && fabs(s.end[1] - 7.5) < 1e-12);
+            assert_true(fabs(f.s.end[0] - 12.5) < 1e-12 && fabs(f.s.end[1] - 7.5) < 1e-12);
         assert_true(k <= NCP_SPLINE_STEPS);
-        n = ncp_canon_map_more(&m, &s, &d);
+        n = map_more(&f);
     }
     assert_int_equal(n, 0);
-    assert_true(fabs(m.pos[0] - 15) < 1e-12 && fabs(m.pos[1] - 15) < 1e-12);
+    assert_true(fabs(f.m.pos[0] - 15) < 1e-12 && fabs(f.m.pos[1] - 15) < 1e-12);
     /* G5 back to (5,5) through (15,10) and (10,5): at t = 1/2,
      * (15 + 3*15 + 3*10 + 5) / 8 = 11.875 and (15 + 3*10 + 3*5 + 5) / 8 = 8.125 */
-    struct ncp_canon cu = op6(NCP_C_NURBS_FEED, 5, 5, 2);
-    cu.i[0] = 4;
-    cu.d[3] = 15;
-    cu.d[4] = 15;
-    cu.d[5] = 15;
-    cu.d[6] = 10;
-    cu.d[7] = 10;
-    cu.d[8] = 5;
+    const double cend[2] = {5, 5}, cpts[6] = {15, 15, 15, 10, 10, 5};
     int segs = 0;
-    for (n = ncp_canon_map_op(&m, &cu, 5, &s, &d); n == 1; n = ncp_canon_map_more(&m, &s, &d)) {
+    for (n = map_op(&f, op_spline(4, cend, cpts), 5); n == 1; n = map_more(&f)) {
         if (++segs == NCP_SPLINE_STEPS / 2)
-            assert_true(fabs(s.end[0] - 11.875) < 1e-12 && fabs(s.end[1] - 8.125) < 1e-12);
+            assert_true(fabs(f.s.end[0] - 11.875) < 1e-12 && fabs(f.s.end[1] - 8.125) < 1e-12);
     }
     assert_int_equal(segs, NCP_SPLINE_STEPS);
 }
