@@ -159,7 +159,7 @@ static int ncp_cyc_pq(struct ncp_analyzer *a, int motion, double *p, double *q)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
-    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    uint16_t col = NCP_MOTION_COL(w);
     int first = s->m.motion != motion;
     int hp = NCP_HAS(w, 'P') && w->v[NCP_LETTER('P')] != -1.0;
     int hq = NCP_HAS(w, 'Q') && w->v[NCP_LETTER('Q')] != -1.0;
@@ -175,7 +175,7 @@ static int ncp_cyc_pq(struct ncp_analyzer *a, int motion, double *p, double *q)
 static int ncp_cyc_spindle_check(struct ncp_analyzer *a, int motion)
 {
     const struct ncp_words *w = &a->w;
-    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    uint16_t col = NCP_MOTION_COL(w);
     if ((motion == 860 || motion == 870 || motion == 880) && a->st.m.spindle_dir == 0)
         return ncp_an_error(a, col, "Spindle not turning in g%d", motion / 10);
     if (motion == 840 && a->st.m.spindle_dir != 1)
@@ -189,7 +189,7 @@ static int ncp_cyc_g87_words(struct ncp_analyzer *a, double bottom, double *ijk)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
-    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    uint16_t col = NCP_MOTION_COL(w);
     static const char l[3] = {'I', 'J', 'K'};
     static const char *const miss[3] = {"I word missing with g87", "J word missing with g87",
                                         "K word missing with g87"};
@@ -208,7 +208,7 @@ static int ncp_cyc_checks(struct ncp_analyzer *a, int motion, double *r, int *l)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
-    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    uint16_t col = NCP_MOTION_COL(w);
     if (s->feed == 0.0)
         return ncp_an_error(a, col, "Cannot feed with zero feed rate");
     if (s->m.feed_mode == 1)
@@ -262,7 +262,7 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
     char nl = ncp_axis_letter[ax[2]];
     int has_n = NCP_HAS(w, nl);
     if (s->m.motion != motion && !has_n)
-        return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col,
+        return ncp_an_error(a, NCP_MOTION_COL(w),
                             "%s", ncp_cyc_no_depth[pl]);
     double depth = has_n ? w->v[NCP_LETTER(nl)] : s->cycle_cc;
     double cur = s->pos[ax[2]];
@@ -301,7 +301,7 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
         bb = s->pos[ax[1]];
     }
     if (rr < cc)
-        return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col,
+        return ncp_an_error(a, NCP_MOTION_COL(w),
                             "%s", ncp_cyc_r_low[pl]);
     struct ncp_cyc c = {a, ax, {0}};
     memcpy(c.pos, s->pos, sizeof c.pos);
@@ -347,7 +347,7 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
                 TRAV(&c, aa, bb, rr);
         }
         if ((motion == 830 || motion == 730) && q <= 0.0)
-            return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col,
+            return ncp_an_error(a, NCP_MOTION_COL(w),
                                 "Negative or zero q value used");
         if (motion == 870) {
             double off[3] = {aa + ijk[0], bb + ijk[1], ijk[2]};

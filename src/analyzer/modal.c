@@ -167,13 +167,13 @@ static int ncp_check_other(struct ncp_analyzer *a)
         return ncp_an_error(a, w->gcol[NCP_GG_SPINDLE], "S word missing with g96");
     if (mt == 330 || mt == 331) {
         if (!NCP_HAS(w, 'K'))
-            return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col,
+            return ncp_an_error(a, NCP_MOTION_COL(w),
                                 "K word missing with g33/g33.1");
         if (NCP_HAS(w, 'F'))
             return ncp_an_error(a, COL('F'), "F word used with a g33/g33.1");
     }
     if (mt == 760) {
-        uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+        uint16_t col = NCP_MOTION_COL(w);
         if (!NCP_HAS(w, 'P') || w->v[NCP_LETTER('P')] == -1.0) /* rs274: P-1 is no P */
             return ncp_an_error(a, col, "P word missing with G76");
         if (!NCP_HAS(w, 'I') || !NCP_HAS(w, 'J') || !NCP_HAS(w, 'K'))

@@ -115,15 +115,13 @@ static int ncp_straight(struct ncp_analyzer *a, int motion)
     } else {
         if (s->m.feed_mode == 1) {
             if (!NCP_HAS(w, 'F'))
-                return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION]
-                                                              : w->line_col,
+                return ncp_an_error(a, NCP_MOTION_COL(w),
                                     "F word missing with inverse time g1 move");
             double rate = ncp_straight_length(s->pos, end) * w->v[NCP_LETTER('F')];
             s->feed = rate < 0.1 ? 0.1 : rate; /* what #<_feed> reads afterwards */
             ncp_an_emit(a, NCP_C_SET_FEED_RATE)->d[0] = s->feed;
         } else if (s->feed == 0.0) {
-            return ncp_an_error(a, w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION]
-                                                          : w->line_col,
+            return ncp_an_error(a, NCP_MOTION_COL(w),
                                 "Cannot do g1 with zero feed rate");
         }
         if (ncp_cutcomp_engaged(&a->comp))
@@ -190,7 +188,7 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
     const struct ncp_words *w = &a->w;
     int pl = s->m.plane;
     const int *ax = ncp_plane_axes[pl];
-    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    uint16_t col = NCP_MOTION_COL(w);
     int crc = ncp_cutcomp_check_motion(&a->comp, 1, &a->err, a->line);
     if (crc != NCP_OK)
         return crc;
@@ -278,7 +276,7 @@ static int ncp_arc(struct ncp_analyzer *a, int motion)
 static int ncp_probe(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
-    uint16_t col = a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION] : a->w.line_col;
+    uint16_t col = NCP_MOTION_COL(&a->w);
     if (s->m.comp_side != 0)
         return ncp_an_error(a, col, "Cannot probe with cutter radius comp on");
     if (s->feed == 0.0)
@@ -324,8 +322,7 @@ static int ncp_synced(struct ncp_analyzer *a, int motion)
         return rc;
     }
     if (s->m.spindle_dir == 0)
-        return ncp_an_error(a, a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION]
-                                                        : a->w.line_col,
+        return ncp_an_error(a, NCP_MOTION_COL(&a->w),
                             motion == 330 ? "Spindle not turning in G33"
                                           : "Spindle not turning in G33.1");
     struct ncp_canon *sync = ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH);
@@ -350,7 +347,7 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
-    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    uint16_t col = NCP_MOTION_COL(w);
     if (s->m.comp_side != 0)
         return ncp_an_error(a, col, "Cannot convert spline with cutter radius compensation");
     if (s->m.feed_mode == 0 && s->feed == 0.0)
@@ -413,7 +410,7 @@ static int ncp_threading(struct ncp_analyzer *a)
             memcpy(s->pos, end, sizeof end);
         return rc;
     }
-    uint16_t col = a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION] : a->w.line_col;
+    uint16_t col = NCP_MOTION_COL(&a->w);
     if (s->m.spindle_dir == 0)
         return ncp_an_error(a, col, "Chosen spindle (0) not turning in G76");
     for (int ax = NCP_A; ax < NCP_NAX; ax++)
@@ -448,7 +445,7 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
     case 890:
         return ncp_canned_run(a, motion);
     default: {
-        uint16_t col = a->w.gcol[NCP_GG_MOTION] ? a->w.gcol[NCP_GG_MOTION] : a->w.line_col;
+        uint16_t col = NCP_MOTION_COL(&a->w);
         if (motion % 10)
             return ncp_an_error(a, col, "G%d.%d is not supported", motion / 10, motion % 10);
         return ncp_an_error(a, col, "G%d is not supported", motion / 10);

@@ -32,6 +32,9 @@ enum ncp_mgroup {
 #define NCP_WORD_SLOTS 29
 #define NCP_POLAR_BITS ((1u << 26) | (1u << 27))
 #define NCP_HAS(w, c) (((w)->has >> NCP_LETTER(c)) & 1u)
+/* Where an error about the block's motion points: its motion G word, or the
+ * line's start when the motion mode came from an earlier block. */
+#define NCP_MOTION_COL(w) ((w)->gcol[NCP_GG_MOTION] ? (w)->gcol[NCP_GG_MOTION] : (w)->line_col)
 #define NCP_AXIS_LETTERS ((1u << NCP_LETTER('X')) | (1u << NCP_LETTER('Y')) | \
     (1u << NCP_LETTER('Z')) | (1u << NCP_LETTER('A')) | (1u << NCP_LETTER('B')) | \
     (1u << NCP_LETTER('C')) | (1u << NCP_LETTER('U')) | (1u << NCP_LETTER('V')) | \

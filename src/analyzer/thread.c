@@ -76,7 +76,7 @@ int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
-    uint16_t col = w->gcol[NCP_GG_MOTION] ? w->gcol[NCP_GG_MOTION] : w->line_col;
+    uint16_t col = NCP_MOTION_COL(w);
     if (s->m.comp_side != 0)
         return ncp_an_error(a, col, "Cannot use G76 threading cycle with cutter radius compensation on");
     double i_number = w->v[NCP_LETTER('I')], j_number = w->v[NCP_LETTER('J')],
