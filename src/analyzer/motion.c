@@ -303,10 +303,11 @@ static int ncp_probe(struct ncp_analyzer *a, int motion)
     return NCP_OK;
 }
 
-/* G33 (a straight feed locked to the spindle, K the distance per turn) and
- * G33.1 (rigid tapping to the end and back: rs274 keeps its current point).
- * Under cutter compensation rs274 hands them to its compensation code, which
- * knows only G0 and G1 (see ncp_cutcomp_move). */
+/* G33 (a straight feed locked to the spindle, K the distance per turn),
+ * G33.1 (rigid tapping to the end and back: rs274 keeps its current point)
+ * and G76 (the threading cycle: its checks here, its passes in thread.c).
+ * Under cutter compensation rs274 hands all three to its compensation code,
+ * which knows only G0 and G1 (see ncp_cutcomp_move). */
 static int ncp_synced(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
@@ -321,10 +322,17 @@ static int ncp_synced(struct ncp_analyzer *a, int motion)
             memcpy(s->pos, end, sizeof end);
         return rc;
     }
+    uint16_t col = NCP_MOTION_COL(&a->w);
     if (s->m.spindle_dir == 0)
-        return ncp_an_error(a, NCP_MOTION_COL(&a->w),
-                            motion == 330 ? "Spindle not turning in G33"
-                                          : "Spindle not turning in G33.1");
+        return ncp_an_error(a, col, motion == 330   ? "Spindle not turning in G33"
+                                    : motion == 331 ? "Spindle not turning in G33.1"
+                                                    : "Chosen spindle (0) not turning in G76");
+    if (motion == 760) {
+        for (int ax = NCP_A; ax < NCP_NAX; ax++)
+            if (end[ax] != s->pos[ax])
+                return ncp_an_error(a, col, "Cannot move rotary axes with G76");
+        return ncp_thread_cycle(a, end);
+    }
     struct ncp_canon *sync = ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH);
     sync->d[0] = a->w.v[NCP_LETTER('K')];
     if (motion == 330) {
@@ -394,31 +402,6 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
     return NCP_OK;
 }
 
-/* G76 as rs274 dispatches it: the move's checks here, the passes in
- * thread.c. Under cutter compensation it goes where G33 goes. */
-static int ncp_threading(struct ncp_analyzer *a)
-{
-    struct ncp_state *s = &a->st;
-    double end[NCP_NAX];
-    int rc = ncp_motion_ends(a, 0, end);
-    if (rc != NCP_OK)
-        return rc;
-    s->m.motion = 760;
-    if (ncp_cutcomp_engaged(&a->comp)) {
-        rc = ncp_comp_move_straight(a, 760, end, 0);
-        if (rc == NCP_OK)
-            memcpy(s->pos, end, sizeof end);
-        return rc;
-    }
-    uint16_t col = NCP_MOTION_COL(&a->w);
-    if (s->m.spindle_dir == 0)
-        return ncp_an_error(a, col, "Chosen spindle (0) not turning in G76");
-    for (int ax = NCP_A; ax < NCP_NAX; ax++)
-        if (end[ax] != s->pos[ax])
-            return ncp_an_error(a, col, "Cannot move rotary axes with G76");
-    return ncp_thread_cycle(a, end);
-}
-
 int ncp_motion_run(struct ncp_analyzer *a, int motion)
 {
     if (motion != 730 && (motion < 810 || motion > 890))
@@ -435,10 +418,8 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         return NCP_OK;
     case 50: case 51:
         return ncp_spline(a, motion);
-    case 330: case 331:
+    case 330: case 331: case 760:
         return ncp_synced(a, motion);
-    case 760:
-        return ncp_threading(a);
     case 382: case 383: case 384: case 385:
         return ncp_probe(a, motion);
     case 730: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
