@@ -95,18 +95,27 @@ int ncp_predef_lookup(void *ctx, const char *name, size_t len, double *out)
     return 0;
 }
 
-/* Numbered reads through the analyzer: rs274 refuses the current position
- * (#5420..#5428) while cutter compensation is on. rs274 reads back a probe's
- * or a tool change's results as it reads the next line, O-word lines too;
- * those never reach ncp_an_block, so any read catches up first (nothing in
- * the probing or changing block itself reads after the move). */
-static int ncp_predef_get_numbered(void *ctx, int index, double *out, struct ncp_diag *d)
+/* rs274 reads back a probe's or a tool change's results, and runs an M73
+ * restore a return left, as it reads the next line, O-word lines too; those
+ * never reach ncp_an_block, so any parameter read catches up first (nothing
+ * in the probing, changing or returning block itself reads after that). */
+static int ncp_predef_catch_up(struct ncp_analyzer *a, struct ncp_diag *d)
 {
-    struct ncp_analyzer *a = ctx;
     int rc = ncp_m7x_pending(a);
     if (rc != NCP_OK)
         return ncp_diag_set(d, (enum ncp_status)rc, 0, 0, "%s", a->err.msg);
     ncp_sai_resync(a);
+    return NCP_OK;
+}
+
+/* Numbered reads through the analyzer: rs274 refuses the current position
+ * (#5420..#5428) while cutter compensation is on. */
+static int ncp_predef_get_numbered(void *ctx, int index, double *out, struct ncp_diag *d)
+{
+    struct ncp_analyzer *a = ctx;
+    int rc = ncp_predef_catch_up(a, d);
+    if (rc != NCP_OK)
+        return rc;
     if (index >= 5420 && index <= 5428 && a->st.m.comp_side != 0)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "Cannot read current position with cutter radius compensation on");
@@ -117,10 +126,9 @@ static int ncp_predef_get_named(void *ctx, const char *name, size_t len, double 
                                 struct ncp_diag *d)
 {
     struct ncp_analyzer *a = ctx;
-    int rc = ncp_m7x_pending(a);
+    int rc = ncp_predef_catch_up(a, d);
     if (rc != NCP_OK)
-        return ncp_diag_set(d, (enum ncp_status)rc, 0, 0, "%s", a->err.msg);
-    ncp_sai_resync(a);
+        return rc;
     return ncp_params_get_named(a->params, name, len, out, d);
 }
 
