@@ -102,14 +102,13 @@ struct ncp_canon_map {
     double g5x[6], g92[6], tool[6]; /* mm */
     double rotation;        /* XY rotation, degrees */
     int plane;              /* 0 XY, 1 YZ, 2 XZ */
-    double feed;            /* G93/G94 feed, mm/s */
+    double feed;            /* F in mm: per minute, or per turn under G95 */
     double feed_override;   /* 1.0 = 100 % */
-    /* Feeds tied to the spindle: G95 (mm per turn), G33/G33.1/G76 (the pitch,
-     * mm per turn, while synchronised), at the spindle's speed: S in rpm, or
+    /* Feeds tied to the spindle: G95 (F per turn), G33/G33.1/G76 (the pitch
+     * per turn, while synchronised), at the spindle's speed: S in rpm, or
      * under G96 the surface speed S at the end point's X as the radius,
      * capped at G96's D. */
     int per_rev;
-    double per_rev_feed;    /* mm per turn */
     double sync_pitch;      /* mm per turn; 0: not synchronised */
     double speed;           /* S as programmed */
     double css_max;         /* > 0: G96 (constant surface speed), rpm cap */

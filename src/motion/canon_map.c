@@ -94,7 +94,6 @@ static void seg_common(const struct ncp_canon_map *m, struct ncp_seg *s, uint32_
     s->line = line;
     s->term = (uint8_t)m->term;
     s->tolerance = m->tolerance;
-    s->feed = m->feed * m->feed_override;
     memcpy(s->start, m->pos, sizeof s->start);
 }
 
@@ -117,8 +116,8 @@ static double feed_at(const struct ncp_canon_map *m, double x_mm)
 {
     if (m->sync_pitch > 0)
         return m->sync_pitch * spindle_rpm(m, x_mm) / 60.0;
-    double f = m->per_rev ? m->per_rev_feed * spindle_rpm(m, x_mm) / 60.0 : m->feed;
-    return f * m->feed_override;
+    double per_min = m->per_rev ? m->feed * spindle_rpm(m, x_mm) : m->feed;
+    return per_min / 60.0 * m->feed_override;
 }
 
 static int finite3(const double *v, int n)
@@ -340,8 +339,7 @@ static int state_op(struct ncp_canon_map *m, const struct ncp_canon *op)
         m->plane = op->i[0] >= 0 && op->i[0] <= 2 ? op->i[0] : 0;
         break;
     case NCP_C_SET_FEED_RATE:
-        m->feed = op->d[0] * m->scale / 60.0;
-        m->per_rev_feed = op->d[0] * m->scale;
+        m->feed = op->d[0] * m->scale;
         break;
     case NCP_C_SET_FEED_MODE:
         m->per_rev = op->i[1] == 1;
