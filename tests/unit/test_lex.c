@@ -849,7 +849,26 @@ static void expect_fast_like_general(const char *line, size_t len, int *taken)
 {
     static struct ncp_block fast, general;
     memset(&fast, 0x5A, sizeof fast);
-    if (!ncp_lex_fast(line, len, 11, 99, &fast))
+    int took = ncp_lex_fast(line, len, 11, 99, &fast);
+    /* the same line inside a text, ended by its '\n' and more text behind it:
+     * the reader's unbounded build, which must decide exactly as the bounded */
+    static struct ncp_block in_text;
+    char text[400];
+    size_t next = 0;
+    assert_true(len + 8 < sizeof text);
+    memcpy(text, line, len);
+    memcpy(text + len, "\nG1 X1\n", 8);
+    memset(&in_text, 0x5A, sizeof in_text);
+    int took_in_text = ncp_lex_fast_line(text, len + 8, 11, 99, &in_text, &next);
+    /* (a line of the full limit is the reader's only when nothing follows it) */
+    if (len < NCP_LEX_TOO_LONG && !memchr(line, '\n', len) && !memchr(line, '\r', len)) {
+        assert_int_equal(took_in_text, took);
+        if (took) {
+            assert_int_equal(next, len + 1);
+            assert_same_block(&fast, &in_text);
+        }
+    }
+    if (!took)
         return;
     (*taken)++;
     if (ncp_lex_block_general(line, len, 11, 99, &general) != NCP_OK)
