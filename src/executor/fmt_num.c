@@ -4,6 +4,7 @@
 #include "fmt_num.h"
 #include "ncpar/executor.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -13,17 +14,9 @@ static const char ncp_digit_pairs[201] =
     "60616263646566676869" "70717273747576777879" "80818283848586878889"
     "90919293949596979899";
 
-/* Writes the decimal digits of n ending just before `end`; returns the start.
- * Machining values stay below 2^32, where 32-bit division is much cheaper. */
-static char *ncp_utoa_back(char *end, uint64_t n)
+/* Writes the decimal digits of m ending just before `end`; returns the start. */
+static char *ncp_utoa32_back(char *end, uint32_t m)
 {
-    while (n > UINT32_MAX) {
-        size_t pair = (size_t)(n % 100u) * 2u;
-        n /= 100u;
-        end -= 2;
-        memcpy(end, ncp_digit_pairs + pair, 2);
-    }
-    uint32_t m = (uint32_t)n;
     while (m >= 100u) {
         size_t pair = (size_t)(m % 100u) * 2u;
         m /= 100u;
@@ -37,6 +30,19 @@ static char *ncp_utoa_back(char *end, uint64_t n)
         *--end = (char)('0' + m);
     }
     return end;
+}
+
+/* Machining values stay below 2^32, where 32-bit division is much cheaper:
+ * only the rest of a larger n takes 64-bit steps. */
+static char *ncp_utoa_back(char *end, uint64_t n)
+{
+    while (n > UINT32_MAX) {
+        size_t pair = (size_t)(n % 100u) * 2u;
+        n /= 100u;
+        end -= 2;
+        memcpy(end, ncp_digit_pairs + pair, 2);
+    }
+    return ncp_utoa32_back(end, (uint32_t)n);
 }
 
 static const uint64_t ncp_pow10[20] = {
@@ -61,7 +67,7 @@ size_t ncp_fmt_int(char *buf, int32_t v)
     char tmp[12];
     char *end = tmp + sizeof tmp;
     uint32_t mag = v < 0 ? 0u - (uint32_t)v : (uint32_t)v;
-    char *p = ncp_utoa_back(end, mag);
+    char *p = ncp_utoa32_back(end, mag);
     if (v < 0)
         *--p = '-';
     size_t len = (size_t)(end - p);
@@ -81,41 +87,31 @@ static size_t ncp_fmt_slow(char *buf, const char *fmt, double v)
 /* Below 2^-27 a value prints as (-)0.0000 whatever its bits. */
 #define NCP_FMT_ZERO_SHIFT 80
 
-/* Below 1e8 the product a * 10^4 is within 1.2e-4 of its exact value (half an
- * ulp of a number below 2^40), so when its fraction is more than 1e-3 away from
- * one half, rounding the double product rounds the exact one the same way.
- * Returns 0 (decide exactly) otherwise: near-ties, and the values printf must
- * settle half-to-even, are left to the integer path below. */
-static int ncp_scaled_round(double a, uint64_t *ipart, unsigned *dec)
+/* sign, integer part, '.', four decimals, NUL: digits go straight to their
+ * final place, no scratch copy. */
+static size_t ncp_put_fixed4(char *buf, int neg, uint64_t ipart, unsigned dec)
 {
-    if (!(a < 1e8))
-        return 0;
-    double t = a * 10000.0;
-    uint64_t q = (uint64_t)t;
-    double f = t - (double)q; /* exact: t < 2^40 */
-    if (f > 0.501)
-        q++;
-    else if (!(f < 0.499))
-        return 0;
-    *ipart = q / 10000u;
-    *dec = (unsigned)(q % 10000u);
-    return 1;
+    size_t len = (size_t)neg + ncp_digit_count(ipart) + 5;
+    char *end = buf + len;
+    *end = '\0';
+    memcpy(end - 4, ncp_digit_pairs + (size_t)(dec / 100u) * 2u, 2);
+    memcpy(end - 2, ncp_digit_pairs + (size_t)(dec % 100u) * 2u, 2);
+    end[-5] = '.';
+    ncp_utoa_back(end - 5, ipart);
+    if (neg)
+        buf[0] = '-';
+    return len;
 }
 
 /* The double's exact value is mant * 2^-shift. Splitting it into integer and
  * fraction bits and scaling the fraction by 10^4 in 128-bit integers gives the
  * exact decimal digits and the exact remainder, so the rounding decision is
- * printf's own: up above one half, half-to-even on an exact tie. */
-size_t ncp_fmt_fixed4(char *buf, double v)
+ * printf's own: up above one half, half-to-even on an exact tie. Kept out of
+ * line: the common case below then needs no registers saved. */
+static __attribute__((noinline)) size_t ncp_fmt_fixed4_exact(char *buf, double v)
 {
     uint64_t bits;
     memcpy(&bits, &v, sizeof bits);
-    if ((bits << 1) == 0) { /* +-0: most of a move's nine coordinates */
-        const char *z = bits ? "-0.0000" : "0.0000";
-        size_t n = bits ? 7 : 6;
-        memcpy(buf, z, n + 1);
-        return n;
-    }
     int neg = (int)(bits >> 63);
     int bexp = (int)((bits >> 52) & 0x7ffu);
     if (bexp >= NCP_FMT_FAST_EXP_MAX)
@@ -123,9 +119,7 @@ size_t ncp_fmt_fixed4(char *buf, double v)
     uint64_t ipart = 0;
     unsigned dec = 0;
     int shift = 1075 - bexp; /* > 0 here */
-    if (ncp_scaled_round(neg ? -v : v, &ipart, &dec)) {
-        /* decided in double arithmetic: far from a rounding boundary */
-    } else if (bexp != 0 && shift < NCP_FMT_ZERO_SHIFT) {
+    if (bexp != 0 && shift < NCP_FMT_ZERO_SHIFT) {
         typedef unsigned __int128 u128;
         uint64_t mant = (bits & ((UINT64_C(1) << 52) - 1u)) | (UINT64_C(1) << 52);
         u128 one = (u128)1 << shift;
@@ -140,18 +134,28 @@ size_t ncp_fmt_fixed4(char *buf, double v)
             ipart++;
         }
     }
+    return ncp_put_fixed4(buf, neg, ipart, dec);
+}
 
-    /* Digits go straight to their final place: no scratch copy. */
-    size_t len = (size_t)neg + ncp_digit_count(ipart) + 5;
-    char *end = buf + len;
-    *end = '\0';
-    memcpy(end - 4, ncp_digit_pairs + (size_t)(dec / 100u) * 2u, 2);
-    memcpy(end - 2, ncp_digit_pairs + (size_t)(dec % 100u) * 2u, 2);
-    end[-5] = '.';
-    ncp_utoa_back(end - 5, ipart);
-    if (neg)
-        buf[0] = '-';
-    return len;
+/* Below 1e8 the product |v| * 10^4 is within 1.2e-4 of its exact value (half
+ * an ulp of a number below 2^40), so when its fraction is more than 1e-3 away
+ * from one half, rounding the double product rounds the exact one the same
+ * way (zeros and values too small to print included). Near-ties, the values
+ * printf must settle half-to-even, and what is not below 1e8 (NaN too) are
+ * decided exactly. */
+size_t ncp_fmt_fixed4(char *buf, double v)
+{
+    double a = fabs(v);
+    if (a < 1e8) {
+        double t = a * 10000.0;
+        uint64_t q = (uint64_t)t;
+        double f = t - (double)q; /* exact: t < 2^40 */
+        if (f > 0.501 || f < 0.499) {
+            q += f > 0.501;
+            return ncp_put_fixed4(buf, signbit(v) != 0, q / 10000u, (unsigned)(q % 10000u));
+        }
+    }
+    return ncp_fmt_fixed4_exact(buf, v);
 }
 
 size_t ncp_fmt_fixed6(char *buf, double v)

@@ -9,6 +9,7 @@
 #include "fmt_num.h"
 #include "ncpar/executor.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
@@ -262,9 +263,90 @@ static void ncp_op_text(const struct ncp_cmd *cmd, const struct ncp_canon *op,
     *n = len;
 }
 
+/* The calls a CAM program is made of, written as straight-line code instead
+ * of a template walk (half the instructions per line): the same text as
+ * their templates above, which tests/unit/test_executor.c holds them to. Only
+ * when every number is below 1e14 (at most 32 bytes of text each) and the
+ * line surely fits; otherwise the template walk with its checks. */
+#define NCP_HOT_NUM 32
+#define NCP_HOT_LINE (NCP_LIT_BLOCK + 9 * (NCP_HOT_NUM + NCP_LIT_BLOCK) + 12)
+
+_Static_assert(NCP_C_STRAIGHT_FEED == NCP_C_STRAIGHT_TRAVERSE + 1 &&
+                   NCP_C_STRAIGHT_PROBE == NCP_C_STRAIGHT_TRAVERSE + 2,
+               "the straight moves are consecutive kinds");
+_Static_assert(NCP_HOT_LINE < NCP_CMD_OUT_MAX, "a motion line fits an empty slot");
+
+static const char ncp_hot_heads[3][NCP_LIT_BLOCK] = {
+    "STRAIGHT_TRAVERSE(", "STRAIGHT_FEED(", "STRAIGHT_PROBE("};
+static const uint8_t ncp_hot_head_len[3] = {18, 14, 15};
+
+static int ncp_hot_numbers(const double *d, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (!(fabs(d[k]) < 1e14))
+            return 0;
+    return 1;
+}
+
+/* ", " + number; +0, what most of a move's A, B, C are, as one eight-byte
+ * move. Both without a NUL: these are pieces of a line (room is assured). */
+static const char ncp_sep[2] = {',', ' '};
+static const char ncp_sep_zero[8] = {',', ' ', '0', '.', '0', '0', '0', '0'};
+
+static char *ncp_hot_next(char *p, double v)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    if (bits == 0) {
+        memcpy(p, ncp_sep_zero, sizeof ncp_sep_zero);
+        return p + sizeof ncp_sep_zero;
+    }
+    memcpy(p, ncp_sep, sizeof ncp_sep);
+    p += sizeof ncp_sep;
+    return p + ncp_fmt_fixed4(p, v);
+}
+
+static int ncp_format_hot(struct ncp_out *o, const struct ncp_canon *op)
+{
+    unsigned kind = op->kind;
+    if (o->full || o->end - o->p < NCP_HOT_LINE)
+        return 0;
+    char *p = o->p;
+    if (kind >= NCP_C_STRAIGHT_TRAVERSE && kind <= NCP_C_STRAIGHT_PROBE) {
+        if (!ncp_hot_numbers(op->d, 6))
+            return 0;
+        unsigned h = kind - NCP_C_STRAIGHT_TRAVERSE;
+        memcpy(p, ncp_hot_heads[h], NCP_LIT_BLOCK);
+        p += ncp_hot_head_len[h];
+        p += ncp_fmt_fixed4(p, op->d[0]);
+        for (int k = 1; k < 6; k++)
+            p = ncp_hot_next(p, op->d[k]);
+    } else if (kind == NCP_C_ARC_FEED) {
+        if (!ncp_hot_numbers(op->d, 8))
+            return 0;
+        memcpy(p, "ARC_FEED(", 9);
+        p += 9;
+        p += ncp_fmt_fixed4(p, op->d[0]);
+        for (int k = 1; k < 4; k++)
+            p = ncp_hot_next(p, op->d[k]);
+        memcpy(p, ncp_sep, sizeof ncp_sep);
+        p += sizeof ncp_sep;
+        p += ncp_fmt_int(p, op->i[0]);
+        for (int k = 4; k < 8; k++)
+            p = ncp_hot_next(p, op->d[k]);
+    } else {
+        return 0;
+    }
+    memcpy(p, ")\n", 2);
+    o->p = p + 2;
+    return 1;
+}
+
 static void ncp_format_op(struct ncp_out *o, const struct ncp_cmd *cmd,
                           const struct ncp_canon *op)
 {
+    if (ncp_format_hot(o, op))
+        return;
     const struct ncp_seg *s = ncp_tpl_for(op)->seg;
     for (;; s++) {
         ncp_out_lit(o, s);

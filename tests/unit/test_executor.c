@@ -248,6 +248,67 @@ static void test_every_kind(void **state)
             fail_msg("canonical kind %d has no text case", kind);
 }
 
+/* A coordinate for the motion lines: mostly machining sizes, some long enough
+ * to crowd the slot, some beyond the fast formatter's reach. */
+static double hot_value(void)
+{
+    uint64_t r = rng();
+    switch (r % 16) {
+    case 0: return 0.0;
+    case 1: return -0.0;
+    case 2: return 1e14 * (double)(r % 5 + 1); /* the templates' slow path */
+    case 3: return -9.99999999999e13;
+    case 4: return ((double)(r >> 12) / 4503599627370496.0 - 0.5) * 2e13;
+    default: return (double)((int64_t)(r >> 20) % 20000001 - 10000000) / 1000.0;
+    }
+}
+
+static size_t hot_expect(char *w, size_t cap, const struct ncp_canon *op)
+{
+    static const char *const head[] = {"STRAIGHT_TRAVERSE", "STRAIGHT_FEED",
+                                       "STRAIGHT_PROBE"};
+    const double *d = op->d;
+    if (op->kind == NCP_C_ARC_FEED)
+        return (size_t)snprintf(w, cap, "ARC_FEED(%.4f, %.4f, %.4f, %.4f, %d, %.4f, %.4f, "
+                                "%.4f, %.4f)\n", d[0], d[1], d[2], d[3], op->i[0], d[4],
+                                d[5], d[6], d[7]);
+    return (size_t)snprintf(w, cap, "%s(%.4f, %.4f, %.4f, %.4f, %.4f, %.4f)\n",
+                            head[op->kind - NCP_C_STRAIGHT_TRAVERSE], d[0], d[1], d[2],
+                            d[3], d[4], d[5]);
+}
+
+/* Motion lines have a formatter of their own beside the template walk: it must
+ * print exactly what printf would, wherever in the slot the line starts (near
+ * its end the walk takes over) and whatever the magnitudes. */
+static void test_motion_lines_random(void **state)
+{
+    (void)state;
+    static const int kinds[] = {NCP_C_STRAIGHT_TRAVERSE, NCP_C_STRAIGHT_FEED,
+                                NCP_C_STRAIGHT_PROBE, NCP_C_ARC_FEED};
+    char want[NCP_CMD_MAX_OPS * 3200];
+    for (int round = 0; round < 20000; round++) {
+        cmd_clear();
+        size_t len = 0;
+        int n_ops = (int)(rng() % NCP_CMD_MAX_OPS) + 1;
+        for (int k = 0; k < n_ops; k++) {
+            struct ncp_canon *op = add_op(kinds[rng() % 4]);
+            for (int j = 0; j < 8; j++)
+                op->d[j] = hot_value();
+            op->i[0] = (int)(rng() % 7) - 3;
+            len += hot_expect(want + len, sizeof want - len, op);
+        }
+        assert_int_equal(ncp_exec_cmd(&cmd), NCP_OK);
+        if (len <= NCP_CMD_OUT_MAX) {
+            assert_int_equal(cmd.out_len, len);
+            assert_memory_equal(cmd.out, want, len);
+        } else {
+            /* refused whole lines only: what was printed is a prefix of the truth */
+            assert_true(cmd.out_len < len);
+            assert_memory_equal(cmd.out, want, cmd.out_len);
+        }
+    }
+}
+
 static void test_int_extremes(void **state)
 {
     (void)state;
@@ -551,6 +612,7 @@ int main(void)
         cmocka_unit_test(test_fixed4_special),
         cmocka_unit_test(test_fixed4_random),
         cmocka_unit_test(test_every_kind),
+        cmocka_unit_test(test_motion_lines_random),
         cmocka_unit_test(test_int_extremes),
         cmocka_unit_test(test_several_ops_and_silent_kinds),
         cmocka_unit_test(test_text_clamped_to_pool),
