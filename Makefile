@@ -115,7 +115,7 @@ fuzz: $(BUILD)-fuzz/fuzz_pipeline
 	$< -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=10 -rss_limit_mb=2048 \
 	    $(BUILD)-fuzz/corpus
 
-bench-parse: all $(BUILD)/bench/core-latency
+bench-parse: all $(BUILD)/bench/core-latency $(BUILD)/bench/cpu-speed
 	bench/bench-parse $(BUILD)
 
 .PHONY: FORCE

@@ -3,7 +3,7 @@
 # position loop's latency beside cyclictest, then rewrites bench/RESULTS.md and the
 # PNGs in bench/. RUNS, RUNS_BIG, LAT_SECONDS, ... scale it down (bench/run-bench).
 .PHONY: bench
-BENCH_BINS = $(BUILD)/bench/table3 $(BUILD)/bench/core-latency
+BENCH_BINS = $(BUILD)/bench/table3 $(BUILD)/bench/core-latency $(BUILD)/bench/cpu-speed
 
 $(BUILD)/bench/%: bench/%.c $(LIB)
 	@mkdir -p $(@D)
