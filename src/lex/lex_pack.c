@@ -81,15 +81,19 @@ size_t ncp_block_packed_size(const struct ncp_block *b)
     return bytes_of(b, &c);
 }
 
+/* Most parts of a plain block are empty (no assignments, bytecode or pool):
+ * a library call to copy nothing costs more than the test. */
 static unsigned char *put(unsigned char *p, const void *src, size_t n)
 {
-    memcpy(p, src, n);
+    if (n)
+        memcpy(p, src, n);
     return p + n;
 }
 
 static const unsigned char *get(const unsigned char *p, void *dst, size_t n)
 {
-    memcpy(dst, p, n);
+    if (n)
+        memcpy(dst, p, n);
     return p + n;
 }
 
@@ -161,7 +165,8 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
     p = put(p, b->code, c.code * sizeof b->code[0]);
     p = put(p, b->pool, c.pool);
     size_t used = (size_t)(p - (unsigned char *)dst);
-    memset(p, 0, total - used);
+    if (total > used)
+        memset(p, 0, total - used);
     return total;
 }
 

@@ -83,9 +83,14 @@ size_t ncp_cmd_pack(const struct ncp_cmd *c, void *dst)
         memcpy(p, c->diag.msg, msg);
         p += msg;
     }
-    memcpy(p, c->text, text_used);
+    /* a motion command has no text and needs no padding: no library call
+     * for copying or clearing nothing */
+    if (text_used)
+        memcpy(p, c->text, text_used);
     p += text_used;
-    memset(p, 0, total - (size_t)(p - (unsigned char *)dst));
+    size_t pad = total - (size_t)(p - (unsigned char *)dst);
+    if (pad)
+        memset(p, 0, pad);
     return total;
 }
 
@@ -117,7 +122,8 @@ void ncp_cmd_unpack(const void *src, struct ncp_cmd *c)
         c->diag.msg[h.msg_len] = '\0';
         p += h.msg_len;
     }
-    memcpy(c->text, p, h.text_used);
+    if (h.text_used)
+        memcpy(c->text, p, h.text_used);
 }
 
 void ncp_cmd_pack_pad(void *dst)
