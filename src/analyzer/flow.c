@@ -96,6 +96,7 @@ struct ncp_flow {
     double args[NCP_OWORD_MAX_ARGS];
     int nargs;
 
+    int inline_level;                 /* an inline call returns to this level, or -1 */
     char label[FLOW_LABEL_MAX];       /* label of the block being run */
     size_t label_len;
 };
@@ -922,7 +923,22 @@ static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
         rc = run_oword(f, b, d);
         if (rc != NCP_OK)
             return rc;
+        if (f->inline_level >= 0 && f->level == f->inline_level) {
+            f->inline_level = -1;
+            *out = b;
+            return NCP_FLOW_RETURNED;
+        }
     }
+}
+
+int ncp_flow_call_inline(struct ncp_flow *f, const struct ncp_block *call,
+                         struct ncp_diag *d)
+{
+    int level = f->level;
+    int rc = run_oword(f, call, d);
+    if (rc == NCP_OK)
+        f->inline_level = level;
+    return rc;
 }
 
 int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out, struct ncp_diag *d)
@@ -930,7 +946,7 @@ int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out, struct ncp_d
     int rc = flow_step(f, out, d);
     /* no block goes out with an end or an error: hand the last one back now,
      * while the feed surely still exists */
-    if (rc != NCP_OK)
+    if (rc != NCP_OK && rc != NCP_FLOW_RETURNED)
         release_feed(f);
     return rc;
 }
@@ -956,6 +972,7 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
     f->cur.line = f->src->begin_line;
     f->feed_pos = f->cur;
     f->jump_target = UINT64_MAX;
+    f->inline_level = -1;
     return f;
 }
 
@@ -996,5 +1013,6 @@ void ncp_flow_reset(struct ncp_flow *f)
     f->seek_sub.on = 0;
     f->defining.on = 0;
     f->in_sub_context = 0;
+    f->inline_level = -1;
     labels_clear(&f->labels);
 }

@@ -40,6 +40,16 @@ void ncp_flow_set_frame_hooks(struct ncp_flow *f, struct ncp_flow_frames hooks);
 int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out,
                   struct ncp_diag *d);
 
+/* rs274's lathe cycles (G70-G72) record their profile by running the line
+ * "O<q> call" as if it had been read in place of the block being run: call
+ * is that line, lexed by the caller. The subroutine's blocks then come from
+ * ncp_flow_next, which reports its return (endsub or return) as
+ * NCP_FLOW_RETURNED with *out set to that O-word block; the block after the
+ * calling one comes next. */
+#define NCP_FLOW_RETURNED 100
+int ncp_flow_call_inline(struct ncp_flow *f, const struct ncp_block *call,
+                         struct ncp_diag *d);
+
 /* Current subroutine call depth (0 = main program). */
 int ncp_flow_call_depth(const struct ncp_flow *f);
 

@@ -7,6 +7,12 @@
 
 #define BIT(c) (1u << NCP_LETTER(c))
 
+/* G70, G71, G71.1, G71.2, G72, G72.1, G72.2 */
+static int ncp_is_g7x(int m)
+{
+    return m == 700 || (m >= 710 && m <= 712) || (m >= 720 && m <= 722);
+}
+
 static int ncp_first_axis_col(const struct ncp_words *w)
 {
     static const char ax[] = "XYZABCUVW";
@@ -28,12 +34,6 @@ static int ncp_motion_to_be(struct ncp_analyzer *a)
     w->motion_to_be = -1;
     if (m1 != -1) {
         uint16_t col = w->gcol[NCP_GG_MOTION];
-        if (m1 >= 700 && m1 <= 722) { /* before the word checks, which do not know them */
-            if (m1 % 10)
-                return ncp_an_error(a, col, "G%d.%d (lathe profile cycle) is not supported",
-                                    m1 / 10, m1 % 10);
-            return ncp_an_error(a, col, "G%d (lathe profile cycle) is not supported", m1 / 10);
-        }
         if (m1 == 800) {
             if (axis && !covets)
                 return ncp_an_error(a, col, "Cannot use axis values with g80");
@@ -44,7 +44,7 @@ static int ncp_motion_to_be(struct ncp_analyzer *a)
             if (covets)
                 return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
                                     "Cannot use two g codes that both use axis values");
-            if (!axis && m1 != 0 && m1 != 10 && m1 != 20 && m1 != 30)
+            if (!axis && m1 != 0 && m1 != 10 && m1 != 20 && m1 != 30 && !ncp_is_g7x(m1))
                 return ncp_an_error(a, col, "All axes missing with motion code");
         }
         w->motion_to_be = m1;
@@ -113,6 +113,7 @@ static int ncp_check_other(struct ncp_analyzer *a)
     int ctl = w->g[NCP_GG_CONTROL];
     int g10 = m0 == 100;
     int comp_on = comp == 410 || comp == 420 || comp == 411 || comp == 421;
+    int g70 = mt == 700, rough = ncp_is_g7x(mt) && !g70; /* rough: G71*, G72* */
 #define COL(c) w->col[NCP_LETTER(c)]
     if (NCP_HAS(w, 'A') && ncp_is_cycle(mt))
         return ncp_an_error(a, COL('A'), "Cannot put an a in canned cycle");
@@ -120,15 +121,15 @@ static int ncp_check_other(struct ncp_analyzer *a)
         return ncp_an_error(a, COL('B'), "Cannot put a b in canned cycle");
     if (NCP_HAS(w, 'C') && ncp_is_cycle(mt))
         return ncp_an_error(a, COL('C'), "Cannot put a c in canned cycle");
-    if (NCP_HAS(w, 'D') && !comp_on && w->g[NCP_GG_SPINDLE] != 960)
+    if (NCP_HAS(w, 'D') && !comp_on && !ncp_is_g7x(mt) && w->g[NCP_GG_SPINDLE] != 960)
         return ncp_an_error(a, COL('D'), "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
-    if (NCP_HAS(w, 'E') && mt != 760 && mt != 330 && mt != 331 && w->m[NCP_MG_IO] != 66 &&
+    if (NCP_HAS(w, 'E') && mt != 760 && mt != 330 && mt != 331 && !g70 && w->m[NCP_MG_IO] != 66 &&
         w->m[NCP_MG_IO] != 67 && w->m[NCP_MG_IO] != 68)
         return ncp_an_error(a, COL('E'), "E word with no G70, G76, M66, M67 or M68 to use it");
     if (NCP_HAS(w, 'H') && tlo != 430 && mt != 760 && tlo != 432)
         return ncp_an_error(a, COL('H'), "H word with no G43 or G76 to use it");
     if (NCP_HAS(w, 'I') && mt != 20 && mt != 30 && mt != 50 && mt != 51 && mt != 760 &&
-        mt != 870 && mt != 331 && !g10)
+        mt != 870 && mt != 331 && !rough && !g10)
         return ncp_an_error(a, COL('I'), "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it");
     if (NCP_HAS(w, 'J') && mt != 20 && mt != 30 && mt != 50 && mt != 51 && mt != 760 &&
         mt != 870 && !g10)
@@ -143,7 +144,7 @@ static int ncp_check_other(struct ncp_analyzer *a)
         int mo = w->m[NCP_MG_OVERRIDE], mi = w->m[NCP_MG_IO];
         if (!g10 && m0 != 40 && ctl != 640 && mt != 760 && mt != 820 && mt != 860 &&
             mt != 880 && mt != 890 && mt != 50 && mt != 52 && mt != 20 && mt != 30 &&
-            mt != 840 && (mo < 50 || mo > 53) && (mi < 62 || mi > 66) &&
+            mt != 840 && !g70 && (mo < 50 || mo > 53) && (mi < 62 || mi > 66) &&
             w->m[NCP_MG_SPINDLE] != 19)
             return ncp_an_error(a, COL('P'), "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 M63 M64 M65 M66 M98 or user M code to use it");
         double p = w->v[NCP_LETTER('P')];
@@ -156,11 +157,11 @@ static int ncp_check_other(struct ncp_analyzer *a)
         if (arc && pv < 1)
             return ncp_an_error(a, COL('P'), "P value should be 1 or greater with G2 or G3");
     }
-    if (NCP_HAS(w, 'Q') && mt != 830 && mt != 730 && mt != 50 && mt != 760 &&
+    if (NCP_HAS(w, 'Q') && mt != 830 && mt != 730 && mt != 50 && mt != 760 && !ncp_is_g7x(mt) &&
         w->m[NCP_MG_IO] != 66 && w->m[NCP_MG_IO] != 67 && w->m[NCP_MG_IO] != 68 && !g10 &&
         w->m[NCP_MG_TOOL] != 61 && ctl != 640 && w->m[NCP_MG_SPINDLE] != 19)
         return ncp_an_error(a, COL('Q'), "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it");
-    if (NCP_HAS(w, 'R') && mt != 20 && mt != 30 && mt != 760 && (mt < 810 || mt > 890) &&
+    if (NCP_HAS(w, 'R') && mt != 20 && mt != 30 && mt != 760 && (mt < 810 || mt > 890) && !rough &&
         mt != 730 && comp != 411 && comp != 421 && !g10 && w->m[NCP_MG_SPINDLE] != 19)
         return ncp_an_error(a, COL('R'), "R word with no g code that uses it");
     if (!NCP_HAS(w, 'S') && w->g[NCP_GG_SPINDLE] == 960)

@@ -96,7 +96,7 @@ static double ncp_straight_length(const double *p, const double *q)
     return l > 0.0 ? sqrt(l) : sqrt(r);
 }
 
-static int ncp_straight(struct ncp_analyzer *a, int motion)
+int ncp_motion_straight(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
@@ -260,7 +260,7 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
     return NCP_OK;
 }
 
-static int ncp_arc(struct ncp_analyzer *a, int motion)
+int ncp_motion_arc(struct ncp_analyzer *a, int motion)
 {
     double end[NCP_NAX];
     int rc = ncp_motion_ends(a, 0, end);
@@ -408,9 +408,9 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         a->st.cycle_il_flag = 0;
     switch (motion) {
     case 0: case 10:
-        return ncp_straight(a, motion);
+        return ncp_motion_straight(a, motion);
     case 20: case 30:
-        return ncp_arc(a, motion);
+        return ncp_motion_arc(a, motion);
     case 800:
         a->st.m.motion = 800;
         ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
@@ -422,6 +422,8 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         return ncp_synced(a, motion);
     case 382: case 383: case 384: case 385:
         return ncp_probe(a, motion);
+    case 700: case 710: case 711: case 712: case 720: case 721: case 722:
+        return ncp_g7x_run(a, motion);
     case 730: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
     case 890:
         return ncp_canned_run(a, motion);

@@ -180,6 +180,11 @@ int ncp_exec_block(struct ncp_analyzer *a);
 
 /* motion.c / arcs.c / canned.c */
 int ncp_motion_run(struct ncp_analyzer *a, int motion);
+/* G0/G1 and G2/G3 to the block's words, in the current distance modes */
+int ncp_motion_straight(struct ncp_analyzer *a, int motion);
+int ncp_motion_arc(struct ncp_analyzer *a, int motion);
+/* g7x.c: G70, G71, G71.1, G71.2, G72, G72.1, G72.2 (motion x10) */
+int ncp_g7x_run(struct ncp_analyzer *a, int motion);
 int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end);
 int ncp_canned_run(struct ncp_analyzer *a, int motion);
 /* thread.c: G76 from the current point to end (checked by motion.c) */

@@ -39,7 +39,7 @@ static void ncp_g_table_init(void)
         {870, NCP_GG_MOTION}, {880, NCP_GG_MOTION}, {890, NCP_GG_MOTION},
         {330, NCP_GG_MOTION}, {331, NCP_GG_MOTION}, {760, NCP_GG_MOTION},
         {50, NCP_GG_MOTION}, {51, NCP_GG_MOTION}, {52, NCP_GG_MOTION},
-        /* lathe profile cycles: known to rs274, refused as not supported */
+        /* lathe profile cycles (g7x.c) */
         {700, NCP_GG_MOTION}, {710, NCP_GG_MOTION}, {711, NCP_GG_MOTION},
         {712, NCP_GG_MOTION}, {720, NCP_GG_MOTION}, {721, NCP_GG_MOTION},
         {722, NCP_GG_MOTION},
