@@ -165,6 +165,10 @@ int ncp_block_packed_is_end_mark(const void *src);
  * Returns out->err.code. Never reads outside text[0..len). */
 int ncp_lex_block(const char *text, size_t len, uint32_t line, uint64_t offset,
                   struct ncp_block *out);
+/* ncp_lex_block as rs274 reads the blocks of a G70-G72 profile subroutine:
+ * U and W (incremental X and Z there) are words, not bad characters. */
+int ncp_lex_block_profile(const char *text, size_t len, uint32_t line, uint64_t offset,
+                          struct ncp_block *out);
 /* The line at the start of text[0..avail) (the rest of the program or of a
  * chunk), lexed as ncp_lex_block lexes it, with *next = the bytes up to and
  * past its line end (as ncp_source_span splits lines: "\n" ends a line, a

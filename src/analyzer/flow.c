@@ -911,6 +911,10 @@ static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
             /* rs274 does not parse the lines it skips */
             if (skipping)
                 continue;
+            if (f->inline_level >= 0) { /* a G7x profile: the caller reads it its way */
+                *out = b;
+                return NCP_OK;
+            }
             *d = b->err;
             return b->err.code;
         }

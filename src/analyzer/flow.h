@@ -45,7 +45,8 @@ int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out,
  * is that line, lexed by the caller. The subroutine's blocks then come from
  * ncp_flow_next, which reports its return (endsub or return) as
  * NCP_FLOW_RETURNED with *out set to that O-word block; the block after the
- * calling one comes next. */
+ * calling one comes next. Meanwhile a block with a syntax error comes back as
+ * a block (rs274 reads some such lines differently there). */
 #define NCP_FLOW_RETURNED 100
 int ncp_flow_call_inline(struct ncp_flow *f, const struct ncp_block *call,
                          struct ncp_diag *d);

@@ -220,7 +220,7 @@ static int g7x_record_block(struct ncp_analyzer *a, struct g7x_rec *r,
 /* Read the subroutine's blocks as rs274's recording loop does, up to its
  * return; *ret is then the return line (line and column). */
 static int g7x_record(struct ncp_analyzer *a, struct g7x_rec *r, struct ncp_g7x_path *path,
-                      uint32_t *ret_line, uint16_t *ret_col)
+                      struct ncp_block *relex, uint32_t *ret_line, uint16_t *ret_col)
 {
     for (;;) {
         const struct ncp_block *b = NULL;
@@ -236,6 +236,14 @@ static int g7x_record(struct ncp_analyzer *a, struct g7x_rec *r, struct ncp_g7x_
         if (rc != NCP_OK) {
             a->err = d;
             return rc;
+        }
+        if (b->err.code != NCP_OK && relex && b->length < 0xffff &&
+            b->offset + b->length <= a->src->len) {
+            /* it may be a U or W word, which rs274 takes here */
+            ncp_lex_block_profile(a->src->text + b->offset, b->length, b->line, b->offset,
+                                  relex);
+            if (relex->err.code != NCP_OK || relex->oword.kind == NCP_O_NONE)
+                b = relex;
         }
         a->blk = b;
         a->line = b->line;
@@ -331,8 +339,10 @@ int ncp_g7x_run(struct ncp_analyzer *a, int motion)
     uint16_t ret_col = 1;
     if (rc == NCP_OK)
         rc = g7x_call(a, &blk);
+    struct ncp_block *relex = malloc(sizeof *relex); /* NULL: U/W stay refused */
     if (rc == NCP_OK)
-        rc = g7x_record(a, &r, &path, &ret_line, &ret_col);
+        rc = g7x_record(a, &r, &path, relex, &ret_line, &ret_col);
+    free(relex);
     a->blk = NULL; /* the G7x block may be gone: the subroutine's were read over it */
     if (rc == NCP_OK) {
         a->line = ret_line;

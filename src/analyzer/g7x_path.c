@@ -129,7 +129,7 @@ static int copy_path(struct ncp_g7x_path *dst, const struct ncp_g7x_path *src)
     int rc = reserve(dst, src->n);
     if (rc != NCP_OK)
         return rc;
-    if (src->n)
+    if (src->n && dst->seg)
         memcpy(dst->seg, src->seg, (size_t)src->n * sizeof *src->seg);
     dst->n = src->n;
     return NCP_OK;
@@ -855,7 +855,7 @@ static int rough_climb(struct rough *r, int *seg, double complex *loc, int *agai
 static int rough_pockets(struct rough *r, int seg, double complex loc)
 {
     struct ncp_g7x_path *p = r->p;
-    int rc = NCP_OK;
+    int rc;
     if (r->cycle == 2) {
         /* the first roughing pass was G71.1's: pick up after it */
         for (; seg < p->n; seg++) {

@@ -309,8 +309,11 @@ static int cmd_check(int argc, char **argv)
         }
         /* '%' lines are tape delimiters, not blocks: the customary one after
          * M2 is never read, one the run does read is its error above */
+        /* U and W words are good in a G70-G72 profile, and a bad character
+         * anywhere else: only the run knows, and reports that case above */
         if (!ncp_source_percent_line(src.text + sp.off, sp.len) &&
-            ncp_lex_block(src.text + sp.off, sp.len, sp.line, sp.off, b) != NCP_OK) {
+            ncp_lex_block(src.text + sp.off, sp.len, sp.line, sp.off, b) != NCP_OK &&
+            ncp_lex_block_profile(src.text + sp.off, sp.len, sp.line, sp.off, b) != NCP_OK) {
             print_diag(o.prog, &b->err);
             errors++;
         }

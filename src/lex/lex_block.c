@@ -177,7 +177,8 @@ static int items(struct ncp_lexer *lx)
         if (c >= 'a' && c <= 'z') {
             /* canonical output carries XYZABC only, as rs274 -g: U V W are
              * rejected there the same way */
-            if (c == 'n' || c == 'o' || (c >= 'u' && c <= 'w'))
+            if (c == 'n' || c == 'o' || c == 'v' ||
+                ((c == 'u' || c == 'w') && !lx->uw_words))
                 return bad_character(lx, c);
             rc = word(lx, (char)c, &seen);
         } else if (c == '#') {
@@ -236,8 +237,8 @@ int ncp_lex_line(const char *text, size_t avail, uint32_t line, uint64_t offset,
     return ncp_lex_block_general(text, len, line, offset, out);
 }
 
-int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t offset,
-                          struct ncp_block *out)
+static int lex_general(const char *text, size_t len, uint32_t line, uint64_t offset,
+                       struct ncp_block *out, int uw_words)
 {
     struct ncp_lexer lx;
     int rc;
@@ -248,6 +249,7 @@ int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t 
     lx.depth = 0;
     lx.cmt_pos = -1;
     lx.cmt_len = 0;
+    lx.uw_words = uw_words;
     if ((rc = ncp_lex_squeeze(&lx, text, len)))
         return rc;
     if (lx.buf[0] == '/') {
@@ -264,4 +266,16 @@ int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t 
         return rc;
     ncp_lex_store_comment(&lx);
     return NCP_OK;
+}
+
+int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t offset,
+                          struct ncp_block *out)
+{
+    return lex_general(text, len, line, offset, out, 0);
+}
+
+int ncp_lex_block_profile(const char *text, size_t len, uint32_t line, uint64_t offset,
+                          struct ncp_block *out)
+{
+    return lex_general(text, len, line, offset, out, 1);
 }

@@ -22,6 +22,7 @@ struct ncp_lexer {
     int n;                 /* length of buf */
     int depth;             /* nesting of values being read */
     int cmt_pos, cmt_len;  /* last (...) comment seen, inside buf; cmt_pos < 0: none */
+    int uw_words;          /* U and W are words (a G7x profile), not bad characters */
     char buf[NCP_LEX_TOO_LONG + NCP_LEX_PAD];
     uint8_t col[NCP_LEX_TOO_LONG + NCP_LEX_PAD]; /* 1-based source column */
 };
