@@ -79,6 +79,12 @@ static struct ncp_cmd *ncp_an_slot(struct ncp_analyzer *a, size_t text_need)
     return c;
 }
 
+void ncp_an_reline(struct ncp_analyzer *a)
+{
+    if (a->cmd && a->cmd->line != a->line)
+        ncp_an_publish(a);
+}
+
 /* Ops go to a scratch op when the sink has shut down, so callers need no
  * NULL checks on the hot path. */
 static struct ncp_canon ncp_an_scratch;

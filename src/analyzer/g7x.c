@@ -346,6 +346,7 @@ int ncp_g7x_run(struct ncp_analyzer *a, int motion)
     a->blk = NULL; /* the G7x block may be gone: the subroutine's were read over it */
     if (rc == NCP_OK) {
         a->line = ret_line;
+        ncp_an_reline(a);
         g7x_blank_words(&a->w, ret_col);
         if (path.n > 1)
             rc = g7x_passes(a, motion, &blk, &path, CMPLX(z, x));

@@ -147,6 +147,10 @@ struct ncp_canon *ncp_an_emit(struct ncp_analyzer *a, enum ncp_canon_kind kind);
 struct ncp_canon *ncp_an_emit_text(struct ncp_analyzer *a, enum ncp_canon_kind kind,
                                    const char *text, size_t len);
 void ncp_an_emit6(struct ncp_analyzer *a, enum ncp_canon_kind kind, const double *p);
+/* The block now answers for another line (a->line, set by the caller: a G7x
+ * cycle's passes are its profile's return line's): later ops go to a new
+ * slot of that line, so errors found when they execute name it. */
+void ncp_an_reline(struct ncp_analyzer *a);
 int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

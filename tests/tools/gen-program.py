@@ -694,8 +694,10 @@ class Gen:
             return self.st_sync_episode()
         if c < 0.998:
             return self.st_spline()
-        if c < 0.999:
+        if c < 0.9985:
             return self.st_thread()
+        if c < 0.999:
+            return self.st_lathe_cycle_episode()
         return self.st_state_episode()
 
     def st_state_episode(self):
@@ -712,6 +714,89 @@ class Gen:
             self.simple_statement(inner=True)
         self.emit("M72")
         self.dist, self.plane = dist, plane
+
+    def lathe_profile(self, arcs=True):
+        """A profile that runs towards -a and +b (a, b: Z and X of a G71,
+        X and -Z of a G72 before its quarter turn), lines and R arcs, none
+        reversing direction (no pockets: rs274 2.9 can loop for ever on
+        some): [(g, a, b, r)], and the largest b."""
+        # the same numbers in inch: rs274's tolerances are absolute, and on
+        # profiles 25 times smaller it loops for ever more often
+        r, s = self.r, 1.0
+        a, b = r.uniform(-5, 5) * s, r.uniform(0, 5) * s
+        segs, top, flat = [("G1", a, b, None)], b, False
+        for _ in range(r.randint(2, 5)):
+            # two lines in a row along Z meet nowhere: rs274 refuses them
+            da = -r.uniform(1, 5) * s
+            db = r.uniform(0.3, 3) * s if flat or r.random() < 0.7 else 0
+            flat = db == 0
+            na, nb = float(self.n(a + da)), float(self.n(b + db))
+            seg = ("G1", na, nb, None)
+            chord = math.hypot(na - a, nb - b)
+            if arcs and r.random() < 0.4 and chord > 1.5 * s:
+                g = r.choice(["G2", "G3"])
+                rad = float(self.n(chord / 2 * r.uniform(1.1, 3)))
+                # rs274's centre of an R arc, and its test that the arc keeps
+                # to one side of it (with some margin)
+                mid = complex(a + na, b + nb) / 2
+                d = 1j * math.sqrt((rad * rad - chord * chord / 4) / (chord * chord)) \
+                    * complex(na - a, nb - b)
+                c = mid + d if g == "G3" else mid - d
+                e1, e2 = b - c.imag, nb - c.imag
+                if (g == "G3" and e1 >= 0.05 and e2 >= 0.05) or \
+                        (g == "G2" and e1 <= -0.05 and e2 <= -0.05):
+                    seg = (g, na, nb, rad)
+            segs.append(seg)
+            a, b = na, nb
+            top = max(top, b)
+        segs.append(("G1", a, float(self.n(top + r.uniform(0.5, 2) * s)), None))
+        return segs, max(top, segs[-1][2])
+
+    def st_lathe_cycle_episode(self):
+        """G71/G72 roughing (and their .1/.2 forms) and G70 finishing of a
+        profile subroutine defined right here, in G18, G90 and G94, from a
+        point clear of it; the current point is then known no more."""
+        r, s = self.r, 1.0
+        if self.depth:
+            return self.st_straight()
+        face = r.random() < 0.4
+        # arcs only along Z: rs274 2.9 loops for ever on some G72 faces with arcs
+        segs, top = self.lathe_profile(arcs=not face)
+        # a G72 profile is a G71 one turned a quarter: Z = -b, X = a
+        xz = (lambda a, b: (a, -b)) if face else (lambda a, b: (b, a))
+        self.lathe_subs = getattr(self, "lathe_subs", 0) + 1
+        name = "o%d" % (7000 + self.lathe_subs)   # G7x's Q names subs by number
+        self.emit("%s sub" % name)
+        self.depth = 1
+        for g, a, b, rad in segs:
+            x, z = xz(a, b)
+            self.emit("%s X%s Z%s%s" % (g, self.n(x), self.n(z),
+                                        " R" + self.n(rad) if rad else ""))
+        self.depth = 0
+        self.emit("%s endsub" % name)
+        self.set_plane(18)
+        if self.dist != 90:
+            self.set_dist(90)
+        if self.feed_mode == 93:
+            self.set_feed_mode(94)
+        self.ensure_feed_ready()
+        x, z = xz(segs[0][1] + r.uniform(0.5, 2) * s, top + r.uniform(0.5, 2) * s)
+        start = "X%s Z%s" % (self.n(x), self.n(z))
+        # not G71.1/G72.1: rs274 2.9 loops for ever on some plain profiles there
+        g = r.choice(["G72", "G72.2"] if face else ["G71", "G71.2"])
+        words = [start, "D" + self.n(r.uniform(0, 0.3) * s)]
+        words.append("I" + self.n(r.uniform(0.3, 1.5) * s))
+        if r.random() < 0.7:
+            words.append("R" + self.n(r.uniform(0.1, 0.6) * s))
+        self.emit("%s Q%s %s" % (g, name[1:], " ".join(words)))
+        if r.random() < 0.7:
+            words = [start]
+            if r.random() < 0.5:
+                words += ["P%d" % r.randint(1, 3), "D" + self.n(r.uniform(0.2, 1) * s),
+                          "E" + self.n(r.uniform(0, 0.2) * s)]
+            self.emit("G70 Q%s %s" % (name[1:], " ".join(words)))
+        self.forget_position(("X", "Z"))
+        self.emit("G80")
 
     def st_thread(self):
         """A G76 threading cycle along Z (outside or bored, maybe tapered, with
