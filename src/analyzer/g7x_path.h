@@ -11,6 +11,16 @@
 
 #include <complex.h>
 
+/* glibc defines CMPLX for GCC only: the same from its parts, for clang. */
+#ifndef CMPLX
+static inline double complex ncp_g7x_cmplx(double re, double im)
+{
+    union { double complex z; double d[2]; } u = {.d = {re, im}};
+    return u.z;
+}
+#define CMPLX(re, im) ncp_g7x_cmplx((re), (im))
+#endif
+
 /* More than any hand-written profile; beyond it the cycle is refused. */
 #define NCP_G7X_MAX_SEGS 20000
 
