@@ -42,9 +42,12 @@ struct ncp_tool_entry {
 
 #define NCP_MAX_TOOLS 1000
 
+#define NCP_DEFAULT_MAX_LOOPS 10000000u
+
 struct ncp_analyzer_cfg {
     const char *tool_table_path; /* NULL: empty table (as rs274 without -t) */
-    uint32_t max_loop_iterations;/* runaway while/do/repeat guard, 0 = default 10,000,000 */
+    uint32_t max_loop_iterations;/* runaway guard for while/do/repeat loops and the passes
+                                    of one G76 cycle, 0 = NCP_DEFAULT_MAX_LOOPS */
     uint32_t max_call_depth;     /* O-word call nesting, 0 = default (rs274: 10) */
 };
 

@@ -17,7 +17,6 @@
 
 /* rs274 -g runs with the block delete switch off: '/' blocks are executed. */
 #define FLOW_BLOCK_DELETE 0
-#define FLOW_DEFAULT_MAX_LOOPS 10000000u
 #define FLOW_DEFAULT_MAX_DEPTH 10u    /* rs274: INTERP_SUB_ROUTINE_LEVELS */
 #define FLOW_CACHE_BITS 8
 #define FLOW_CACHE_SLOTS (1u << FLOW_CACHE_BITS) /* re-read blocks kept lexed (~2 MB) */
@@ -970,7 +969,7 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
     f->params = params;
     f->pops = ncp_params_ops(params);
     f->max_loops = cfg && cfg->max_loop_iterations ? cfg->max_loop_iterations
-                                                   : FLOW_DEFAULT_MAX_LOOPS;
+                                                   : NCP_DEFAULT_MAX_LOOPS;
     f->max_depth = cfg && cfg->max_call_depth ? cfg->max_call_depth : FLOW_DEFAULT_MAX_DEPTH;
     f->cur.off = f->src->begin;
     f->cur.line = f->src->begin_line;

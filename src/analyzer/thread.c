@@ -131,7 +131,24 @@ int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
     t.exit_taper = taper_flags & 2;
     t.target_z = end[NCP_Z] + fabs(k_number) * tan(compound_angle);
 
-    int pass = 1;
+    /* rs274 cuts until the depth reaches K, however many passes that takes:
+     * with a large R (degression) or H (spring passes) that is forever. The
+     * passes are counted first, against the loop guard, so a runaway cycle
+     * stops before it prints anything. */
+    uint32_t limit = a->cfg.max_loop_iterations ? a->cfg.max_loop_iterations
+                                                : NCP_DEFAULT_MAX_LOOPS;
+    double passes = 0.0;
+    for (double n = 1.0, d = start_depth; d < t.end_depth && passes <= limit;
+         d = full_dia_depth + cut_increment * pow(++n, 1.0 / degression))
+        passes++;
+    passes += (double)spring_cuts + 1.0;
+    if (passes > limit)
+        return ncp_an_error(a, col,
+                            "G76 would cut more than %u passes (J, K and R set the passes to "
+                            "depth, H the spring passes): runaway cycle? (raise "
+                            "max_loop_iterations if intended)", limit);
+
+    double pass = 1.0;
     double depth = start_depth;
     double zoff = (depth - full_dia_depth) * tan(compound_angle);
     while (depth < t.end_depth) {
@@ -141,7 +158,7 @@ int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
     }
     depth = t.end_depth;
     zoff = (depth - full_dia_depth) * tan(compound_angle);
-    for (int k = 0; k < spring_cuts + 1; k++)
+    for (int k = 0; k <= spring_cuts; k++)
         ncp_thread_pass(a, &t, depth, zoff);
     double last[6] = {end[NCP_X], end[NCP_Y], end[NCP_Z], t.abc[0], t.abc[1], t.abc[2]};
     ncp_an_emit6(a, NCP_C_STRAIGHT_TRAVERSE, last);

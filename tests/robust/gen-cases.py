@@ -61,6 +61,12 @@ case("runaway_do", "G21\no1 do\n#1=1\no1 while [1]\nM2\n", 2, "line 2")
 case("runaway_repeat", "G21\no1 repeat [1000000000]\n#1=1\no1 endrepeat\nM2\n", 2, "line 2")
 case("runaway_in_sub", "G21\no100 sub\no101 while [1]\nG0 X1\no101 endwhile\n"
      "o100 endsub\no100 call\nM2\n", 2, "line 3")
+# Runaway cycles: G76 cuts until its depth reaches K, which a large degression
+# R puts astronomically far away, and H adds spring passes without bound.
+case("runaway_g76_degression", "G18 G21 G90\nS600 M3\nG0 X20 Z3\n"
+     "G76 P2.5 Z-28 I-1.2 J0.3 K1.53 R551 H2\nM2\n", 2, "G76 would cut more than")
+case("runaway_g76_spring", "G18 G21 G90\nS600 M3\nG0 X20 Z3\n"
+     "G76 P2.5 Z-28 I-1.2 J0.3 K1.53 H2000000000\nM2\n", 2, "G76 would cut more than")
 # Degenerate files.
 case("empty", "", 2)
 case("only_percent", "%\n", 2)
