@@ -95,13 +95,11 @@ static int g7x_arc(void *ctx, int ccw, double complex centre, double complex end
 /* rs274 reads "O<Q as %f> call": Q must be an integer, as any O number. */
 static int g7x_call(struct ncp_analyzer *a, const struct ncp_words *w)
 {
-    double q = WV(w, 'Q');
     uint16_t col = w->col[NCP_LETTER('Q')];
-    int n = ncp_trunc_int(floor(q));
-    if (q - n > 0.9999)
-        n = ncp_trunc_int(ceil(q));
-    else if (q - n > 0.0001)
-        return ncp_an_error(a, col, "Non integer value for integer");
+    int n;
+    int rc = ncp_integer_word(a, WV(w, 'Q'), col, &n);
+    if (rc != NCP_OK)
+        return rc;
     char text[32];
     int len = snprintf(text, sizeof text, "o%d call", n);
     struct ncp_block *b = malloc(sizeof *b);
@@ -111,7 +109,7 @@ static int g7x_call(struct ncp_analyzer *a, const struct ncp_words *w)
     ncp_lex_line(text, (size_t)len, a->line, a->blk->offset, b, &next);
     b->length = 0; /* not text of the program: nothing to quote */
     b->oword.col = col;
-    int rc = b->err.code;
+    rc = b->err.code;
     if (rc != NCP_OK)
         a->err = b->err;
     else

@@ -166,6 +166,8 @@ int ncp_comp_stop(struct ncp_analyzer *a, int reset);
 
 /* words.c */
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
+/* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
+int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);
 /* Axis ax (enum ncp_axis)'s letter, and its slot in struct ncp_words: a table,
  * since NCP_LETTER of a variable is a chain of compares at run time. */
 extern const char ncp_axis_letter[NCP_NAX];

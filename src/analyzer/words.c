@@ -114,10 +114,10 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
     return NCP_OK;
 }
 
-/* rs274's read_integer_value (M, T, H, L): the floor, or the ceiling when
- * within 0.0001 of it (x86 conversions of the floor, as rs274 makes them);
- * anything further from an integer is an error. */
-static int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out)
+/* rs274's read_integer_value (M, T, H, L, a G7x's Q): the floor, or the
+ * ceiling when within 0.0001 of it (x86 conversions of the floor, as rs274
+ * makes them); anything further from an integer is an error. */
+int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out)
 {
     int i = ncp_trunc_int(floor(v));
     double d = v - i;
