@@ -67,6 +67,14 @@ static void ncp_thread_pass(struct ncp_analyzer *a, const struct ncp_thread *t, 
     ncp_an_emit(a, NCP_C_ENABLE_FEED_OVERRIDE);
 }
 
+/* Depth of cutting pass n (1, 2, ...): the first at J past I, the next ones
+ * taking off ever less as the degression R grows. */
+static double ncp_thread_depth(double full_dia_depth, double cut_increment, double n,
+                               double degression)
+{
+    return full_dia_depth + cut_increment * pow(n, 1.0 / degression);
+}
+
 static double ncp_word_or(const struct ncp_words *w, char c, double absent)
 {
     return NCP_HAS(w, c) ? w->v[NCP_LETTER(c)] : absent;
@@ -139,7 +147,7 @@ int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
                                                 : NCP_DEFAULT_MAX_LOOPS;
     double passes = 0.0;
     for (double n = 1.0, d = start_depth; d < t.end_depth && passes <= limit;
-         d = full_dia_depth + cut_increment * pow(++n, 1.0 / degression))
+         d = ncp_thread_depth(full_dia_depth, cut_increment, ++n, degression))
         passes++;
     passes += (double)spring_cuts + 1.0;
     if (passes > limit)
@@ -153,7 +161,7 @@ int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
     double zoff = (depth - full_dia_depth) * tan(compound_angle);
     while (depth < t.end_depth) {
         ncp_thread_pass(a, &t, depth, zoff);
-        depth = full_dia_depth + cut_increment * pow(++pass, 1.0 / degression);
+        depth = ncp_thread_depth(full_dia_depth, cut_increment, ++pass, degression);
         zoff = (depth - full_dia_depth) * tan(compound_angle);
     }
     depth = t.end_depth;
