@@ -271,14 +271,7 @@ static void ncp_op_text(const struct ncp_cmd *cmd, const struct ncp_canon *op,
 #define NCP_HOT_NUM 32
 #define NCP_HOT_LINE (NCP_LIT_BLOCK + 9 * (NCP_HOT_NUM + NCP_LIT_BLOCK) + 12)
 
-_Static_assert(NCP_C_STRAIGHT_FEED == NCP_C_STRAIGHT_TRAVERSE + 1 &&
-                   NCP_C_STRAIGHT_PROBE == NCP_C_STRAIGHT_TRAVERSE + 2,
-               "the straight moves are consecutive kinds");
 _Static_assert(NCP_HOT_LINE < NCP_CMD_OUT_MAX, "a motion line fits an empty slot");
-
-static const char ncp_hot_heads[3][NCP_LIT_BLOCK] = {
-    "STRAIGHT_TRAVERSE(", "STRAIGHT_FEED(", "STRAIGHT_PROBE("};
-static const uint8_t ncp_hot_head_len[3] = {18, 14, 15};
 
 static int ncp_hot_numbers(const double *d, int n)
 {
@@ -306,27 +299,27 @@ static char *ncp_hot_next(char *p, double v)
     return p + ncp_fmt_fixed4(p, v);
 }
 
+/* The call's name and '(' come from its compiled template (the literal before
+ * its first field), copied as one fixed-size block like any pooled literal. */
 static int ncp_format_hot(struct ncp_out *o, const struct ncp_canon *op)
 {
     unsigned kind = op->kind;
-    if (o->full || o->end - o->p < NCP_HOT_LINE)
+    int straight = kind == NCP_C_STRAIGHT_TRAVERSE || kind == NCP_C_STRAIGHT_FEED ||
+                   kind == NCP_C_STRAIGHT_PROBE;
+    if (!straight && kind != NCP_C_ARC_FEED)
+        return 0;
+    const struct ncp_seg *head = &ncp_tpls[kind][0].seg[0];
+    if (o->full || o->end - o->p < NCP_HOT_LINE || !head->pooled ||
+        !ncp_hot_numbers(op->d, straight ? 6 : 8))
         return 0;
     char *p = o->p;
-    if (kind >= NCP_C_STRAIGHT_TRAVERSE && kind <= NCP_C_STRAIGHT_PROBE) {
-        if (!ncp_hot_numbers(op->d, 6))
-            return 0;
-        unsigned h = kind - NCP_C_STRAIGHT_TRAVERSE;
-        memcpy(p, ncp_hot_heads[h], NCP_LIT_BLOCK);
-        p += ncp_hot_head_len[h];
-        p += ncp_fmt_fixed4(p, op->d[0]);
+    memcpy(p, head->lit, NCP_LIT_BLOCK);
+    p += head->lit_len;
+    p += ncp_fmt_fixed4(p, op->d[0]);
+    if (straight) {
         for (int k = 1; k < 6; k++)
             p = ncp_hot_next(p, op->d[k]);
-    } else if (kind == NCP_C_ARC_FEED) {
-        if (!ncp_hot_numbers(op->d, 8))
-            return 0;
-        memcpy(p, "ARC_FEED(", 9);
-        p += 9;
-        p += ncp_fmt_fixed4(p, op->d[0]);
+    } else {
         for (int k = 1; k < 4; k++)
             p = ncp_hot_next(p, op->d[k]);
         memcpy(p, ncp_sep, sizeof ncp_sep);
@@ -334,8 +327,6 @@ static int ncp_format_hot(struct ncp_out *o, const struct ncp_canon *op)
         p += ncp_fmt_int(p, op->i[0]);
         for (int k = 4; k < 8; k++)
             p = ncp_hot_next(p, op->d[k]);
-    } else {
-        return 0;
     }
     memcpy(p, ")\n", 2);
     o->p = p + 2;
