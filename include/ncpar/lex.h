@@ -105,6 +105,8 @@ struct ncp_block {
     uint16_t length;          /* bytes of the block, without the newline */
     uint8_t block_delete;     /* leading '/' */
     uint8_t has_n;            /* N word present (value in n_number) */
+    uint8_t words_only;       /* 1: constant words and nothing else, as the one-pass
+                                 reader makes them (0 says nothing: check) */
     double n_number;
     uint16_t n_words, n_assign, n_code, pool_used;
     /* rs274 keeps the last comment of a line; MSG/DEBUG/PRINT text after the comma */

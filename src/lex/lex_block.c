@@ -205,6 +205,7 @@ void ncp_lex_init_block(struct ncp_block *b, size_t len, uint32_t line, uint64_t
     b->length = (uint16_t)(len > 0xffff ? 0xffff : len);
     b->block_delete = 0;
     b->has_n = 0;
+    b->words_only = 0;
     b->n_number = 0.0;
     b->err.code = NCP_OK;
     b->err.line = line;

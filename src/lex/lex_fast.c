@@ -157,6 +157,7 @@ fast_line(const char *text, size_t avail, size_t len, uint32_t line, uint64_t of
         int end = line_end(text, avail, len, i, &line_len, next, bounded);
         if (end != 0) {
             out->length = (uint16_t)line_len;
+            out->words_only = 1;
             return end > 0;
         }
         char c = (char)(text[i] | 32); /* letters to lower case; others fail below */

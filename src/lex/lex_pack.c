@@ -10,16 +10,32 @@
 
 #include <string.h>
 
-/* 32 bytes; the N number follows only when the block has one. */
+/* 32 bytes; the N number follows only when the block has one. The first 18
+ * bytes (offset .. form) are those of a plain record too (below). */
 struct packed_head {
     uint64_t offset;
     uint32_t line;
     uint16_t units;           /* the record's size in NCP_PACK_UNIT bytes */
     uint16_t length;
+    uint8_t n_words, form;    /* form: FORM_* bits */
+    uint8_t n_assign, block_delete, has_n, comment_kind, oword_kind, oword_nargs;
     uint16_t n_code, pool_used, comment_off, comment_len;
-    uint8_t n_words, n_assign, block_delete, has_n;
-    uint8_t comment_kind, oword_kind, oword_nargs, has_err;
 };
+
+/* A plain block (constant words only; no assignment, bytecode, pool text,
+ * comment, O-word or error: every CAM line) packs into the common 18 bytes,
+ * its N number and 11 bytes a word, and unpacks without looking at the parts
+ * it does not have: "G1 X Y Z" is 64 bytes, one cache line, where the general
+ * form takes 96, and both sides spend a fraction of the general form's
+ * instructions on it (most of the lexing-ahead hand-over on CAM text). */
+enum {
+    FORM_PLAIN = 1,           /* a plain record */
+    FORM_ERR = 2,             /* general: the block carries a syntax error */
+    FORM_BLOCK_DELETE = 4,    /* plain: leading '/' */
+    FORM_HAS_N = 8,           /* plain: the N number follows the head */
+};
+#define PLAIN_HEAD 18u
+#define PLAIN_WORD 11u        /* value, col, letter */
 
 /* A word in 16 bytes instead of struct ncp_word's 24 (its padding does not
  * travel): "G1 X Y Z" packs into 96 bytes, a cache line and a half. */
@@ -75,8 +91,34 @@ static size_t bytes_of(const struct ncp_block *b, const struct pack_counts *c)
     return round_unit(n);
 }
 
+/* Whether b packs as a plain record. Blocks with a syntax error may carry
+ * any counts: those are never plain. */
+static int is_plain(const struct ncp_block *b)
+{
+    if (b->words_only)
+        return 1;
+    if ((b->n_assign | b->n_code | b->pool_used | b->comment_kind | b->comment_off |
+         b->comment_len | b->oword.kind | b->err.code) != 0 ||
+        b->n_words > NCP_BLOCK_MAX_WORDS)
+        return 0;
+    for (unsigned k = 0; k < b->n_words; k++) {
+        const struct ncp_expr *v = &b->words[k].v;
+        if (!v->is_const || (v->start | v->len) != 0)
+            return 0;
+    }
+    return 1;
+}
+
+static size_t plain_bytes(const struct ncp_block *b)
+{
+    size_t n = PLAIN_HEAD + (b->has_n ? sizeof b->n_number : 0) + b->n_words * PLAIN_WORD;
+    return round_unit(n);
+}
+
 size_t ncp_block_packed_size(const struct ncp_block *b)
 {
+    if (is_plain(b))
+        return plain_bytes(b);
     struct pack_counts c = counts_of(b);
     return bytes_of(b, &c);
 }
@@ -104,6 +146,7 @@ static const unsigned char *get(const unsigned char *p, void *dst, size_t n)
 /* PUT_AT's ctype must be the field's type: with these sizes and no padding,
  * a wrong one would overlap its neighbour (and the round-trip tests fail). */
 _Static_assert(sizeof(struct packed_head) == 32, "packed_head: 8+4+6*2+8*1 bytes");
+_Static_assert(offsetof(struct packed_head, form) == PLAIN_HEAD - 1, "plain head is a prefix");
 _Static_assert(sizeof(struct packed_word) == 16, "packed_word: 8+3*2+2*1 bytes");
 
 static void put_at(unsigned char *base, size_t off, const void *v, size_t n)
@@ -118,8 +161,37 @@ static void put_at(unsigned char *base, size_t off, const void *v, size_t n)
 #define HEAD(field, ctype, val) PUT_AT(p, struct packed_head, field, ctype, val)
 #define WORD(field, ctype, val) PUT_AT(p, struct packed_word, field, ctype, val)
 
+static size_t pack_plain(const struct ncp_block *b, unsigned char *p)
+{
+    size_t total = plain_bytes(b);
+    uint64_t zero = 0;
+    memcpy(p + total - sizeof zero, &zero, sizeof zero); /* the padding, if any */
+    uint8_t form = (uint8_t)(FORM_PLAIN | (b->block_delete ? FORM_BLOCK_DELETE : 0) |
+                             (b->has_n ? FORM_HAS_N : 0));
+    HEAD(offset, uint64_t, b->offset);
+    HEAD(line, uint32_t, b->line);
+    HEAD(units, uint16_t, (uint16_t)(total / NCP_PACK_UNIT));
+    HEAD(length, uint16_t, b->length);
+    HEAD(n_words, uint8_t, (uint8_t)b->n_words);
+    HEAD(form, uint8_t, form);
+    p += PLAIN_HEAD;
+    if (b->has_n) {
+        memcpy(p, &b->n_number, sizeof b->n_number);
+        p += sizeof b->n_number;
+    }
+    for (unsigned k = 0; k < b->n_words; k++, p += PLAIN_WORD) {
+        const struct ncp_word *w = &b->words[k];
+        memcpy(p, &w->v.value, sizeof w->v.value);
+        memcpy(p + 8, &w->col, sizeof w->col);
+        p[10] = (unsigned char)w->letter;
+    }
+    return total;
+}
+
 size_t ncp_block_pack(const struct ncp_block *b, void *dst)
 {
+    if (is_plain(b))
+        return pack_plain(b, dst);
     struct pack_counts c = counts_of(b);
     size_t total = bytes_of(b, &c);
     uint8_t has_n = b->has_n, has_err = b->err.code != NCP_OK, oword_kind = b->oword.kind;
@@ -133,13 +205,13 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
     HEAD(comment_off, uint16_t, b->comment_off);
     HEAD(comment_len, uint16_t, b->comment_len);
     HEAD(n_words, uint8_t, (uint8_t)c.words);
+    HEAD(form, uint8_t, (uint8_t)(has_err ? FORM_ERR : 0));
     HEAD(n_assign, uint8_t, (uint8_t)c.assign);
     HEAD(block_delete, uint8_t, b->block_delete);
     HEAD(has_n, uint8_t, has_n);
     HEAD(comment_kind, uint8_t, b->comment_kind);
     HEAD(oword_kind, uint8_t, oword_kind);
     HEAD(oword_nargs, uint8_t, (uint8_t)c.nargs);
-    HEAD(has_err, uint8_t, has_err);
     p += sizeof(struct packed_head);
     if (has_n)
         p = put(p, &b->n_number, sizeof b->n_number);
@@ -172,13 +244,59 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
 
 size_t ncp_block_packed_units(const void *src)
 {
-    struct packed_head h;
-    memcpy(&h, src, sizeof h);
-    return h.units;
+    uint16_t units; /* a plain record may be shorter than the general head */
+    memcpy(&units, (const unsigned char *)src + offsetof(struct packed_head, units), sizeof units);
+    return units;
+}
+
+/* Everything a plain block does not have, as the lexer leaves it. */
+static void unpack_plain(const unsigned char *p, struct ncp_block *b)
+{
+    uint64_t offset;
+    uint32_t line;
+    uint16_t length;
+    memcpy(&offset, p + offsetof(struct packed_head, offset), sizeof offset);
+    memcpy(&line, p + offsetof(struct packed_head, line), sizeof line);
+    memcpy(&length, p + offsetof(struct packed_head, length), sizeof length);
+    unsigned n_words = p[offsetof(struct packed_head, n_words)];
+    unsigned form = p[offsetof(struct packed_head, form)];
+    b->offset = offset;
+    b->line = line;
+    b->length = length;
+    b->block_delete = (form & FORM_BLOCK_DELETE) != 0;
+    b->has_n = (form & FORM_HAS_N) != 0;
+    b->words_only = 1;
+    b->n_words = (uint16_t)n_words;
+    b->n_assign = b->n_code = b->pool_used = 0;
+    b->comment_kind = NCP_CMT_NONE;
+    b->comment_off = b->comment_len = 0;
+    b->err.code = NCP_OK;
+    b->err.line = line;
+    b->err.col = 0;
+    b->err.msg[0] = '\0';
+    b->oword.kind = NCP_O_NONE;
+    p += PLAIN_HEAD;
+    b->n_number = 0.0;
+    if (form & FORM_HAS_N) {
+        memcpy(&b->n_number, p, sizeof b->n_number);
+        p += sizeof b->n_number;
+    }
+    for (unsigned k = 0; k < n_words; k++, p += PLAIN_WORD) {
+        struct ncp_word *w = &b->words[k];
+        memcpy(&w->v.value, p, sizeof w->v.value);
+        memcpy(&w->col, p + 8, sizeof w->col);
+        w->letter = (char)p[10];
+        w->v.start = w->v.len = 0;
+        w->v.is_const = 1;
+    }
 }
 
 void ncp_block_unpack(const void *src, struct ncp_block *b)
 {
+    if (((const unsigned char *)src)[offsetof(struct packed_head, form)] & FORM_PLAIN) {
+        unpack_plain(src, b);
+        return;
+    }
     struct packed_head h;
     const unsigned char *p = get(src, &h, sizeof h);
     b->offset = h.offset;
@@ -186,6 +304,7 @@ void ncp_block_unpack(const void *src, struct ncp_block *b)
     b->length = h.length;
     b->block_delete = h.block_delete;
     b->has_n = h.has_n;
+    b->words_only = 0;
     b->n_number = 0.0;
     if (h.has_n)
         p = get(p, &b->n_number, sizeof b->n_number);
@@ -196,7 +315,7 @@ void ncp_block_unpack(const void *src, struct ncp_block *b)
     b->comment_kind = h.comment_kind;
     b->comment_off = h.comment_off;
     b->comment_len = h.comment_len;
-    if (h.has_err) {
+    if (h.form & FORM_ERR) {
         p = get(p, &b->err, offsetof(struct ncp_diag, msg));
         size_t n = strnlen((const char *)p, NCP_DIAG_MSG_MAX - 1);
         p = get(p, b->err.msg, n);

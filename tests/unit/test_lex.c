@@ -875,6 +875,10 @@ static void expect_fast_like_general(const char *line, size_t len, int *taken)
         fail_msg("fast path took '%.*s', the general reader says: %s", (int)len, line,
                  general.err.msg);
     assert_same_block(&general, &fast);
+    /* the reader's words-only hint says what the packer would find itself */
+    assert_int_equal(fast.words_only, 1);
+    assert_int_equal(general.words_only, 0);
+    assert_int_equal(ncp_block_packed_size(&fast), ncp_block_packed_size(&general));
 }
 
 static void test_fast_path_is_the_general_reader(void **state)
@@ -997,9 +1001,13 @@ static void test_pack_round_trip(void **state)
         "o100 endsub [#1 ** 2]", "G2 X1 Y1 I[#3/2] J0.5 ;rest of line", "G1 X1 X2",
         "G1 X[1 +", "(unclosed", "M3 S[1000 * #4] T[#5 MOD 3] (DEBUG, #1 and #<x>)",
         "o1 if [[#1 EQ 2] AND [#2 NE 3] OR [ATAN[1]/[2] GT 0]]", "%",
+        "/N10 G1 X1 Y2", "N20 G0 X-1e", "/", "G1 X[1]", "G1 X1 (c)", "N7",
     };
     for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++)
         round_trip(lines[i], strlen(lines[i]));
+    /* a CAM line travels in one cache line (the plain form) */
+    ncp_lex_block("G1 X12.253 Y-3.7 Z-0.540", 24, 1, 0, &blk);
+    assert_int_equal(ncp_block_packed_size(&blk), 64);
     /* the largest block: every word slot and a long comment */
     char big[256];
     size_t n = 0;
