@@ -39,8 +39,20 @@ static size_t bytes_of(const struct ncp_cmd *c, size_t msg)
     return (n + UNIT - 1) / UNIT * UNIT;
 }
 
+/* Most commands are calls only (a motion, a modal change): no error, no
+ * text, so no padding either (head and calls are whole units). */
+static int calls_only(const struct ncp_cmd *c)
+{
+    return !(c->flags & NCP_CMD_F_ERROR) && c->text_used == 0 && c->n_ops <= NCP_CMD_MAX_OPS;
+}
+
+_Static_assert(sizeof(struct packed_cmd_head) % UNIT == 0 && sizeof(struct ncp_canon) % UNIT == 0,
+               "a calls-only record needs no padding");
+
 size_t ncp_cmd_packed_size(const struct ncp_cmd *c)
 {
+    if (calls_only(c))
+        return sizeof(struct packed_cmd_head) + c->n_ops * sizeof c->ops[0];
     return bytes_of(c, msg_of(c));
 }
 
@@ -58,7 +70,11 @@ static void copy_ops(void *dst, const void *src, unsigned n)
 
 size_t ncp_cmd_pack(const struct ncp_cmd *c, void *dst)
 {
-    size_t msg = msg_of(c), total = bytes_of(c, msg);
+    size_t msg = 0, total;
+    if (calls_only(c))
+        total = sizeof(struct packed_cmd_head) + c->n_ops * sizeof c->ops[0];
+    else
+        total = bytes_of(c, msg = msg_of(c));
     /* The header goes field by field straight to its place: built on the
      * stack and copied whole, its mixed-width stores could not be forwarded
      * to the wide load that copies it, a stall on every command. */

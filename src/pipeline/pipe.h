@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include "ncpar/pipeline.h"
 #include "lex_ahead.h"
+#include "rec_stream.h"
 #include "ring.h"
 #include "text_feed.h"
 
@@ -81,6 +82,7 @@ struct ncp_pipe {
     int inline_stopped;          /* the inline output stopped */
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
     struct ncp_block an_block;   /* the block it holds, unpacked */
+    struct ncp_rec_writer cmd_out; /* packed output: its end of cmds[0] */
 
     /* output thread only (the analyzer's with inline output), read after join */
     alignas(64) struct ncp_diag err; /* first error slot, in program order */

@@ -13,7 +13,6 @@
 #include <string.h>
 #include <sys/mman.h>
 
-enum { NCP_RING_EOF = 1u, NCP_RING_ABORT = 2u };
 
 /* Short: the machine may have fewer cores than pipeline threads, and a spinning
  * thread then steals the CPU from the one it waits for. */
@@ -470,10 +469,10 @@ void ncp_ring_abort(struct ncp_ring *r)
     set_state(r, NCP_RING_ABORT);
 }
 
-int ncp_ring_aborted(const struct ncp_ring *r)
+uint32_t ncp_ring_stage_known(const struct ncp_ring *r, unsigned s)
 {
-    return (atomic_load_explicit(&((struct ncp_ring *)r)->state, memory_order_acquire) &
-            NCP_RING_ABORT) != 0;
+    const struct ncp_ring_stage *st = &r->stage[s];
+    return st->seen - st->next;
 }
 
 uint64_t ncp_ring_waits(const struct ncp_ring *r, unsigned s)

@@ -28,6 +28,8 @@
 #include <stdint.h>
 
 #define NCP_RING_MAX_STAGES 3
+
+enum { NCP_RING_EOF = 1u, NCP_RING_ABORT = 2u }; /* struct ncp_ring's state */
 #define NCP_RING_MAX_CAPACITY (1u << 24)
 
 /* Owned by one stage: its position and what it last saw of the stage it
@@ -101,6 +103,10 @@ int ncp_ring_stage_poll(struct ncp_ring *r, unsigned s, uint32_t k);
  * a full cache-to-cache transfer per block. */
 const void *ncp_ring_stage_ahead(const struct ncp_ring *r, unsigned s, uint32_t k);
 void *ncp_ring_reserve_ahead(const struct ncp_ring *r, uint32_t k);
+/* Stage s (>= 1): how many elements from its next one it already knows to be
+ * there (no waiting, no shared line touched); at least 1 right after a
+ * successful ncp_ring_stage_peek(r, s, 0). */
+uint32_t ncp_ring_stage_known(const struct ncp_ring *r, unsigned s);
 
 /* Runs of elements (records of several units, e.g. packed blocks): the
  * producer reserves k elements at once (waiting for room) and commits them
@@ -125,7 +131,11 @@ void ncp_ring_close(struct ncp_ring *r);
 /* Anyone: shut down now. Every waiting or later call returns NULL. The slots
  * stay allocated until ncp_ring_destroy, so a stage still writing one is safe. */
 void ncp_ring_abort(struct ncp_ring *r);
-int ncp_ring_aborted(const struct ncp_ring *r);
+static inline int ncp_ring_aborted(const struct ncp_ring *r)
+{
+    return (atomic_load_explicit(&((struct ncp_ring *)r)->state, memory_order_acquire) &
+            NCP_RING_ABORT) != 0;
+}
 
 /* Publish every position this thread holds back (its open batches) and wake
  * every sleeper it deferred. Ring calls that wait or end do it; a stage thread

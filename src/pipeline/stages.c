@@ -171,8 +171,8 @@ static size_t block_record_units(const void *src)
 static const struct record_kind block_records = {
     ncp_block_pack_pad, ncp_block_packed_is_pad, block_record_units, 2
 };
-static const struct record_kind cmd_records = {
-    ncp_cmd_pack_pad, ncp_cmd_packed_is_pad, ncp_cmd_packed_units, 3
+static const struct ncp_record_kind cmd_stream = {
+    ncp_cmd_pack_pad, ncp_cmd_packed_is_pad, ncp_cmd_packed_units
 };
 
 /* Room for a record of `units` (padding to the ring's end first if it would
@@ -379,15 +379,14 @@ static struct ncp_cmd *packed_acquire(void *ctx)
 static void packed_publish(void *ctx, struct ncp_cmd *c)
 {
     struct ncp_pipe *p = ctx;
-    struct ncp_ring *r = &p->cmds[0];
     p->next_id++;
     p->analyzer.items++;
     uint32_t units = (uint32_t)(ncp_cmd_packed_size(c) / NCP_PACK_UNIT);
-    void *dst = put_record(r, &cmd_records, units);
+    void *dst = ncp_rec_reserve(&p->cmd_out, units);
     if (!dst)
         return; /* aborted: the next acquire says so */
     ncp_cmd_pack(c, dst);
-    ncp_ring_commit_n(r, units);
+    ncp_rec_commit(&p->cmd_out, units);
 }
 
 void *ncp_pipe_analyzer(void *arg)
@@ -411,8 +410,10 @@ void *ncp_pipe_analyzer(void *arg)
         struct ncp_cmd_sink sink = { p, sink_acquire, sink_publish };
         if (p->inline_out)
             sink = (struct ncp_cmd_sink){ p, inline_acquire, inline_publish };
-        else if (p->packed_out)
+        else if (p->packed_out) {
+            ncp_rec_writer_start(&p->cmd_out, &p->cmds[0], &cmd_stream);
             sink = (struct ncp_cmd_sink){ p, packed_acquire, packed_publish };
+        }
         p->an_rc = ncp_analyzer_run(an, &feed, &sink);
         if (p->ahead) {
             ncp_lex_ahead_finish(p->ahead);
@@ -451,15 +452,14 @@ void *ncp_pipe_executor(void *arg)
 
 /* The next packed command, unpacked into the output thread's own slot; NULL
  * at the end of the data or on abort. */
-static struct ncp_cmd *take_packed(struct ncp_pipe *p)
+static struct ncp_cmd *take_packed(struct ncp_pipe *p, struct ncp_rec_reader *in)
 {
-    struct ncp_ring *r = &p->cmds[0];
     uint32_t units;
-    const void *rec = take_record(r, &cmd_records, &units);
+    const void *rec = ncp_rec_take(in, &units);
     if (!rec)
         return NULL;
     ncp_cmd_unpack(rec, p->out_cmd);
-    ncp_ring_stage_release_n(r, 1, units);
+    ncp_rec_release(in, units);
     return p->out_cmd;
 }
 
@@ -470,15 +470,16 @@ static struct ncp_cmd *take_packed(struct ncp_pipe *p)
 static void output_packed(struct ncp_pipe *p)
 {
     struct ncp_lex_ahead *ahead = p->ahead;
-    struct ncp_ring *r = &p->cmds[0];
+    struct ncp_rec_reader in;
+    ncp_rec_reader_start(&in, &p->cmds[0], &cmd_stream);
     struct ncp_cmd *c;
     for (;;) {
-        if (ahead && ncp_ring_stage_poll(r, 1, 0) == 0) {
+        if (ahead && ncp_rec_poll(&in) == 0) {
             ncp_ring_wake_owed();
             if (ncp_lex_ahead_help(ahead))
                 continue;
         }
-        if ((c = take_packed(p)) == NULL)
+        if ((c = take_packed(p, &in)) == NULL)
             break;
         p->output.items++;
         if (ncp_exec_emit_cmd(c, p->out, &p->err, &p->emit_failed))
