@@ -83,6 +83,7 @@ struct ncp_pipe {
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
     struct ncp_block an_block;   /* the block it holds, unpacked */
     struct ncp_rec_writer cmd_out; /* packed output: its end of cmds[0] */
+    struct ncp_rec_reader block_in[NCP_MAX_LEXERS]; /* its ends of parsed[] */
 
     /* output thread only (the analyzer's with inline output), read after join */
     alignas(64) struct ncp_diag err; /* first error slot, in program order */

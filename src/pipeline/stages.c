@@ -73,10 +73,6 @@ static void prefetch_slot(const struct ncp_cmd *cmd, enum slot_use use)
     }
 }
 
-/* How far ahead (8-byte units, a few kB) the writer of a ring of packed
- * records claims the lines of the records it is about to write. */
-#define PACK_PREFETCH_UNITS 256u
-
 void ncp_pipe_open_gate(struct ncp_pipe *p)
 {
     if (atomic_exchange(&p->gate, 1) == 0)
@@ -153,14 +149,8 @@ void *ncp_pipe_prefaulter(void *arg)
 
 /* Blocks (lexer -> analyzer) and, without executor threads, commands
  * (analyzer -> output) cross in rings of 8-byte units as records of their
- * own size that never wrap: the writer pads to the ring's end first. What
- * differs between the two is how a record marks a pad and tells its size. */
-struct record_kind {
-    void (*pad)(void *dst);
-    int (*is_pad)(const void *src);
-    size_t (*units)(const void *src);
-    unsigned prefetch_lines;     /* lines a record of this kind usually takes */
-};
+ * own size (rec_stream.h). What differs between the two is how a record
+ * marks a pad and tells its size. */
 
 /* A chunk's end mark is one unit, without a block header to read. */
 static size_t block_record_units(const void *src)
@@ -168,91 +158,40 @@ static size_t block_record_units(const void *src)
     return ncp_block_packed_is_end_mark(src) ? 1 : ncp_block_packed_units(src);
 }
 
-static const struct record_kind block_records = {
-    ncp_block_pack_pad, ncp_block_packed_is_pad, block_record_units, 2
+static const struct ncp_record_kind block_stream = {
+    ncp_block_pack_pad, ncp_block_packed_is_pad, block_record_units
 };
 static const struct ncp_record_kind cmd_stream = {
     ncp_cmd_pack_pad, ncp_cmd_packed_is_pad, ncp_cmd_packed_units
 };
 
-/* Room for a record of `units` (padding to the ring's end first if it would
- * wrap), the lines of the records to come claimed for writing; NULL once the
- * ring is closed or aborted. The caller writes it and commits `units`. */
-static void *put_record(struct ncp_ring *r, const struct record_kind *k, uint32_t units)
-{
-    uint32_t to_end = ncp_ring_to_end(r, 0);
-    if (units > to_end) {
-        void *pad = ncp_ring_reserve_n(r, to_end);
-        if (!pad)
-            return NULL;
-        k->pad(pad);
-        ncp_ring_commit_n(r, to_end);
-    }
-    void *dst = ncp_ring_reserve_n(r, units);
-    if (!dst)
-        return NULL;
-    const char *later = ncp_ring_reserve_ahead(r, units + PACK_PREFETCH_UNITS);
-    for (unsigned l = 0; later && l < k->prefetch_lines; l++)
-        ncp_prefetch_w(later + (size_t)64 * l);
-    return dst;
-}
-
-/* The next whole record for the ring's reader (stage 1), pads skipped, and
- * its size in units; NULL at the end of the data or on abort. The caller
- * releases `units` when done with it. */
-static const void *take_record(struct ncp_ring *r, const struct record_kind *k,
-                               uint32_t *units)
-{
-    for (;;) {
-        const void *rec = ncp_ring_stage_peek(r, 1, 0);
-        if (!rec)
-            return NULL;
-        if (k->is_pad(rec)) {
-            ncp_ring_stage_release_n(r, 1, ncp_ring_to_end(r, 1));
-            continue;
-        }
-        uint32_t n = (uint32_t)k->units(rec);
-        if (n > 1 && !ncp_ring_stage_peek(r, 1, n - 1))
-            return NULL;
-        /* the writer wrote the next records on its core: start their transfer */
-        const char *later = ncp_ring_stage_ahead(r, 1, n + 1024 / NCP_PACK_UNIT);
-        if (later) {
-            __builtin_prefetch(later, 0);
-            __builtin_prefetch(later + 64, 0);
-            __builtin_prefetch(later + 128, 0);
-        }
-        *units = n;
-        return rec;
-    }
-}
-
 /* LEX_i lexes into a block of its own (hot in its cache) and passes it on
  * packed: only the used parts cross to the analyzer's core. */
-static int put_packed(struct ncp_ring *out, const struct ncp_block *b)
+static int put_packed(struct ncp_rec_writer *out, const struct ncp_block *b)
 {
     uint32_t units = (uint32_t)(ncp_block_packed_size(b) / NCP_PACK_UNIT);
-    void *dst = put_record(out, &block_records, units);
+    void *dst = ncp_rec_reserve(out, units);
     if (!dst)
         return -1;
     ncp_block_pack(b, dst);
-    ncp_ring_commit_n(out, units);
+    ncp_rec_commit(out, units);
     return 0;
 }
 
 /* The analyzer moves on to the next column when it meets this. */
-static int put_end_mark(struct ncp_ring *out)
+static int put_end_mark(struct ncp_rec_writer *out)
 {
-    void *dst = put_record(out, &block_records, 1);
+    void *dst = ncp_rec_reserve(out, 1);
     if (!dst)
         return -1;
     ncp_block_pack_end_mark(dst);
-    ncp_ring_commit_n(out, 1);
+    ncp_rec_commit(out, 1);
     return 0;
 }
 
 /* Every block of the chunk, in order, then the chunk's end mark. */
 static int lex_chunk(struct ncp_pipe_worker *w, const struct ncp_chunk *c,
-                     struct ncp_ring *out, struct ncp_block *b)
+                     struct ncp_rec_writer *out, struct ncp_block *b)
 {
     const char *text = w->p->src->text;
     uint32_t line = c->line;
@@ -271,16 +210,18 @@ void *ncp_pipe_lexer(void *arg)
 {
     struct ncp_pipe_worker *w = arg;
     struct ncp_pipe *p = w->p;
-    struct ncp_ring *in = &p->strings[w->index], *out = &p->parsed[w->index];
+    struct ncp_ring *in = &p->strings[w->index];
+    struct ncp_rec_writer out;
+    ncp_rec_writer_start(&out, &p->parsed[w->index], &block_stream);
     struct ncp_block *b = &p->lex_block[w->index].b;
     const struct ncp_chunk *slot;
     while ((slot = ncp_ring_peek(in)) != NULL) {
         struct ncp_chunk c = *slot;
         ncp_ring_release(in);
-        if (lex_chunk(w, &c, out, b) != 0)
+        if (lex_chunk(w, &c, &out, b) != 0)
             break;
     }
-    ncp_ring_close(out);
+    ncp_ring_close(&p->parsed[w->index]);
     return stage_done(arg);
 }
 
@@ -292,20 +233,20 @@ void *ncp_pipe_lexer(void *arg)
 static const struct ncp_block *feed_next(void *ctx)
 {
     struct ncp_pipe *p = ctx;
-    struct ncp_ring *r = &p->parsed[p->chunk % (uint64_t)p->n];
+    struct ncp_rec_reader *in = &p->block_in[p->chunk % (uint64_t)p->n];
     for (;;) {
         uint32_t units;
-        const void *rec = take_record(r, &block_records, &units);
+        const void *rec = ncp_rec_take(in, &units);
         if (!rec)
             return NULL;
         if (ncp_block_packed_is_end_mark(rec)) {
-            ncp_ring_stage_release_n(r, 1, 1);
+            ncp_rec_release(in, 1);
             p->chunk++;
-            r = &p->parsed[p->chunk % (uint64_t)p->n];
+            in = &p->block_in[p->chunk % (uint64_t)p->n];
             continue;
         }
         ncp_block_unpack(rec, &p->an_block);
-        ncp_ring_stage_release_n(r, 1, units);
+        ncp_rec_release(in, units);
         break;
     }
     p->taken++;
@@ -399,6 +340,8 @@ void *ncp_pipe_analyzer(void *arg)
         p->an_rc = p->an_diag.code;
     } else {
         struct ncp_block_feed feed = { p, feed_next, feed_release, p->src };
+        for (int i = 0; i < p->n; i++)
+            ncp_rec_reader_start(&p->block_in[i], &p->parsed[i], &block_stream);
         if (p->ahead) { /* started with the run (ncp_pipe_set_run) */
             feed = (struct ncp_block_feed){ p->ahead, ncp_lex_ahead_next, ncp_text_feed_release,
                                             p->src };
