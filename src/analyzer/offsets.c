@@ -49,16 +49,13 @@ static double *ncp_par(struct ncp_analyzer *a, int index)
  * follows the spindle's tool table entry, see ncp_tools_sync_params). */
 void ncp_offsets_sync_params(struct ncp_analyzer *a)
 {
-    if (!a->par_pos[0]) {
-        for (int ax = 0; ax < NCP_NAX; ax++)
-            a->par_pos[ax] = ncp_par(a, 5420 + ax);
+    if (!a->par_pos) {
+        a->par_pos = ncp_par(a, 5420);
         a->par_origin = ncp_par(a, 5220);
-        if (!a->par_pos[0] || !a->par_origin)
-            return;
     }
-    for (int ax = 0; ax < NCP_NAX; ax++)
-        if (a->par_pos[ax])
-            *a->par_pos[ax] = a->st.pos[ax];
+    /* numbered parameters are one array: #5420..#5428 are one copy */
+    _Static_assert(5420 + NCP_NAX <= NCP_PARAMS_MAX, "#5420.. are numbered parameters");
+    memcpy(a->par_pos, a->st.pos, sizeof a->st.pos);
     *a->par_origin = a->st.m.origin;
 }
 

@@ -27,7 +27,8 @@ void ncp_params_set_predef(struct ncp_params *p, ncp_predef_fn fn, void *ctx);
 int ncp_params_get(const struct ncp_params *p, int index, double *out,
                    struct ncp_diag *d);
 int ncp_params_set(struct ncp_params *p, int index, double v, struct ncp_diag *d);
-/* Raw access for the core to keep #5420.. etc. current (no checks, no errors). */
+/* Raw access for the core to keep #5420.. etc. current (no checks, no errors).
+ * In-range indices are one array: index + 1's slot follows index's. */
 double *ncp_params_slot(struct ncp_params *p, int index);
 
 int ncp_params_get_named(const struct ncp_params *p, const char *name, size_t len,

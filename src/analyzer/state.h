@@ -121,7 +121,7 @@ struct ncp_analyzer {
     const struct ncp_block *blk;
     const struct ncp_source *src;
     struct ncp_param_ops pops;
-    double *par_pos[NCP_NAX], *par_origin; /* #5420.., #5220 */
+    double *par_pos, *par_origin; /* #5420..#5428 (adjacent slots), #5220 */
     /* tool table: entry[i] for pocket-ordered tools as rs274 loads them */
     int n_tools;
     int tool_no[NCP_MAX_TOOLS];

@@ -93,11 +93,16 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
 {
     struct ncp_words *w = &a->w;
     double t = v * 10.0;
-    int code = ncp_trunc_int(floor(t));
-    if (t - code > 0.999)
+    int code;
+    /* G1, G2, G17.1: whole tenths, where the rounding below changes nothing
+     * (floor and ceil are library calls on this target) */
+    if (t >= 0.0 && t < 1000.0 && (double)(code = (int)t) == t) {
+        /* exact */
+    } else if (code = ncp_trunc_int(floor(t)), t - code > 0.999) {
         code = ncp_trunc_int(ceil(t));
-    else if (t - code > 0.001)
+    } else if (t - code > 0.001) {
         return ncp_an_error(a, col, "G-code out of range");
+    }
     if (code > 999)
         return ncp_an_error(a, col, "G-code out of range");
     if (code < 0)
@@ -119,6 +124,10 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
  * makes them); anything further from an integer is an error. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out)
 {
+    if (v >= 0.0 && v < 2147483647.0 && (double)(int)v == v) {
+        *out = (int)v; /* a whole number: what the rounding below makes of it */
+        return NCP_OK;
+    }
     int i = ncp_trunc_int(floor(v));
     double d = v - i;
     if (d > 0.9999)
