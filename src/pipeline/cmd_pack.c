@@ -68,45 +68,50 @@ static void copy_ops(void *dst, const void *src, unsigned n)
         memcpy(d + (size_t)i * OP_BYTES, s + (size_t)i * OP_BYTES, OP_BYTES);
 }
 
-size_t ncp_cmd_pack(const struct ncp_cmd *c, void *dst)
+/* The command is written where its record goes: its head and calls already
+ * stand where the record wants them, and only the error and the text (rare)
+ * move down behind the calls. */
+_Static_assert(offsetof(struct ncp_cmd, cmd_id) == offsetof(struct packed_cmd_head, cmd_id) &&
+                   offsetof(struct ncp_cmd, line) == offsetof(struct packed_cmd_head, line) &&
+                   offsetof(struct ncp_cmd, n_ops) == offsetof(struct packed_cmd_head, n_ops) &&
+                   offsetof(struct ncp_cmd, flags) == offsetof(struct packed_cmd_head, flags) &&
+                   offsetof(struct ncp_cmd, text_used) ==
+                       offsetof(struct packed_cmd_head, text_used) &&
+                   offsetof(struct ncp_cmd, ops) == sizeof(struct packed_cmd_head),
+               "a command's head and calls are its record's");
+/* each part moves down, never onto a part still to move */
+_Static_assert(offsetof(struct ncp_cmd, text) >= offsetof(struct ncp_cmd, diag) + sizeof(struct ncp_diag),
+               "the text follows the error");
+
+size_t ncp_cmd_pack_in_place(struct ncp_cmd *c)
 {
     size_t msg = 0, total;
     if (calls_only(c))
         total = sizeof(struct packed_cmd_head) + c->n_ops * sizeof c->ops[0];
     else
         total = bytes_of(c, msg = msg_of(c));
-    /* The header goes field by field straight to its place: built on the
-     * stack and copied whole, its mixed-width stores could not be forwarded
-     * to the wide load that copies it, a stall on every command. */
-    struct packed_cmd_head h;
-    unsigned char *p = dst;
+    unsigned char *base = (unsigned char *)c;
     uint16_t n_ops = (uint16_t)ops_of(c), text_used = (uint16_t)text_of(c);
     uint16_t units = (uint16_t)(total / UNIT);
     uint32_t msg_len = (uint32_t)msg;
-    memcpy(p + offsetof(struct packed_cmd_head, cmd_id), &c->cmd_id, sizeof h.cmd_id);
-    memcpy(p + offsetof(struct packed_cmd_head, line), &c->line, sizeof h.line);
-    memcpy(p + offsetof(struct packed_cmd_head, n_ops), &n_ops, sizeof h.n_ops);
-    memcpy(p + offsetof(struct packed_cmd_head, flags), &c->flags, sizeof h.flags);
-    memcpy(p + offsetof(struct packed_cmd_head, text_used), &text_used, sizeof h.text_used);
-    memcpy(p + offsetof(struct packed_cmd_head, units), &units, sizeof h.units);
-    memcpy(p + offsetof(struct packed_cmd_head, msg_len), &msg_len, sizeof h.msg_len);
-    p += sizeof h;
-    copy_ops(p, c->ops, n_ops);
-    p += n_ops * sizeof c->ops[0];
+    unsigned char *p = base + sizeof(struct packed_cmd_head) + n_ops * sizeof c->ops[0];
     if (c->flags & NCP_CMD_F_ERROR) {
-        memcpy(p, &c->diag, offsetof(struct ncp_diag, msg));
+        memmove(p, &c->diag, offsetof(struct ncp_diag, msg));
         p += offsetof(struct ncp_diag, msg);
-        memcpy(p, c->diag.msg, msg);
+        memmove(p, c->diag.msg, msg);
         p += msg;
     }
-    /* a motion command has no text and needs no padding: no library call
-     * for copying or clearing nothing */
     if (text_used)
-        memcpy(p, c->text, text_used);
+        memmove(p, c->text, text_used);
     p += text_used;
-    size_t pad = total - (size_t)(p - (unsigned char *)dst);
+    size_t pad = total - (size_t)(p - base);
     if (pad)
         memset(p, 0, pad);
+    /* the head's own fields last: units and msg_len lie over out_len */
+    memcpy(base + offsetof(struct packed_cmd_head, n_ops), &n_ops, sizeof n_ops);
+    memcpy(base + offsetof(struct packed_cmd_head, text_used), &text_used, sizeof text_used);
+    memcpy(base + offsetof(struct packed_cmd_head, units), &units, sizeof units);
+    memcpy(base + offsetof(struct packed_cmd_head, msg_len), &msg_len, sizeof msg_len);
     return total;
 }
 

@@ -12,7 +12,12 @@
 /* Bytes ncp_cmd_pack writes for c (a multiple of 8, at most NCP_CMD_PACK_MAX). */
 size_t ncp_cmd_packed_size(const struct ncp_cmd *c);
 #define NCP_CMD_PACK_MAX (sizeof(struct ncp_cmd) + 64u)
-size_t ncp_cmd_pack(const struct ncp_cmd *c, void *dst);
+/* The analyzer writes each command straight into the ring, as a struct
+ * ncp_cmd of which this many bytes (all but the executor's output) have
+ * room; ncp_cmd_pack_in_place then makes the record of it where it stands
+ * (its first ncp_cmd_packed_size(c) bytes, returned). */
+#define NCP_CMD_IN_PLACE_BYTES offsetof(struct ncp_cmd, out)
+size_t ncp_cmd_pack_in_place(struct ncp_cmd *c);
 size_t ncp_cmd_packed_units(const void *src);
 /* Restores what formatting and emitting read: header, calls, text, error. */
 void ncp_cmd_unpack(const void *src, struct ncp_cmd *c);

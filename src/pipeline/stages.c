@@ -308,13 +308,21 @@ static void inline_publish(void *ctx, struct ncp_cmd *c)
  * output thread would. Executing is about a third of the analyzer's work on
  * CAM programs; on two cores it then runs on the other core, which has time
  * to spare. */
+/* The slot is room for a whole command in the ring itself: the analyzer
+ * writes it where its record goes, and publishing only makes it a record
+ * (cmd_pack.h). */
+#define CMD_IN_PLACE_UNITS ((uint32_t)((NCP_CMD_IN_PLACE_BYTES + NCP_PACK_UNIT - 1) / NCP_PACK_UNIT))
+
 static struct ncp_cmd *packed_acquire(void *ctx)
 {
     struct ncp_pipe *p = ctx;
     if (ncp_ring_aborted(&p->cmds[0]))
         return NULL;
-    ncp_cmd_reset_header(p->an_cmd, p->next_id);
-    return p->an_cmd;
+    struct ncp_cmd *c = ncp_rec_reserve(&p->cmd_out, CMD_IN_PLACE_UNITS);
+    if (!c)
+        return NULL;
+    ncp_cmd_reset_header(c, p->next_id);
+    return c;
 }
 
 static void packed_publish(void *ctx, struct ncp_cmd *c)
@@ -322,12 +330,7 @@ static void packed_publish(void *ctx, struct ncp_cmd *c)
     struct ncp_pipe *p = ctx;
     p->next_id++;
     p->analyzer.items++;
-    uint32_t units = (uint32_t)(ncp_cmd_packed_size(c) / NCP_PACK_UNIT);
-    void *dst = ncp_rec_reserve(&p->cmd_out, units);
-    if (!dst)
-        return; /* aborted: the next acquire says so */
-    ncp_cmd_pack(c, dst);
-    ncp_rec_commit(&p->cmd_out, units);
+    ncp_rec_commit(&p->cmd_out, (uint32_t)(ncp_cmd_pack_in_place(c) / NCP_PACK_UNIT));
 }
 
 void *ncp_pipe_analyzer(void *arg)
