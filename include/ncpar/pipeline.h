@@ -103,6 +103,8 @@ struct ncp_run_stats {
                                a pre-started pool */
     struct ncp_stage_stats feeder, analyzer, output;
     uint64_t lexed_ahead;   /* blocks the output thread lexed for the analyzer */
+    uint64_t ahead_waits, ahead_sleeps; /* the analyzer found a chunk the output
+                               thread was still lexing; of those, it slept */
     struct ncp_stage_stats lexer[NCP_MAX_LEXERS];
     struct ncp_stage_stats executor[NCP_MAX_EXECUTORS];
 };

@@ -62,8 +62,10 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
     else
         fprintf(stderr, "%s, output %.1f", map->n_executors ? "" : " none", st->output.cpu_ms);
     if (!inline_out && map->n_lexers == 0 && map->n_executors == 0)
-        fprintf(stderr, " (lexed %" PRIu64 " of the %" PRIu64 " blocks ahead)", st->lexed_ahead,
-                st->blocks);
+        fprintf(stderr,
+                " (lexed %" PRIu64 " of the %" PRIu64 " blocks ahead; the analyzer waited"
+                " for it %" PRIu64 " times, slept %" PRIu64 ")",
+                st->lexed_ahead, st->blocks, st->ahead_waits, st->ahead_sleeps);
     if (!inline_out)
         fputc('\n', stderr);
     /* who waited for whom: a stage that often finds its input empty is starved,

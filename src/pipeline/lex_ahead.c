@@ -93,6 +93,7 @@ void ncp_lex_ahead_start(struct ncp_lex_ahead *la, const struct ncp_source *src)
     atomic_store_explicit(&la->over, 0, memory_order_relaxed);
     la->h_next = 0;
     la->h_chunks = la->h_blocks = 0;
+    la->a_waits = la->a_slept = 0;
     ncp_text_feed_start(&la->feed, src);
     la->recs_left = 0;
     la->rec = NULL;
@@ -174,6 +175,7 @@ static void wait_ready(struct ncp_lex_ahead *la, struct ncp_ahead_slot *s, uint6
     uint64_t ready = TAG(k, AHEAD_READY);
     if (atomic_load_explicit(&s->tag, memory_order_acquire) == ready)
         return;
+    la->a_waits++;
     for (int i = 0; i < AHEAD_SPIN; i++) {
         ncp_cpu_relax();
         if (atomic_load_explicit(&s->tag, memory_order_acquire) == ready)
@@ -183,8 +185,10 @@ static void wait_ready(struct ncp_lex_ahead *la, struct ncp_ahead_slot *s, uint6
         /* the key before the flag, as in the rings */
         uint32_t key = atomic_load(&la->done);
         atomic_store(&la->a_sleeps, 1);
-        if (atomic_load(&s->tag) != ready)
+        if (atomic_load(&s->tag) != ready) {
+            la->a_slept++;
             ncp_futex_wait(&la->done, key, NULL);
+        }
         atomic_store_explicit(&la->a_sleeps, 0, memory_order_relaxed);
         if (atomic_load_explicit(&s->tag, memory_order_acquire) == ready)
             return;
