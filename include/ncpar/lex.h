@@ -154,6 +154,13 @@ size_t ncp_block_packed_size(const struct ncp_block *b);
 size_t ncp_block_pack(const struct ncp_block *b, void *dst);
 size_t ncp_block_packed_units(const void *src);
 void ncp_block_unpack(const void *src, struct ncp_block *b);
+/* ncp_lex_line (line number 0) and ncp_block_pack in one: the line at text
+ * lexed straight into a packed record at dst, which has room bytes (what
+ * follows the record there may be overwritten). The record's size, or 0 if
+ * it does not fit. scratch: where the general reader builds the block of a
+ * line the one-pass reader leaves to it. */
+size_t ncp_lex_line_packed(const char *text, size_t avail, uint64_t offset, void *dst,
+                           size_t room, struct ncp_block *scratch, size_t *next);
 /* A one-unit filler record meaning "nothing more up to the end of the buffer"
  * (a ring's wrap-around point), and its test. */
 void ncp_block_pack_pad(void *dst);

@@ -119,7 +119,7 @@ word_ends(const char *text, size_t len, size_t p, const int bounded)
  * where the next word starts, or 0 to give up ("N10.5", "N 10", a comment or
  * a digit after it). */
 static inline __attribute__((always_inline)) size_t
-line_number(const char *text, size_t len, size_t i, struct ncp_block *out, const int bounded)
+line_number(const char *text, size_t len, size_t i, double *out, const int bounded)
 {
     size_t p = i + 1;
     unsigned d;
@@ -131,34 +131,74 @@ line_number(const char *text, size_t len, size_t i, struct ncp_block *out, const
     size_t j = NCP_IN(p) && text[p] == '.' ? 0 : word_ends(text, len, p, bounded);
     if (j == 0)
         return 0;
-    out->has_n = 1;
-    out->n_number = v;
+    *out = v;
     return j;
 }
 
-/* The line in text[0..len) (len: its '\n' when unbounded, the reader's limit
- * or the text's end when bounded). */
-static inline __attribute__((always_inline)) int
-fast_line(const char *text, size_t avail, size_t len, uint32_t line, uint64_t offset,
-          struct ncp_block *out, size_t *next, const int bounded)
+/* The plain record's head, written last (lex_pack.c reads it back). */
+static void put_plain_head(unsigned char *pk, uint64_t offset, size_t units, size_t length,
+                           unsigned n_words, int has_n)
 {
-    ncp_lex_init_block(out, 0, line, offset);
+    uint32_t line = 0;
+    uint16_t u = (uint16_t)units, l = (uint16_t)length;
+    memcpy(pk + offsetof(struct packed_head, offset), &offset, sizeof offset);
+    memcpy(pk + offsetof(struct packed_head, line), &line, sizeof line);
+    memcpy(pk + offsetof(struct packed_head, units), &u, sizeof u);
+    memcpy(pk + offsetof(struct packed_head, length), &l, sizeof l);
+    pk[offsetof(struct packed_head, n_words)] = (unsigned char)n_words;
+    pk[offsetof(struct packed_head, form)] =
+        (unsigned char)(FORM_PLAIN | (has_n ? FORM_HAS_N : 0));
+}
+
+/* The line in text[0..len) (len: its '\n' when unbounded, the reader's limit
+ * or the text's end when bounded), into *out, or, with pk, straight into a
+ * plain packed record there (its size returned): the same words either way,
+ * the packed build a constant in each caller. */
+static inline __attribute__((always_inline)) size_t
+fast_line(const char *text, size_t avail, size_t len, uint32_t line, uint64_t offset,
+          struct ncp_block *out, size_t *next, const int bounded, unsigned char *pk)
+{
+    if (!pk)
+        ncp_lex_init_block(out, 0, line, offset);
     uint32_t seen = 0;
     size_t i = 0;
+    unsigned n_words = 0;
+    int has_n = 0;
+    unsigned char *wp = pk ? pk + PLAIN_HEAD : NULL; /* the packed build's next word */
     while (NCP_IN(i) && is_blank(text[i]))
         i++;
-    if (NCP_IN(i) && (text[i] == 'N' || text[i] == 'n') &&
-        (i = line_number(text, len, i, out, bounded)) == 0)
-        return 0;
+    if (NCP_IN(i) && (text[i] == 'N' || text[i] == 'n')) {
+        double nv;
+        if ((i = line_number(text, len, i, &nv, bounded)) == 0)
+            return 0;
+        has_n = 1;
+        if (pk) {
+            memcpy(wp, &nv, sizeof nv);
+            wp += sizeof nv;
+        } else {
+            out->has_n = 1;
+            out->n_number = nv;
+        }
+    }
     for (;;) {
         while (NCP_IN(i) && is_blank(text[i]))
             i++;
         size_t line_len = 0;
         int end = line_end(text, avail, len, i, &line_len, next, bounded);
         if (end != 0) {
-            out->length = (uint16_t)line_len;
-            out->words_only = 1;
-            return end > 0;
+            if (end < 0)
+                return 0;
+            if (!pk) {
+                out->n_words = (uint16_t)n_words;
+                out->length = (uint16_t)line_len;
+                out->words_only = 1;
+                return 1;
+            }
+            size_t used = (size_t)(wp - pk), total = (used + NCP_PACK_UNIT - 1) / NCP_PACK_UNIT;
+            uint64_t zero = 0; /* the padding (and up to 8 bytes past the record) */
+            memcpy(wp, &zero, sizeof zero);
+            put_plain_head(pk, offset, total, line_len, n_words, has_n);
+            return total * NCP_PACK_UNIT;
         }
         char c = (char)(text[i] | 32); /* letters to lower case; others fail below */
         /* n, o: N and O words; u, v, w: not axes here (rs274 -g rejects them) */
@@ -170,7 +210,7 @@ fast_line(const char *text, size_t avail, size_t len, uint32_t line, uint64_t of
                 return 0; /* "Multiple X words": the general reader's error */
             seen |= bit;
         }
-        if (out->n_words >= NCP_BLOCK_MAX_WORDS)
+        if (n_words >= NCP_BLOCK_MAX_WORDS)
             return 0;
         size_t letter = i++;
         double v;
@@ -179,12 +219,21 @@ fast_line(const char *text, size_t avail, size_t len, uint32_t line, uint64_t of
         size_t j = word_ends(text, len, i, bounded);
         if (j == 0)
             return 0;
-        struct ncp_word *w = &out->words[out->n_words++];
-        w->letter = (char)(c - 32);
-        w->col = (uint16_t)(letter + 1);
-        w->v.value = v;
-        w->v.start = w->v.len = 0;
-        w->v.is_const = 1;
+        uint16_t col = (uint16_t)(letter + 1);
+        if (pk) {
+            memcpy(wp, &v, sizeof v);
+            memcpy(wp + 8, &col, sizeof col);
+            wp[10] = (unsigned char)(c - 32);
+            wp += PLAIN_WORD;
+        } else {
+            struct ncp_word *w = &out->words[n_words];
+            w->letter = (char)(c - 32);
+            w->col = col;
+            w->v.value = v;
+            w->v.start = w->v.len = 0;
+            w->v.is_const = 1;
+        }
+        n_words++;
         i = j;
     }
 }
@@ -196,10 +245,22 @@ int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t of
     size_t lim = avail < NCP_LEX_TOO_LONG ? avail : NCP_LEX_TOO_LONG;
     const char *nl = memchr(text, '\n', lim);
     if (nl)
-        return fast_line(text, avail, (size_t)(nl - text), line, offset, out, next, 0);
+        return fast_line(text, avail, (size_t)(nl - text), line, offset, out, next, 0, NULL) != 0;
     if (avail > NCP_LEX_TOO_LONG)
         return 0; /* too long for this reader: the general one says so */
-    return fast_line(text, avail, avail, line, offset, out, next, 1);
+    return fast_line(text, avail, avail, line, offset, out, next, 1, NULL) != 0;
+}
+
+size_t ncp_lex_fast_line_packed(const char *text, size_t avail, uint64_t offset, void *dst,
+                                size_t *next)
+{
+    size_t lim = avail < NCP_LEX_TOO_LONG ? avail : NCP_LEX_TOO_LONG;
+    const char *nl = memchr(text, '\n', lim);
+    if (nl)
+        return fast_line(text, avail, (size_t)(nl - text), 0, offset, NULL, next, 0, dst);
+    if (avail > NCP_LEX_TOO_LONG)
+        return 0;
+    return fast_line(text, avail, avail, 0, offset, NULL, next, 1, dst);
 }
 
 int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,

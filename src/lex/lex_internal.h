@@ -50,6 +50,44 @@ int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,
 int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t offset,
                       struct ncp_block *out, size_t *next);
 
+/* The same again, the block written straight as a plain packed record to
+ * dst (room for NCP_LEX_PLAIN_MAX bytes; what follows the record there is
+ * overwritten) with line number 0: its size, or 0 for a line the one-pass
+ * reader leaves to the general one. */
+size_t ncp_lex_fast_line_packed(const char *text, size_t avail, uint64_t offset, void *dst,
+                                size_t *next);
+
+/* ---- packed records (lex_pack.c; lex_fast.c writes plain ones) ---------- */
+
+/* 32 bytes; the N number follows only when the block has one. The first 18
+ * bytes (offset .. form) are those of a plain record too (below). */
+struct packed_head {
+    uint64_t offset;
+    uint32_t line;
+    uint16_t units;           /* the record's size in NCP_PACK_UNIT bytes */
+    uint16_t length;
+    uint8_t n_words, form;    /* form: FORM_* bits */
+    uint8_t n_assign, block_delete, has_n, comment_kind, oword_kind, oword_nargs;
+    uint16_t n_code, pool_used, comment_off, comment_len;
+};
+
+/* A plain block (constant words only; no assignment, bytecode, pool text,
+ * comment, O-word or error: every CAM line) packs into the common 18 bytes,
+ * its N number and 11 bytes a word, and unpacks without looking at the parts
+ * it does not have: "G1 X Y Z" is 64 bytes, one cache line, where the general
+ * form takes 96, and both sides spend a fraction of the general form's
+ * instructions on it (most of the lexing-ahead hand-over on CAM text). */
+enum {
+    FORM_PLAIN = 1,           /* a plain record */
+    FORM_ERR = 2,             /* general: the block carries a syntax error */
+    FORM_BLOCK_DELETE = 4,    /* plain: leading '/' */
+    FORM_HAS_N = 8,           /* plain: the N number follows the head */
+};
+#define PLAIN_HEAD 18u
+#define PLAIN_WORD 11u        /* value, col, letter */
+/* room a plain record may take while it is written (8 past the last word) */
+#define NCP_LEX_PLAIN_MAX (PLAIN_HEAD + 8u + NCP_BLOCK_MAX_WORDS * PLAIN_WORD + 8u)
+
 /* Stores a syntax error at buf position pos; returns NCP_ERR_SYNTAX. */
 int ncp_lex_fail(struct ncp_lexer *lx, int pos, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));

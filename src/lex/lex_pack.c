@@ -6,36 +6,9 @@
  * or more, and the lines arrive in sequence for the hardware prefetcher. Unpacking restores every field the analyzer
  * may read (arrays up to their counts), so it sees the very block the lexer
  * produced. */
-#include "ncpar/lex.h"
+#include "lex_internal.h"
 
 #include <string.h>
-
-/* 32 bytes; the N number follows only when the block has one. The first 18
- * bytes (offset .. form) are those of a plain record too (below). */
-struct packed_head {
-    uint64_t offset;
-    uint32_t line;
-    uint16_t units;           /* the record's size in NCP_PACK_UNIT bytes */
-    uint16_t length;
-    uint8_t n_words, form;    /* form: FORM_* bits */
-    uint8_t n_assign, block_delete, has_n, comment_kind, oword_kind, oword_nargs;
-    uint16_t n_code, pool_used, comment_off, comment_len;
-};
-
-/* A plain block (constant words only; no assignment, bytecode, pool text,
- * comment, O-word or error: every CAM line) packs into the common 18 bytes,
- * its N number and 11 bytes a word, and unpacks without looking at the parts
- * it does not have: "G1 X Y Z" is 64 bytes, one cache line, where the general
- * form takes 96, and both sides spend a fraction of the general form's
- * instructions on it (most of the lexing-ahead hand-over on CAM text). */
-enum {
-    FORM_PLAIN = 1,           /* a plain record */
-    FORM_ERR = 2,             /* general: the block carries a syntax error */
-    FORM_BLOCK_DELETE = 4,    /* plain: leading '/' */
-    FORM_HAS_N = 8,           /* plain: the N number follows the head */
-};
-#define PLAIN_HEAD 18u
-#define PLAIN_WORD 11u        /* value, col, letter */
 
 /* A word in 16 bytes instead of struct ncp_word's 24 (its padding does not
  * travel): "G1 X Y Z" packs into 96 bytes, a cache line and a half. */
@@ -240,6 +213,19 @@ size_t ncp_block_pack(const struct ncp_block *b, void *dst)
     if (total > used)
         memset(p, 0, total - used);
     return total;
+}
+
+size_t ncp_lex_line_packed(const char *text, size_t avail, uint64_t offset, void *dst,
+                           size_t room, struct ncp_block *scratch, size_t *next)
+{
+    if (room >= NCP_LEX_PLAIN_MAX) {
+        size_t n = ncp_lex_fast_line_packed(text, avail, offset, dst, next);
+        if (n)
+            return n; /* no block built and then copied: most of CAM text */
+    }
+    ncp_lex_line(text, avail, 0, offset, scratch, next);
+    size_t size = ncp_block_packed_size(scratch);
+    return size <= room ? ncp_block_pack(scratch, dst) : 0;
 }
 
 size_t ncp_block_packed_units(const void *src)

@@ -113,15 +113,14 @@ static void lex_chunk(struct ncp_lex_ahead *la, uint64_t k, struct ncp_ahead_slo
     uint32_t n = 0;
     while (off < end) {
         size_t next;
-        ncp_lex_line(src->text + off, src->end - off, 0, off, &la->h_block, &next);
-        size_t size = ncp_block_packed_size(&la->h_block);
-        if (size > room)
-            break;
         if (room > AHEAD_PREFETCH + 128u) {
             ncp_prefetch_w(dst + AHEAD_PREFETCH);
             ncp_prefetch_w(dst + AHEAD_PREFETCH + 64);
         }
-        ncp_block_pack(&la->h_block, dst);
+        size_t size = ncp_lex_line_packed(src->text + off, src->end - off, off, dst, room,
+                                          &la->h_block, &next);
+        if (size == 0)
+            break;
         dst += size;
         room -= size;
         n++;

@@ -991,6 +991,55 @@ static void test_line_reader_splits_as_spans(void **state)
     }
 }
 
+/* Lexing straight into a packed record (the lexing-ahead helper's path) must
+ * give the record ncp_lex_line + ncp_block_pack give, for lines either reader
+ * takes, and say 0 when the record does not fit. */
+static void expect_packed_like_lexed(const char *text, size_t avail)
+{
+    static struct ncp_block lexed, back, scratch;
+    static unsigned char want[NCP_BLOCK_PACK_MAX + 64], got[NCP_BLOCK_PACK_MAX + 64];
+    size_t next_lexed = 0, next_packed = 0;
+    ncp_lex_line(text, avail, 0, 4321, &lexed, &next_lexed);
+    size_t size = ncp_block_pack(&lexed, want);
+    memset(got, 0xA5, sizeof got);
+    size_t n = ncp_lex_line_packed(text, avail, 4321, got, sizeof got, &scratch, &next_packed);
+    assert_int_equal(n, size);
+    assert_int_equal(next_packed, next_lexed);
+    assert_memory_equal(got, want, size);
+    memset(&back, 0x5A, sizeof back);
+    ncp_block_unpack(got, &back);
+    assert_same_block(&lexed, &back);
+    /* exactly the room it needs (the general reader then packs), and less */
+    assert_int_equal(ncp_lex_line_packed(text, avail, 4321, got, size, &scratch, &next_packed),
+                     size);
+    assert_memory_equal(got, want, size);
+    assert_int_equal(ncp_lex_line_packed(text, avail, 4321, got, size - 1, &scratch,
+                                         &next_packed), 0);
+}
+
+static void test_lex_line_packed(void **state)
+{
+    (void)state;
+    static const char *const texts[] = {
+        "G1 X12.253 Y-3.7 Z-0.540 F600\nG1 X1\n", "N10 G1 X1\n", "G1 X1", "G1 X1\r\n",
+        "G1 X1 (c)\n", "#1 = 2\n", "\n", "", "o100 sub\n", "N7\n", "G1 X1 X2\n", "/G1 X1\n",
+    };
+    for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++)
+        expect_packed_like_lexed(texts[i], strlen(texts[i]));
+    uint64_t seed = 17;
+    char text[300];
+    for (int iter = 0; iter < 50000; iter++) {
+        seed = seed * 6364136223846793005u + 1442695040888963407u;
+        size_t len = (size_t)(seed >> 33) % 60;
+        for (size_t i = 0; i < len; i++) {
+            seed = seed * 6364136223846793005u + 1442695040888963407u;
+            unsigned r = (unsigned)(seed >> 33);
+            text[i] = r % 5 ? "GXYZNM0123456789.- "[r / 5 % 19] : "\n\r(;#[/\tO"[r / 5 % 10];
+        }
+        expect_packed_like_lexed(text, len);
+    }
+}
+
 static void test_pack_round_trip(void **state)
 {
     (void)state;
@@ -1060,6 +1109,7 @@ int main(void)
         cmocka_unit_test(test_long_lines),
         cmocka_unit_test(test_nul_and_garbage),
         cmocka_unit_test(test_pack_round_trip),
+        cmocka_unit_test(test_lex_line_packed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
