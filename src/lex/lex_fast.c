@@ -155,11 +155,9 @@ static void put_plain_head(unsigned char *pk, uint64_t offset, size_t units, siz
  * plain packed record there (its size returned): the same words either way,
  * the packed build a constant in each caller. */
 static inline __attribute__((always_inline)) size_t
-fast_line(const char *text, size_t avail, size_t len, uint32_t line, uint64_t offset,
-          struct ncp_block *out, size_t *next, const int bounded, unsigned char *pk)
+fast_line(const char *text, size_t avail, size_t len, uint64_t offset, struct ncp_block *out,
+          size_t *next, const int bounded, unsigned char *pk)
 {
-    if (!pk)
-        ncp_lex_init_block(out, 0, line, offset);
     uint32_t seen = 0;
     size_t i = 0;
     unsigned n_words = 0;
@@ -244,11 +242,12 @@ int ncp_lex_fast_line(const char *text, size_t avail, uint32_t line, uint64_t of
     /* never further than the general reader's line limit */
     size_t lim = avail < NCP_LEX_TOO_LONG ? avail : NCP_LEX_TOO_LONG;
     const char *nl = memchr(text, '\n', lim);
+    ncp_lex_init_block(out, 0, line, offset);
     if (nl)
-        return fast_line(text, avail, (size_t)(nl - text), line, offset, out, next, 0, NULL) != 0;
+        return fast_line(text, avail, (size_t)(nl - text), offset, out, next, 0, NULL) != 0;
     if (avail > NCP_LEX_TOO_LONG)
         return 0; /* too long for this reader: the general one says so */
-    return fast_line(text, avail, avail, line, offset, out, next, 1, NULL) != 0;
+    return fast_line(text, avail, avail, offset, out, next, 1, NULL) != 0;
 }
 
 size_t ncp_lex_fast_line_packed(const char *text, size_t avail, uint64_t offset, void *dst,
@@ -257,10 +256,10 @@ size_t ncp_lex_fast_line_packed(const char *text, size_t avail, uint64_t offset,
     size_t lim = avail < NCP_LEX_TOO_LONG ? avail : NCP_LEX_TOO_LONG;
     const char *nl = memchr(text, '\n', lim);
     if (nl)
-        return fast_line(text, avail, (size_t)(nl - text), 0, offset, NULL, next, 0, dst);
+        return fast_line(text, avail, (size_t)(nl - text), offset, NULL, next, 0, dst);
     if (avail > NCP_LEX_TOO_LONG)
         return 0;
-    return fast_line(text, avail, avail, 0, offset, NULL, next, 1, dst);
+    return fast_line(text, avail, avail, offset, NULL, next, 1, dst);
 }
 
 int ncp_lex_fast(const char *text, size_t len, uint32_t line, uint64_t offset,

@@ -84,7 +84,7 @@ static int is_plain(const struct ncp_block *b)
 
 static size_t plain_bytes(const struct ncp_block *b)
 {
-    size_t n = PLAIN_HEAD + (b->has_n ? sizeof b->n_number : 0) + b->n_words * PLAIN_WORD;
+    size_t n = PLAIN_HEAD + (b->has_n ? sizeof b->n_number : 0) + (size_t)b->n_words * PLAIN_WORD;
     return round_unit(n);
 }
 
