@@ -36,6 +36,7 @@ struct flow_label {
     uint32_t line;
     uint64_t off;
     uint64_t iterations;              /* of the current run of the loop */
+    uint64_t idle_laps;               /* jumps back to it that ran no iteration */
 };
 
 struct flow_labels {
@@ -482,14 +483,36 @@ static void jump_to(struct ncp_flow *f, const struct flow_label *op)
 static void loop_entered(const struct ncp_flow *f, struct flow_label *op)
 {
     if (!f->by_jump)
-        op->iterations = 0;
+        op->iterations = op->idle_laps = 0;
 }
+
+static int runaway(const struct ncp_flow *f, const struct ncp_block *b,
+                   const struct flow_label *op, struct ncp_diag *d);
 
 static int count_iteration(struct ncp_flow *f, const struct ncp_block *b,
                            struct flow_label *op, struct ncp_diag *d)
 {
     if (++op->iterations <= f->max_loops)
         return NCP_OK;
+    return runaway(f, b, op, d);
+}
+
+/* A loop head reached by a jump back whose test ends the loop: once per run
+ * normally, but an end line of the same name further down (rs274 skips to
+ * the first) can send control back to it for ever, each lap running what
+ * lies between the two and no iteration. rs274 loops; we count those laps
+ * against the same limit. */
+static int count_idle_lap(struct ncp_flow *f, const struct ncp_block *b,
+                          struct flow_label *op, struct ncp_diag *d)
+{
+    if (!f->by_jump || ++op->idle_laps <= f->max_loops)
+        return NCP_OK;
+    return runaway(f, b, op, d);
+}
+
+static int runaway(const struct ncp_flow *f, const struct ncp_block *b,
+                   const struct flow_label *op, struct ncp_diag *d)
+{
     char name[80];
     display_name(b, name, sizeof name);
     return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
@@ -688,14 +711,14 @@ static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
         double r = floor(f->test_value + 0.5);
         op->repeat_count = r > INT32_MAX ? INT32_MAX : r < 0 ? 0 : (int32_t)r;
     }
+    loop_entered(f, op);
     if (op->repeat_count > 0) {
         op->repeat_count--;
-        loop_entered(f, op);
         return count_iteration(f, b, op, d);
     }
     skip_to_label(f, b);
     op->repeat_count = -1;
-    return NCP_OK;
+    return count_idle_lap(f, b, op, d);
 }
 
 static int do_while(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
@@ -710,7 +733,7 @@ static int do_while(struct ncp_flow *f, const struct ncp_block *b, struct ncp_di
         if (f->test_value != 0.0)
             return count_iteration(f, b, op, d);
         skip_to_label(f, b);
-        return NCP_OK;
+        return count_idle_lap(f, b, op, d);
     }
     /* the closing line of a do/while loop */
     if (f->test_value != 0.0 && !f->doing_break) {

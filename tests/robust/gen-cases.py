@@ -61,6 +61,13 @@ case("runaway_do", "G21\no1 do\n#1=1\no1 while [1]\nM2\n", 2, "line 2")
 case("runaway_repeat", "G21\no1 repeat [1000000000]\n#1=1\no1 endrepeat\nM2\n", 2, "line 2")
 case("runaway_in_sub", "G21\no100 sub\no101 while [1]\nG0 X1\no101 endwhile\n"
      "o100 endsub\no100 call\nM2\n", 2, "line 3")
+# A false test skips to the first end line of that name; a second one below
+# sends control back to the head for ever, running no iteration (found by the
+# fuzzer; rs274 loops too). Each such lap counts against the limit.
+case("runaway_while_second_end", "G21\no1 while [0]\no1 endwhile\nG0 X1\no1 endwhile\nM2\n",
+     2, "line 2")
+case("runaway_repeat_second_end", "G21\no1 repeat [0]\no1 endrepeat\nG0 X1\no1 endrepeat\nM2\n",
+     2, "line 2")
 # Runaway cycles: G76 cuts until its depth reaches K, which a large degression
 # R puts astronomically far away, and H adds spring passes without bound.
 case("runaway_g76_degression", "G18 G21 G90\nS600 M3\nG0 X20 Z3\n"
