@@ -107,6 +107,16 @@ static int ncp_check_other(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int mt = w->motion_to_be;
+#define BIT(c) (1u << NCP_LETTER(c))
+    /* every check below needs one of these words, G96 or G33/G33.1/G76: a
+     * plain move (X Y Z F) has none of them, one test instead of the list */
+    const uint32_t checked = BIT('A') | BIT('B') | BIT('C') | BIT('D') | BIT('E') | BIT('H') |
+                             BIT('I') | BIT('J') | BIT('K') | BIT('L') | BIT('P') | BIT('Q') |
+                             BIT('R');
+#undef BIT
+    if (!(w->has & checked) && w->g[NCP_GG_SPINDLE] != 960 && mt != 330 && mt != 331 &&
+        mt != 760)
+        return NCP_OK;
     int m0 = w->g[NCP_GG_NONMODAL];
     int comp = w->g[NCP_GG_COMP];
     int tlo = w->g[NCP_GG_TLO];
