@@ -135,21 +135,6 @@ line_number(const char *text, size_t len, size_t i, double *out, const int bound
     return j;
 }
 
-/* The plain record's head, written last (lex_pack.c reads it back). */
-static void put_plain_head(unsigned char *pk, uint64_t offset, size_t units, size_t length,
-                           unsigned n_words, int has_n)
-{
-    uint32_t line = 0;
-    uint16_t u = (uint16_t)units, l = (uint16_t)length;
-    memcpy(pk + offsetof(struct packed_head, offset), &offset, sizeof offset);
-    memcpy(pk + offsetof(struct packed_head, line), &line, sizeof line);
-    memcpy(pk + offsetof(struct packed_head, units), &u, sizeof u);
-    memcpy(pk + offsetof(struct packed_head, length), &l, sizeof l);
-    pk[offsetof(struct packed_head, n_words)] = (unsigned char)n_words;
-    pk[offsetof(struct packed_head, form)] =
-        (unsigned char)(FORM_PLAIN | (has_n ? FORM_HAS_N : 0));
-}
-
 /* The line in text[0..len) (len: its '\n' when unbounded, the reader's limit
  * or the text's end when bounded), into *out, or, with pk, straight into a
  * plain packed record there (its size returned): the same words either way,
@@ -195,7 +180,8 @@ fast_line(const char *text, size_t avail, size_t len, uint64_t offset, struct nc
             size_t used = (size_t)(wp - pk), total = (used + NCP_PACK_UNIT - 1) / NCP_PACK_UNIT;
             uint64_t zero = 0; /* the padding (and up to 8 bytes past the record) */
             memcpy(wp, &zero, sizeof zero);
-            put_plain_head(pk, offset, total, line_len, n_words, has_n);
+            ncp_plain_put_head(pk, offset, 0, total, line_len, n_words,
+                               FORM_PLAIN | (has_n ? FORM_HAS_N : 0));
             return total * NCP_PACK_UNIT;
         }
         char c = (char)(text[i] | 32); /* letters to lower case; others fail below */
@@ -219,9 +205,7 @@ fast_line(const char *text, size_t avail, size_t len, uint64_t offset, struct nc
             return 0;
         uint16_t col = (uint16_t)(letter + 1);
         if (pk) {
-            memcpy(wp, &v, sizeof v);
-            memcpy(wp + 8, &col, sizeof col);
-            wp[10] = (unsigned char)(c - 32);
+            ncp_plain_put_word(wp, v, col, (char)(c - 32));
             wp += PLAIN_WORD;
         } else {
             struct ncp_word *w = &out->words[n_words];

@@ -3,7 +3,9 @@
 #ifndef NCP_LEX_INTERNAL_H
 #define NCP_LEX_INTERNAL_H
 
+#include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 #include "ncpar/lex.h"
 
 /* rs274 reads lines with fgets(buf, 255): a line of 253 characters or more
@@ -87,6 +89,29 @@ enum {
 #define PLAIN_WORD 11u        /* value, col, letter */
 /* room a plain record may take while it is written (8 past the last word) */
 #define NCP_LEX_PLAIN_MAX (PLAIN_HEAD + 8u + NCP_BLOCK_MAX_WORDS * PLAIN_WORD + 8u)
+
+/* A plain record's head and words, as the packer and the one-pass reader's
+ * packed build both write them (unpack_plain reads them back). form: FORM_PLAIN
+ * and the plain bits. */
+static inline void ncp_plain_put_head(unsigned char *pk, uint64_t offset, uint32_t line,
+                                      size_t units, size_t length, unsigned n_words,
+                                      unsigned form)
+{
+    uint16_t u = (uint16_t)units, l = (uint16_t)length;
+    memcpy(pk + offsetof(struct packed_head, offset), &offset, sizeof offset);
+    memcpy(pk + offsetof(struct packed_head, line), &line, sizeof line);
+    memcpy(pk + offsetof(struct packed_head, units), &u, sizeof u);
+    memcpy(pk + offsetof(struct packed_head, length), &l, sizeof l);
+    pk[offsetof(struct packed_head, n_words)] = (unsigned char)n_words;
+    pk[offsetof(struct packed_head, form)] = (unsigned char)form;
+}
+
+static inline void ncp_plain_put_word(unsigned char *wp, double value, uint16_t col, char letter)
+{
+    memcpy(wp, &value, sizeof value);
+    memcpy(wp + 8, &col, sizeof col);
+    wp[10] = (unsigned char)letter;
+}
 
 /* Stores a syntax error at buf position pos; returns NCP_ERR_SYNTAX. */
 int ncp_lex_fail(struct ncp_lexer *lx, int pos, const char *fmt, ...)

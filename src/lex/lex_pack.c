@@ -139,25 +139,16 @@ static size_t pack_plain(const struct ncp_block *b, unsigned char *p)
     size_t total = plain_bytes(b);
     uint64_t zero = 0;
     memcpy(p + total - sizeof zero, &zero, sizeof zero); /* the padding, if any */
-    uint8_t form = (uint8_t)(FORM_PLAIN | (b->block_delete ? FORM_BLOCK_DELETE : 0) |
-                             (b->has_n ? FORM_HAS_N : 0));
-    HEAD(offset, uint64_t, b->offset);
-    HEAD(line, uint32_t, b->line);
-    HEAD(units, uint16_t, (uint16_t)(total / NCP_PACK_UNIT));
-    HEAD(length, uint16_t, b->length);
-    HEAD(n_words, uint8_t, (uint8_t)b->n_words);
-    HEAD(form, uint8_t, form);
+    ncp_plain_put_head(p, b->offset, b->line, total / NCP_PACK_UNIT, b->length, b->n_words,
+                       FORM_PLAIN | (b->block_delete ? FORM_BLOCK_DELETE : 0) |
+                           (b->has_n ? FORM_HAS_N : 0));
     p += PLAIN_HEAD;
     if (b->has_n) {
         memcpy(p, &b->n_number, sizeof b->n_number);
         p += sizeof b->n_number;
     }
-    for (unsigned k = 0; k < b->n_words; k++, p += PLAIN_WORD) {
-        const struct ncp_word *w = &b->words[k];
-        memcpy(p, &w->v.value, sizeof w->v.value);
-        memcpy(p + 8, &w->col, sizeof w->col);
-        p[10] = (unsigned char)w->letter;
-    }
+    for (unsigned k = 0; k < b->n_words; k++, p += PLAIN_WORD)
+        ncp_plain_put_word(p, b->words[k].v.value, b->words[k].col, b->words[k].letter);
     return total;
 }
 
