@@ -49,11 +49,20 @@ static int calls_only(const struct ncp_cmd *c)
 _Static_assert(sizeof(struct packed_cmd_head) % UNIT == 0 && sizeof(struct ncp_canon) % UNIT == 0,
                "a calls-only record needs no padding");
 
-size_t ncp_cmd_packed_size(const struct ncp_cmd *c)
+/* The record's size, and the length of its error text (0 without one). */
+static size_t record_bytes(const struct ncp_cmd *c, size_t *msg)
 {
+    *msg = 0;
     if (calls_only(c))
         return sizeof(struct packed_cmd_head) + c->n_ops * sizeof c->ops[0];
-    return bytes_of(c, msg_of(c));
+    *msg = msg_of(c);
+    return bytes_of(c, *msg);
+}
+
+size_t ncp_cmd_packed_size(const struct ncp_cmd *c)
+{
+    size_t msg;
+    return record_bytes(c, &msg);
 }
 
 /* One call at a time, each a copy of constant size: the compiler makes it a
@@ -85,11 +94,7 @@ _Static_assert(offsetof(struct ncp_cmd, text) >= offsetof(struct ncp_cmd, diag) 
 
 size_t ncp_cmd_pack_in_place(struct ncp_cmd *c)
 {
-    size_t msg = 0, total;
-    if (calls_only(c))
-        total = sizeof(struct packed_cmd_head) + c->n_ops * sizeof c->ops[0];
-    else
-        total = bytes_of(c, msg = msg_of(c));
+    size_t msg, total = record_bytes(c, &msg);
     unsigned char *base = (unsigned char *)c;
     uint16_t n_ops = (uint16_t)ops_of(c), text_used = (uint16_t)text_of(c);
     uint16_t units = (uint16_t)(total / UNIT);
