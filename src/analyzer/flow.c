@@ -487,7 +487,15 @@ static void loop_entered(const struct ncp_flow *f, struct flow_label *op)
 }
 
 static int runaway(const struct ncp_flow *f, const struct ncp_block *b,
-                   const struct flow_label *op, struct ncp_diag *d);
+                   const struct flow_label *op, struct ncp_diag *d)
+{
+    char name[80];
+    display_name(b, name, sizeof name);
+    return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
+                        "loop %s at line %u repeated more than %u times: runaway loop? "
+                        "(raise max_loop_iterations if intended)",
+                        name, op->line, f->max_loops);
+}
 
 static int count_iteration(struct ncp_flow *f, const struct ncp_block *b,
                            struct flow_label *op, struct ncp_diag *d)
@@ -508,17 +516,6 @@ static int count_idle_lap(struct ncp_flow *f, const struct ncp_block *b,
     if (!f->by_jump || ++op->idle_laps <= f->max_loops)
         return NCP_OK;
     return runaway(f, b, op, d);
-}
-
-static int runaway(const struct ncp_flow *f, const struct ncp_block *b,
-                   const struct flow_label *op, struct ncp_diag *d)
-{
-    char name[80];
-    display_name(b, name, sizeof name);
-    return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
-                        "loop %s at line %u repeated more than %u times: runaway loop? "
-                        "(raise max_loop_iterations if intended)",
-                        name, op->line, f->max_loops);
 }
 
 /* What rs274 does while reading an O-word line: evaluate its expressions unless

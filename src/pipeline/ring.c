@@ -13,7 +13,6 @@
 #include <string.h>
 #include <sys/mman.h>
 
-
 /* Short: the machine may have fewer cores than pipeline threads, and a spinning
  * thread then steals the CPU from the one it waits for. */
 #define NCP_RING_SPIN 128
