@@ -9,13 +9,15 @@
 #include "ncpar/diag.h"
 
 struct ncp_source {
-    const char *text;   /* whole program text (mmap'd file or heap copy of a pipe) */
+    const char *text;   /* whole program text (mapped file, or a copy: huge pages or heap) */
     size_t len;
     size_t begin, end;  /* program body: after a leading '%' line, before the closing '%' */
     uint32_t begin_line;/* line number of the first body byte */
     const char *name;   /* file name for diagnostics ("-" for stdin) */
-    int mapped;         /* 1 if mmap'd */
+    int mapped;         /* 1 if the file is mapped: each page faults on its first touch */
     int owned;          /* 1 if text is a heap copy freed by ncp_source_close */
+    void *copy;         /* the anonymous mapping holding a copy of the text, or NULL */
+    size_t copy_len;
     int has_percent;    /* program was delimited by '%' lines */
 };
 
@@ -28,7 +30,13 @@ struct ncp_span {
     uint64_t next;
 };
 
-/* Load a file (mmap) or "-" (stdin, read() into memory). Fills d on failure. */
+/* Above this a program is mapped, not copied: a copy is anonymous memory the
+ * kernel cannot drop and re-read as it can a mapped file's pages. */
+#define NCP_SOURCE_COPY_MAX ((size_t)256 << 20)
+
+/* Load a file or "-" (stdin). A regular file up to NCP_SOURCE_COPY_MAX bytes
+ * is read into memory on huge pages where the kernel offers them, a larger one
+ * is mapped; a pipe is read into memory. Fills d on failure. */
 int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d);
 /* Wrap an in-memory buffer (fuzzing, tests). The buffer must outlive src. */
 int ncp_source_from_memory(struct ncp_source *src, const char *text, size_t len,

@@ -1,6 +1,7 @@
 /* Program text loading and block splitting. The split is a pure function of the
  * text so the analyzer can re-read earlier blocks (loops, calls) without the file. */
 #include "ncpar/feeder.h"
+#include "text_mem.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -164,18 +165,42 @@ static int read_all(int fd, char **buf, size_t *len)
     return 0;
 }
 
+/* src takes over the copy in m. */
+static void adopt_copy(struct ncp_source *src, struct ncp_text_mem *m)
+{
+    ncp_source_from_memory(src, m->text, m->len, NULL, NULL);
+    src->copy = m->base;
+    src->copy_len = m->base_len;
+}
+
+/* A pipe's text: on huge pages where the kernel offers them, else on the heap. */
+static int read_stream(struct ncp_source *src, int fd)
+{
+    if (ncp_text_mem_usable()) {
+        struct ncp_text_mem m;
+        if (ncp_text_mem_read_stream(&m, fd) != 0)
+            return -1;
+        adopt_copy(src, &m);
+        return 0;
+    }
+    char *buf;
+    size_t n;
+    if (read_all(fd, &buf, &n) != 0)
+        return -1;
+    ncp_source_from_memory(src, buf, n, NULL, NULL);
+    src->owned = 1;
+    return 0;
+}
+
 int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d)
 {
     memset(src, 0, sizeof *src);
     src->name = path;
     if (strcmp(path, "-") == 0) {
-        char *buf;
-        size_t n;
-        if (read_all(0, &buf, &n) != 0)
+        if (read_stream(src, 0) != 0)
             return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read standard input: %s",
                                 strerror(errno));
-        ncp_source_from_memory(src, buf, n, path, d);
-        src->owned = 1;
+        src->name = path;
         return NCP_OK;
     }
     int fd = open(path, O_RDONLY | O_CLOEXEC);
@@ -185,18 +210,25 @@ int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d
     struct stat st;
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         /* not a regular file (a FIFO, a device): read it like a pipe */
-        char *buf;
-        size_t n;
-        int rc = read_all(fd, &buf, &n);
+        int rc = read_stream(src, fd);
         close(fd);
         if (rc != 0)
             return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read program: %s",
                                 strerror(errno));
-        ncp_source_from_memory(src, buf, n, path, d);
-        src->owned = 1;
+        src->name = path;
         return NCP_OK;
     }
     size_t size = (size_t)st.st_size;
+    if (size > 0 && size <= NCP_SOURCE_COPY_MAX && ncp_text_mem_usable()) {
+        struct ncp_text_mem m;
+        if (ncp_text_mem_read_file(&m, fd, size) == 0) {
+            close(fd);
+            adopt_copy(src, &m);
+            src->name = path;
+            return NCP_OK;
+        }
+        /* no room for a copy: map it instead */
+    }
     const char *text = "";
     if (size > 0) {
         void *m = mmap(NULL, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
@@ -221,6 +253,8 @@ void ncp_source_close(struct ncp_source *src)
 {
     if (src->mapped)
         munmap((void *)src->text, src->len);
+    else if (src->copy)
+        munmap(src->copy, src->copy_len);
     else if (src->owned)
         free((void *)src->text);
     memset(src, 0, sizeof *src);

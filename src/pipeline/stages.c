@@ -137,6 +137,8 @@ void *ncp_pipe_prefaulter(void *arg)
     const struct ncp_source *src = w->p->src;
     const volatile char *text = src->text; /* volatile: every read happens */
     uint64_t pages = 0;
+    if (!src->mapped) /* a copy in memory (text_mem.h): its pages are in */
+        return stage_done(arg);
     for (uint64_t off = src->begin; off < src->end; off += NCP_PAGE_BYTES, pages++)
         (void)text[off];
     if (src->end > src->begin)

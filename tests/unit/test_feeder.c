@@ -7,11 +7,16 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
+#include "../../src/feeder/text_mem.h"
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #define MAX_SPANS 4096
 
@@ -137,12 +142,137 @@ static void test_count_newlines(void **state)
         }
 }
 
+/* A text of `n` bytes of G-code-like lines, different from run to run of the
+ * generator's seed so a copy that drops or repeats a piece cannot match. */
+static char *some_text(size_t n, unsigned seed)
+{
+    char *t = malloc(n);
+    assert_non_null(t);
+    srand(seed);
+    for (size_t i = 0; i < n; i++)
+        t[i] = rand() % 23 == 0 ? '\n' : "G01XYZ.-23456789"[rand() % 16];
+    return t;
+}
+
+static void write_file(const char *path, const char *text, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(text, 1, n, f), n);
+    assert_int_equal(fclose(f), 0);
+}
+
+/* Sizes around the 2 MB page: one byte, just below, at and above a page, and
+ * several pages (the huge-page copy, or the mapping where THP is off). */
+static void test_open_regular_file(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ncp-feeder-XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    const size_t sizes[] = { 1, 4095, ((size_t)2 << 20) - 1, (size_t)2 << 20,
+                             ((size_t)2 << 20) + 1, ((size_t)5 << 20) + 777 };
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++) {
+        char *text = some_text(sizes[i], (unsigned)i + 1);
+        write_file(path, text, sizes[i]);
+        struct ncp_source src;
+        struct ncp_diag d;
+        assert_int_equal(ncp_source_open(&src, path, &d), NCP_OK);
+        assert_int_equal(src.len, sizes[i]);
+        assert_memory_equal(src.text, text, sizes[i]);
+        if (ncp_text_mem_usable()) {
+            assert_non_null(src.copy);
+            assert_int_equal(src.mapped, 0);
+            assert_int_equal((uintptr_t)src.text % ((uintptr_t)2 << 20), 0);
+        } else {
+            assert_null(src.copy);
+            assert_int_equal(src.mapped, 1);
+        }
+        ncp_source_close(&src);
+        assert_null(src.text);
+        free(text);
+    }
+    unlink(path);
+}
+
+/* A pipe: read to its end through every growth of the copy (2, 4, 8 MB). */
+static void test_read_stream_grows(void **state)
+{
+    (void)state;
+    const size_t n = ((size_t)7 << 20) + 12345;
+    char *text = some_text(n, 99);
+    char path[] = "/tmp/ncp-feeder-XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    write_file(path, text, n);
+    fd = open(path, O_RDONLY);
+    assert_true(fd >= 0);
+    struct ncp_text_mem m;
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    close(fd);
+    assert_int_equal(m.len, n);
+    assert_true(m.cap >= n && m.cap % ((size_t)2 << 20) == 0);
+    assert_memory_equal(m.text, text, n);
+    ncp_text_mem_free(&m);
+    assert_null(m.text);
+
+    /* exactly a whole region: the read that finds the end needs a bigger one */
+    const size_t whole = (size_t)2 << 20;
+    write_file(path, text, whole);
+    fd = open(path, O_RDONLY);
+    assert_true(fd >= 0);
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    close(fd);
+    assert_int_equal(m.len, whole);
+    assert_memory_equal(m.text, text, whole);
+    ncp_text_mem_free(&m);
+
+    /* an empty stream is an empty text, not an error */
+    write_file(path, text, 0);
+    fd = open(path, O_RDONLY);
+    assert_true(fd >= 0);
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    close(fd);
+    assert_int_equal(m.len, 0);
+    ncp_text_mem_free(&m);
+    unlink(path);
+    free(text);
+}
+
+/* A file that shrank between its size being taken and the read: the copy
+ * holds what there is, no stale or zero bytes counted as text. */
+static void test_read_file_shorter_than_said(void **state)
+{
+    (void)state;
+    char *text = some_text(1000, 7);
+    char path[] = "/tmp/ncp-feeder-XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    write_file(path, text, 1000);
+    fd = open(path, O_RDONLY);
+    assert_true(fd >= 0);
+    struct ncp_text_mem m;
+    assert_int_equal(ncp_text_mem_read_file(&m, fd, 5000), 0);
+    close(fd);
+    assert_int_equal(m.len, 1000);
+    assert_memory_equal(m.text, text, 1000);
+    ncp_text_mem_free(&m);
+    unlink(path);
+    free(text);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_chunks_split_like_the_whole),
         cmocka_unit_test(test_random_texts),
         cmocka_unit_test(test_count_newlines),
+        cmocka_unit_test(test_open_regular_file),
+        cmocka_unit_test(test_read_stream_grows),
+        cmocka_unit_test(test_read_file_shorter_than_said),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
