@@ -21,9 +21,14 @@
  * them keep the start-up of a short program to a few milliseconds. */
 #define DEFAULT_CMD_SLOTS 256
 #define DEFAULT_START_TIMEOUT_US 1000
-/* 8 KB of CAM text is ~280 blocks, ~20 us of lexing: fine enough to balance,
- * coarse enough that the hand-over costs nothing */
-#define DEFAULT_LEX_AHEAD_BYTES 8192
+/* 32 KB of CAM text is ~1100 blocks, ~80 us of lexing: fine enough to
+ * balance, and the helper may run up to 8 chunks (256 KB) ahead, which rides
+ * out the analyzer's and its own uneven spells. 8 KB chunks (64 KB ahead) left
+ * the analyzer lexing ~50% of the blocks itself and the two threads 20 ms of
+ * CPU apart; 32 KB: ~60-80%, within a few ms. Interleaved, 1M blocks, whole
+ * process, 12 rounds: medians 114.2 (8 KB), 108.4 (16), 108.2 (32), 106.2 ms
+ * (64) (bench/RESULTS.md). */
+#define DEFAULT_LEX_AHEAD_BYTES 32768
 #define MAX_LEX_AHEAD_BYTES (1 << 20)
 #define MAX_ROWS (1 << 20)
 #define MAX_START_TIMEOUT_US 10000000

@@ -207,7 +207,7 @@ static void test_no_lexer_threads(void **state)
         assert_int_not_equal(m.analyzer.cpu, m.output.cpu);
     expect_error("[pipeline]\nlexers = 0\n[lexer.0]\ncpu = 1\n", 3, "lexer.0");
     /* the output thread lexes ahead in 8 KB chunks unless told otherwise */
-    assert_int_equal(m.lex_ahead_bytes, 8192);
+    assert_int_equal(m.lex_ahead_bytes, 32768);
     assert_int_equal(load_text("[pipeline]\nlexers = 0\nexecutors = 0\nlex_ahead_bytes = 0\n",
                                &d, &m), NCP_OK);
     assert_int_equal(m.lex_ahead_bytes, 0);
