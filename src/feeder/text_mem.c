@@ -44,10 +44,10 @@ static int reserve(struct ncp_text_mem *m, size_t bytes)
                       MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
     if (base == MAP_FAILED)
         return -1;
-    uintptr_t at = ((uintptr_t)base + HUGE_BYTES - 1) & ~(uintptr_t)(HUGE_BYTES - 1);
+    size_t skip = (HUGE_BYTES - (uintptr_t)base % HUGE_BYTES) % HUGE_BYTES;
     m->base = base;
     m->base_len = len;
-    m->text = (char *)at;
+    m->text = (char *)base + skip;
     m->cap = want;
     (void)madvise(m->text, m->cap, MADV_HUGEPAGE);
     return 0;
