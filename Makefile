@@ -17,6 +17,12 @@ ALL_CFLAGS   = -std=c11 $(WARN) $(CFLAGS) -pthread
 ALL_CXXFLAGS = -std=c++17 $(WARN) $(CXXFLAGS) -pthread -fno-exceptions -fno-rtti \
                -I/usr/include/eigen3
 LDLIBS   += -lm -linih -pthread
+# cnc-run itself is linked statically: the dynamic loader's mapping and
+# relocating of libstdc++, libm and libc cost every start ~1.7 ms here (a
+# shadow-paging fault for each page it touches), 2-4 ms of a 1M-block run
+# (bench/RESULTS.md). Sanitizer builds cannot be static; `make CLI_LDFLAGS=`
+# links it dynamically.
+CLI_LDFLAGS ?= -static
 
 ifeq ($(V),1)
 Q =
@@ -44,7 +50,7 @@ $(LIB): $(LIB_OBJS)
 	$(Q)rm -f $@ && $(AR) rcs $@ $^
 
 $(BUILD)/cnc-run: $(CLI_OBJS) $(LIB)
-	$(Q)$(CXX) $(ALL_CXXFLAGS) -o $@ $(CLI_OBJS) $(LIB) $(LDLIBS)
+	$(Q)$(CXX) $(ALL_CXXFLAGS) $(CLI_LDFLAGS) -o $@ $(CLI_OBJS) $(LIB) $(LDLIBS)
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(@D)
@@ -92,11 +98,11 @@ include bench/bench.mk
 SAN_FLAGS = -O1 -g -fno-omit-frame-pointer
 # ASan+UBSan over the whole test suite; TSan over the parallel equivalence tests.
 sanitize:
-	$(MAKE) BUILD=build-asan CC=clang CXX=clang++ \
+	$(MAKE) BUILD=build-asan CC=clang CXX=clang++ CLI_LDFLAGS= \
 	    CFLAGS="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
 	    CXXFLAGS="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
 	    LDLIBS="-lm -linih -pthread -fsanitize=address,undefined" test
-	$(MAKE) BUILD=build-tsan CC=clang CXX=clang++ \
+	$(MAKE) BUILD=build-tsan CC=clang CXX=clang++ CLI_LDFLAGS= \
 	    CFLAGS="$(SAN_FLAGS) -fsanitize=thread" CXXFLAGS="$(SAN_FLAGS) -fsanitize=thread" \
 	    LDLIBS="-lm -linih -pthread -fsanitize=thread" all
 	TSAN_OPTIONS=halt_on_error=1 tests/tools/equivalence --bin build-tsan/cnc-run ncprograms/*.ngc
