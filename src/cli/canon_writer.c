@@ -8,38 +8,27 @@
  * program, det -j 0: 158 ms with the thread, 142 ms without. */
 #include "canon_writer.h"
 
+#include "ncpar/mem.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <sys/xattr.h>
 #include <unistd.h>
 
 #define WRITER_BUF (1u << 20)
 
-/* Prefaulted by the kernel in one go (MAP_POPULATE): touched page by page
- * instead, a buffer costs 256 page faults in the thread that emits, and in a
- * virtual machine a fault is microseconds (~7 ms per run here). */
-static char *buffer_new(void)
-{
-    void *m = mmap(NULL, WRITER_BUF, PROT_READ | PROT_WRITE,
-                   MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
-    return m == MAP_FAILED ? NULL : m;
-}
-
-static void buffer_free(char *b)
-{
-    if (b)
-        munmap(b, WRITER_BUF);
-}
-
+/* Prefaulted before the run (ncpar/mem.h): touched page by page instead, the
+ * buffer costs 256 page faults in the thread that emits, and in a virtual
+ * machine a fault is microseconds (~7 ms per run here). */
 struct canon_writer {
     int fd;
     char *buf;
+    struct ncp_mem mem;         /* where buf is */
     size_t used;
     int failed;                 /* errno of the first failed write */
 };
@@ -97,7 +86,7 @@ int canon_writer_commit(void *ctx, const struct ncp_cmd *cmd)
 
 static void writer_free(struct canon_writer *w)
 {
-    buffer_free(w->buf);
+    ncp_mem_unmap(&w->mem);
     free(w);
 }
 
@@ -179,7 +168,8 @@ struct canon_writer *canon_writer_open(const char *path)
         fprintf(stderr, "cnc-run: out of memory for the output buffers\n");
         return NULL;
     }
-    w->buf = buffer_new();
+    if (ncp_mem_map(&w->mem, WRITER_BUF) == 0)
+        w->buf = w->mem.p;
     if (!w->buf) {
         fprintf(stderr, "cnc-run: out of memory for the output buffers\n");
         writer_free(w);

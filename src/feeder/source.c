@@ -169,14 +169,14 @@ static int read_all(int fd, char **buf, size_t *len)
 static void adopt_copy(struct ncp_source *src, struct ncp_text_mem *m)
 {
     ncp_source_from_memory(src, m->text, m->len, NULL, NULL);
-    src->copy = m->base;
-    src->copy_len = m->base_len;
+    src->copy = m->mem.base;
+    src->copy_len = m->mem.base_len;
 }
 
 /* A pipe's text: on huge pages where the kernel offers them, else on the heap. */
 static int read_stream(struct ncp_source *src, int fd)
 {
-    if (ncp_text_mem_usable()) {
+    if (ncp_mem_huge_usable()) {
         struct ncp_text_mem m;
         if (ncp_text_mem_read_stream(&m, fd) != 0)
             return -1;
@@ -219,7 +219,7 @@ int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d
         return NCP_OK;
     }
     size_t size = (size_t)st.st_size;
-    if (size > 0 && size <= NCP_SOURCE_COPY_MAX && ncp_text_mem_usable()) {
+    if (size > 0 && size <= NCP_SOURCE_COPY_MAX && ncp_mem_huge_usable()) {
         struct ncp_text_mem m;
         if (ncp_text_mem_read_file(&m, fd, size) == 0) {
             close(fd);

@@ -5,7 +5,6 @@
 #include "ring.h"
 
 #include <string.h>
-#include <sys/mman.h>
 
 /* A slot's tag: the chunk it is for, and who has that chunk. */
 enum { AHEAD_OPEN = 0, AHEAD_HELPER = 1, AHEAD_READY = 2, AHEAD_ANALYZER = 3 };
@@ -39,26 +38,18 @@ int ncp_lex_ahead_init(struct ncp_lex_ahead *la, uint64_t chunk_bytes)
         return -1;
     la->chunk_bytes = chunk_bytes;
     la->buf_bytes = slot_bytes(chunk_bytes);
-    la->mem_bytes = la->buf_bytes * NCP_AHEAD_SLOTS;
     /* prefaulted: first-touch faults cost microseconds each in a VM */
-    void *m = mmap(NULL, la->mem_bytes, PROT_READ | PROT_WRITE,
-                   MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
-    if (m == MAP_FAILED) {
-        la->mem = NULL;
+    if (ncp_mem_map(&la->mem, la->buf_bytes * NCP_AHEAD_SLOTS) != 0)
         return -1;
-    }
-    la->mem = m;
     for (unsigned s = 0; s < NCP_AHEAD_SLOTS; s++)
-        la->slot[s].buf = la->mem + (size_t)s * la->buf_bytes;
+        la->slot[s].buf = (unsigned char *)la->mem.p + (size_t)s * la->buf_bytes;
     atomic_init(&la->done, 0);
     return 0;
 }
 
 void ncp_lex_ahead_destroy(struct ncp_lex_ahead *la)
 {
-    if (la->mem)
-        munmap(la->mem, la->mem_bytes);
-    la->mem = NULL;
+    ncp_mem_unmap(&la->mem);
 }
 
 /* Where chunk k begins: a line start, the same for both sides. */

@@ -30,6 +30,7 @@
 
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
+#include "ncpar/mem.h"
 #include "text_feed.h"
 
 #define NCP_AHEAD_SLOTS 8u
@@ -46,8 +47,7 @@ struct ncp_lex_ahead {
     uint64_t chunk_bytes;
     uint64_t n_chunks;
     size_t buf_bytes;                 /* per slot */
-    unsigned char *mem;               /* all slot buffers, prefaulted */
-    size_t mem_bytes;
+    struct ncp_mem mem;               /* all slot buffers, prefaulted */
     struct ncp_ahead_slot slot[NCP_AHEAD_SLOTS];
 
     /* shared */

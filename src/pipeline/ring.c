@@ -11,28 +11,15 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 
 /* Short: the machine may have fewer cores than pipeline threads, and a spinning
  * thread then steals the CPU from the one it waits for. */
 #define NCP_RING_SPIN 128
 #define NCP_RING_MAX_BATCH 32u
 
-/* Slots come straight from mmap, prefaulted by the kernel in one go
- * (MAP_POPULATE): the stage threads then never stop for a first-touch page
- * fault, which costs microseconds each in a virtual machine. No huge pages:
- * asking for them can stall the start for compaction, and a program of a
- * thousand blocks is done in a few milliseconds. */
-static unsigned char *slots_alloc(size_t want, size_t *bytes)
-{
-    void *m = mmap(NULL, want, PROT_READ | PROT_WRITE,
-                   MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
-    if (m == MAP_FAILED)
-        return NULL;
-    *bytes = want;
-    return m;
-}
-
+/* Slots are prefaulted before the start (ncpar/mem.h): the stage threads
+ * then never stop for a first-touch page fault, which costs microseconds
+ * each in a virtual machine; rings of 512 KB and more are on 2 MB pages. */
 uint32_t ncp_ring_capacity(uint32_t want)
 {
     uint32_t c = 1;
@@ -53,9 +40,9 @@ int ncp_ring_init_staged(struct ncp_ring *r, size_t elem_size, uint32_t capacity
     size_t align = elem_size >= 64 ? 64 : 8;
     size_t stride = (elem_size + align - 1) / align * align;
     size_t bytes = ((size_t)cap * stride + 63) / 64 * 64;
-    r->slots = slots_alloc(bytes, &r->bytes);
-    if (!r->slots)
+    if (ncp_mem_map(&r->mem, bytes) != 0)
         return -1;
+    r->slots = r->mem.p;
     r->n_stages = n_stages;
     r->mask = cap - 1;
     r->stride = stride;
@@ -99,8 +86,7 @@ static void forget(const struct ncp_ring *r);
 void ncp_ring_destroy(struct ncp_ring *r)
 {
     forget(r);
-    if (r->slots)
-        munmap(r->slots, r->bytes);
+    ncp_mem_unmap(&r->mem);
     r->slots = NULL;
 }
 

@@ -27,6 +27,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "ncpar/mem.h"
+
 #define NCP_RING_MAX_STAGES 3
 
 enum { NCP_RING_EOF = 1u, NCP_RING_ABORT = 2u }; /* struct ncp_ring's state */
@@ -55,8 +57,8 @@ struct ncp_ring {
     uint32_t spin;                       /* polls before a waiting stage sleeps */
     uint32_t mask;                       /* capacity - 1 */
     size_t stride;
-    size_t bytes;                        /* mapped for the slots */
     unsigned char *slots;
+    struct ncp_mem mem;                  /* where the slots are */
 };
 
 /* Round up to a power of two within [1, NCP_RING_MAX_CAPACITY]. */

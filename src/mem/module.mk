@@ -1,0 +1,2 @@
+# sources of src/mem, appended by the module
+LIB_SRCS += $(wildcard src/mem/*.c)
