@@ -11,7 +11,7 @@
 static int reserve(struct ncp_text_mem *m, size_t bytes)
 {
     memset(m, 0, sizeof *m);
-    if (ncp_mem_reserve(&m->mem, bytes) != 0)
+    if (ncp_mem_reserve_huge(&m->mem, bytes) != 0)
         return -1;
     m->text = m->mem.p;
     m->cap = m->mem.bytes;

@@ -6,7 +6,7 @@
  * for a 28 MB program, and 2 ms more to unmap it at exit. read() into a region
  * on 2 MB pages (ncpar/mem.h) costs 6 ms for the same file (the copy and 14
  * zeroed 2 MB pages), then nothing to touch (0.25 ms) or to unmap (0.3 ms)
- * (bench/RESULTS.md, "Program text and buffers on huge pages"). The same read
+ * (bench/RESULTS.md, "Program text on huge pages"). The same read
  * into small anonymous pages took 100 ms here: a copy is only made where the
  * kernel offers huge pages (ncp_mem_huge_usable). */
 #ifndef NCP_FEEDER_TEXT_MEM_H

@@ -1,4 +1,4 @@
-/* Prefaulted working memory, on huge pages where they are offered (mem.h). */
+/* Prefaulted working memory; the program text on huge pages (mem.h). */
 #include "ncpar/mem.h"
 
 #include <fcntl.h>
@@ -42,40 +42,14 @@ static size_t round_up(size_t n, size_t unit)
     return n > SIZE_MAX - unit ? 0 : (n + unit - 1) / unit * unit;
 }
 
-/* A mapping of at least `bytes`: on 2 MB pages (aligned start, whole pages)
- * when they are on offer and worth it, else 4 KB ones. */
-static int map_region(struct ncp_mem *m, size_t bytes, int populate)
+int ncp_mem_map(struct ncp_mem *m, size_t bytes)
 {
     memset(m, 0, sizeof *m);
-    if (bytes == 0)
-        return -1;
-    if (bytes >= HUGE_FROM && ncp_mem_huge_usable()) {
-        size_t want = round_up(bytes, HUGE_BYTES);
-        if (want == 0 || want > SIZE_MAX - HUGE_BYTES)
-            return -1;
-        size_t len = want + HUGE_BYTES; /* slack to align the start */
-        void *base = mmap(NULL, len, PROT_READ | PROT_WRITE,
-                          MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
-        if (base == MAP_FAILED)
-            return -1;
-        size_t skip = (HUGE_BYTES - (uintptr_t)base % HUGE_BYTES) % HUGE_BYTES;
-        m->base = base;
-        m->base_len = len;
-        m->p = (char *)base + skip;
-        m->bytes = want;
-        m->huge = 1;
-        (void)madvise(m->p, want, MADV_HUGEPAGE);
-        /* where MADV_POPULATE_WRITE is unknown (before Linux 5.14), by hand */
-        if (populate && madvise(m->p, want, MADV_POPULATE_WRITE) != 0)
-            for (size_t off = 0; off < want; off += PAGE_BYTES)
-                ((volatile char *)m->p)[off] = 0;
-        return 0;
-    }
     size_t want = round_up(bytes, PAGE_BYTES);
     if (want == 0)
         return -1;
     void *p = mmap(NULL, want, PROT_READ | PROT_WRITE,
-                   MAP_PRIVATE | MAP_ANONYMOUS | (populate ? MAP_POPULATE : MAP_NORESERVE), -1, 0);
+                   MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
     if (p == MAP_FAILED)
         return -1;
     m->base = m->p = p;
@@ -83,14 +57,37 @@ static int map_region(struct ncp_mem *m, size_t bytes, int populate)
     return 0;
 }
 
-int ncp_mem_map(struct ncp_mem *m, size_t bytes)
+int ncp_mem_reserve_huge(struct ncp_mem *m, size_t bytes)
 {
-    return map_region(m, bytes, 1);
-}
-
-int ncp_mem_reserve(struct ncp_mem *m, size_t bytes)
-{
-    return map_region(m, bytes, 0);
+    memset(m, 0, sizeof *m);
+    if (bytes < HUGE_FROM || !ncp_mem_huge_usable()) {
+        size_t want = round_up(bytes, PAGE_BYTES);
+        if (want == 0)
+            return -1;
+        void *p = mmap(NULL, want, PROT_READ | PROT_WRITE,
+                       MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+        if (p == MAP_FAILED)
+            return -1;
+        m->base = m->p = p;
+        m->base_len = m->bytes = want;
+        return 0;
+    }
+    size_t want = round_up(bytes, HUGE_BYTES);
+    if (want == 0 || want > SIZE_MAX - HUGE_BYTES)
+        return -1;
+    size_t len = want + HUGE_BYTES; /* slack to align the start */
+    void *base = mmap(NULL, len, PROT_READ | PROT_WRITE,
+                      MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+    if (base == MAP_FAILED)
+        return -1;
+    size_t skip = (HUGE_BYTES - (uintptr_t)base % HUGE_BYTES) % HUGE_BYTES;
+    m->base = base;
+    m->base_len = len;
+    m->p = (char *)base + skip;
+    m->bytes = want;
+    m->huge = 1;
+    (void)madvise(m->p, want, MADV_HUGEPAGE);
+    return 0;
 }
 
 void ncp_mem_unmap(struct ncp_mem *m)
