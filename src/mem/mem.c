@@ -42,14 +42,14 @@ static size_t round_up(size_t n, size_t unit)
     return n > SIZE_MAX - unit ? 0 : (n + unit - 1) / unit * unit;
 }
 
-int ncp_mem_map(struct ncp_mem *m, size_t bytes)
+/* Whole 4 KB pages, each faulted in now (MAP_POPULATE) or at first touch. */
+static int map_small(struct ncp_mem *m, size_t bytes, int flags)
 {
     memset(m, 0, sizeof *m);
     size_t want = round_up(bytes, PAGE_BYTES);
     if (want == 0)
         return -1;
-    void *p = mmap(NULL, want, PROT_READ | PROT_WRITE,
-                   MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+    void *p = mmap(NULL, want, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | flags, -1, 0);
     if (p == MAP_FAILED)
         return -1;
     m->base = m->p = p;
@@ -57,21 +57,16 @@ int ncp_mem_map(struct ncp_mem *m, size_t bytes)
     return 0;
 }
 
+int ncp_mem_map(struct ncp_mem *m, size_t bytes)
+{
+    return map_small(m, bytes, MAP_POPULATE);
+}
+
 int ncp_mem_reserve_huge(struct ncp_mem *m, size_t bytes)
 {
+    if (bytes < HUGE_FROM || !ncp_mem_huge_usable())
+        return map_small(m, bytes, MAP_NORESERVE);
     memset(m, 0, sizeof *m);
-    if (bytes < HUGE_FROM || !ncp_mem_huge_usable()) {
-        size_t want = round_up(bytes, PAGE_BYTES);
-        if (want == 0)
-            return -1;
-        void *p = mmap(NULL, want, PROT_READ | PROT_WRITE,
-                       MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
-        if (p == MAP_FAILED)
-            return -1;
-        m->base = m->p = p;
-        m->base_len = m->bytes = want;
-        return 0;
-    }
     size_t want = round_up(bytes, HUGE_BYTES);
     if (want == 0 || want > SIZE_MAX - HUGE_BYTES)
         return -1;
