@@ -86,8 +86,12 @@ int main(int argc, char **argv)
         return 2;
     }
     double *a = calloc((size_t)n, sizeof *a), *b = calloc((size_t)n, sizeof *b);
-    if (!a || !b)
+    if (!a || !b) {
+        free(a);
+        free(b);
+        close(fd);
         return 2;
+    }
     for (int i = 0; i < n; i++) {
         a[i] = mapped(fd, (size_t)st.st_size);
         b[i] = copied(fd, (size_t)st.st_size);
