@@ -106,21 +106,28 @@ static void ncp_cyc_body(struct ncp_cyc *c, int motion, double x, double y, doub
         ncp_cyc_spindle_on(c);
         break;
     case 840:
-        /* rigid-ish tapping: overrides off, reverse out, restore */
+    case 740: {
+        /* tapping, right hand (G84) or left hand (G74): overrides off, the
+         * spindle reversed to come out, then turned back and restored */
+        enum ncp_canon_kind in = motion == 840 ? NCP_C_START_SPINDLE_CLOCKWISE
+                                               : NCP_C_START_SPINDLE_COUNTERCLOCKWISE;
+        enum ncp_canon_kind out = motion == 840 ? NCP_C_START_SPINDLE_COUNTERCLOCKWISE
+                                                : NCP_C_START_SPINDLE_CLOCKWISE;
         ncp_an_emit(c->a, NCP_C_DISABLE_FEED_OVERRIDE);
         ncp_an_emit(c->a, NCP_C_DISABLE_SPEED_OVERRIDE);
         FEED(c, x, y, bottom);
         ncp_an_emit(c->a, NCP_C_STOP_SPINDLE_TURNING);
-        ncp_an_emit(c->a, NCP_C_START_SPINDLE_COUNTERCLOCKWISE);
+        ncp_an_emit(c->a, out);
         ncp_cyc_dwell(c, p);
         FEED(c, x, y, clear);
         ncp_an_emit(c->a, NCP_C_STOP_SPINDLE_TURNING);
-        ncp_an_emit(c->a, NCP_C_START_SPINDLE_CLOCKWISE);
+        ncp_an_emit(c->a, in);
         if (c->a->st.m.feed_override)
             ncp_an_emit(c->a, NCP_C_ENABLE_FEED_OVERRIDE);
         if (c->a->st.m.speed_override)
             ncp_an_emit(c->a, NCP_C_ENABLE_SPEED_OVERRIDE);
         break;
+    }
     case 880:
         FEED(c, x, y, bottom);
         ncp_cyc_dwell(c, p);
@@ -178,8 +185,20 @@ static int ncp_cyc_spindle_check(struct ncp_analyzer *a, int motion)
     uint16_t col = NCP_MOTION_COL(w);
     if ((motion == 860 || motion == 870 || motion == 880) && a->st.m.spindle_dir == 0)
         return ncp_an_error(a, col, "Spindle not turning in g%d", motion / 10);
-    if (motion == 840 && a->st.m.spindle_dir != 1)
-        return ncp_an_error(a, col, "Spindle not turning clockwise in g84");
+    return NCP_OK;
+}
+
+/* The tapping cycles want the spindle turning their way; rs274 looks at the
+ * hole, after the moves that bring the tap over it. */
+static int ncp_cyc_tap_check(struct ncp_analyzer *a, int motion)
+{
+    uint16_t col = NCP_MOTION_COL(&a->w);
+    int dir = a->st.m.spindle_dir, want = motion == 840 ? 1 : -1;
+    if (dir == 0)
+        return ncp_an_error(a, col, "Spindle not turning in G%d", motion / 10);
+    if (dir != want)
+        return ncp_an_error(a, col, "Spindle turning %s in G%d",
+                            motion == 840 ? "counterclockwise" : "clockwise", motion / 10);
     return NCP_OK;
 }
 
@@ -349,6 +368,8 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
         if ((motion == 830 || motion == 730) && q <= 0.0)
             return ncp_an_error(a, NCP_MOTION_COL(w),
                                 "Negative or zero q value used");
+        if ((motion == 840 || motion == 740) && (rc = ncp_cyc_tap_check(a, motion)) != NCP_OK)
+            return rc;
         if (motion == 870) {
             double off[3] = {aa + ijk[0], bb + ijk[1], ijk[2]};
             ncp_cyc_g87(&c, aa, bb, off, rr, clear, cc);
@@ -364,7 +385,8 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
     s->cycle_cc = depth;
     s->cycle_r = r;
     s->cycle_l = l;
-    if (motion == 820 || motion == 840 || motion == 860 || motion == 880 || motion == 890)
+    if (motion == 820 || motion == 840 || motion == 740 || motion == 860 || motion == 880 ||
+        motion == 890)
         s->cycle_p = p;
     if (motion == 830 || motion == 730)
         s->cycle_q = q;

@@ -99,7 +99,7 @@ static int ncp_check_g(struct ncp_analyzer *a)
 
 static int ncp_is_cycle(int m)
 {
-    return m == 730 || (m >= 810 && m <= 890);
+    return m == 730 || m == 740 || (m >= 810 && m <= 890);
 }
 
 /* Words that need a code to use them. */
@@ -154,7 +154,7 @@ static int ncp_check_other(struct ncp_analyzer *a)
         int mo = w->m[NCP_MG_OVERRIDE], mi = w->m[NCP_MG_IO];
         if (!g10 && m0 != 40 && ctl != 640 && mt != 760 && mt != 820 && mt != 860 &&
             mt != 880 && mt != 890 && mt != 50 && mt != 52 && mt != 20 && mt != 30 &&
-            mt != 840 && !g70 && (mo < 50 || mo > 53) && (mi < 62 || mi > 66) &&
+            mt != 840 && mt != 740 && !g70 && (mo < 50 || mo > 53) && (mi < 62 || mi > 66) &&
             w->m[NCP_MG_SPINDLE] != 19)
             return ncp_an_error(a, COL('P'), "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 M63 M64 M65 M66 M98 or user M code to use it");
         double p = w->v[NCP_LETTER('P')];
@@ -172,7 +172,7 @@ static int ncp_check_other(struct ncp_analyzer *a)
         w->m[NCP_MG_TOOL] != 61 && ctl != 640 && w->m[NCP_MG_SPINDLE] != 19)
         return ncp_an_error(a, COL('Q'), "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it");
     if (NCP_HAS(w, 'R') && mt != 20 && mt != 30 && mt != 760 && (mt < 810 || mt > 890) && !rough &&
-        mt != 730 && comp != 411 && comp != 421 && !g10 && w->m[NCP_MG_SPINDLE] != 19)
+        mt != 730 && mt != 740 && comp != 411 && comp != 421 && !g10 && w->m[NCP_MG_SPINDLE] != 19)
         return ncp_an_error(a, COL('R'), "R word with no g code that uses it");
     if (!NCP_HAS(w, 'S') && w->g[NCP_GG_SPINDLE] == 960)
         return ncp_an_error(a, w->gcol[NCP_GG_SPINDLE], "S word missing with g96");

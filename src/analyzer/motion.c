@@ -404,7 +404,7 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
 
 int ncp_motion_run(struct ncp_analyzer *a, int motion)
 {
-    if (motion != 730 && (motion < 810 || motion > 890))
+    if (motion != 730 && motion != 740 && (motion < 810 || motion > 890))
         a->st.cycle_il_flag = 0;
     switch (motion) {
     case 0: case 10:
@@ -424,7 +424,7 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         return ncp_probe(a, motion);
     case 700: case 710: case 711: case 712: case 720: case 721: case 722:
         return ncp_g7x_run(a, motion);
-    case 730: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
+    case 730: case 740: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
     case 890:
         return ncp_canned_run(a, motion);
     default: {

@@ -358,11 +358,13 @@ class Gen:
         if self.plane != 17 or self.feed_mode != 94 or self.depth > 0 and r.random() < 0.5:
             return self.st_straight()
         s = self.s()
-        g = r.choice(["G81", "G82", "G83", "G73", "G84", "G85", "G86", "G87", "G88",
-                      "G89"])
-        if g in ("G84", "G86", "G87", "G88") and self.spindle != 3:
-            self.emit("M3 S%d" % r.choice([500, 900]))
-            self.spindle = 3
+        g = r.choice(["G81", "G82", "G83", "G73", "G74", "G84", "G85", "G86", "G87",
+                      "G88", "G89"])
+        # G74 taps left-handed: the spindle must turn counterclockwise
+        want = 4 if g == "G74" else 3
+        if g in ("G74", "G84", "G86", "G87", "G88") and self.spindle != want:
+            self.emit("M%d S%d" % (want, r.choice([500, 900])))
+            self.spindle = want
         self.emit(r.choice(["G98", "G99"]))
         words = [g]
         if self.dist == 90:
@@ -378,7 +380,8 @@ class Gen:
             for a in "XY":
                 words.append(a + self.n(r.uniform(-10, 10) * s))
                 self.pos[a] = None
-            if r.random() < 0.5:
+            # rs274 takes no L (repeats) with G74
+            if g != "G74" and r.random() < 0.5:
                 words.append("L%d" % r.randint(2, 4))
         words += ["Z" + self.n(z), "R" + self.n(rr)]
         if g in ("G83", "G73"):
