@@ -49,6 +49,10 @@ struct ncp_analyzer_cfg {
     uint32_t max_loop_iterations;/* runaway guard for while/do/repeat loops and the passes
                                     of one G76 cycle, 0 = NCP_DEFAULT_MAX_LOOPS */
     uint32_t max_call_depth;     /* O-word call nesting, 0 = default (rs274: 10) */
+    /* Where `o<name> call` looks for name.ngc when no sub of that name was
+     * defined yet: the current folder, then these (colon-separated), as
+     * rs274 with [RS274NGC]SUBROUTINE_PATH. NULL: the current folder only. */
+    const char *subroutine_path;
 };
 
 struct ncp_analyzer;

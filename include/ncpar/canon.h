@@ -132,6 +132,12 @@ enum ncp_cmd_flags {
     NCP_CMD_F_ERROR = 1u << 1,  /* diag holds the error; ops before it are valid */
     NCP_CMD_F_CONT = 1u << 2    /* continues the previous slot's block */
 };
+/* The bits above the flags: the block's subroutine file, as a tag of
+ * ncp_diag_file_tag (0: the program itself), for errors found after the
+ * analyzer (arc geometry, output) to name the file their line is in. */
+#define NCP_CMD_FILE_SHIFT 3u
+#define NCP_CMD_FILE(c) ((unsigned)(c)->flags >> NCP_CMD_FILE_SHIFT)
+_Static_assert(NCP_DIAG_FILE_TAGS < (1u << (16 - NCP_CMD_FILE_SHIFT)), "a tag fits the flags");
 
 /* Slots cross cores in the pipeline's rings: what every slot writes (the
  * header and its first op) is contiguous from the start; the error, which

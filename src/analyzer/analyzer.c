@@ -74,14 +74,14 @@ static struct ncp_cmd *ncp_an_slot(struct ncp_analyzer *a, size_t text_need)
     }
     c->cmd_id = a->next_id++;
     c->line = a->line;
-    c->flags = cont;
+    c->flags = (uint16_t)(cont | a->file_tag << NCP_CMD_FILE_SHIFT);
     a->cmd = c;
     return c;
 }
 
 void ncp_an_reline(struct ncp_analyzer *a)
 {
-    if (a->cmd && a->cmd->line != a->line)
+    if (a->cmd && (a->cmd->line != a->line || NCP_CMD_FILE(a->cmd) != a->file_tag))
         ncp_an_publish(a);
 }
 
@@ -305,6 +305,7 @@ static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
 {
     a->blk = b;
     a->line = b->line;
+    a->file_tag = ncp_flow_file_tag(a->flow);
     if (b->err.code != NCP_OK) {
         a->err = b->err;
         return b->err.code;
@@ -330,6 +331,7 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
     a->next_id = 0;
     a->stopped = 0;
     a->line = 0;
+    a->file_tag = 0;
     memset(&a->err, 0, sizeof a->err);
     if (a->flow)
         ncp_flow_free(a->flow);
@@ -355,6 +357,7 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
         d.code = NCP_OK;
         d.line = 0;
         d.col = 0;
+        d.file = NULL;
         d.msg[0] = '\0';
         rc = ncp_flow_next(a->flow, &b, &d);
         if (rc == NCP_END) {
@@ -381,6 +384,8 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
     if (a->err.code == NCP_OK)
         ncp_diag_set(&a->err, rc ? (enum ncp_status)rc : NCP_ERR_SEMANTIC, a->line, 0,
                      "internal error");
+    /* the error is in the block last served, whichever file that came from */
+    a->err.file = ncp_flow_file(a->flow);
     ncp_flow_reset(a->flow);
     ncp_an_finish(a, NCP_CMD_F_ERROR);
     return a->err.code;

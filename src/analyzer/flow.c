@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* rs274 -g runs with the block delete switch off: '/' blocks are executed. */
 #define FLOW_BLOCK_DELETE 0
@@ -22,10 +23,14 @@
 #define FLOW_CACHE_SLOTS (1u << FLOW_CACHE_BITS) /* re-read blocks kept lexed (~2 MB) */
 #define FLOW_NAME_MAX NCP_BLOCK_POOL
 #define FLOW_LABEL_MAX (2 * FLOW_NAME_MAX + 2)
+#define FLOW_MAX_FILES 64             /* the program and the subroutine files it calls */
 
+/* file 0 is the program; others are subroutine files (o<name> call finds
+ * name.ngc when no sub of that name was defined yet, as rs274 does) */
 struct flow_pos {
     uint64_t off;
     uint32_t line;
+    uint32_t file;
 };
 
 /* One entry of the label table: where a sub, loop or if was first seen. */
@@ -33,7 +38,7 @@ struct flow_label {
     uint32_t hash, key_off, key_len;  /* key_len 0: empty slot */
     uint8_t type;                     /* enum ncp_oword_kind that defined it */
     int32_t repeat_count;             /* -1: not counting */
-    uint32_t line;
+    uint32_t line, file;
     uint64_t off;
     uint64_t iterations;              /* of the current run of the loop */
     uint64_t idle_laps;               /* jumps back to it that ran no iteration */
@@ -55,7 +60,15 @@ struct flow_frame {
 struct flow_cached {
     struct ncp_block blk;
     uint64_t next;
+    uint32_t file;
     int valid;
+};
+
+/* A subroutine file, read whole when first called. */
+struct flow_file {
+    struct ncp_source src;
+    const char *name;                 /* ncp_diag_file_name's copy */
+    unsigned tag;                     /* its ncp_diag_file_tag */
 };
 
 /* Text-valued state ("skip to label", "seeking sub", "defining sub"). */
@@ -67,7 +80,11 @@ struct flow_name {
 
 struct ncp_flow {
     struct ncp_block_feed feed;
-    const struct ncp_source *src;
+    const struct ncp_source *src;     /* the file the current block is in */
+    const struct ncp_source *prog;    /* the program's own (file 0) */
+    struct flow_file *files;          /* [1 .. n_files] */
+    uint32_t n_files;
+    const char *sub_path;             /* colon-separated folders, after the current one */
     struct ncp_params *params;
     struct ncp_param_ops pops;
     struct ncp_flow_frames hooks;
@@ -114,6 +131,24 @@ static void name_set(struct flow_name *n, const char *s, size_t len)
 static int name_eq(const struct flow_name *n, const char *s, size_t len)
 {
     return n->on && n->len == len && memcmp(n->s, s, len) == 0;
+}
+
+static const struct ncp_source *file_src(const struct ncp_flow *f, uint32_t file)
+{
+    return file == 0 ? f->prog : &f->files[file - 1].src;
+}
+
+static const char *file_name(const struct ncp_flow *f, uint32_t file)
+{
+    const char *n = file == 0 ? f->prog->name : f->files[file - 1].name;
+    return n ? n : "";
+}
+
+/* Every move of the position goes through here: it may change file. */
+static void go_to(struct ncp_flow *f, struct flow_pos p)
+{
+    f->cur = p;
+    f->src = file_src(f, p.file);
 }
 
 /* ======================================================================
@@ -252,9 +287,10 @@ static int from_text(struct ncp_flow *f, int skipping, const struct ncp_block **
         if (!f->cache)
             return ncp_diag_set(d, NCP_ERR_IO, f->cur.line, 0, "out of memory");
     }
+    uint64_t key = f->cur.off ^ (uint64_t)f->cur.file << 40;
     struct flow_cached *c =
-        &f->cache[(f->cur.off * 0x9E3779B97F4A7C15ull) >> (64 - FLOW_CACHE_BITS)];
-    if (c->valid && c->blk.offset == f->cur.off) {
+        &f->cache[(key * 0x9E3779B97F4A7C15ull) >> (64 - FLOW_CACHE_BITS)];
+    if (c->valid && c->blk.offset == f->cur.off && c->file == f->cur.file) {
         f->cur.off = c->next;
         f->cur.line = c->blk.line + 1;
         *out = &c->blk;
@@ -272,6 +308,7 @@ static int from_text(struct ncp_flow *f, int skipping, const struct ncp_block **
     }
     ncp_lex_block(text, sp.len, sp.line, sp.off, &c->blk);
     c->next = sp.next;
+    c->file = f->cur.file;
     c->valid = 1;
     *out = &c->blk;
     return NCP_OK;
@@ -281,7 +318,7 @@ static int fetch(struct ncp_flow *f, int skipping, const struct ncp_block **out,
                  struct ncp_diag *d)
 {
     release_feed(f);
-    if (f->cur.off >= f->feed_pos.off)
+    if (f->cur.file == 0 && f->cur.off >= f->feed_pos.off)
         return from_feed(f, out);
     return from_text(f, skipping, out, d);
 }
@@ -449,20 +486,21 @@ static int save_label(struct ncp_flow *f, const struct ncp_block *b,
 {
     const struct flow_label *old = find_label(f);
     if (old) {
-        const char *file = f->src->name ? f->src->name : "";
-        if (old->line == b->line)
+        const char *file = file_name(f, f->cur.file);
+        if (old->line == b->line && old->file == f->cur.file)
             return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                                 "File:%s line:%u sub: o|%s| found in illegal location",
                                 file, b->line, f->label);
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                             "File:%s line:%u redefining sub: o|%s| already defined in "
-                            "file:%s", file, b->line, f->label, file);
+                            "file:%s", file, b->line, f->label, file_name(f, old->file));
     }
     struct flow_label *e = labels_add(&f->labels, f->label, f->label_len);
     if (!e)
         return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
     e->type = b->oword.kind;
     e->line = b->line;
+    e->file = f->cur.file;
     e->off = b->offset;
     if (out)
         *out = e;
@@ -471,8 +509,7 @@ static int save_label(struct ncp_flow *f, const struct ncp_block *b,
 
 static void jump_to(struct ncp_flow *f, const struct flow_label *op)
 {
-    f->cur.off = op->off;
-    f->cur.line = op->line;
+    go_to(f, (struct flow_pos){ op->off, op->line, op->file });
     f->jump_target = op->off;
 }
 
@@ -619,7 +656,7 @@ static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
         f->skip.on = 0;
     if (f->level > 0) {
         ncp_params_pop_call(f->params);
-        f->cur = f->frames[f->level].ret;
+        go_to(f, f->frames[f->level].ret);
         f->level--;
         if (f->level == 0)
             f->in_sub_context = 1;
@@ -648,6 +685,62 @@ static int grow_frames(struct ncp_flow *f)
     return 0;
 }
 
+/* A regular file that can be read: a folder of the name or no file at all
+ * is not one (rs274 opens with fopen, which a folder does not pass for reading). */
+static int is_readable_file(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* folder/name.ngc for the called name, searched in the current folder, then
+ * in each folder of the subroutine path; *file = 0 when there is none. A
+ * file found is read whole, once: a second call of a sub it defines finds
+ * the label. */
+static int open_sub_file(struct ncp_flow *f, const struct ncp_block *b, uint32_t *file,
+                         struct ncp_diag *d)
+{
+    char path[4096];
+    const char *dirs = f->sub_path ? f->sub_path : "";
+    const char *dir = "";
+    size_t dir_len = 0;
+    *file = 0;
+    for (;;) {
+        int n = dir_len ? snprintf(path, sizeof path, "%.*s/%.*s.ngc", (int)dir_len, dir,
+                                   (int)f->label_len, f->label)
+                        : snprintf(path, sizeof path, "%.*s.ngc", (int)f->label_len, f->label);
+        if (n > 0 && (size_t)n < sizeof path && is_readable_file(path))
+            break;
+        if (*dirs == '\0')
+            return NCP_OK;
+        dir = dirs;
+        const char *colon = strchr(dirs, ':');
+        dir_len = colon ? (size_t)(colon - dirs) : strlen(dirs);
+        dirs = colon ? colon + 1 : dirs + dir_len;
+    }
+    for (uint32_t k = 1; k <= f->n_files; k++)
+        if (strcmp(f->files[k - 1].name, path) == 0) {
+            *file = k;
+            return NCP_OK;
+        }
+    if (f->n_files >= FLOW_MAX_FILES)
+        return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, b->oword.col,
+                            "more than %d subroutine files called", FLOW_MAX_FILES);
+    if (!f->files && !(f->files = calloc(FLOW_MAX_FILES, sizeof *f->files)))
+        return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
+    struct flow_file *nf = &f->files[f->n_files];
+    nf->tag = ncp_diag_file_tag(path);
+    nf->name = ncp_diag_file_of_tag(nf->tag);
+    if (!nf->name)
+        return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
+    struct ncp_diag od;
+    if (ncp_source_open(&nf->src, nf->name, &od) != NCP_OK)
+        return ncp_diag_set(d, NCP_ERR_IO, b->line, b->oword.col, "Unable to open file <%s>: %s",
+                            nf->name, od.msg);
+    *file = ++f->n_files;
+    return NCP_OK;
+}
+
 static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     if ((uint32_t)f->level + 1 >= f->max_depth)
@@ -671,9 +764,19 @@ static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_dia
         jump_to(f, op);
         return NCP_OK;
     }
-    /* not seen yet: read on until its definition, as rs274 does */
+    /* not seen yet: rs274 looks for a file of its name first, and reads that
+     * from its start for the definition; without one it reads on here */
+    uint32_t file = 0;
+    rc = open_sub_file(f, b, &file, d);
+    if (rc != NCP_OK)
+        return rc;
     skip_to_label(f, b);
     name_set(&f->seek_sub, f->label, f->label_len);
+    if (file) {
+        const struct ncp_source *s = file_src(f, file);
+        go_to(f, (struct flow_pos){ s->begin, s->begin_line, file });
+        f->skip_start = 0; /* rs274 counts lines afresh in the new file */
+    }
     return NCP_OK;
 }
 
@@ -906,7 +1009,12 @@ static int at_end(struct ncp_flow *f, struct ncp_diag *d)
     if (f->seek_sub.on)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->skip_start, 0,
                             "EOF in file:%s seeking o-word: o<%s> from line: %u",
-                            f->src->name ? f->src->name : "", f->seek_sub.s, f->skip_start);
+                            file_name(f, f->cur.file), f->seek_sub.s, f->skip_start);
+    /* a subroutine file read to its end without endsub or return: the
+     * program has no end either */
+    if (f->cur.file != 0)
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->cur.line > 1 ? f->cur.line - 1 : 1, 0,
+                            "File ended with no percent sign or program end");
     return NCP_END;
 }
 
@@ -985,7 +1093,8 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
     if (!f)
         return NULL;
     f->feed = *feed;
-    f->src = feed->src;
+    f->src = f->prog = feed->src;
+    f->sub_path = cfg ? cfg->subroutine_path : NULL;
     f->params = params;
     f->pops = ncp_params_ops(params);
     f->max_loops = cfg && cfg->max_loop_iterations ? cfg->max_loop_iterations
@@ -1014,11 +1123,29 @@ void ncp_flow_free(struct ncp_flow *f)
     if (!f)
         return;
     release_feed(f);
+    for (uint32_t k = 0; k < f->n_files; k++)
+        ncp_source_close(&f->files[k].src);
+    free(f->files);
     free(f->cache);
     free(f->labels.slots);
     free(f->labels.arena);
     free(f->frames);
     free(f);
+}
+
+const struct ncp_source *ncp_flow_source(const struct ncp_flow *f)
+{
+    return f->src;
+}
+
+const char *ncp_flow_file(const struct ncp_flow *f)
+{
+    return f->cur.file == 0 ? NULL : f->files[f->cur.file - 1].name;
+}
+
+unsigned ncp_flow_file_tag(const struct ncp_flow *f)
+{
+    return f->cur.file == 0 ? 0 : f->files[f->cur.file - 1].tag;
 }
 
 int ncp_flow_call_depth(const struct ncp_flow *f)

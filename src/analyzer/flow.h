@@ -51,6 +51,12 @@ int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out,
 int ncp_flow_call_inline(struct ncp_flow *f, const struct ncp_block *call,
                          struct ncp_diag *d);
 
+/* The text the last block served came from (the program, or a subroutine
+ * file), and that file's name for diagnostics: NULL for the program's own. */
+const struct ncp_source *ncp_flow_source(const struct ncp_flow *f);
+const char *ncp_flow_file(const struct ncp_flow *f);
+unsigned ncp_flow_file_tag(const struct ncp_flow *f); /* its ncp_diag_file_tag, 0 */
+
 /* Current subroutine call depth (0 = main program). */
 int ncp_flow_call_depth(const struct ncp_flow *f);
 

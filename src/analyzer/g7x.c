@@ -235,16 +235,18 @@ static int g7x_record(struct ncp_analyzer *a, struct g7x_rec *r, struct ncp_g7x_
             a->err = d;
             return rc;
         }
+        const struct ncp_source *src = ncp_flow_source(a->flow);
         if (b->err.code != NCP_OK && relex && b->length < 0xffff &&
-            b->offset + b->length <= a->src->len) {
+            b->offset + b->length <= src->len) {
             /* it may be a U or W word, which rs274 takes here */
-            ncp_lex_block_profile(a->src->text + b->offset, b->length, b->line, b->offset,
+            ncp_lex_block_profile(src->text + b->offset, b->length, b->line, b->offset,
                                   relex);
             if (relex->err.code != NCP_OK || relex->oword.kind == NCP_O_NONE)
                 b = relex;
         }
         a->blk = b;
         a->line = b->line;
+        a->file_tag = ncp_flow_file_tag(a->flow);
         if (b->err.code != NCP_OK) {
             a->err = b->err;
             return b->err.code;
@@ -334,6 +336,7 @@ int ncp_g7x_run(struct ncp_analyzer *a, int motion)
     struct ncp_g7x_path path;
     ncp_g7x_path_init(&path);
     uint32_t ret_line = a->line;
+    unsigned ret_file = a->file_tag; /* the G7x block's, back after the profile */
     uint16_t ret_col = 1;
     if (rc == NCP_OK)
         rc = g7x_call(a, &blk);
@@ -344,6 +347,7 @@ int ncp_g7x_run(struct ncp_analyzer *a, int motion)
     a->blk = NULL; /* the G7x block may be gone: the subroutine's were read over it */
     if (rc == NCP_OK) {
         a->line = ret_line;
+        a->file_tag = ret_file;
         ncp_an_reline(a);
         g7x_blank_words(&a->w, ret_col);
         if (path.n > 1)

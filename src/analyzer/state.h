@@ -132,6 +132,7 @@ struct ncp_analyzer {
     struct ncp_cmd *cmd;
     uint64_t next_id;
     uint32_t line;
+    unsigned file_tag;           /* the block's subroutine file (NCP_CMD_FILE), 0 */
     int stopped;
     struct ncp_diag err;
     /* M70-M73 (m7x.c) */

@@ -20,10 +20,10 @@ enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_PROGRAM = 2, EXIT_RUNTIME = 3 };
 static void print_diag(const char *prog, const struct ncp_diag *d)
 {
     if (d->line)
-        fprintf(stderr, "%s:%u:%u: error: %s\n", prog, d->line, d->col ? (unsigned)d->col : 1u,
-                d->msg);
+        fprintf(stderr, "%s:%u:%u: error: %s\n", d->file ? d->file : prog, d->line,
+                d->col ? (unsigned)d->col : 1u, d->msg);
     else
-        fprintf(stderr, "%s: error: %s\n", prog, d->msg);
+        fprintf(stderr, "%s: error: %s\n", d->file ? d->file : prog, d->msg);
 }
 
 static void print_waits(const struct ncp_stage_stats *s)
@@ -98,7 +98,8 @@ static void usage(FILE *f)
     fputs("usage: cnc-run parse PROG [-j N] [--executors M] [--mode serial|det|att]\n"
           "                          [--config INI] [--tool-table FILE] [--canon FILE|-]\n"
           "                          [--stats] [--max-loops N] [--inline-output]\n"
-          "       cnc-run check PROG [--tool-table FILE]\n"
+          "                          [--subroutine-path DIR[:DIR...]]\n"
+          "       cnc-run check PROG [--tool-table FILE] [--subroutine-path DIRS]\n"
           "       cnc-run run PROG [--config INI] [--trace CSV] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
           "\n"
@@ -108,6 +109,8 @@ static void usage(FILE *f)
           "       analyzer executes and writes each command itself (no output thread).\n"
           "       -j 0: no lexer threads, the analyzer lexes the text itself.\n"
           "       Default: -j 2 --executors 1; with 2 CPUs or fewer, -j 0 --executors 0.\n"
+          "       `o<name> call` of a sub not defined yet reads name.ngc from the\n"
+          "       current folder, then from the --subroutine-path folders (as rs274).\n"
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
           "run    run PROG on the machine: planner, interpolator, position loop, backend\n"
           "       (the simulated servo by default); `cnc-run run --help` for details.\n"
@@ -152,12 +155,13 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         { "stats", no_argument, 0, 's' },
         { "inline-output", no_argument, 0, 'I' },
         { "max-loops", required_argument, 0, 'L' },
+        { "subroutine-path", required_argument, 0, 'P' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
     int c, v;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "j:e:m:c:t:o:shL:I", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "j:e:m:c:t:o:shL:IP:", longopts, NULL)) != -1) {
         switch (c) {
         case 'j':
             o->counts_given = 1;
@@ -177,6 +181,7 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         case 'c': o->config = optarg; break;
         case 't': o->acfg.tool_table_path = optarg; break;
         case 'o': o->canon = optarg; break;
+        case 'P': o->acfg.subroutine_path = optarg; break;
         case 's': o->stats = 1; break;
         case 'I': o->inline_output = 1; break;
         case 'L':

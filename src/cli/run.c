@@ -175,7 +175,7 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                 cfg->axis[res->fault_axis].ferror);
     } else if (res->status != RUN_OK && res->diag.line) {
         fprintf(stderr, "%s:%u:%u: error: %s (motion stopped after the last good block)\n",
-                o->prog, res->diag.line, res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
+                res->diag.file ? res->diag.file : o->prog, res->diag.line, res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
     } else if (res->status != RUN_OK) {
         fprintf(stderr, "%s: error: %s\n", o->prog, res->diag.msg);
     }

@@ -395,10 +395,12 @@ void ncp_exec_format_into(struct ncp_cmd *cmd, char *dst)
              * rather than emit a cut line. */
             o.p = line;
             cmd->n_ops = (uint16_t)k;
-            if (!(cmd->flags & NCP_CMD_F_ERROR))
+            if (!(cmd->flags & NCP_CMD_F_ERROR)) {
                 ncp_diag_set(&cmd->diag, NCP_ERR_LIMIT, cmd->line, 0,
                              "canonical output of this block exceeds %d bytes",
                              NCP_CMD_OUT_MAX);
+                cmd->diag.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
+            }
             cmd->flags |= NCP_CMD_F_ERROR;
             break;
         }

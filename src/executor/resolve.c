@@ -130,6 +130,7 @@ int ncp_exec_resolve(struct ncp_cmd *cmd)
         if (ncp_resolve_arc(cmd, op, feed_op) != NCP_OK) {
             /* rs274 sets the G93 rate only once the arc is known good */
             cmd->n_ops = (uint16_t)(feed_op ? k - 1 : k);
+            cmd->diag.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
             cmd->flags |= NCP_CMD_F_ERROR;
             break;
         }

@@ -210,6 +210,7 @@ void ncp_lex_init_block(struct ncp_block *b, size_t len, uint32_t line, uint64_t
     b->err.code = NCP_OK;
     b->err.line = line;
     b->err.col = 0;
+    b->err.file = NULL;
     b->err.msg[0] = '\0';
     b->n_words = b->n_assign = b->n_code = b->pool_used = 0;
     b->oword.kind = NCP_O_NONE;

@@ -250,6 +250,7 @@ static void unpack_plain(const unsigned char *p, struct ncp_block *b)
     b->err.code = NCP_OK;
     b->err.line = line;
     b->err.col = 0;
+    b->err.file = NULL;
     b->err.msg[0] = '\0';
     b->oword.kind = NCP_O_NONE;
     p += PLAIN_HEAD;
@@ -302,6 +303,7 @@ void ncp_block_unpack(const void *src, struct ncp_block *b)
         b->err.code = NCP_OK;
         b->err.line = h.line;
         b->err.col = 0;
+        b->err.file = NULL;
         b->err.msg[0] = '\0';
     }
     for (unsigned k = 0; k < h.n_words; k++) {

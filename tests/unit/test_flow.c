@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
@@ -345,6 +346,78 @@ static void test_loop_limit(void **state)
     assert_int_equal(r.blocks, 151);
 }
 
+/* ---- subroutine files ---------------------------------------------------- */
+
+static void write_file(const char *dir, const char *name, const char *text)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *fp = fopen(path, "w");
+    assert_non_null(fp);
+    fputs(text, fp);
+    fclose(fp);
+}
+
+/* o<name> call of a sub not defined yet reads name.ngc from the subroutine
+ * path (after the current folder), from its start: a sub defined before the
+ * called one there is skipped and stays unknown, as in rs274; the called one
+ * is known from then on, so a second call jumps to it. Lines count in the
+ * file they are in. */
+static void test_sub_files(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/ncp-flow-subs.XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    write_file(dir, "tflow_a.ngc", "o<tflow_x> sub\ng0x9\no<tflow_x> endsub\n"
+                                   "o<tflow_a> sub\ng0x#1\no<tflow_b> call\no<tflow_a> endsub\n");
+    write_file(dir, "tflow_b.ngc", "o<tflow_b> sub\no1 repeat [2]\ng0y1\no1 endrepeat\n"
+                                   "o<tflow_b> endsub\nm2\n");
+    write_file(dir, "tflow_bad.ngc", "o<tflow_bad> sub\ng0x1\ng2x2\no<tflow_bad> endsub\n");
+    char path[600];
+    snprintf(path, sizeof path, "/nonexistent-folder:%s", dir);
+    struct ncp_analyzer_cfg cfg = { .subroutine_path = path };
+    struct result r;
+    run_cfg("g0x0\no<tflow_a> call [1]\no<tflow_a> call [2]\nm2", &cfg, &r);
+    assert_int_equal(r.rc, NCP_END);
+    assert_string_equal(r.trace, "1 5 3 3 5 3 3 4");
+    /* the sub skipped over in tflow_a.ngc is not defined: read on for it */
+    run_cfg("o<tflow_a> call [1]\no<tflow_x> call\nm2", &cfg, &r);
+    assert_int_equal(r.rc, NCP_ERR_SEMANTIC);
+    assert_string_equal(r.d.msg, "EOF in file:t.ngc seeking o-word: o<tflow_x> from line: 2");
+    /* without the path, the files are not found */
+    run_cfg("o<tflow_a> call [1]\nm2", NULL, &r);
+    assert_int_equal(r.rc, NCP_ERR_SEMANTIC);
+    /* a file without the sub: searched to its end, from its line 0 */
+    write_file(dir, "tflow_c.ngc", "g0x7\n");
+    run_cfg("o<tflow_c> call\nm2", &cfg, &r);
+    assert_int_equal(r.rc, NCP_ERR_SEMANTIC);
+    assert_int_equal(r.d.line, 0);
+    assert_non_null(strstr(r.d.msg, "tflow_c.ngc seeking o-word: o<tflow_c> from line: 0"));
+    const char *names[] = { "tflow_a.ngc", "tflow_b.ngc", "tflow_bad.ngc", "tflow_c.ngc" };
+    for (unsigned k = 0; k < 4; k++) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        remove(path);
+    }
+    rmdir(dir);
+}
+
+/* Diagnostics name subroutine files through a table that outlives the run. */
+static void test_diag_file_names(void **state)
+{
+    (void)state;
+    unsigned a = ncp_diag_file_tag("dir/a.ngc"), b = ncp_diag_file_tag("dir/b.ngc");
+    assert_true(a > 0 && b > 0 && a != b);
+    assert_int_equal(ncp_diag_file_tag("dir/a.ngc"), a);
+    assert_string_equal(ncp_diag_file_of_tag(a), "dir/a.ngc");
+    assert_ptr_equal(ncp_diag_file_name("dir/b.ngc"), ncp_diag_file_of_tag(b));
+    assert_null(ncp_diag_file_of_tag(0));
+    assert_null(ncp_diag_file_of_tag(NCP_DIAG_FILE_TAGS + 1));
+    struct ncp_diag d;
+    d.file = "x";
+    ncp_diag_set(&d, NCP_ERR_SEMANTIC, 1, 1, "m");
+    assert_null(d.file);
+}
+
 static void test_call_depth(void **state)
 {
     (void)state;
@@ -460,6 +533,8 @@ int main(void)
         cmocka_unit_test(test_big_and_long_loops),
         cmocka_unit_test(test_loop_limit),
         cmocka_unit_test(test_call_depth),
+        cmocka_unit_test(test_sub_files),
+        cmocka_unit_test(test_diag_file_names),
         cmocka_unit_test(test_label_errors),
         cmocka_unit_test(test_sub_errors),
         cmocka_unit_test(test_end_of_file),

@@ -51,7 +51,7 @@ static void run_one(struct ncp_pipeline_pool *pool, const char *prog, long fail_
     memset(o, 0, sizeof *o);
     o->text.fail_after = fail_after;
     assert_int_equal(ncp_source_from_memory(&src, prog, strlen(prog), "t.ngc", &d), 0);
-    struct ncp_analyzer_cfg cfg = { NULL, 1000, 0 };
+    struct ncp_analyzer_cfg cfg = { .max_loop_iterations = 1000 };
     struct ncp_output out = { .ctx = &o->text, .emit = collect };
     o->rc = pool ? ncp_pipeline_pool_run(pool, &src, &cfg, &out, &o->st, &o->d)
                  : ncp_serial_run(&src, &cfg, &out, &o->st, &o->d);
