@@ -20,7 +20,7 @@
 enum { RUN_OK = 0, RUN_USAGE = 1, RUN_PROGRAM = 2, RUN_FAULT = 3 };
 
 struct run_opts {
-    const char *prog, *config, *trace, *plot, *tool_table;
+    const char *prog, *config, *trace, *plot, *tool_table, *sub_path;
     double for_s;               /* 0 = whole program */
     double feed_override;       /* 1.0 = 100 % */
     int virtual_clock;
@@ -51,6 +51,7 @@ static void usage(FILE *f)
     fputs("usage: cnc-run run PROG [--config INI] [--trace CSV] [--plot PNG] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
           "                        [--mode serial|det|att] [--tool-table FILE]\n"
+          "                        [--subroutine-path DIR[:DIR...]]\n"
           "                        [--backend sim|socketcan[:IFACE]]\n"
           "Runs PROG on the simulated machine (or CiA 402 drives over CAN): interpreter ->\n"
           "look-ahead planner -> interpolator -> position loop (SCHED_FIFO when permitted).\n"
@@ -63,6 +64,8 @@ static void usage(FILE *f)
           "  --feed-override PCT 1..200 (default 100)\n"
           "  --clock virtual     simulated clock, as fast as the CPU allows\n"
           "  --tool-table FILE   LinuxCNC tool table (default: rs274's built-in T1-T3)\n"
+          "  --subroutine-path DIRS  where o<name> call finds name.ngc after the current\n"
+          "                      folder (colon-separated, as rs274's SUBROUTINE_PATH)\n"
           "  --backend sim       the simulated machine (default)\n"
           "  --backend socketcan[:IFACE]  CiA 402 drives in CSP mode over SocketCAN on\n"
           "                      IFACE (default: the INI's [CAN] INTERFACE); each axis\n"
@@ -97,6 +100,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "clock", required_argument, 0, 'k' },
         { "mode", required_argument, 0, 'm' },
         { "tool-table", required_argument, 0, 'T' },
+        { "subroutine-path", required_argument, 0, 'S' },
         { "backend", required_argument, 0, 'b' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
@@ -104,12 +108,13 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     double pct;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': o->config = optarg; break;
         case 't': o->trace = optarg; break;
         case 'p': o->plot = optarg; break;
         case 'T': o->tool_table = optarg; break;
+        case 'S': o->sub_path = optarg; break;
         case 'b': o->backend = optarg; break;
         case 'f':
             if (parse_num(optarg, 1e-6, 1e9, &o->for_s))
@@ -303,7 +308,8 @@ static int draw_plot(const struct run_opts *o, const char *trace, const struct n
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
 {
-    struct interp_ctx ic = { src, { .tool_table_path = o->tool_table }, o->mode };
+    struct interp_ctx ic = { src, { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path },
+                             o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
