@@ -97,11 +97,6 @@ static int ncp_check_g(struct ncp_analyzer *a)
     return NCP_OK;
 }
 
-static int ncp_is_cycle(int m)
-{
-    return m == 730 || m == 740 || (m >= 810 && m <= 890);
-}
-
 /* Words that need a code to use them. */
 static int ncp_check_other(struct ncp_analyzer *a)
 {
@@ -125,11 +120,11 @@ static int ncp_check_other(struct ncp_analyzer *a)
     int comp_on = comp == 410 || comp == 420 || comp == 411 || comp == 421;
     int g70 = mt == 700, rough = ncp_is_g7x(mt) && !g70; /* rough: G71*, G72* */
 #define COL(c) w->col[NCP_LETTER(c)]
-    if (NCP_HAS(w, 'A') && ncp_is_cycle(mt))
+    if (NCP_HAS(w, 'A') && ncp_is_canned_cycle(mt))
         return ncp_an_error(a, COL('A'), "Cannot put an a in canned cycle");
-    if (NCP_HAS(w, 'B') && ncp_is_cycle(mt))
+    if (NCP_HAS(w, 'B') && ncp_is_canned_cycle(mt))
         return ncp_an_error(a, COL('B'), "Cannot put a b in canned cycle");
-    if (NCP_HAS(w, 'C') && ncp_is_cycle(mt))
+    if (NCP_HAS(w, 'C') && ncp_is_canned_cycle(mt))
         return ncp_an_error(a, COL('C'), "Cannot put a c in canned cycle");
     if (NCP_HAS(w, 'D') && !comp_on && !ncp_is_g7x(mt) && w->g[NCP_GG_SPINDLE] != 960)
         return ncp_an_error(a, COL('D'), "D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it");
@@ -171,8 +166,8 @@ static int ncp_check_other(struct ncp_analyzer *a)
         w->m[NCP_MG_IO] != 66 && w->m[NCP_MG_IO] != 67 && w->m[NCP_MG_IO] != 68 && !g10 &&
         w->m[NCP_MG_TOOL] != 61 && ctl != 640 && w->m[NCP_MG_SPINDLE] != 19)
         return ncp_an_error(a, COL('Q'), "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it");
-    if (NCP_HAS(w, 'R') && mt != 20 && mt != 30 && mt != 760 && (mt < 810 || mt > 890) && !rough &&
-        mt != 730 && mt != 740 && comp != 411 && comp != 421 && !g10 && w->m[NCP_MG_SPINDLE] != 19)
+    if (NCP_HAS(w, 'R') && mt != 20 && mt != 30 && mt != 760 && !ncp_is_canned_cycle(mt) &&
+        !rough && comp != 411 && comp != 421 && !g10 && w->m[NCP_MG_SPINDLE] != 19)
         return ncp_an_error(a, COL('R'), "R word with no g code that uses it");
     if (!NCP_HAS(w, 'S') && w->g[NCP_GG_SPINDLE] == 960)
         return ncp_an_error(a, w->gcol[NCP_GG_SPINDLE], "S word missing with g96");

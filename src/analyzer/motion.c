@@ -404,7 +404,7 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
 
 int ncp_motion_run(struct ncp_analyzer *a, int motion)
 {
-    if (motion != 730 && motion != 740 && (motion < 810 || motion > 890))
+    if (!ncp_is_canned_cycle(motion))
         a->st.cycle_il_flag = 0;
     switch (motion) {
     case 0: case 10:

@@ -15,6 +15,13 @@ enum ncp_axis { NCP_X, NCP_Y, NCP_Z, NCP_A, NCP_B, NCP_C, NCP_U, NCP_V, NCP_W, N
 /* rs274's standalone "user" length unit (parameters, tool table) is the inch. */
 #define NCP_MM_PER_INCH 25.4
 
+/* G73, G74 and G81-G89 (motion codes in tenths): the canned cycles, one
+ * list for the word checks and the motion dispatch alike. */
+static inline int ncp_is_canned_cycle(int motion)
+{
+    return motion == 730 || motion == 740 || (motion >= 810 && motion <= 890);
+}
+
 /* Modal group slots of the per-block G-code record. */
 enum ncp_ggroup {
     NCP_GG_NONMODAL, NCP_GG_MOTION, NCP_GG_PLANE, NCP_GG_DIST, NCP_GG_ARCDIST,
