@@ -22,7 +22,7 @@ struct ncp_diag {
     uint16_t col;               /* 1-based column, 0 = whole line */
     uint16_t code;              /* enum ncp_status */
     /* NULL: the program's own file; else the subroutine file the line is in
-     * (a name from ncp_diag_file_name, valid for the life of the process) */
+     * (a name from ncp_diag_file_of_tag, valid for the life of the process) */
     const char *file;
     char msg[NCP_DIAG_MSG_MAX]; /* machinist-readable, no trailing newline */
 };
@@ -32,12 +32,11 @@ int ncp_diag_set(struct ncp_diag *d, enum ncp_status code, uint32_t line,
                  uint16_t col, const char *fmt, ...)
     __attribute__((format(printf, 5, 6)));
 
-/* A lasting copy of a file's name, for struct ncp_diag's file: diagnostics
- * outlive whatever read the file (they are printed after the run). The same
- * name gives the same copy; NULL when out of memory. Thread-safe. */
-const char *ncp_diag_file_name(const char *name);
-/* The same names by number, for records too small for a pointer: 1, 2, ...
- * in the order first named (0: none, or the table is full); and back. */
+/* Lasting copies of file names, for struct ncp_diag's file: diagnostics
+ * outlive whatever read the file (they are printed after the run). A name's
+ * tag is 1, 2, ... in the order first named (0: the table is full, or out of
+ * memory), small enough for records that have no room for a pointer; the
+ * same name always gives the same tag and the same copy. Thread-safe. */
 #define NCP_DIAG_FILE_TAGS 8191u
 unsigned ncp_diag_file_tag(const char *name);
 const char *ncp_diag_file_of_tag(unsigned tag);

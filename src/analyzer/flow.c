@@ -67,7 +67,7 @@ struct flow_cached {
 /* A subroutine file, read whole when first called. */
 struct flow_file {
     struct ncp_source src;
-    const char *name;                 /* ncp_diag_file_name's copy */
+    const char *name;                 /* ncp_diag_file_of_tag(tag) */
     unsigned tag;                     /* its ncp_diag_file_tag */
 };
 

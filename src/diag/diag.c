@@ -59,8 +59,3 @@ const char *ncp_diag_file_of_tag(unsigned tag)
     pthread_mutex_unlock(&names_lock);
     return name;
 }
-
-const char *ncp_diag_file_name(const char *name)
-{
-    return ncp_diag_file_of_tag(ncp_diag_file_tag(name));
-}

@@ -19,7 +19,7 @@
 
 /* Slots are prefaulted before the start (ncpar/mem.h): the stage threads
  * then never stop for a first-touch page fault, which costs microseconds
- * each in a virtual machine; rings of 512 KB and more are on 2 MB pages. */
+ * each in a virtual machine. They are on 4 KB pages (mem.h says why). */
 uint32_t ncp_ring_capacity(uint32_t want)
 {
     uint32_t c = 1;
