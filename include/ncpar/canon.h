@@ -101,13 +101,21 @@ enum ncp_canon_kind {
     NCP_C_SET_AUX_OUTPUT_VALUE, NCP_C_SET_MOTION_OUTPUT_VALUE,  /* i[0], d[0] */
     NCP_C_START_SPEED_FEED_SYNCH,/* i[0] spindle, d[0] feed per rev, i[1] velocity mode */
     NCP_C_STOP_SPEED_FEED_SYNCH,
-    NCP_C_NURBS_FEED,            /* i[0] order (3 G5.1, 4 G5); d[0..2] the end x y z, d[3..4]
-                                    the start, d[5..6] and (G5) d[7..8] the control points, x y:
-                                    for the NCK only, rs274 -g prints no point */
+    NCP_C_NURBS_FEED,            /* i[0] control points (3 G5.1, 4 G5, n G5.3), d[0..2] the end
+                                    x y z. G5/G5.1: d[3..4] the start, d[5..6] and (G5) d[7..8]
+                                    the control points, x y. G5.3: i[1] the order, i[2]
+                                    NCP_NURBS_POINTS_FOLLOW, the points in the NURBS_POINTS ops
+                                    right after. For the NCK only: rs274 -g prints no point */
+    NCP_C_NURBS_POINTS,          /* i[0] points (1..NCP_NURBS_POINTS_PER_OP), d[3k..3k+2] x y
+                                    weight, program units; prints nothing */
     NCP_C_RIGID_TAP,             /* d[0..2] x y z of the hole's bottom (G33.1); back at the start after */
     NCP_C_RAW_TEXT,              /* text printed verbatim (for calls not modelled above) */
     NCP_C__COUNT
 };
+
+/* NURBS_FEED's i[2]: the control points follow in NURBS_POINTS ops */
+#define NCP_NURBS_POINTS_FOLLOW 1
+#define NCP_NURBS_POINTS_PER_OP 4
 
 /* ncp_canon.flags of SET_FEED_RATE (see above) */
 #define NCP_FEED_F_INVERSE_ARC 1u

@@ -37,6 +37,17 @@ int ncp_cutcomp_engaged(const struct ncp_cutcomp *c)
     return c->side != 0 && c->radius > 0.0;
 }
 
+void ncp_cutcomp_moved_to(struct ncp_cutcomp *c, double x, double y)
+{
+    if (c->plane == 2) { /* plane coords (z, x, y) */
+        c->cur[1] = x;
+        c->cur[2] = y;
+    } else {
+        c->cur[0] = x;
+        c->cur[1] = y;
+    }
+}
+
 static double ncp_spiral_tol(const struct ncp_cutcomp *c)
 {
     if (c->inches)

@@ -128,6 +128,10 @@ void ncp_cutcomp_scale(struct ncp_cutcomp *c, double k, int inches);
 /* Side != off and radius > 0: moves must go through ncp_cutcomp_move. */
 int ncp_cutcomp_engaged(const struct ncp_cutcomp *c);
 
+/* A call outside compensation left the tool at machine-plane X Y (G5.3:
+ * rs274 moves its current point, not the programmed one, to the NURBS end). */
+void ncp_cutcomp_moved_to(struct ncp_cutcomp *c, double x, double y);
+
 /* Before every G0/G1/G2/G3 (engaged or not): the arc-after-G40 rule. */
 int ncp_cutcomp_check_motion(struct ncp_cutcomp *c, int is_arc, struct ncp_diag *d,
                              uint32_t line);

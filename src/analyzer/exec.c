@@ -310,8 +310,10 @@ static int ncp_exec_g_codes(struct ncp_analyzer *a)
         ncp_exec_arc_distance(a, w->g[NCP_GG_ARCDIST]);
     if (w->g[NCP_GG_RETRACT] != -1)
         ncp_exec_retract(a, w->g[NCP_GG_RETRACT]);
-    if (w->g[NCP_GG_NONMODAL] != -1 && w->g[NCP_GG_NONMODAL] != 40 &&
-        w->g[NCP_GG_NONMODAL] != 530)
+    if (w->g[NCP_GG_NONMODAL] == 53)
+        rc = ncp_nurbs_draw(a);
+    else if (w->g[NCP_GG_NONMODAL] != -1 && w->g[NCP_GG_NONMODAL] != 40 &&
+             w->g[NCP_GG_NONMODAL] != 530)
         rc = ncp_offsets_modal0(a, w->g[NCP_GG_NONMODAL]);
     if (rc == NCP_OK && w->motion_to_be != -1)
         rc = ncp_motion_run(a, w->motion_to_be);

@@ -44,7 +44,8 @@ static int ncp_motion_to_be(struct ncp_analyzer *a)
             if (covets)
                 return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
                                     "Cannot use two g codes that both use axis values");
-            if (!axis && m1 != 0 && m1 != 10 && m1 != 20 && m1 != 30 && !ncp_is_g7x(m1))
+            if (!axis && m1 != 0 && m1 != 10 && m1 != 20 && m1 != 30 && m1 != 52 &&
+                !ncp_is_g7x(m1))
                 return ncp_an_error(a, col, "All axes missing with motion code");
         }
         w->motion_to_be = m1;
@@ -87,7 +88,10 @@ static int ncp_check_g(struct ncp_analyzer *a)
             return ncp_an_error(a, col, "P value out of range (0-9) with G10 L%d", l);
         if ((l == 1 || l == 10 || l == 11) && pi < 1)
             return ncp_an_error(a, col, "P value out of range with G10 L%d", l);
-    } else if (m0 == 530) {
+    } else if (m0 == 53) {
+        if (m1 != 52 && m1 != -1)
+            return ncp_an_error(a, col, "Between G5.2 and G5.3 codes, only additional G5.2 codes are allowed.");
+    } else if (m0 == 530 && m1 != 52) { /* rs274 checks no G53 beside G5.2 */
         int mt = w->motion_to_be;
         if (mt != 0 && mt != 10)
             return ncp_an_error(a, col, "Must use g0 or g1 with g53");

@@ -418,6 +418,8 @@ int ncp_motion_run(struct ncp_analyzer *a, int motion)
         return NCP_OK;
     case 50: case 51:
         return ncp_spline(a, motion);
+    case 52:
+        return ncp_nurbs_point(a);
     case 330: case 331: case 760:
         return ncp_synced(a, motion);
     case 382: case 383: case 384: case 385:

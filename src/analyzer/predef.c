@@ -40,7 +40,7 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     }
     switch (k) {
     case P_LINE: return a->line;
-    case P_MOTION: return m->motion < 0 ? 800 : m->motion;
+    case P_MOTION: return m->motion; /* -1 after G5.3, as rs274 */
     case P_PLANE: return m->plane == 0 ? 170 : m->plane == 1 ? 190 : 180;
     case P_CCOMP: return m->comp_side == 0 ? 400 : m->comp_side == 1 ? 410 : 420;
     case P_METRIC: return !m->inches;

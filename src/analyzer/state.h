@@ -116,6 +116,13 @@ struct ncp_staged {
     char text[NCP_CMD_TEXT_POOL];
 };
 
+/* G5.2 control points until G5.3 draws them (nurbs.c): x y weight */
+struct ncp_nurbs_pts {
+    double (*pt)[3];
+    uint32_t n, cap;
+    int order;
+};
+
 struct ncp_analyzer {
     struct ncp_analyzer_cfg cfg;
     struct ncp_sai sai;
@@ -148,6 +155,7 @@ struct ncp_analyzer {
     int m7x_restore_from;         /* a return left an M73 level: restore from it, else -1 */
     int block_consumed;           /* an M72 ran restore lines in this block's place */
     struct ncp_block *m7x_block;  /* the restore line being run */
+    struct ncp_nurbs_pts nurbs;
 };
 
 /* analyzer.c: append one op to the block's slot (opens/continues slots). */
@@ -211,6 +219,11 @@ int ncp_m7x_pending(struct ncp_analyzer *a);
 void ncp_m7x_reset(struct ncp_analyzer *a);
 void ncp_m7x_free(struct ncp_analyzer *a);
 int ncp_motion_ends(struct ncp_analyzer *a, int absolute53, double *end);
+
+/* nurbs.c: G5.2 (a control point, as the motion) and G5.3 (draw them) */
+int ncp_nurbs_point(struct ncp_analyzer *a);
+int ncp_nurbs_draw(struct ncp_analyzer *a);
+void ncp_nurbs_free(struct ncp_analyzer *a);
 
 /* offsets.c */
 int ncp_offsets_units(struct ncp_analyzer *a, int inches);

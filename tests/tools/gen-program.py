@@ -4,7 +4,7 @@
 Writes to stdout a random RS274/NGC program of about N lines that LinuxCNC's rs274
 accepts (with simpockets.tbl): every arc is geometrically valid, F is set before
 feeds, parameters are defined before they are read, loops terminate. It covers
-G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G5/G5.1 splines, G4, G10 L2/L20,
+G0-G3 (IJK and R, helices, all planes, G90.1/G91.1), G5/G5.1 splines, G5.2/G5.3 NURBS, G4, G10 L2/L20,
 G17-G19, G20/G21, G28/G30, G43/G43.2/G49, G52, G53, G54-G59.3, G61/G61.1/G64 P Q, canned cycles
 G73 G81-G89 with R L Q P and G98/G99, G90/G91, G92/G92.1/G92.2/G92.3, G93/G94/G95,
 G7/G8 (X words as diameters), G33/G33.1 (spindle-synchronised feeds, rigid taps), G76,
@@ -695,8 +695,10 @@ class Gen:
             return self.st_probe_episode()
         if c < 0.996:
             return self.st_sync_episode()
-        if c < 0.998:
+        if c < 0.997:
             return self.st_spline()
+        if c < 0.998:
+            return self.st_nurbs()
         if c < 0.9985:
             return self.st_thread()
         if c < 0.999:
@@ -860,6 +862,51 @@ class Gen:
         if self.feed_mode == 93:
             line += " F" + self.feed()
         self.emit(line)
+
+    def st_nurbs(self):
+        """A G5.2/G5.3 NURBS: the first block may be P alone (the start's
+        weight), every point X Y with P > 0, L the order on any of them, other
+        lines between; G91 counts every point from where the curve starts.
+        After G5.3 the motion mode is none, as after G80."""
+        r = self.r
+        self.ensure_feed_ready()
+        s = self.s()
+        order = r.choice([3, 3, 4, 5])
+        count = r.randint(order - 1, order + 5)   # points after the start
+        start = {a: self.pos[a] for a in ("X", "Y")}
+        first = "G5.2"
+        if r.random() < 0.3:
+            first += " P" + num(r.uniform(0.3, 3), 3)
+            if order > 3:
+                first += " L%d" % order
+            if self.feed_mode != 95:
+                first += " F" + self.feed()
+            self.emit(first)
+            first = ""
+        last = None
+        for k in range(count):
+            words = []
+            for a in ("X", "Y"):
+                v = float(self.n(r.uniform(-15, 15) * s if self.dist == 91
+                                 else r.uniform(-40, 40) * s))
+                words.append(a + self.n(v))
+            last = words
+            words.append("P" + num(r.uniform(0.3, 3), 3))
+            if first and order > 3:
+                words.append("L%d" % order)
+            if first and self.feed_mode != 95:
+                words.append("F" + self.feed())
+            self.emit(" ".join(([first] if first else []) + words))
+            first = ""
+            if r.random() < 0.1:
+                self.emit(r.choice(["(nurbs)", "M8", "M9", "S%d" % r.choice([500, 900])]))
+        self.emit("G5.3")
+        for a, w in zip(("X", "Y"), last):
+            v = float(w[1:])
+            if self.dist != 91:
+                self.pos[a] = v
+            else:
+                self.pos[a] = None if start[a] is None else start[a] + v
 
     def st_sync_episode(self):
         """G33 feeds (K per turn, on every line) and G33.1 taps, which end where

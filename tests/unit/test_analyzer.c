@@ -297,6 +297,67 @@ static const struct ncp_canon *last_op(const struct run *r, int kind)
     return NULL;
 }
 
+/* G5.2/G5.3: the NURBS_FEED call carries count and order, and its points
+ * follow it in order, up to four an op: the start with the weight of the
+ * P-only first block, then each X Y P; under G91 every point counts from the
+ * start (rs274 keeps its current point until G5.3). */
+static void test_nurbs_points(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r,
+                "G0 X1 Y2 F100\nG5.2 P2 L4\nX3 Y4 P0.5\nG91 X1 Y1 P1\nX2 Y0 P3\n"
+                "X0 Y3 P1\nX5 Y5 P1\nX6 Y1 P1\nX7 Y2 P1\nX8 Y0 P1\nX9 Y4 P1\nG5.3\n"
+                "G1 X1\nM2\n",
+                1);
+    assert_int_equal(r.rc, NCP_END);
+    unsigned k = 0;
+    while (k < r.c.n_ops && r.c.ops[k].kind != NCP_C_NURBS_FEED)
+        k++;
+    assert_true(k < r.c.n_ops);
+    const struct ncp_canon *head = &r.c.ops[k];
+    assert_int_equal(head->i[0], 10);
+    assert_int_equal(head->i[1], 4);
+    assert_int_equal(head->i[2], NCP_NURBS_POINTS_FOLLOW);
+    assert_true(head->d[0] == 10 && head->d[1] == 6); /* the last point: start + (9, 4) */
+    const double want[10][3] = {{1, 2, 2}, {3, 4, 0.5}, {2, 3, 1}, {3, 2, 3}, {1, 5, 1},
+                                {6, 7, 1}, {7, 3, 1}, {8, 4, 1}, {9, 2, 1}, {10, 6, 1}};
+    unsigned got = 0;
+    for (k++; k < r.c.n_ops && r.c.ops[k].kind == NCP_C_NURBS_POINTS; k++) {
+        const struct ncp_canon *op = &r.c.ops[k];
+        assert_true(op->i[0] >= 1 && op->i[0] <= NCP_NURBS_POINTS_PER_OP);
+        for (int j = 0; j < op->i[0]; j++, got++) {
+            assert_true(got < 10);
+            assert_true(op->d[3 * j] == want[got][0] && op->d[3 * j + 1] == want[got][1] &&
+                        op->d[3 * j + 2] == want[got][2]);
+        }
+    }
+    assert_int_equal(got, 10);
+    /* the next move starts from the curve's end: G91 X1 from (10, 6) */
+    assert_int_equal(r.c.ops[k].kind, NCP_C_STRAIGHT_FEED);
+    assert_true(r.c.ops[k].d[0] == 11 && r.c.ops[k].d[1] == 6);
+    run_free(&r);
+
+    /* 1 + 40 points from a loop: the call's points run on into continuation slots */
+    run_program(&r,
+                "G0 X0 Y0 F100\n#1=0\nG5.2 X0 Y1 P1\no1 while [#1 LT 40]\n"
+                "#1=[#1+1]\nX#1 Y[#1 MOD 3] P1\no1 endwhile\nG5.3\nM2\n",
+                1);
+    assert_int_equal(r.rc, NCP_END);
+    unsigned cont = 0, pts = 0, heads = 0;
+    for (k = 0; k < r.c.n_slots; k++)
+        cont += (r.c.slots[k].flags & NCP_CMD_F_CONT) != 0;
+    for (k = 0; k < r.c.n_ops; k++) {
+        heads += r.c.ops[k].kind == NCP_C_NURBS_FEED && r.c.ops[k].i[0] == 42;
+        if (r.c.ops[k].kind == NCP_C_NURBS_POINTS)
+            pts += (unsigned)r.c.ops[k].i[0];
+    }
+    assert_int_equal(heads, 1);
+    assert_int_equal(pts, 42);
+    assert_true(cont >= 1);
+    run_free(&r);
+}
+
 /* G53 goes through the XY rotation of the active system (rs274: -11.1603, 0.6699). */
 static void test_rotation_g53(void **state)
 {
@@ -431,6 +492,7 @@ int main(void)
         cmocka_unit_test(test_params_pre_block),
         cmocka_unit_test(test_slot_continuation),
         cmocka_unit_test(test_g92_and_coords),
+        cmocka_unit_test(test_nurbs_points),
         cmocka_unit_test(test_rotation_g53),
         cmocka_unit_test(test_rotation_switch_and_abs),
         cmocka_unit_test(test_rotation_change_while_active),
