@@ -96,6 +96,17 @@ void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
 
 /* ---- canonical calls -> segments ------------------------------------------- */
 
+/* A G5.3 NURBS being drawn (src/motion/nurbs_eval.h): the last points in, as
+ * w x, w y, w, in a ring indexed by point number. */
+#define NCP_NURBS_MAX_ORDER 28
+#define NCP_NURBS_WINDOW 32
+struct ncp_nurbs_stream {
+    uint32_t count, received;
+    int order;
+    uint32_t span, step;          /* the next line: span's step-th of NCP_SPLINE_STEPS */
+    double pt[NCP_NURBS_WINDOW][3];
+};
+
 struct ncp_canon_map {
     const struct ncp_machine_cfg *cfg;
     double scale;           /* mm per program unit */
@@ -120,6 +131,7 @@ struct ncp_canon_map {
     double more_ctrl[4][2];       /* NURBS_FEED: Bezier control points, program X Y */
     int more_points;              /* 3 (G5.1) or 4 (G5) */
     double more_z;                /* NURBS_FEED: Z, program units */
+    struct ncp_nurbs_stream nurbs; /* G5.3: the curve whose points are coming */
     int term;               /* enum ncp_seg_term */
     double tolerance;       /* mm */
     double pos[NCP_AXES];   /* machine position at the end of the last segment */
@@ -134,7 +146,8 @@ int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
                      struct ncp_seg *seg, struct ncp_diag *d);
 /* After a call that made a segment: the next segment the same call makes
  * (1), none left (0), or minus an error code. A rigid tap is two segments
- * (in, back out), a G5/G5.1 spline NCP_SPLINE_STEPS lines along the curve. */
+ * (in, back out), a G5/G5.1 spline NCP_SPLINE_STEPS lines along the curve,
+ * a G5.3 NURBS as many for each knot span, drawn as its points come in. */
 int ncp_canon_map_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_diag *d);
 #define NCP_SPLINE_STEPS 16
 

@@ -2,6 +2,7 @@
  * machine = rotate_xy(program * scale + g92) + g5x + tool, offsets converted to mm
  * with the units in force when they were issued (as LinuxCNC's canon layer). */
 #include "ncpar/motion.h"
+#include "nurbs_eval.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -194,10 +195,72 @@ static void spline_point(const struct ncp_canon_map *m, double t, double out[NCP
     to_machine(m, p, out);
 }
 
+/* The next line of a G5.3 NURBS whose points are in: 1, 0 when none is. */
+static int nurbs_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_diag *d)
+{
+    struct ncp_nurbs_stream *nb = &m->nurbs;
+    uint32_t ready = ncp_nurbs_stream_ready(nb);
+    while (nb->span < ready) {
+        uint32_t span = nb->span;
+        nb->step++;
+        double t = span + (double)nb->step / NCP_SPLINE_STEPS;
+        if (nb->step == NCP_SPLINE_STEPS) {
+            nb->step = 0;
+            nb->span++;
+        }
+        double p[3], end[NCP_AXES];
+        ncp_nurbs_stream_point(nb, span, t, p);
+        p[2] = m->more_z;
+        to_machine(m, p, end);
+        int rc = line_to(m, end, 0, m->more_line, seg, d);
+        if (rc != 0) {
+            if (rc < 0) { /* the run stops: nothing more of this curve */
+                nb->received = nb->span = 0;
+                m->more_kind = 0;
+            }
+            return rc;
+        }
+    }
+    m->more_kind = 0;
+    return 0;
+}
+
+/* G5.3: the curve's order and size now, its points in the NURBS_POINTS ops
+ * that follow; each adds points and draws the spans they complete. */
+static int nurbs_begin(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
+                       struct ncp_diag *d)
+{
+    if (ncp_nurbs_stream_begin(&m->nurbs, (uint32_t)op->i[0], op->i[1]) != 0)
+        return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
+                             "NURBS of order L=%d with %d points: the NCK draws orders 3 to %d",
+                             op->i[1], op->i[0], NCP_NURBS_MAX_ORDER);
+    m->more_z = op->d[2];
+    m->more_line = line;
+    return 0;
+}
+
+static int nurbs_points(struct ncp_canon_map *m, const struct ncp_canon *op, struct ncp_seg *s,
+                        struct ncp_diag *d)
+{
+    int n = op->i[0] < NCP_NURBS_POINTS_PER_OP ? op->i[0] : NCP_NURBS_POINTS_PER_OP;
+    int rc = ncp_nurbs_stream_add(&m->nurbs, op->d, n);
+    if (rc == -1)
+        return -ncp_diag_set(d, NCP_ERR_SEMANTIC, m->more_line, 0,
+                             "NURBS control point with a weight P that is not above 0: "
+                             "the machine cannot follow that curve");
+    if (rc != 0)
+        return -ncp_diag_set(d, NCP_ERR_SEMANTIC, m->more_line, 0,
+                             "NURBS control points beyond the count G5.3 gave");
+    m->more_kind = NCP_C_NURBS_POINTS;
+    return nurbs_more(m, s, d);
+}
+
 /* The next line along a spline, or a tap's way out: 1, 0 when done. Lines of
  * zero length (a degenerate curve) are passed over. */
 int ncp_canon_map_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_diag *d)
 {
+    if (m->more_kind == NCP_C_NURBS_POINTS)
+        return nurbs_more(m, seg, d);
     while (m->more_left > 0) {
         m->more_left--;
         double end[NCP_AXES];
@@ -381,7 +444,11 @@ int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
     case NCP_C_RIGID_TAP:
         return rigid_tap(m, op, line, seg, d);
     case NCP_C_NURBS_FEED:
+        if (op->i[2] == NCP_NURBS_POINTS_FOLLOW)
+            return nurbs_begin(m, op, line, d);
         return spline(m, op, line, seg, d);
+    case NCP_C_NURBS_POINTS:
+        return nurbs_points(m, op, seg, d);
     case NCP_C_DWELL:
         seg_common(m, seg, line);
         seg->kind = NCP_SEG_DWELL;

@@ -501,6 +501,113 @@ static void test_canon_tap_and_spline(void **state)
     assert_int_equal(segs, NCP_SPLINE_STEPS);
 }
 
+/* Reference for G5.3 curves, independent of de Boor: the Cox-de Boor basis
+ * on LinuxCNC's knots (order zeros, 1 .. n - order + 1, then order times
+ * n - order + 2, for points 0..n), the rational sum written out. */
+static double ref_knot(int j, int n, int k)
+{
+    return j < k ? 0 : j <= n ? j - k + 1 : n - k + 2;
+}
+
+static double ref_basis(int i, int k, double t, int n, int order)
+{
+    if (k == 1) {
+        double lo = ref_knot(i, n, order), hi = ref_knot(i + 1, n, order);
+        double top = ref_knot(n + 1, n, order);
+        return (t >= lo && t < hi) || (t == top && hi == top && lo < hi) ? 1 : 0;
+    }
+    double v = 0, a = ref_knot(i, n, order), b = ref_knot(i + k - 1, n, order);
+    double c = ref_knot(i + 1, n, order), e = ref_knot(i + k, n, order);
+    if (b > a)
+        v += (t - a) / (b - a) * ref_basis(i, k - 1, t, n, order);
+    if (e > c)
+        v += (e - t) / (e - c) * ref_basis(i + 1, k - 1, t, n, order);
+    return v;
+}
+
+static void ref_nurbs(const double (*p)[3], int count, int order, double t, double xy[2])
+{
+    double sx = 0, sy = 0, sw = 0;
+    for (int i = 0; i < count; i++) {
+        double b = ref_basis(i, order, t, count - 1, order) * p[i][2];
+        sx += b * p[i][0];
+        sy += b * p[i][1];
+        sw += b;
+    }
+    xy[0] = sx / sw;
+    xy[1] = sy / sw;
+}
+
+static struct ncp_canon op_nurbs_head(int count, int order, double x, double y, double z)
+{
+    struct ncp_canon c = op6(NCP_C_NURBS_FEED, x, y, z);
+    c.i[0] = count;
+    c.i[1] = order;
+    c.i[2] = NCP_NURBS_POINTS_FOLLOW;
+    return c;
+}
+
+static struct ncp_canon op_nurbs_points(const double (*p)[3], int n)
+{
+    struct ncp_canon c = op6(NCP_C_NURBS_POINTS, 0, 0, 0);
+    c.i[0] = n;
+    memcpy(c.d, p, (size_t)n * sizeof p[0]);
+    return c;
+}
+
+/* G5.3: a rational quadratic that is exactly a quarter circle, then an order
+ * 4 curve of 9 points drawn span by span as its points come in, four at a
+ * time, every line ending on the reference curve; bad weights and orders
+ * stop with a message. */
+static void test_canon_nurbs(void **state)
+{
+    (void)state;
+    struct map_fixture f;
+    map_fixture_init(&f, 1.0);
+    assert_int_equal(map_op(&f, op_feed(600), 1), 0);
+    assert_int_equal(map_op(&f, op6(NCP_C_STRAIGHT_TRAVERSE, 50, 0, 0), 2), 1);
+    const double arc[3][3] = {{50, 0, 1}, {50, 50, M_SQRT1_2}, {0, 50, 1}};
+    assert_int_equal(map_op(&f, op_nurbs_head(3, 3, 0, 50, 0), 3), 0);
+    int segs = 0, n;
+    for (n = map_op(&f, op_nurbs_points(arc, 3), 3); n == 1; n = map_more(&f)) {
+        segs++;
+        assert_true(fabs(hypot(f.s.end[0], f.s.end[1]) - 50) < 1e-9);
+        assert_int_equal(f.s.line, 3);
+    }
+    assert_int_equal(n, 0);
+    assert_int_equal(segs, NCP_SPLINE_STEPS);
+    assert_true(fabs(f.m.pos[0]) < 1e-12 && fabs(f.m.pos[1] - 50) < 1e-12);
+
+    const double pts[9][3] = {{0, 50, 1}, {-20, 60, 1}, {-40, 30, 2}, {-60, 10, 1},
+                              {-50, -10, 0.5}, {-30, -20, 1}, {0, -30, 3}, {10, -5, 1},
+                              {20, 0, 1}};
+    assert_int_equal(map_op(&f, op_nurbs_head(9, 4, 20, 0, 0), 4), 0);
+    int spans_done = 0, step = 0;
+    for (int first = 0; first < 9; first += 4) {
+        int m = 9 - first < 4 ? 9 - first : 4;
+        for (n = map_op(&f, op_nurbs_points(pts + first, m), 4); n == 1; n = map_more(&f)) {
+            step++;
+            double t = (double)step / NCP_SPLINE_STEPS, want[2];
+            ref_nurbs(pts, 9, 4, t, want);
+            assert_true(fabs(f.s.end[0] - want[0]) < 1e-9 && fabs(f.s.end[1] - want[1]) < 1e-9);
+        }
+        assert_int_equal(n, 0);
+        /* a span is drawn once its 4 points are in: 1 after 4 points, 5 after 8, 6 */
+        spans_done = first + m >= 4 ? first + m - 3 : 0;
+        assert_int_equal(step, spans_done * NCP_SPLINE_STEPS);
+    }
+    assert_int_equal(spans_done, 6);
+    assert_true(fabs(f.m.pos[0] - 20) < 1e-9 && fabs(f.m.pos[1]) < 1e-9);
+
+    const double zero_w[3][3] = {{20, 0, 1}, {30, 0, 0}, {30, 10, 1}};
+    assert_int_equal(map_op(&f, op_nurbs_head(3, 3, 30, 10, 0), 5), 0);
+    assert_true(map_op(&f, op_nurbs_points(zero_w, 3), 5) < 0);
+    assert_non_null(strstr(f.d.msg, "weight"));
+    assert_int_equal(f.d.line, 5);
+    assert_true(map_op(&f, op_nurbs_head(40, NCP_NURBS_MAX_ORDER + 1, 0, 0, 0), 6) < 0);
+    assert_non_null(strstr(f.d.msg, "order"));
+}
+
 static void test_soft_limit(void **state)
 {
     (void)state;
@@ -581,6 +688,7 @@ int main(void)
         cmocka_unit_test(test_canon_units_offsets),
         cmocka_unit_test(test_canon_spindle_feeds),
         cmocka_unit_test(test_canon_tap_and_spline),
+        cmocka_unit_test(test_canon_nurbs),
         cmocka_unit_test(test_soft_limit),
         cmocka_unit_test(test_replan_cost_bounded),
     };
