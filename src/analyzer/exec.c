@@ -347,7 +347,7 @@ int ncp_exec_block(struct ncp_analyzer *a)
     }
     if (NCP_HAS(w, 'T'))
         rc = ncp_tools_select(a);
-    if (rc == NCP_OK)
+    if (rc == NCP_OK && w->n_m != 0) /* most blocks have none: skip the group tests */
         rc = ncp_exec_m_codes(a);
     if (a->block_consumed) { /* M72's restore lines ran in this block's place */
         a->block_consumed = 0;

@@ -71,6 +71,8 @@ static int ncp_check_g(struct ncp_analyzer *a)
     const struct ncp_words *w = &a->w;
     int m0 = w->g[NCP_GG_NONMODAL], m1 = w->g[NCP_GG_MOTION];
     uint16_t col = w->gcol[NCP_GG_NONMODAL];
+    if (m0 == -1)
+        return NCP_OK;
     if (m0 == 40) {
         if (!NCP_HAS(w, 'P') || w->v[NCP_LETTER('P')] == -1.0) /* rs274: P-1 is no P */
             return ncp_an_error(a, col, "Dwell time missing with g4");

@@ -63,7 +63,8 @@ struct ncp_words {
 };
 
 struct ncp_modal {
-    int motion;                   /* G code*10 of the active motion mode, -1 none (G80) */
+    int motion;                   /* G code*10 of the active motion mode: 800 G80, -1 none
+                                     (after G5.3) */
     int plane;                    /* 0 XY, 1 YZ, 2 XZ */
     int incremental, arc_incremental;
     int feed_mode;                /* 0 units/min, 1 inverse time, 2 units/rev */
