@@ -124,14 +124,13 @@ struct ncp_canon_map {
     double speed;           /* S as programmed */
     double css_max;         /* > 0: G96 (constant surface speed), rpm cap */
     /* A call that makes several segments, what ncp_canon_map_more has left:
-     * RIGID_TAP the way back out; NURBS_FEED the rest of the curve in lines. */
-    int more_left, more_kind, more_steps;
+     * more_left 1, a rigid tap's way back out; more_kind NCP_C_NURBS_POINTS,
+     * the rest of a curve (G5, G5.1, G5.3) in lines. */
+    int more_left, more_kind;
     uint32_t more_line;
     double more_back[NCP_AXES];   /* RIGID_TAP: where the tap started, mm */
-    double more_ctrl[4][2];       /* NURBS_FEED: Bezier control points, program X Y */
-    int more_points;              /* 3 (G5.1) or 4 (G5) */
-    double more_z;                /* NURBS_FEED: Z, program units */
-    struct ncp_nurbs_stream nurbs; /* G5.3: the curve whose points are coming */
+    double more_z;                /* the curve's Z, program units */
+    struct ncp_nurbs_stream nurbs; /* the curve, its points as they come */
     int term;               /* enum ncp_seg_term */
     double tolerance;       /* mm */
     double pos[NCP_AXES];   /* machine position at the end of the last segment */

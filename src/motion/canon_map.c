@@ -173,29 +173,14 @@ static int rigid_tap(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
     to_machine(m, op->d, end);
     int rc = line_to(m, end, 0, line, s, d);
     if (rc == 1) {
-        m->more_kind = NCP_C_RIGID_TAP;
         m->more_left = 1;
         m->more_line = line;
     }
     return rc;
 }
 
-/* The point at t of the spline's Bezier curve (its control points are the
- * start, start + IJ, [end + PQ,] end: G5.1 quadratic, G5 cubic), machine mm. */
-static void spline_point(const struct ncp_canon_map *m, double t, double out[NCP_AXES])
-{
-    const double (*c)[2] = m->more_ctrl;
-    double u = 1.0 - t, p[3];
-    for (int k = 0; k < 2; k++)
-        p[k] = m->more_points == 3
-                   ? u * u * c[0][k] + 2 * u * t * c[1][k] + t * t * c[2][k]
-                   : u * u * u * c[0][k] + 3 * u * u * t * c[1][k] + 3 * u * t * t * c[2][k] +
-                         t * t * t * c[3][k];
-    p[2] = m->more_z;
-    to_machine(m, p, out);
-}
-
-/* The next line of a G5.3 NURBS whose points are in: 1, 0 when none is. */
+/* The next line of a curve (G5, G5.1, G5.3) whose points are in: 1, 0 when
+ * none is. Lines of zero length (a degenerate curve) are passed over. */
 static int nurbs_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_diag *d)
 {
     struct ncp_nurbs_stream *nb = &m->nurbs;
@@ -255,54 +240,37 @@ static int nurbs_points(struct ncp_canon_map *m, const struct ncp_canon *op, str
     return nurbs_more(m, s, d);
 }
 
-/* The next line along a spline, or a tap's way out: 1, 0 when done. Lines of
- * zero length (a degenerate curve) are passed over. */
+/* The next line along a curve, or a tap's way out: 1, 0 when done. */
 int ncp_canon_map_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_diag *d)
 {
     if (m->more_kind == NCP_C_NURBS_POINTS)
         return nurbs_more(m, seg, d);
-    while (m->more_left > 0) {
-        m->more_left--;
-        double end[NCP_AXES];
-        if (m->more_kind == NCP_C_RIGID_TAP) {
-            memcpy(end, m->more_back, sizeof end);
-        } else {
-            int k = m->more_steps - m->more_left;
-            spline_point(m, (double)k / m->more_steps, end);
-        }
-        int rc = line_to(m, end, 0, m->more_line, seg, d);
-        if (rc != 0) {
-            if (rc < 0)
-                m->more_left = 0;
-            return rc;
-        }
+    if (m->more_left > 0) { /* the tap's way back out */
+        m->more_left = 0;
+        return line_to(m, m->more_back, 0, m->more_line, seg, d);
     }
     return 0;
 }
 
 /* G5/G5.1: op->d[0..2] the end, d[3..4] the start, d[5..6] the first control
- * point, d[7..8] the second (G5) - program X Y. The first line now. */
+ * point, d[7..8] the second (G5) - program X Y. Their Bezier curve is the
+ * one-span B-spline of those points (order = count), drawn as a G5.3 NURBS
+ * with weights 1. The first line now. */
 static int spline(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
                   struct ncp_seg *s, struct ncp_diag *d)
 {
-    m->more_points = op->i[0] == 4 ? 4 : 3;
-    m->more_ctrl[0][0] = op->d[3];
-    m->more_ctrl[0][1] = op->d[4];
-    m->more_ctrl[1][0] = op->d[5];
-    m->more_ctrl[1][1] = op->d[6];
-    int last = m->more_points - 1;
-    if (last == 3) {
-        m->more_ctrl[2][0] = op->d[7];
-        m->more_ctrl[2][1] = op->d[8];
-    }
-    m->more_ctrl[last][0] = op->d[0];
-    m->more_ctrl[last][1] = op->d[1];
+    int n = op->i[0] == 4 ? 4 : 3;
+    double pts[4][3] = {{op->d[3], op->d[4], 1}, {op->d[5], op->d[6], 1},
+                        {op->d[7], op->d[8], 1}, {0, 0, 1}};
+    pts[n - 1][0] = op->d[0];
+    pts[n - 1][1] = op->d[1];
+    ncp_nurbs_stream_begin(&m->nurbs, (uint32_t)n, n);
+    if (ncp_nurbs_stream_add(&m->nurbs, &pts[0][0], n) != 0)
+        return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "move to a non-finite position");
     m->more_z = op->d[2];
-    m->more_kind = NCP_C_NURBS_FEED;
-    m->more_steps = NCP_SPLINE_STEPS;
-    m->more_left = NCP_SPLINE_STEPS;
     m->more_line = line;
-    return ncp_canon_map_more(m, s, d);
+    m->more_kind = NCP_C_NURBS_POINTS;
+    return nurbs_more(m, s, d);
 }
 
 /* Axis indices (machine X=0 Y=1 Z=2) of first, second and normal per plane. */
