@@ -6,6 +6,7 @@
 #include "ncpar/executor.h"
 
 #include <math.h>
+#include <string.h>
 
 /* rs274 (interp_internal.hh) defaults, used when the analyzer leaves d[10] or
  * d[11] zero. RADIUS_TOLERANCE_* is not configurable in rs274, so it is not
@@ -138,16 +139,34 @@ int ncp_exec_resolve(struct ncp_cmd *cmd)
     return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }
 
+/* rs274's driver resets the canon twice as it exits, after any error. The
+ * analyzer writes those calls behind its own errors; an error found here
+ * (an arc that cannot be drawn) ends the program as well, after calls the
+ * analyzer has long since moved past, so its two lines go behind the text of
+ * the calls that still print. Text only: they are the driver's exit, nothing
+ * for the machine to do. */
+static const char exit_resets[] = "ON_RESET()\nON_RESET()\n";
+
+static void exec_into(struct ncp_cmd *cmd, char *dst)
+{
+    int had_error = (cmd->flags & NCP_CMD_F_ERROR) != 0;
+    ncp_exec_resolve(cmd);
+    int failed_here = !had_error && (cmd->flags & NCP_CMD_F_ERROR);
+    ncp_exec_format_into(cmd, dst);
+    if (failed_here && cmd->out_len + sizeof exit_resets - 1 <= NCP_CMD_OUT_MAX) {
+        memcpy(dst + cmd->out_len, exit_resets, sizeof exit_resets - 1);
+        cmd->out_len += (uint32_t)(sizeof exit_resets - 1);
+    }
+}
+
 int ncp_exec_cmd(struct ncp_cmd *cmd)
 {
-    ncp_exec_resolve(cmd);
-    ncp_exec_format(cmd);
+    exec_into(cmd, cmd->out);
     return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }
 
 int ncp_exec_cmd_into(struct ncp_cmd *cmd, char *dst)
 {
-    ncp_exec_resolve(cmd);
-    ncp_exec_format_into(cmd, dst);
+    exec_into(cmd, dst);
     return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }
