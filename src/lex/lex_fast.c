@@ -200,6 +200,9 @@ fast_line(const char *text, size_t avail, size_t len, uint64_t offset, struct nc
         double v;
         if (!plain_number(text, len, &i, &v, bounded))
             return 0;
+        /* M98 or M99 first on the line: a Fanuc-style call or return */
+        if (c == 'm' && n_words == 0 && (v == 98.0 || v == 99.0))
+            return 0;
         size_t j = word_ends(text, len, i, bounded);
         if (j == 0)
             return 0;
