@@ -4,6 +4,7 @@
  * comments, a ';' tail). Only what rs274's reader itself rejects is an error
  * here; what the words mean is the analyzer's business. */
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 #include "lex_internal.h"
@@ -221,12 +222,10 @@ static int fanuc_m(struct ncp_lexer *lx)
     lx->pos = pos;
     if (m != 98 && m != 99)
         return items(lx);
+    /* the fields the packed form carries, padding included, all set */
+    memset(&b->oword, 0, offsetof(struct ncp_oword, args));
     b->oword.kind = (uint8_t)(m == 98 ? NCP_O_M98 : NCP_O_M99);
     b->oword.col = lx->col[pos];
-    b->oword.nargs = 0;
-    b->oword.has_cond = 0;
-    b->oword.name_off = b->oword.name_len = 0;
-    b->oword.tail_col = 0;
     if (m == 98) {
         lx->pos = pos + 3 < lx->n ? pos + 3 : lx->n;
         return items(lx);

@@ -163,6 +163,13 @@ fast_line(const char *text, size_t avail, size_t len, uint64_t offset, struct nc
             out->n_number = nv;
         }
     }
+    /* M first on the line (M98, M99: Fanuc-style calls and returns) is the
+     * general reader's: tested once a line, where a test of each word costs
+     * more on CAM text, whose few M lines lose little */
+    while (NCP_IN(i) && is_blank(text[i]))
+        i++;
+    if (NCP_IN(i) && (text[i] | 32) == 'm')
+        return 0;
     for (;;) {
         while (NCP_IN(i) && is_blank(text[i]))
             i++;
@@ -199,9 +206,6 @@ fast_line(const char *text, size_t avail, size_t len, uint64_t offset, struct nc
         size_t letter = i++;
         double v;
         if (!plain_number(text, len, &i, &v, bounded))
-            return 0;
-        /* M98 or M99 first on the line: a Fanuc-style call or return */
-        if (c == 'm' && n_words == 0 && (v == 98.0 || v == 99.0))
             return 0;
         size_t j = word_ends(text, len, i, bounded);
         if (j == 0)
