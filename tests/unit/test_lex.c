@@ -718,6 +718,12 @@ static void test_fanuc_lines(void **state)
      * (the analyzer rejects it there) */
     assert_int_equal(lex("M98.5 P1"), NCP_OK);
     assert_int_equal(blk.oword.kind, NCP_O_NONE);
+    /* Known difference (README): rs274 reads an M value first on the line
+     * with the parameters of the moment, so "M#1 P100" with #1 = 98 is a
+     * call there (and "m#1" happens to be three characters); a lexer cannot
+     * know #1, and we read the line as plain words (M98: unknown M code). */
+    assert_int_equal(lex("M#1 P100"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_NONE);
     /* "m098" and "m98.0": three characters on is the rest of the number */
     expect_error("M098 P100", "Bad character '8' used", 4);
     assert_int_equal(blk.oword.kind, NCP_O_M98);
@@ -945,13 +951,15 @@ static void test_fast_path_is_the_general_reader(void **state)
     int taken = 0;
     for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++)
         expect_fast_like_general(lines[i], strlen(lines[i]), &taken);
-    assert_true(taken >= 18);
+    /* all but the empty lines and those that start with M (M98, M99: the
+     * general reader's, see test_fanuc_lines) */
+    assert_true(taken >= 15);
     /* and what it must leave alone */
     static const char *const general_only[] = {
         "N10.5 G1 X1", "N 10 G1", "N10(c)", "N10 ;c", "G1 N10 X1", "N", "NX1", "N10 O100 sub",
         "N10 N20", "N10 2", "/N10 G1", "G1 X1 (c)", "G1 X1 ;c", "/G1 X1", "G1 X#1", "G1 X[1]", "G1 X1 X2",
         "G1 X1.2.3", "G1 X--1", "G1 X1 2", "G1 X", "o100 sub", "G1 U1", "G1 X1\r",
-        "G1 X1\v", "#1=2", "G1 $1", "G1 X 1",
+        "G1 X1\v", "#1=2", "G1 $1", "G1 X 1", "M98 P1", "N10 M99", "m3",
     };
     for (size_t i = 0; i < sizeof general_only / sizeof general_only[0]; i++) {
         static struct ncp_block b;
