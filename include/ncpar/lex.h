@@ -74,13 +74,23 @@ enum ncp_oword_kind {
     NCP_O_NONE = 0, NCP_O_SUB, NCP_O_ENDSUB, NCP_O_CALL, NCP_O_RETURN,
     NCP_O_IF, NCP_O_ELSEIF, NCP_O_ELSE, NCP_O_ENDIF,
     NCP_O_WHILE, NCP_O_ENDWHILE, NCP_O_DO, NCP_O_REPEAT, NCP_O_ENDREPEAT,
-    NCP_O_BREAK, NCP_O_CONTINUE
+    NCP_O_BREAK, NCP_O_CONTINUE,
+    /* Fanuc-style subroutines, as rs274 2.9 reads them:
+     * FANUC: a bare "O100" line (a definition, run into at level 0);
+     * M98:   a line whose first item (after '/' and N) is M98: the call, its
+     *        P (the sub's number) and L (repeats) among the block's words, the
+     *        M98 itself not; the rest of the line is read as words, not run;
+     * M99:   a line whose first item is M99, lexed as usual (M99 one of its
+     *        words): a return inside a sub, an end (like M2) at level 0. */
+    NCP_O_FANUC, NCP_O_M98, NCP_O_M99
 };
 
 struct ncp_oword {
     uint8_t kind;             /* enum ncp_oword_kind */
     uint8_t nargs;            /* CALL: number of [args] */
     uint16_t col;
+    uint16_t tail_col;        /* M99: column of the first thing after "m99" that
+                                 is no comment (an error there in a sub), 0 none */
     /* the O-word's name: numeric ("o100" -> "100", leading zeros stripped) or
      * named ("o<foo>" -> "foo", lower-cased), always as text in the pool */
     uint16_t name_off, name_len;

@@ -302,6 +302,35 @@ int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b)
     return rc;
 }
 
+/* An M98 line as rs274's read_o and parse_line read it (the flow's reader):
+ * every word's value and the reader's checks, then its P, then, unless
+ * skipping, the block's word checks, where P and L are M98's. Nothing of the
+ * line is executed (rs274 does not set its parameters either). */
+static int ncp_an_read_m98(void *ctx, const struct ncp_block *b, int skipping, int *p,
+                           int *l, struct ncp_diag *d)
+{
+    struct ncp_analyzer *a = ctx;
+    struct ncp_words *w = &a->w;
+    a->blk = b;
+    a->line = b->line;
+    int rc = ncp_words_collect(a, b);
+    if (rc == NCP_OK && !NCP_HAS(w, 'P'))
+        rc = ncp_an_error(a, b->oword.col, "Found 'm98' code with no P-word");
+    if (rc == NCP_OK && ncp_flow_m98_number(w->v[NCP_LETTER('P')], p) != 0)
+        rc = ncp_an_error(a, w->col[NCP_LETTER('P')], "Non integer value for integer");
+    if (rc == NCP_OK && !skipping) {
+        w->m98 = 1;
+        rc = ncp_modal_check(a);
+        w->m98 = 0;
+    }
+    *l = -1;
+    if (rc == NCP_OK && NCP_HAS(w, 'L'))
+        rc = ncp_integer_word(a, w->v[NCP_LETTER('L')], w->col[NCP_LETTER('L')], l);
+    if (rc != NCP_OK)
+        *d = a->err;
+    return rc;
+}
+
 static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
 {
     a->blk = b;
@@ -344,6 +373,8 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
     }
     ncp_flow_set_param_ops(a->flow, a->pops);
     ncp_flow_set_frame_hooks(a->flow, ncp_m7x_hooks(a));
+    ncp_flow_set_m98_reader(a->flow,
+                            (struct ncp_flow_m98_reader){ .ctx = a, .read = ncp_an_read_m98 });
     ncp_m7x_reset(a);
     ncp_cutcomp_init(&a->comp, NULL);
     a->staged.pending = 0;

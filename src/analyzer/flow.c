@@ -51,8 +51,14 @@ struct flow_labels {
     size_t used, acap;
 };
 
+/* How a call level was entered (rs274's call_type): frame 0 by none. */
+enum { FLOW_CT_NONE, FLOW_CT_OWORD, FLOW_CT_M98 };
+
 struct flow_frame {
     struct flow_pos ret;              /* block after the call */
+    uint8_t call_type;                /* FLOW_CT_* */
+    int32_t m98_loops;                /* M98 L repeats left of a call made from
+                                         this level (rs274's m98_loop_counter), -1 */
     uint16_t name_len;
     char name[FLOW_NAME_MAX];         /* the called sub: scope of its labels */
 };
@@ -88,6 +94,7 @@ struct ncp_flow {
     struct ncp_params *params;
     struct ncp_param_ops pops;
     struct ncp_flow_frames hooks;
+    struct ncp_flow_m98_reader m98_reader;
     uint32_t max_loops, max_depth;
 
     struct flow_pos cur;              /* next block to execute */
@@ -112,6 +119,7 @@ struct ncp_flow {
     double test_value;
     double args[NCP_OWORD_MAX_ARGS];
     int nargs;
+    int m98_p, m98_l;                 /* the M98 line being run: sub number, L or -1 */
 
     int inline_level;                 /* an inline call returns to this level, or -1 */
     char label[FLOW_LABEL_MAX];       /* label of the block being run */
@@ -248,9 +256,10 @@ static void release_feed(struct ncp_flow *f)
     }
 }
 
+/* O-word lines, and M98 lines, which rs274 reads even where it skips */
 static int may_be_oword(const char *s, size_t n)
 {
-    return memchr(s, 'o', n) || memchr(s, 'O', n);
+    return memchr(s, 'o', n) || memchr(s, 'O', n) || memchr(s, 'm', n) || memchr(s, 'M', n);
 }
 
 static int from_feed(struct ncp_flow *f, const struct ncp_block **out)
@@ -336,6 +345,7 @@ static const char *kind_name(int kind)
         [NCP_O_WHILE] = "while", [NCP_O_ENDWHILE] = "endwhile", [NCP_O_DO] = "do",
         [NCP_O_REPEAT] = "repeat", [NCP_O_ENDREPEAT] = "endrepeat",
         [NCP_O_BREAK] = "break", [NCP_O_CONTINUE] = "continue",
+        [NCP_O_FANUC] = "", [NCP_O_M98] = "M98", [NCP_O_M99] = "M99",
     };
     if (kind < 0 || kind >= (int)(sizeof names / sizeof names[0]) || !names[kind])
         return "?";
@@ -404,7 +414,7 @@ static void display_name(const struct ncp_block *b, char *buf, size_t cap)
 static int is_global_kind(int kind)
 {
     return kind == NCP_O_SUB || kind == NCP_O_ENDSUB || kind == NCP_O_CALL ||
-           kind == NCP_O_RETURN;
+           kind == NCP_O_RETURN || kind >= NCP_O_FANUC;
 }
 
 /* Subroutine names are global; other labels belong to the subroutine they are
@@ -413,6 +423,14 @@ static void make_label(struct ncp_flow *f, const struct ncp_block *b)
 {
     const char *name = b->pool + b->oword.name_off;
     size_t len = b->oword.name_len, n = 0;
+    char num[16];
+    if (b->oword.kind == NCP_O_M98) {         /* the sub's number from P */
+        len = (size_t)snprintf(num, sizeof num, "%d", f->m98_p);
+        name = num;
+    } else if (b->oword.kind == NCP_O_M99) {  /* the sub it is in */
+        name = f->frames[f->level].name;
+        len = f->frames[f->level].name_len;
+    }
     if (len > FLOW_NAME_MAX)
         len = FLOW_NAME_MAX;
     if (!is_global_kind(b->oword.kind)) {
@@ -566,8 +584,22 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
     *ignore = 0;
     switch (o->kind) {
     case NCP_O_SUB:
+    case NCP_O_FANUC:
         if (f->defining.on)
             return oword_error(b, "Nested subroutine definition", d);
+        return NCP_OK;
+    case NCP_O_M99: /* read as an O-word in a sub only (level > 0) */
+        if (f->defining.on)
+            return oword_error(b, "Found 'M99' instead of 'O endsub' after 'O sub'", d);
+        if (skipping_other(f)) {
+            *ignore = 1;
+            return NCP_OK;
+        }
+        ncp_params_set_return(f->params, 0.0, 0);
+        /* rs274 looks at the rest of the line unless it is skipping */
+        if (!f->skip.on && o->tail_col)
+            return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, o->tail_col,
+                                "Unexpected character after O-word");
         return NCP_OK;
     case NCP_O_ENDSUB:
     case NCP_O_RETURN:
@@ -625,6 +657,8 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
 
 static int do_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
+    if (f->frames[f->level].call_type == FLOW_CT_M98)
+        return oword_error(b, "'O.... sub' subroutine must be called with 'O.... call'", d);
     if (f->skip.on) {
         /* found the sub a call was seeking: it is defined from now on */
         int rc = save_label(f, b, NULL, d);
@@ -644,6 +678,23 @@ static int do_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag
     return NCP_OK;
 }
 
+/* A bare "O100" line: where an M98 call was seeking it, the sub is defined
+ * from here on; otherwise (at level 0, or further down in a sub) rs274 just
+ * reads on into it, defining nothing. */
+static int do_fanuc(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    if (f->frames[f->level].call_type == FLOW_CT_OWORD)
+        return oword_error(b, "Fanuc 'O....' subroutine must be called with 'M98'", d);
+    if (f->skip.on) {
+        int rc = save_label(f, b, NULL, d);
+        if (rc != NCP_OK)
+            return rc;
+        f->skip.on = 0;
+    }
+    f->seek_sub.on = 0;
+    return NCP_OK;
+}
+
 static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     if (f->level == 0 && !f->in_sub_context) {
@@ -651,6 +702,15 @@ static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
         int n = line_text(f, b, &s);
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                             "not in a subroutine definition: '%.*s'", n, s);
+    }
+    if (f->level > 0) {
+        /* a sub is left the way it was entered */
+        int ct = f->frames[f->level].call_type;
+        if (ct == FLOW_CT_M98 && b->oword.kind != NCP_O_M99)
+            return oword_error(b, "Fanuc 'O....' subroutine definition must end with 'M99'", d);
+        if (ct == FLOW_CT_OWORD && b->oword.kind == NCP_O_M99)
+            return oword_error(b, "'O.... endsub' or 'O.... return' must follow 'O.... sub' "
+                                  "subroutine definition", d);
     }
     if (f->skip.on && b->oword.kind == NCP_O_ENDSUB)
         f->skip.on = 0;
@@ -741,33 +801,45 @@ static int open_sub_file(struct ncp_flow *f, const struct ncp_block *b, uint32_t
     return NCP_OK;
 }
 
-static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+/* A new call level for the sub named by the label: a copy of the arguments
+ * for o-word calls, the caller's #1..#30 for M98 (ct). */
+static int enter_call(struct ncp_flow *f, const struct ncp_block *b, int ct,
+                      struct ncp_diag *d)
 {
     if ((uint32_t)f->level + 1 >= f->max_depth)
         return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, b->oword.col,
                             "Too many subroutine levels");
     if (grow_frames(f) != 0)
         return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
-    int rc = ncp_params_push_call(f->params, f->args, f->nargs, d);
+    int rc = ct == FLOW_CT_M98 ? ncp_params_push_shared(f->params, d)
+                               : ncp_params_push_call(f->params, f->args, f->nargs, d);
     if (rc != NCP_OK)
         return rc;
     struct flow_frame *fr = &f->frames[++f->level];
     if (f->hooks.entered)
         f->hooks.entered(f->hooks.ctx, f->level);
     fr->ret = f->cur;
+    fr->call_type = (uint8_t)ct;
+    fr->m98_loops = -1;
     size_t n = f->label_len < FLOW_NAME_MAX ? f->label_len : FLOW_NAME_MAX;
     memcpy(fr->name, f->label, n);
     fr->name_len = (uint16_t)n;
+    return NCP_OK;
+}
+
+/* Go to the called sub's definition: its recorded line, or, not seen yet,
+ * rs274 looks for a file of its name first, and reads that from its start
+ * for the definition; without one it reads on here. */
+static int go_to_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
     f->skip.on = 0;
     const struct flow_label *op = find_label(f);
     if (op) {
         jump_to(f, op);
         return NCP_OK;
     }
-    /* not seen yet: rs274 looks for a file of its name first, and reads that
-     * from its start for the definition; without one it reads on here */
     uint32_t file = 0;
-    rc = open_sub_file(f, b, &file, d);
+    int rc = open_sub_file(f, b, &file, d);
     if (rc != NCP_OK)
         return rc;
     skip_to_label(f, b);
@@ -777,6 +849,72 @@ static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_dia
         go_to(f, (struct flow_pos){ s->begin, s->begin_line, file });
         f->skip_start = 0; /* rs274 counts lines afresh in the new file */
     }
+    return NCP_OK;
+}
+
+static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    int rc = enter_call(f, b, FLOW_CT_OWORD, d);
+    return rc == NCP_OK ? go_to_sub(f, b, d) : rc;
+}
+
+/* M98 P.. [L..], as rs274's execute_call: with L, the calling level counts
+ * the repeats down and, while some are left, returns to the M98 line itself,
+ * which then runs again (its P read anew); L0 enters the call level and
+ * reads on after the M98 line, without going to the sub. */
+static int do_m98(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    if (f->m98_l > 0 && (uint32_t)f->m98_l > f->max_loops)
+        return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, b->oword.col,
+                            "M98 L%d repeats a sub more than %u times: runaway loop? "
+                            "(raise max_loop_iterations if intended)",
+                            f->m98_l, f->max_loops);
+    struct flow_pos here = { b->offset, b->line, f->cur.file };
+    int rc = enter_call(f, b, FLOW_CT_M98, d);
+    if (rc != NCP_OK)
+        return rc;
+    if (f->m98_l >= 0) {
+        struct flow_frame *caller = &f->frames[f->level - 1];
+        if (caller->m98_loops == -1)
+            caller->m98_loops = f->m98_l;
+        if (--caller->m98_loops > 0)
+            f->frames[f->level].ret = here;
+        else
+            caller->m98_loops = -1;
+        if (f->m98_l == 0)
+            return NCP_OK;
+    }
+    return go_to_sub(f, b, d);
+}
+
+/* The M98 line's words, read before anything else is done with it. */
+static int read_m98(struct ncp_flow *f, const struct ncp_block *b, int skipping,
+                    struct ncp_diag *d)
+{
+    f->m98_p = 0;
+    f->m98_l = -1;
+    if (f->m98_reader.read)
+        return f->m98_reader.read(f->m98_reader.ctx, b, skipping, &f->m98_p, &f->m98_l, d);
+    int has_p = 0;
+    double p = 0.0, v;
+    for (unsigned k = 0; k < b->n_words && k < NCP_BLOCK_MAX_WORDS; k++) {
+        const struct ncp_word *w = &b->words[k];
+        if (w->letter != 'P' && w->letter != 'L')
+            continue;
+        int rc = eval(f, b, &w->v, &v, d);
+        if (rc != NCP_OK)
+            return rc;
+        if (w->letter == 'P') {
+            has_p = 1;
+            p = v;
+        } else {
+            f->m98_l = ncp_trunc_int_round(v);
+        }
+    }
+    if (!has_p)
+        return oword_error(b, "Found 'm98' code with no P-word", d);
+    if (ncp_flow_m98_number(p, &f->m98_p) != 0)
+        return oword_error(b, "Non integer value for integer", d);
     return NCP_OK;
 }
 
@@ -962,20 +1100,30 @@ static int do_endloop(struct ncp_flow *f, const struct ncp_block *b, struct ncp_
 static int run_oword(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     int ignore;
+    if (b->oword.kind == NCP_O_M98) {
+        int rc = read_m98(f, b, f->skip.on, d);
+        if (rc != NCP_OK)
+            return rc;
+    }
     make_label(f, b);
     int rc = read_oword(f, b, &ignore, d);
     if (rc != NCP_OK || ignore || skipping_other(f))
         return rc;
-    if (f->seek_sub.on && b->oword.kind != NCP_O_SUB)
+    if (f->seek_sub.on && b->oword.kind != NCP_O_SUB && b->oword.kind != NCP_O_FANUC)
         return NCP_OK;
     switch (b->oword.kind) {
     case NCP_O_SUB:
         return do_sub(f, b, d);
+    case NCP_O_FANUC:
+        return do_fanuc(f, b, d);
     case NCP_O_ENDSUB:
     case NCP_O_RETURN:
+    case NCP_O_M99:
         return do_return(f, b, d);
     case NCP_O_CALL:
         return do_call(f, b, d);
+    case NCP_O_M98:
+        return do_m98(f, b, d);
     case NCP_O_DO:
         return do_do(f, b, d);
     case NCP_O_REPEAT:
@@ -1034,10 +1182,19 @@ static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
         if (!b || (FLOW_BLOCK_DELETE && b->block_delete))
             continue;
         f->by_jump = b->offset == target;
+        int kind = b->oword.kind;
+        /* M99 first on a line returns from a sub; in the main program it
+         * is an M code like M2 */
+        if (kind == NCP_O_M99 && f->level == 0)
+            kind = NCP_O_NONE;
         if (b->err.code != NCP_OK) {
-            /* rs274 does not parse the lines it skips */
-            if (skipping)
+            /* rs274 does not parse the lines it skips, but for M98 lines;
+             * the rest of an M99 line in a sub, only comments are allowed */
+            if (skipping && kind != NCP_O_M98)
                 continue;
+            if (kind == NCP_O_M99 && b->oword.tail_col)
+                return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.tail_col,
+                                    "Unexpected character after O-word");
             if (f->inline_level >= 0) { /* a G7x profile: the caller reads it its way */
                 *out = b;
                 return NCP_OK;
@@ -1045,7 +1202,7 @@ static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
             *d = b->err;
             return b->err.code;
         }
-        if (b->oword.kind == NCP_O_NONE) {
+        if (kind == NCP_O_NONE) {
             if (skipping)
                 continue;
             *out = b;
@@ -1105,6 +1262,12 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
     f->feed_pos = f->cur;
     f->jump_target = UINT64_MAX;
     f->inline_level = -1;
+    if (grow_frames(f) != 0) {
+        free(f);
+        return NULL;
+    }
+    memset(&f->frames[0], 0, sizeof f->frames[0]);
+    f->frames[0].m98_loops = -1;
     return f;
 }
 
@@ -1116,6 +1279,11 @@ void ncp_flow_set_param_ops(struct ncp_flow *f, struct ncp_param_ops ops)
 void ncp_flow_set_frame_hooks(struct ncp_flow *f, struct ncp_flow_frames hooks)
 {
     f->hooks = hooks;
+}
+
+void ncp_flow_set_m98_reader(struct ncp_flow *f, struct ncp_flow_m98_reader r)
+{
+    f->m98_reader = r;
 }
 
 void ncp_flow_free(struct ncp_flow *f)
@@ -1164,5 +1332,6 @@ void ncp_flow_reset(struct ncp_flow *f)
     f->defining.on = 0;
     f->in_sub_context = 0;
     f->inline_level = -1;
+    f->frames[0].m98_loops = -1;
     labels_clear(&f->labels);
 }

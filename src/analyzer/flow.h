@@ -9,6 +9,7 @@
 #ifndef NCP_ANALYZER_FLOW_H
 #define NCP_ANALYZER_FLOW_H
 
+#include <math.h>
 #include "ncpar/analyzer.h"
 #include "params.h"
 
@@ -31,6 +32,34 @@ struct ncp_flow_frames {
     void (*left)(void *ctx, int level);
 };
 void ncp_flow_set_frame_hooks(struct ncp_flow *f, struct ncp_flow_frames hooks);
+
+/* Fanuc-style calls (M98 lines): rs274 reads the whole line, even where it
+ * skips, before it looks at the call: every word's value and the reader's
+ * checks, then the P word ("Found 'm98' code with no P-word", P not an
+ * integer), then, unless skipping, the block's word checks. The analyzer does
+ * that here; *p is the sub's number, *l the L word (repeats) or -1 without
+ * one. Without a reader the flow evaluates P and L itself. */
+struct ncp_flow_m98_reader {
+    void *ctx;
+    int (*read)(void *ctx, const struct ncp_block *b, int skipping, int *p, int *l,
+                struct ncp_diag *d);
+};
+void ncp_flow_set_m98_reader(struct ncp_flow *f, struct ncp_flow_m98_reader r);
+
+/* M98's P as rs274's read_o makes it a sub number: the floor, or the ceiling
+ * within 0.0001 of it; 0 and *out, or -1 for a value further from an integer
+ * ("Non integer value for integer"). */
+static inline int ncp_flow_m98_number(double p, int *out)
+{
+    double fl = floor(p);
+    int n = ncp_trunc_int(fl);
+    if (p - n > 0.9999)
+        n = ncp_trunc_int(ceil(p));
+    else if (p - n > 0.0001)
+        return -1;
+    *out = n;
+    return 0;
+}
 
 /* Next non-O-word block to interpret. Returns NCP_OK and sets *out (valid until
  * the next call), NCP_END at the end of the program body, or an error with *d
@@ -57,7 +86,8 @@ const struct ncp_source *ncp_flow_source(const struct ncp_flow *f);
 const char *ncp_flow_file(const struct ncp_flow *f);
 unsigned ncp_flow_file_tag(const struct ncp_flow *f); /* its ncp_diag_file_tag, 0 */
 
-/* Current subroutine call depth (0 = main program). */
+/* Current subroutine call depth (0 = main program): an M99 not first on its
+ * line inside a sub is an error rs274 reports as a bug of its own. */
 int ncp_flow_call_depth(const struct ncp_flow *f);
 
 /* M2/M30 inside a subroutine, or errors: drop all frames. */

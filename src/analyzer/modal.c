@@ -149,14 +149,14 @@ static int ncp_check_other(struct ncp_analyzer *a)
         mt != 870)
         return ncp_an_error(a, COL('K'), "K word with no G2, G3, G33, G33.1, G76, or G87 to use it");
     if (NCP_HAS(w, 'L') && (mt < 810 || mt > 890) && mt != 760 && mt != 52 && mt != 730 &&
-        !g10 && !comp_on && w->m[NCP_MG_IO] != 66)
+        !g10 && !comp_on && w->m[NCP_MG_IO] != 66 && !w->m98)
         return ncp_an_error(a, COL('L'), "L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or NURBS code");
     if (NCP_HAS(w, 'P')) {
         int mo = w->m[NCP_MG_OVERRIDE], mi = w->m[NCP_MG_IO];
         if (!g10 && m0 != 40 && ctl != 640 && mt != 760 && mt != 820 && mt != 860 &&
             mt != 880 && mt != 890 && mt != 50 && mt != 52 && mt != 20 && mt != 30 &&
             mt != 840 && mt != 740 && !g70 && (mo < 50 || mo > 53) && (mi < 62 || mi > 66) &&
-            w->m[NCP_MG_SPINDLE] != 19)
+            w->m[NCP_MG_SPINDLE] != 19 && !w->m98)
             return ncp_an_error(a, COL('P'), "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 M63 M64 M65 M66 M98 or user M code to use it");
         double p = w->v[NCP_LETTER('P')];
         int pv = ncp_trunc_int_round(p);

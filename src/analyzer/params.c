@@ -28,6 +28,7 @@ struct nametab {
 
 struct call_frame {
     double saved[NCP_CALL_ARGS];
+    int shared;                /* an M98 call: #1..#30 are the caller's */
 };
 
 struct ncp_params {
@@ -340,8 +341,8 @@ int ncp_params_exists(const struct ncp_params *p, const char *name, size_t len)
 
 /* ---- calls --------------------------------------------------------------- */
 
-int ncp_params_push_call(struct ncp_params *p, const double *args, int nargs,
-                         struct ncp_diag *d)
+static int push_frame(struct ncp_params *p, const double *args, int nargs, int shared,
+                      struct ncp_diag *d)
 {
     if (p->level >= p->frames_cap) {
         int ncap = p->frames_cap ? p->frames_cap * 2 : 16;
@@ -352,17 +353,31 @@ int ncp_params_push_call(struct ncp_params *p, const double *args, int nargs,
         p->frames = nf;
         p->frames_cap = ncap;
     }
-    if (nargs < 0)
-        nargs = 0;
-    if (nargs > NCP_CALL_ARGS)
-        nargs = NCP_CALL_ARGS;
-    memcpy(p->frames[p->level].saved, &p->num[1], sizeof p->frames[0].saved);
-    for (int i = 0; i < NCP_CALL_ARGS; i++)
-        p->num[1 + i] = i < nargs ? args[i] : 0.0;
+    p->frames[p->level].shared = shared;
+    if (!shared) {
+        if (nargs < 0)
+            nargs = 0;
+        if (nargs > NCP_CALL_ARGS)
+            nargs = NCP_CALL_ARGS;
+        memcpy(p->frames[p->level].saved, &p->num[1], sizeof p->frames[0].saved);
+        for (int i = 0; i < NCP_CALL_ARGS; i++)
+            p->num[1 + i] = i < nargs ? args[i] : 0.0;
+    }
     p->level++;
     if (p->level < p->n_levels)
         tab_clear(&p->locals[p->level]);
     return NCP_OK;
+}
+
+int ncp_params_push_call(struct ncp_params *p, const double *args, int nargs,
+                         struct ncp_diag *d)
+{
+    return push_frame(p, args, nargs, 0, d);
+}
+
+int ncp_params_push_shared(struct ncp_params *p, struct ncp_diag *d)
+{
+    return push_frame(p, NULL, 0, 1, d);
 }
 
 void ncp_params_pop_call(struct ncp_params *p)
@@ -372,7 +387,8 @@ void ncp_params_pop_call(struct ncp_params *p)
     if (p->level < p->n_levels)
         tab_clear(&p->locals[p->level]);
     p->level--;
-    memcpy(&p->num[1], p->frames[p->level].saved, sizeof p->frames[0].saved);
+    if (!p->frames[p->level].shared)
+        memcpy(&p->num[1], p->frames[p->level].saved, sizeof p->frames[0].saved);
 }
 
 int ncp_params_call_level(const struct ncp_params *p)

@@ -52,6 +52,9 @@ void ncp_params_set_return(struct ncp_params *p, double value, int returned);
  * #1..#nargs from args (the rest 0, as rs274). Return restores both. */
 int ncp_params_push_call(struct ncp_params *p, const double *args, int nargs,
                          struct ncp_diag *d);
+/* An M98 call: a new local-name scope, #1..#30 shared with the caller (rs274
+ * neither saves nor sets them); its pop restores only the scope. */
+int ncp_params_push_shared(struct ncp_params *p, struct ncp_diag *d);
 void ncp_params_pop_call(struct ncp_params *p);
 int ncp_params_call_level(const struct ncp_params *p);
 

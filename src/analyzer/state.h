@@ -60,6 +60,7 @@ struct ncp_words {
     int n_m;
     uint16_t line_col;            /* col of the first word, for block-level errors */
     int motion_to_be;             /* motion this block performs (x10), -1 none */
+    int m98;                      /* 1 while an M98 line is checked: P and L are its */
 };
 
 struct ncp_modal {

@@ -95,11 +95,17 @@ static int ncp_stop_end(struct ncp_analyzer *a, int m)
     return NCP_END;
 }
 
+/* M99 in the main program ends it as M2 does (rs274 -g does not loop back
+ * to the start); in a sub, M99 first on its line returns (flow.c), so one
+ * that gets here stood after other words, which rs274 calls a bug of its own. */
 int ncp_stop_run(struct ncp_analyzer *a, int m)
 {
-    int rc = ncp_comp_stop(a, m == 2 || m == 30);
+    int rc = ncp_comp_stop(a, m == 2 || m == 30 || m == 99);
     if (rc != NCP_OK)
         return rc;
+    if (m == 99 && ncp_flow_call_depth(a->flow) > 0)
+        return ncp_an_error(a, a->w.mcol[NCP_MG_STOP],
+                            "Bug:  Reached convert_stop() from M99 as subprogram return");
     switch (m) {
     case 0:
         ncp_an_emit(a, NCP_C_PROGRAM_STOP);

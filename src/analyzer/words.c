@@ -68,7 +68,8 @@ static void ncp_g_table_init(void)
 static int ncp_m_group(int m)
 {
     switch (m) {
-    case 0: case 1: case 2: case 30: case 60: return NCP_MG_STOP;
+    /* M99: a return where it is first on a line in a sub (flow.c); else an end */
+    case 0: case 1: case 2: case 30: case 60: case 99: return NCP_MG_STOP;
     case 6: case 61: return NCP_MG_TOOL;
     case 3: case 4: case 5: case 19:
     case 70: case 71: case 72: case 73: /* rs274's group 7 holds M70-M73 too */

@@ -4,6 +4,7 @@
  * comments, a ';' tail). Only what rs274's reader itself rejects is an error
  * here; what the words mean is the analyzer's business. */
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 #include "lex_internal.h"
@@ -198,6 +199,50 @@ static int items(struct ncp_lexer *lx)
     return NCP_OK;
 }
 
+/* rs274's read_items() reads the value of an M first on the line (after '/'
+ * and N) before anything else: M98 there makes the line a Fanuc-style call,
+ * read from three characters on (so "m098" leaves "8" behind, a bad
+ * character, as in rs274); M99 there is marked, and lexed as usual. A value
+ * that cannot be read, or depends on parameters, leaves the line to the
+ * usual reader (rs274 would decide on the parameter's value: not done here). */
+static int fanuc_m(struct ncp_lexer *lx)
+{
+    struct ncp_block *b = lx->b;
+    int pos = lx->pos;
+    uint16_t code_mark = b->n_code, pool_mark = b->pool_used;
+    struct ncp_lex_val v;
+    lx->pos++;
+    int rc = ncp_lex_integer_value(lx, &v);
+    int m = rc == NCP_OK && v.is_const ? ncp_trunc_int(v.k) : -1;
+    b->err.code = NCP_OK;
+    b->err.col = 0;
+    b->err.msg[0] = '\0';
+    b->n_code = code_mark;
+    b->pool_used = pool_mark;
+    lx->pos = pos;
+    if (m != 98 && m != 99)
+        return items(lx);
+    /* the fields the packed form carries, padding included, all set */
+    memset(&b->oword, 0, offsetof(struct ncp_oword, args));
+    b->oword.kind = (uint8_t)(m == 98 ? NCP_O_M98 : NCP_O_M99);
+    b->oword.col = lx->col[pos];
+    if (m == 98) {
+        lx->pos = pos + 3 < lx->n ? pos + 3 : lx->n;
+        return items(lx);
+    }
+    /* in a sub, rs274 allows only comments after the three characters */
+    for (int k = pos + 3; k < lx->n && lx->buf[k] != ';';) {
+        if (lx->buf[k] != '(') {
+            b->oword.tail_col = lx->col[k];
+            break;
+        }
+        while (k < lx->n && lx->buf[k] != ')')
+            k++;
+        k++;
+    }
+    return items(lx);
+}
+
 void ncp_lex_init_block(struct ncp_block *b, size_t len, uint32_t line, uint64_t offset)
 {
     b->offset = offset;
@@ -262,6 +307,8 @@ static int lex_general(const char *text, size_t len, uint32_t line, uint64_t off
         return rc;
     if (lx.buf[lx.pos] == 'o')
         rc = ncp_lex_oword(&lx);
+    else if (lx.buf[lx.pos] == 'm')
+        rc = fanuc_m(&lx);
     else
         rc = items(&lx);
     if (rc)

@@ -163,6 +163,13 @@ fast_line(const char *text, size_t avail, size_t len, uint64_t offset, struct nc
             out->n_number = nv;
         }
     }
+    /* M first on the line (M98, M99: Fanuc-style calls and returns) is the
+     * general reader's: tested once a line, where a test of each word costs
+     * more on CAM text, whose few M lines lose little */
+    while (NCP_IN(i) && is_blank(text[i]))
+        i++;
+    if (NCP_IN(i) && (text[i] | 32) == 'm')
+        return 0;
     for (;;) {
         while (NCP_IN(i) && is_blank(text[i]))
             i++;

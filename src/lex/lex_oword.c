@@ -134,6 +134,7 @@ int ncp_lex_oword(struct ncp_lexer *lx)
     int opos = lx->pos, rc;
 
     o->col = lx->col[opos];
+    o->tail_col = 0;
     o->nargs = 0;
     o->has_cond = 0;
     o->name_off = o->name_len = 0;
@@ -149,10 +150,9 @@ int ncp_lex_oword(struct ncp_lexer *lx)
         char next = lx->buf[lx->pos];
         if (next != '(' && next != ';' && next != '\0')
             return ncp_lex_fail(lx, lx->pos, "Unknown control command in o word");
-        if ((rc = rest_of_line(lx)))
-            return rc;
-        return ncp_lex_fail(lx, opos,
-                            "O-word without a command (Fanuc-style subroutine) is not supported");
+        /* a bare O-word: a Fanuc-style subroutine's first line */
+        o->kind = NCP_O_FANUC;
+        return rest_of_line(lx);
     }
     if ((rc = arguments(lx, o)))
         return rc;

@@ -12,6 +12,7 @@ G38.2-G38.5 (probing), M66 (wait for an input), M70/M72 (modal state save and
 restore), M0-M9 M30 M48/M49, S T M6 F, comments,
 MSG and DEBUG with parameters, numbered and named parameters, expressions with every
 operator and function, O-word subroutines with arguments and return values,
+Fanuc-style subroutines (O8000 ... M99 after the program end, M98 P8000 [L n]),
 if/elseif/else, while, do-while, repeat, break and continue. The same seed always gives the same program.
 
 How validity is kept without simulating the interpreter:
@@ -77,6 +78,10 @@ class Gen:
         self.next_label = 100
         self.next_counter = 1000
         self.subs = []                 # (call name, nargs, returns a value)
+        # Fanuc-style subs draw from a generator of their own, so a seed
+        # without them gives the program it gave before they were added
+        self.r98 = random.Random(seed * 7919 + 98)
+        self.fanuc = []                # their numbers, defined after M30/M2
         self.depth = 0                 # control-structure nesting of the code now
         self.scope = Scope(0, [])
         self.value_defined = False
@@ -615,6 +620,8 @@ class Gen:
 
     def st_call(self):
         r = self.r
+        if self.fanuc and self.depth == 0 and self.r98.random() < 0.4:
+            return self.st_m98()
         if not self.subs or self.depth > 0:
             return self.st_message()
         name, nargs, returns = r.choice(self.subs)
@@ -627,6 +634,29 @@ class Gen:
             self.value_defined = True
             if r.random() < 0.6:
                 self.emit("#%d = [#<_value> MOD 50]" % r.choice(SCRATCH))
+
+    def st_m98(self):
+        """M98 P.. [L..]: the sub shares #1-#30 with the caller and reads none."""
+        self.sub_entry_state()
+        reps = self.r98.choice(["", "", " L1", " L2", " L3"])
+        self.emit("M98 P%s%s" % (self.r98.choice(self.fanuc), reps))
+        self.forget_position()
+
+    def define_fanuc(self, number):
+        """O<number> ... M99, after the program end (rs274 would run into it)."""
+        r = self.r
+        saved = (self.scope, self.depth, dict(self.pos))
+        self.scope = Scope(0, GLOBAL_NAMES)
+        self.emit("O%s" % number)
+        self.depth = 1
+        self.units, self.plane, self.dist, self.ijk_abs = self.home_units, 17, 90, False
+        self.feed_mode = 94
+        self.forget_position()
+        for _ in range(r.randint(2, 6)):
+            self.simple_statement(inner=True, in_sub=True)
+        self.depth = 0
+        self.emit("M99")
+        self.scope, self.depth, self.pos = saved
 
     def define_sub(self, idx):
         r = self.r
@@ -1016,6 +1046,8 @@ class Gen:
                 self.emit("#%d = %s" % (p, num(v, 3)))
         for i in range(r.randint(1, 3)):
             self.define_sub(i)
+        if self.r98.random() < 0.5:
+            self.fanuc = ["%d" % (8000 + i) for i in range(self.r98.randint(1, 2))]
         self.emit("T%d M6" % r.choice(TOOLS))
         self.emit("G43")
         self.emit("S%d M3" % r.choice([1000, 3000, 6000]))
@@ -1030,6 +1062,8 @@ class Gen:
         self.emit("G80 G90 G94")
         self.emit("M5 M9")
         self.emit(self.r.choice(["M30", "M2"]))
+        for number in self.fanuc:
+            self.define_fanuc(number)
         return "\n".join(self.out) + "\n"
 
 

@@ -246,6 +246,49 @@ static void test_calls(void **state)
                  "3 8 14 16");
 }
 
+/* Fanuc-style subs (rs274 2.9): O100 ... M99, called with M98 P100 [L n] */
+static void test_fanuc_calls(void **state)
+{
+    (void)state;
+    /* the sub after the program end is found by reading on, then by its label */
+    expect_trace("g0x1\nm98 p100\ng0x2\nm98 p100\nm30\no100\ng0x3\nm99", "1 7 3 7 5");
+    /* L repeats: the M98 line runs again; L0 enters the level and reads on */
+    expect_trace("m98 p100 l3\nm30\no100\ng0x3\nm99", "4 4 4 2");
+    expect_trace("m98 p1 l0\ng0x1\nm99\nm30", "2 2 3 4");
+    /* the same counter rule for repeats inside repeats: 2 x (1 + 2) */
+    expect_trace("m98 p1 l2\nm30\no1\ng0x1\nm98 p2 l2\nm99\no2\ng0x2\nm99",
+                 "4 8 8 4 8 8 2");
+    /* #1..#30 are shared with the caller, P is read anew on every repeat */
+    expect_trace("#1=1\nm98 p#1 l2\nm30\no1\n#1=2\nm99\no2\ng0x2\nm99", "1 5 8 3");
+    /* run into at level 0: a bare O line defines nothing; M99 there is a block */
+    expect_trace("g0x1\no100\ng0x2\nm99\nm30", "1 3 4 5");
+    /* M98 lines are read where rs274 skips, but not acted on */
+    expect_trace("o1 if [0]\nm98 p5\no1 endif\nm30", "4");
+}
+
+static void test_fanuc_errors(void **state)
+{
+    (void)state;
+    expect_error("o1 if [0]\nm98\no1 endif\nm30", NCP_ERR_SEMANTIC, 2,
+                 "Found 'm98' code with no P-word", "");
+    expect_error("m98 p1.5\nm30", NCP_ERR_SEMANTIC, 1, "Non integer value for integer", "");
+    expect_error("o100 call\nm30\no100\ng0x1\nm99", NCP_ERR_SEMANTIC, 3,
+                 "Fanuc 'O....' subroutine must be called with 'M98'", "");
+    expect_error("m98 p100\nm30\no100 sub\nm99", NCP_ERR_SEMANTIC, 3,
+                 "'O.... sub' subroutine must be called with 'O.... call'", "");
+    expect_error("m98 p100\nm30\no100\ng0x1\no100 endsub", NCP_ERR_SEMANTIC, 5,
+                 "Fanuc 'O....' subroutine definition must end with 'M99'", "4");
+    expect_error("o100 call\nm30\no100 sub\ng0x1\nm99\no100 endsub", NCP_ERR_SEMANTIC, 5,
+                 "'O.... endsub' or 'O.... return' must follow 'O.... sub' subroutine "
+                 "definition", "4");
+    expect_error("m98 p1\nm30\no1\nm99 g0x1", NCP_ERR_SEMANTIC, 4,
+                 "Unexpected character after O-word", "");
+    expect_error("m98 p1\nm30\no1\nm98 p1\nm99", NCP_ERR_LIMIT, 4,
+                 "Too many subroutine levels", "");
+    expect_error("m98 p7\nm30", NCP_ERR_SEMANTIC, 1,
+                 "EOF in file:t.ngc seeking o-word: o<7> from line: 1", "");
+}
+
 static void test_return_values(void **state)
 {
     (void)state;
@@ -528,6 +571,8 @@ int main(void)
         cmocka_unit_test(test_loops),
         cmocka_unit_test(test_break_continue),
         cmocka_unit_test(test_calls),
+        cmocka_unit_test(test_fanuc_calls),
+        cmocka_unit_test(test_fanuc_errors),
         cmocka_unit_test(test_return_values),
         cmocka_unit_test(test_skipped_text_not_evaluated),
         cmocka_unit_test(test_line_endings_and_block_delete),
