@@ -89,6 +89,9 @@ enum ncp_canon_kind {
     NCP_C_COMMENT,               /* text */
     NCP_C_MESSAGE,               /* text */
     NCP_C_LOGOPEN, NCP_C_LOGAPPEND, NCP_C_LOGCLOSE, NCP_C_LOG, /* text */
+    NCP_C_PRINT,                 /* text: a (PRINT,...) comment, expanded, and '\n'. rs274 writes it to
+                                    its own stdout, not to the canonical stream: prints
+                                    nothing there (ncp_exec_write_prints has it) */
     NCP_C_ENABLE_FEED_OVERRIDE, NCP_C_DISABLE_FEED_OVERRIDE,
     NCP_C_ENABLE_SPEED_OVERRIDE, NCP_C_DISABLE_SPEED_OVERRIDE, /* i[0] spindle */
     NCP_C_ENABLE_FEED_HOLD, NCP_C_DISABLE_FEED_HOLD,

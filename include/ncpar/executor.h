@@ -5,6 +5,7 @@
 #define NCPAR_EXECUTOR_H
 
 #include <stddef.h>
+#include <stdio.h>
 #include "ncpar/canon.h"
 
 /* Resolve requests in cmd->ops (ARC_REQUEST -> ARC_FEED, ...). On a geometry error
@@ -23,6 +24,11 @@ void ncp_exec_format(struct ncp_cmd *cmd);
  * cmd->out: a thread that formats and writes a command itself can format
  * into its output buffer. cmd->out_len is set as ncp_exec_format sets it. */
 void ncp_exec_format_into(struct ncp_cmd *cmd, char *dst);
+
+/* The text of cmd's PRINT calls (a line each) to f, as rs274 writes them to
+ * its stdout: the canonical text has none of it. Returns 0, or -1 when f
+ * refused a write. */
+int ncp_exec_write_prints(const struct ncp_cmd *cmd, FILE *f);
 
 /* Both, as an executor thread does; and both with the text into dst. */
 int ncp_exec_cmd(struct ncp_cmd *cmd);

@@ -1,6 +1,7 @@
 /* Comments: COMMENT, MSG, DEBUG/LOG with parameter substitution (#5, #<name>,
  * %d %f %.Nf formats, as rs274 expands them), LOGOPEN/LOGAPPEND/LOGCLOSE.
- * PRINT goes to rs274's stdout, not to the canonical stream. */
+ * PRINT is a call of its own that prints nothing in the canonical stream:
+ * rs274 writes it to its stdout, cnc-run to stderr. */
 #include "state.h"
 
 #include <ctype.h>
@@ -137,6 +138,14 @@ int ncp_comment_run(struct ncp_analyzer *a)
         ncp_an_emit_text(a, NCP_C_MESSAGE, e.buf, e.n);
         break;
     }
+    case NCP_CMT_PRINT:
+        /* with its line end, so that an empty one still has text to carry */
+        ncp_expand(a, t, len, &e);
+        if (e.n == sizeof e.buf)
+            e.n--;
+        e.buf[e.n++] = '\n';
+        ncp_an_emit_text(a, NCP_C_PRINT, e.buf, e.n);
+        break;
     case NCP_CMT_LOG:
         ncp_expand(a, t, len, &e);
         ncp_an_emit_text(a, NCP_C_LOG, e.buf, e.n);

@@ -8,6 +8,7 @@
  * program, det -j 0: 158 ms with the thread, 142 ms without. */
 #include "canon_writer.h"
 
+#include "ncpar/executor.h"
 #include "ncpar/mem.h"
 
 #include <errno.h>
@@ -57,9 +58,18 @@ static int hand_over(struct canon_writer *w)
     return w->failed;
 }
 
+/* (PRINT,...) text goes where rs274's goes, beside the canonical stream: to
+ * stderr here, since the canonical text may be on stdout. */
+static void write_prints(const struct ncp_cmd *cmd)
+{
+    if (cmd->text_used)
+        (void)ncp_exec_write_prints(cmd, stderr);
+}
+
 int canon_writer_emit(void *ctx, const struct ncp_cmd *cmd)
 {
     struct canon_writer *w = ctx;
+    write_prints(cmd);
     if (!w)
         return 0;
     if (w->used + cmd->out_len > WRITER_BUF && hand_over(w))
@@ -80,6 +90,7 @@ char *canon_writer_reserve(void *ctx)
 int canon_writer_commit(void *ctx, const struct ncp_cmd *cmd)
 {
     struct canon_writer *w = ctx;
+    write_prints(cmd);
     w->used += cmd->out_len;
     return w->failed != 0;
 }

@@ -3,6 +3,8 @@
  * thread: it takes a setpoint, steps the backend and hands the cycle on. */
 #include "nck_int.h"
 
+#include "ncpar/executor.h"
+
 #include <math.h>
 #include <sched.h>
 #include <stdio.h>
@@ -45,6 +47,9 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
     struct nck *n = ctx;
     struct nck_seg_msg m;
     memset(&m, 0, sizeof m);
+    /* as the interpreter reaches them, ahead of the motion, as in LinuxCNC */
+    if (cmd->text_used)
+        (void)ncp_exec_write_prints(cmd, stderr);
     for (unsigned i = 0; i < cmd->n_ops; i++) {
         int rc = ncp_canon_map_op(&n->map, &cmd->ops[i], cmd->line, &m.seg, &n->map_diag);
         if (rc < 0) {

@@ -244,6 +244,10 @@ class Gen:
             bits = ["%s=%s" % (w, self.leaf()) for w in
                     r.sample(["a", "depth", "n", "val", "r"], r.randint(1, 3))]
             self.emit("(DEBUG, %s)" % " ".join(bits))
+        elif c < 0.9:
+            bits = ["%s %s" % (w, self.leaf()) for w in
+                    r.sample(["pass", "z", "count"], r.randint(1, 2))]
+            self.emit("(PRINT,%s)" % " ".join(bits))
         else:
             self.emit("(%s)" % r.choice(["plain comment", "T1 is 1/8 end mill",
                                          "G1 X0 in a comment", "-- section --"]))

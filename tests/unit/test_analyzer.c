@@ -143,6 +143,36 @@ static void test_preamble_and_end(void **state)
     run_free(&r);
 }
 
+/* (PRINT,...) is a call of its own with the expanded text and its line end
+ * (rs274 writes it to its stdout), an empty one too; a DEBUG beside it stays
+ * a MESSAGE. */
+static void test_print_calls(void **state)
+{
+    (void)state;
+    struct run r;
+    run_program(&r, "#1 = 2.5\n(PRINT, v=#1 %d#1)\n(print,)\n(DEBUG, d=#1)\nM2\n", 1);
+    assert_int_equal(r.rc, NCP_END);
+    static const char *const want[] = {" v=2.500000 2\n", "\n"};
+    unsigned prints = 0, messages = 0;
+    for (unsigned s = 0; s < r.c.n_slots; s++) {
+        const struct ncp_cmd *c = &r.c.slots[s];
+        for (unsigned k = 0; k < c->n_ops; k++) {
+            const struct ncp_canon *op = &c->ops[k];
+            if (op->kind == NCP_C_MESSAGE)
+                messages++;
+            if (op->kind != NCP_C_PRINT)
+                continue;
+            assert_true(prints < 2);
+            assert_int_equal(op->text_len, strlen(want[prints]));
+            assert_memory_equal(c->text + op->text_off, want[prints], op->text_len);
+            prints++;
+        }
+    }
+    assert_int_equal(prints, 2);
+    assert_int_equal(messages, 1);
+    run_free(&r);
+}
+
 static void test_straight_feed(void **state)
 {
     (void)state;
@@ -484,6 +514,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_preamble_and_end),
+        cmocka_unit_test(test_print_calls),
         cmocka_unit_test(test_straight_feed),
         cmocka_unit_test(test_lathe_diameter_mode),
         cmocka_unit_test(test_error_slot),

@@ -243,10 +243,12 @@ static void test_every_kind(void **state)
         assert_string_equal(line, kind_cases[k].want);
         seen[kind_cases[k].kind] = 1;
     }
-    /* Every printable kind has a case; only NONE, the arc request and the
-     * NURBS points (rs274 -g prints none) are silent. */
+    /* Every printable kind has a case; only NONE, the arc request, the
+     * NURBS points (rs274 -g prints none) and PRINT (rs274's stdout, not its
+     * canonical stream: test_print_text) are silent. */
     for (int kind = 1; kind < NCP_C__COUNT; kind++)
-        if (kind != NCP_C_ARC_REQUEST && kind != NCP_C_NURBS_POINTS && !seen[kind])
+        if (kind != NCP_C_ARC_REQUEST && kind != NCP_C_NURBS_POINTS && kind != NCP_C_PRINT &&
+            !seen[kind])
             fail_msg("canonical kind %d has no text case", kind);
 }
 
@@ -600,6 +602,33 @@ static void test_arc_inverse_time(void **state)
     assert_memory_equal(cmd.out, want3, cmd.out_len);
 }
 
+/* PRINT calls print nothing in the canonical text; ncp_exec_write_prints
+ * writes theirs, in order, and nothing else. */
+static void test_print_text(void **state)
+{
+    (void)state;
+    cmd_clear();
+    add_text(add_op(NCP_C_PRINT), "first 1.000000\n");
+    add_text(add_op(NCP_C_COMMENT), "not printed");
+    add_op(NCP_C_FLOOD_ON);
+    add_text(add_op(NCP_C_PRINT), "\n");
+    add_text(add_op(NCP_C_PRINT), " last\n");
+    assert_int_equal(ncp_exec_cmd(&cmd), NCP_OK);
+    const char canon[] = "COMMENT(\"not printed\")\nFLOOD_ON()\n";
+    assert_int_equal(cmd.out_len, strlen(canon));
+    assert_memory_equal(cmd.out, canon, cmd.out_len);
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    assert_int_equal(ncp_exec_write_prints(&cmd, f), 0);
+    char buf[64] = {0};
+    rewind(f);
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    const char want[] = "first 1.000000\n\n last\n";
+    assert_int_equal(n, strlen(want));
+    assert_string_equal(buf, want);
+}
+
 /* An earlier analyzer error in the slot stays; resolve reports its code. */
 static void test_resolve_keeps_analyzer_error(void **state)
 {
@@ -628,6 +657,7 @@ int main(void)
         cmocka_unit_test(test_arc_tolerance_from_op),
         cmocka_unit_test(test_arc_rotary_passthrough),
         cmocka_unit_test(test_arc_inverse_time),
+        cmocka_unit_test(test_print_text),
         cmocka_unit_test(test_resolve_keeps_analyzer_error),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
