@@ -9,8 +9,7 @@ int ncp_exec_write_prints(const struct ncp_cmd *cmd, FILE *f)
 {
     if (cmd->text_used == 0)
         return 0;
-    unsigned n_ops = cmd->n_ops < NCP_CMD_MAX_OPS ? cmd->n_ops : NCP_CMD_MAX_OPS;
-    for (unsigned k = 0; k < n_ops; k++) {
+    for (unsigned k = 0; k < cmd->n_ops && k < NCP_CMD_MAX_OPS; k++) {
         const struct ncp_canon *op = &cmd->ops[k];
         if (op->kind != NCP_C_PRINT)
             continue;
