@@ -655,18 +655,27 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
     }
 }
 
-static int do_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+/* A sub's first line (o-sub or Fanuc): where a call was skipping ahead to
+ * it, it is defined from now on and the skipping ends. */
+static int reach_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    if (f->frames[f->level].call_type == FLOW_CT_M98)
-        return oword_error(b, "'O.... sub' subroutine must be called with 'O.... call'", d);
     if (f->skip.on) {
-        /* found the sub a call was seeking: it is defined from now on */
         int rc = save_label(f, b, NULL, d);
         if (rc != NCP_OK)
             return rc;
         f->skip.on = 0;
     }
     f->seek_sub.on = 0;
+    return NCP_OK;
+}
+
+static int do_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+{
+    if (f->frames[f->level].call_type == FLOW_CT_M98)
+        return oword_error(b, "'O.... sub' subroutine must be called with 'O.... call'", d);
+    int reached = reach_sub(f, b, d);
+    if (reached != NCP_OK)
+        return reached;
     if (f->level > 0)
         return NCP_OK;           /* the called sub's own first line */
     int rc = save_label(f, b, NULL, d);
@@ -685,14 +694,7 @@ static int do_fanuc(struct ncp_flow *f, const struct ncp_block *b, struct ncp_di
 {
     if (f->frames[f->level].call_type == FLOW_CT_OWORD)
         return oword_error(b, "Fanuc 'O....' subroutine must be called with 'M98'", d);
-    if (f->skip.on) {
-        int rc = save_label(f, b, NULL, d);
-        if (rc != NCP_OK)
-            return rc;
-        f->skip.on = 0;
-    }
-    f->seek_sub.on = 0;
-    return NCP_OK;
+    return reach_sub(f, b, d);
 }
 
 static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
