@@ -646,18 +646,23 @@ class Gen:
         self.emit("M98 P%s%s" % (self.r98.choice(self.fanuc), reps))
         self.forget_position()
 
-    def define_fanuc(self, number):
-        """O<number> ... M99, after the program end (rs274 would run into it)."""
-        r = self.r
+    def open_sub_body(self, first_line, nargs):
+        """A sub's first line and 2-6 statements, from the modal state a call
+        may find; returns what the caller restores once the sub is closed."""
         saved = (self.scope, self.depth, dict(self.pos))
-        self.scope = Scope(0, GLOBAL_NAMES)
-        self.emit("O%s" % number)
+        self.scope = Scope(nargs, GLOBAL_NAMES)
+        self.emit(first_line)
         self.depth = 1
         self.units, self.plane, self.dist, self.ijk_abs = self.home_units, 17, 90, False
         self.feed_mode = 94
         self.forget_position()
-        for _ in range(r.randint(2, 6)):
+        for _ in range(self.r.randint(2, 6)):
             self.simple_statement(inner=True, in_sub=True)
+        return saved
+
+    def define_fanuc(self, number):
+        """O<number> ... M99, after the program end (rs274 would run into it)."""
+        saved = self.open_sub_body("O%s" % number, 0)
         self.depth = 0
         self.emit("M99")
         self.scope, self.depth, self.pos = saved
@@ -667,15 +672,7 @@ class Gen:
         name = r.choice(["o<contour%d>" % idx, "o<Pocket_%d>" % idx, "o%d" % (9000 + idx)])
         nargs = r.randint(0, 4)
         returns = r.random() < 0.6
-        saved = (self.scope, self.depth, dict(self.pos))
-        self.scope = Scope(nargs, GLOBAL_NAMES)
-        self.emit("%s sub" % name)
-        self.depth = 1
-        self.units, self.plane, self.dist, self.ijk_abs = self.home_units, 17, 90, False
-        self.feed_mode = 94
-        self.forget_position()
-        for _ in range(r.randint(2, 6)):
-            self.simple_statement(inner=True, in_sub=True)
+        saved = self.open_sub_body("%s sub" % name, nargs)
         if returns and r.random() < 0.5:
             lab = self.label()
             self.emit("%s if [%s]" % (lab, self.cond(1)))
