@@ -81,8 +81,12 @@ enum ncp_oword_kind {
      *        P (the sub's number) and L (repeats) among the block's words, the
      *        M98 itself not; the rest of the line is read as words, not run;
      * M99:   a line whose first item is M99, lexed as usual (M99 one of its
-     *        words): a return inside a sub, an end (like M2) at level 0. */
-    NCP_O_FANUC, NCP_O_M98, NCP_O_M99
+     *        words): a return inside a sub, an end (like M2) at level 0;
+     * M_VALUE: a line whose first item is an M with a value from parameters
+     *        ("M#1", "M[#2+1]"), lexed as usual (the M its first word): rs274
+     *        reads the value as it reads the line, and a 98, or a 99 inside a
+     *        sub, makes it one of the two above (ncp_lex_block_fanuc). */
+    NCP_O_FANUC, NCP_O_M98, NCP_O_M99, NCP_O_M_VALUE
 };
 
 struct ncp_oword {
@@ -184,6 +188,11 @@ int ncp_block_packed_is_end_mark(const void *src);
  * Returns out->err.code. Never reads outside text[0..len). */
 int ncp_lex_block(const char *text, size_t len, uint32_t line, uint64_t offset,
                   struct ncp_block *out);
+/* An NCP_O_M_VALUE line as rs274 reads it once its M is known to be m (98 or
+ * 99): an M98 or M99 line, read from three characters on as always ("m#1"
+ * happens to be three characters; "m#10" leaves a bad character '0'). */
+int ncp_lex_block_fanuc(const char *text, size_t len, uint32_t line, uint64_t offset, int m,
+                        struct ncp_block *out);
 /* ncp_lex_block as rs274 reads the blocks of a G70-G72 profile subroutine:
  * U and W (incremental X and Z there) are words, not bad characters. */
 int ncp_lex_block_profile(const char *text, size_t len, uint32_t line, uint64_t offset,

@@ -101,6 +101,7 @@ struct ncp_flow {
     struct flow_pos feed_pos;         /* next block the feed will deliver */
     int feed_done, feed_held;
     struct flow_cached *cache;
+    struct ncp_block *fanuc_blk;      /* an M_VALUE line read again as M98/M99 */
 
     struct flow_labels labels;
     struct flow_frame *frames;        /* [1 .. level] */
@@ -1168,6 +1169,36 @@ static int at_end(struct ncp_flow *f, struct ncp_diag *d)
     return NCP_END;
 }
 
+/* A line that starts with an M whose value comes from parameters ("M#1"):
+ * rs274 reads that value as it reads the line, skipping or not, and a 98, or
+ * a 99 inside a sub, makes the line a Fanuc call or return, read again as
+ * such; any other value, or one it cannot read, an ordinary line. Sets *kind
+ * and returns the block to go on with (the line read again, or b). */
+static int resolve_m_value(struct ncp_flow *f, const struct ncp_block **b, int *kind,
+                           struct ncp_diag *d)
+{
+    const struct ncp_block *blk = *b;
+    *kind = NCP_O_NONE;
+    if (blk->n_words == 0 || blk->words[0].letter != 'M')
+        return NCP_OK;
+    double v;
+    int m;
+    struct ncp_diag unread;
+    if (eval(f, blk, &blk->words[0].v, &v, &unread) != NCP_OK ||
+        ncp_flow_m98_number(v, &m) != 0 || !(m == 98 || (m == 99 && f->level > 0)))
+        return NCP_OK;
+    struct ncp_span sp;
+    if (ncp_source_span(f->src, blk->offset, blk->line, &sp) != 0)
+        return NCP_OK;
+    if (!f->fanuc_blk && !(f->fanuc_blk = malloc(sizeof *f->fanuc_blk)))
+        return ncp_diag_set(d, NCP_ERR_IO, blk->line, 0, "out of memory");
+    ncp_lex_block_fanuc(f->src->text + sp.off, sp.len, blk->line, blk->offset, m,
+                        f->fanuc_blk);
+    *b = f->fanuc_blk;
+    *kind = f->fanuc_blk->oword.kind;
+    return NCP_OK;
+}
+
 static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
                      struct ncp_diag *d)
 {
@@ -1185,10 +1216,14 @@ static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
             continue;
         f->by_jump = b->offset == target;
         int kind = b->oword.kind;
-        /* M99 first on a line returns from a sub; in the main program it
-         * is an M code like M2 */
-        if (kind == NCP_O_M99 && f->level == 0)
-            kind = NCP_O_NONE;
+        if (kind != NCP_O_NONE) { /* one test on the plain path for the rare kinds */
+            if (kind == NCP_O_M_VALUE && (rc = resolve_m_value(f, &b, &kind, d)) != NCP_OK)
+                return rc;
+            /* M99 first on a line returns from a sub; in the main program it
+             * is an M code like M2 */
+            if (kind == NCP_O_M99 && f->level == 0)
+                kind = NCP_O_NONE;
+        }
         if (b->err.code != NCP_OK) {
             /* rs274 does not parse the lines it skips, but for M98 lines;
              * the rest of an M99 line in a sub, only comments are allowed */
@@ -1297,6 +1332,7 @@ void ncp_flow_free(struct ncp_flow *f)
         ncp_source_close(&f->files[k].src);
     free(f->files);
     free(f->cache);
+    free(f->fanuc_blk);
     free(f->labels.slots);
     free(f->labels.arena);
     free(f->frames);

@@ -203,8 +203,9 @@ static int items(struct ncp_lexer *lx)
  * and N) before anything else: M98 there makes the line a Fanuc-style call,
  * read from three characters on (so "m098" leaves "8" behind, a bad
  * character, as in rs274); M99 there is marked, and lexed as usual. A value
- * that cannot be read, or depends on parameters, leaves the line to the
- * usual reader (rs274 would decide on the parameter's value: not done here). */
+ * that cannot be read leaves the line to the usual reader; one that depends
+ * on parameters is marked M_VALUE and lexed as usual, for the flow to decide
+ * with the parameters of the moment (lx->fanuc_m is its decision). */
 static int fanuc_m(struct ncp_lexer *lx)
 {
     struct ncp_block *b = lx->b;
@@ -214,18 +215,25 @@ static int fanuc_m(struct ncp_lexer *lx)
     lx->pos++;
     int rc = ncp_lex_integer_value(lx, &v);
     int m = rc == NCP_OK && v.is_const ? ncp_trunc_int(v.k) : -1;
+    int by_value = rc == NCP_OK && !v.is_const;
+    if (lx->fanuc_m)
+        m = lx->fanuc_m;
     b->err.code = NCP_OK;
     b->err.col = 0;
     b->err.msg[0] = '\0';
     b->n_code = code_mark;
     b->pool_used = pool_mark;
     lx->pos = pos;
-    if (m != 98 && m != 99)
+    if (m != 98 && m != 99 && !by_value)
         return items(lx);
     /* the fields the packed form carries, padding included, all set */
     memset(&b->oword, 0, offsetof(struct ncp_oword, args));
-    b->oword.kind = (uint8_t)(m == 98 ? NCP_O_M98 : NCP_O_M99);
     b->oword.col = lx->col[pos];
+    if (m != 98 && m != 99) {
+        b->oword.kind = NCP_O_M_VALUE;
+        return items(lx);
+    }
+    b->oword.kind = (uint8_t)(m == 98 ? NCP_O_M98 : NCP_O_M99);
     if (m == 98) {
         lx->pos = pos + 3 < lx->n ? pos + 3 : lx->n;
         return items(lx);
@@ -285,7 +293,7 @@ int ncp_lex_line(const char *text, size_t avail, uint32_t line, uint64_t offset,
 }
 
 static int lex_general(const char *text, size_t len, uint32_t line, uint64_t offset,
-                       struct ncp_block *out, int uw_words)
+                       struct ncp_block *out, int uw_words, int fanuc)
 {
     struct ncp_lexer lx;
     int rc;
@@ -297,6 +305,7 @@ static int lex_general(const char *text, size_t len, uint32_t line, uint64_t off
     lx.cmt_pos = -1;
     lx.cmt_len = 0;
     lx.uw_words = uw_words;
+    lx.fanuc_m = fanuc;
     if ((rc = ncp_lex_squeeze(&lx, text, len)))
         return rc;
     if (lx.buf[0] == '/') {
@@ -320,11 +329,17 @@ static int lex_general(const char *text, size_t len, uint32_t line, uint64_t off
 int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t offset,
                           struct ncp_block *out)
 {
-    return lex_general(text, len, line, offset, out, 0);
+    return lex_general(text, len, line, offset, out, 0, 0);
 }
 
 int ncp_lex_block_profile(const char *text, size_t len, uint32_t line, uint64_t offset,
                           struct ncp_block *out)
 {
-    return lex_general(text, len, line, offset, out, 1);
+    return lex_general(text, len, line, offset, out, 1, 0);
+}
+
+int ncp_lex_block_fanuc(const char *text, size_t len, uint32_t line, uint64_t offset, int m,
+                        struct ncp_block *out)
+{
+    return lex_general(text, len, line, offset, out, 0, m == 98 || m == 99 ? m : 0);
 }

@@ -25,6 +25,7 @@ struct ncp_lexer {
     int depth;             /* nesting of values being read */
     int cmt_pos, cmt_len;  /* last (...) comment seen, inside buf; cmt_pos < 0: none */
     int uw_words;          /* U and W are words (a G7x profile), not bad characters */
+    int fanuc_m;           /* 98 or 99: the first M's value, known (M_VALUE lines); 0 */
     char buf[NCP_LEX_TOO_LONG + NCP_LEX_PAD];
     uint8_t col[NCP_LEX_TOO_LONG + NCP_LEX_PAD]; /* 1-based source column */
 };

@@ -643,7 +643,13 @@ class Gen:
         """M98 P.. [L..]: the sub shares #1-#30 with the caller and reads none."""
         self.sub_entry_state()
         reps = self.r98.choice(["", "", " L1", " L2", " L3"])
-        self.emit("M98 P%s%s" % (self.r98.choice(self.fanuc), reps))
+        m = "M98"
+        if self.r98.random() < 0.25:
+            # the M from a parameter: rs274 decides on its value as it reads
+            # the line (#9: one character, as "three characters on" needs)
+            self.emit("#9 = 98")
+            m = "M#9"
+        self.emit("%s P%s%s" % (m, self.r98.choice(self.fanuc), reps))
         self.forget_position()
 
     def open_sub_body(self, first_line, nargs):
@@ -664,7 +670,11 @@ class Gen:
         """O<number> ... M99, after the program end (rs274 would run into it)."""
         saved = self.open_sub_body("O%s" % number, 0)
         self.depth = 0
-        self.emit("M99")
+        if self.r98.random() < 0.25:
+            self.emit("#9 = 99")
+            self.emit("M#9")
+        else:
+            self.emit("M99")
         self.scope, self.depth, self.pos = saved
 
     def define_sub(self, idx):

@@ -718,12 +718,30 @@ static void test_fanuc_lines(void **state)
      * (the analyzer rejects it there) */
     assert_int_equal(lex("M98.5 P1"), NCP_OK);
     assert_int_equal(blk.oword.kind, NCP_O_NONE);
-    /* Known difference (README): rs274 reads an M value first on the line
-     * with the parameters of the moment, so "M#1 P100" with #1 = 98 is a
-     * call there (and "m#1" happens to be three characters); a lexer cannot
-     * know #1, and we read the line as plain words (M98: unknown M code). */
+    /* rs274 reads an M value first on the line with the parameters of the
+     * moment, so "M#1 P100" with #1 = 98 is a call: the lexer marks the
+     * line, lexed as usual, for the flow to decide; once decided, the line is
+     * read again from three characters on ("m#1" happens to be three, "m#10"
+     * leaves a bad character, as in rs274) */
     assert_int_equal(lex("M#1 P100"), NCP_OK);
-    assert_int_equal(blk.oword.kind, NCP_O_NONE);
+    assert_int_equal(blk.oword.kind, NCP_O_M_VALUE);
+    assert_int_equal(blk.oword.col, 1);
+    assert_int_equal(blk.n_words, 2);
+    assert_int_equal(blk.words[0].letter, 'M');
+    assert_false(blk.words[0].v.is_const);
+    assert_int_equal(lex("N5 M[#2 + 1]"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_M_VALUE);
+    assert_int_equal(blk.oword.col, 4);
+    assert_int_equal(ncp_lex_block_fanuc("M#1 P100 L2", 11, 1, 0, 98, &blk), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_M98);
+    assert_int_equal(blk.n_words, 2); /* P and L: the M is the call itself */
+    assert_int_equal(ncp_lex_block_fanuc("M#10 P100", 9, 1, 0, 98, &blk), NCP_ERR_SYNTAX);
+    assert_string_equal(blk.err.msg, "Bad character '0' used");
+    assert_int_equal(ncp_lex_block_fanuc("M#3 (done)", 10, 1, 0, 99, &blk), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_M99);
+    assert_int_equal(blk.oword.tail_col, 0);
+    assert_int_equal(ncp_lex_block_fanuc("M#3 G1", 6, 1, 0, 99, &blk), NCP_OK);
+    assert_int_equal(blk.oword.tail_col, 5);
     /* "m098" and "m98.0": three characters on is the rest of the number */
     expect_error("M098 P100", "Bad character '8' used", 4);
     assert_int_equal(blk.oword.kind, NCP_O_M98);
