@@ -1172,8 +1172,8 @@ static int at_end(struct ncp_flow *f, struct ncp_diag *d)
 /* A line that starts with an M whose value comes from parameters ("M#1"):
  * rs274 reads that value as it reads the line, skipping or not, and a 98, or
  * a 99 inside a sub, makes the line a Fanuc call or return, read again as
- * such; any other value, or one it cannot read, an ordinary line. Sets *kind
- * and returns the block to go on with (the line read again, or b). */
+ * such; any other value, or one it cannot read, an ordinary line. Sets *kind,
+ * and *b to the block to go on with (the line read again, or as it was). */
 static int resolve_m_value(struct ncp_flow *f, const struct ncp_block **b, int *kind,
                            struct ncp_diag *d)
 {
