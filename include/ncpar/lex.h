@@ -144,6 +144,20 @@ static inline int ncp_trunc_int(double t)
     return (-2147483647 - 1);
 }
 
+/* rs274's "integer value" (read_integer_value): the floor, or the ceiling
+ * when within 0.0001 of it; 0 and *out, or -1 for a value further from an
+ * integer ("Non integer value for integer"). */
+static inline int ncp_rs274_int(double v, int *out)
+{
+    int i = ncp_trunc_int(floor(v));
+    if (v - (double)i > 0.9999)
+        i = ncp_trunc_int(ceil(v));
+    else if (v - (double)i > 0.0001)
+        return -1;
+    *out = i;
+    return 0;
+}
+
 /* Nearest integer, halves away from zero (lround), INT_MIN when out of range. */
 static inline int ncp_trunc_int_round(double t)
 {

@@ -316,7 +316,7 @@ static int ncp_an_read_m98(void *ctx, const struct ncp_block *b, int skipping, i
     int rc = ncp_words_collect(a, b);
     if (rc == NCP_OK && !NCP_HAS(w, 'P'))
         rc = ncp_an_error(a, b->oword.col, "Found 'm98' code with no P-word");
-    if (rc == NCP_OK && ncp_flow_m98_number(w->v[NCP_LETTER('P')], p) != 0)
+    if (rc == NCP_OK && ncp_rs274_int(w->v[NCP_LETTER('P')], p) != 0)
         rc = ncp_an_error(a, w->col[NCP_LETTER('P')], "Non integer value for integer");
     if (rc == NCP_OK && !skipping) {
         w->m98 = 1;

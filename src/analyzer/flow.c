@@ -916,7 +916,7 @@ static int read_m98(struct ncp_flow *f, const struct ncp_block *b, int skipping,
     }
     if (!has_p)
         return oword_error(b, "Found 'm98' code with no P-word", d);
-    if (ncp_flow_m98_number(p, &f->m98_p) != 0)
+    if (ncp_rs274_int(p, &f->m98_p) != 0)
         return oword_error(b, "Non integer value for integer", d);
     return NCP_OK;
 }
@@ -1185,7 +1185,7 @@ static int resolve_m_value(struct ncp_flow *f, const struct ncp_block **b, int *
     int m;
     struct ncp_diag unread;
     if (eval(f, blk, &blk->words[0].v, &v, &unread) != NCP_OK ||
-        ncp_flow_m98_number(v, &m) != 0 || !(m == 98 || (m == 99 && f->level > 0)))
+        ncp_rs274_int(v, &m) != 0 || !(m == 98 || (m == 99 && f->level > 0)))
         return NCP_OK;
     struct ncp_span sp;
     if (ncp_source_span(f->src, blk->offset, blk->line, &sp) != 0)

@@ -9,7 +9,6 @@
 #ifndef NCP_ANALYZER_FLOW_H
 #define NCP_ANALYZER_FLOW_H
 
-#include <math.h>
 #include "ncpar/analyzer.h"
 #include "params.h"
 
@@ -45,21 +44,6 @@ struct ncp_flow_m98_reader {
                 struct ncp_diag *d);
 };
 void ncp_flow_set_m98_reader(struct ncp_flow *f, struct ncp_flow_m98_reader r);
-
-/* M98's P as rs274's read_o makes it a sub number: the floor, or the ceiling
- * within 0.0001 of it; 0 and *out, or -1 for a value further from an integer
- * ("Non integer value for integer"). */
-static inline int ncp_flow_m98_number(double p, int *out)
-{
-    double fl = floor(p);
-    int n = ncp_trunc_int(fl);
-    if (p - n > 0.9999)
-        n = ncp_trunc_int(ceil(p));
-    else if (p - n > 0.0001)
-        return -1;
-    *out = n;
-    return 0;
-}
 
 /* Next non-O-word block to interpret. Returns NCP_OK and sets *out (valid until
  * the next call), NCP_END at the end of the program body, or an error with *d

@@ -130,13 +130,8 @@ int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out)
         *out = (int)v; /* a whole number: what the rounding below makes of it */
         return NCP_OK;
     }
-    int i = ncp_trunc_int(floor(v));
-    double d = v - i;
-    if (d > 0.9999)
-        i = ncp_trunc_int(ceil(v));
-    else if (d > 0.0001)
+    if (ncp_rs274_int(v, out) != 0)
         return ncp_an_error(a, col, "Non integer value for integer");
-    *out = i;
     return NCP_OK;
 }
 

@@ -32,13 +32,7 @@ static inline int ncp_math_trunc_int(double t)
 /* rs274's "integer value": within 0.0001 of an integer, else an error. */
 static inline const char *ncp_math_to_int(double v, int *out)
 {
-    int i = ncp_math_trunc_int(floor(v));
-    if (v - (double)i > 0.9999)
-        i = ncp_math_trunc_int(ceil(v));
-    else if (v - (double)i > 0.0001)
-        return "Non integer value for integer";
-    *out = i;
-    return 0;
+    return ncp_rs274_int(v, out) == 0 ? 0 : "Non integer value for integer";
 }
 
 static inline const char *ncp_math_finite(double v)
