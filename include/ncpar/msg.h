@@ -1,0 +1,64 @@
+/* LCM messaging of a serving NCK: the generated types of lcm/*.lcm (lcm-gen at
+ * build time, fixed-size) over LCM's UDP multicast protocol ("udpm://"), so
+ * lcm-spy, lcm-logger and any LCM client see and send the same messages.
+ *
+ * The NCK's side is its own small transport rather than liblcm: it links into
+ * the static cnc-run, receives into one fixed buffer (a flood of datagrams
+ * allocates nothing) and counts what it cannot use. Channels are
+ * <prefix>CMD (in), <prefix>ACK, <prefix>STATUS and <prefix>EVENT (out).
+ * Not for the real-time threads: the service thread calls it. */
+#ifndef NCPAR_MSG_H
+#define NCPAR_MSG_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ncpar/diag.h"
+#include "ncp_ack_t.h"
+#include "ncp_command_t.h"
+#include "ncp_event_t.h"
+#include "ncp_status_t.h"
+
+#define NCP_MSG_DEFAULT_URL "udpm://239.255.76.67:7667?ttl=0"
+#define NCP_MSG_DEFAULT_PREFIX "NCP_"
+#define NCP_MSG_PREFIX_MAX 32
+
+struct ncp_msg;
+
+struct ncp_msg_stats {
+    uint64_t received;    /* datagrams read */
+    uint64_t commands;    /* valid commands handed on */
+    uint64_t garbage;     /* on <prefix>CMD, or unreadable at all: bad magic,
+                             truncated, wrong fingerprint, bad fields */
+    uint64_t sent, send_errors;
+};
+
+/* url NULL or "": $LCM_DEFAULT_URL, else NCP_MSG_DEFAULT_URL. Only udpm://
+ * is understood (host must be a multicast group; ?ttl=N, ?recv_buf_size=N).
+ * prefix NULL: NCP_MSG_DEFAULT_PREFIX. On error d->msg says why. */
+int ncp_msg_open(struct ncp_msg **m, const char *url, const char *prefix, struct ncp_diag *d);
+void ncp_msg_close(struct ncp_msg *m);
+
+/* Waits up to timeout_ms (0: only what is queued) and hands every valid
+ * command on <prefix>CMD to on_cmd, in arrival order. Messages on other
+ * channels are skipped silently (other NCKs and tools share the group).
+ * Returns the number of commands handed on, or -1 on a socket error. */
+int ncp_msg_poll(struct ncp_msg *m, int timeout_ms,
+                 void (*on_cmd)(void *ctx, const ncp_command_t *cmd), void *ctx);
+
+int ncp_msg_send_ack(struct ncp_msg *m, const ncp_ack_t *a);
+int ncp_msg_send_status(struct ncp_msg *m, const ncp_status_t *s);
+int ncp_msg_send_event(struct ncp_msg *m, const ncp_event_t *e);
+
+void ncp_msg_get_stats(const struct ncp_msg *m, struct ncp_msg_stats *st);
+
+/* Pure helpers (tested without a network). */
+/* One LCM datagram (LC02 short message): channel and payload, or -1 when it
+ * is not one (bad magic, no NUL-terminated channel, fragment). */
+int ncp_msg_parse_datagram(const uint8_t *buf, size_t len, const char **channel,
+                           const uint8_t **payload, size_t *payload_len);
+/* Decodes and validates a command (fingerprint, NUL in text, known kind,
+ * client_id != 0). 0 ok, -1 garbage. */
+int ncp_msg_decode_command(const uint8_t *payload, size_t len, ncp_command_t *cmd);
+
+#endif
