@@ -53,6 +53,15 @@ struct ncp_analyzer_cfg {
      * defined yet: the current folder, then these (colon-separated), as
      * rs274 with [RS274NGC]SUBROUTINE_PATH. NULL: the current folder only. */
     const char *subroutine_path;
+    /* The NCK's resident interpreter: modal state, parameters, offsets and
+     * tool carry over from one run to the next (programs and MDI lines run one
+     * after another, as on a controller), so a run emits no rs274 start-up
+     * calls and no closing resets, and the end of the text without M2/M30 is
+     * an ordinary end (an MDI line). */
+    int resident;
+    /* ncp_serial_run / ncp_pipeline_run: run on this analyzer (made with
+     * resident set, owned by the caller) instead of a new one. */
+    struct ncp_analyzer *instance;
 };
 
 struct ncp_analyzer;
@@ -66,5 +75,10 @@ void ncp_analyzer_free(struct ncp_analyzer *a);
  * slot so that it comes out in program order). Returns NCP_OK, or the error code. */
 int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
                      const struct ncp_cmd_sink *sink);
+
+/* Between runs of a resident analyzer: the machine moved without it (a
+ * stopped program, a jog, homing), so its current point becomes pos (X Y Z in
+ * program coordinates and units: see ncp_canon_map_to_program). */
+void ncp_analyzer_set_position(struct ncp_analyzer *a, const double pos[3]);
 
 #endif

@@ -149,6 +149,11 @@ int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
  * a G5.3 NURBS as many for each knot span, drawn as its points come in. */
 int ncp_canon_map_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_diag *d);
 #define NCP_SPLINE_STEPS 16
+/* The inverse of what the map does to a call's X Y Z: a machine position in
+ * the program's coordinates and units under the offsets, rotation and units
+ * the map holds now (to put an interpreter back where the machine is). */
+void ncp_canon_map_to_program(const struct ncp_canon_map *m, const double machine[NCP_AXES],
+                              double prog[3]);
 
 /* ---- planner + interpolator ------------------------------------------------ */
 

@@ -224,8 +224,10 @@ static void ncp_an_finish(struct ncp_analyzer *a, uint16_t flag)
         ncp_an_commit(a);
     /* whatever compensation still holds is never output, as in rs274 */
     ncp_cutcomp_reset(&a->comp);
-    ncp_an_emit(a, NCP_C_ON_RESET);
-    ncp_an_emit(a, NCP_C_ON_RESET);
+    if (!a->cfg.resident) {
+        ncp_an_emit(a, NCP_C_ON_RESET);
+        ncp_an_emit(a, NCP_C_ON_RESET);
+    }
     struct ncp_cmd *c = ncp_an_slot(a, 0);
     if (c) {
         c->flags |= flag;
@@ -253,6 +255,8 @@ static int ncp_an_eof(struct ncp_analyzer *a, const struct ncp_source *src)
 {
     if (src)
         a->line = ncp_an_last_line(src);
+    if (a->cfg.resident)
+        return NCP_END;
     if (src && src->has_percent && src->end < src->len) {
         ncp_an_emit_text(a, NCP_C_RAW_TEXT, "FINISH()", 8);
         return NCP_END;
@@ -378,8 +382,10 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
     ncp_m7x_reset(a);
     ncp_cutcomp_init(&a->comp, NULL);
     a->staged.pending = 0;
-    ncp_an_preamble(a);
-    ncp_an_publish(a);
+    if (!a->cfg.resident) {
+        ncp_an_preamble(a);
+        ncp_an_publish(a);
+    }
 
     uint32_t last_line = 0;
     int rc;
@@ -421,4 +427,12 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
     ncp_flow_reset(a->flow);
     ncp_an_finish(a, NCP_CMD_F_ERROR);
     return a->err.code;
+}
+
+void ncp_analyzer_set_position(struct ncp_analyzer *a, const double pos[3])
+{
+    for (int k = 0; k < 3; k++) {
+        a->st.pos[k] = pos[k];
+        a->sai.pos[k] = pos[k];
+    }
 }

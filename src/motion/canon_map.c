@@ -34,6 +34,21 @@ static void to_machine(const struct ncp_canon_map *m, const double p[3], double 
         out[i] = q[i] + m->g5x[i] + m->tool[i];
 }
 
+void ncp_canon_map_to_program(const struct ncp_canon_map *m, const double machine[NCP_AXES],
+                              double prog[3])
+{
+    double q[3];
+    for (int i = 0; i < 3; i++)
+        q[i] = machine[i] - m->g5x[i] - m->tool[i];
+    double th = -m->rotation * (M_PI / 180.0);
+    double c = cos(th), s = sin(th);
+    double x = q[0] * c - q[1] * s, y = q[0] * s + q[1] * c;
+    q[0] = x;
+    q[1] = y;
+    for (int i = 0; i < 3; i++)
+        prog[i] = (q[i] - m->g92[i]) / m->scale;
+}
+
 static double dot(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];

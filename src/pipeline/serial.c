@@ -82,7 +82,7 @@ int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *
     sink->emit_failed = 0;
     sink->err.code = NCP_OK;
 
-    an = ncp_analyzer_new(acfg, d);
+    an = acfg && acfg->instance ? acfg->instance : ncp_analyzer_new(acfg, d);
     if (!an) {
         rc = d->code ? d->code : NCP_ERR_IO;
         goto done;
@@ -107,7 +107,8 @@ done:
         stats->wall_ms = now_ms() - t0;
         stats->threads = 1;
     }
-    ncp_analyzer_free(an);
+    if (!acfg || an != acfg->instance)
+        ncp_analyzer_free(an);
     free(feed);
     free(sink);
     return rc;

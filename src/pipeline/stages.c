@@ -338,7 +338,9 @@ static void packed_publish(void *ctx, struct ncp_cmd *c)
 void *ncp_pipe_analyzer(void *arg)
 {
     struct ncp_pipe *p = ((struct ncp_pipe_worker *)arg)->p;
-    struct ncp_analyzer *an = ncp_analyzer_new(p->acfg, &p->an_diag);
+    struct ncp_analyzer *an = p->acfg && p->acfg->instance
+                                  ? p->acfg->instance
+                                  : ncp_analyzer_new(p->acfg, &p->an_diag);
     if (!an) {
         if (p->an_diag.code == NCP_OK)
             ncp_diag_set(&p->an_diag, NCP_ERR_IO, 0, 0, "out of memory");
@@ -369,7 +371,8 @@ void *ncp_pipe_analyzer(void *arg)
         } else if (p->n == 0) {
             p->taken = p->text->blocks;
         }
-        ncp_analyzer_free(an);
+        if (!p->acfg || an != p->acfg->instance)
+            ncp_analyzer_free(an);
     }
     if (p->inline_out)
         p->end_ms = ncp_pipe_now_ms();
