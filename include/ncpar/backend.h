@@ -21,6 +21,7 @@ struct ncp_sim_axis {
 struct ncp_sim {
     double T, K, p, E;   /* E = exp(-p T) */
     double kp, ki, kd, ff1, ff2;
+    int disabled;        /* drives off (E-stop): no controller output */
     struct ncp_sim_axis ax[NCP_AXES];
 };
 
@@ -53,6 +54,10 @@ struct ncp_backend_ops {
     /* The fault that made start() or cycle() fail, naming node, object and cause. */
     void (*describe_fault)(const struct ncp_backend *b, char *buf, size_t len);
     void (*close)(struct ncp_backend *b);
+    /* Real-time, from the position loop: drives on (1) or off (0: E-stop;
+     * no torque, CiA 402 "disable operation"). NULL: the backend cannot turn
+     * its drives off; the loop then holds them at a frozen setpoint. */
+    void (*enable)(struct ncp_backend *b, int on);
 };
 
 struct ncp_backend {

@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include "ncpar/canon.h"
 #include "ncpar/diag.h"
+#include "ncpar/rt.h"
 
 #define NCP_AXES 3  /* X Y Z; the canon stream's A B C are carried but not moved */
 
@@ -21,6 +22,9 @@ struct ncp_axis_cfg {
      * position scaling, encoder counts per mm (0 = not set) */
     int node_id;
     double counts_per_mm;
+    /* homing (cnc-run serve): where the axis homes to, mm, and how fast, mm/s
+     * (HOME, HOME_SEARCH_VEL; 0 = half of MAX_VELOCITY) */
+    double home, home_vel;
 };
 
 /* What the position loop drives (backend.h): the simulated machine, or CiA 402
@@ -59,6 +63,15 @@ struct ncp_machine_cfg {
     double planning_period;
     enum ncp_backend_kind backend; /* not from the INI: cnc-run run --backend */
     struct ncp_can_cfg can;
+    /* [TRAJ] NO_FORCE_HOMING = 1: programs, MDI and jogs may run before the
+     * axes are homed (LinuxCNC's key; 0, the default, refuses them) */
+    int no_force_homing;
+    double default_linear_vel;    /* [TRAJ] DEFAULT_LINEAR_VELOCITY: jog speed, mm/s */
+    struct ncp_lcm_cfg {          /* [LCM]: cnc-run serve's messaging */
+        char url[256];            /* URL ("" = $LCM_DEFAULT_URL or LCM's default) */
+        char prefix[32];          /* CHANNEL_PREFIX, default NCP_ */
+        double status_hz;         /* STATUS_HZ, default 50 */
+    } lcm;
 };
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c);
@@ -185,6 +198,11 @@ int ncp_planner_idle(const struct ncp_planner *p);
 void ncp_planner_push(struct ncp_planner *p, const struct ncp_seg *s);
 /* No more segments will come: the queue may be run to its end. */
 void ncp_planner_finish(struct ncp_planner *p);
+/* After a finished queue has run out (ncp_planner_step returned 0): take
+ * segments again, the next one starting from rest (no blend with the last). */
+void ncp_planner_restart(struct ncp_planner *p);
+/* Drops everything queued: at rest at pos, as if new (statistics kept). */
+void ncp_planner_reset(struct ncp_planner *p, const double pos[NCP_AXES]);
 /* Advances the interpolator by one servo period and writes the setpoint.
  * Returns 1 while moving or waiting for segments, 0 once everything has run
  * after ncp_planner_finish(). */
@@ -220,5 +238,59 @@ double ncp_scurve_dist(double va, double vb, double a, double j);
 double ncp_scurve_reach(double v, double len, double a, double j);
 /* Distance and velocity at time t (clamped to the duration). */
 double ncp_trap_eval(const struct ncp_trap *tp, double t, double *v);
+
+/* ---- the position loop's reading of the setpoint stream (scaler.c) ---------
+ * Time scaling (feed override, feed hold, underruns: the path stays, only the
+ * time along it changes) and fine interpolation between planning periods. */
+struct ncp_scaler {
+    struct ncp_setpoint z;     /* the sample before a (fine interpolation's accelerations) */
+    struct ncp_setpoint a, b;  /* samples around the read position */
+    struct ncp_setpoint c;     /* the sample after b, fetched ahead (have_c) */
+    int have_c, have_z;
+    double f;                  /* read position between a (0) and b (1) */
+    double r;                  /* rate: setpoints per period, 0..1 */
+    double rd;                 /* its rate of change, 1/s (jerk-limited rate changes) */
+    double decel, period;
+    /* Jerk budget of a rate change along the path, mm/s^3: > 0 makes rate
+     * changes jerk-limited (S-curve), 0 leaves them linear ramps. */
+    double jerk;
+    double rd_cap;             /* cap on |rd|, 1/s (S-curve; see ncp_scaler_limits) */
+    /* the stream's largest acceleration soon, positive and negative (S-curve) */
+    double ahead[NCP_AXES], behind[NCP_AXES];
+    double vahead[NCP_AXES];   /* and its largest |velocity| */
+    double vpath_ahead;        /* and path speed */
+    /* Per-axis limits the output's second and third differences must keep
+     * (INFINITY: unchecked); the last three outputs for them. */
+    double amax[NCP_AXES], jmax[NCP_AXES];
+    double last[3][NCP_AXES];
+    int nlast;
+    /* Fine interpolation: servo periods per stream sample (1: the stream is
+     * at the servo rate and is read linearly), and the stream's period. */
+    int ratio;
+    double tp;
+    /* END samples reached (the read position landed on them), each once */
+    uint64_t ends;
+    int b_counted;
+};
+
+void ncp_scaler_init(struct ncp_scaler *s, const double start[NCP_AXES], double decel,
+                     double period);
+/* Axis limits from the machine: acceleration always, jerk and jerk-limited
+ * rate changes with the S-curve profile. */
+void ncp_scaler_limits(struct ncp_scaler *s, const struct ncp_machine_cfg *cfg);
+double ncp_scaler_stop_cycles(const struct ncp_scaler *s);
+/* Drops the stream (the caller has emptied the ring): at rest at pos, rate
+ * 0, the configuration (limits, ratio, deceleration) kept. */
+void ncp_scaler_rebase(struct ncp_scaler *s, const double pos[NCP_AXES]);
+/* The stream comes every ratio periods: read it through quintic Hermite
+ * interpolation on the samples' velocities and accelerations (see scaler.c). */
+void ncp_scaler_set_ratio(struct ncp_scaler *s, int ratio);
+/* How many samples the ring should hold for a full look-ahead (1 without
+ * the S-curve): a virtual clock waits for them, a real one cannot. */
+size_t ncp_scaler_wants(const struct ncp_scaler *s, size_t capacity);
+/* One period at a rate moving towards target. Returns -1 when the stream ran
+ * dry in motion (the output holds the last sample), else 0. */
+int ncp_scaler_step(struct ncp_scaler *s, double target, struct ncp_spsc *ring,
+                    struct ncp_setpoint *out);
 
 #endif

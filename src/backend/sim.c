@@ -39,6 +39,15 @@ void ncp_sim_step(struct ncp_sim *s, const double cmd[NCP_AXES], const double ne
     for (int i = 0; i < NCP_AXES; i++) {
         struct ncp_sim_axis *a = &s->ax[i];
         act[i] = a->x;
+        if (s->disabled) {
+            /* no torque: the axis coasts to rest on the plant's own damping,
+             * and the controller starts afresh when enabled again */
+            a->integ = 0;
+            a->e_prev = 0;
+            a->vff_prev = 0;
+            plant(s, a, 0.0);
+            continue;
+        }
         double vff = (next[i] - cmd[i]) / s->T;
         double aff = (vff - a->vff_prev) / s->T;
         double e = cmd[i] - a->x;

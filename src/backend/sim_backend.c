@@ -37,8 +37,14 @@ static void sim_close(struct ncp_backend *b)
     b->impl = NULL;
 }
 
+static void sim_enable(struct ncp_backend *b, int on)
+{
+    struct ncp_sim *s = b->impl;
+    s->disabled = !on;
+}
+
 static const struct ncp_backend_ops sim_ops = {
-    "sim", sim_start, sim_cycle, sim_stop, sim_describe, sim_close,
+    "sim", sim_start, sim_cycle, sim_stop, sim_describe, sim_close, sim_enable,
 };
 
 int ncp_backend_open_sim(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,

@@ -81,7 +81,7 @@ static void sc_close(struct ncp_backend *b)
 }
 
 static const struct ncp_backend_ops sc_ops = {
-    "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close,
+    "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, NULL,
 };
 
 int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,

@@ -7,7 +7,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/motion.h"
 #include "ncpar/pipeline.h"
-#include "ncpar/rt.h"
+#include "ncpar/nck.h"
 
 #include <errno.h>
 #include <getopt.h>

@@ -16,7 +16,7 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->servo_period = 1e-3;
     c->max_linear_vel = 200.0;
     for (int i = 0; i < NCP_AXES; i++) {
-        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 100000.0, 1.0, 0, 0 };
+        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 100000.0, 1.0, 0, 0, 0, 0 };
     }
     c->axis[2].min_limit = -250.0;
     c->axis[2].max_limit = 50.0;
@@ -40,6 +40,9 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->can.heartbeat_period_ms = 50;
     c->can.heartbeat_timeout_ms = 500;
     c->can.sdo_timeout_ms = 200;
+    c->default_linear_vel = 10.0;
+    snprintf(c->lcm.prefix, sizeof c->lcm.prefix, "NCP_");
+    c->lcm.status_hz = 50.0;
 }
 
 struct load_ctx {
@@ -82,6 +85,8 @@ static int axis_key(struct ncp_axis_cfg *a, const char *k, const char *v)
         { "MAX_JERK", &a->max_jerk, 0, 1e12 },
         { "FERROR", &a->ferror, 1e-9, 1e6 },
         { "COUNTS_PER_MM", &a->counts_per_mm, 1e-3, 1e9 },
+        { "HOME", &a->home, -1e6, 1e6 },
+        { "HOME_SEARCH_VEL", &a->home_vel, 0, 1e6 },
     };
     if (!strcasecmp(k, "NODE_ID"))
         return integer(v, 1, 127, &a->node_id) ? -1 : 1;
@@ -158,6 +163,28 @@ static int can_key(struct ncp_can_cfg *c, const char *k, const char *v)
     return 0;
 }
 
+static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v)
+{
+    if (!strcasecmp(k, "URL")) {
+        size_t n = strlen(v);
+        if (n == 0 || n >= sizeof l->url)
+            return -1;
+        memcpy(l->url, v, n + 1);
+        return 1;
+    }
+    if (!strcasecmp(k, "CHANNEL_PREFIX")) {
+        /* LCM channel names: letters, digits and _ keep lcm-spy's filters simple */
+        size_t n = strlen(v);
+        if (n >= sizeof l->prefix || strspn(v, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_") != n)
+            return -1;
+        memcpy(l->prefix, v, n + 1);
+        return 1;
+    }
+    if (!strcasecmp(k, "STATUS_HZ"))
+        return num(v, 1, 1000, &l->status_hz) ? -1 : 1;
+    return 0;
+}
+
 static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, const char *v)
 {
     double x;
@@ -181,8 +208,14 @@ static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, c
         }
         if (!strcasecmp(k, "DEFAULT_LINEAR_ACCELERATION"))
             return num(v, 0, 1e8, &c->default_linear_acc) ? -1 : 1;
+        if (!strcasecmp(k, "DEFAULT_LINEAR_VELOCITY"))
+            return num(v, 1e-6, 1e6, &c->default_linear_vel) ? -1 : 1;
+        if (!strcasecmp(k, "NO_FORCE_HOMING"))
+            return integer(v, 0, 1, &c->no_force_homing) ? -1 : 1;
         return 0;
     }
+    if (!strcasecmp(sec, "LCM"))
+        return lcm_key(&c->lcm, k, v);
     if (!strncasecmp(sec, "AXIS_", 5) && strlen(sec) == 6) {
         const char *p = strchr("XYZ", sec[5] & ~0x20);
         if (!p || !*p)

@@ -96,6 +96,26 @@ void ncp_planner_finish(struct ncp_planner *p)
     p->finished = 1;
 }
 
+void ncp_planner_restart(struct ncp_planner *p)
+{
+    p->finished = 0;
+    p->have_last = 0;
+}
+
+void ncp_planner_reset(struct ncp_planner *p, const double pos[NCP_AXES])
+{
+    p->head = 0;
+    p->count = 0;
+    p->programmed = 0;
+    p->active = 0;
+    p->finished = 0;
+    p->have_last = 0;
+    p->t = 0;
+    p->dur = 0;
+    p->v_now = 0;
+    memcpy(p->pos, pos, sizeof p->pos);
+}
+
 void ncp_planner_get_stats(const struct ncp_planner *p, struct ncp_planner_stats *st)
 {
     *st = p->st;

@@ -11,7 +11,7 @@
 #include "ncpar/analyzer.h"
 #include "ncpar/feeder.h"
 #include "ncpar/pipeline.h"
-#include "ncpar/rt.h"
+#include "ncpar/nck.h"
 #include "trace_rows.h"
 
 struct gcode_ctx {

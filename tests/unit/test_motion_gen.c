@@ -34,7 +34,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/motion.h"
 #include "ncpar/pipeline.h"
-#include "ncpar/rt.h"
+#include "ncpar/nck.h"
 #include "gcode_src.h"
 
 #define POINT_TOL 2e-6      /* mm: print rounding of a 3-D point (0.87e-6) and some */

@@ -19,7 +19,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/motion.h"
 #include "ncpar/pipeline.h"
-#include "ncpar/rt.h"
+#include "ncpar/nck.h"
 #include "gcode_src.h"
 
 /* the trace prints 6 decimals: half a unit of the last digit */

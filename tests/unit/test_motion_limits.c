@@ -21,8 +21,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/motion.h"
 #include "ncpar/pipeline.h"
-#include "ncpar/rt.h"
-#include "../../src/rt/nck_int.h"
+#include "ncpar/nck.h"
 #include "gcode_src.h"
 
 /* The trace prints positions with 6 decimals: a k-th difference may be off by
@@ -393,8 +392,8 @@ static double underrun_worst_acc(int governed)
     struct ncp_spsc ring;
     assert_int_equal(ncp_spsc_init(&ring, sizeof(struct ncp_setpoint), 1024), 0);
     double zero[NCP_AXES] = { 0 }, x = 0, vel = v;
-    struct nck_scaler s;
-    nck_scaler_init(&s, zero, 0.5 * a, T);
+    struct ncp_scaler s;
+    ncp_scaler_init(&s, zero, 0.5 * a, T);
     if (governed)
         for (int j = 0; j < NCP_AXES; j++)
             s.amax[j] = a;
@@ -412,7 +411,7 @@ static double underrun_worst_acc(int governed)
     double p[3] = { 0, 0, 0 }, worst = 0;
     for (int k = 0; k < 600; k++) {
         struct ncp_setpoint out;
-        nck_scaler_step(&s, k < 100 ? 1.0 : 0.0, &ring, &out);
+        ncp_scaler_step(&s, k < 100 ? 1.0 : 0.0, &ring, &out);
         p[0] = p[1];
         p[1] = p[2];
         p[2] = out.pos[0];
@@ -445,9 +444,9 @@ static double underrun_scurve_worst(int jerk_limited, double *worst_acc)
     struct ncp_spsc ring;
     assert_int_equal(ncp_spsc_init(&ring, sizeof(struct ncp_setpoint), 2048), 0);
     double zero[NCP_AXES] = { 0 }, s = 0, vel = 100, acc = 0;
-    struct nck_scaler sc;
-    nck_scaler_init(&sc, zero, 0.5 * 1000, T);
-    nck_scaler_limits(&sc, &cfg);
+    struct ncp_scaler sc;
+    ncp_scaler_init(&sc, zero, 0.5 * 1000, T);
+    ncp_scaler_limits(&sc, &cfg);
     if (!jerk_limited) {  /* linear rate ramps, as with the trapezoid */
         sc.jerk = 0;
         for (int j = 0; j < NCP_AXES; j++)
@@ -480,7 +479,7 @@ static double underrun_scurve_worst(int jerk_limited, double *worst_acc)
     int stopped = 0;
     for (int k = 0; k < 2400; k++) {
         struct ncp_setpoint out;
-        nck_scaler_step(&sc, k < 120 || k > 700 ? 1.0 : 0.0, &ring, &out);
+        ncp_scaler_step(&sc, k < 120 || k > 700 ? 1.0 : 0.0, &ring, &out);
         memmove(p[1], p[0], 3 * sizeof p[0]);
         p[0][0] = out.pos[0];
         p[0][1] = out.pos[1];

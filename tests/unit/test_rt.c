@@ -19,8 +19,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/motion.h"
 #include "ncpar/pipeline.h"
-#include "ncpar/rt.h"
-#include "../../src/rt/nck_int.h"
+#include "ncpar/nck.h"
 #include "gcode_src.h"
 
 /* ---- SPSC ring ----------------------------------------------------------------- */
@@ -179,9 +178,9 @@ static void test_scaler_slows_along_path(void **state)
     const double T = 1e-3, v = 100, decel = 1000;
     struct ncp_spsc ring;
     assert_int_equal(ncp_spsc_init(&ring, sizeof(struct ncp_setpoint), 4096), 0);
-    struct nck_scaler s;
+    struct ncp_scaler s;
     double zero[NCP_AXES] = { 0 };
-    nck_scaler_init(&s, zero, decel, T);
+    ncp_scaler_init(&s, zero, decel, T);
     /* a line at 100 mm/s along (3,4,0)/5, already at speed */
     for (int k = 1; k <= 2000; k++) {
         struct ncp_setpoint sp;
@@ -198,7 +197,7 @@ static void test_scaler_slows_along_path(void **state)
     for (int k = 0; k < 1500; k++) {
         double target = k < 200 ? 1 : k < 600 ? 0 : 1;
         struct ncp_setpoint out;
-        assert_int_equal(nck_scaler_step(&s, target, &ring, &out), 0);
+        assert_int_equal(ncp_scaler_step(&s, target, &ring, &out), 0);
         /* on the path: y = 4/3 x */
         assert_true(fabs(out.pos[1] - out.pos[0] * 4.0 / 3.0) < 1e-9);
         if (k >= 2) {
@@ -223,7 +222,7 @@ static void test_scaler_slows_along_path(void **state)
     struct ncp_setpoint out;
     int dry = 0;
     for (int k = 0; k < 2000 && !dry; k++)
-        dry = nck_scaler_step(&s, 1, &ring, &out) != 0;
+        dry = ncp_scaler_step(&s, 1, &ring, &out) != 0;
     assert_true(dry);
     assert_true(out.pos[0] == 0.6 * v * T * 2000);
     ncp_spsc_destroy(&ring);

@@ -41,7 +41,7 @@
  * from v is that of a jerk-limited stop at the budgets above (the test
  * computes it); a hold that meets the plan at full acceleration the same way
  * waits until that phase is over. A virtual clock waits for the look-ahead
- * to be in the ring (nck_scaler_wants), so its runs are deterministic. Between
+ * to be in the ring (ncp_scaler_wants), so its runs are deterministic. Between
  * samples the output follows the quintic below even at the servo rate: a
  * straight line between samples read at a fractional rate would step the
  * velocity at every sample.
@@ -74,12 +74,13 @@
  * per axis, and with the S-curve a look-ahead over decel / jerk / Tp samples
  * (about 40 at the shipped limits).
  */
-#include "nck_int.h"
+#include "ncpar/motion.h"
+#include "ncpar/rt.h"
 
 #include <math.h>
 #include <string.h>
 
-void nck_scaler_init(struct nck_scaler *s, const double start[NCP_AXES], double decel,
+void ncp_scaler_init(struct ncp_scaler *s, const double start[NCP_AXES], double decel,
                      double period)
 {
     memset(s, 0, sizeof *s);
@@ -98,7 +99,7 @@ void nck_scaler_init(struct nck_scaler *s, const double start[NCP_AXES], double 
     s->rd_cap = INFINITY;
 }
 
-void nck_scaler_limits(struct nck_scaler *s, const struct ncp_machine_cfg *cfg)
+void ncp_scaler_limits(struct ncp_scaler *s, const struct ncp_machine_cfg *cfg)
 {
     double jmin = INFINITY, ja = INFINITY;
     for (int j = 0; j < NCP_AXES; j++) {
@@ -116,7 +117,7 @@ void nck_scaler_limits(struct nck_scaler *s, const struct ncp_machine_cfg *cfg)
     s->rd_cap = isfinite(jmin) ? 0.25 * ja / 3 : INFINITY;
 }
 
-void nck_scaler_set_ratio(struct nck_scaler *s, int ratio)
+void ncp_scaler_set_ratio(struct ncp_scaler *s, int ratio)
 {
     s->ratio = ratio < 1 ? 1 : ratio;
     s->tp = s->period * s->ratio;
@@ -124,7 +125,7 @@ void nck_scaler_set_ratio(struct nck_scaler *s, int ratio)
 
 /* Cycles needed to bring the path speed to rest at the scaler's deceleration
  * (and jerk). */
-double nck_scaler_stop_cycles(const struct nck_scaler *s)
+double ncp_scaler_stop_cycles(const struct ncp_scaler *s)
 {
     double vs = fmax(s->a.v, s->b.v), v = s->r * vs;
     double a = fmin(s->decel, s->rd_cap * vs), t = v / a;
@@ -133,7 +134,7 @@ double nck_scaler_stop_cycles(const struct nck_scaler *s)
     return t / s->period;
 }
 
-static double stream_speed(const struct nck_scaler *s)
+static double stream_speed(const struct ncp_scaler *s)
 {
     return fmax(s->a.v, s->b.v);
 }
@@ -142,13 +143,13 @@ static double stream_speed(const struct nck_scaler *s)
  * within the look-ahead, whichever is higher; below a crawl the rate may
  * change no faster than at it (an r changing fast on a stream at rest would
  * be a jolt once the stream moves). */
-static double rate_speed(const struct nck_scaler *s)
+static double rate_speed(const struct ncp_scaler *s)
 {
     return fmax(fmax(stream_speed(s), s->vpath_ahead), s->decel * s->decel / s->jerk);
 }
 
 /* Trapezoid: r moves linearly towards target. */
-static double ramp(const struct nck_scaler *s, double target)
+static double ramp(const struct ncp_scaler *s, double target)
 {
     double vs = stream_speed(s);
     double dr = vs > 1e-9 ? s->decel * s->period / vs : 1.0;
@@ -159,7 +160,7 @@ static double ramp(const struct nck_scaler *s, double target)
 /* S-curve: the next r on a jerk-limited approach to target. rd may change by
  * g T per period, and is never more than what still stops at target with
  * that jerk: a stop from rd covers rd^2 / 2g plus its discrete steps. */
-static double track(const struct nck_scaler *s, double target)
+static double track(const struct ncp_scaler *s, double target)
 {
     const double T = s->period;
     double vs = rate_speed(s);
@@ -223,7 +224,7 @@ static void quintic(const struct ncp_setpoint *z, const struct ncp_setpoint *a,
 }
 
 /* Output at read position f in [a, b] (f > 1: in [b, c]). */
-static void blend(const struct nck_scaler *s, double f, double pos[NCP_AXES])
+static void blend(const struct ncp_scaler *s, double f, double pos[NCP_AXES])
 {
     int next = f > 1;
     const struct ncp_setpoint *z = next ? &s->a : &s->z, *a = next ? &s->b : &s->a,
@@ -242,7 +243,7 @@ static void blend(const struct nck_scaler *s, double f, double pos[NCP_AXES])
 
 /* Output position if this period advances the read position by r; -1 when
  * that needs a sample the ring has not delivered. */
-static int probe(const struct nck_scaler *s, double r, double pos[NCP_AXES])
+static int probe(const struct ncp_scaler *s, double r, double pos[NCP_AXES])
 {
     double f = s->f + r / s->ratio;
     if (f > 1.0 && !s->have_c)
@@ -254,7 +255,7 @@ static int probe(const struct nck_scaler *s, double r, double pos[NCP_AXES])
 /* How far the output at rate r exceeds the limits, as the worst fraction of
  * an axis's limit over (<= 0: fits): second difference against MAX_ACCELERATION,
  * third difference against MAX_JERK (S-curve). */
-static double excess(const struct nck_scaler *s, double r)
+static double excess(const struct ncp_scaler *s, double r)
 {
     double pos[NCP_AXES], worst = -INFINITY;
     if (s->nlast < 2 || probe(s, r, pos) != 0)
@@ -275,7 +276,7 @@ static double excess(const struct nck_scaler *s, double r)
  * Fallbacks, in order: keep changing r as in the last period (no added
  * jerk), ease the change off at the rate jerk, keep r (no added
  * acceleration); if none fits, the candidate that exceeds least. */
-static double govern(const struct nck_scaler *s, double want)
+static double govern(const struct ncp_scaler *s, double want)
 {
     double e_want = excess(s, want);
     if (e_want <= 0)
@@ -315,7 +316,7 @@ static double govern(const struct nck_scaler *s, double want)
     return ok;
 }
 
-static void remember(struct nck_scaler *s, const double pos[NCP_AXES])
+static void remember(struct ncp_scaler *s, const double pos[NCP_AXES])
 {
     memmove(s->last[1], s->last[0], 2 * sizeof s->last[0]);
     memcpy(s->last[0], pos, sizeof s->last[0]);
@@ -336,7 +337,7 @@ static const struct ncp_setpoint *peek(struct ncp_spsc *ring, size_t i, size_t a
 /* Largest acceleration either way and |velocity| per axis of the stream
  * (second differences of its samples) from a to as far as a rate change takes
  * to ease off (decel/jerk), as far as the ring holds it. */
-static void look_ahead(struct nck_scaler *s, struct ncp_spsc *ring)
+static void look_ahead(struct ncp_scaler *s, struct ncp_spsc *ring)
 {
     size_t h = atomic_load_explicit(&ring->head, memory_order_relaxed);
     size_t avail = atomic_load_explicit(&ring->tail, memory_order_acquire) - h;
@@ -369,7 +370,7 @@ static void look_ahead(struct nck_scaler *s, struct ncp_spsc *ring)
     }
 }
 
-size_t nck_scaler_wants(const struct nck_scaler *s, size_t capacity)
+size_t ncp_scaler_wants(const struct ncp_scaler *s, size_t capacity)
 {
     if (s->jerk <= 0)
         return 1;
@@ -377,14 +378,14 @@ size_t nck_scaler_wants(const struct nck_scaler *s, size_t capacity)
     return n < capacity / 2 ? n : capacity / 2 > 1 ? capacity / 2 : 1;
 }
 
-static double next_rate(const struct nck_scaler *s, double target)
+static double next_rate(const struct ncp_scaler *s, double target)
 {
     if (s->jerk > 0)
         return govern(s, track(s, target));
     return govern(s, ramp(s, target));
 }
 
-int nck_scaler_step(struct nck_scaler *s, double target, struct ncp_spsc *ring,
+int ncp_scaler_step(struct ncp_scaler *s, double target, struct ncp_spsc *ring,
                     struct ncp_setpoint *out)
 {
     int dry = 0;
@@ -411,9 +412,14 @@ int nck_scaler_step(struct nck_scaler *s, double target, struct ncp_spsc *ring,
             s->z = s->a;
             s->a = s->b;
             s->b = s->c;
+            s->b_counted = 0;
             s->f -= 1.0;
             s->have_c = ncp_spsc_pop(ring, &s->c) == 0;
         }
+    }
+    if (s->f >= 1.0 && (s->b.flags & NCP_SP_END) && !s->b_counted) {
+        s->ends++;
+        s->b_counted = 1;
     }
     double f = s->f;
     blend(s, f, out->pos);
@@ -429,4 +435,17 @@ int nck_scaler_step(struct nck_scaler *s, double target, struct ncp_spsc *ring,
         out->flags |= near->flags & NCP_SP_ARC;
     remember(s, out->pos);
     return dry ? -1 : 0;
+}
+
+void ncp_scaler_rebase(struct ncp_scaler *s, const double pos[NCP_AXES])
+{
+    struct ncp_scaler keep = *s;
+    ncp_scaler_init(s, pos, keep.decel, keep.period);
+    s->r = 0;
+    s->jerk = keep.jerk;
+    s->rd_cap = keep.rd_cap;
+    s->ratio = keep.ratio;
+    s->tp = keep.tp;
+    memcpy(s->amax, keep.amax, sizeof s->amax);
+    memcpy(s->jmax, keep.jmax, sizeof s->jmax);
 }

@@ -5,7 +5,6 @@
 
 #include <math.h>
 #include <string.h>
-#include <time.h>
 
 static double dist_to_seg(const double p[NCP_AXES], const double a[NCP_AXES],
                           const double b[NCP_AXES])
@@ -71,6 +70,7 @@ void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
         s->contour_sum += c;
     }
     s->line = fb->line;
+    memcpy(s->act, fb->act, sizeof s->act);
     s->t = fb->t;
     s->v = fb->v;
     if (trace)
@@ -79,50 +79,22 @@ void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
                 nck_motion_column(fb->flags));
 }
 
-static int64_t mono_ns(void)
+void nck_trace_header(FILE *trace)
 {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+    fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n", trace);
 }
 
-static void progress(const struct nck *n, const struct nck_summary *s)
+int nck_read_cycles(struct nck *n)
 {
-    uint32_t total = n->o->total_lines;
-    /* lat_max_ns is written by the loop thread; a torn read only blurs a display */
-    fprintf(n->o->progress,
-            "\r  line %u/%u (%3.0f%%)  t %.2f s  feed %.0f mm/min  max latency %.1f us  ",
-            s->line, total, total ? 100.0 * s->line / total : 0.0, s->t, s->v * 60,
-            (double)n->loop.stats.lat_max_ns / 1e3);
-    fflush(n->o->progress);
-}
-
-void nck_drain(struct nck *n, struct nck_summary *s)
-{
-    int64_t last_print = 0;
     struct nck_fb fb;
-    FILE *tty = n->o->progress;
-    if (n->o->trace)
-        fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n", n->o->trace);
-    for (;;) {
-        int got = 0;
-        while (ncp_spsc_pop(&n->fbs, &fb) == 0) {
-            nck_account(s, &fb, n->o->trace);
-            got = 1;
-        }
-        if (!got && !atomic_load(&n->loop.running) && ncp_spsc_count(&n->fbs) == 0)
-            break;
-        if (tty && mono_ns() - last_print > 200000000) {
-            last_print = mono_ns();
-            progress(n, s);
-        }
-        if (!got) {
-            struct timespec ts = { 0, n->o->virtual_clock ? 50000 : 1000000 };
-            nanosleep(&ts, NULL);
-        }
+    int got = 0;
+    while (ncp_spsc_pop(&n->fbs, &fb) == 0) {
+        nck_account(&n->sum, &fb, n->setup.trace);
+        n->last_fb = fb;
+        n->have_fb = 1;
+        got++;
     }
-    if (tty && last_print)
-        fputc('\n', tty);
+    return got;
 }
 
 /* cyclictest-like histogram, folded into a few readable buckets for a terminal. */

@@ -1,0 +1,219 @@
+/* The NCK: a controller that stays up. Its threads, joined by SPSC rings:
+ *
+ *   job thread (interpreter of a program or an MDI line, or a jog or homing
+ *   move) -> canon map -> planner/interpolator thread -> position loop (the
+ *   periodic real-time thread, driving the backend) -> the caller's thread
+ *   (trace rows, statistics, status).
+ *
+ * The position loop and the planner run for the life of the NCK, so the
+ * machine holds its position between jobs; one job runs at a time. The caller
+ * owns the NCK from one thread (the service thread): it sends commands,
+ * which are accepted or refused with a reason by the state machine, and calls
+ * ncp_nck_poll often to move the NCK on and read its status and events.
+ * `cnc-run run` is the batch form of the same core (ncp_nck_run).
+ *
+ * On the real clock the position loop never waits for a slower stage; the
+ * virtual clock waits instead, so runs are deterministic. */
+#ifndef NCPAR_NCK_H
+#define NCPAR_NCK_H
+
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "ncpar/analyzer.h"
+#include "ncpar/diag.h"
+#include "ncpar/motion.h"
+#include "ncpar/pipeline.h"
+#include "ncpar/rt.h"
+
+/* ---- one program, start to end (cnc-run run) ------------------------------------ */
+
+struct ncp_output;
+struct ncp_machine_cfg;
+
+/* Live controls of a running NCK, safe to use from any thread. */
+struct ncp_nck_ctl {
+    _Atomic int override_permille;  /* feed override, 0..2000 (1000 = 100 %) */
+    _Atomic int hold;               /* feed hold: brake along the path and wait */
+    _Atomic int64_t now_ns;         /* machine time of the last position cycle */
+    /* Virtual clock only: time stands still at this instant (before its cycle
+     * runs) until it is moved on, so a script can act at an exact machine
+     * time. INT64_MAX (the default) never pauses. */
+    _Atomic int64_t pause_at_ns;
+    _Atomic int rapid_permille;     /* rapid override of G0 moves, 0..1000 */
+};
+
+void ncp_nck_ctl_init(struct ncp_nck_ctl *c, double feed_override);
+/* 0.0 .. 2.0. Applied by the position loop at run time by rescaling the planned
+ * setpoint stream in time, ramped so that no axis exceeds its acceleration
+ * limit. The plan itself is made at opts.feed_override: a live value above it
+ * runs at it (start with --feed-override 200 for the full range). */
+void ncp_nck_set_feed_override(struct ncp_nck_ctl *c, double ov);
+void ncp_nck_feed_hold(struct ncp_nck_ctl *c, int hold);
+
+struct ncp_nck_opts {
+    const struct ncp_machine_cfg *cfg;
+    /* Runs the program, handing command slots to out in program order
+     * (ncp_serial_run / ncp_pipeline_run). Called twice: once for the soft-limit
+     * check before any motion, once for the run. Returns NCP_OK or d->code. */
+    int (*interpret)(void *ctx, const struct ncp_output *out, struct ncp_diag *d);
+    void *interp_ctx;
+    int virtual_clock;
+    double for_s;            /* feed hold after this much machine time, 0 = whole program */
+    double feed_override;    /* 1.0 = 100 % (0.01 .. 2.0) */
+    FILE *trace;             /* per-cycle CSV or NULL */
+    FILE *progress;          /* live progress line (a terminal) or NULL */
+    uint32_t total_lines;    /* for the progress line */
+    struct ncp_nck_ctl *ctl; /* live override / hold, or NULL */
+};
+
+enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };
+
+struct ncp_nck_result {
+    int status;              /* enum ncp_nck_status */
+    int limit_violation;     /* soft limit found before motion (diag says where) */
+    int fault;               /* following-error fault */
+    int fault_axis;
+    double fault_err;
+    uint32_t fault_line;
+    struct ncp_diag diag;    /* program error or soft-limit violation */
+    int for_expired;
+    double program_time, path_length;
+    double ferr_max, ferr_avg, ferr_axis_max[3];
+    double contour_max, contour_avg;
+    uint64_t segments, starved, trace_dropped, replans;
+    uint64_t underruns;      /* setpoint ring ran low: slowed down along the path */
+    uint64_t dry;            /* cycles it ran empty in motion anyway (held position) */
+    int fifo;
+    char warning[200];
+    struct ncp_rt_stats lat;
+};
+
+/* Runs the whole chain. Returns res->status. */
+int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res);
+void ncp_nck_print_summary(const struct ncp_nck_result *res, const char *prog, FILE *f);
+
+
+/* ---- the NCK as a service -------------------------------------------------------- */
+
+/* The controller's states (the values of lcm/ncp_status_t.lcm's constants). */
+enum ncp_nck_state {
+    NCP_ST_IDLE = 0,
+    NCP_ST_RUNNING,
+    NCP_ST_PAUSED,
+    NCP_ST_STEPPING,
+    NCP_ST_MDI,
+    NCP_ST_JOGGING,
+    NCP_ST_HOMING,
+    NCP_ST_STOPPING,
+    NCP_ST_ESTOP,
+    NCP_ST_FAULT,
+    NCP_ST_COUNT
+};
+const char *ncp_nck_state_name(int state);
+/* -1 when the name is none of the states */
+int ncp_nck_state_parse(const char *name);
+
+/* Operator commands (the values of lcm/ncp_command_t.lcm's kinds). */
+enum ncp_nck_cmd_kind {
+    NCP_CMD_LOAD = 1,
+    NCP_CMD_RUN,
+    NCP_CMD_PAUSE,
+    NCP_CMD_RESUME,
+    NCP_CMD_STOP,
+    NCP_CMD_ABORT,
+    NCP_CMD_STEP,
+    NCP_CMD_MDI,
+    NCP_CMD_JOG,
+    NCP_CMD_JOG_STOP,
+    NCP_CMD_HOME,
+    NCP_CMD_OVERRIDE,
+    NCP_CMD_ESTOP,
+    NCP_CMD_RESET,
+    NCP_CMD_SHUTDOWN,
+    NCP_CMD_KEEPALIVE,
+    NCP_CMD_KIND_MAX = NCP_CMD_KEEPALIVE
+};
+
+#define NCP_NCK_TEXT_MAX 512
+
+struct ncp_nck_cmd {
+    int kind;                       /* enum ncp_nck_cmd_kind */
+    char text[NCP_NCK_TEXT_MAX];    /* path, MDI line, axis letter(s) */
+    double value[4];
+    int32_t ivalue[4];
+};
+
+struct ncp_nck_setup {
+    const struct ncp_machine_cfg *cfg;
+    int virtual_clock;
+    FILE *trace;                     /* per-cycle CSV, or NULL */
+    struct ncp_analyzer_cfg interp;  /* tool table, subroutine path of the interpreter */
+    enum ncp_thread_mode mode;       /* how programs are interpreted */
+    double jog_keepalive_s;          /* a continuous jog stops this long after the last
+                                        keep-alive (0: 0.5 s) */
+    double virtual_pace;             /* virtual clock: machine seconds per real second
+                                        while moving (0: as fast as the CPU allows) */
+};
+
+struct ncp_nck;
+
+/* Starts the backend, the planner and the position loop: the machine holds
+ * where it is, unhomed unless the INI says homing is not required. NULL
+ * with d->msg on failure. */
+struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *s, struct ncp_diag *d);
+/* Stops every thread (a job in motion is held first), the backend under
+ * control, and frees everything. */
+void ncp_nck_free(struct ncp_nck *n);
+
+/* Accepted (0), or refused (-1) with the reason in reason[len]. */
+int ncp_nck_command(struct ncp_nck *n, const struct ncp_nck_cmd *c, char *reason, size_t len);
+/* Moves the NCK on: reads the position loop's cycles (trace, status), ends
+ * jobs whose motion is complete, goes through the steps of a stop, notices
+ * faults and lost keep-alives. Call it at least every 10 ms. Returns 1 when
+ * the state changed since the last call. */
+int ncp_nck_poll(struct ncp_nck *n);
+
+#define NCP_NCK_AXES_MAX 9
+struct ncp_nck_snapshot {
+    int state;                       /* enum ncp_nck_state */
+    char program[256];
+    uint32_t line;
+    int n_axes;
+    char axes[NCP_NCK_AXES_MAX];
+    int homed[NCP_NCK_AXES_MAX];
+    double pos_cmd[NCP_NCK_AXES_MAX], pos_act[NCP_NCK_AXES_MAX];
+    double vel;                      /* mm/min */
+    double feed_override, rapid_override, spindle_override; /* percent */
+    double spindle_speed;
+    int spindle_dir;
+    int mist, flood;
+    int tool;
+    int g5x_index;                   /* 1 = G54 ... 9 = G59.3 */
+    double g5x_offset[NCP_NCK_AXES_MAX];
+    int step_mode;
+    char error[256];                 /* the last error, "" = none */
+    uint64_t rejected, cycles, deadline_misses;
+    double latency_max_us;
+};
+void ncp_nck_get_status(const struct ncp_nck *n, struct ncp_nck_snapshot *st);
+
+enum ncp_nck_event_kind {
+    NCP_EV_INFO = 0, NCP_EV_MSG, NCP_EV_DEBUG, NCP_EV_PRINT, NCP_EV_ERROR, NCP_EV_FAULT
+};
+struct ncp_nck_event {
+    int kind;                        /* enum ncp_nck_event_kind */
+    char file[256];
+    uint32_t line, col;
+    char text[NCP_NCK_TEXT_MAX];
+};
+/* The next event, oldest first: 1, or 0 when there is none. */
+int ncp_nck_next_event(struct ncp_nck *n, struct ncp_nck_event *ev);
+/* A shutdown command was accepted: the caller should free the NCK. */
+int ncp_nck_shutdown_requested(const struct ncp_nck *n);
+/* SIGINT/SIGTERM: a controlled stop along the path, as the stop command, from
+ * any state that moves; then shutdown. */
+void ncp_nck_request_shutdown(struct ncp_nck *n);
+
+#endif

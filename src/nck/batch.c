@@ -1,0 +1,203 @@
+/* One program from start to end (cnc-run run): the NCK's core with a single
+ * program job; the position loop ends by itself once the plant has settled
+ * after the program (or after --for's hold, or at a fault). */
+#include "nck_int.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* ---- soft limits, before any motion ---------------------------------------------- */
+
+struct precheck {
+    struct ncp_canon_map map;
+    struct ncp_diag d;
+    int failed;
+};
+
+static int emit_check(void *ctx, const struct ncp_cmd *cmd)
+{
+    struct precheck *pc = ctx;
+    struct ncp_seg s;
+    for (unsigned i = 0; i < cmd->n_ops; i++) {
+        int rc = ncp_canon_map_op(&pc->map, &cmd->ops[i], cmd->line, &s, &pc->d);
+        while (rc == 1)
+            rc = ncp_canon_map_more(&pc->map, &s, &pc->d);
+        if (rc < 0) {
+            pc->failed = pc->d.code == NCP_ERR_LIMIT;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* The program is interpreted once without motion: a soft-limit violation
+ * anywhere stops the run before the machine moves. Program errors are left to
+ * the real run, which moves up to the last good block. */
+static int precheck_limits(const struct ncp_nck_opts *o, const double start[NCP_AXES],
+                           struct ncp_diag *d)
+{
+    struct precheck *pc = calloc(1, sizeof *pc);
+    if (!pc)
+        return -1;
+    ncp_canon_map_init(&pc->map, o->cfg, start, o->feed_override);
+    struct ncp_output out = { .ctx = pc, .emit = emit_check };
+    struct ncp_diag ignored;
+    o->interpret(o->interp_ctx, &out, &ignored);
+    int failed = pc->failed;
+    if (failed)
+        *d = pc->d;
+    free(pc);
+    return failed;
+}
+
+/* ---- the run ------------------------------------------------------------------------- */
+
+static int64_t mono_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+static void progress(const struct nck *n, const struct ncp_nck_opts *o)
+{
+    const struct nck_summary *s = &n->sum;
+    uint32_t total = o->total_lines;
+    fprintf(o->progress,
+            "\r  line %u/%u (%3.0f%%)  t %.2f s  feed %.0f mm/min  max latency %.1f us  ",
+            s->line, total, total ? 100.0 * s->line / total : 0.0, s->t, s->v * 60,
+            (double)atomic_load(&n->pub_lat_max_ns) / 1e3);
+    fflush(o->progress);
+}
+
+/* Reads the loop's cycles until the loop has ended and its ring is empty. */
+static void drain(struct nck *n, const struct ncp_nck_opts *o)
+{
+    int64_t last_print = 0;
+    if (o->trace)
+        nck_trace_header(o->trace);
+    for (;;) {
+        int got = nck_read_cycles(n);
+        if (!got && !atomic_load(&n->loop.running) && ncp_spsc_count(&n->fbs) == 0)
+            break;
+        if (o->progress && mono_ns() - last_print > 200000000) {
+            last_print = mono_ns();
+            progress(n, o);
+        }
+        if (!got) {
+            struct timespec ts = { 0, o->virtual_clock ? 50000 : 1000000 };
+            nanosleep(&ts, NULL);
+        }
+    }
+    if (o->progress && last_print)
+        fputc('\n', o->progress);
+}
+
+/* "node 2: EMCY (0x082): ... (last completed block: line 7)", at the line
+ * of the block in progress. */
+static void backend_diag(const struct nck *n, struct ncp_nck_result *res)
+{
+    char why[NCP_DIAG_MSG_MAX];
+    n->be.ops->describe_fault(&n->be, why, sizeof why);
+    char done[48] = "none";
+    if (n->line_done)
+        snprintf(done, sizeof done, "line %u", n->line_done);
+    ncp_diag_set(&res->diag, NCP_ERR_IO, n->fault_line, 0, "%.*s (last completed block: %s)",
+                 (int)(sizeof res->diag.msg - 40), why, done);
+    res->status = NCP_NCK_FAULT;
+}
+
+static void collect(const struct nck *n, struct ncp_nck_result *res)
+{
+    const struct nck_summary *s = &n->sum;
+    struct ncp_planner_stats ps;
+    ncp_planner_get_stats(n->planner, &ps);
+    res->program_time = n->ended ? (double)n->end_ns * 1e-9 : s->t;
+    res->path_length = s->path;
+    res->segments = ps.segments;
+    res->starved = ps.starved;
+    res->replans = ps.replans;
+    res->ferr_max = s->ferr_max;
+    res->ferr_avg = s->moving ? s->ferr_sum / (double)s->moving : 0;
+    _Static_assert(NCP_AXES == sizeof res->ferr_axis_max / sizeof res->ferr_axis_max[0],
+                   "result arrays follow the axis count");
+    for (int j = 0; j < NCP_AXES; j++)
+        res->ferr_axis_max[j] = s->ferr_axis_max[j];
+    res->contour_max = s->contour_max;
+    res->contour_avg = s->moving ? s->contour_sum / (double)s->moving : 0;
+    res->underruns = n->underruns;
+    res->dry = n->dry;
+    res->trace_dropped = n->fb_dropped;
+    res->fifo = n->loop.fifo;
+    memcpy(res->warning, n->loop.warning, sizeof res->warning);
+    res->lat = n->loop.stats;
+    res->for_expired = n->for_expired;
+    const struct nck_job *j = &n->job;
+    int fault = atomic_load(&n->loop_fault);
+    if (fault == NCK_LF_BACKEND) {
+        backend_diag(n, res);
+    } else if (fault == NCK_LF_FERROR) {
+        res->fault = 1;
+        res->fault_axis = n->fault_axis;
+        res->fault_err = n->fault_err;
+        res->fault_line = n->fault_line;
+        res->status = NCP_NCK_FAULT;
+    } else if (n->for_expired) {
+        /* the interpreter was cut short by us: its "stopped" is no program error */
+    } else if (j->map_failed || j->rc != NCP_OK) {
+        res->diag = j->map_failed ? j->map_diag : j->diag;
+        res->status = res->diag.code == NCP_ERR_LIMIT ? NCP_NCK_FAULT : NCP_NCK_PROGRAM_ERROR;
+    }
+}
+
+int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
+{
+    memset(res, 0, sizeof res[0]);
+    ncp_rt_stats_reset(&res->lat);
+    struct nck *n = calloc(1, sizeof *n);
+    if (!n) {
+        snprintf(res->diag.msg, sizeof res->diag.msg, "cannot set up the runtime");
+        return res->status = NCP_NCK_FAULT;
+    }
+    n->plan_override = o->feed_override > 0 ? o->feed_override : 1.0;
+    n->for_s = o->for_s;
+    n->ctl = o->ctl;
+    struct ncp_nck_setup setup = { .cfg = o->cfg, .virtual_clock = o->virtual_clock,
+                                   .trace = o->trace };
+    /* the soft limits are checked from where the machine is, before it moves:
+     * the backend reports that as it starts */
+    if (nck_start(n, &setup, 1, &res->diag)) {
+        if (!res->diag.code)
+            res->diag.code = NCP_ERR_IO;
+        res->status = NCP_NCK_FAULT;
+    } else if ((res->limit_violation = precheck_limits(o, n->start, &res->diag)) != 0) {
+        res->limit_violation = res->limit_violation > 0;
+        res->status = NCP_NCK_FAULT;
+    } else {
+        n->job.kind = NCK_JOB_PROGRAM;
+        n->job.interpret = o->interpret;
+        n->job.interp_ctx = o->interp_ctx;
+        if (nck_job_start(n) || nck_start_loop(n, &res->diag)) {
+            snprintf(res->diag.msg, sizeof res->diag.msg, "cannot set up the runtime");
+            res->status = NCP_NCK_FAULT;
+        } else {
+            if (n->loop.warning[0] && o->progress)
+                fprintf(o->progress, "warning: %s\n", n->loop.warning);
+            drain(n, o);
+        }
+    }
+    nck_finish(n);
+    if (res->status == NCP_NCK_OK)
+        collect(n, res);
+    if (n->be_open)
+        n->be.ops->close(&n->be);
+    ncp_spsc_destroy(&n->segs);
+    ncp_spsc_destroy(&n->sps);
+    ncp_spsc_destroy(&n->fbs);
+    ncp_planner_free(n->planner);
+    pthread_mutex_destroy(&n->ev_lock);
+    free(n);
+    return res->status;
+}

@@ -1,0 +1,739 @@
+/* The serving NCK's state machine: which command fits which state, what each
+ * does, and how the NCK moves on between commands (ncp_nck_poll). Runs on the
+ * caller's thread only (the service thread). */
+#include "nck_int.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+#include <unistd.h>
+
+static const char *const state_names[NCP_ST_COUNT] = {
+    "idle", "running", "paused", "stepping", "mdi", "jogging", "homing", "stopping", "estop",
+    "fault",
+};
+
+const char *ncp_nck_state_name(int state)
+{
+    return state >= 0 && state < NCP_ST_COUNT ? state_names[state] : "?";
+}
+
+int ncp_nck_state_parse(const char *name)
+{
+    for (int s = 0; s < NCP_ST_COUNT; s++)
+        if (!strcmp(name, state_names[s]))
+            return s;
+    return -1;
+}
+
+static int64_t mono_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+static int refuse(char *reason, size_t len, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static int refuse(char *reason, size_t len, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(reason, len, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+static void set_state(struct ncp_nck *s, int state)
+{
+    if (s->state != state) {
+        s->state = state;
+        s->changed = 1;
+    }
+}
+
+static int axis_index(const char *text)
+{
+    if (!text[0] || text[1])
+        return -1;
+    const char *p = strchr("xyz", tolower((unsigned char)text[0]));
+    return p ? (int)(p - "xyz") : -1;
+}
+
+static int all_homed(const struct ncp_nck *s)
+{
+    for (int j = 0; j < NCP_AXES; j++)
+        if (!s->homed[j])
+            return 0;
+    return 1;
+}
+
+static int need_homing(const struct ncp_nck *s)
+{
+    return !s->n.cfg->no_force_homing && !all_homed(s);
+}
+
+/* ---- the interpreter ---------------------------------------------------------------- */
+
+static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
+{
+    struct ncp_nck *s = ctx;
+    struct ncp_run_stats st;
+    memset(&st, 0, sizeof st);
+    if (s->n.setup.mode == NCP_MODE_SERIAL || s->run_src == &s->mdi_src)
+        return ncp_serial_run(s->run_src, &s->acfg, out, &st, d);
+    struct ncp_thread_map map;
+    ncp_thread_map_default(&map, s->n.setup.mode, 2, 1);
+    return ncp_pipeline_run(s->run_src, &map, &s->acfg, out, &st, d);
+}
+
+/* The interpreter's current point is where the machine is. */
+static void sync_interp(struct ncp_nck *s)
+{
+    double prog[3];
+    ncp_canon_map_to_program(&s->n.map, s->n.map.pos, prog);
+    ncp_analyzer_set_position(s->interp, prog);
+}
+
+static int emit_state_only(void *ctx, const struct ncp_cmd *cmd)
+{
+    struct ncp_nck *s = ctx;
+    struct ncp_seg seg;
+    struct ncp_diag d;
+    for (unsigned i = 0; i < cmd->n_ops; i++) {
+        int rc = ncp_canon_map_op(&s->n.map, &cmd->ops[i], cmd->line, &seg, &d);
+        while (rc == 1)
+            rc = ncp_canon_map_more(&s->n.map, &seg, &d);
+    }
+    return 0;
+}
+
+/* After a stop, an error or an E-stop: the interpreter's end-of-program reset
+ * (G54, G17, G90, G94, spindle and coolant off, ...), as M2 would. */
+static void reset_interp(struct ncp_nck *s)
+{
+    static const char m2[] = "M2\n";
+    struct ncp_source src;
+    struct ncp_diag d;
+    if (ncp_source_from_memory(&src, m2, sizeof m2 - 1, "reset", &d) != NCP_OK)
+        return;
+    sync_interp(s);
+    struct ncp_output out = { .ctx = s, .emit = emit_state_only };
+    struct ncp_run_stats st;
+    ncp_serial_run(&src, &s->acfg, &out, &st, &d);
+    ncp_source_close(&src);
+    pthread_mutex_lock(&s->n.ev_lock);
+    s->n.io.dir = 0;
+    s->n.io.mist = 0;
+    s->n.io.flood = 0;
+    pthread_mutex_unlock(&s->n.ev_lock);
+    sync_interp(s);
+}
+
+/* ---- dropping what is queued --------------------------------------------------------- */
+
+static void begin_drop(struct ncp_nck *s, int hold, int full, int after, int reset)
+{
+    struct nck *n = &s->n;
+    if (hold) {
+        atomic_store(&n->full_decel, full);
+        ncp_nck_feed_hold(n->ctl, 1);
+        s->drop = NCK_DROP_HOLD;
+    } else {
+        s->drop = NCK_DROP_JOB;
+    }
+    s->drop_after = after;
+    s->drop_reset = reset;
+    set_state(s, NCP_ST_STOPPING);
+}
+
+static void drop_step(struct ncp_nck *s)
+{
+    struct nck *n = &s->n;
+    switch (s->drop) {
+    case NCK_DROP_HOLD:
+        if (!atomic_load(&n->at_rest))
+            return;
+        s->drop = NCK_DROP_JOB;
+        /* fall through */
+    case NCK_DROP_JOB:
+        atomic_store(&n->job.abort, 1);
+        nck_job_join(n);
+        n->job.kind = NCK_JOB_NONE;
+        nck_park_planner(n);
+        s->drop = NCK_DROP_PARK;
+        /* fall through */
+    case NCK_DROP_PARK:
+        if (!nck_planner_parked(n))
+            return;
+        nck_discard(n, atomic_load(&n->frozen));
+        s->drop = NCK_DROP_DISCARD;
+        /* fall through */
+    case NCK_DROP_DISCARD:
+        if (!nck_discarded(n))
+            return;
+        nck_unpark_planner(n);
+        s->drop = NCK_DROP_UNPARK;
+        /* fall through */
+    case NCK_DROP_UNPARK:
+        if (!nck_planner_unparked(n))
+            return;
+        s->drop = NCK_DROP_NONE;
+        atomic_store(&n->full_decel, 0);
+        if (s->drop_after == NCP_ST_IDLE)
+            atomic_store(&n->frozen, 0);
+        ncp_nck_feed_hold(n->ctl, 0);
+        if (s->drop_reset)
+            reset_interp(s);
+        else
+            sync_interp(s);
+        set_state(s, s->drop_after);
+        break;
+    case NCK_DROP_NONE:
+        break;
+    }
+}
+
+/* ---- starting jobs ------------------------------------------------------------------ */
+
+static int start_interp_job(struct ncp_nck *s, const struct ncp_source *src, uint32_t from,
+                            int kind)
+{
+    struct nck *n = &s->n;
+    sync_interp(s);
+    s->run_src = src;
+    n->job.kind = kind;
+    n->job.interpret = interpret;
+    n->job.interp_ctx = s;
+    n->job.from_line = from;
+    s->error[0] = 0;
+    return nck_job_start(n);
+}
+
+static int start_moves(struct ncp_nck *s, const struct ncp_seg *moves, int count)
+{
+    struct nck *n = &s->n;
+    n->job.kind = NCK_JOB_MOVE;
+    n->job.n_moves = count;
+    memcpy(n->job.moves, moves, (size_t)count * sizeof moves[0]);
+    return nck_job_start(n);
+}
+
+/* ---- commands --------------------------------------------------------------------------- */
+
+static int moving_state(int st)
+{
+    return st == NCP_ST_RUNNING || st == NCP_ST_PAUSED || st == NCP_ST_STEPPING ||
+           st == NCP_ST_MDI || st == NCP_ST_JOGGING || st == NCP_ST_HOMING;
+}
+
+static int emit_nothing(void *ctx, const struct ncp_cmd *cmd)
+{
+    (void)ctx;
+    (void)cmd;
+    return 0;
+}
+
+static int cmd_load(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    if (s->state != NCP_ST_IDLE)
+        return refuse(why, len, "cannot load a program while %s", ncp_nck_state_name(s->state));
+    struct ncp_source src;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (ncp_source_open(&src, c->text, &d) != NCP_OK)
+        return refuse(why, len, "%s: %s", c->text, d.msg);
+    /* every program error a fresh interpreter finds is refused now, with its
+     * place, rather than after the machine has run half the part */
+    struct ncp_analyzer_cfg acfg = s->acfg;
+    acfg.resident = 0;
+    acfg.instance = NULL;
+    struct ncp_output out = { .ctx = s, .emit = emit_nothing };
+    struct ncp_run_stats st;
+    int rc = ncp_serial_run(&src, &acfg, &out, &st, &d);
+    if (rc != NCP_OK && rc != NCP_END) {
+        ncp_source_close(&src);
+        return refuse(why, len, "%s:%u:%u: %s", d.file ? d.file : c->text, d.line,
+                      d.col ? d.col : 1u, d.msg);
+    }
+    if (s->have_prog)
+        ncp_source_close(&s->prog);
+    s->prog = src;
+    s->have_prog = 1;
+    snprintf(s->program, sizeof s->program, "%s", c->text);
+    nck_post(&s->n, NCP_EV_INFO, s->program, 0, 0, "loaded %s", s->program);
+    return 0;
+}
+
+static int cmd_run(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    if (s->state != NCP_ST_IDLE)
+        return refuse(why, len, "cannot run while %s", ncp_nck_state_name(s->state));
+    if (!s->have_prog)
+        return refuse(why, len, "no program loaded (cnc-ctl load PROG)");
+    if (need_homing(s))
+        return refuse(why, len, "the machine is not homed (cnc-ctl home all)");
+    if (c->ivalue[0] < 0)
+        return refuse(why, len, "run --from-line wants a line number of 1 or more");
+    if (start_interp_job(s, &s->prog, (uint32_t)c->ivalue[0], NCK_JOB_PROGRAM))
+        return refuse(why, len, "cannot start the interpreter thread");
+    set_state(s, atomic_load(&s->n.job.step) ? NCP_ST_STEPPING : NCP_ST_RUNNING);
+    nck_post(&s->n, NCP_EV_INFO, s->program, 0, 0, "running %s%s", s->program,
+             c->ivalue[0] > 0 ? " from a line" : "");
+    return 0;
+}
+
+static int cmd_mdi(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    if (s->state != NCP_ST_IDLE)
+        return refuse(why, len, "cannot run MDI while %s", ncp_nck_state_name(s->state));
+    if (need_homing(s))
+        return refuse(why, len, "the machine is not homed (cnc-ctl home all)");
+    size_t k = strnlen(c->text, sizeof c->text);
+    if (k == 0 || memchr(c->text, '\n', k))
+        return refuse(why, len, "MDI takes one non-empty line");
+    memcpy(s->mdi, c->text, k);
+    s->mdi[k] = '\n';
+    s->mdi[k + 1] = 0;
+    struct ncp_diag d;
+    ncp_source_from_memory(&s->mdi_src, s->mdi, k + 1, "MDI", &d);
+    if (start_interp_job(s, &s->mdi_src, 0, NCK_JOB_MDI))
+        return refuse(why, len, "cannot start the interpreter thread");
+    set_state(s, NCP_ST_MDI);
+    return 0;
+}
+
+/* A jog is a line at the jog speed: continuous ones towards the soft limit
+ * (they end there, or when stopped), incremental ones by the distance, cut
+ * at the soft limit. */
+static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    struct nck *n = &s->n;
+    if (s->state != NCP_ST_IDLE)
+        return refuse(why, len, "cannot jog while %s", ncp_nck_state_name(s->state));
+    int j = axis_index(c->text);
+    if (j < 0)
+        return refuse(why, len, "no axis '%s' on this machine (it has X Y Z)", c->text);
+    int dir = c->ivalue[0] > 0 ? 1 : c->ivalue[0] < 0 ? -1 : 0;
+    if (!dir)
+        return refuse(why, len, "jog wants a direction, + or -");
+    const struct ncp_axis_cfg *a = &n->cfg->axis[j];
+    double speed = c->value[0] > 0 ? c->value[0] / 60.0 : n->cfg->default_linear_vel;
+    if (!isfinite(speed) || !isfinite(c->value[1]) || c->value[1] < 0)
+        return refuse(why, len, "jog speed and distance must be positive numbers");
+    speed = fmin(speed, a->max_vel);
+    double target[NCP_AXES];
+    memcpy(target, n->map.pos, sizeof target);
+    double limit = dir > 0 ? a->max_limit : a->min_limit;
+    double dist = c->value[1];
+    target[j] = dist > 0 ? target[j] + dir * dist : limit;
+    target[j] = dir > 0 ? fmin(target[j], limit) : fmax(target[j], limit);
+    if (fabs(target[j] - n->map.pos[j]) < 1e-9)
+        return refuse(why, len, "%c is at its soft limit %.4f mm", "XYZ"[j], limit);
+    struct ncp_seg seg;
+    n->job.step_line = 0;
+    nck_line(n, &seg, n->map.pos, target, speed, 0);
+    if (start_moves(s, &seg, 1))
+        return refuse(why, len, "cannot start the jog");
+    memcpy(n->map.pos, target, sizeof n->map.pos);
+    s->jog_continuous = dist <= 0;
+    s->jog_last_ns = mono_ns();
+    set_state(s, NCP_ST_JOGGING);
+    return 0;
+}
+
+/* Homing on the simulated machine: its positions are absolute, so an axis
+ * homes by moving to its HOME position at HOME_SEARCH_VEL; all axes: Z first
+ * (out of the work), then X and Y. */
+static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    struct nck *n = &s->n;
+    if (s->state != NCP_ST_IDLE)
+        return refuse(why, len, "cannot home while %s", ncp_nck_state_name(s->state));
+    int all = !strcasecmp(c->text, "all");
+    int j = all ? -1 : axis_index(c->text);
+    if (!all && j < 0)
+        return refuse(why, len, "home takes an axis letter (X Y Z) or all, not '%s'", c->text);
+    static const int order[NCP_AXES] = { 2, 0, 1 };
+    struct ncp_seg moves[NCP_AXES];
+    int count = 0, mask = 0;
+    double at[NCP_AXES];
+    memcpy(at, n->map.pos, sizeof at);
+    n->job.step_line = 0;
+    for (int k = 0; k < NCP_AXES; k++) {
+        int ax = order[k];
+        if (!all && ax != j)
+            continue;
+        const struct ncp_axis_cfg *a = &n->cfg->axis[ax];
+        double to[NCP_AXES];
+        memcpy(to, at, sizeof to);
+        to[ax] = a->home;
+        double v = a->home_vel > 0 ? fmin(a->home_vel, a->max_vel) : 0.5 * a->max_vel;
+        nck_line(n, &moves[count], at, to, v, 0);
+        if (moves[count].length > 1e-9)
+            count++;
+        memcpy(at, to, sizeof at);
+        mask |= 1 << ax;
+    }
+    if (start_moves(s, moves, count))
+        return refuse(why, len, "cannot start homing");
+    memcpy(n->map.pos, at, sizeof n->map.pos);
+    s->homing_axes = mask;
+    set_state(s, NCP_ST_HOMING);
+    return 0;
+}
+
+static int cmd_override(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    double pct = c->value[0];
+    if (!isfinite(pct) || pct < 0)
+        return refuse(why, len, "an override is a percentage of 0 or more");
+    switch (c->ivalue[0]) {
+    case 0:
+        if (pct > 100.0 * s->n.plan_override)
+            return refuse(why, len, "feed override above %.0f %% is not supported: motion is "
+                          "planned at %.0f %% of F", 100.0 * s->n.plan_override,
+                          100.0 * s->n.plan_override);
+        ncp_nck_set_feed_override(s->n.ctl, pct / 100.0);
+        return 0;
+    case 1:
+        if (pct > 100)
+            return refuse(why, len, "rapid override is 0..100 %%: rapids already run at the "
+                          "axes' maximum velocity");
+        atomic_store(&s->n.ctl->rapid_permille, (int)lround(pct * 10));
+        s->rapid_override = pct;
+        return 0;
+    case 2:
+        if (pct > 200)
+            return refuse(why, len, "spindle override is 0..200 %%");
+        s->spindle_override = pct;
+        return 0;
+    default:
+        return refuse(why, len, "override is feed, rapid or spindle");
+    }
+}
+
+static int cmd_pause(struct ncp_nck *s, char *why, size_t len)
+{
+    if (s->state != NCP_ST_RUNNING && s->state != NCP_ST_STEPPING && s->state != NCP_ST_MDI)
+        return refuse(why, len, "nothing to pause while %s", ncp_nck_state_name(s->state));
+    s->resume_state = s->state;
+    ncp_nck_feed_hold(s->n.ctl, 1);
+    set_state(s, NCP_ST_PAUSED);
+    return 0;
+}
+
+static int cmd_resume(struct ncp_nck *s, char *why, size_t len)
+{
+    if (s->state == NCP_ST_PAUSED) {
+        ncp_nck_feed_hold(s->n.ctl, 0);
+        set_state(s, s->resume_state);
+        return 0;
+    }
+    if (s->state == NCP_ST_STEPPING) {
+        atomic_fetch_add(&s->n.job.step_go, 1);
+        return 0;
+    }
+    return refuse(why, len, "nothing to resume while %s", ncp_nck_state_name(s->state));
+}
+
+static int cmd_step(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    if (s->state == NCP_ST_ESTOP || s->state == NCP_ST_FAULT)
+        return refuse(why, len, "not while %s", ncp_nck_state_name(s->state));
+    int on = c->ivalue[0] != 0;
+    atomic_store(&s->n.job.step, on);
+    if (on && s->state == NCP_ST_RUNNING)
+        set_state(s, NCP_ST_STEPPING);
+    else if (!on && s->state == NCP_ST_STEPPING) {
+        atomic_fetch_add(&s->n.job.step_go, 1);
+        set_state(s, NCP_ST_RUNNING);
+    }
+    if (s->state == NCP_ST_PAUSED && s->resume_state != NCP_ST_MDI)
+        s->resume_state = on ? NCP_ST_STEPPING : NCP_ST_RUNNING;
+    return 0;
+}
+
+static int cmd_stop(struct ncp_nck *s, int full, char *why, size_t len)
+{
+    if (!moving_state(s->state))
+        return s->state == NCP_ST_IDLE || s->state == NCP_ST_STOPPING
+                   ? 0
+                   : refuse(why, len, "not while %s", ncp_nck_state_name(s->state));
+    int interp = s->n.job.kind == NCK_JOB_PROGRAM || s->n.job.kind == NCK_JOB_MDI;
+    begin_drop(s, 1, full, NCP_ST_IDLE, interp);
+    return 0;
+}
+
+static int cmd_estop(struct ncp_nck *s)
+{
+    struct nck *n = &s->n;
+    atomic_store(&n->frozen, 1);
+    if (s->state == NCP_ST_ESTOP)
+        return 0;
+    int interp = n->job.kind == NCK_JOB_PROGRAM || n->job.kind == NCK_JOB_MDI;
+    if (s->drop != NCK_DROP_NONE && s->drop != NCK_DROP_HOLD) {
+        s->drop_after = NCP_ST_ESTOP;   /* already dropping: end there */
+        s->drop_reset |= interp;
+    } else {
+        begin_drop(s, 0, 0, NCP_ST_ESTOP, interp);
+    }
+    nck_post(n, NCP_EV_FAULT, NULL, 0, 0, "E-stop: setpoints frozen, drives off");
+    return 0;
+}
+
+/* Out of E-stop or a fault: the commanded position becomes the actual one
+ * (the axes coasted meanwhile), the drives come on again. */
+static int cmd_reset(struct ncp_nck *s, char *why, size_t len)
+{
+    struct nck *n = &s->n;
+    if (s->state != NCP_ST_ESTOP && s->state != NCP_ST_FAULT)
+        return s->state == NCP_ST_IDLE ? (s->error[0] = 0, 0)
+                                       : refuse(why, len, "nothing to reset while %s",
+                                                ncp_nck_state_name(s->state));
+    atomic_store(&n->loop_fault, NCK_LF_NONE);
+    s->error[0] = 0;
+    /* rest at the actual position while still frozen, then let go */
+    begin_drop(s, 0, 0, NCP_ST_IDLE, 0);
+    return 0;
+}
+
+int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    if (len)
+        why[0] = 0;
+    if (memchr(c->text, 0, sizeof c->text) == NULL)
+        return refuse(why, len, "command text not terminated");
+    int rc;
+    int locked = s->state == NCP_ST_ESTOP || s->state == NCP_ST_FAULT ||
+                 s->state == NCP_ST_STOPPING;
+    switch (c->kind) {
+    case NCP_CMD_ESTOP: rc = cmd_estop(s); break;
+    case NCP_CMD_RESET:
+        rc = s->state == NCP_ST_STOPPING ? refuse(why, len, "a stop is in progress")
+                                         : cmd_reset(s, why, len);
+        break;
+    case NCP_CMD_SHUTDOWN: ncp_nck_request_shutdown(s); rc = 0; break;
+    case NCP_CMD_OVERRIDE: rc = cmd_override(s, c, why, len); break;
+    case NCP_CMD_STEP: rc = cmd_step(s, c, why, len); break;
+    case NCP_CMD_KEEPALIVE:
+        s->jog_last_ns = mono_ns();
+        rc = 0;
+        break;
+    default:
+        if (locked) {
+            rc = refuse(why, len, "the NCK is %s%s", ncp_nck_state_name(s->state),
+                        s->state == NCP_ST_STOPPING ? "" : " (cnc-ctl reset first)");
+            break;
+        }
+        switch (c->kind) {
+        case NCP_CMD_LOAD: rc = cmd_load(s, c, why, len); break;
+        case NCP_CMD_RUN: rc = cmd_run(s, c, why, len); break;
+        case NCP_CMD_PAUSE: rc = cmd_pause(s, why, len); break;
+        case NCP_CMD_RESUME: rc = cmd_resume(s, why, len); break;
+        case NCP_CMD_STOP: rc = cmd_stop(s, 0, why, len); break;
+        case NCP_CMD_ABORT: rc = cmd_stop(s, 1, why, len); break;
+        case NCP_CMD_MDI: rc = cmd_mdi(s, c, why, len); break;
+        case NCP_CMD_JOG: rc = cmd_jog(s, c, why, len); break;
+        case NCP_CMD_JOG_STOP:
+            rc = s->state == NCP_ST_JOGGING ? (begin_drop(s, 1, 0, NCP_ST_IDLE, 0), 0)
+                 : s->state == NCP_ST_IDLE  ? 0
+                                            : refuse(why, len, "not jogging (%s)",
+                                                     ncp_nck_state_name(s->state));
+            break;
+        case NCP_CMD_HOME: rc = cmd_home(s, c, why, len); break;
+        default: rc = refuse(why, len, "unknown command %d", c->kind); break;
+        }
+    }
+    if (rc)
+        s->rejected++;
+    return rc;
+}
+
+/* ---- moving on ---------------------------------------------------------------------------- */
+
+static void job_ended(struct ncp_nck *s)
+{
+    struct nck *n = &s->n;
+    struct nck_job *j = &n->job;
+    nck_job_join(n);
+    int kind = j->kind;
+    j->kind = NCK_JOB_NONE;
+    const struct ncp_diag *d = j->map_failed ? &j->map_diag : j->rc != NCP_OK ? &j->diag : NULL;
+    if (kind == NCK_JOB_MOVE && s->state == NCP_ST_HOMING) {
+        for (int a = 0; a < NCP_AXES; a++)
+            if (s->homing_axes & (1 << a))
+                s->homed[a] = 1;
+        nck_post(n, NCP_EV_INFO, NULL, 0, 0, "homed");
+    }
+    if (d) {
+        const char *file = d->file ? d->file : kind == NCK_JOB_MDI ? "MDI" : s->program;
+        snprintf(s->error, sizeof s->error, "%s:%u:%u: %s", file, d->line,
+                 d->col ? d->col : 1u, d->msg);
+        nck_post(n, NCP_EV_ERROR, file, d->line, d->col, "%s", d->msg);
+        /* the machine stands at the end of the last good block */
+        reset_interp(s);
+    } else if (kind == NCK_JOB_PROGRAM) {
+        nck_post(n, NCP_EV_INFO, s->program, 0, 0, "program finished");
+    }
+    set_state(s, NCP_ST_IDLE);
+}
+
+static void check_fault(struct ncp_nck *s)
+{
+    struct nck *n = &s->n;
+    int f = atomic_load_explicit(&n->loop_fault, memory_order_acquire);
+    if (f == NCK_LF_NONE || s->state == NCP_ST_FAULT ||
+        (s->drop != NCK_DROP_NONE && s->drop_after == NCP_ST_FAULT))
+        return;
+    if (f == NCK_LF_FERROR)
+        snprintf(s->error, sizeof s->error,
+                 "following error on %c: %.4f mm exceeds FERROR %.4f mm (line %u); drives off",
+                 "XYZ"[n->fault_axis], n->fault_err, n->cfg->axis[n->fault_axis].ferror,
+                 n->fault_line);
+    else {
+        char why[NCP_DIAG_MSG_MAX];
+        n->be.ops->describe_fault(&n->be, why, sizeof why);
+        snprintf(s->error, sizeof s->error, "drive fault: %s", why);
+    }
+    nck_post(n, NCP_EV_FAULT, NULL, n->fault_line, 0, "%s", s->error);
+    int interp = n->job.kind == NCK_JOB_PROGRAM || n->job.kind == NCK_JOB_MDI;
+    begin_drop(s, 0, 0, NCP_ST_FAULT, interp);
+}
+
+int ncp_nck_poll(struct ncp_nck *s)
+{
+    struct nck *n = &s->n;
+    nck_read_cycles(n);
+    check_fault(s);
+    if (s->drop != NCK_DROP_NONE)
+        drop_step(s);
+    int st = s->state;
+    if ((st == NCP_ST_RUNNING || st == NCP_ST_STEPPING || st == NCP_ST_MDI ||
+         st == NCP_ST_JOGGING || st == NCP_ST_HOMING) &&
+        atomic_load(&n->job.finished) && nck_motion_done(n))
+        job_ended(s);
+    if (s->state == NCP_ST_JOGGING && s->jog_continuous && s->drop == NCK_DROP_NONE) {
+        double limit = n->setup.jog_keepalive_s > 0 ? n->setup.jog_keepalive_s : 0.5;
+        if ((double)(mono_ns() - s->jog_last_ns) * 1e-9 > limit) {
+            nck_post(n, NCP_EV_INFO, NULL, 0, 0,
+                     "jog stopped: no keep-alive from its client for %.1f s", limit);
+            begin_drop(s, 1, 0, NCP_ST_IDLE, 0);
+        }
+    }
+    if (s->shutdown_pending && s->drop == NCK_DROP_NONE && !moving_state(s->state))
+        s->shutdown = 1;
+    int changed = s->changed;
+    s->changed = 0;
+    return changed;
+}
+
+/* ---- life ---------------------------------------------------------------------------------- */
+
+struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *d)
+{
+    struct ncp_nck *s = calloc(1, sizeof *s);
+    if (!s) {
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
+        return NULL;
+    }
+    struct nck *n = &s->n;
+    n->plan_override = 1.0;
+    n->post_prints = 1;
+    s->rapid_override = 100;
+    s->spindle_override = 100;
+    s->acfg = setup->interp;
+    s->acfg.resident = 1;
+    s->acfg.instance = NULL;
+    s->interp = ncp_analyzer_new(&s->acfg, d);
+    s->acfg.instance = s->interp;
+    if (setup->trace)
+        nck_trace_header(setup->trace);
+    if (!s->interp || nck_start(n, setup, 0, d) || nck_start_loop(n, d)) {
+        ncp_nck_free(s);
+        return NULL;
+    }
+    for (int j = 0; j < NCP_AXES; j++)
+        s->homed[j] = 0;
+    s->state = NCP_ST_IDLE;
+    sync_interp(s);
+    return s;
+}
+
+void ncp_nck_free(struct ncp_nck *s)
+{
+    if (!s)
+        return;
+    struct nck *n = &s->n;
+    nck_finish(n);
+    nck_read_cycles(n);
+    if (n->be_open)
+        n->be.ops->close(&n->be);
+    ncp_spsc_destroy(&n->segs);
+    ncp_spsc_destroy(&n->sps);
+    ncp_spsc_destroy(&n->fbs);
+    ncp_planner_free(n->planner);
+    ncp_analyzer_free(s->interp);
+    if (s->have_prog)
+        ncp_source_close(&s->prog);
+    pthread_mutex_destroy(&n->ev_lock);
+    free(s);
+}
+
+void ncp_nck_request_shutdown(struct ncp_nck *s)
+{
+    s->shutdown_pending = 1;
+    if (moving_state(s->state))
+        begin_drop(s, 1, 0, NCP_ST_IDLE, 1);
+}
+
+int ncp_nck_shutdown_requested(const struct ncp_nck *s)
+{
+    return s->shutdown;
+}
+
+/* ---- status ------------------------------------------------------------------------------- */
+
+void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
+{
+    const struct nck *n = &s->n;
+    memset(st, 0, sizeof *st);
+    st->state = s->state;
+    snprintf(st->program, sizeof st->program, "%s", s->program);
+    st->n_axes = NCP_AXES;
+    for (int j = 0; j < NCP_AXES; j++) {
+        st->axes[j] = "XYZ"[j];
+        st->homed[j] = s->homed[j];
+        st->pos_cmd[j] = n->have_fb ? n->last_fb.cmd[j] : n->cur.pos[j];
+        st->pos_act[j] = n->have_fb ? n->last_fb.act[j] : n->cur.pos[j];
+    }
+    st->vel = n->have_fb ? n->last_fb.v * 60.0 : 0;
+    st->feed_override = atomic_load(&n->ctl->override_permille) / 10.0;
+    st->rapid_override = s->rapid_override;
+    st->spindle_override = s->spindle_override;
+    pthread_mutex_t *lock = (pthread_mutex_t *)&n->ev_lock;
+    pthread_mutex_lock(lock);
+    st->line = moving_state(s->state) && n->have_fb && n->last_fb.line ? n->last_fb.line
+                                                                       : n->io.interp_line;
+    st->spindle_speed = n->io.dir ? n->io.speed * s->spindle_override / 100.0 : 0;
+    st->spindle_dir = n->io.dir;
+    st->mist = n->io.mist;
+    st->flood = n->io.flood;
+    st->tool = n->io.tool;
+    st->g5x_index = n->io.g5x_index ? n->io.g5x_index : 1;
+    for (int k = 0; k < 6 && k < NCP_NCK_AXES_MAX; k++)
+        st->g5x_offset[k] = n->io.g5x[k];
+    pthread_mutex_unlock(lock);
+    st->step_mode = atomic_load(&n->job.step);
+    snprintf(st->error, sizeof st->error, "%s", s->error);
+    st->rejected = s->rejected;
+    st->cycles = n->sum.rows;
+    st->deadline_misses = atomic_load(&n->pub_misses);
+    st->latency_max_us = (double)atomic_load(&n->pub_lat_max_ns) / 1e3;
+}

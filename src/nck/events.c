@@ -1,0 +1,43 @@
+/* The NCK's events, oldest first, for the service to publish. A full queue
+ * drops the oldest: an operator needs the latest word more than the first. */
+#include "nck_int.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+void nck_post(struct nck *n, int kind, const char *file, uint32_t line, uint32_t col,
+              const char *fmt, ...)
+{
+    pthread_mutex_lock(&n->ev_lock);
+    if (n->ev_count == NCK_EVENTS) {
+        n->ev_head = (n->ev_head + 1) % NCK_EVENTS;
+        n->ev_count--;
+        n->ev_dropped++;
+    }
+    struct ncp_nck_event *e = &n->ev[(n->ev_head + n->ev_count) % NCK_EVENTS];
+    n->ev_count++;
+    e->kind = kind;
+    snprintf(e->file, sizeof e->file, "%s", file ? file : "");
+    e->line = line;
+    e->col = col;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(e->text, sizeof e->text, fmt, ap);
+    va_end(ap);
+    pthread_mutex_unlock(&n->ev_lock);
+}
+
+int ncp_nck_next_event(struct ncp_nck *s, struct ncp_nck_event *ev)
+{
+    struct nck *n = &s->n;
+    pthread_mutex_lock(&n->ev_lock);
+    int got = n->ev_count > 0;
+    if (got) {
+        *ev = n->ev[n->ev_head];
+        n->ev_head = (n->ev_head + 1) % NCK_EVENTS;
+        n->ev_count--;
+    }
+    pthread_mutex_unlock(&n->ev_lock);
+    return got;
+}

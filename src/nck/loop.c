@@ -1,0 +1,250 @@
+/* The position cycle: the only code on the real-time thread. It takes the
+ * period's setpoint from the scaler, steps the backend and hands the cycle on.
+ * No allocation, locks or I/O: requests from other threads arrive as atomic
+ * counters and are answered the same way. */
+#include "nck_int.h"
+
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#define SETTLE_CYCLES 100          /* batch: hold after the end so the plant settles */
+
+static int check_ferror(struct nck *n, const double act[NCP_AXES])
+{
+    for (int j = 0; j < NCP_AXES; j++) {
+        double e = fabs(n->cur.pos[j] - act[j]);
+        if (e > n->cfg->axis[j].ferror) {
+            n->fault_axis = j;
+            n->fault_err = e;
+            n->fault_line = n->cur.line;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Live feed override relative to the override the plan was made at; feed hold
+ * (and --for) bring it to 0. Above the planned override the plan's own caps
+ * hold: a faster stream could exceed the acceleration limits. */
+static double feed_rate(struct nck *n)
+{
+    if (n->for_expired || atomic_load_explicit(&n->ctl->hold, memory_order_relaxed))
+        return 0.0;
+    /* a serving NCK's rapids follow the rapid override, as LinuxCNC's (a
+     * batch run's --feed-override and live override apply to all motion) */
+    if (!n->batch && (n->cur.flags & NCP_SP_RAPID))
+        return fmin(1.0, atomic_load_explicit(&n->ctl->rapid_permille, memory_order_relaxed) /
+                             1000.0);
+    double ov = atomic_load_explicit(&n->ctl->override_permille, memory_order_relaxed) / 1000.0;
+    return fmin(1.0, ov / n->plan_override);
+}
+
+/* The end of the stream is in the ring: running it down is no underrun. */
+static int end_in_ring(const struct nck *n)
+{
+    return atomic_load_explicit(&n->ends_pushed, memory_order_acquire) >
+           atomic_load_explicit(&n->ends_taken, memory_order_relaxed);
+}
+
+/* Real clock: when the ring holds fewer setpoints than a stop along the path
+ * needs, slow the stream down (an underrun in the making); speed up again
+ * once it has refilled. The virtual clock never needs to: it waits instead. */
+double nck_rate_target(struct nck *n)
+{
+    double feed = feed_rate(n);
+    if (feed <= 0 || n->setup.virtual_clock || end_in_ring(n))
+        return feed;
+    /* ramping the rate down to 0 reads half as many samples as cycles pass;
+     * a ring too small for that still gets the attempt (see SETPOINT_RING) */
+    double cap = (double)ncp_spsc_capacity(&n->sps);
+    double need = fmin(0.5 * ncp_scaler_stop_cycles(&n->scaler) / n->scaler.ratio + 8, 0.75 * cap);
+    double fill = (double)ncp_spsc_count(&n->sps);
+    if (!n->slowing && fill < need) {
+        n->slowing = 1;
+        n->underruns += need > 8;  /* only in motion: at rest it just waits */
+    } else if (n->slowing && fill >= fmin(2 * need, cap - 1)) {
+        n->slowing = 0;
+    }
+    return n->slowing ? 0.0 : feed;
+}
+
+/* Motion the loop must wait for on the virtual clock: a job has motion open
+ * that the loop has not reached the end of, the planner has not pushed that
+ * end yet, and the job is not waiting for the operator (single block). */
+static int stream_expected(const struct nck *n)
+{
+    return atomic_load_explicit(&n->marks_sent, memory_order_acquire) >
+               atomic_load_explicit(&n->ends_taken, memory_order_relaxed) &&
+           !end_in_ring(n) && !atomic_load_explicit(&n->job.waiting, memory_order_relaxed);
+}
+
+/* The servo sees one setpoint ahead (the command runs one period late), so
+ * its feed-forward uses the velocity of the interval it is about to drive. */
+static int take_setpoint(struct nck *n)
+{
+    if (!n->ended && n->setup.virtual_clock &&
+        ncp_spsc_count(&n->sps) < ncp_scaler_wants(&n->scaler, ncp_spsc_capacity(&n->sps)) &&
+        stream_expected(n))
+        return NCP_RT_RETRY;
+    n->cur = n->next;
+    if (!n->ended && ncp_scaler_step(&n->scaler, nck_rate_target(n), &n->sps, &n->next) != 0)
+        n->dry++;
+    if (n->scaler.ends != n->ends_seen) {
+        atomic_fetch_add_explicit(&n->ends_taken, n->scaler.ends - n->ends_seen,
+                                  memory_order_release);
+        n->ends_seen = n->scaler.ends;
+    }
+    /* a batch run ends with the period that commands its END sample */
+    n->end_seen = (n->cur.flags & NCP_SP_END) != 0;
+    if (n->batch && n->end_seen && !n->ended) {
+        n->ended = 1;
+        n->end_ns = n->now_ns;
+    }
+    return NCP_RT_CONTINUE;
+}
+
+/* The line of the setpoint changes when its block's motion is complete. */
+static void track_blocks(struct nck *n)
+{
+    if (n->cur.line != n->line_now) {
+        n->line_done = n->line_now;
+        n->line_now = n->cur.line;
+    }
+}
+
+/* A drop request: the planner is parked, so nothing more comes into the ring;
+ * empty it and rest where the machine is. */
+static void discard(struct nck *n, const double act[NCP_AXES])
+{
+    struct ncp_setpoint sp;
+    while (ncp_spsc_pop(&n->sps, &sp) == 0)
+        ;
+    double at[NCP_AXES];
+    memcpy(at, atomic_load_explicit(&n->discard_to_actual, memory_order_relaxed) ? act : n->cur.pos,
+           sizeof at);
+    memcpy(n->rest, at, sizeof n->rest);
+    ncp_scaler_rebase(&n->scaler, at);
+    n->scaler.decel = n->decel_normal;
+    memset(&n->cur, 0, sizeof n->cur);
+    memcpy(n->cur.pos, at, sizeof n->cur.pos);
+    n->next = n->cur;
+    n->slowing = 0;
+    n->end_seen = 0;
+    n->ends_seen = n->scaler.ends;
+    atomic_store_explicit(&n->ends_taken,
+                          atomic_load_explicit(&n->ends_pushed, memory_order_acquire),
+                          memory_order_relaxed);
+    atomic_store_explicit(&n->discard_ack,
+                          atomic_load_explicit(&n->discard_req, memory_order_relaxed),
+                          memory_order_release);
+}
+
+static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES])
+{
+    struct nck_fb fb;
+    fb.t = (double)now_ns * 1e-9;
+    fb.v = n->cur.v;
+    fb.line = n->cur.line;
+    fb.flags = n->cur.flags;
+    memcpy(fb.cmd, n->cur.pos, sizeof fb.cmd);
+    memcpy(fb.act, act, sizeof fb.act);
+    if (ncp_spsc_push(&n->fbs, &fb) != 0)
+        n->fb_dropped++;
+}
+
+static void publish_stats(struct nck *n)
+{
+    atomic_store_explicit(&n->pub_misses, n->loop.stats.misses, memory_order_relaxed);
+    atomic_store_explicit(&n->pub_lat_max_ns, n->loop.stats.lat_max_ns, memory_order_relaxed);
+}
+
+/* Nothing to do on a serving NCK's virtual clock: time goes on at the real
+ * rate rather than racing ahead of the operator. */
+static void idle_nap(const struct nck *n)
+{
+    struct timespec ts = { 0, (long)(n->cfg->servo_period * 1e9) };
+    clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, NULL);
+}
+
+/* E-stop or a fault: the setpoint stays where it was, the drives are off. */
+static int frozen_cycle(struct nck *n, int64_t now_ns)
+{
+    if (n->drives_on && n->be.ops->enable) {
+        n->be.ops->enable(&n->be, 0);
+        n->drives_on = 0;
+    }
+    double act[NCP_AXES];
+    n->be.ops->cycle(&n->be, n->cur.pos, n->cur.pos, act);
+    if (atomic_load_explicit(&n->discard_req, memory_order_acquire) !=
+        atomic_load_explicit(&n->discard_ack, memory_order_relaxed))
+        discard(n, act);
+    n->cur.v = 0;
+    push_cycle(n, now_ns, act);
+    atomic_store_explicit(&n->at_rest, 1, memory_order_relaxed);
+    if (n->setup.virtual_clock)
+        idle_nap(n);
+    return NCP_RT_CONTINUE;
+}
+
+int nck_position_cycle(void *ctx, int64_t now_ns)
+{
+    struct nck *n = ctx;
+    atomic_store_explicit(&n->ctl->now_ns, now_ns, memory_order_release);
+    int virt = n->setup.virtual_clock;
+    if (virt && now_ns >= atomic_load_explicit(&n->ctl->pause_at_ns, memory_order_acquire))
+        return NCP_RT_RETRY;
+    n->now_ns = now_ns;
+    if (virt && ncp_spsc_count(&n->fbs) >= ncp_spsc_capacity(&n->fbs))
+        return NCP_RT_RETRY;
+    publish_stats(n);
+    if (atomic_load_explicit(&n->frozen, memory_order_acquire))
+        return frozen_cycle(n, now_ns);
+    if (!n->drives_on && n->be.ops->enable) {
+        n->be.ops->enable(&n->be, 1);
+        n->drives_on = 1;
+    }
+    n->scaler.decel = atomic_load_explicit(&n->full_decel, memory_order_relaxed)
+                          ? n->decel_full : n->decel_normal;
+    if (take_setpoint(n) == NCP_RT_RETRY)
+        return NCP_RT_RETRY;
+    double act[NCP_AXES];
+    int be_rc = n->be.ops->cycle(&n->be, n->cur.pos, n->next.pos, act);
+    track_blocks(n);
+    push_cycle(n, now_ns, act);
+    int rest = n->cur.v == 0 && n->next.v == 0 && (n->scaler.r == 0 || n->end_seen ||
+                                                   ncp_spsc_count(&n->sps) == 0);
+    atomic_store_explicit(&n->at_rest, rest, memory_order_relaxed);
+    if (atomic_load_explicit(&n->discard_req, memory_order_acquire) !=
+        atomic_load_explicit(&n->discard_ack, memory_order_relaxed))
+        discard(n, act);
+    /* A drive fault (EMCY, heartbeat, device state, bus) or a following error
+     * ends motion: a batch run's loop stops (the backend's stop() then brings
+     * every axis to a controlled stop); a serving NCK freezes its setpoints
+     * and turns its drives off until reset, as LinuxCNC does. */
+    int fault = be_rc != 0 ? NCK_LF_BACKEND : check_ferror(n, act) ? NCK_LF_FERROR : NCK_LF_NONE;
+    if (fault) {
+        if (fault == NCK_LF_BACKEND)
+            n->fault_line = n->cur.line;
+        atomic_store_explicit(&n->loop_fault, fault, memory_order_release);
+        if (n->batch)
+            return NCP_RT_STOP;
+        atomic_store_explicit(&n->frozen, 1, memory_order_release);
+        return NCP_RT_CONTINUE;
+    }
+    if (n->batch) {
+        if (n->for_s > 0 && (double)now_ns * 1e-9 >= n->for_s)
+            n->for_expired = 1;
+        int done = n->ended || (n->for_expired && n->scaler.r == 0 && n->cur.v == 0);
+        if (done && ++n->settle >= SETTLE_CYCLES)
+            return NCP_RT_STOP;
+    } else if (virt && n->setup.virtual_pace > 0 && !rest) {
+        struct timespec ts = { 0, (long)(n->cfg->servo_period * 1e9 / n->setup.virtual_pace) };
+        clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, NULL);
+    } else if (virt && rest &&
+               (atomic_load_explicit(&n->ctl->hold, memory_order_relaxed) ||
+                (!stream_expected(n) && ncp_spsc_count(&n->sps) == 0))) {
+        idle_nap(n);
+    }
+    return NCP_RT_CONTINUE;
+}

@@ -1,0 +1,2 @@
+# sources of src/nck, appended by the module
+LIB_SRCS += $(wildcard src/nck/*.c)

@@ -1,0 +1,246 @@
+/* One NCK's threads and what they share. Not part of the public contract.
+ *
+ * Who writes what:
+ * - the job thread (one at a time): the segment ring's producer, job.*, the
+ *   canon map while a job runs;
+ * - the planner thread: the planner, the setpoint ring's producer;
+ * - the position loop (real-time): the setpoint ring's and the scaler's
+ *   consumer, the cycle ring's producer, the loop-only fields below;
+ * - the caller's thread (the service thread): everything else, the cycle
+ *   ring's consumer, the canon map between jobs.
+ * Requests between them are pairs of counters (req written by one side, ack by
+ * the other), so nothing ever blocks the position loop. */
+#ifndef NCPAR_NCK_INT_H
+#define NCPAR_NCK_INT_H
+
+#include "ncpar/backend.h"
+#include "ncpar/nck.h"
+
+#include <pthread.h>
+
+#define NCK_CONTOUR_HISTORY 64
+
+/* The segment ring's messages. END closes a job's motion; SYNC makes the
+ * planner run what it has to a stop without ending the job (single block). */
+enum { NCK_MSG_SEG, NCK_MSG_END, NCK_MSG_SYNC };
+struct nck_seg_msg {
+    int kind;
+    struct ncp_seg seg;
+};
+
+/* One servo cycle as the position loop saw it. */
+struct nck_fb {
+    double t, v;
+    double cmd[NCP_AXES], act[NCP_AXES];
+    uint32_t line;
+    uint32_t flags;          /* the setpoint's (NCP_SP_RAPID / NCP_SP_ARC for the trace) */
+};
+
+struct nck_summary {
+    uint64_t rows, moving;
+    double ferr_max, ferr_sum, ferr_axis_max[NCP_AXES];
+    double contour_max, contour_sum;
+    double hist[NCK_CONTOUR_HISTORY][NCP_AXES];
+    size_t hist_n, hist_at;
+    uint32_t line;
+    double t, v;
+    double path;             /* length of the commanded path actually run */
+    double last[NCP_AXES];
+    double act[NCP_AXES];    /* the last cycle's actual position */
+};
+
+enum nck_loop_fault { NCK_LF_NONE, NCK_LF_FERROR, NCK_LF_BACKEND };
+
+enum nck_job_kind { NCK_JOB_NONE, NCK_JOB_PROGRAM, NCK_JOB_MDI, NCK_JOB_MOVE };
+
+/* A program, an MDI line or a list of moves (jog, homing, a safe approach). */
+#define NCK_JOB_MOVES 4
+struct nck_job {
+    int kind;
+    pthread_t thread;
+    int started;
+    _Atomic int finished;        /* the job thread pushed its END and returned */
+    _Atomic int abort;           /* stop pushing, return */
+    /* interpreter jobs */
+    int (*interpret)(void *ctx, const struct ncp_output *out, struct ncp_diag *d);
+    void *interp_ctx;
+    int rc;
+    struct ncp_diag diag;        /* the interpreter's error */
+    int map_failed;
+    struct ncp_diag map_diag;    /* a call the machine cannot run (soft limit, ...) */
+    uint32_t from_line;          /* run from this line: earlier lines move nothing */
+    int reached;                 /* from_line reached and approached */
+    double max_z;                /* highest machine Z of the skipped moves */
+    int seen_motion;
+    /* single block: after each block's motion the job waits for a resume */
+    _Atomic int step;
+    _Atomic uint64_t step_go;    /* resume presses (service thread) */
+    uint64_t step_used;
+    _Atomic int waiting;         /* at a block end, waiting for resume */
+    uint32_t step_line;
+    /* move jobs */
+    struct ncp_seg moves[NCK_JOB_MOVES];
+    int n_moves;
+    uint64_t marks;              /* END/SYNC messages this job pushed */
+    double origin[NCP_AXES];     /* where the machine was when the job started */
+};
+
+/* What the interpreter last set that the machine does not act on yet, for
+ * the status (guarded by ev_lock: the job thread writes, the caller reads). */
+struct nck_io {
+    double speed;
+    int dir, mist, flood, tool, g5x_index;
+    double g5x[6];
+    uint32_t interp_line;
+};
+
+struct nck {
+    struct ncp_nck_setup setup;
+    const struct ncp_machine_cfg *cfg;
+    /* batch (ncp_nck_run): one program, then the loop ends by itself */
+    int batch;
+    double plan_override;        /* feed override the plan is made at (1.0 = 100 %) */
+    double for_s;                /* batch: feed hold after this much machine time */
+    struct ncp_nck_ctl own_ctl;
+    struct ncp_nck_ctl *ctl;     /* live override / hold / virtual pause */
+    struct ncp_backend be;
+    int be_open, be_started;
+    struct ncp_spsc segs, sps, fbs;
+    struct ncp_planner *planner;
+    struct ncp_canon_map map;
+    struct ncp_rt_loop loop;
+    pthread_t planner_thread;
+    int planner_started, loop_started;
+    _Atomic int quit;            /* planner thread: leave */
+    double start[NCP_AXES];      /* where the backend reported the axes at start */
+
+    /* Stream marks: END/SYNC messages sent (job), END setpoints pushed
+     * (planner), END setpoints reached (loop). A job's motion is complete when
+     * ends_taken reaches the marks it sent. */
+    _Atomic uint64_t marks_sent, ends_pushed, ends_taken;
+    uint64_t marks_base;             /* marks_sent when the current job started */
+
+    /* The steps of dropping what is queued (stop, abort, E-stop, fault):
+     * park the planner, discard the setpoint ring, start the planner again. */
+    _Atomic int park_req, park_ack;
+    _Atomic int discard_req, discard_ack;
+    _Atomic int discard_to_actual;   /* rest at the actual position, not the commanded */
+    double rest[NCP_AXES];           /* where the loop rested; valid once discard_ack */
+    _Atomic int unpark_req, unpark_ack;
+    _Atomic int full_decel;          /* abort: hold at the axes' full deceleration */
+    _Atomic int frozen;              /* E-stop / fault: setpoints frozen, drives off */
+
+    /* position loop: its thread only, except the atomics */
+    struct ncp_setpoint cur, next;
+    struct ncp_scaler scaler;
+    double decel_normal, decel_full;
+    int slowing;
+    uint64_t dry, underruns, fb_dropped;
+    int end_seen;                    /* the output sits on an END sample */
+    uint64_t ends_seen;              /* the scaler's END count already added to ends_taken */
+    int ended, settle, for_expired;  /* batch */
+    int drives_on;
+    int64_t end_ns, now_ns;
+    uint32_t line_now, line_done;
+    _Atomic int loop_fault;          /* enum nck_loop_fault; details written before it */
+    int fault_axis;
+    double fault_err;
+    uint32_t fault_line;
+    _Atomic int at_rest;             /* no motion: rate 0 or the stream at a stop */
+    _Atomic uint64_t pub_misses;
+    _Atomic int64_t pub_lat_max_ns;
+
+    /* events, oldest first (job thread and caller's thread post them) */
+#define NCK_EVENTS 256
+    pthread_mutex_t ev_lock;
+    struct ncp_nck_event ev[NCK_EVENTS];
+    unsigned ev_head, ev_count;
+    uint64_t ev_dropped;
+    int post_prints;                 /* service: PRINT/MSG/DEBUG as events, not stderr */
+    struct nck_io io;
+
+    /* the caller's thread */
+    struct nck_job job;
+    struct nck_summary sum;
+    struct nck_fb last_fb;
+    int have_fb;
+};
+
+/* The steps of dropping what is queued (control.c). */
+enum nck_drop {
+    NCK_DROP_NONE,
+    NCK_DROP_HOLD,       /* feed hold until at rest */
+    NCK_DROP_JOB,        /* end the job thread */
+    NCK_DROP_PARK,       /* planner parked? then discard */
+    NCK_DROP_DISCARD,    /* setpoints discarded? then unpark */
+    NCK_DROP_UNPARK      /* planner running again? then done */
+};
+
+/* The service's NCK: the core plus the state machine (control.c). */
+struct ncp_nck {
+    struct nck n;
+    int state;                       /* enum ncp_nck_state */
+    int resume_state;                /* what a resume returns to */
+    struct ncp_analyzer *interp;     /* resident: modal state lives here */
+    struct ncp_analyzer_cfg acfg;
+    struct ncp_source prog;
+    int have_prog;
+    char program[256];
+    char mdi[NCP_NCK_TEXT_MAX + 2];
+    struct ncp_source mdi_src;
+    const struct ncp_source *run_src;
+    enum nck_drop drop;
+    int drop_after;                  /* state after the drop */
+    int drop_reset;                  /* the interpreter's end-of-program reset after it */
+    int homed[NCP_AXES];
+    int homing_axes;                 /* bit per axis of the homing job */
+    int jog_continuous;
+    int64_t jog_last_ns;
+    double rapid_override, spindle_override;
+    char error[256];
+    uint64_t rejected;
+    int shutdown, shutdown_pending;
+    int changed;
+};
+
+/* core.c */
+/* Backend, rings, planner thread; the position loop separately (a batch run
+ * starts it with the program, so its clock starts with the motion). */
+int nck_start(struct nck *n, const struct ncp_nck_setup *s, int batch, struct ncp_diag *d);
+int nck_start_loop(struct nck *n, struct ncp_diag *d);
+void nck_finish(struct nck *n);
+/* The steps of a drop, each a request that the other thread acknowledges. */
+void nck_park_planner(struct nck *n);
+int nck_planner_parked(const struct nck *n);
+void nck_discard(struct nck *n, int to_actual);
+int nck_discarded(const struct nck *n);
+void nck_unpark_planner(struct nck *n);
+int nck_planner_unparked(const struct nck *n);
+/* The job's motion is complete: every mark it sent has been reached. */
+int nck_motion_done(const struct nck *n);
+
+/* loop.c: the position cycle (real-time path) */
+int nck_position_cycle(void *ctx, int64_t now_ns);
+double nck_rate_target(struct nck *n);
+
+/* planner_thread.c */
+void *nck_planner_main(void *arg);
+
+/* job.c */
+int nck_job_start(struct nck *n);
+void nck_job_join(struct nck *n);
+/* a line from the map's position to end, traverse or at feed mm/s */
+void nck_line(const struct nck *n, struct ncp_seg *s, const double from[NCP_AXES],
+              const double to[NCP_AXES], double feed, int traverse);
+
+/* events.c */
+void nck_post(struct nck *n, int kind, const char *file, uint32_t line, uint32_t col,
+              const char *fmt, ...) __attribute__((format(printf, 6, 7)));
+
+/* stats.c */
+void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace);
+/* Reads every cycle the loop has written: trace, summary, last cycle. */
+int nck_read_cycles(struct nck *n);
+void nck_trace_header(FILE *trace);
+
+#endif

@@ -1,0 +1,113 @@
+/* The planner/interpolator thread: segments in, one setpoint per planning
+ * period out. It lives as long as the NCK; between jobs it waits. */
+#include "nck_int.h"
+
+#include <math.h>
+#include <sched.h>
+#include <string.h>
+#include <time.h>
+
+#define START_WAIT_NS 20000000LL   /* real clock: wait this long for a full window at rest */
+
+static void nap_ns(long ns)
+{
+    struct timespec ts = { 0, ns };
+    nanosleep(&ts, NULL);
+}
+
+static int64_t mono_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+/* END and SYNC both make the planner run what it has to a stop; after the
+ * END setpoint the next job starts afresh (no blend with what went before). */
+static void pull_segments(struct nck *n, int *finishing)
+{
+    struct nck_seg_msg m;
+    while (!*finishing && !ncp_planner_full(n->planner) && ncp_spsc_pop(&n->segs, &m) == 0) {
+        if (m.kind == NCK_MSG_SEG) {
+            ncp_planner_push(n->planner, &m.seg);
+        } else {
+            *finishing = 1;
+            ncp_planner_finish(n->planner);
+        }
+    }
+}
+
+/* Virtual clock: the window is always full (or a stop is due) before a step,
+ * so runs are deterministic. Real clock: only a start from rest waits
+ * (briefly) for the window; in motion the planner never holds the loop up.
+ * Nothing queued and nothing due: no step (idle setpoints would only delay
+ * the next job's motion by the ring's length). */
+static int may_step(struct nck *n, int finishing, int64_t *wait_since)
+{
+    if (finishing || ncp_planner_full(n->planner)) {
+        *wait_since = 0;
+        return 1;
+    }
+    if (ncp_planner_idle(n->planner) && ncp_planner_queued(n->planner) == 0)
+        return 0;
+    if (n->setup.virtual_clock)
+        return 0;
+    if (!ncp_planner_idle(n->planner))
+        return 1;
+    int64_t now = mono_ns();
+    if (!*wait_since)
+        *wait_since = now;
+    return now - *wait_since > START_WAIT_NS;
+}
+
+/* Parked (a drop in progress): the segment ring is emptied (its producer has
+ * been stopped) and nothing is planned until the loop has rested and the
+ * service thread says where. */
+static void parked(struct nck *n, int *finishing)
+{
+    struct nck_seg_msg m;
+    while (ncp_spsc_pop(&n->segs, &m) == 0)
+        ;
+    atomic_store_explicit(&n->park_ack, atomic_load(&n->park_req), memory_order_release);
+    while (!atomic_load(&n->quit) &&
+           atomic_load_explicit(&n->unpark_req, memory_order_acquire) ==
+               atomic_load_explicit(&n->unpark_ack, memory_order_relaxed))
+        nap_ns(200000);
+    ncp_planner_reset(n->planner, n->rest);
+    *finishing = 0;
+    atomic_store_explicit(&n->unpark_ack, atomic_load(&n->unpark_req), memory_order_release);
+}
+
+void *nck_planner_main(void *arg)
+{
+    struct nck *n = arg;
+    int finishing = 0;
+    int64_t wait_since = 0;
+    long nap = (long)(n->cfg->servo_period * ncp_machine_cfg_ipo_ratio(n->cfg) * 1e9 / 4) + 1000;
+    while (!atomic_load(&n->quit)) {
+        if (atomic_load_explicit(&n->park_req, memory_order_acquire) !=
+            atomic_load_explicit(&n->park_ack, memory_order_relaxed)) {
+            parked(n, &finishing);
+            continue;
+        }
+        pull_segments(n, &finishing);
+        if (ncp_spsc_count(&n->sps) >= ncp_spsc_capacity(&n->sps) ||
+            !may_step(n, finishing, &wait_since)) {
+            int idle = ncp_planner_idle(n->planner) && ncp_planner_queued(n->planner) == 0;
+            if (n->setup.virtual_clock && !idle)
+                sched_yield();
+            else
+                nap_ns(nap);
+            continue;
+        }
+        struct ncp_setpoint sp;
+        int more = ncp_planner_step(n->planner, &sp);
+        ncp_spsc_push(&n->sps, &sp);
+        if (!more) {
+            atomic_fetch_add_explicit(&n->ends_pushed, 1, memory_order_release);
+            ncp_planner_restart(n->planner);
+            finishing = 0;
+        }
+    }
+    return NULL;
+}

@@ -1,0 +1,405 @@
+/* The serving NCK driven in-process through its commands, on the virtual
+ * clock: homing, programs, pause and resume along the path, stop, single
+ * block, run from a line, MDI with the live modal state, jogs, E-stop and
+ * the commands each state refuses. (tests/service drives the same NCK over
+ * LCM with cnc-ctl.) */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "trace_rows.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "ncpar/nck.h"
+
+struct svc {
+    struct ncp_machine_cfg cfg;
+    struct ncp_nck *nck;
+    FILE *trace;
+    char prog[64];
+};
+
+static void nap_ms(int ms)
+{
+    struct timespec ts = { 0, ms * 1000000L };
+    nanosleep(&ts, NULL);
+}
+
+static void start(struct svc *s, int with_trace)
+{
+    memset(s, 0, sizeof *s);
+    ncp_machine_cfg_default(&s->cfg);
+    s->cfg.position.priority = 0;
+    s->trace = with_trace ? tmpfile() : NULL;
+    struct ncp_nck_setup setup = { .cfg = &s->cfg, .virtual_clock = 1, .trace = s->trace,
+                                   .mode = NCP_MODE_SERIAL, .virtual_pace = 10 };
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    s->nck = ncp_nck_new(&setup, &d);
+    assert_non_null(s->nck);
+}
+
+static void stop(struct svc *s)
+{
+    ncp_nck_free(s->nck);
+    if (s->trace)
+        fclose(s->trace);
+    if (s->prog[0])
+        unlink(s->prog);
+}
+
+static int cmd(struct svc *s, int kind, const char *text, double v0, int i0, char *why)
+{
+    struct ncp_nck_cmd c;
+    memset(&c, 0, sizeof c);
+    c.kind = kind;
+    snprintf(c.text, sizeof c.text, "%s", text ? text : "");
+    c.value[0] = v0;
+    c.ivalue[0] = i0;
+    char local[256];
+    return ncp_nck_command(s->nck, &c, why ? why : local, 256);
+}
+
+static int state(struct svc *s)
+{
+    struct ncp_nck_snapshot st;
+    ncp_nck_get_status(s->nck, &st);
+    return st.state;
+}
+
+/* Polls until the state is want (or 60 s of wall time). */
+static void wait_state(struct svc *s, int want)
+{
+    for (int i = 0; i < 60000; i++) {
+        ncp_nck_poll(s->nck);
+        if (state(s) == want)
+            return;
+        nap_ms(1);
+    }
+    fail_msg("state %s never reached (now %s)", ncp_nck_state_name(want),
+             ncp_nck_state_name(state(s)));
+}
+
+static void write_prog(struct svc *s, const char *text)
+{
+    snprintf(s->prog, sizeof s->prog, "/tmp/ncp-svc-%d.ngc", (int)getpid());
+    FILE *f = fopen(s->prog, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void home_all(struct svc *s)
+{
+    assert_int_equal(cmd(s, NCP_CMD_HOME, "all", 0, 0, NULL), 0);
+    wait_state(s, NCP_ST_IDLE);
+}
+
+static void pos(struct svc *s, double p[3])
+{
+    struct ncp_nck_snapshot st;
+    ncp_nck_poll(s->nck);
+    ncp_nck_get_status(s->nck, &st);
+    memcpy(p, st.pos_cmd, 3 * sizeof p[0]);
+}
+
+static const char *square =
+    "G21 G90 G64 P0.01\nG0 X0 Y0 Z5\nG1 Z-1 F600\nG1 X20 F1500\nY20\nX0\nY0\n"
+    "G2 X10 Y10 I5 J5\nG0 Z5\nM2\n";
+
+static void test_refusals(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    start(&s, 0);
+    char why[256];
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, why), -1);
+    assert_non_null(strstr(why, "no program"));
+    assert_int_equal(cmd(&s, NCP_CMD_MDI, "G0 X1", 0, 0, why), -1);
+    assert_non_null(strstr(why, "not homed"));
+    assert_int_equal(cmd(&s, NCP_CMD_RESUME, NULL, 0, 0, why), -1);
+    assert_int_equal(cmd(&s, NCP_CMD_JOG, "Q", 0, 1, why), -1);
+    assert_int_equal(cmd(&s, NCP_CMD_OVERRIDE, NULL, 150, 0, why), -1);
+    write_prog(&s, "G1 X1 F100\nG1 X2 Y\nM2\n");
+    assert_int_equal(cmd(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), -1);
+    assert_non_null(strstr(why, ":2:"));
+    home_all(&s);
+    write_prog(&s, "G1 X50 F600\nM2\n");
+    assert_int_equal(cmd(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), 0);
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, why), 0);
+    assert_int_equal(cmd(&s, NCP_CMD_MDI, "G0 X1", 0, 0, why), -1);
+    assert_non_null(strstr(why, "while running"));
+    assert_int_equal(cmd(&s, NCP_CMD_JOG, "X", 0, 1, why), -1);
+    assert_int_equal(cmd(&s, NCP_CMD_HOME, "all", 0, 0, why), -1);
+    wait_state(&s, NCP_ST_IDLE);
+    stop(&s);
+}
+
+/* The path of a paused and resumed run is the uninterrupted run's. */
+static void test_pause_resume_path(void **state_)
+{
+    (void)state_;
+    struct svc a, b;
+    start(&a, 1);
+    home_all(&a);
+    write_prog(&a, square);
+    assert_int_equal(cmd(&a, NCP_CMD_LOAD, a.prog, 0, 0, NULL), 0);
+    assert_int_equal(cmd(&a, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
+    wait_state(&a, NCP_ST_IDLE);
+    start(&b, 1);
+    home_all(&b);
+    assert_int_equal(cmd(&b, NCP_CMD_LOAD, a.prog, 0, 0, NULL), 0);
+    assert_int_equal(cmd(&b, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
+    int pauses = 0, last = 0;
+    for (int i = 0; i < 200000 && state(&b) != NCP_ST_IDLE; i++) {
+        ncp_nck_poll(b.nck);
+        struct ncp_nck_snapshot st;
+        ncp_nck_get_status(b.nck, &st);
+        if (st.state == NCP_ST_RUNNING && st.vel > 0 && pauses < 3 && i > last + 20) {
+            assert_int_equal(cmd(&b, NCP_CMD_PAUSE, NULL, 0, 0, NULL), 0);
+            pauses++;
+            nap_ms(30);
+            ncp_nck_poll(b.nck);
+            assert_int_equal(state(&b), NCP_ST_PAUSED);
+            assert_int_equal(cmd(&b, NCP_CMD_RESUME, NULL, 0, 0, NULL), 0);
+            last = i;
+        }
+        nap_ms(1);
+    }
+    assert_true(pauses >= 1);
+    fflush(a.trace);
+    fflush(b.trace);
+    size_t na, nb;
+    struct row *ra = read_trace(a.trace, &na), *rb = read_trace(b.trace, &nb);
+    /* every commanded point of the paused run lies on the uninterrupted path */
+    double worst = 0;
+    size_t k = 0;
+    for (size_t i = 0; i < nb; i++) {
+        double best = INFINITY;
+        for (size_t m = k > 50 ? k - 50 : 0; m + 1 < na && m < k + 5000; m++) {
+            double d2 = 0;
+            for (int j = 0; j < 3; j++)
+                d2 += (rb[i].cmd[j] - ra[m].cmd[j]) * (rb[i].cmd[j] - ra[m].cmd[j]);
+            if (d2 < best) {
+                best = d2;
+                if (d2 < 1e-8)
+                    k = m;
+            }
+        }
+        /* the samples are 1 ms apart: compare with the chord between them */
+        worst = fmax(worst, sqrt(best));
+    }
+    double tail[3], end[3];
+    pos(&a, tail);
+    pos(&b, end);
+    for (int j = 0; j < 3; j++)
+        assert_true(fabs(tail[j] - end[j]) < 1e-6);
+    /* 1 ms samples at up to 25 mm/s: half a sample spacing at most */
+    assert_true(worst < 0.0126 + 1e-6);
+    free(ra);
+    free(rb);
+    stop(&a);
+    b.prog[0] = 0;
+    stop(&b);
+}
+
+static void test_stop_then_run_again(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    start(&s, 0);
+    home_all(&s);
+    write_prog(&s, "G21 G90 G55\nG1 X100 F3000\nG1 X0\nM2\n");
+    assert_int_equal(cmd(&s, NCP_CMD_LOAD, s.prog, 0, 0, NULL), 0);
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
+    for (int i = 0; i < 20000; i++) {
+        struct ncp_nck_snapshot st;
+        ncp_nck_poll(s.nck);
+        ncp_nck_get_status(s.nck, &st);
+        if (st.pos_cmd[0] > 30)
+            break;
+        nap_ms(1);
+    }
+    assert_int_equal(cmd(&s, NCP_CMD_STOP, NULL, 0, 0, NULL), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    double p[3];
+    pos(&s, p);
+    assert_true(p[0] > 30 && p[0] < 100);
+    struct ncp_nck_snapshot st;
+    ncp_nck_get_status(s.nck, &st);
+    assert_int_equal(st.g5x_index, 1);   /* back to G54 as at M2 */
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    pos(&s, p);
+    assert_true(fabs(p[0]) < 1e-6);
+    stop(&s);
+}
+
+static void test_mdi_keeps_modal_state(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    start(&s, 0);
+    home_all(&s);
+    const char *lines[] = { "G10 L2 P2 X10 Y5", "G55", "G91", "G0 X1 Y1", "G0 X1",
+                            "G90 G1 X0 Y0 F1000", "G2 X2 Y0 I1 J0" };
+    /* machine coordinates: G91 moves from where the machine is, G90 to G55's */
+    double want[][2] = { { 0, 0 }, { 0, 0 }, { 0, 0 }, { 1, 1 }, { 2, 1 }, { 10, 5 },
+                         { 12, 5 } };
+    for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
+        char why[256];
+        assert_int_equal(cmd(&s, NCP_CMD_MDI, lines[i], 0, 0, why), 0);
+        wait_state(&s, NCP_ST_IDLE);
+        double p[3];
+        pos(&s, p);
+        assert_true(fabs(p[0] - want[i][0]) < 1e-6);
+        assert_true(fabs(p[1] - want[i][1]) < 1e-6);
+    }
+    char why[256];
+    assert_int_equal(cmd(&s, NCP_CMD_MDI, "G1 X1 Y1 Q", 0, 0, why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    struct ncp_nck_snapshot st;
+    ncp_nck_get_status(s.nck, &st);
+    assert_true(st.error[0] != 0);
+    stop(&s);
+}
+
+static void test_jogs(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    start(&s, 0);
+    struct ncp_nck_cmd c;
+    memset(&c, 0, sizeof c);
+    c.kind = NCP_CMD_JOG;
+    strcpy(c.text, "x");
+    c.ivalue[0] = 1;
+    c.value[0] = 600;
+    c.value[1] = 2.5;
+    char why[256];
+    assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    double p[3];
+    pos(&s, p);
+    assert_true(fabs(p[0] - 2.5) < 1e-9);
+    /* continuous, towards the limit, stopped by the missing keep-alive */
+    c.value[1] = 0;
+    c.value[0] = 6000;
+    assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), 0);
+    wait_state(&s, NCP_ST_STOPPING);
+    wait_state(&s, NCP_ST_IDLE);
+    pos(&s, p);
+    assert_true(p[0] > 2.5 && p[0] < 500);
+    /* incremental beyond the soft limit stops at it */
+    c.value[1] = 1000;
+    assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    pos(&s, p);
+    assert_true(fabs(p[0] - s.cfg.axis[0].max_limit) < 1e-9);
+    assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), -1);
+    stop(&s);
+}
+
+static void test_estop_reset(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    start(&s, 0);
+    home_all(&s);
+    write_prog(&s, "G1 X200 F6000\nM2\n");
+    assert_int_equal(cmd(&s, NCP_CMD_LOAD, s.prog, 0, 0, NULL), 0);
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
+    for (int i = 0; i < 20000; i++) {
+        double p[3];
+        pos(&s, p);
+        if (p[0] > 20)
+            break;
+        nap_ms(1);
+    }
+    assert_int_equal(cmd(&s, NCP_CMD_ESTOP, NULL, 0, 0, NULL), 0);
+    wait_state(&s, NCP_ST_ESTOP);
+    double p1[3], p2[3];
+    pos(&s, p1);
+    nap_ms(50);
+    pos(&s, p2);
+    assert_true(p1[0] == p2[0]);
+    char why[256];
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, why), -1);
+    assert_non_null(strstr(why, "estop"));
+    assert_int_equal(cmd(&s, NCP_CMD_RESET, NULL, 0, 0, why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    assert_int_equal(cmd(&s, NCP_CMD_MDI, "G0 X0", 0, 0, why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    pos(&s, p1);
+    assert_true(fabs(p1[0]) < 1e-9);
+    stop(&s);
+}
+
+static void test_single_block_and_from_line(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    start(&s, 0);
+    home_all(&s);
+    write_prog(&s, "G21 G90\nG0 Z10\nG1 X10 F3000\nG1 Y10\nG1 Z-2\nG1 X0\nM2\n");
+    assert_int_equal(cmd(&s, NCP_CMD_LOAD, s.prog, 0, 0, NULL), 0);
+    assert_int_equal(cmd(&s, NCP_CMD_STEP, NULL, 0, 1, NULL), 0);
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
+    assert_int_equal(state(&s), NCP_ST_STEPPING);
+    double want[][3] = { { 0, 0, 10 }, { 10, 0, 10 }, { 10, 10, 10 }, { 10, 10, -2 },
+                         { 0, 10, -2 } };
+    for (int k = 0; k < 5; k++) {
+        double p[3] = { 0, 0, 0 };
+        for (int i = 0; i < 20000; i++) {
+            nap_ms(1);
+            pos(&s, p);
+            if (fabs(p[0] - want[k][0]) + fabs(p[1] - want[k][1]) + fabs(p[2] - want[k][2]) < 1e-9)
+                break;
+        }
+        nap_ms(50);
+        pos(&s, p);
+        for (int j = 0; j < 3; j++)
+            assert_true(fabs(p[j] - want[k][j]) < 1e-9);
+        assert_int_equal(cmd(&s, NCP_CMD_RESUME, NULL, 0, 0, NULL), 0);
+    }
+    wait_state(&s, NCP_ST_IDLE);
+    assert_int_equal(cmd(&s, NCP_CMD_STEP, NULL, 0, 0, NULL), 0);
+    /* from line 5 (G1 Z-2): up to Z10, over to X10 Y10, down, then on */
+    assert_int_equal(cmd(&s, NCP_CMD_MDI, "G0 X50 Y50 Z0", 0, 0, NULL), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 5, NULL), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    double p[3];
+    pos(&s, p);
+    assert_true(fabs(p[0]) < 1e-9 && fabs(p[1] - 10) < 1e-9 && fabs(p[2] + 2) < 1e-9);
+    struct ncp_nck_event ev;
+    int saw = 0;
+    while (ncp_nck_next_event(s.nck, &ev))
+        saw |= strstr(ev.text, "run from line 5") != NULL;
+    assert_true(saw);
+    stop(&s);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1)
+        cmocka_set_test_filter(argv[1]);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_pause_resume_path),
+        cmocka_unit_test(test_stop_then_run_again),
+        cmocka_unit_test(test_mdi_keeps_modal_state),
+        cmocka_unit_test(test_jogs),
+        cmocka_unit_test(test_estop_reset),
+        cmocka_unit_test(test_single_block_and_from_line),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
