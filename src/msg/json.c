@@ -20,7 +20,8 @@ __attribute__((format(printf, 2, 3))) static void put(struct out *o, const char 
         return;
     va_list ap;
     va_start(ap, fmt);
-    int n = vsnprintf(o->buf + o->len, o->size - o->len, fmt, ap);
+    /* the analyzer loses va_start when it analyses several files in one run */
+    int n = vsnprintf(o->buf + o->len, o->size - o->len, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
     va_end(ap);
     if (n < 0 || (size_t)n >= o->size - o->len)
         o->full = 1;
@@ -61,7 +62,7 @@ static void put_num(struct out *o, const char *fmt, double v)
 
 static int n_axes(const ncp_status_t *s)
 {
-    int n = s->n_axes;
+    int n = (int)s->n_axes;
     return n < 0 ? 0 : n > 9 ? 9 : n;
 }
 
