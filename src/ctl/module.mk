@@ -6,5 +6,6 @@ CTL_OBJS = $(CTL_SRCS:%.c=$(BUILD)/%.o)
 
 all: $(BUILD)/cnc-ctl
 
-$(BUILD)/cnc-ctl: $(CTL_OBJS) $(LIB)
-	$(Q)$(CC) $(ALL_CFLAGS) -o $@ $(CTL_OBJS) $(LIB) -llcm $(LDLIBS)
+# (the library by its path: $(LIB) is defined after the fragments are read)
+$(BUILD)/cnc-ctl: $(CTL_OBJS) $(BUILD)/libncpar.a
+	$(Q)$(CC) $(ALL_CFLAGS) -o $@ $(CTL_OBJS) $(BUILD)/libncpar.a -llcm $(LDLIBS)
