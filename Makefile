@@ -12,7 +12,7 @@ CXXFLAGS ?= -O2 -g -flto=auto
 # gcc-ar: an archive of LTO objects needs the linker plugin's symbol index
 AR       := $(if $(findstring -flto,$(CFLAGS)),gcc-ar,ar)
 WARN      = -Wall -Wextra -Werror
-CPPFLAGS += -Iinclude -D_GNU_SOURCE -MMD -MP
+CPPFLAGS += -Iinclude -I$(BUILD)/gen -D_GNU_SOURCE -MMD -MP
 ALL_CFLAGS   = -std=c11 $(WARN) $(CFLAGS) -pthread
 ALL_CXXFLAGS = -std=c++17 $(WARN) $(CXXFLAGS) -pthread -fno-exceptions -fno-rtti \
                -I/usr/include/eigen3
@@ -30,11 +30,23 @@ else
 Q = @
 endif
 
+# The C of the LCM message types (lcm/*.lcm) is generated at build time into
+# $(BUILD)/gen/ (never committed) and compiled into the library. Every object
+# waits for it (order-only on the stamp): any source may include the
+# generated headers through include/ncpar/msg.h, and a fresh build has no .d
+# files yet to say which do. A changed .lcm regenerates, and the .d files
+# then rebuild whatever included the headers.
+GEN_DIR   = $(BUILD)/gen
+GEN_STAMP = $(GEN_DIR)/.stamp
+LCM_TYPES := $(wildcard lcm/*.lcm)
+GEN_SRCS  = $(LCM_TYPES:lcm/%.lcm=$(GEN_DIR)/%.c)
+GEN_OBJS  = $(GEN_SRCS:%.c=%.o)
+
 LIB_SRCS :=
 LIB_CXXSRCS :=
 include $(wildcard src/*/module.mk)
 
-LIB_OBJS = $(LIB_SRCS:%.c=$(BUILD)/%.o) $(LIB_CXXSRCS:%.cpp=$(BUILD)/%.o)
+LIB_OBJS = $(LIB_SRCS:%.c=$(BUILD)/%.o) $(LIB_CXXSRCS:%.cpp=$(BUILD)/%.o) $(GEN_OBJS)
 LIB      = $(BUILD)/libncpar.a
 CLI_SRCS = $(wildcard src/cli/*.c)
 CLI_OBJS = $(CLI_SRCS:%.c=$(BUILD)/%.o)
@@ -52,23 +64,38 @@ $(LIB): $(LIB_OBJS)
 $(BUILD)/cnc-run: $(CLI_OBJS) $(LIB)
 	$(Q)$(CXX) $(ALL_CXXFLAGS) $(CLI_LDFLAGS) -o $@ $(CLI_OBJS) $(LIB) $(LDLIBS)
 
-$(BUILD)/%.o: %.c
+# lcm-gen names each file after package and type (ncp_command_t.{c,h}), as
+# the .lcm files are named. It skips files newer than their .lcm, so the
+# stamp is touched on its own.
+$(GEN_STAMP): $(LCM_TYPES)
+	@mkdir -p $(@D)
+	@$(if $(Q),echo "  GEN  $(GEN_DIR)/ ($(notdir $(LCM_TYPES)))")
+	$(Q)lcm-gen -c --c-no-pubsub --c-cpath $(GEN_DIR) --c-hpath $(GEN_DIR) $(LCM_TYPES)
+	$(Q)touch $@
+$(GEN_SRCS): $(GEN_STAMP) ;
+
+# lcm-gen's code has unused parameters (its decode_cleanup functions).
+$(GEN_DIR)/%.o: $(GEN_DIR)/%.c | $(GEN_STAMP)
+	@$(if $(Q),echo "  CC   $<")
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -Wno-unused-parameter -c -o $@ $<
+
+$(BUILD)/%.o: %.c | $(GEN_STAMP)
 	@mkdir -p $(@D)
 	@$(if $(Q),echo "  CC   $<")
 	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -c -o $@ $<
 
-$(BUILD)/%.o: %.cpp
+$(BUILD)/%.o: %.cpp | $(GEN_STAMP)
 	@mkdir -p $(@D)
 	@$(if $(Q),echo "  CXX  $<")
 	$(Q)$(CXX) $(CPPFLAGS) $(ALL_CXXFLAGS) -c -o $@ $<
 
-$(BUILD)/tests/%: tests/unit/%.c $(LIB)
+$(BUILD)/tests/%: tests/unit/%.c $(LIB) | $(GEN_STAMP)
 	@mkdir -p $(@D)
 	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -o $@ $< $(LIB) $(LDLIBS) -lcmocka -lstdc++
 
 # The ring's sleep protocol with a test hook compiled in (see the test's header):
 # its own copy of ring.c, not the library's.
-$(BUILD)/tests/test_ring_race: tests/unit/test_ring_race.c src/pipeline/ring.c $(LIB)
+$(BUILD)/tests/test_ring_race: tests/unit/test_ring_race.c src/pipeline/ring.c $(LIB) | $(GEN_STAMP)
 	@mkdir -p $(@D)
 	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -DNCP_RING_TEST_HOOKS -o $@ $< src/pipeline/ring.c \
 	    $(LIB) $(LDLIBS) -lcmocka
@@ -80,6 +107,7 @@ deps:
 	apt-get update -qq
 	DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
 	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev linuxcnc-uspace \
+	    liblcm-dev liblcm-bin \
 	    python3 python3-matplotlib valgrind cppcheck clang-tidy
 	tools/rtvm/install-deps
 
@@ -115,7 +143,8 @@ $(BUILD)-fuzz/fuzz_pipeline: tests/fuzz/fuzz_pipeline.c FORCE
 	$(MAKE) BUILD=$(BUILD)-fuzz CC=clang CXX=clang++ \
 	    CFLAGS="$(FUZZ_FLAGS) -fsanitize=fuzzer-no-link" \
 	    CXXFLAGS="$(FUZZ_FLAGS) -fsanitize=fuzzer-no-link" $(BUILD)-fuzz/libncpar.a
-	clang $(CPPFLAGS) -std=c11 $(FUZZ_FLAGS) -fsanitize=fuzzer -pthread -o $@ $< \
+	clang $(filter-out -I$(BUILD)/gen,$(CPPFLAGS)) -I$(BUILD)-fuzz/gen -std=c11 $(FUZZ_FLAGS) \
+	    -fsanitize=fuzzer -pthread -o $@ $< \
 	    $(BUILD)-fuzz/libncpar.a -lm -linih -lstdc++
 fuzz: $(BUILD)-fuzz/fuzz_pipeline
 	mkdir -p $(BUILD)-fuzz/corpus
@@ -129,10 +158,11 @@ bench-parse: all $(BUILD)/bench/core-latency $(BUILD)/bench/cpu-speed
 .PHONY: FORCE
 FORCE:
 
-# Static analysis: both must stay quiet on our sources.
-lint:
+# Static analysis: both must stay quiet on our sources (not on lcm-gen's
+# code in $(GEN_DIR), which is in neither list; its headers are only read).
+lint: $(GEN_STAMP)
 	cppcheck --quiet --error-exitcode=1 --enable=warning,style,performance,portability \
-	    --inline-suppr --suppress=missingIncludeSystem -Iinclude -D_GNU_SOURCE \
+	    --inline-suppr --suppress=missingIncludeSystem -Iinclude -I$(GEN_DIR) -D_GNU_SOURCE \
 	    --std=c11 src tests/unit
-	clang-tidy --quiet $(LIB_SRCS) $(CLI_SRCS) -- $(CPPFLAGS) -std=c11 -I/usr/include/eigen3
+	clang-tidy --quiet $(LIB_SRCS) $(CLI_SRCS) $(CTL_SRCS) -- $(CPPFLAGS) -std=c11 -I/usr/include/eigen3
 .PHONY: lint

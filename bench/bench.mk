@@ -5,7 +5,7 @@
 .PHONY: bench
 BENCH_BINS = $(BUILD)/bench/table3 $(BUILD)/bench/core-latency $(BUILD)/bench/cpu-speed
 
-$(BUILD)/bench/%: bench/%.c $(LIB)
+$(BUILD)/bench/%: bench/%.c $(LIB) | $(GEN_STAMP)
 	@mkdir -p $(@D)
 	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -o $@ $< $(LIB) $(LDLIBS) -lstdc++
 

@@ -1,4 +1,4 @@
-/* LCM messaging of a serving NCK: the generated types of lcm/*.lcm (lcm-gen at
+/* LCM messaging of a serving NCK: the generated types of lcm/ncp_*.lcm (lcm-gen at
  * build time, fixed-size) over LCM's UDP multicast protocol ("udpm://"), so
  * lcm-spy, lcm-logger and any LCM client see and send the same messages.
  *
@@ -52,7 +52,24 @@ int ncp_msg_send_event(struct ncp_msg *m, const ncp_event_t *e);
 
 void ncp_msg_get_stats(const struct ncp_msg *m, struct ncp_msg_stats *st);
 
+/* The socket, for a caller that waits on it beside others (POLLIN: call
+ * ncp_msg_poll with timeout 0). */
+int ncp_msg_fd(const struct ncp_msg *m);
+
 /* Pure helpers (tested without a network). */
+/* What a udpm:// URL says (LCM's syntax and defaults: udpm://239.255.76.67:7667,
+ * ttl 0). 0 ok, else d->msg says why. */
+struct ncp_msg_url {
+    char group[16];      /* dotted quad, a multicast group */
+    uint16_t port;
+    int ttl;             /* 0: the messages stay on this host */
+    int recv_buf_size;   /* bytes, 0: the system's default */
+};
+int ncp_msg_parse_url(const char *url, struct ncp_msg_url *u, struct ncp_diag *d);
+/* Writes an LC02 header (magic, seqno, channel and its NUL) to buf: its
+ * length (the payload follows), or -1 when it does not fit or the channel is
+ * empty or longer than LCM's 63 characters. */
+int ncp_msg_frame_header(uint8_t *buf, size_t size, uint32_t seqno, const char *channel);
 /* One LCM datagram (LC02 short message): channel and payload, or -1 when it
  * is not one (bad magic, no NUL-terminated channel, fragment). */
 int ncp_msg_parse_datagram(const uint8_t *buf, size_t len, const char **channel,
@@ -60,5 +77,14 @@ int ncp_msg_parse_datagram(const uint8_t *buf, size_t len, const char **channel,
 /* Decodes and validates a command (fingerprint, NUL in text, known kind,
  * client_id != 0). 0 ok, -1 garbage. */
 int ncp_msg_decode_command(const uint8_t *payload, size_t len, ncp_command_t *cmd);
+
+/* status_t's state constants by name ("idle", "running", "paused", "stepping",
+ * "mdi", "jogging", "homing", "stopping", "estop", "fault"): NULL / -1 for
+ * anything else. */
+const char *ncp_msg_state_name(int state);
+int ncp_msg_state_parse(const char *name);
+/* A status as one JSON object (no newline), the keys of `cnc-ctl status
+ * --json`. Returns its length, or -1 when size is too small (4096 is enough). */
+int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size);
 
 #endif

@@ -32,7 +32,7 @@ test-can-host: all
 CAN_MASTER_TEST = $(BUILD)/tests/rt/can-master-test
 CAN_MASTER_SRCS = tests/rt/can_master_test.c tests/rt/can_selftest.c tests/rt/ramp_check.c \
                   $(wildcard src/can/*.c) $(wildcard src/diag/*.c)
-$(CAN_MASTER_TEST): $(CAN_MASTER_SRCS) tests/rt/ramp_check.h include/ncpar/can.h include/ncpar/diag.h
+$(CAN_MASTER_TEST): $(CAN_MASTER_SRCS) tests/rt/ramp_check.h include/ncpar/can.h include/ncpar/diag.h | $(GEN_STAMP)
 	@mkdir -p $(@D)
 	$(Q)$(CC) $(filter-out -MMD -MP,$(CPPFLAGS)) $(ALL_CFLAGS) -o $@ $(CAN_MASTER_SRCS)
 

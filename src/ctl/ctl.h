@@ -1,0 +1,71 @@
+/* cnc-ctl's side of the conversation with a serving NCK, over liblcm: send a
+ * command and wait for its ACK (resending it until answered), wait for
+ * STATUS. Exit statuses are the program's. */
+#ifndef NCPAR_CTL_H
+#define NCPAR_CTL_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include <lcm/lcm.h>
+
+#include "ncpar/msg.h"
+
+enum ctl_exit {
+    CTL_OK = 0,        /* accepted; for wait: reached */
+    CTL_USAGE = 1,     /* bad command line, or LCM could not be set up */
+    CTL_REJECTED = 2,  /* the NCK said no (reason on stderr) */
+    CTL_FAULT = 3,     /* the NCK is in fault */
+    CTL_NO_ANSWER = 4, /* nothing within the timeout */
+};
+
+struct ctl {
+    lcm_t *lcm;
+    const char *url; /* as given, for messages; NULL: liblcm's default */
+    char ch_cmd[NCP_MSG_PREFIX_MAX + 8];
+    char ch_ack[NCP_MSG_PREFIX_MAX + 8];
+    char ch_status[NCP_MSG_PREFIX_MAX + 8];
+    int8_t channel;  /* NC channel */
+    double timeout;  /* seconds; 0: none (wait and status --watch only) */
+    int32_t client_id;
+    int32_t seq;     /* the last one used */
+    /* filled by the handlers */
+    int32_t want_seq;
+    int have_ack;
+    ncp_ack_t ack;
+    uint64_t n_status; /* statuses of our NC channel received so far */
+    ncp_status_t status;
+    double status_at;  /* ctl_now() of the last one */
+};
+
+/* Set by SIGINT/SIGTERM (a second one ends the program). */
+extern volatile sig_atomic_t ctl_interrupted;
+void ctl_catch_signals(void);
+
+double ctl_now(void);
+int ctl_open(struct ctl *c, const char *url, const char *prefix);
+void ctl_close(struct ctl *c);
+
+/* A command with its fields of the kind filled in: sent with our client id
+ * and the next seq. ctl_send only sends; ctl_command sends, resends every
+ * 500 ms and waits for the ACK: CTL_OK, CTL_REJECTED, CTL_FAULT or
+ * CTL_NO_ANSWER, with the reason printed. */
+int ctl_send(struct ctl *c, ncp_command_t *cmd);
+int ctl_command(struct ctl *c, ncp_command_t *cmd);
+/* Handles what arrives for up to seconds: 0, or -1 when LCM failed. */
+int ctl_handle(struct ctl *c, double seconds);
+/* Waits for the next status (c->status), up to timeout seconds (0: for
+ * ever): CTL_OK, CTL_NO_ANSWER, CTL_USAGE when LCM failed (said on stderr),
+ * -1 when interrupted. */
+int ctl_next_status(struct ctl *c, double timeout);
+/* "cnc-ctl: no WHAT from the NCK within S s (is ... running?)" */
+void ctl_no_answer(const char *what, double seconds);
+
+/* jog AXIS +|-: incremental (distance > 0) or continuous (see cnc-ctl jog
+ * --help); speed 0 is the NCK's default. */
+int ctl_jog(struct ctl *c, char axis, int dir, double speed, double distance);
+
+/* cnc-ctl status: the readable lines. */
+void ctl_print_status(const ncp_status_t *s);
+
+#endif

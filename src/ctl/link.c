@@ -1,0 +1,209 @@
+/* cnc-ctl's LCM link: liblcm for the socket work, the generated types for
+ * the messages (subscribed raw, decoded here). */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/random.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "ctl.h"
+
+#define RESEND_S 0.5
+
+volatile sig_atomic_t ctl_interrupted;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    ctl_interrupted = 1;
+}
+
+void ctl_catch_signals(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sa.sa_flags = (int)SA_RESETHAND; /* a second ^C ends it at once */
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+double ctl_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static int64_t utime_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+static void on_ack(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    (void)channel;
+    struct ctl *c = user;
+    ncp_ack_t a;
+    if (rbuf->data_size > (uint32_t)INT32_MAX ||
+        ncp_ack_t_decode(rbuf->data, 0, (int)rbuf->data_size, &a) != (int)rbuf->data_size)
+        return;
+    if (a.client_id != c->client_id || a.seq != c->want_seq || c->want_seq == 0)
+        return;
+    c->ack = a;
+    c->have_ack = 1;
+}
+
+static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    (void)channel;
+    struct ctl *c = user;
+    ncp_status_t s;
+    if (rbuf->data_size > (uint32_t)INT32_MAX ||
+        ncp_status_t_decode(rbuf->data, 0, (int)rbuf->data_size, &s) != (int)rbuf->data_size)
+        return;
+    if (s.channel != c->channel)
+        return;
+    c->status = s;
+    c->status_at = ctl_now();
+    c->n_status++;
+}
+
+static int32_t random_client_id(void)
+{
+    int32_t id = 0;
+    while (id == 0) {
+        if (getrandom(&id, sizeof id, 0) != (ssize_t)sizeof id)
+            id = (int32_t)((uint32_t)getpid() * 2654435761u ^ (uint32_t)utime_now());
+    }
+    return id;
+}
+
+int ctl_open(struct ctl *c, const char *url, const char *prefix)
+{
+    if (strlen(prefix) > NCP_MSG_PREFIX_MAX) {
+        fprintf(stderr, "cnc-ctl: the channel prefix '%s' is longer than %d characters\n",
+                prefix, NCP_MSG_PREFIX_MAX);
+        return CTL_USAGE;
+    }
+    snprintf(c->ch_cmd, sizeof c->ch_cmd, "%sCMD", prefix);
+    snprintf(c->ch_ack, sizeof c->ch_ack, "%sACK", prefix);
+    snprintf(c->ch_status, sizeof c->ch_status, "%sSTATUS", prefix);
+    c->url = url;
+    c->client_id = random_client_id();
+    c->lcm = lcm_create(url);
+    if (c->lcm == NULL) {
+        fprintf(stderr, "cnc-ctl: cannot open LCM at %s (see README: LCM and multicast)\n",
+                url ? url : "the default URL");
+        return CTL_USAGE;
+    }
+    if (lcm_subscribe(c->lcm, c->ch_ack, on_ack, c) == NULL ||
+        lcm_subscribe(c->lcm, c->ch_status, on_status, c) == NULL) {
+        fprintf(stderr, "cnc-ctl: cannot subscribe to %s and %s\n", c->ch_ack, c->ch_status);
+        return CTL_USAGE;
+    }
+    return CTL_OK;
+}
+
+void ctl_close(struct ctl *c)
+{
+    if (c->lcm)
+        lcm_destroy(c->lcm);
+    c->lcm = NULL;
+}
+
+static int publish(struct ctl *c, const ncp_command_t *cmd)
+{
+    uint8_t buf[1024];
+    int n = ncp_command_t_encode(buf, 0, (int)sizeof buf, cmd);
+    if (n < 0 || lcm_publish(c->lcm, c->ch_cmd, buf, (unsigned)n) != 0) {
+        fprintf(stderr, "cnc-ctl: cannot send on %s (see README: LCM and multicast)\n",
+                c->ch_cmd);
+        return -1;
+    }
+    return 0;
+}
+
+int ctl_send(struct ctl *c, ncp_command_t *cmd)
+{
+    cmd->utime = utime_now();
+    cmd->client_id = c->client_id;
+    cmd->seq = ++c->seq;
+    cmd->channel = c->channel;
+    return publish(c, cmd);
+}
+
+int ctl_handle(struct ctl *c, double seconds)
+{
+    int ms = seconds <= 0 ? 0 : (int)ceil(seconds * 1000.0);
+    int r = lcm_handle_timeout(c->lcm, ms);
+    if (r < 0 && errno != EINTR) {
+        fprintf(stderr, "cnc-ctl: cannot receive LCM messages (is there a multicast route? "
+                        "see README: LCM and multicast)\n");
+        return -1;
+    }
+    return 0;
+}
+
+void ctl_no_answer(const char *what, double seconds)
+{
+    fprintf(stderr,
+            "cnc-ctl: no %s from the NCK within %g s (is `cnc-run serve` running, with the "
+            "same LCM URL and prefix?)\n",
+            what, seconds);
+}
+
+int ctl_command(struct ctl *c, ncp_command_t *cmd)
+{
+    if (ctl_send(c, cmd) != 0)
+        return CTL_USAGE;
+    c->want_seq = cmd->seq;
+    c->have_ack = 0;
+    double start = ctl_now(), resend = start + RESEND_S;
+    while (!c->have_ack) {
+        double now = ctl_now();
+        if (c->timeout > 0 && now - start >= c->timeout) {
+            ctl_no_answer("answer", c->timeout);
+            return CTL_NO_ANSWER;
+        }
+        if (now >= resend) {
+            /* the same seq: the NCK re-acks a duplicate instead of acting twice */
+            if (publish(c, cmd) != 0)
+                return CTL_USAGE;
+            resend = now + RESEND_S;
+        }
+        double wait = resend - now;
+        if (c->timeout > 0 && start + c->timeout - now < wait)
+            wait = start + c->timeout - now;
+        if (ctl_handle(c, wait) != 0)
+            return CTL_USAGE;
+    }
+    c->want_seq = 0;
+    if (c->ack.result == NCP_ACK_T_ACCEPTED)
+        return CTL_OK;
+    fprintf(stderr, "cnc-ctl: rejected: %.*s\n", (int)strnlen((const char *)c->ack.reason,
+                                                              sizeof c->ack.reason),
+            (const char *)c->ack.reason);
+    return c->ack.state == NCP_STATUS_T_FAULT ? CTL_FAULT : CTL_REJECTED;
+}
+
+int ctl_next_status(struct ctl *c, double timeout)
+{
+    uint64_t seen = c->n_status;
+    double start = ctl_now();
+    while (c->n_status == seen) {
+        if (ctl_interrupted)
+            return -1;
+        double left = timeout > 0 ? start + timeout - ctl_now() : 0.25;
+        if (left <= 0)
+            return CTL_NO_ANSWER;
+        if (ctl_handle(c, left < 0.25 ? left : 0.25) != 0)
+            return CTL_USAGE;
+    }
+    return CTL_OK;
+}

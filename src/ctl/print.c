@@ -1,0 +1,62 @@
+/* cnc-ctl status without --json: a few lines a machinist reads at a glance. */
+#include <stdio.h>
+#include <string.h>
+
+#include "ctl.h"
+
+static int n_axes(const ncp_status_t *s)
+{
+    return s->n_axes < 0 ? 0 : s->n_axes > 9 ? 9 : s->n_axes;
+}
+
+static void print_axes(const char *label, const ncp_status_t *s, const double *v)
+{
+    printf("%-9s", label);
+    for (int i = 0; i < n_axes(s); i++)
+        printf(" %c %11.4f", s->axes[i], v[i]);
+    printf("\n");
+}
+
+static const char *text(const uint8_t *t, size_t size, char *buf, size_t bufsize)
+{
+    snprintf(buf, bufsize, "%.*s", (int)strnlen((const char *)t, size), (const char *)t);
+    return buf;
+}
+
+void ctl_print_status(const ncp_status_t *s)
+{
+    static const char *const g5x[] = {"G54", "G55", "G56", "G57", "G58",
+                                      "G59", "G59.1", "G59.2", "G59.3"};
+    char buf[260];
+    const char *state = ncp_msg_state_name(s->state);
+    printf("state     %s%s\n", state ? state : "unknown", s->step_mode ? " (single block)" : "");
+    text(s->program, sizeof s->program, buf, sizeof buf);
+    if (buf[0])
+        printf("program   %s, line %d\n", buf, (int)s->line);
+    else
+        printf("program   none\n");
+    print_axes("position", s, s->pos_cmd);
+    print_axes("actual", s, s->pos_act);
+    printf("homed    ");
+    int homed = 0;
+    for (int i = 0; i < n_axes(s); i++)
+        if (s->homed[i]) {
+            printf(" %c", s->axes[i]);
+            homed++;
+        }
+    printf("%s\n", homed == 0 ? " none" : "");
+    printf("feed      %.1f mm/min, overrides feed %.0f%% rapid %.0f%% spindle %.0f%%\n",
+           s->vel, s->feed_override, s->rapid_override, s->spindle_override);
+    printf("spindle   %.0f rpm %s, coolant %s%s%s, tool %d, %s\n", s->spindle_speed,
+           s->spindle_dir > 0 ? "cw" : s->spindle_dir < 0 ? "ccw" : "stopped",
+           s->mist ? "mist" : "", s->mist && s->flood ? "+" : "",
+           s->flood ? "flood" : (s->mist ? "" : "off"), (int)s->tool,
+           s->g5x_index >= 1 && s->g5x_index <= 9 ? g5x[s->g5x_index - 1] : "G5x?");
+    text(s->error, sizeof s->error, buf, sizeof buf);
+    if (buf[0])
+        printf("error     %s\n", buf);
+    printf("messages  %lld commands, %lld garbage, %lld rejected; loop %lld cycles, %lld "
+           "misses, %.1f us worst latency\n",
+           (long long)s->commands, (long long)s->garbage, (long long)s->rejected,
+           (long long)s->cycles, (long long)s->deadline_misses, s->latency_max_us);
+}

@@ -1,0 +1,139 @@
+/* status_t as one JSON object: what `cnc-ctl status --json` prints and what a
+ * browser panel can take as it is. Written into the caller's buffer. */
+#include <ctype.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "ncpar/msg.h"
+
+struct out {
+    char *buf;
+    size_t size, len;
+    int full; /* something did not fit */
+};
+
+__attribute__((format(printf, 2, 3))) static void put(struct out *o, const char *fmt, ...)
+{
+    if (o->full)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    /* the analyzer loses va_start when it analyses several files in one run */
+    int n = vsnprintf(o->buf + o->len, o->size - o->len, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    va_end(ap);
+    if (n < 0 || (size_t)n >= o->size - o->len)
+        o->full = 1;
+    else
+        o->len += (size_t)n;
+}
+
+/* A fixed-size text field (NUL-terminated, or not if the sender broke it);
+ * "" is null. */
+static void put_text(struct out *o, const uint8_t *s, size_t size)
+{
+    size_t n = strnlen((const char *)s, size);
+    if (n == 0) {
+        put(o, "null");
+        return;
+    }
+    put(o, "\"");
+    for (size_t i = 0; i < n; i++) {
+        unsigned c = s[i];
+        if (c == '"' || c == '\\')
+            put(o, "\\%c", (char)c);
+        else if (c < 0x20 || c == 0x7f)
+            put(o, "\\u%04x", c);
+        else
+            put(o, "%c", (char)c);
+    }
+    put(o, "\"");
+}
+
+/* JSON has no NaN or infinity. */
+static void put_num(struct out *o, const char *fmt, double v)
+{
+    if (isfinite(v))
+        put(o, fmt, v);
+    else
+        put(o, "null");
+}
+
+static int n_axes(const ncp_status_t *s)
+{
+    int n = (int)s->n_axes;
+    return n < 0 ? 0 : n > 9 ? 9 : n;
+}
+
+/* {"x": ..., "y": ...} over the status's axes; bools when b is set. */
+static void put_axes(struct out *o, const ncp_status_t *s, const double *v, const int8_t *b)
+{
+    put(o, "{");
+    int first = 1;
+    for (int i = 0; i < n_axes(s); i++) {
+        if (!isalpha(s->axes[i]))
+            continue;
+        put(o, "%s\"%c\": ", first ? "" : ", ", tolower(s->axes[i]));
+        first = 0;
+        if (b)
+            put(o, "%s", b[i] ? "true" : "false");
+        else
+            put_num(o, "%.6f", v[i]);
+    }
+    put(o, "}");
+}
+
+static const char *g5x_name(int index)
+{
+    static const char *const names[] = {"G54",   "G55",   "G56",  "G57", "G58",
+                                        "G59",   "G59.1", "G59.2", "G59.3"};
+    return index >= 1 && index <= 9 ? names[index - 1] : NULL;
+}
+
+int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
+{
+    struct out o = {.buf = buf, .size = size};
+    if (size == 0)
+        return -1;
+    const char *state = ncp_msg_state_name(s->state);
+    put(&o, "{\"state\": ");
+    put(&o, state ? "\"%s\"" : "null", state ? state : "");
+    put(&o, ", \"program\": ");
+    put_text(&o, s->program, sizeof s->program);
+    put(&o, ", \"line\": %d, \"homed\": ", (int)s->line);
+    put_axes(&o, s, NULL, s->homed);
+    put(&o, ", \"pos_cmd\": ");
+    put_axes(&o, s, s->pos_cmd, NULL);
+    put(&o, ", \"pos_act\": ");
+    put_axes(&o, s, s->pos_act, NULL);
+    put(&o, ", \"vel\": ");
+    put_num(&o, "%.3f", s->vel);
+    put(&o, ", \"feed_override\": ");
+    put_num(&o, "%.6g", s->feed_override);
+    put(&o, ", \"rapid_override\": ");
+    put_num(&o, "%.6g", s->rapid_override);
+    put(&o, ", \"spindle_override\": ");
+    put_num(&o, "%.6g", s->spindle_override);
+    put(&o, ", \"spindle\": {\"speed\": ");
+    put_num(&o, "%.3f", s->spindle_speed);
+    put(&o, ", \"dir\": %d}", (int)s->spindle_dir);
+    put(&o, ", \"coolant\": {\"mist\": %s, \"flood\": %s}", s->mist ? "true" : "false",
+        s->flood ? "true" : "false");
+    put(&o, ", \"tool\": %d", (int)s->tool);
+    const char *g5x = g5x_name(s->g5x_index);
+    put(&o, ", \"g5x\": {\"index\": %d, \"name\": ", (int)s->g5x_index);
+    put(&o, g5x ? "\"%s\"" : "null", g5x ? g5x : "");
+    put(&o, ", \"offset\": ");
+    put_axes(&o, s, s->g5x_offset, NULL);
+    put(&o, "}, \"step\": %s, \"error\": ", s->step_mode ? "true" : "false");
+    put_text(&o, s->error, sizeof s->error);
+    put(&o,
+        ", \"seq\": %lld, \"commands\": %lld, \"garbage\": %lld, \"rejected\": %lld, "
+        "\"cycles\": %lld, \"deadline_misses\": %lld, \"latency_max_us\": ",
+        (long long)s->seq, (long long)s->commands, (long long)s->garbage,
+        (long long)s->rejected, (long long)s->cycles, (long long)s->deadline_misses);
+    put_num(&o, "%.3f", s->latency_max_us);
+    put(&o, "}");
+    return o.full ? -1 : (int)o.len;
+}

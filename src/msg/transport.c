@@ -1,0 +1,243 @@
+/* The NCK's end of LCM's UDP multicast transport: one socket joined to the
+ * group, shared with every other LCM process on the host exactly as liblcm
+ * shares it (SO_REUSEADDR, SO_REUSEPORT, multicast loop on), so cnc-ctl,
+ * lcm-spy and lcm-logger on the same machine see what the NCK sends and it
+ * sees what they send.
+ *
+ * Receiving reads into one buffer of the largest UDP datagram; sending
+ * encodes into another. Nothing is allocated after ncp_msg_open. */
+#include <arpa/inet.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "msg_int.h"
+#include "ncpar/msg.h"
+
+/* At most this many datagrams per ncp_msg_poll: a flood on the group must
+ * not keep the service thread from its other work (the rest wait in the
+ * socket's buffer, or the kernel drops them). */
+#define POLL_DATAGRAMS_MAX 256
+
+#define CHANNEL_SIZE (NCP_MSG_PREFIX_MAX + 8)
+#define UDP_DATAGRAM_MAX 65536
+#define SEND_BUF_SIZE 4096 /* header + the largest type (status_t) */
+
+struct ncp_msg {
+    int fd;
+    struct sockaddr_in group;
+    uint32_t seqno; /* LC02 sequence number of the next datagram sent */
+    char ch_cmd[CHANNEL_SIZE], ch_ack[CHANNEL_SIZE], ch_status[CHANNEL_SIZE],
+        ch_event[CHANNEL_SIZE];
+    struct ncp_msg_stats stats;
+    uint8_t sbuf[SEND_BUF_SIZE];
+    uint8_t rbuf[UDP_DATAGRAM_MAX];
+};
+
+/* The socket as liblcm's udpm sets up its own (receive and send in one). */
+static int open_socket(struct ncp_msg *m, const struct ncp_msg_url *u, struct ncp_diag *d)
+{
+    int one = 1;
+    int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    if (fd < 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot open a UDP socket for LCM: %s",
+                            strerror(errno));
+    m->fd = fd;
+    if (setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) < 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
+                            "cannot share UDP port %u with other LCM processes: %s", u->port,
+                            strerror(errno));
+#ifdef SO_REUSEPORT
+    /* liblcm sets it where SO_REUSEADDR alone does not share a port (BSD,
+     * macOS); on Linux SO_REUSEADDR suffices and this is harmless. */
+    (void)setsockopt(fd, SOL_SOCKET, SO_REUSEPORT, &one, sizeof one);
+#endif
+    if (u->recv_buf_size > 0 &&
+        setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &u->recv_buf_size, sizeof u->recv_buf_size) < 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot set the receive buffer to %d bytes: %s",
+                            u->recv_buf_size, strerror(errno));
+    struct sockaddr_in addr;
+    memset(&addr, 0, sizeof addr);
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_ANY);
+    addr.sin_port = htons(u->port);
+    if (bind(fd, (struct sockaddr *)&addr, sizeof addr) < 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
+                            "cannot bind UDP port %u for LCM: %s (another program that uses "
+                            "the port without sharing it?)",
+                            u->port, strerror(errno));
+    struct ip_mreq mreq;
+    memset(&mreq, 0, sizeof mreq);
+    mreq.imr_multiaddr = m->group.sin_addr;
+    mreq.imr_interface.s_addr = htonl(INADDR_ANY);
+    if (setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) < 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
+                            "cannot join multicast group %s on port %u: %s (is there a "
+                            "multicast route? see README)",
+                            u->group, u->port, strerror(errno));
+    unsigned char ttl = (unsigned char)u->ttl, loop = 1;
+    if (setsockopt(fd, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl) < 0 ||
+        setsockopt(fd, IPPROTO_IP, IP_MULTICAST_LOOP, &loop, sizeof loop) < 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
+                            "cannot set multicast ttl %d and loopback on group %s: %s", u->ttl,
+                            u->group, strerror(errno));
+    return NCP_OK;
+}
+
+int ncp_msg_open(struct ncp_msg **mp, const char *url, const char *prefix, struct ncp_diag *d)
+{
+    *mp = NULL;
+    if (url == NULL || url[0] == 0) {
+        url = getenv("LCM_DEFAULT_URL");
+        if (url == NULL || url[0] == 0)
+            url = NCP_MSG_DEFAULT_URL;
+    }
+    if (prefix == NULL)
+        prefix = NCP_MSG_DEFAULT_PREFIX;
+    if (strlen(prefix) > NCP_MSG_PREFIX_MAX)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
+                            "LCM channel prefix '%s' is longer than %d characters", prefix,
+                            NCP_MSG_PREFIX_MAX);
+    struct ncp_msg_url u;
+    int rc = ncp_msg_parse_url(url, &u, d);
+    if (rc != NCP_OK)
+        return rc;
+    struct ncp_msg *m = calloc(1, sizeof *m);
+    if (m == NULL)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the LCM transport");
+    m->fd = -1;
+    m->group.sin_family = AF_INET;
+    m->group.sin_port = htons(u.port);
+    (void)inet_pton(AF_INET, u.group, &m->group.sin_addr);
+    snprintf(m->ch_cmd, sizeof m->ch_cmd, "%sCMD", prefix);
+    snprintf(m->ch_ack, sizeof m->ch_ack, "%sACK", prefix);
+    snprintf(m->ch_status, sizeof m->ch_status, "%sSTATUS", prefix);
+    snprintf(m->ch_event, sizeof m->ch_event, "%sEVENT", prefix);
+    rc = open_socket(m, &u, d);
+    if (rc != NCP_OK) {
+        ncp_msg_close(m);
+        return rc;
+    }
+    *mp = m;
+    return NCP_OK;
+}
+
+void ncp_msg_close(struct ncp_msg *m)
+{
+    if (m == NULL)
+        return;
+    if (m->fd >= 0)
+        close(m->fd);
+    free(m);
+}
+
+int ncp_msg_fd(const struct ncp_msg *m)
+{
+    return m->fd;
+}
+
+void ncp_msg_get_stats(const struct ncp_msg *m, struct ncp_msg_stats *st)
+{
+    *st = m->stats;
+}
+
+/* One datagram: a command handed on (1), or not (0). */
+static int take_datagram(struct ncp_msg *m, size_t len,
+                         void (*on_cmd)(void *ctx, const ncp_command_t *cmd), void *ctx)
+{
+    const char *channel;
+    const uint8_t *payload;
+    size_t plen;
+    m->stats.received++;
+    if (ncp_msg_parse_datagram(m->rbuf, len, &channel, &payload, &plen) != 0) {
+        /* A fragment is LCM's own business unless it claims to carry a
+         * command (a command always fits one datagram); anything else that
+         * is not LCM at all is garbage. */
+        if (ncp_msg_is_fragment(m->rbuf, len)) {
+            const char *fch = ncp_msg_fragment_channel(m->rbuf, len);
+            if (fch != NULL && strcmp(fch, m->ch_cmd) == 0)
+                m->stats.garbage++;
+        } else {
+            m->stats.garbage++;
+        }
+        return 0;
+    }
+    if (strcmp(channel, m->ch_cmd) != 0)
+        return 0;
+    ncp_command_t cmd;
+    if (ncp_msg_decode_command(payload, plen, &cmd) != 0) {
+        m->stats.garbage++;
+        return 0;
+    }
+    m->stats.commands++;
+    if (on_cmd)
+        on_cmd(ctx, &cmd);
+    return 1;
+}
+
+int ncp_msg_poll(struct ncp_msg *m, int timeout_ms,
+                 void (*on_cmd)(void *ctx, const ncp_command_t *cmd), void *ctx)
+{
+    struct pollfd p = {.fd = m->fd, .events = POLLIN};
+    int r = poll(&p, 1, timeout_ms);
+    if (r < 0)
+        return errno == EINTR ? 0 : -1;
+    if (r == 0)
+        return 0;
+    int handed = 0;
+    for (int i = 0; i < POLL_DATAGRAMS_MAX; i++) {
+        ssize_t n = recv(m->fd, m->rbuf, sizeof m->rbuf, MSG_DONTWAIT);
+        if (n < 0) {
+            if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)
+                break;
+            return -1;
+        }
+        handed += take_datagram(m, (size_t)n, on_cmd, ctx);
+    }
+    return handed;
+}
+
+/* Sends the header already in sbuf plus its encoded payload (n < 0: the
+ * encoding failed). Never blocks: a full socket buffer is a send error. */
+static int send_frame(struct ncp_msg *m, int header, int n)
+{
+    if (header < 0 || n < 0) {
+        m->stats.send_errors++;
+        return -1;
+    }
+    ssize_t sent = sendto(m->fd, m->sbuf, (size_t)header + (size_t)n, MSG_DONTWAIT,
+                          (const struct sockaddr *)&m->group, sizeof m->group);
+    if (sent < 0) {
+        m->stats.send_errors++;
+        return -1;
+    }
+    m->seqno++;
+    m->stats.sent++;
+    return 0;
+}
+
+int ncp_msg_send_ack(struct ncp_msg *m, const ncp_ack_t *a)
+{
+    int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, m->ch_ack);
+    int n = h < 0 ? -1 : ncp_ack_t_encode(m->sbuf, h, (int)sizeof m->sbuf - h, a);
+    return send_frame(m, h, n);
+}
+
+int ncp_msg_send_status(struct ncp_msg *m, const ncp_status_t *s)
+{
+    int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, m->ch_status);
+    int n = h < 0 ? -1 : ncp_status_t_encode(m->sbuf, h, (int)sizeof m->sbuf - h, s);
+    return send_frame(m, h, n);
+}
+
+int ncp_msg_send_event(struct ncp_msg *m, const ncp_event_t *e)
+{
+    int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, m->ch_event);
+    int n = h < 0 ? -1 : ncp_event_t_encode(m->sbuf, h, (int)sizeof m->sbuf - h, e);
+    return send_frame(m, h, n);
+}
