@@ -216,4 +216,17 @@ int ncp_nck_shutdown_requested(const struct ncp_nck *n);
  * any state that moves; then shutdown. */
 void ncp_nck_request_shutdown(struct ncp_nck *n);
 
+/* ---- on LCM (service.c; messages in lcm/, transport in src/msg/) ------------------- */
+
+struct ncp_nck_serve_opts {
+    const char *url, *prefix;        /* NULL or "": the INI's [LCM] URL / CHANNEL_PREFIX */
+    int (*stop_requested)(void *ctx);/* polled: SIGINT/SIGTERM arrived */
+    void (*ready)(void *ctx, const char *prefix); /* listening (may be NULL) */
+    void *ctx;
+};
+/* Serves commands, status and events until a shutdown (command or
+ * stop_requested, after a controlled stop). 0; 1 when the NCK was in fault
+ * meanwhile; -1 with d->msg when LCM cannot be opened. */
+int ncp_nck_serve(struct ncp_nck *n, const struct ncp_nck_serve_opts *o, struct ncp_diag *d);
+
 #endif

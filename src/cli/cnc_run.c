@@ -5,6 +5,7 @@
 #include "ncpar/pipeline.h"
 #include "canon_writer.h"
 #include "run.h"
+#include "serve.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -102,6 +103,7 @@ static void usage(FILE *f)
           "       cnc-run check PROG [--tool-table FILE] [--subroutine-path DIRS]\n"
           "       cnc-run run PROG [--config INI] [--trace CSV] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
+          "       cnc-run serve [--config INI] [--lcm-url URL] [--clock real|virtual] [--trace CSV]\n"
           "\n"
           "parse  interpret PROG (\"-\" = standard input) with the parallel pipeline and\n"
           "       write canonical machining calls (rs274 -g format) to --canon.\n"
@@ -114,6 +116,8 @@ static void usage(FILE *f)
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
           "run    run PROG on the machine: planner, interpolator, position loop, backend\n"
           "       (the simulated servo by default); `cnc-run run --help` for details.\n"
+          "serve  the NCK as a service: operator commands, status and events over LCM\n"
+          "       (cnc-ctl is its client); `cnc-run serve --help` for details.\n"
           "\n"
           "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault\n",
           f);
@@ -348,6 +352,8 @@ int main(int argc, char **argv)
         return cmd_check(argc - 1, argv + 1);
     if (!strcmp(argv[1], "run"))
         return ncp_cli_run(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "serve"))
+        return ncp_cli_serve(argc - 1, argv + 1);
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
         usage(stdout);
         return EXIT_OK;

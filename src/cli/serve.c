@@ -1,0 +1,153 @@
+/* cnc-run serve: the NCK as a long-running service on LCM. Options, the
+ * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
+#include "serve.h"
+
+#include "ncpar/nck.h"
+
+#include <getopt.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { SERVE_OK = 0, SERVE_USAGE = 1, SERVE_FAULT = 3 };
+
+static volatile sig_atomic_t stop_signal;
+
+static void on_signal(int sig)
+{
+    stop_signal = sig;
+}
+
+static int stop_requested(void *ctx)
+{
+    (void)ctx;
+    return stop_signal != 0;
+}
+
+static void ready(void *ctx, const char *prefix)
+{
+    (void)ctx;
+    fprintf(stderr, "cnc-run serve: listening on %sCMD (status, events and acks on %sSTATUS, "
+                    "%sEVENT, %sACK)\n", prefix, prefix, prefix, prefix);
+}
+
+static void usage(FILE *f)
+{
+    fputs("usage: cnc-run serve [--config INI] [--lcm-url URL] [--prefix P]\n"
+          "                     [--clock real|virtual] [--trace CSV] [--mode serial|det|att]\n"
+          "                     [--tool-table FILE] [--subroutine-path DIR[:DIR...]]\n"
+          "Runs the NCK as a service on the simulated machine: it holds the axes where they\n"
+          "are and waits for commands on LCM (cnc-ctl is its command-line client).\n"
+          "  --config INI        machine INI (default: built-in 3-axis mill); [LCM] URL,\n"
+          "                      CHANNEL_PREFIX (NCP_) and STATUS_HZ (50) are read from it\n"
+          "  --lcm-url URL       LCM URL (default: the INI's, else $LCM_DEFAULT_URL, else\n"
+          "                      udpm://239.255.76.67:7667?ttl=0)\n"
+          "  --prefix P          channel prefix (channels PCMD, PACK, PSTATUS, PEVENT)\n"
+          "  --clock virtual     simulated clock: as fast as the CPU allows while moving,\n"
+          "                      real time while idle\n"
+          "  --trace CSV         per-cycle trace of the whole service life\n"
+          "SIGINT/SIGTERM: a controlled stop along the path, then shutdown.\n"
+          "exit status: 0 ok, 1 usage or set-up, 3 a fault happened while serving\n",
+          f);
+}
+
+struct serve_args {
+    const char *config, *url, *prefix, *trace, *tool_table, *sub_path;
+    int virtual_clock;
+    enum ncp_thread_mode mode;
+};
+
+static int parse(int argc, char **argv, struct serve_args *a)
+{
+    static const struct option longopts[] = {
+        { "config", required_argument, 0, 'c' }, { "lcm-url", required_argument, 0, 'u' },
+        { "prefix", required_argument, 0, 'P' }, { "clock", required_argument, 0, 'k' },
+        { "trace", required_argument, 0, 't' }, { "mode", required_argument, 0, 'm' },
+        { "tool-table", required_argument, 0, 'T' },
+        { "subroutine-path", required_argument, 0, 'S' }, { "help", no_argument, 0, 'h' },
+        { 0, 0, 0, 0 },
+    };
+    int c;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "c:u:P:k:t:m:T:S:h", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'c': a->config = optarg; break;
+        case 'u': a->url = optarg; break;
+        case 'P': a->prefix = optarg; break;
+        case 't': a->trace = optarg; break;
+        case 'T': a->tool_table = optarg; break;
+        case 'S': a->sub_path = optarg; break;
+        case 'k':
+            if (strcmp(optarg, "real") && strcmp(optarg, "virtual"))
+                return fprintf(stderr, "cnc-run serve: --clock is real or virtual\n"), -1;
+            a->virtual_clock = !strcmp(optarg, "virtual");
+            break;
+        case 'm':
+            if (ncp_thread_mode_parse(optarg, &a->mode))
+                return fprintf(stderr, "cnc-run serve: --mode is serial, det or att\n"), -1;
+            break;
+        case 'h': usage(stdout); exit(SERVE_OK);
+        default: return -1;
+        }
+    }
+    if (optind != argc)
+        return fprintf(stderr, "cnc-run serve: unexpected argument '%s'\n", argv[optind]), -1;
+    return 0;
+}
+
+int ncp_cli_serve(int argc, char **argv)
+{
+    struct serve_args a = { 0 };
+    a.mode = NCP_MODE_SERIAL;
+    if (parse(argc, argv, &a))
+        return usage(stderr), SERVE_USAGE;
+    struct ncp_machine_cfg cfg;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    ncp_machine_cfg_default(&cfg);
+    if (a.config && ncp_machine_cfg_load(&cfg, a.config, &d) != NCP_OK) {
+        if (d.line)
+            fprintf(stderr, "%s:%u: error: %s\n", a.config, d.line, d.msg);
+        else
+            fprintf(stderr, "error: %s\n", d.msg);
+        return SERVE_USAGE;
+    }
+    /* an explicit handler: a SIGINT inherited as ignored must still stop it */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    FILE *trace = NULL;
+    if (a.trace && !(trace = fopen(a.trace, "w"))) {
+        perror(a.trace);
+        return SERVE_USAGE;
+    }
+    struct ncp_nck_setup setup = {
+        .cfg = &cfg, .virtual_clock = a.virtual_clock, .trace = trace, .mode = a.mode,
+        .interp = { .tool_table_path = a.tool_table, .subroutine_path = a.sub_path },
+    };
+    struct ncp_nck *nck = ncp_nck_new(&setup, &d);
+    if (!nck) {
+        fprintf(stderr, "cnc-run serve: error: %s\n", d.msg);
+        if (trace)
+            fclose(trace);
+        return SERVE_FAULT;
+    }
+    struct ncp_nck_serve_opts so = { .url = a.url, .prefix = a.prefix,
+                                     .stop_requested = stop_requested, .ready = ready };
+    int rc = ncp_nck_serve(nck, &so, &d);
+    ncp_nck_free(nck);
+    if (trace && fclose(trace) != 0) {
+        fprintf(stderr, "cnc-run serve: error writing %s\n", a.trace);
+        rc = rc < 0 ? rc : 1;
+    }
+    if (rc < 0) {
+        fprintf(stderr, "cnc-run serve: error: %s\n", d.msg);
+        return SERVE_USAGE;
+    }
+    fprintf(stderr, "cnc-run serve: shut down%s\n", rc ? " (a fault happened while serving)" : "");
+    return rc ? SERVE_FAULT : SERVE_OK;
+}

@@ -1,0 +1,235 @@
+/* The NCK on LCM: commands in on <prefix>CMD, an ACK for each, STATUS at the
+ * status rate and at every state change, EVENTs as they come. One thread (the
+ * caller's) does all of it; the NCK's real-time threads never see a message. */
+#include "nck_int.h"
+
+#include "ncpar/msg.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/time.h>
+#include <time.h>
+
+/* The last command of each client: a repeated seq is a resend (answered
+ * with the same ACK, not acted on twice), an older one is out of order. */
+#define SERVE_CLIENTS 64
+struct client {
+    int32_t id, seq;
+    int64_t last_ns;
+    ncp_ack_t ack;
+};
+
+struct serve {
+    struct ncp_nck *nck;
+    struct ncp_msg *msg;
+    struct client clients[SERVE_CLIENTS];
+    int32_t jog_client;              /* whose keep-alives hold a continuous jog */
+    uint64_t out_of_order, duplicates;
+    int64_t status_seq, event_seq;
+    int fault_seen;
+};
+
+static int64_t mono_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+static int64_t utime_now(void)
+{
+    struct timeval tv;
+    gettimeofday(&tv, NULL);
+    return (int64_t)tv.tv_sec * 1000000 + tv.tv_usec;
+}
+
+static struct client *client_of(struct serve *sv, int32_t id)
+{
+    struct client *oldest = &sv->clients[0];
+    for (int i = 0; i < SERVE_CLIENTS; i++) {
+        struct client *c = &sv->clients[i];
+        if (c->id == id)
+            return c;
+        if (c->last_ns < oldest->last_ns)
+            oldest = c;
+    }
+    memset(oldest, 0, sizeof *oldest);
+    oldest->id = id;
+    return oldest;
+}
+
+static void send_status(struct serve *sv)
+{
+    struct ncp_nck_snapshot st;
+    ncp_nck_get_status(sv->nck, &st);
+    struct ncp_msg_stats ms;
+    ncp_msg_get_stats(sv->msg, &ms);
+    ncp_status_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = utime_now();
+    m.seq = ++sv->status_seq;
+    m.state = (int8_t)st.state;
+    snprintf((char *)m.program, sizeof m.program, "%s", st.program);
+    m.line = (int32_t)st.line;
+    m.n_axes = (int8_t)st.n_axes;
+    for (int j = 0; j < st.n_axes && j < 9; j++) {
+        m.axes[j] = (uint8_t)st.axes[j];
+        m.homed[j] = (int8_t)st.homed[j];
+        m.pos_cmd[j] = st.pos_cmd[j];
+        m.pos_act[j] = st.pos_act[j];
+        m.g5x_offset[j] = st.g5x_offset[j];
+    }
+    m.vel = st.vel;
+    m.feed_override = st.feed_override;
+    m.rapid_override = st.rapid_override;
+    m.spindle_override = st.spindle_override;
+    m.spindle_speed = st.spindle_speed;
+    m.spindle_dir = (int8_t)st.spindle_dir;
+    m.mist = (int8_t)st.mist;
+    m.flood = (int8_t)st.flood;
+    m.tool = st.tool;
+    m.g5x_index = (int8_t)st.g5x_index;
+    m.step_mode = (int8_t)st.step_mode;
+    snprintf((char *)m.error, sizeof m.error, "%s", st.error);
+    m.commands = (int64_t)ms.commands;
+    m.garbage = (int64_t)(ms.garbage + sv->out_of_order);
+    m.rejected = (int64_t)st.rejected;
+    m.cycles = (int64_t)st.cycles;
+    m.deadline_misses = (int64_t)st.deadline_misses;
+    m.latency_max_us = st.latency_max_us;
+    ncp_msg_send_status(sv->msg, &m);
+    if (st.state == NCP_ST_FAULT)
+        sv->fault_seen = 1;
+}
+
+static void send_events(struct serve *sv)
+{
+    struct ncp_nck_event ev;
+    while (ncp_nck_next_event(sv->nck, &ev)) {
+        ncp_event_t m;
+        memset(&m, 0, sizeof m);
+        m.utime = utime_now();
+        m.seq = ++sv->event_seq;
+        m.kind = (int8_t)ev.kind;
+        snprintf((char *)m.file, sizeof m.file, "%s", ev.file);
+        m.line = (int32_t)ev.line;
+        m.col = (int32_t)ev.col;
+        snprintf((char *)m.text, sizeof m.text, "%s", ev.text);
+        ncp_msg_send_event(sv->msg, &m);
+        if (ev.kind >= NCP_EV_ERROR)
+            fprintf(stderr, "cnc-run serve: %s%s%s%s\n", ev.file[0] ? ev.file : "",
+                    ev.file[0] ? ": " : "", ev.kind == NCP_EV_FAULT ? "fault: " : "error: ",
+                    ev.text);
+    }
+}
+
+static void on_command(void *ctx, const ncp_command_t *c)
+{
+    struct serve *sv = ctx;
+    if (c->kind == NCP_CMD_KEEPALIVE) {
+        /* only the jogging client's keep-alives hold its jog */
+        if (c->client_id == sv->jog_client) {
+            struct ncp_nck_cmd k;
+            memset(&k, 0, sizeof k);
+            k.kind = NCP_CMD_KEEPALIVE;
+            char why[8];
+            ncp_nck_command(sv->nck, &k, why, sizeof why);
+        }
+        return;
+    }
+    struct client *cl = client_of(sv, c->client_id);
+    cl->last_ns = mono_ns();
+    if (cl->seq && c->seq == cl->seq) {
+        sv->duplicates++;
+        ncp_msg_send_ack(sv->msg, &cl->ack);
+        return;
+    }
+    if (cl->seq && c->seq < cl->seq) {
+        sv->out_of_order++;
+        return;
+    }
+    struct ncp_nck_cmd k;
+    memset(&k, 0, sizeof k);
+    k.kind = c->kind;
+    memcpy(k.text, c->text, sizeof k.text < sizeof c->text ? sizeof k.text : sizeof c->text);
+    k.text[sizeof k.text - 1] = 0;
+    for (int i = 0; i < 4; i++) {
+        k.value[i] = c->value[i];
+        k.ivalue[i] = c->ivalue[i];
+    }
+    ncp_ack_t *a = &cl->ack;
+    memset(a, 0, sizeof *a);
+    char why[sizeof a->reason];
+    int rc = ncp_nck_command(sv->nck, &k, why, sizeof why);
+    if (rc == 0 && c->kind == NCP_CMD_JOG && !(c->value[1] > 0))
+        sv->jog_client = c->client_id;
+    /* the command may change the state at once: the ACK says the new one */
+    ncp_nck_poll(sv->nck);
+    struct ncp_nck_snapshot st;
+    ncp_nck_get_status(sv->nck, &st);
+    cl->seq = c->seq;
+    a->utime = utime_now();
+    a->client_id = c->client_id;
+    a->seq = c->seq;
+    a->channel = c->channel;
+    a->result = rc == 0 ? NCP_ACK_T_ACCEPTED : NCP_ACK_T_REJECTED;
+    a->state = (int8_t)st.state;
+    snprintf((char *)a->reason, sizeof a->reason, "%s", rc == 0 ? "" : why);
+    ncp_msg_send_ack(sv->msg, a);
+    send_status(sv);
+}
+
+int ncp_nck_serve(struct ncp_nck *nck, const struct ncp_nck_serve_opts *o, struct ncp_diag *d)
+{
+    struct serve *sv = calloc(1, sizeof *sv);
+    if (!sv)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory"), -1;
+    sv->nck = nck;
+    const struct ncp_machine_cfg *cfg = nck->n.cfg;
+    const char *url = o->url && *o->url ? o->url : cfg->lcm.url;
+    const char *prefix = o->prefix && *o->prefix ? o->prefix : cfg->lcm.prefix;
+    if (ncp_msg_open(&sv->msg, url, prefix, d) != 0) {
+        free(sv);
+        return -1;
+    }
+    double hz = cfg->lcm.status_hz > 0 ? cfg->lcm.status_hz : 50.0;
+    int64_t period = (int64_t)llround(1e9 / hz);
+    int64_t next_status = mono_ns();
+    int stopping = 0;
+    if (o->ready)
+        o->ready(o->ctx, prefix);
+    while (!ncp_nck_shutdown_requested(nck)) {
+        if (!stopping && o->stop_requested && o->stop_requested(o->ctx)) {
+            stopping = 1;
+            ncp_nck_request_shutdown(nck);
+        }
+        int64_t now = mono_ns();
+        int64_t wait_ms = (next_status - now) / 1000000;
+        if (wait_ms > 5)
+            wait_ms = 5;   /* the NCK is polled at least every 5 ms */
+        if (wait_ms < 0)
+            wait_ms = 0;
+        if (ncp_msg_poll(sv->msg, (int)wait_ms, on_command, sv) < 0) {
+            ncp_diag_set(d, NCP_ERR_IO, 0, 0, "LCM socket failed");
+            break;
+        }
+        int changed = ncp_nck_poll(nck);
+        send_events(sv);
+        now = mono_ns();
+        if (changed || now >= next_status) {
+            send_status(sv);
+            if (now >= next_status)
+                next_status += period;
+            if (next_status < now)   /* fell behind: no burst to catch up */
+                next_status = now + period;
+        }
+    }
+    send_events(sv);
+    send_status(sv);
+    int fault = sv->fault_seen;
+    ncp_msg_close(sv->msg);
+    free(sv);
+    return fault ? 1 : 0;
+}
