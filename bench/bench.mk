@@ -11,3 +11,12 @@ $(BUILD)/bench/%: bench/%.c $(LIB) | $(GEN_STAMP)
 
 bench: all $(BENCH_BINS)
 	bench/run-bench $(BUILD)
+
+# The service benchmark's client speaks LCM through liblcm, as any client would.
+$(BUILD)/bench/service-bench: bench/service-bench.c $(LIB) | $(GEN_STAMP)
+	@mkdir -p $(@D)
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -o $@ $< $(LIB) -llcm $(LDLIBS)
+
+bench-service: all $(BUILD)/bench/service-bench
+	bench/bench-service $(BUILD)
+.PHONY: bench-service

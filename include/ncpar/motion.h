@@ -70,7 +70,8 @@ struct ncp_machine_cfg {
     struct ncp_lcm_cfg {          /* [LCM]: cnc-run serve's messaging */
         char url[256];            /* URL ("" = $LCM_DEFAULT_URL or LCM's default) */
         char prefix[32];          /* CHANNEL_PREFIX, default NCP_ */
-        double status_hz;         /* STATUS_HZ, default 50 */
+        double status_hz;         /* STATUS_HZ, default 50; 0: only at state changes
+                                     and after each command */
     } lcm;
 };
 

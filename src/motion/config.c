@@ -181,7 +181,7 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v)
         return 1;
     }
     if (!strcasecmp(k, "STATUS_HZ"))
-        return num(v, 1, 1000, &l->status_hz) ? -1 : 1;
+        return num(v, 0, 1000, &l->status_hz) ? -1 : 1;
     return 0;
 }
 

@@ -6,6 +6,7 @@
 #include "ncpar/msg.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -194,9 +195,10 @@ int ncp_nck_serve(struct ncp_nck *nck, const struct ncp_nck_serve_opts *o, struc
         free(sv);
         return -1;
     }
-    double hz = cfg->lcm.status_hz > 0 ? cfg->lcm.status_hz : 50.0;
-    int64_t period = (int64_t)llround(1e9 / hz);
-    int64_t next_status = mono_ns();
+    /* STATUS_HZ 0: no periodic status (state changes and acks still send one) */
+    double hz = cfg->lcm.status_hz;
+    int64_t period = hz > 0 ? (int64_t)llround(1e9 / hz) : INT64_MAX / 4;
+    int64_t next_status = hz > 0 ? mono_ns() : INT64_MAX / 2;
     int stopping = 0;
     if (o->ready)
         o->ready(o->ctx, prefix);
