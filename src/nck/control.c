@@ -107,6 +107,7 @@ static int emit_state_only(void *ctx, const struct ncp_cmd *cmd)
     struct ncp_seg seg;
     struct ncp_diag d;
     for (unsigned i = 0; i < cmd->n_ops; i++) {
+        nck_note_state(&s->n, &cmd->ops[i]);   /* the status shows the reset G5x too */
         int rc = ncp_canon_map_op(&s->n.map, &cmd->ops[i], cmd->line, &seg, &d);
         while (rc == 1)
             rc = ncp_canon_map_more(&s->n.map, &seg, &d);

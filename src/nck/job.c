@@ -124,7 +124,7 @@ static int approach(struct nck *n, uint32_t line)
 
 /* ---- interpreter jobs ------------------------------------------------------------ */
 
-static void note_state(struct nck *n, const struct ncp_canon *op)
+void nck_note_state(struct nck *n, const struct ncp_canon *op)
 {
     struct nck_io *io = &n->io;
     pthread_mutex_lock(&n->ev_lock);
@@ -137,7 +137,7 @@ static void note_state(struct nck *n, const struct ncp_canon *op)
     case NCP_C_MIST_OFF: io->mist = 0; break;
     case NCP_C_FLOOD_ON: io->flood = 1; break;
     case NCP_C_FLOOD_OFF: io->flood = 0; break;
-    case NCP_C_CHANGE_TOOL: io->tool = op->i[0]; break;
+    case NCP_C_CHANGE_TOOL:
     case NCP_C_CHANGE_TOOL_NUMBER: io->tool = op->i[0]; break;
     case NCP_C_SET_G5X_OFFSET:
         io->g5x_index = op->i[0];
@@ -197,7 +197,7 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
             post_text(n, cmd, op, NCP_EV_PRINT);
         else if (n->post_prints && op->kind == NCP_C_MESSAGE)
             post_text(n, cmd, op, NCP_EV_MSG);
-        note_state(n, op);
+        nck_note_state(n, op);
         int rc = ncp_canon_map_op(&n->map, op, cmd->line, &seg, &j->map_diag);
         while (rc == 1) {
             if (take_seg(n, &seg))

@@ -232,6 +232,8 @@ void nck_job_join(struct nck *n);
 /* a line from the map's position to end, traverse or at feed mm/s */
 void nck_line(const struct nck *n, struct ncp_seg *s, const double from[NCP_AXES],
               const double to[NCP_AXES], double feed, int traverse);
+/* what the status shows of an interpreter op: spindle, coolant, tool, G5x */
+void nck_note_state(struct nck *n, const struct ncp_canon *op);
 
 /* events.c */
 void nck_post(struct nck *n, int kind, const char *file, uint32_t line, uint32_t col,
