@@ -102,6 +102,15 @@ $(BUILD)/tests/test_ring_race: tests/unit/test_ring_race.c src/pipeline/ring.c $
 
 unit: $(UNIT_BINS)
 
+# The fuzz target as a plain program (tests/fuzz/replay.c): `make` compiles and
+# links it, so an API change that breaks it stops the build, not `make fuzz` later.
+FUZZ_REPLAY = $(BUILD)/tests/fuzz-replay
+all: $(FUZZ_REPLAY)
+$(FUZZ_REPLAY): tests/fuzz/replay.c tests/fuzz/fuzz_pipeline.c $(LIB)
+	@mkdir -p $(@D)
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -o $@ tests/fuzz/replay.c tests/fuzz/fuzz_pipeline.c \
+	    $(LIB) $(LDLIBS) -lstdc++
+
 # Build and test dependencies on Debian 12 (run as root).
 deps:
 	apt-get update -qq

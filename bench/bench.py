@@ -68,13 +68,33 @@ def sh(cmd):
         return ""
 
 
+def lscpu_summary():
+    """One line from lscpu: model, family/model, CPUs as sockets x cores x threads,
+    NUMA nodes, whether a hypervisor runs it; and the memory. "" without lscpu."""
+    f = {}
+    for line in sh("LC_ALL=C lscpu").splitlines():
+        k, _, v = line.partition(":")
+        f[k.strip()] = v.strip()
+    if not f.get("Model name"):
+        return ""
+    mem = sh("awk '/^MemTotal/ {printf \"%.1f\", $2 / 1048576}' /proc/meminfo")
+    return "%s (family %s, model %s), %s CPUs = %s socket(s) x %s cores x %s thread(s) per core, " \
+        "%s NUMA node(s), %s; %s GB RAM" % (
+            f["Model name"], f.get("CPU family", "?"), f.get("Model", "?"),
+            f.get("CPU(s)", "?"), f.get("Socket(s)", "?"), f.get("Core(s) per socket", "?"),
+            f.get("Thread(s) per core", "?"), f.get("NUMA node(s)", "?"),
+            "virtual machine (%s)" % f["Hypervisor vendor"] if f.get("Hypervisor vendor")
+            else "virtual machine" if " hypervisor " in " %s " % f.get("Flags", "")
+            else "bare metal", mem or "?")
+
+
 def machine_facts():
     model = sh("grep -m1 'model name' /proc/cpuinfo | cut -d: -f2-").strip()
     return {
         "date": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime()),
         "kernel": platform.release(), "kernel_version": platform.version(),
         "preempt_rt": sh("cat /sys/kernel/realtime 2>/dev/null") == "1",
-        "cpu_model": model, "cpus": os.cpu_count(),
+        "cpu_model": model, "lscpu": lscpu_summary(), "cpus": os.cpu_count(),
         "cpus_allowed": len(os.sched_getaffinity(0)),
         "loadavg_start": open("/proc/loadavg").read().split()[:3],
         "rt_runtime_us": sh("cat /proc/sys/kernel/sched_rt_runtime_us"),

@@ -2,8 +2,9 @@
 """report.py DATA.json RESULTS.md: writes the `make bench` sections of RESULTS.md
 and the PNGs beside it from one run's measurements (bench/bench.py).
 
-Sections of an existing RESULTS.md that other scripts own (bench-motion,
-bench-parse) are kept verbatim after ours, each with its own date."""
+Only the part between the two OURS marker lines is replaced; everything before
+and after it (the introduction, the sections of other benchmarks, the findings)
+stays as it is, in place. A file without the markers gets the part appended."""
 import json
 import math
 import os
@@ -74,27 +75,44 @@ def gains(rows, cfg, pool):
     return g, (min(h1, h2), max(h1, h2))
 
 
-def table3_md(rows, pool):
-    out = ["| configuration | runs | mean (ms) | min (ms) | max (ms) | σ (ms) | gain | "
-           "gain, 1st/2nd half | paper gain |", "|---|--:|--:|--:|--:|--:|--:|--:|--:|"]
-    for fifo in ("", "-fifo"):
-        for base in bases(rows):
+def short_label(base):
+    if base.startswith("paper4-"):
+        return short_label(base[len("paper4-"):]) + " (paper's 4-CPU map)"
+    if base.endswith("-inline"):
+        return base + " (ours: inline output)"
+    if base.endswith("-j0"):
+        return base + " (ours: analyzer lexes)"
+    return base
+
+
+def table3_compact_md(rows):
+    """One row per map: mean and gain at both priorities, with thread creation and
+    on the pre-started pool; the paper's gains beside them."""
+    out = ["| map | Non RT: mean (ms) | gain | gain, pool | Prio 90: mean (ms) | gain | "
+           "gain, pool | paper gain, Non RT / Prio 90 |",
+           "|---|--:|--:|--:|--:|--:|--:|--:|"]
+    for base in bases(rows):
+        cells = [short_label(base)]
+        for fifo in ("", "-fifo"):
             cfg = base + fifo
             row = rows.get(cfg, {})
-            s = stats(series(row, pool))
+            s = stats(series(row, False))
             if not s:
-                out.append("| %s | 0 | failed: %s | | | | | | |" % (
-                    label(cfg), row.get("error", "no runs").replace("|", "/")[:80]))
+                cells += ["failed: %s" % row.get("error", "no runs").replace("|", "/")[:60],
+                          "", ""]
                 continue
-            g, halves = gains(rows, cfg, pool)
-            is_serial = base == "serial"
-            out.append("| %s | %d%s | %s | %s | %s | %s | %s | %s | %s |" % (
-                label(cfg), s["n"], "*" if row.get("stopped") else "", fmt(s["mean"]),
-                fmt(s["min"]), fmt(s["max"]), fmt(s["sd"]),
-                "-" if is_serial else fmt(g),
-                "-" if is_serial or not halves else "%s / %s" % (fmt(halves[0]), fmt(halves[1])),
-                ("(mean %.3f ms)" % PAPER_SERIAL_MS[fifo]) if is_serial
-                else fmt(PAPER_GAIN.get(cfg.replace("paper4-", "")))))
+            mean = fmt(s["mean"]) + ("*" if row.get("stopped") else "")
+            if base == "serial":
+                cells += [mean, "-", "-"]
+            else:
+                cells += [mean, fmt(gains(rows, cfg, False)[0], 2),
+                          fmt(gains(rows, cfg, True)[0], 2)]
+        key = base.replace("paper4-", "")
+        pg = (PAPER_GAIN.get(key), PAPER_GAIN.get(key + "-fifo"))
+        cells.append("%.2f / %.2f" % pg if pg[0] else
+                     "(serial %.3f / %.3f ms)" % (PAPER_SERIAL_MS[""], PAPER_SERIAL_MS["-fifo"])
+                     if base == "serial" else "-")
+        out.append("| " + " | ".join(cells) + " |")
     return out
 
 
@@ -220,26 +238,20 @@ def driver_cmd(rows):
     return " ".join("OUT/maps/MAP.ini" if w.endswith("serial.ini") else w for w in words)
 
 
-def keep_other_sections(path):
-    """Sections of the old file not generated here, verbatim."""
+def splice(path, part):
+    """The file's text with the part between the OURS markers replaced by part (a
+    list of lines starting and ending with OURS); appended when there are no markers,
+    under a title when there is no file."""
+    block = "\n".join(part) + "\n"
     if not os.path.exists(path):
-        return []
+        return "# Benchmark results\n\n" + block
     text = open(path, encoding="utf-8").read()
-    if OURS in text:
+    if text.count(OURS) >= 2:
         a = text.index(OURS)
-        b = text.index(OURS, a + 1) + len(OURS) if text.count(OURS) > 1 else len(text)
-        text = text[:a] + text[b:]
-    out, cur = [], []
-    for line in text.splitlines():
-        if line.startswith("## "):
-            if cur:
-                out.append(cur)
-            cur = [line]
-        elif cur:
-            cur.append(line)
-    if cur:
-        out.append(cur)
-    return ["\n".join(s).rstrip() for s in out]
+        b = text.index(OURS, a + len(OURS)) + len(OURS)
+        rest = text[b:]
+        return text[:a] + block.rstrip("\n") + ("" if rest.startswith("\n") else "\n") + rest
+    return text.rstrip("\n") + "\n\n" + block
 
 
 def maps_md(maps_dir):
@@ -263,18 +275,17 @@ def maps_md(maps_dir):
 
 def head_section(data):
     F, E = data["facts"], data["env"]
-    return [OURS, "# Benchmark results", "",
-         "The sections from *Machine and commands* to *3. Loop latency* are written by",
-         "`make bench` (bench/run-bench: bench/bench.py measures, bench/report.py writes them",
-         "and the PNGs beside this file), all from the one run dated below. The sections",
-         "after them come from other scripts and carry their own dates.", "",
-         "## Machine and commands (make bench)", "",
+    return [OURS, "<!-- From here to the next marker line: written by every `make bench` "
+            "(bench/report.py); change that script, not this text. -->", "",
+         "## `make bench`: machine, date and commands", "",
+         "The next three sections come from one `make bench` run, described here.", "",
          "| | |", "|---|---|",
          "| date | %s |" % F["date"],
+         "| machine | %s |" % (F.get("lscpu") or "%s (/proc/cpuinfo), %d CPUs" % (
+             F["cpu_model"], F["cpus"])),
+         "| CPUs used | %d of %d online |" % (F["cpus_allowed"], F["cpus"]),
          "| kernel | %s `%s` (%s) |" % (F["kernel"], F["kernel_version"],
                                       "PREEMPT_RT" if F["preempt_rt"] else "not PREEMPT_RT"),
-         "| CPU | %s (/proc/cpuinfo), %d CPUs online, %d usable by the run |" % (
-             F["cpu_model"], F["cpus"], F["cpus_allowed"]),
          "| load average | %s at the start, %s at the end |" % (
              " ".join(F["loadavg_start"]), " ".join(F.get("loadavg_end", ["?"]))),
          "| RT throttling | sched_rt_runtime_us = %s; run as uid %d |" % (F["rt_runtime_us"],
@@ -282,19 +293,23 @@ def head_section(data):
          "| source | git %s%s; LinuxCNC rs274 %s; rt-tests %s |" % (
              F["git"], " + uncommitted changes in src/ or include/" if F["git_dirty"] else "",
              F["rs274"] or "missing", F["rt_tests"] or "missing"),
-         "| duration | %d s; settings %s |" % (F.get("duration_s", 0), ", ".join(
-             "%s=%s" % kv for kv in E.items())), "",
-         "Exact commands (from the top of the tree; `make bench` = `bench/run-bench build`;",
-         "OUT = the run's directory, bench/out/run by default):", "",
+         "| duration | %d s |" % F.get("duration_s", 0),
+         "| settings | %s |" % ", ".join("%s=%s" % kv for kv in E.items()), "",
+         "The run, from the top of the tree (`make bench` = build, then `bench/run-bench "
+         "build`; the settings above are its environment variables, e.g. "
+         "`RUNS=20 RUNS_BIG=3 LAT_SECONDS=5 make bench` for a quick run):", "",
+         "```sh",
+         " ".join("%s=%s" % kv for kv in E.items()) + " make bench",
+         "```", "",
+         "What it runs (OUT = the run's directory, bench/out/run by default):", "",
          "```text",
          "bench/gen-maps.py OUT/maps        # thread maps for this CPU count",
          driver_cmd(data["table3_part998"]),
          driver_cmd(data["table3_big"]),
-         "   (MAP = each of {serial,det2,att2,det4,att4,det8,att8}{,-fifo} in that order, all",
-         "    of them once per round, %d rounds (%d for the 1M-block program): the runs of a"
+         "   (MAP = each of the maps below, normal and -fifo, one after the other, all of",
+         "    them once per round, %d rounds (%d for the 1M-block program), so that a change"
          % (E.get("ROUNDS", 1), E.get("ROUNDS_BIG", 1)),
-         "    configuration are spread over the suite, so that a change of load hits all",
-         "    configurations alike)",
+         "    of load on the machine hits all configurations alike)",
          "HOME=TMP rs274 -g -t TABLE PROG TMP/rs274.out </dev/null        # in TMP",
          "build/cnc-run parse PROG --tool-table TABLE --canon FILE --stats --mode serial",
          "build/cnc-run parse PROG --tool-table TABLE --canon FILE --stats --config OUT/maps/MAP.ini",
@@ -306,41 +321,27 @@ def head_section(data):
          "```", ""]
 
 
-
 def table3_section(data, run_dir):
     F = data["facts"]
     bigname = os.path.basename(data["programs"]["big"])
-    L = []
-    n_threads = "n+3"
-    L += ["## 1. Table 3 of seed 001 reproduced: Serial, DETn, ATTn", "",
-          "As in the paper, *n threads* counts the active threads feeder + lexers (its Table 1:",
-          "ATT4 = feeder + LEX0..2), so DETn/ATTn run n-1 lexers; our pipeline adds the",
-          "analyzer, one executor and the output stage (%s threads in all, the starting"
-          % n_threads,
-          "thread sleeping as the paper's main thread does). The rows marked *(ours)* are not",
-          "in the paper: *inline output*, feeder and one lexer, and the analyzer executing and",
-          "writing each command itself (`--inline-output`), 3 threads in all; *analyzer lexes*",
-          "(`-j 0 --executors 0`, the layout `cnc-run parse` uses by default on 2 CPUs), no",
-          "lexer threads: the analyzer lexes the text itself and the output thread executes and",
-          "writes, two busy threads (the feeder only prefaults the text). The paper timed",
-          "feeder + lexers;",
-          "we time the whole interpreter: from the start of `ncp_pipeline_run` (thread creation",
-          "included) to the last canonical command out, as `ncp_run_stats.wall_ms` reports it",
-          "(build/bench/table3 does a round's runs of one configuration in one process after",
-          "an untimed warm-up run, the program mapped once; output text copied to a buffer,",
-          "not written). *Without thread creation* is measured on a pre-started pool of",
-          "the same map (`ncp_pipeline_pool_run`: the threads created once per process,",
-          "rings reset between runs), each run right after its with-creation twin: from",
-          "the start of the run to the last command out.",
-          "Gain = serial mean / configuration mean at the same priority (the paper's",
-          "definition); *1st/2nd half* is the same gain from each half of the runs, a",
-          "measure of how much it moves within one run. Paper gains are for an Intel i3-2370M",
-          "(2 cores, 4 logical CPUs) under PREEMPT_RT; it has no n = 2 rows. Rows marked *",
-          "stopped early at the per-configuration time bound (T3_MAX_S). Maps (generated",
-          "for %d CPUs: feeder on CPU0, lexers round-robin over the other CPUs, then"
-          % F["cpus_allowed"],
-          "analyzer, executor, output round-robin from CPU0; -fifo: every thread SCHED_FIFO 90;",
-          "the paper's own 4-CPU ATT maps are in rt-config/paper4/):", ""]
+    L = ["## Table 3 of seed 001: serial, DETn, ATTn (`make bench`)", "",
+         "**Measures** the paper's Table 3 on our interpreter: the time from the start of a",
+         "run (thread creation included) to the last canonical command out, for the serial",
+         "reference and each thread map, on part998.ngc (996 blocks) and on %s;" % bigname,
+         "*gain* = serial mean / the map's mean at the same priority, as the paper defines",
+         "it. *Pool*: the same map on threads created once (`ncp_pipeline_pool_run`), so",
+         "without thread creation. One process per round of a map (build/bench/table3), the",
+         "program mapped once, the text copied to a buffer, not written.", "",
+         "**Maps.** As in the paper, DETn/ATTn have n threads of feeder + lexers (n-1",
+         "lexers); ours adds the analyzer, one executor and the output stage (n+3 threads).",
+         "DET lets the OS place the threads, ATT pins them as below; *Prio 90* runs every",
+         "thread SCHED_FIFO 90. Not in the paper: *inline output* (feeder, one lexer, the",
+         "analyzer executing and writing: 3 threads) and *analyzer lexes* (`-j 0",
+         "--executors 0`, the default of `cnc-run parse` on 2 CPUs: the analyzer lexes, the",
+         "output thread executes, writes and lexes ahead; two busy threads). Paper gains:",
+         "Intel i3-2370M (2 cores, 4 logical CPUs), PREEMPT_RT, no n = 2 rows. * = stopped",
+         "at the per-map time bound (T3_MAX_S). Placement on this machine (%d CPUs):"
+         % F["cpus_allowed"], ""]
     L += maps_md(os.path.join(run_dir, "maps")) + [""]
     for key, name in (("table3_part998", "part998.ngc"), ("table3_big", bigname)):
         rows = data[key]
@@ -349,33 +350,23 @@ def table3_section(data, run_dir):
                                                    ser.get("commands", "?")), ""]
         bad = [c for c in rows if rows[c].get("hash") and ser.get("hash")
                and rows[c]["hash"] != ser["hash"]]
-        L += ["Every configuration's canonical output equals the serial reference's (hash of "
-              "the text)." if not bad else "**Output differs from serial in: %s**" % ", ".join(bad),
-              ""]
         warn = sorted({w for r in rows.values() for w in r.get("warnings", [])})
+        L += table3_compact_md(rows) + [""]
+        L += [("Every map's canonical output equals the serial reference's (hash of the "
+               "text). " if not bad else "**Output differs from serial in: %s.** "
+               % ", ".join(bad)) + " ".join(table3_text(rows, "n+3", name))]
         if warn:
-            L += ["Warnings from the runs: " + "; ".join(warn), ""]
-        L += ["With thread creation (the paper's measure):", ""] + table3_md(rows, False)
-        L += ["", "Without thread creation (a pre-started pool; the paper "
-              "gain column repeats the paper's figures, which include thread creation):", ""]
-        L += table3_md(rows, True) + [""]
-        L += table3_text(rows, n_threads, name) + [""]
-        L += ["Box plots: `table3-%s.png` (all configurations); per configuration "
-              "`box-CONFIG.png` (both programs, with and without thread creation)." % (
-                  "part998" if key == "table3_part998" else "big"), ""]
-    L += ["Why ours differs from the paper (known differences of set-up, not separately "
-          "measured here): this machine has %d CPUs where the paper had 4 logical CPUs, so "
-          "each of the paper's configurations runs more threads (n+3, at least 5) than there "
-          "are CPUs and ATT "
-          "stacks several threads on one CPU; the kernel is %s; our pipeline has three "
-          "stages more than the paper's feeder + lexers, each a hand-off between threads, and we time up to the "
-          "last command out, not the lexers alone; and the program differs (ours: "
-          "part998.ngc, written for this, and a generated 1M-block program; the paper's "
-          "998-block program is not published). On the 1M-block program start-up is a small "
-          "share of each run (see the share of ring allocation and thread creation above), "
-          "so its gains are the better measure of the pipeline's throughput here." % (
+            L += ["", "Warnings from the runs: " + "; ".join(warn)]
+        L += ["", "Spread of the runs: `table3-%s.png`, and `box-MAP.png` per map." % (
+            "part998" if key == "table3_part998" else "big"), ""]
+    L += ["Why the paper's gains are not reached here: this machine has %d CPUs where the "
+          "paper had 4 logical CPUs, so its maps run more threads (n+3) than there are CPUs; "
+          "the kernel is %s; our pipeline has three stages more than the paper's feeder + "
+          "lexers, each a hand-off between cores (see *How we got here*), and we time to the "
+          "last command out, not the lexers alone. On the 1M-block program start-up is a "
+          "small share of a run, so its gains measure the pipeline's throughput." % (
               F["cpus_allowed"], "PREEMPT_RT" if F["preempt_rt"]
-              else "%s, not PREEMPT_RT as in the paper" % F["kernel"]), ""]
+              else "%s, not PREEMPT_RT" % F["kernel"]), ""]
     return L
 
 
@@ -383,9 +374,10 @@ def rs274_section(data):
     L = []
     md, inner = rs274_md(data)
     fl = data.get("startup_floor", {})
-    L += ["## 2. Against LinuxCNC: rs274 -g vs cnc-run parse", "",
-          "Each program: rs274, our serial run and our best parallel map (the lowest mean "
-          "on part998 for part998, on the 1M-block program for the others, from section 1) "
+    L += ["## Against LinuxCNC: rs274 -g vs cnc-run parse (`make bench`)", "",
+          "**Measures** whole-process wall time of LinuxCNC's interpreter and ours on the "
+          "same programs, and checks that both produce the same canonical calls. Each program: rs274, our serial run and our best parallel map (the lowest mean "
+          "on part998 for part998, on the 1M-block program for the others, from Table 3) "
           "run one after the other, repeated RS_REPS times (RS_REPS_BIG for programs over "
           "5 MB), interleaved; the table gives medians of the whole process's wall time, "
           "both writing canonical text to a file. Blocks = lines our feeder read. The three "
@@ -414,8 +406,9 @@ def latency_section(data, outdir):
     bigname = os.path.basename(data["programs"]["big"])
     L = []
     lat, guest = data.get("latency", {}), data.get("latency_guest", {})
-    L += ["## 3. Loop latency: cyclictest vs the ncpar position loop", "",
-          "Both at 1 ms, SCHED_FIFO 90, in the same run one after the other (%s s each), "
+    L += ["## Loop latency: cyclictest vs the ncpar position loop (`make bench`)", "",
+          "**Measures** how late the 1 ms position loop wakes up, beside cyclictest (the "
+          "usual yardstick) on the same machine and load. Both at 1 ms, SCHED_FIFO 90, in the same run one after the other (%s s each), "
           "while a loop of `cnc-run parse` interprets %s in the background the whole time. "
           "cyclictest -S runs one thread per CPU (both counted); our loop is one thread, "
           "`cnc-run run %s --for %s` on rt-config/sim-3axis.ini (planner, interpolator and "
@@ -426,7 +419,7 @@ def latency_section(data, outdir):
           "|---|---|--:|--:|--:|--:|--:|--:|"]
     L += lat_rows(lat, lat.get("label", "host"))
     if guest.get("skipped"):
-        L += ["", "PREEMPT_RT guest: not measured (%s)." % guest["skipped"]]
+        L += ["", "PREEMPT_RT guest: not measured (%s)." % " ".join(guest["skipped"].split())]
     elif guest:
         L += lat_rows(guest, guest.get("label", "guest"))
         L += ["", "Guest rows: `%s` (part998.ngc as the program and as the background load: "
@@ -446,12 +439,12 @@ def main():
     results = sys.argv[2]
     outdir = os.path.dirname(os.path.abspath(results))
     run_dir = os.path.dirname(os.path.abspath(sys.argv[1]))
-    others = keep_other_sections(results)
     plots_table3(data, outdir)
-    L = (head_section(data) + table3_section(data, run_dir) + rs274_section(data)
-         + latency_section(data, outdir) + ["", OURS, ""])
+    part = (head_section(data) + table3_section(data, run_dir) + rs274_section(data)
+            + latency_section(data, outdir) + ["", OURS])
+    text = splice(results, part)
     with open(results, "w", encoding="utf-8") as f:
-        f.write("\n".join(L) + "\n" + "\n\n".join(others) + ("\n" if others else ""))
+        f.write(text)
 
 
 def rs274_text(data):

@@ -88,7 +88,7 @@ static int run_once(const struct ncp_source *src, const struct ncp_thread_map *m
                     struct ncp_pipeline_pool *pool, const struct ncp_analyzer_cfg *acfg,
                     struct sink *s, struct ncp_run_stats *st, struct ncp_diag *d)
 {
-    struct ncp_output out = { s, emit };
+    struct ncp_output out = { .ctx = s, .emit = emit };
     memset(st, 0, sizeof *st);
     memset(d, 0, sizeof *d);
     s->used = 0;
