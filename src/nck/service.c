@@ -154,7 +154,8 @@ static void on_command(void *ctx, const ncp_command_t *c)
     struct ncp_nck_cmd k;
     memset(&k, 0, sizeof k);
     k.kind = c->kind;
-    memcpy(k.text, c->text, sizeof k.text < sizeof c->text ? sizeof k.text : sizeof c->text);
+    _Static_assert(sizeof k.text == sizeof c->text, "command text as on the wire");
+    memcpy(k.text, c->text, sizeof k.text);
     k.text[sizeof k.text - 1] = 0;
     for (int i = 0; i < 4; i++) {
         k.value[i] = c->value[i];

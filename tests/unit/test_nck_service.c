@@ -179,22 +179,31 @@ static void test_pause_resume_path(void **state_)
     fflush(b.trace);
     size_t na, nb;
     struct row *ra = read_trace(a.trace, &na), *rb = read_trace(b.trace, &nb);
-    /* every commanded point of the paused run lies on the uninterrupted path */
+    /* every commanded point of the paused run lies on the uninterrupted path:
+     * its distance to the nearest chord of that run's samples (the chords of
+     * a 1 ms path are far inside 1 um of the curve at these speeds) */
     double worst = 0;
     size_t k = 0;
     for (size_t i = 0; i < nb; i++) {
         double best = INFINITY;
+        size_t at = k;
         for (size_t m = k > 50 ? k - 50 : 0; m + 1 < na && m < k + 5000; m++) {
-            double d2 = 0;
-            for (int j = 0; j < 3; j++)
-                d2 += (rb[i].cmd[j] - ra[m].cmd[j]) * (rb[i].cmd[j] - ra[m].cmd[j]);
+            double ab2 = 0, ap = 0, d2 = 0;
+            for (int j = 0; j < 3; j++) {
+                ab2 += (ra[m + 1].cmd[j] - ra[m].cmd[j]) * (ra[m + 1].cmd[j] - ra[m].cmd[j]);
+                ap += (rb[i].cmd[j] - ra[m].cmd[j]) * (ra[m + 1].cmd[j] - ra[m].cmd[j]);
+            }
+            double f = ab2 > 0 ? fmin(1, fmax(0, ap / ab2)) : 0;
+            for (int j = 0; j < 3; j++) {
+                double q = ra[m].cmd[j] + f * (ra[m + 1].cmd[j] - ra[m].cmd[j]) - rb[i].cmd[j];
+                d2 += q * q;
+            }
             if (d2 < best) {
                 best = d2;
-                if (d2 < 1e-8)
-                    k = m;
+                at = m;
             }
         }
-        /* the samples are 1 ms apart: compare with the chord between them */
+        k = at;
         worst = fmax(worst, sqrt(best));
     }
     double tail[3], end[3];
@@ -202,8 +211,7 @@ static void test_pause_resume_path(void **state_)
     pos(&b, end);
     for (int j = 0; j < 3; j++)
         assert_true(fabs(tail[j] - end[j]) < 1e-6);
-    /* 1 ms samples at up to 25 mm/s: half a sample spacing at most */
-    assert_true(worst < 0.0126 + 1e-6);
+    assert_true(worst < 1e-3);
     free(ra);
     free(rb);
     stop(&a);
