@@ -191,13 +191,7 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     nck_finish(n);
     if (res->status == NCP_NCK_OK)
         collect(n, res);
-    if (n->be_open)
-        n->be.ops->close(&n->be);
-    ncp_spsc_destroy(&n->segs);
-    ncp_spsc_destroy(&n->sps);
-    ncp_spsc_destroy(&n->fbs);
-    ncp_planner_free(n->planner);
-    pthread_mutex_destroy(&n->ev_lock);
+    nck_release(n);
     free(n);
     return res->status;
 }

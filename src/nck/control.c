@@ -674,16 +674,10 @@ void ncp_nck_free(struct ncp_nck *s)
     struct nck *n = &s->n;
     nck_finish(n);
     nck_read_cycles(n);
-    if (n->be_open)
-        n->be.ops->close(&n->be);
-    ncp_spsc_destroy(&n->segs);
-    ncp_spsc_destroy(&n->sps);
-    ncp_spsc_destroy(&n->fbs);
-    ncp_planner_free(n->planner);
+    nck_release(n);
     ncp_analyzer_free(s->interp);
     if (s->have_prog)
         ncp_source_close(&s->prog);
-    pthread_mutex_destroy(&n->ev_lock);
     free(s);
 }
 

@@ -127,6 +127,19 @@ void nck_finish(struct nck *n)
     n->be_started = 0;
 }
 
+void nck_release(struct nck *n)
+{
+    if (n->be_open)
+        n->be.ops->close(&n->be);
+    n->be_open = 0;
+    ncp_spsc_destroy(&n->segs);
+    ncp_spsc_destroy(&n->sps);
+    ncp_spsc_destroy(&n->fbs);
+    ncp_planner_free(n->planner);
+    n->planner = NULL;
+    pthread_mutex_destroy(&n->ev_lock);
+}
+
 void nck_park_planner(struct nck *n)
 {
     atomic_fetch_add_explicit(&n->park_req, 1, memory_order_release);

@@ -209,6 +209,8 @@ struct ncp_nck {
 int nck_start(struct nck *n, const struct ncp_nck_setup *s, int batch, struct ncp_diag *d);
 int nck_start_loop(struct nck *n, struct ncp_diag *d);
 void nck_finish(struct nck *n);
+/* After nck_finish: the backend closed, the rings and the planner freed. */
+void nck_release(struct nck *n);
 /* The steps of a drop, each a request that the other thread acknowledges. */
 void nck_park_planner(struct nck *n);
 int nck_planner_parked(const struct nck *n);
