@@ -79,7 +79,7 @@ static int parse(int argc, char **argv, struct serve_args *a)
         case 'T': a->tool_table = optarg; break;
         case 'S': a->sub_path = optarg; break;
         case 'k':
-            if (strcmp(optarg, "real") && strcmp(optarg, "virtual"))
+            if (strcmp(optarg, "real") != 0 && strcmp(optarg, "virtual") != 0)
                 return fprintf(stderr, "cnc-run serve: --clock is real or virtual\n"), -1;
             a->virtual_clock = !strcmp(optarg, "virtual");
             break;

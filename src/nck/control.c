@@ -45,7 +45,7 @@ static int refuse(char *reason, size_t len, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(reason, len, fmt, ap);
+    vsnprintf(reason, len, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
     va_end(ap);
     return -1;
 }

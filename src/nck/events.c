@@ -23,7 +23,7 @@ void nck_post(struct nck *n, int kind, const char *file, uint32_t line, uint32_t
     e->col = col;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(e->text, sizeof e->text, fmt, ap);
+    vsnprintf(e->text, sizeof e->text, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
     va_end(ap);
     pthread_mutex_unlock(&n->ev_lock);
 }
