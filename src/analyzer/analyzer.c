@@ -184,11 +184,13 @@ struct ncp_canon *ncp_an_emit_text(struct ncp_analyzer *a, enum ncp_canon_kind k
 void ncp_an_emit6(struct ncp_analyzer *a, enum ncp_canon_kind kind, const double *p)
 {
     struct ncp_canon *op = ncp_an_emit(a, kind);
-    memcpy(op->d, p, 6 * sizeof(double));
-    if (kind == NCP_C_SET_G92_OFFSET)
+    if (kind == NCP_C_SET_G92_OFFSET) {
+        memcpy(op->offset.v, p, sizeof op->offset.v);
         ncp_sai_g92(a, p);
-    else
+    } else {
+        memcpy(op->move.end, p, sizeof op->move.end);
         ncp_sai_move(a, p);
+    }
 }
 
 int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
@@ -206,12 +208,12 @@ int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
 static void ncp_an_preamble(struct ncp_analyzer *a)
 {
     static const double zero[6];
-    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->i[0] = 1;
+    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->units.mm = 1;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
-    op->i[0] = 1;
+    op->offset.index = 1;
     ncp_an_emit6(a, NCP_C_SET_G92_OFFSET, zero);
     ncp_an_emit(a, NCP_C_SET_XY_ROTATION);
-    ncp_an_emit(a, NCP_C_SET_FEED_REFERENCE)->i[0] = 1;
+    ncp_an_emit(a, NCP_C_SET_FEED_REFERENCE)->feed_reference.xyz = 1;
     ncp_an_emit(a, NCP_C_ON_RESET);
 }
 

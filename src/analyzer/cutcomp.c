@@ -91,29 +91,29 @@ static int ncp_emit_entry(const struct ncp_cutcomp *c, const struct ncp_comp_ent
     struct ncp_canon op = {0};
     if (e->kind == NCP_CQ_ARC) {
         op.kind = NCP_C_ARC_FEED;
-        op.d[0] = ncp_lathe_z(c, e->p[0]);
-        op.d[1] = ncp_lathe_x(c, e->p[1]);
-        op.d[2] = ncp_lathe_z(c, e->centre[0]);
-        op.d[3] = ncp_lathe_x(c, e->centre[1]);
-        op.i[0] = e->turn;
-        op.d[4] = e->p[2];
-        op.d[5] = e->abc[0];
-        op.d[6] = e->abc[1];
-        op.d[7] = e->abc[2];
+        op.arc_feed.first_end = ncp_lathe_z(c, e->p[0]);
+        op.arc_feed.second_end = ncp_lathe_x(c, e->p[1]);
+        op.arc_feed.first_axis = ncp_lathe_z(c, e->centre[0]);
+        op.arc_feed.second_axis = ncp_lathe_x(c, e->centre[1]);
+        op.arc_feed.rotation = e->turn;
+        op.arc_feed.axis_end = e->p[2];
+        op.arc_feed.abc[0] = e->abc[0];
+        op.arc_feed.abc[1] = e->abc[1];
+        op.arc_feed.abc[2] = e->abc[2];
     } else {
         op.kind = e->kind == NCP_CQ_FEED ? NCP_C_STRAIGHT_FEED : NCP_C_STRAIGHT_TRAVERSE;
         if (c->plane == 2) {
-            op.d[0] = ncp_lathe_x(c, e->p[1]);
-            op.d[1] = e->p[2];
-            op.d[2] = ncp_lathe_z(c, e->p[0]);
+            op.move.end[0] = ncp_lathe_x(c, e->p[1]);
+            op.move.end[1] = e->p[2];
+            op.move.end[2] = ncp_lathe_z(c, e->p[0]);
         } else {
-            op.d[0] = e->p[0];
-            op.d[1] = e->p[1];
-            op.d[2] = e->p[2];
+            op.move.end[0] = e->p[0];
+            op.move.end[1] = e->p[1];
+            op.move.end[2] = e->p[2];
         }
-        op.d[3] = e->abc[0];
-        op.d[4] = e->abc[1];
-        op.d[5] = e->abc[2];
+        op.move.end[3] = e->abc[0];
+        op.move.end[4] = e->abc[1];
+        op.move.end[5] = e->abc[2];
     }
     return sink->emit(sink->ctx, &op, NULL, 0);
 }
@@ -507,9 +507,10 @@ static int ncp_comp_arc_feed(struct ncp_cutcomp *c, const struct ncp_arc_in *in,
         return NCP_OK;
     struct ncp_canon op = c->inv_feed;
     c->inv_pending = 0;
-    double rate = ncp_arc_length(in, out, op.d[1], axis_end) * op.d[0];
-    op.d[0] = rate > 0.1 ? rate : 0.1;
-    op.d[1] = 0.0;
+    double rate = ncp_arc_length(in, out, op.feed_rate.arc_axis_start, axis_end) *
+                  op.feed_rate.rate;
+    op.feed_rate.rate = rate > 0.1 ? rate : 0.1;
+    op.feed_rate.arc_axis_start = 0.0;
     op.flags &= (uint16_t)~NCP_FEED_F_INVERSE_ARC;
     return ncp_cutcomp_other(c, &op, NULL, 0, sink, d, line);
 }

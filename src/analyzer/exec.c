@@ -23,7 +23,7 @@ static int ncp_exec_feed_mode(struct ncp_analyzer *a, int g)
     ncp_an_emit_text(a, NCP_C_COMMENT, m, n);
     a->st.m.feed_mode = mode;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_FEED_MODE);
-    op->i[1] = mode == 2 ? 1 : 0;
+    op->feed_mode.per_rev = mode == 2 ? 1 : 0;
     if (mode != 1) {
         a->st.feed = 0.0;
         ncp_an_emit(a, NCP_C_SET_FEED_RATE);
@@ -57,8 +57,8 @@ static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
         a->st.m.spindle_dir = 0;
         if (NCP_HAS(&a->w, 'R') || NCP_HAS(&a->w, 'P')) {
             struct ncp_canon *op = ncp_an_emit(a, NCP_C_ORIENT_SPINDLE);
-            op->d[0] = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
-            op->i[1] = NCP_HAS(&a->w, 'P') ? ncp_trunc_int_round(W(a, 'P')) : 0;
+            op->orient.angle = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
+            op->orient.direction = NCP_HAS(&a->w, 'P') ? ncp_trunc_int_round(W(a, 'P')) : 0;
         }
         if (NCP_HAS(&a->w, 'Q')) { /* wait for the orientation, Q seconds at most */
             if (W(a, 'Q') <= 0.0)
@@ -163,7 +163,7 @@ static int ncp_exec_io(struct ncp_analyzer *a, int m)
     if (m >= 62 && m <= 65) {
         if (!NCP_HAS(&a->w, 'P'))
             return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "No valid P word with M%d", m);
-        ncp_an_emit(a, bits[m - 62])->i[0] = ncp_trunc_int_round(W(a, 'P'));
+        ncp_an_emit(a, bits[m - 62])->output.index = ncp_trunc_int_round(W(a, 'P'));
         return NCP_OK;
     }
     if (m == 67 || m == 68) {
@@ -171,8 +171,8 @@ static int ncp_exec_io(struct ncp_analyzer *a, int m)
             return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "Invalid analog index with M%d", m);
         struct ncp_canon *op = ncp_an_emit(a, m == 67 ? NCP_C_SET_MOTION_OUTPUT_VALUE
                                                       : NCP_C_SET_AUX_OUTPUT_VALUE);
-        op->i[0] = ncp_trunc_int_round(W(a, 'E'));
-        op->d[0] = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
+        op->output.index = ncp_trunc_int_round(W(a, 'E'));
+        op->output.value = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
         return NCP_OK;
     }
     if (m == 66)
@@ -185,7 +185,7 @@ static int ncp_exec_plane(struct ncp_analyzer *a, int g)
     if (g != 170 && g != 180 && g != 190)
         return ncp_an_error(a, a->w.gcol[NCP_GG_PLANE], "G%d.1 planes are not supported", g / 10);
     int p = g == 170 ? 0 : g == 190 ? 1 : 2;
-    ncp_an_emit(a, NCP_C_SELECT_PLANE)->i[0] = p;
+    ncp_an_emit(a, NCP_C_SELECT_PLANE)->plane.plane = p;
     a->st.m.plane = p;
     return NCP_OK;
 }
@@ -200,11 +200,11 @@ static int ncp_exec_control(struct ncp_analyzer *a, int g)
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_MOTION_CONTROL_MODE);
     /* the canon keeps the naivecam tolerance across G61/G61.1 */
     if (g == 610) {
-        op->i[0] = 1;
+        op->motion_control.mode = 1;
         a->st.m.control = 1;
         a->st.m.p_tol = 0.0;
     } else if (g == 611) {
-        op->i[0] = 0;
+        op->motion_control.mode = 0;
         a->st.m.control = 0;
         a->st.m.p_tol = 0.0;
     } else {
@@ -213,14 +213,14 @@ static int ncp_exec_control(struct ncp_analyzer *a, int g)
         double q_in = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
         double p = p_in >= 0 ? p_in : 0.0;
         double q = q_in >= 0 ? q_in : p;
-        op->i[0] = 2;
-        op->d[0] = p;
+        op->motion_control.mode = 2;
+        op->motion_control.tolerance = p;
         a->st.m.control = 2;
         a->st.m.p_tol = p;
         a->st.m.q_tol = q;
         a->st.m.g64_p = p;
         a->st.m.g64_q = q;
-        ncp_an_emit(a, NCP_C_SET_NAIVECAM_TOLERANCE)->d[0] = q;
+        ncp_an_emit(a, NCP_C_SET_NAIVECAM_TOLERANCE)->naivecam.tolerance = q;
     }
     return NCP_OK;
 }
@@ -285,7 +285,7 @@ static int ncp_exec_g_codes(struct ncp_analyzer *a)
     const struct ncp_words *w = &a->w;
     int rc = NCP_OK;
     if (w->g[NCP_GG_NONMODAL] == 40)
-        ncp_an_emit(a, NCP_C_DWELL)->d[0] = W(a, 'P');
+        ncp_an_emit(a, NCP_C_DWELL)->dwell.seconds = W(a, 'P');
     if (w->g[NCP_GG_PLANE] != -1)
         rc = ncp_exec_plane(a, w->g[NCP_GG_PLANE]);
     if (rc == NCP_OK && w->g[NCP_GG_UNITS] != -1)
@@ -331,7 +331,7 @@ int ncp_exec_block(struct ncp_analyzer *a)
         struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_SPINDLE_MODE);
         a->st.m.css = w->g[NCP_GG_SPINDLE] == 960;
         if (w->g[NCP_GG_SPINDLE] == 960)
-            op->d[0] = NCP_HAS(w, 'D') ? W(a, 'D') : 1e30;
+            op->spindle_mode.css_max = NCP_HAS(w, 'D') ? W(a, 'D') : 1e30;
     }
     if (rc == NCP_OK && w->g[NCP_GG_FEEDMODE] != -1)
         rc = ncp_exec_feed_mode(a, w->g[NCP_GG_FEEDMODE]);
@@ -339,11 +339,11 @@ int ncp_exec_block(struct ncp_analyzer *a)
         return rc;
     if (NCP_HAS(w, 'F') && a->st.m.feed_mode != 1) {
         a->st.feed = W(a, 'F');
-        ncp_an_emit(a, NCP_C_SET_FEED_RATE)->d[0] = a->st.feed;
+        ncp_an_emit(a, NCP_C_SET_FEED_RATE)->feed_rate.rate = a->st.feed;
     }
     if (NCP_HAS(w, 'S')) {
         a->st.speed = W(a, 'S');
-        ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->d[0] = a->st.speed;
+        ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->spindle_speed.speed = a->st.speed;
     }
     if (NCP_HAS(w, 'T'))
         rc = ncp_tools_select(a);

@@ -119,7 +119,7 @@ int ncp_motion_straight(struct ncp_analyzer *a, int motion)
                                     "F word missing with inverse time g1 move");
             double rate = ncp_straight_length(s->pos, end) * w->v[NCP_LETTER('F')];
             s->feed = rate < 0.1 ? 0.1 : rate; /* what #<_feed> reads afterwards */
-            ncp_an_emit(a, NCP_C_SET_FEED_RATE)->d[0] = s->feed;
+            ncp_an_emit(a, NCP_C_SET_FEED_RATE)->feed_rate.rate = s->feed;
         } else if (s->feed == 0.0) {
             return ncp_an_error(a, NCP_MOTION_COL(w),
                                 "Cannot do g1 with zero feed rate");
@@ -149,10 +149,11 @@ static const char *const ncp_plane_missing[3] = {
  * rate): arc length as rs274 measures it, centre from IJK or R. */
 static double ncp_arc_length(const struct ncp_canon *q)
 {
-    double x1 = q->d[0], y1 = q->d[1], x2 = q->d[2], y2 = q->d[3], cx, cy;
-    int ccw = q->i[0] > 0;
-    if (q->i[1]) {
-        double r = q->d[8], ar = fabs(r);
+    double x1 = q->arc.first_start, y1 = q->arc.second_start;
+    double x2 = q->arc.first_end, y2 = q->arc.second_end, cx, cy;
+    int ccw = q->arc.dir > 0;
+    if (q->arc.radius_form) {
+        double r = q->arc.radius, ar = fabs(r);
         double mx = (x1 + x2) / 2, my = (y1 + y2) / 2;
         double half = hypot(mx - x2, my - y2);
         if (ar == 0.0)
@@ -164,10 +165,10 @@ static double ncp_arc_length(const struct ncp_canon *q)
         cx = mx + off * cos(th);
         cy = my + off * sin(th);
     } else {
-        cx = q->d[8];
-        cy = q->d[9];
+        cx = q->arc.first_centre;
+        cy = q->arc.second_centre;
     }
-    int turn = (q->i[2] > 0 ? q->i[2] : 1) * (ccw ? 1 : -1);
+    int turn = (q->arc.turns > 0 ? q->arc.turns : 1) * (ccw ? 1 : -1);
     double alpha = atan2(y1 - cy, x1 - cx), beta = atan2(y2 - cy, x2 - cx), theta;
     if (turn > 0) {
         if (beta <= alpha)
@@ -210,22 +211,22 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
     if (s->m.feed_mode == 1) {
         struct ncp_canon *f = ncp_an_emit(a, NCP_C_SET_FEED_RATE);
         f->flags = NCP_FEED_F_INVERSE_ARC;
-        f->d[0] = w->v[NCP_LETTER('F')];
-        f->d[1] = s->pos[ax[2]];
+        f->feed_rate.rate = w->v[NCP_LETTER('F')];
+        f->feed_rate.arc_axis_start = s->pos[ax[2]];
     }
     struct ncp_canon req = {.kind = NCP_C_ARC_REQUEST};
     struct ncp_canon *op = &req;
-    op->d[0] = s->pos[ax[0]];
-    op->d[1] = s->pos[ax[1]];
-    op->d[2] = end[ax[0]];
-    op->d[3] = end[ax[1]];
-    op->d[4] = end[ax[2]];
-    op->d[5] = end[NCP_A];
-    op->d[6] = end[NCP_B];
-    op->d[7] = end[NCP_C];
+    op->arc.first_start = s->pos[ax[0]];
+    op->arc.second_start = s->pos[ax[1]];
+    op->arc.first_end = end[ax[0]];
+    op->arc.second_end = end[ax[1]];
+    op->arc.axis_end = end[ax[2]];
+    op->arc.abc[0] = end[NCP_A];
+    op->arc.abc[1] = end[NCP_B];
+    op->arc.abc[2] = end[NCP_C];
     if (has_r) {
-        op->d[8] = w->v[NCP_LETTER('R')];
-        op->i[1] = 1;
+        op->arc.radius = w->v[NCP_LETTER('R')];
+        op->arc.radius_form = 1;
     } else {
         double o1 = NCP_HAS(w, ncp_plane_ijk[pl][0]) ? w->v[NCP_LETTER(ncp_plane_ijk[pl][0])] : 0;
         double o2 = NCP_HAS(w, ncp_plane_ijk[pl][1]) ? w->v[NCP_LETTER(ncp_plane_ijk[pl][1])] : 0;
@@ -233,12 +234,12 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
             o1 += s->pos[ax[0]];
             o2 += s->pos[ax[1]];
         }
-        op->d[8] = o1;
-        op->d[9] = o2;
+        op->arc.first_centre = o1;
+        op->arc.second_centre = o2;
     }
-    op->i[0] = motion == 30 ? 1 : -1;
-    op->i[2] = NCP_HAS(w, 'P') ? ncp_trunc_int_round(w->v[NCP_LETTER('P')]) : 1;
-    op->i[3] = pl;
+    op->arc.dir = motion == 30 ? 1 : -1;
+    op->arc.turns = NCP_HAS(w, 'P') ? ncp_trunc_int_round(w->v[NCP_LETTER('P')]) : 1;
+    op->arc.plane = pl;
     op->flags = s->m.inches ? 1 : 0;
     if (s->m.feed_mode == 1) {
         double len = ncp_arc_length(op), dz = end[ax[2]] - s->pos[ax[2]];
@@ -296,7 +297,7 @@ static int ncp_probe(struct ncp_analyzer *a, int motion)
             return ncp_an_error(a, col, "Start point too close to probe point");
     }
     ncp_an_emit(a, NCP_C_TURN_PROBE_ON);
-    memcpy(ncp_an_emit(a, NCP_C_STRAIGHT_PROBE)->d, end, 6 * sizeof(double));
+    memcpy(ncp_an_emit(a, NCP_C_STRAIGHT_PROBE)->move.end, end, 6 * sizeof(double));
     ncp_sai_probe(a, end);
     ncp_an_emit(a, NCP_C_TURN_PROBE_OFF);
     s->m.motion = motion;
@@ -334,12 +335,12 @@ static int ncp_synced(struct ncp_analyzer *a, int motion)
         return ncp_thread_cycle(a, end);
     }
     struct ncp_canon *sync = ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH);
-    sync->d[0] = a->w.v[NCP_LETTER('K')];
+    sync->synch.per_rev = a->w.v[NCP_LETTER('K')];
     if (motion == 330) {
         ncp_an_emit6(a, NCP_C_STRAIGHT_FEED, end);
         memcpy(s->pos, end, sizeof end);
     } else {
-        memcpy(ncp_an_emit(a, NCP_C_RIGID_TAP)->d, end, 3 * sizeof(double));
+        memcpy(ncp_an_emit(a, NCP_C_RIGID_TAP)->rigid_tap.bottom, end, 3 * sizeof(double));
     }
     ncp_an_emit(a, NCP_C_STOP_SPEED_FEED_SYNCH);
     return NCP_OK;
@@ -383,19 +384,19 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
      * start + IJ, [end + PQ,] end; a G5 without I J continues the last G5's
      * direction (-P, -Q), as LinuxCNC draws it */
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_NURBS_FEED);
-    op->i[0] = motion == 51 ? 3 : 4;
-    memcpy(op->d, end, 3 * sizeof(double));
+    op->nurbs.n_points = motion == 51 ? 3 : 4;
+    memcpy(op->nurbs.end, end, sizeof op->nurbs.end);
     double i = NCP_HAS(w, 'I') ? w->v[NCP_LETTER('I')] : -s->g5_pq[0];
     double j = NCP_HAS(w, 'J') ? w->v[NCP_LETTER('J')] : -s->g5_pq[1];
-    op->d[3] = s->pos[NCP_X];
-    op->d[4] = s->pos[NCP_Y];
-    op->d[5] = s->pos[NCP_X] + i;
-    op->d[6] = s->pos[NCP_Y] + j;
+    op->nurbs.start[0] = s->pos[NCP_X];
+    op->nurbs.start[1] = s->pos[NCP_Y];
+    op->nurbs.ctrl[0][0] = s->pos[NCP_X] + i;
+    op->nurbs.ctrl[0][1] = s->pos[NCP_Y] + j;
     if (motion == 50) {
         s->g5_pq[0] = w->v[NCP_LETTER('P')];
         s->g5_pq[1] = w->v[NCP_LETTER('Q')];
-        op->d[7] = end[NCP_X] + s->g5_pq[0];
-        op->d[8] = end[NCP_Y] + s->g5_pq[1];
+        op->nurbs.ctrl[1][0] = end[NCP_X] + s->g5_pq[0];
+        op->nurbs.ctrl[1][1] = end[NCP_Y] + s->g5_pq[1];
     }
     a->sai.pos[NCP_X] = a->sai.pos[NCP_Y] = 0.0;
     memcpy(s->pos, end, sizeof end);

@@ -95,17 +95,17 @@ int ncp_nurbs_draw(struct ncp_analyzer *a)
                             nb->order);
     const double *last = nb->pt[nb->n - 1];
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_NURBS_FEED);
-    op->i[0] = (int32_t)nb->n;
-    op->i[1] = nb->order;
-    op->i[2] = NCP_NURBS_POINTS_FOLLOW;
-    op->d[0] = last[0];
-    op->d[1] = last[1];
-    op->d[2] = s->pos[NCP_Z];
+    op->nurbs.n_points = (int32_t)nb->n;
+    op->nurbs.order = nb->order;
+    op->nurbs.follow = NCP_NURBS_POINTS_FOLLOW;
+    op->nurbs.end[0] = last[0];
+    op->nurbs.end[1] = last[1];
+    op->nurbs.end[2] = s->pos[NCP_Z];
     for (uint32_t k = 0; k < nb->n; k += NCP_NURBS_POINTS_PER_OP) {
         uint32_t m = nb->n - k < NCP_NURBS_POINTS_PER_OP ? nb->n - k : NCP_NURBS_POINTS_PER_OP;
         op = ncp_an_emit(a, NCP_C_NURBS_POINTS);
-        op->i[0] = (int32_t)m;
-        memcpy(op->d, nb->pt[k], m * sizeof nb->pt[0]);
+        op->nurbs_points.n = (int32_t)m;
+        memcpy(op->nurbs_points.pt, nb->pt[k], m * sizeof nb->pt[0]);
     }
     /* rs274's canon reads the point after the last for its own X Y (past the
      * end of its vector; 0 here, as after G5 and G5.1: see motion.c) */

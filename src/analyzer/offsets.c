@@ -67,12 +67,12 @@ static void ncp_emit_g92(struct ncp_analyzer *a)
 static void ncp_emit_tlo_values(struct ncp_analyzer *a, const double *v)
 {
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_USE_TOOL_LENGTH_OFFSET);
-    memcpy(op->d, v, NCP_NAX * sizeof(double));
+    memcpy(op->tool_length.v, v, NCP_NAX * sizeof(double));
 }
 
 int ncp_offsets_units(struct ncp_analyzer *a, int inches)
 {
-    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->i[0] = inches ? 0 : 1;
+    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->units.mm = inches ? 0 : 1;
     ncp_sai_units(a, inches);
     if (inches == a->st.m.inches)
         return NCP_OK;
@@ -117,11 +117,11 @@ int ncp_offsets_coord(struct ncp_analyzer *a, int origin)
     s->rotation = ncp_frame_param(a, 5210 + 20 * origin);
     s->m.origin = origin;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
-    op->i[0] = origin;
-    memcpy(op->d, s->g5x, 6 * sizeof(double));
+    op->offset.index = origin;
+    memcpy(op->offset.v, s->g5x, sizeof op->offset.v);
     ncp_sai_g5x(a, s->g5x);
     ncp_emit_g92(a);
-    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->d[0] = s->rotation;
+    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->rotation.degrees = s->rotation;
     return NCP_OK;
 }
 

@@ -111,19 +111,19 @@ void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op)
     switch (op->kind) {
     case NCP_C_STRAIGHT_TRAVERSE:
     case NCP_C_STRAIGHT_FEED:
-        ncp_sai_move(a, op->d);
+        ncp_sai_move(a, op->move.end);
         break;
     case NCP_C_ARC_FEED:
-        a->sai.pos[axes[pl][0]] = op->d[0];
-        a->sai.pos[axes[pl][1]] = op->d[1];
-        a->sai.pos[axes[pl][2]] = op->d[4];
-        memcpy(a->sai.pos + NCP_A, op->d + 5, 3 * sizeof(double));
+        a->sai.pos[axes[pl][0]] = op->arc_feed.first_end;
+        a->sai.pos[axes[pl][1]] = op->arc_feed.second_end;
+        a->sai.pos[axes[pl][2]] = op->arc_feed.axis_end;
+        memcpy(a->sai.pos + NCP_A, op->arc_feed.abc, 3 * sizeof(double));
         break;
     case NCP_C_ARC_REQUEST:
-        a->sai.pos[axes[pl][0]] = op->d[2];
-        a->sai.pos[axes[pl][1]] = op->d[3];
-        a->sai.pos[axes[pl][2]] = op->d[4];
-        memcpy(a->sai.pos + NCP_A, op->d + 5, 3 * sizeof(double));
+        a->sai.pos[axes[pl][0]] = op->arc.first_end;
+        a->sai.pos[axes[pl][1]] = op->arc.second_end;
+        a->sai.pos[axes[pl][2]] = op->arc.axis_end;
+        memcpy(a->sai.pos + NCP_A, op->arc.abc, 3 * sizeof(double));
         break;
     default:
         break;

@@ -26,7 +26,7 @@ static void ncp_thread_move(struct ncp_analyzer *a, const struct ncp_thread *t,
 
 static void ncp_thread_sync(struct ncp_analyzer *a, double pitch)
 {
-    ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH)->d[0] = pitch;
+    ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH)->synch.per_rev = pitch;
 }
 
 /* X at `depth` below the start (or above it, boring). */
