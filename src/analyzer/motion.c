@@ -214,8 +214,15 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
         f->feed_rate.rate = w->v[NCP_LETTER('F')];
         f->feed_rate.arc_axis_start = s->pos[ax[2]];
     }
-    struct ncp_canon req = {.kind = NCP_C_ARC_REQUEST};
-    struct ncp_canon *op = &req;
+    /* the request is filled where it goes: the block's slot, or here for the
+     * compensation queue */
+    struct ncp_canon req;
+    int comp = ncp_cutcomp_engaged(&a->comp);
+    struct ncp_canon *op = comp ? &req : ncp_an_emit(a, NCP_C_ARC_REQUEST);
+    if (comp) {
+        memset(&req, 0, sizeof req);
+        req.kind = NCP_C_ARC_REQUEST;
+    }
     op->arc.first_start = s->pos[ax[0]];
     op->arc.second_start = s->pos[ax[1]];
     op->arc.first_end = end[ax[0]];
@@ -248,12 +255,11 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
         double rate = len * w->v[NCP_LETTER('F')];
         s->feed = rate < 0.1 ? 0.1 : rate;
     }
-    if (ncp_cutcomp_engaged(&a->comp)) {
+    if (comp) {
         int rc = ncp_comp_move_arc(a, op, end);
         if (rc != NCP_OK)
             return rc;
     } else {
-        *ncp_an_emit(a, NCP_C_ARC_REQUEST) = req;
         ncp_sai_move(a, end);
     }
     memcpy(s->pos, end, NCP_NAX * sizeof(double));

@@ -308,28 +308,28 @@ static int ncp_format_hot(struct ncp_out *o, const struct ncp_canon *op)
                    kind == NCP_C_STRAIGHT_PROBE;
     if (!straight && kind != NCP_C_ARC_FEED)
         return 0;
-    /* the numbers in print order: move.end, or arc_feed's doubles, which
-     * stand in print order at raw.d (canon.h asserts their places) */
-    const double *v = op->raw.d;
+    /* The numbers in print order: move.end, or arc_feed's doubles and its
+     * rotation, which stand in print order in raw (canon.h asserts their
+     * places). */
     const struct ncp_seg *head = &ncp_tpls[kind][0].seg[0];
     if (o->full || o->end - o->p < NCP_HOT_LINE || !head->pooled ||
-        !ncp_hot_numbers(v, straight ? 6 : 8))
+        !ncp_hot_numbers(op->raw.d, straight ? 6 : 8))
         return 0;
     char *p = o->p;
     memcpy(p, head->lit, NCP_LIT_BLOCK);
     p += head->lit_len;
-    p += ncp_fmt_fixed4(p, v[0]);
+    p += ncp_fmt_fixed4(p, op->raw.d[0]);
     if (straight) {
         for (int k = 1; k < 6; k++)
-            p = ncp_hot_next(p, v[k]);
+            p = ncp_hot_next(p, op->raw.d[k]);
     } else {
         for (int k = 1; k < 4; k++)
-            p = ncp_hot_next(p, v[k]);
+            p = ncp_hot_next(p, op->raw.d[k]);
         memcpy(p, ncp_sep, sizeof ncp_sep);
         p += sizeof ncp_sep;
-        p += ncp_fmt_int(p, op->arc_feed.rotation);
+        p += ncp_fmt_int(p, op->raw.i[0]);
         for (int k = 4; k < 8; k++)
-            p = ncp_hot_next(p, v[k]);
+            p = ncp_hot_next(p, op->raw.d[k]);
     }
     memcpy(p, ")\n", 2);
     o->p = p + 2;

@@ -53,8 +53,7 @@ static int ncp_arc_error(struct ncp_cmd *cmd, const struct ncp_canon *op, int st
 {
     char a, b;
     ncp_plane_axes(op->arc.plane, &a, &b);
-    double x1 = op->arc.first_start, y1 = op->arc.second_start;
-    double x2 = op->arc.first_end, y2 = op->arc.second_end;
+    const struct ncp_canon_arc *q = &op->arc;
     struct ncp_diag *g = &cmd->diag;
     switch (status) {
     case NCP_ARC_SAME_POINT:
@@ -67,15 +66,17 @@ static int ncp_arc_error(struct ncp_cmd *cmd, const struct ncp_canon *op, int st
         return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
                             "Zero-radius arc: start=(%c%.4f,%c%.4f) center=(%c%.4f,%c%.4f) "
                             "end=(%c%.4f,%c%.4f) r1=%.4f r2=%.4f",
-                            a, x1, b, y1, a, out->centre[0], b, out->centre[1],
-                            a, x2, b, y2, out->r1, out->r2);
+                            a, q->first_start, b, q->second_start, a, out->centre[0],
+                            b, out->centre[1], a, q->first_end, b, q->second_end,
+                            out->r1, out->r2);
     default:
         return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
                             "Radius to end of arc differs from radius to start: "
                             "start=(%c%.4f,%c%.4f) center=(%c%.4f,%c%.4f) "
                             "end=(%c%.4f,%c%.4f) r1=%.4f r2=%.4f abs_err=%.4g rel_err=%.4f%%",
-                            a, x1, b, y1, a, out->centre[0], b, out->centre[1],
-                            a, x2, b, y2, out->r1, out->r2,
+                            a, q->first_start, b, q->second_start, a, out->centre[0],
+                            b, out->centre[1], a, q->first_end, b, q->second_end,
+                            out->r1, out->r2,
                             out->abs_err, out->rel_err * 100);
     }
 }
@@ -108,17 +109,18 @@ static int ncp_resolve_arc(struct ncp_cmd *cmd, struct ncp_canon *op, struct ncp
         feed_op->feed_rate.arc_axis_start = 0.0;
         feed_op->flags &= (uint16_t)~NCP_FEED_F_INVERSE_ARC;
     }
-    struct ncp_canon feed = {.kind = NCP_C_ARC_FEED};
-    feed.arc_feed.first_end = in.end[0];
-    feed.arc_feed.second_end = in.end[1];
-    feed.arc_feed.first_axis = out.centre[0];
-    feed.arc_feed.second_axis = out.centre[1];
-    feed.arc_feed.rotation = out.rotation;
-    feed.arc_feed.axis_end = axis_end;
-    feed.arc_feed.abc[0] = a;
-    feed.arc_feed.abc[1] = b;
-    feed.arc_feed.abc[2] = c;
-    *op = feed;
+    /* the request's numbers are all read: the call is written over it */
+    memset(op, 0, sizeof *op);
+    op->kind = NCP_C_ARC_FEED;
+    op->arc_feed.first_end = in.end[0];
+    op->arc_feed.second_end = in.end[1];
+    op->arc_feed.first_axis = out.centre[0];
+    op->arc_feed.second_axis = out.centre[1];
+    op->arc_feed.rotation = out.rotation;
+    op->arc_feed.axis_end = axis_end;
+    op->arc_feed.abc[0] = a;
+    op->arc_feed.abc[1] = b;
+    op->arc_feed.abc[2] = c;
     return NCP_OK;
 }
 
