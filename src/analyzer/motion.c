@@ -147,7 +147,7 @@ static const char *const ncp_plane_missing[3] = {
 
 /* Only for #<_feed> after a G93 arc (the executor computes the printed
  * rate): arc length as rs274 measures it, centre from IJK or R. */
-static double ncp_arc_length(const struct ncp_canon *q)
+static double ncp_request_arc_length(const struct ncp_canon *q)
 {
     double x1 = q->arc.first_start, y1 = q->arc.second_start;
     double x2 = q->arc.first_end, y2 = q->arc.second_end, cx, cy;
@@ -249,7 +249,7 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
     op->arc.plane = pl;
     op->flags = s->m.inches ? 1 : 0;
     if (s->m.feed_mode == 1) {
-        double len = ncp_arc_length(op), dz = end[ax[2]] - s->pos[ax[2]];
+        double len = ncp_request_arc_length(op), dz = end[ax[2]] - s->pos[ax[2]];
         if (dz != 0.0)
             len = hypot(len, dz);
         double rate = len * w->v[NCP_LETTER('F')];

@@ -2,7 +2,7 @@
  * analyzer knows the end point and the centre word or R, the executor finds
  * the centre, checks it the way rs274 does and reports its errors in rs274's
  * words. */
-#include "arc_geom.h"
+#include "ncpar/geom.h"
 #include "ncpar/executor.h"
 
 #include <math.h>
@@ -96,14 +96,14 @@ static int ncp_resolve_arc(struct ncp_cmd *cmd, struct ncp_canon *op, struct ncp
     struct ncp_arc_in in;
     struct ncp_arc_out out;
     ncp_arc_in_from_op(op, &in);
-    int status = ncp_arc_solve(&in, &out);
+    int status = ncp_geom_arc_solve(&in, &out);
     if (status != NCP_ARC_OK)
         return ncp_arc_error(cmd, op, status, &out);
 
     double axis_end = op->arc.axis_end;
     double a = op->arc.abc[0], b = op->arc.abc[1], c = op->arc.abc[2];
     if (feed_op) {
-        double rate = ncp_arc_length(&in, &out, feed_op->feed_rate.arc_axis_start, axis_end) *
+        double rate = ncp_geom_arc_length(&in, &out, feed_op->feed_rate.arc_axis_start, axis_end) *
                       feed_op->feed_rate.rate;
         feed_op->feed_rate.rate = rate > 0.1 ? rate : 0.1;
         feed_op->feed_rate.arc_axis_start = 0.0;
