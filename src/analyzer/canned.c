@@ -1,6 +1,7 @@
 /* Canned cycles G73 G81 G82 G83 G85 G89 in any of the three planes: sticky
  * R/Z/P/Q values, L repeats, G98/G99 retract, incremental positioning, all
  * expanded into traverses, feeds and dwells as rs274 does. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>

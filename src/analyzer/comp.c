@@ -2,6 +2,7 @@
  * moves while it is engaged, and the flush at stop codes. The queue and the
  * geometry live in cutcomp.c; here we translate state and words into its
  * requests and keep the programmed/compensated points straight. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>

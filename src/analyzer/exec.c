@@ -1,6 +1,7 @@
 /* One block in rs274's execution order: comment, feed mode, F, S, T, M codes
  * by group, then G codes by group, motion, and the stop codes last. Each step
  * is a small function; the order lives in ncp_exec_block only. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
@@ -280,6 +281,43 @@ static void ncp_exec_lathe_mode(struct ncp_analyzer *a, int diameter)
                                      : "interpreter: Lathe diameter mode changed to radius");
 }
 
+/* The block's motion (G code x10) to its handler. */
+static int ncp_exec_motion(struct ncp_analyzer *a, int motion)
+{
+    if (!ncp_is_canned_cycle(motion))
+        a->st.cycle_il_flag = 0;
+    switch (motion) {
+    case 0: case 10:
+        return ncp_motion_straight(a, motion);
+    case 20: case 30:
+        return ncp_motion_arc(a, motion);
+    case 800:
+        a->st.m.motion = 800;
+        ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
+                         sizeof "interpreter: motion mode set to none" - 1);
+        return NCP_OK;
+    case 50: case 51:
+        return ncp_motion_spline(a, motion);
+    case 52:
+        return ncp_nurbs_point(a);
+    case 330: case 331: case 760:
+        return ncp_motion_synced(a, motion);
+    case 382: case 383: case 384: case 385:
+        return ncp_motion_probe(a, motion);
+    case 700: case 710: case 711: case 712: case 720: case 721: case 722:
+        return ncp_g7x_run(a, motion);
+    case 730: case 740: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
+    case 890:
+        return ncp_canned_run(a, motion);
+    default: {
+        uint16_t col = NCP_MOTION_COL(&a->w);
+        if (motion % 10)
+            return ncp_an_error(a, col, "G%d.%d is not supported", motion / 10, motion % 10);
+        return ncp_an_error(a, col, "G%d is not supported", motion / 10);
+    }
+    }
+}
+
 static int ncp_exec_g_codes(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
@@ -316,7 +354,7 @@ static int ncp_exec_g_codes(struct ncp_analyzer *a)
              w->g[NCP_GG_NONMODAL] != 530)
         rc = ncp_offsets_modal0(a, w->g[NCP_GG_NONMODAL]);
     if (rc == NCP_OK && w->motion_to_be != -1)
-        rc = ncp_motion_run(a, w->motion_to_be);
+        rc = ncp_exec_motion(a, w->motion_to_be);
     return rc;
 }
 
@@ -359,5 +397,45 @@ int ncp_exec_block(struct ncp_analyzer *a)
     if (rc == NCP_OK && w->m[NCP_MG_STOP] != -1)
         rc = ncp_stop_run(a, w->m[NCP_MG_STOP]);
     ncp_offsets_sync_params(a);
+    return rc;
+}
+
+/* G7 (lathe diameter mode): an X word is a diameter, so the axis moves half
+ * of it, whatever uses X (moves, G10, G92, G28, cycles). rs274 halves X as it
+ * reads the word when the mode is already on, then, if this block's G7 turns
+ * it on, halves it there, or, if its G8 turns it off, doubles it back: done
+ * in that order here, so every value (even a subnormal) comes out as rs274's.
+ * Before any step of the block uses X, after the checks that only look at
+ * whether it is there. */
+static void ncp_lathe_x_word(struct ncp_analyzer *a)
+{
+    struct ncp_words *w = &a->w;
+    if (!NCP_HAS(w, 'X'))
+        return;
+    int before = a->st.m.lathe_diameter, g = w->g[NCP_GG_LATHE];
+    double *x = &w->v[NCP_LETTER('X')];
+    if (before)
+        *x /= 2;
+    if (g == 70 && !before)
+        *x /= 2;
+    else if (g == 80 && before)
+        *x *= 2;
+}
+
+/* A block as rs274 reads and executes it: what the canon did since the last
+ * one read back, the words, their checks, then the steps in rs274's order. */
+int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b)
+{
+    a->blk = b;
+    ncp_offsets_resync(a);
+    int rc = ncp_words_collect(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_words_assign(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_modal_check(a);
+    if (rc == NCP_OK) {
+        ncp_lathe_x_word(a);
+        rc = ncp_exec_block(a);
+    }
     return rc;
 }

@@ -2,6 +2,7 @@
  * write a tool table entry, L0 reloads the table. Stored values are in rs274's
  * user unit (inch). L20 and L10/L11 measure from the current point, which goes
  * through the rotation of the systems involved (see frames.c). */
+#include "floor.h"
 #include "state.h"
 
 #include <stdio.h>

@@ -1,5 +1,6 @@
 /* G0/G1 (and G53), G2/G3 arc requests, G80 and the dispatch to canned cycles.
  * End points are in program coordinates; arcs are resolved by the executor. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
@@ -280,7 +281,7 @@ int ncp_motion_arc(struct ncp_analyzer *a, int motion)
  * release), G38.5 (away): rs274's checks, then the probe move between the
  * probe switching calls. rs274 leaves its current point alone here: it reads
  * the canon's (backed off, see sai.c) at the next block, with the results. */
-static int ncp_probe(struct ncp_analyzer *a, int motion)
+int ncp_motion_probe(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
     uint16_t col = NCP_MOTION_COL(&a->w);
@@ -315,7 +316,7 @@ static int ncp_probe(struct ncp_analyzer *a, int motion)
  * and G76 (the threading cycle: its checks here, its passes in thread.c).
  * Under cutter compensation rs274 hands all three to its compensation code,
  * which knows only G0 and G1 (see ncp_cutcomp_move). */
-static int ncp_synced(struct ncp_analyzer *a, int motion)
+int ncp_motion_synced(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
     double end[NCP_NAX];
@@ -358,7 +359,7 @@ static int ncp_synced(struct ncp_analyzer *a, int motion)
  * end and the motion mode stays what it was; rs274's canon puts its own X
  * and Y at 0 (what a probe backs off from, or a tool change reads back,
  * shows it: measured with rs274 2.9 from several start and end points). */
-static int ncp_spline(struct ncp_analyzer *a, int motion)
+int ncp_motion_spline(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
@@ -407,40 +408,4 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
     a->sai.pos[NCP_X] = a->sai.pos[NCP_Y] = 0.0;
     memcpy(s->pos, end, sizeof end);
     return NCP_OK;
-}
-
-int ncp_motion_run(struct ncp_analyzer *a, int motion)
-{
-    if (!ncp_is_canned_cycle(motion))
-        a->st.cycle_il_flag = 0;
-    switch (motion) {
-    case 0: case 10:
-        return ncp_motion_straight(a, motion);
-    case 20: case 30:
-        return ncp_motion_arc(a, motion);
-    case 800:
-        a->st.m.motion = 800;
-        ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
-                         sizeof "interpreter: motion mode set to none" - 1);
-        return NCP_OK;
-    case 50: case 51:
-        return ncp_spline(a, motion);
-    case 52:
-        return ncp_nurbs_point(a);
-    case 330: case 331: case 760:
-        return ncp_synced(a, motion);
-    case 382: case 383: case 384: case 385:
-        return ncp_probe(a, motion);
-    case 700: case 710: case 711: case 712: case 720: case 721: case 722:
-        return ncp_g7x_run(a, motion);
-    case 730: case 740: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
-    case 890:
-        return ncp_canned_run(a, motion);
-    default: {
-        uint16_t col = NCP_MOTION_COL(&a->w);
-        if (motion % 10)
-            return ncp_an_error(a, col, "G%d.%d is not supported", motion / 10, motion % 10);
-        return ncp_an_error(a, col, "G%d is not supported", motion / 10);
-    }
-    }
 }

@@ -10,6 +10,7 @@
  *   error, as after G80.
  * rs274 -g prints NURBS_FEED(count, ...) only; the points follow the call
  * as NURBS_POINTS ops, which print nothing and carry the curve to the NCK. */
+#include "floor.h"
 #include "state.h"
 
 #include <stdlib.h>

@@ -2,13 +2,11 @@
  * calls and by SET_G5X_OFFSET / SET_G92_OFFSET / USE_LENGTH_UNITS, never by
  * tool length offsets, backed off after a probe), and rs274 reloads its
  * current point from that copy at the block after a tool change or a probe.
- * We mirror it so that block matches. */
+ * We mirror it so that block matches (offsets.c reads it back). */
 #include "state.h"
 
 #include <math.h>
 #include <string.h>
-
-#include "params.h"
 
 void ncp_sai_move(struct ncp_analyzer *a, const double *end)
 {
@@ -69,37 +67,6 @@ void ncp_sai_probe(struct ncp_analyzer *a, const double *end)
         pos[NCP_Z] = end[NCP_Z] + backoff * (dz / distance);
     }
     a->sai.probe_flag = 1;
-}
-
-/* rs274 reads back what the canon did before it reads the block after a
- * probe (set_probe_data) or a tool change: the current point becomes the
- * canon's (U, V, W read 0 there), and after a probe #5061-#5069 hold the
- * tripped point and #5070 the probe input, which the stand-in reports as 0. */
-static void ncp_sai_take_position(struct ncp_analyzer *a)
-{
-    memcpy(a->st.pos, a->sai.pos, sizeof a->sai.pos);
-    for (int ax = 6; ax < NCP_NAX; ax++)
-        a->st.pos[ax] = 0.0;
-}
-
-void ncp_sai_resync(struct ncp_analyzer *a)
-{
-    if (!(a->st.toolchange_flag | a->sai.probe_flag))
-        return;
-    if (a->sai.probe_flag) {
-        a->sai.probe_flag = 0;
-        for (int k = 0; k <= 9; k++) {
-            double *par = ncp_params_slot(a->params, 5061 + k);
-            if (par)
-                *par = k < 6 ? a->sai.probed[k] : 0.0;
-        }
-    }
-    ncp_sai_take_position(a);
-    ncp_offsets_sync_params(a); /* before this block's expressions read #5420.. */
-    if (a->st.toolchange_flag) {
-        a->st.toolchange_flag = 0;
-        ncp_tools_sync_params(a, 1);
-    }
 }
 
 /* A move finished by the comp queue: the canon's point is its end. */

@@ -1,6 +1,7 @@
 /* Start-up state and the stop codes M0 M1 M60 M2 M30 (the end-of-program
  * reset rs274 performs: back to G54, XY plane, G90, G94, F0, spindle off,
  * coolant off, feed override on). */
+#include "floor.h"
 #include "state.h"
 
 #include <string.h>

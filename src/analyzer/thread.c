@@ -4,6 +4,7 @@
  * from the start point; I < 0 cuts an outside thread, I > 0 bores. The
  * arithmetic follows rs274's line for line (its compound angle is scaled
  * in long double) so that every coordinate prints the same. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>

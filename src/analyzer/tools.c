@@ -1,6 +1,7 @@
 /* Tool table (LinuxCNC .tbl format), T selection, M6 and M61. Entries keep
  * rs274's indexing: 0 is the spindle, 1..n the table lines in file order, and
  * offsets stay in the table's unit (inch), converted when used. */
+#include "floor.h"
 #include "state.h"
 
 #include <errno.h>
