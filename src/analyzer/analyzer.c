@@ -44,7 +44,7 @@ void ncp_analyzer_free(struct ncp_analyzer *a)
     if (a->flow)
         ncp_flow_free(a->flow);
     ncp_m7x_free(a);
-    ncp_nurbs_free(a);
+    ncp_g52_free(a);
     ncp_params_free(a->params);
     free(a);
 }

@@ -313,7 +313,7 @@ int ncp_motion_probe(struct ncp_analyzer *a, int motion)
 
 /* G33 (a straight feed locked to the spindle, K the distance per turn),
  * G33.1 (rigid tapping to the end and back: rs274 keeps its current point)
- * and G76 (the threading cycle: its checks here, its passes in thread.c).
+ * and G76 (the threading cycle: its checks here, its passes in g76.c).
  * Under cutter compensation rs274 hands all three to its compensation code,
  * which knows only G0 and G1 (see ncp_cutcomp_move). */
 int ncp_motion_synced(struct ncp_analyzer *a, int motion)
@@ -339,7 +339,7 @@ int ncp_motion_synced(struct ncp_analyzer *a, int motion)
         for (int ax = NCP_A; ax < NCP_NAX; ax++)
             if (end[ax] != s->pos[ax])
                 return ncp_an_error(a, col, "Cannot move rotary axes with G76");
-        return ncp_thread_cycle(a, end);
+        return ncp_g76_cycle(a, end);
     }
     struct ncp_canon *sync = ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH);
     sync->synch.per_rev = a->w.v[NCP_LETTER('K')];

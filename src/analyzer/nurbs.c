@@ -18,9 +18,9 @@
 
 #define NCP_NURBS_MAX_POINTS (1u << 20)
 
-static int ncp_nurbs_push(struct ncp_analyzer *a, double x, double y, double w)
+static int ncp_g52_push(struct ncp_analyzer *a, double x, double y, double w)
 {
-    struct ncp_nurbs_pts *nb = &a->nurbs;
+    struct ncp_g52_points *nb = &a->nurbs;
     if (nb->n == nb->cap) {
         if (nb->cap >= NCP_NURBS_MAX_POINTS)
             return ncp_an_error(a, a->w.line_col,
@@ -40,11 +40,11 @@ static int ncp_nurbs_push(struct ncp_analyzer *a, double x, double y, double w)
     return NCP_OK;
 }
 
-int ncp_nurbs_point(struct ncp_analyzer *a)
+int ncp_g52_point(struct ncp_analyzer *a)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
-    struct ncp_nurbs_pts *nb = &a->nurbs;
+    struct ncp_g52_points *nb = &a->nurbs;
     uint16_t col = NCP_MOTION_COL(w);
     int has_x = NCP_HAS(w, 'X'), has_y = NCP_HAS(w, 'Y');
     double p = NCP_HAS(w, 'P') ? w->v[NCP_LETTER('P')] : -1.0; /* rs274: no P is -1 */
@@ -61,7 +61,7 @@ int ncp_nurbs_point(struct ncp_analyzer *a)
         nb->n = 0;
     int rc;
     if (nb->n == 0) {
-        rc = ncp_nurbs_push(a, s->pos[NCP_X], s->pos[NCP_Y], !has_x && p > 0.0 ? p : 1.0);
+        rc = ncp_g52_push(a, s->pos[NCP_X], s->pos[NCP_Y], !has_x && p > 0.0 ? p : 1.0);
         if (rc != NCP_OK)
             return rc;
         nb->order = 3;
@@ -75,7 +75,7 @@ int ncp_nurbs_point(struct ncp_analyzer *a)
         double end[NCP_NAX];
         rc = ncp_motion_ends(a, w->g[NCP_GG_NONMODAL] == 530, end);
         if (rc == NCP_OK)
-            rc = ncp_nurbs_push(a, end[NCP_X], end[NCP_Y], p);
+            rc = ncp_g52_push(a, end[NCP_X], end[NCP_Y], p);
         if (rc != NCP_OK)
             return rc;
     }
@@ -83,10 +83,10 @@ int ncp_nurbs_point(struct ncp_analyzer *a)
     return NCP_OK;
 }
 
-int ncp_nurbs_draw(struct ncp_analyzer *a)
+int ncp_g52_draw(struct ncp_analyzer *a)
 {
     struct ncp_state *s = &a->st;
-    struct ncp_nurbs_pts *nb = &a->nurbs;
+    struct ncp_g52_points *nb = &a->nurbs;
     uint16_t col = a->w.gcol[NCP_GG_NONMODAL];
     if (s->m.motion != 52)
         return ncp_an_error(a, col, "Cannot use G5.3 without G5.2 first");
@@ -125,7 +125,7 @@ int ncp_nurbs_draw(struct ncp_analyzer *a)
     return NCP_OK;
 }
 
-void ncp_nurbs_free(struct ncp_analyzer *a)
+void ncp_g52_free(struct ncp_analyzer *a)
 {
     free(a->nurbs.pt);
     memset(&a->nurbs, 0, sizeof a->nurbs);

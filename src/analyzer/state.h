@@ -119,7 +119,7 @@ struct ncp_staged {
 };
 
 /* G5.2 control points until G5.3 draws them (nurbs.c): x y weight */
-struct ncp_nurbs_pts {
+struct ncp_g52_points {
     double (*pt)[3];
     uint32_t n, cap;
     int order;
@@ -157,7 +157,7 @@ struct ncp_analyzer {
     int m7x_restore_from;         /* a return left an M73 level: restore from it, else -1 */
     int block_consumed;           /* an M72 ran restore lines in this block's place */
     struct ncp_block *m7x_block;  /* the restore line being run */
-    struct ncp_nurbs_pts nurbs;
+    struct ncp_g52_points nurbs;
     /* How a handler runs a line of its own as a block (M72's restore lines):
      * ncp_an_execute, handed down by the run loop so that no handler calls
      * back up into the file that calls it. */
@@ -184,12 +184,12 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b);
 
 /* modal.c */
 int ncp_modal_check(struct ncp_analyzer *a);
-/* exec.c: read back what the canon did, then read and execute block b (the
- * whole block in rs274's order: ncp_exec_block) */
+/* steps.c: read back what the canon did, then read and execute block b (the
+ * whole block in rs274's order: ncp_an_steps) */
 int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b);
-int ncp_exec_block(struct ncp_analyzer *a);
+int ncp_an_steps(struct ncp_analyzer *a);
 
-/* motion.c: the motions; exec.c picks the one the block's motion mode names */
+/* motion.c: the motions; steps.c picks the one the block's motion mode names */
 /* G0/G1 and G2/G3 to the block's words, in the current distance modes */
 int ncp_motion_straight(struct ncp_analyzer *a, int motion);
 int ncp_motion_arc(struct ncp_analyzer *a, int motion);
@@ -201,8 +201,8 @@ int ncp_motion_probe(struct ncp_analyzer *a, int motion);
 int ncp_g7x_run(struct ncp_analyzer *a, int motion);
 int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end);
 int ncp_canned_run(struct ncp_analyzer *a, int motion);
-/* thread.c: G76 from the current point to end (checked by motion.c) */
-int ncp_thread_cycle(struct ncp_analyzer *a, const double *end);
+/* g76.c: G76 from the current point to end (checked by motion.c) */
+int ncp_g76_cycle(struct ncp_analyzer *a, const double *end);
 /* m7x.c: M70-M73 (m is 70..73); the flow's frame hooks; a restore a return
  * left pending (before the next block, or a parameter read); teardown */
 int ncp_m7x_run(struct ncp_analyzer *a, int m);
@@ -213,9 +213,9 @@ void ncp_m7x_free(struct ncp_analyzer *a);
 int ncp_motion_ends(struct ncp_analyzer *a, int absolute53, double *end);
 
 /* nurbs.c: G5.2 (a control point, as the motion) and G5.3 (draw them) */
-int ncp_nurbs_point(struct ncp_analyzer *a);
-int ncp_nurbs_draw(struct ncp_analyzer *a);
-void ncp_nurbs_free(struct ncp_analyzer *a);
+int ncp_g52_point(struct ncp_analyzer *a);
+int ncp_g52_draw(struct ncp_analyzer *a);
+void ncp_g52_free(struct ncp_analyzer *a);
 
 /* offsets.c */
 int ncp_offsets_units(struct ncp_analyzer *a, int inches);

@@ -1,6 +1,6 @@
 /* One block in rs274's execution order: comment, feed mode, F, S, T, M codes
  * by group, then G codes by group, motion, and the stop codes last. Each step
- * is a small function; the order lives in ncp_exec_block only. */
+ * is a small function; the order lives in ncp_an_steps only. */
 #include "floor.h"
 #include "state.h"
 
@@ -9,7 +9,7 @@
 
 #define W(a, c) ((a)->w.v[NCP_LETTER(c)])
 
-static int ncp_exec_feed_mode(struct ncp_analyzer *a, int g)
+static int ncp_step_feed_mode(struct ncp_analyzer *a, int g)
 {
     static const char *const msg[] = {
         "interpreter: feed mode set to units per minute",
@@ -32,7 +32,7 @@ static int ncp_exec_feed_mode(struct ncp_analyzer *a, int g)
     return NCP_OK;
 }
 
-static void ncp_exec_comment_lit(struct ncp_analyzer *a, const char *m)
+static void ncp_step_comment_lit(struct ncp_analyzer *a, const char *m)
 {
     size_t n = 0;
     while (m[n])
@@ -40,7 +40,7 @@ static void ncp_exec_comment_lit(struct ncp_analyzer *a, const char *m)
     ncp_an_emit_text(a, NCP_C_COMMENT, m, n);
 }
 
-static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
+static int ncp_step_spindle(struct ncp_analyzer *a, int m)
 {
     if (m >= 70)
         return ncp_m7x_run(a, m);
@@ -74,7 +74,7 @@ static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
     return NCP_OK;
 }
 
-static int ncp_exec_coolant(struct ncp_analyzer *a, int m)
+static int ncp_step_coolant(struct ncp_analyzer *a, int m)
 {
     if (m == 7) {
         ncp_an_emit(a, NCP_C_MIST_ON);
@@ -90,7 +90,7 @@ static int ncp_exec_coolant(struct ncp_analyzer *a, int m)
     return NCP_OK;
 }
 
-static int ncp_exec_override(struct ncp_analyzer *a, int m)
+static int ncp_step_override(struct ncp_analyzer *a, int m)
 {
     int on = !NCP_HAS(&a->w, 'P') || W(a, 'P') != 0.0;
     switch (m) {
@@ -129,7 +129,7 @@ static int ncp_exec_override(struct ncp_analyzer *a, int m)
  * rs274 -g, whose stand-in returns the default: after a digital wait #5399
  * (the result) becomes 1 if it was not 0, else 0; after an analog one it
  * keeps its value. Nothing is printed (rs274 -g prints no call for it). */
-static int ncp_exec_wait_input(struct ncp_analyzer *a)
+static int ncp_step_wait_input(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     uint16_t col = w->mcol[NCP_MG_IO];
@@ -155,7 +155,7 @@ static int ncp_exec_wait_input(struct ncp_analyzer *a)
     return NCP_OK;
 }
 
-static int ncp_exec_io(struct ncp_analyzer *a, int m)
+static int ncp_step_io(struct ncp_analyzer *a, int m)
 {
     static const enum ncp_canon_kind bits[] = {
         NCP_C_SET_MOTION_OUTPUT_BIT, NCP_C_CLEAR_MOTION_OUTPUT_BIT,
@@ -177,11 +177,11 @@ static int ncp_exec_io(struct ncp_analyzer *a, int m)
         return NCP_OK;
     }
     if (m == 66)
-        return ncp_exec_wait_input(a);
+        return ncp_step_wait_input(a);
     return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "M%d is not supported", m);
 }
 
-static int ncp_exec_plane(struct ncp_analyzer *a, int g)
+static int ncp_step_plane(struct ncp_analyzer *a, int g)
 {
     if (g != 170 && g != 180 && g != 190)
         return ncp_an_error(a, a->w.gcol[NCP_GG_PLANE], "G%d.1 planes are not supported", g / 10);
@@ -191,12 +191,12 @@ static int ncp_exec_plane(struct ncp_analyzer *a, int g)
     return NCP_OK;
 }
 
-static int ncp_exec_comp(struct ncp_analyzer *a, int g)
+static int ncp_step_comp(struct ncp_analyzer *a, int g)
 {
     return ncp_comp_gcode(a, g);
 }
 
-static int ncp_exec_control(struct ncp_analyzer *a, int g)
+static int ncp_step_control(struct ncp_analyzer *a, int g)
 {
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_MOTION_CONTROL_MODE);
     /* the canon keeps the naivecam tolerance across G61/G61.1 */
@@ -226,63 +226,63 @@ static int ncp_exec_control(struct ncp_analyzer *a, int g)
     return NCP_OK;
 }
 
-static void ncp_exec_distance(struct ncp_analyzer *a, int g)
+static void ncp_step_distance(struct ncp_analyzer *a, int g)
 {
     int inc = g == 910;
     if (inc != a->st.m.incremental)
-        ncp_exec_comment_lit(a, inc ? "interpreter: distance mode changed to incremental"
+        ncp_step_comment_lit(a, inc ? "interpreter: distance mode changed to incremental"
                                     : "interpreter: distance mode changed to absolute");
     a->st.m.incremental = inc;
 }
 
-static void ncp_exec_arc_distance(struct ncp_analyzer *a, int g)
+static void ncp_step_arc_distance(struct ncp_analyzer *a, int g)
 {
     int inc = g == 911;
     if (inc != a->st.m.arc_incremental)
-        ncp_exec_comment_lit(a, inc ? "interpreter: IJK distance mode changed to incremental"
+        ncp_step_comment_lit(a, inc ? "interpreter: IJK distance mode changed to incremental"
                                     : "interpreter: IJK distance mode changed to absolute");
     a->st.m.arc_incremental = inc;
 }
 
-static void ncp_exec_retract(struct ncp_analyzer *a, int g)
+static void ncp_step_retract(struct ncp_analyzer *a, int g)
 {
     a->st.m.retract_r = g == 990;
-    ncp_exec_comment_lit(a, g == 990 ? "interpreter: retract mode set to r_plane"
+    ncp_step_comment_lit(a, g == 990 ? "interpreter: retract mode set to r_plane"
                                      : "interpreter: retract mode set to old_z");
 }
 
-static int ncp_exec_m_codes(struct ncp_analyzer *a)
+static int ncp_step_m_codes(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int rc = NCP_OK;
     if (w->m[NCP_MG_IO] != -1)
-        rc = ncp_exec_io(a, w->m[NCP_MG_IO]);
+        rc = ncp_step_io(a, w->m[NCP_MG_IO]);
     if (rc == NCP_OK && w->m[NCP_MG_TOOL] != -1)
         rc = ncp_tools_change(a);
     if (rc == NCP_OK && w->m[NCP_MG_SPINDLE] != -1)
-        rc = ncp_exec_spindle(a, w->m[NCP_MG_SPINDLE]);
-    if (a->block_consumed) /* see ncp_exec_block */
+        rc = ncp_step_spindle(a, w->m[NCP_MG_SPINDLE]);
+    if (a->block_consumed) /* see ncp_an_steps */
         return rc;
     if (rc == NCP_OK && w->m[NCP_MG_COOLANT] != -1)
-        rc = ncp_exec_coolant(a, w->m[NCP_MG_COOLANT]);
+        rc = ncp_step_coolant(a, w->m[NCP_MG_COOLANT]);
     if (rc == NCP_OK && w->m[NCP_MG_OVERRIDE] != -1)
-        rc = ncp_exec_override(a, w->m[NCP_MG_OVERRIDE]);
+        rc = ncp_step_override(a, w->m[NCP_MG_OVERRIDE]);
     return rc;
 }
 
 /* G7/G8. The block's X word was already scaled (analyzer.c, ncp_lathe_x_word);
  * rs274 says so only when the mode changes. */
-static void ncp_exec_lathe_mode(struct ncp_analyzer *a, int diameter)
+static void ncp_step_lathe_mode(struct ncp_analyzer *a, int diameter)
 {
     if (a->st.m.lathe_diameter == diameter)
         return;
     a->st.m.lathe_diameter = diameter;
-    ncp_exec_comment_lit(a, diameter ? "interpreter: Lathe diameter mode changed to diameter"
+    ncp_step_comment_lit(a, diameter ? "interpreter: Lathe diameter mode changed to diameter"
                                      : "interpreter: Lathe diameter mode changed to radius");
 }
 
 /* The block's motion (G code x10) to its handler. */
-static int ncp_exec_motion(struct ncp_analyzer *a, int motion)
+static int ncp_step_motion(struct ncp_analyzer *a, int motion)
 {
     if (!ncp_is_canned_cycle(motion))
         a->st.cycle_il_flag = 0;
@@ -299,7 +299,7 @@ static int ncp_exec_motion(struct ncp_analyzer *a, int motion)
     case 50: case 51:
         return ncp_motion_spline(a, motion);
     case 52:
-        return ncp_nurbs_point(a);
+        return ncp_g52_point(a);
     case 330: case 331: case 760:
         return ncp_motion_synced(a, motion);
     case 382: case 383: case 384: case 385:
@@ -318,20 +318,20 @@ static int ncp_exec_motion(struct ncp_analyzer *a, int motion)
     }
 }
 
-static int ncp_exec_g_codes(struct ncp_analyzer *a)
+static int ncp_step_g_codes(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int rc = NCP_OK;
     if (w->g[NCP_GG_NONMODAL] == 40)
         ncp_an_emit(a, NCP_C_DWELL)->dwell.seconds = W(a, 'P');
     if (w->g[NCP_GG_PLANE] != -1)
-        rc = ncp_exec_plane(a, w->g[NCP_GG_PLANE]);
+        rc = ncp_step_plane(a, w->g[NCP_GG_PLANE]);
     if (rc == NCP_OK && w->g[NCP_GG_UNITS] != -1)
         rc = ncp_offsets_units(a, w->g[NCP_GG_UNITS] == 200);
     if (rc == NCP_OK && w->g[NCP_GG_LATHE] != -1)
-        ncp_exec_lathe_mode(a, w->g[NCP_GG_LATHE] == 70);
+        ncp_step_lathe_mode(a, w->g[NCP_GG_LATHE] == 70);
     if (rc == NCP_OK && w->g[NCP_GG_COMP] != -1)
-        rc = ncp_exec_comp(a, w->g[NCP_GG_COMP]);
+        rc = ncp_step_comp(a, w->g[NCP_GG_COMP]);
     if (rc == NCP_OK && w->g[NCP_GG_TLO] != -1)
         rc = ncp_offsets_tlo(a, w->g[NCP_GG_TLO]);
     if (rc == NCP_OK && w->g[NCP_GG_COORD] != -1)
@@ -339,26 +339,26 @@ static int ncp_exec_g_codes(struct ncp_analyzer *a)
                                        ? 5 + w->g[NCP_GG_COORD] - 590
                                        : (w->g[NCP_GG_COORD] - 540) / 10));
     if (rc == NCP_OK && w->g[NCP_GG_CONTROL] != -1)
-        rc = ncp_exec_control(a, w->g[NCP_GG_CONTROL]);
+        rc = ncp_step_control(a, w->g[NCP_GG_CONTROL]);
     if (rc != NCP_OK)
         return rc;
     if (w->g[NCP_GG_DIST] != -1)
-        ncp_exec_distance(a, w->g[NCP_GG_DIST]);
+        ncp_step_distance(a, w->g[NCP_GG_DIST]);
     if (w->g[NCP_GG_ARCDIST] != -1)
-        ncp_exec_arc_distance(a, w->g[NCP_GG_ARCDIST]);
+        ncp_step_arc_distance(a, w->g[NCP_GG_ARCDIST]);
     if (w->g[NCP_GG_RETRACT] != -1)
-        ncp_exec_retract(a, w->g[NCP_GG_RETRACT]);
+        ncp_step_retract(a, w->g[NCP_GG_RETRACT]);
     if (w->g[NCP_GG_NONMODAL] == 53)
-        rc = ncp_nurbs_draw(a);
+        rc = ncp_g52_draw(a);
     else if (w->g[NCP_GG_NONMODAL] != -1 && w->g[NCP_GG_NONMODAL] != 40 &&
              w->g[NCP_GG_NONMODAL] != 530)
         rc = ncp_offsets_modal0(a, w->g[NCP_GG_NONMODAL]);
     if (rc == NCP_OK && w->motion_to_be != -1)
-        rc = ncp_exec_motion(a, w->motion_to_be);
+        rc = ncp_step_motion(a, w->motion_to_be);
     return rc;
 }
 
-int ncp_exec_block(struct ncp_analyzer *a)
+int ncp_an_steps(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int rc = NCP_OK;
@@ -372,7 +372,7 @@ int ncp_exec_block(struct ncp_analyzer *a)
             op->spindle_mode.css_max = NCP_HAS(w, 'D') ? W(a, 'D') : 1e30;
     }
     if (rc == NCP_OK && w->g[NCP_GG_FEEDMODE] != -1)
-        rc = ncp_exec_feed_mode(a, w->g[NCP_GG_FEEDMODE]);
+        rc = ncp_step_feed_mode(a, w->g[NCP_GG_FEEDMODE]);
     if (rc != NCP_OK)
         return rc;
     if (NCP_HAS(w, 'F') && a->st.m.feed_mode != 1) {
@@ -386,14 +386,14 @@ int ncp_exec_block(struct ncp_analyzer *a)
     if (NCP_HAS(w, 'T'))
         rc = ncp_tools_select(a);
     if (rc == NCP_OK && w->n_m != 0) /* most blocks have none: skip the group tests */
-        rc = ncp_exec_m_codes(a);
+        rc = ncp_step_m_codes(a);
     if (a->block_consumed) { /* M72's restore lines ran in this block's place */
         a->block_consumed = 0;
         ncp_offsets_sync_params(a);
         return rc;
     }
     if (rc == NCP_OK)
-        rc = ncp_exec_g_codes(a);
+        rc = ncp_step_g_codes(a);
     if (rc == NCP_OK && w->m[NCP_MG_STOP] != -1)
         rc = ncp_stop_run(a, w->m[NCP_MG_STOP]);
     ncp_offsets_sync_params(a);
@@ -435,7 +435,7 @@ int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b)
         rc = ncp_modal_check(a);
     if (rc == NCP_OK) {
         ncp_lathe_x_word(a);
-        rc = ncp_exec_block(a);
+        rc = ncp_an_steps(a);
     }
     return rc;
 }
