@@ -11,6 +11,7 @@
 struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
                                       struct ncp_diag *d)
 {
+    ncp_words_init();
     struct ncp_analyzer *a = calloc(1, sizeof *a);
     if (!a) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");

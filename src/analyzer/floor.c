@@ -37,10 +37,6 @@ void ncp_an_reline(struct ncp_analyzer *a)
         ncp_an_publish(a);
 }
 
-/* Ops go to a scratch op when the sink has shut down, so callers need no
- * NULL checks on the hot path. */
-static struct ncp_canon ncp_an_scratch;
-
 /* Append a finished op (and its text) to the block's slot. */
 static int ncp_an_append(void *ctx, const struct ncp_canon *src, const char *text, size_t len)
 {
@@ -104,7 +100,7 @@ struct ncp_canon *ncp_an_emit(struct ncp_analyzer *a, enum ncp_canon_kind kind)
     if (a->comp.n != 0 || a->staged.pending)
         return ncp_an_stage(a, kind, NULL, 0);
     struct ncp_cmd *c = ncp_an_slot(a, 0);
-    struct ncp_canon *op = c ? &c->ops[c->n_ops++] : &ncp_an_scratch;
+    struct ncp_canon *op = c ? &c->ops[c->n_ops++] : &a->scratch;
     memset(op, 0, sizeof *op);
     op->kind = (uint16_t)kind;
     return op;
@@ -118,7 +114,7 @@ struct ncp_canon *ncp_an_emit_text(struct ncp_analyzer *a, enum ncp_canon_kind k
     if (len > NCP_CMD_TEXT_POOL)
         len = NCP_CMD_TEXT_POOL;
     struct ncp_cmd *c = ncp_an_slot(a, len);
-    struct ncp_canon *op = c ? &c->ops[c->n_ops++] : &ncp_an_scratch;
+    struct ncp_canon *op = c ? &c->ops[c->n_ops++] : &a->scratch;
     memset(op, 0, sizeof *op);
     op->kind = (uint16_t)kind;
     if (c) {

@@ -146,6 +146,10 @@ struct ncp_analyzer {
     /* output */
     const struct ncp_cmd_sink *sink;
     struct ncp_cmd *cmd;
+    /* Ops go here once the sink has shut down, so callers need no NULL checks
+     * on the hot path: this analyzer's own, as analyzers of other threads
+     * write theirs at the same time. */
+    struct ncp_canon scratch;
     uint64_t next_id;
     uint32_t line;
     unsigned file_tag;           /* the block's subroutine file (NCP_CMD_FILE), 0 */
@@ -170,7 +174,9 @@ int ncp_comp_move_straight(struct ncp_analyzer *a, int motion, const double *end
 int ncp_comp_move_arc(struct ncp_analyzer *a, const struct ncp_canon *req, const double *end);
 int ncp_comp_stop(struct ncp_analyzer *a, int reset);
 
-/* words.c */
+/* words.c: ncp_words_init once before any analyzer reads a block (builds
+ * the G code table) */
+void ncp_words_init(void);
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
 /* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);
