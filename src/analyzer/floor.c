@@ -140,11 +140,11 @@ void ncp_an_emit6(struct ncp_analyzer *a, enum ncp_canon_kind kind, const double
 
 int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
 {
-    va_list ap;
-    va_start(ap, fmt);
     a->err.code = NCP_ERR_SEMANTIC;
     a->err.line = a->line;
     a->err.col = col;
+    va_list ap;
+    va_start(ap, fmt);
     vsnprintf(a->err.msg, sizeof a->err.msg, fmt, ap);
     va_end(ap);
     return NCP_ERR_SEMANTIC;
