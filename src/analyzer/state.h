@@ -110,7 +110,7 @@ struct ncp_sai {
 };
 
 /* An op held back while cutter compensation has a move queued: it is handed
- * to the comp queue once the caller has filled it (see analyzer.c). */
+ * to the comp queue once the caller has filled it (see floor.c). */
 struct ncp_staged {
     int pending;
     struct ncp_canon op;
