@@ -1,16 +1,14 @@
 /* Working memory of the stage threads: rings, buffers and the program text.
  *
  * Rings and buffers are prefaulted before the threads start, so that none of
- * them stops for a first-touch page fault (microseconds each under this
- * host's shadow paging). The program text is read onto 2 MB pages where the
- * kernel offers transparent huge pages for advised memory: 14 faults instead
- * of 7,000 for a 28 MB program (feeder/text_mem.h). Buffers stay on 4 KB
- * pages: a 1 MB buffer on one 2 MB page took 0.065 ms instead of 0.57 ms to
- * map, touch and unmap (median of 200), but here a fresh 2 MB page now and
- * then costs ~5 ms (the host backs it again after the guest gave it back),
- * and with three such buffers a run of the pipeline paid ~10 ms at its start
- * in 3 runs of 10: more than the saving (bench/RESULTS.md, "Program text on
- * huge pages"). */
+ * them stops for a first-touch page fault (microseconds each under a
+ * hypervisor's shadow paging). The program text is read onto 2 MB pages where
+ * the kernel offers transparent huge pages for advised memory: one fault per
+ * 2 MB instead of one per 4 KB (feeder/text_mem.h). Buffers stay on 4 KB
+ * pages: a huge page is cheaper to map and touch, but in a virtual machine a
+ * fresh 2 MB page now and then costs milliseconds (the host backs it again
+ * after the guest gave it back), more than the saving for buffers of a
+ * megabyte or two (bench/RESULTS.md, "Program text on huge pages"). */
 #ifndef NCPAR_MEM_H
 #define NCPAR_MEM_H
 

@@ -1,5 +1,6 @@
 /* The analyzer's run loop and its output: one slot per block that produces
  * calls, consecutive cmd_ids, errors carried in program order. */
+#include "floor.h"
 #include "state.h"
 
 #include <stdarg.h>
@@ -10,6 +11,7 @@
 struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
                                       struct ncp_diag *d)
 {
+    ncp_words_init();
     struct ncp_analyzer *a = calloc(1, sizeof *a);
     if (!a) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
@@ -30,6 +32,7 @@ struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
         return NULL;
     }
     ncp_state_init(a);
+    a->execute = ncp_an_execute;
     ncp_cutcomp_init(&a->comp, NULL);
     ncp_m7x_reset(a);
     return a;
@@ -42,176 +45,20 @@ void ncp_analyzer_free(struct ncp_analyzer *a)
     if (a->flow)
         ncp_flow_free(a->flow);
     ncp_m7x_free(a);
-    ncp_nurbs_free(a);
+    ncp_g52_free(a);
     ncp_params_free(a->params);
     free(a);
-}
-
-static void ncp_an_publish(struct ncp_analyzer *a)
-{
-    if (a->cmd) {
-        a->sink->publish(a->sink->ctx, a->cmd);
-        a->cmd = NULL;
-    }
-}
-
-/* The block's current slot, opening one (or a continuation) when needed. */
-static struct ncp_cmd *ncp_an_slot(struct ncp_analyzer *a, size_t text_need)
-{
-    uint16_t cont = 0;
-    if (a->cmd && a->cmd->n_ops < NCP_CMD_MAX_OPS &&
-        a->cmd->text_used + text_need <= NCP_CMD_TEXT_POOL)
-        return a->cmd;
-    if (a->cmd) {
-        cont = NCP_CMD_F_CONT;
-        ncp_an_publish(a);
-    }
-    if (a->stopped)
-        return NULL;
-    struct ncp_cmd *c = a->sink->acquire(a->sink->ctx);
-    if (!c) {
-        a->stopped = 1;
-        return NULL;
-    }
-    c->cmd_id = a->next_id++;
-    c->line = a->line;
-    c->flags = (uint16_t)(cont | a->file_tag << NCP_CMD_FILE_SHIFT);
-    a->cmd = c;
-    return c;
-}
-
-void ncp_an_reline(struct ncp_analyzer *a)
-{
-    if (a->cmd && (a->cmd->line != a->line || NCP_CMD_FILE(a->cmd) != a->file_tag))
-        ncp_an_publish(a);
-}
-
-/* Ops go to a scratch op when the sink has shut down, so callers need no
- * NULL checks on the hot path. */
-static struct ncp_canon ncp_an_scratch;
-
-/* Append a finished op (and its text) to the block's slot. */
-static int ncp_an_append(void *ctx, const struct ncp_canon *src, const char *text, size_t len)
-{
-    struct ncp_analyzer *a = ctx;
-    if (len > NCP_CMD_TEXT_POOL)
-        len = NCP_CMD_TEXT_POOL;
-    struct ncp_cmd *c = ncp_an_slot(a, len);
-    if (!c)
-        return NCP_OK;
-    struct ncp_canon *op = &c->ops[c->n_ops++];
-    *op = *src;
-    ncp_sai_op(a, op);
-    op->text_off = 0;
-    op->text_len = 0;
-    if (len) {
-        memcpy(c->text + c->text_used, text, len);
-        op->text_off = c->text_used;
-        op->text_len = (uint16_t)len;
-        c->text_used = (uint16_t)(c->text_used + len);
-    }
-    return NCP_OK;
-}
-
-struct ncp_comp_sink ncp_an_comp_sink(struct ncp_analyzer *a)
-{
-    struct ncp_comp_sink s = {a, ncp_an_append};
-    return s;
-}
-
-/* While compensation holds a queued move, ops are staged and then offered to
- * its queue, which keeps some of them behind the move as rs274 does. */
-int ncp_an_commit(struct ncp_analyzer *a)
-{
-    struct ncp_staged *st = &a->staged;
-    if (!st->pending)
-        return NCP_OK;
-    st->pending = 0;
-    struct ncp_comp_sink sink = ncp_an_comp_sink(a);
-    int rc = ncp_cutcomp_other(&a->comp, &st->op, st->text, st->len, &sink, &a->err, a->line);
-    if (rc != NCP_OK && a->err.code == NCP_OK)
-        a->err.code = (uint16_t)rc;
-    return rc;
-}
-
-static struct ncp_canon *ncp_an_stage(struct ncp_analyzer *a, enum ncp_canon_kind kind,
-                                      const char *text, size_t len)
-{
-    ncp_an_commit(a);
-    struct ncp_staged *st = &a->staged;
-    memset(&st->op, 0, sizeof st->op);
-    st->op.kind = (uint16_t)kind;
-    if (len > sizeof st->text)
-        len = sizeof st->text;
-    if (len)
-        memcpy(st->text, text, len);
-    st->len = len;
-    st->pending = 1;
-    return &st->op;
-}
-
-struct ncp_canon *ncp_an_emit(struct ncp_analyzer *a, enum ncp_canon_kind kind)
-{
-    if (a->comp.n != 0 || a->staged.pending)
-        return ncp_an_stage(a, kind, NULL, 0);
-    struct ncp_cmd *c = ncp_an_slot(a, 0);
-    struct ncp_canon *op = c ? &c->ops[c->n_ops++] : &ncp_an_scratch;
-    memset(op, 0, sizeof *op);
-    op->kind = (uint16_t)kind;
-    return op;
-}
-
-struct ncp_canon *ncp_an_emit_text(struct ncp_analyzer *a, enum ncp_canon_kind kind,
-                                   const char *text, size_t len)
-{
-    if (a->comp.n != 0 || a->staged.pending)
-        return ncp_an_stage(a, kind, text, len);
-    if (len > NCP_CMD_TEXT_POOL)
-        len = NCP_CMD_TEXT_POOL;
-    struct ncp_cmd *c = ncp_an_slot(a, len);
-    struct ncp_canon *op = c ? &c->ops[c->n_ops++] : &ncp_an_scratch;
-    memset(op, 0, sizeof *op);
-    op->kind = (uint16_t)kind;
-    if (c) {
-        memcpy(c->text + c->text_used, text, len);
-        op->text_off = c->text_used;
-        op->text_len = (uint16_t)len;
-        c->text_used = (uint16_t)(c->text_used + len);
-    }
-    return op;
-}
-
-void ncp_an_emit6(struct ncp_analyzer *a, enum ncp_canon_kind kind, const double *p)
-{
-    struct ncp_canon *op = ncp_an_emit(a, kind);
-    memcpy(op->d, p, 6 * sizeof(double));
-    if (kind == NCP_C_SET_G92_OFFSET)
-        ncp_sai_g92(a, p);
-    else
-        ncp_sai_move(a, p);
-}
-
-int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    a->err.code = NCP_ERR_SEMANTIC;
-    a->err.line = a->line;
-    a->err.col = col;
-    vsnprintf(a->err.msg, sizeof a->err.msg, fmt, ap);
-    va_end(ap);
-    return NCP_ERR_SEMANTIC;
 }
 
 static void ncp_an_preamble(struct ncp_analyzer *a)
 {
     static const double zero[6];
-    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->i[0] = 1;
+    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->units.mm = 1;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
-    op->i[0] = 1;
+    op->offset.index = 1;
     ncp_an_emit6(a, NCP_C_SET_G92_OFFSET, zero);
     ncp_an_emit(a, NCP_C_SET_XY_ROTATION);
-    ncp_an_emit(a, NCP_C_SET_FEED_REFERENCE)->i[0] = 1;
+    ncp_an_emit(a, NCP_C_SET_FEED_REFERENCE)->feed_reference.xyz = 1;
     ncp_an_emit(a, NCP_C_ON_RESET);
 }
 
@@ -264,46 +111,6 @@ static int ncp_an_eof(struct ncp_analyzer *a, const struct ncp_source *src)
     if (src && src->has_percent)
         return ncp_an_error(a, 0, "File ended with no percent sign");
     return ncp_an_error(a, 0, "File ended with no percent sign or program end");
-}
-
-/* G7 (lathe diameter mode): an X word is a diameter, so the axis moves half
- * of it, whatever uses X (moves, G10, G92, G28, cycles). rs274 halves X as it
- * reads the word when the mode is already on, then, if this block's G7 turns
- * it on, halves it there, or, if its G8 turns it off, doubles it back: done
- * in that order here, so every value (even a subnormal) comes out as rs274's.
- * Before any step of the block uses X, after the checks that only look at
- * whether it is there. */
-static void ncp_lathe_x_word(struct ncp_analyzer *a)
-{
-    struct ncp_words *w = &a->w;
-    if (!NCP_HAS(w, 'X'))
-        return;
-    int before = a->st.m.lathe_diameter, g = w->g[NCP_GG_LATHE];
-    double *x = &w->v[NCP_LETTER('X')];
-    if (before)
-        *x /= 2;
-    if (g == 70 && !before)
-        *x /= 2;
-    else if (g == 80 && before)
-        *x *= 2;
-}
-
-/* A block as rs274 reads and executes it: what the canon did since the last
- * one read back, the words, their checks, then the steps in rs274's order. */
-int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b)
-{
-    a->blk = b;
-    ncp_sai_resync(a);
-    int rc = ncp_words_collect(a, b);
-    if (rc == NCP_OK)
-        rc = ncp_words_assign(a, b);
-    if (rc == NCP_OK)
-        rc = ncp_modal_check(a);
-    if (rc == NCP_OK) {
-        ncp_lathe_x_word(a);
-        rc = ncp_exec_block(a);
-    }
-    return rc;
 }
 
 /* An M98 line as rs274's read_o and parse_line read it (the flow's reader):

@@ -1,6 +1,7 @@
 /* Canned cycles G73 G81 G82 G83 G85 G89 in any of the three planes: sticky
  * R/Z/P/Q values, L repeats, G98/G99 retract, incremental positioning, all
  * expanded into traverses, feeds and dwells as rs274 does. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
@@ -40,7 +41,7 @@ static void ncp_cyc_move(struct ncp_cyc *c, enum ncp_canon_kind kind, double p1,
 
 static void ncp_cyc_dwell(struct ncp_cyc *c, double t)
 {
-    ncp_an_emit(c->a, NCP_C_DWELL)->d[0] = t;
+    ncp_an_emit(c->a, NCP_C_DWELL)->dwell.seconds = t;
 }
 
 static void ncp_cyc_peck(struct ncp_cyc *c, int motion, double x, double y, double r,
@@ -71,7 +72,7 @@ static void ncp_cyc_orient(struct ncp_cyc *c)
 {
     ncp_an_emit(c->a, NCP_C_STOP_SPINDLE_TURNING);
     /* rs274 passes its CANON_DIRECTION value: 2 clockwise, 3 counterclockwise */
-    ncp_an_emit(c->a, NCP_C_ORIENT_SPINDLE)->i[1] = c->a->st.m.spindle_dir > 0 ? 2 : 3;
+    ncp_an_emit(c->a, NCP_C_ORIENT_SPINDLE)->orient.direction = c->a->st.m.spindle_dir > 0 ? 2 : 3;
 }
 
 /* G87 back boring: out to the offset point, down, back in, cut up to the
@@ -259,12 +260,12 @@ static void ncp_cyc_motion_mode(struct ncp_analyzer *a, int on)
         return;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_MOTION_CONTROL_MODE);
     if (on) {
-        op->i[0] = 1;
+        op->motion_control.mode = 1;
         return;
     }
-    op->i[0] = m->control;
-    op->d[0] = m->p_tol;
-    ncp_an_emit(a, NCP_C_SET_NAIVECAM_TOLERANCE)->d[0] = m->q_tol;
+    op->motion_control.mode = m->control;
+    op->motion_control.tolerance = m->p_tol;
+    ncp_an_emit(a, NCP_C_SET_NAIVECAM_TOLERANCE)->naivecam.tolerance = m->q_tol;
 }
 
 int ncp_canned_run(struct ncp_analyzer *a, int motion)

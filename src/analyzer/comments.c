@@ -2,6 +2,7 @@
  * %d %f %.Nf formats, as rs274 expands them), LOGOPEN/LOGAPPEND/LOGCLOSE.
  * PRINT is a call of its own that prints nothing in the canonical stream:
  * rs274 writes it to its stdout, cnc-run to stderr. */
+#include "floor.h"
 #include "state.h"
 
 #include <ctype.h>

@@ -2,6 +2,7 @@
  * moves while it is engaged, and the flush at stop codes. The queue and the
  * geometry live in cutcomp.c; here we translate state and words into its
  * requests and keep the programmed/compensated points straight. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
@@ -82,17 +83,17 @@ int ncp_comp_move_arc(struct ncp_analyzer *a, const struct ncp_canon *req, const
     int rc = ncp_an_commit(a);
     if (rc != NCP_OK)
         return rc;
-    struct ncp_comp_move m = {.motion = req->i[0] > 0 ? 3 : 2, .inches = a->st.m.inches,
-                              .line = a->line, .turns = req->i[2]};
+    struct ncp_comp_move m = {.motion = req->arc.dir > 0 ? 3 : 2, .inches = a->st.m.inches,
+                              .line = a->line, .turns = req->arc.turns};
     ncp_comp_plane(a->comp.plane, a->st.pos, m.start);
     ncp_comp_plane(a->comp.plane, end, m.end);
     m.abc[0] = end[NCP_A];
     m.abc[1] = end[NCP_B];
     m.abc[2] = end[NCP_C];
-    m.radius_form = req->i[1];
-    m.r = req->d[8];
-    m.centre[0] = req->d[8];
-    m.centre[1] = req->d[9];
+    m.radius_form = req->arc.radius_form;
+    m.r = req->arc.radius;
+    m.centre[0] = req->arc.first_centre;
+    m.centre[1] = req->arc.second_centre;
     return ncp_cutcomp_move(&a->comp, &m, &sink, &a->err);
 }
 

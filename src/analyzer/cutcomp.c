@@ -1,8 +1,7 @@
 /* The sequential half of cutter compensation: rs274's queue of calls held back
  * until the next move fixes the corner. See cutcomp.h. */
 #include "cutcomp.h"
-#include "../executor/arc_geom.h"
-#include "../executor/comp_geom.h"
+#include "ncpar/geom.h"
 
 #include <math.h>
 #include <string.h>
@@ -91,29 +90,29 @@ static int ncp_emit_entry(const struct ncp_cutcomp *c, const struct ncp_comp_ent
     struct ncp_canon op = {0};
     if (e->kind == NCP_CQ_ARC) {
         op.kind = NCP_C_ARC_FEED;
-        op.d[0] = ncp_lathe_z(c, e->p[0]);
-        op.d[1] = ncp_lathe_x(c, e->p[1]);
-        op.d[2] = ncp_lathe_z(c, e->centre[0]);
-        op.d[3] = ncp_lathe_x(c, e->centre[1]);
-        op.i[0] = e->turn;
-        op.d[4] = e->p[2];
-        op.d[5] = e->abc[0];
-        op.d[6] = e->abc[1];
-        op.d[7] = e->abc[2];
+        op.arc_feed.first_end = ncp_lathe_z(c, e->p[0]);
+        op.arc_feed.second_end = ncp_lathe_x(c, e->p[1]);
+        op.arc_feed.first_axis = ncp_lathe_z(c, e->centre[0]);
+        op.arc_feed.second_axis = ncp_lathe_x(c, e->centre[1]);
+        op.arc_feed.rotation = e->turn;
+        op.arc_feed.axis_end = e->p[2];
+        op.arc_feed.abc[0] = e->abc[0];
+        op.arc_feed.abc[1] = e->abc[1];
+        op.arc_feed.abc[2] = e->abc[2];
     } else {
         op.kind = e->kind == NCP_CQ_FEED ? NCP_C_STRAIGHT_FEED : NCP_C_STRAIGHT_TRAVERSE;
         if (c->plane == 2) {
-            op.d[0] = ncp_lathe_x(c, e->p[1]);
-            op.d[1] = e->p[2];
-            op.d[2] = ncp_lathe_z(c, e->p[0]);
+            op.move.end[0] = ncp_lathe_x(c, e->p[1]);
+            op.move.end[1] = e->p[2];
+            op.move.end[2] = ncp_lathe_z(c, e->p[0]);
         } else {
-            op.d[0] = e->p[0];
-            op.d[1] = e->p[1];
-            op.d[2] = e->p[2];
+            op.move.end[0] = e->p[0];
+            op.move.end[1] = e->p[1];
+            op.move.end[2] = e->p[2];
         }
-        op.d[3] = e->abc[0];
-        op.d[4] = e->abc[1];
-        op.d[5] = e->abc[2];
+        op.move.end[3] = e->abc[0];
+        op.move.end[4] = e->abc[1];
+        op.move.end[5] = e->abc[2];
     }
     return sink->emit(sink->ctx, &op, NULL, 0);
 }
@@ -139,7 +138,7 @@ static void ncp_set_endpoint(struct ncp_cutcomp *c, double x, double y)
 
 static int ncp_comp_fail(struct ncp_diag *d, uint32_t line, int status)
 {
-    return ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "%s", ncp_comp_strerror(status));
+    return ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "%s", ncp_geom_comp_strerror(status));
 }
 
 /* Moves the end of every queued move to (x, y) (an inside corner), refusing
@@ -156,10 +155,10 @@ static int ncp_move_endpoint_and_flush(struct ncp_cutcomp *c, double x, double y
         if (e->kind == NCP_CQ_ARC) {
             double r1 = hypot(e->p[0] - e->centre[0], e->p[1] - e->centre[1]);
             double r2 = hypot(x - e->centre[0], y - e->centre[1]);
-            double l2 = ncp_comp_find_turn(c->endpoint, e->centre, e->turn, to);
+            double l2 = ncp_geom_comp_find_turn(c->endpoint, e->centre, e->turn, to);
             if (fabs(r1 - r2) > .01)
                 return ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0,
-                                    "%s r1 %f r2 %f", ncp_comp_strerror(NCP_COMP_E_ARC_MISMATCH),
+                                    "%s r1 %f r2 %f", ncp_geom_comp_strerror(NCP_COMP_E_ARC_MISMATCH),
                                     r1, r2);
             double slack = c->inches ? .001 : .0254;
             if (e->original_turns != 0.0 && c->endpoint_valid &&
@@ -489,7 +488,7 @@ static int ncp_comp_arc_solve(const struct ncp_cutcomp *c, const struct ncp_comp
     int inside = ncp_tool_inside(c->side, ccw);
     if (check_fit && in->radius_form && fabs(m->r) <= c->radius && inside)
         return ncp_comp_fail(d, m->line, NCP_COMP_E_TOOL_TOO_BIG);
-    int st = ncp_arc_solve(in, out);
+    int st = ncp_geom_arc_solve(in, out);
     if (st != NCP_ARC_OK)
         return ncp_arc_fail(c, in, st, out, d, m->line);
     if (check_fit && !in->radius_form && out->r1 <= c->radius && inside)
@@ -507,9 +506,10 @@ static int ncp_comp_arc_feed(struct ncp_cutcomp *c, const struct ncp_arc_in *in,
         return NCP_OK;
     struct ncp_canon op = c->inv_feed;
     c->inv_pending = 0;
-    double rate = ncp_arc_length(in, out, op.d[1], axis_end) * op.d[0];
-    op.d[0] = rate > 0.1 ? rate : 0.1;
-    op.d[1] = 0.0;
+    double rate = ncp_geom_arc_length(in, out, op.feed_rate.arc_axis_start, axis_end) *
+                  op.feed_rate.rate;
+    op.feed_rate.rate = rate > 0.1 ? rate : 0.1;
+    op.feed_rate.arc_axis_start = 0.0;
     op.flags &= (uint16_t)~NCP_FEED_F_INVERSE_ARC;
     return ncp_cutcomp_other(c, &op, NULL, 0, sink, d, line);
 }
@@ -533,7 +533,7 @@ static int ncp_line_first(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
 {
     (void)sink;
     double end[2], dir[2];
-    int st = ncp_comp_line_entry(c->side, c->radius, m->start, m->end, end, dir);
+    int st = ncp_geom_comp_line_entry(c->side, c->radius, m->start, m->end, end, dir);
     if (st != NCP_COMP_OK)
         return ncp_comp_fail(d, m->line, st);
     ncp_set_endpoint(c, m->start[0], m->start[1]);
@@ -562,7 +562,7 @@ static int ncp_line_next(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
     }
     struct ncp_comp_prev front = ncp_front(c);
     struct ncp_comp_corner_out out;
-    int st = ncp_comp_line_next(c->side, c->radius, cur, op, p, &front, &out);
+    int st = ncp_geom_comp_line_next(c->side, c->radius, cur, op, p, &front, &out);
     if (st != NCP_COMP_OK)
         return ncp_comp_fail(d, m->line, st);
     int rc;
@@ -608,7 +608,7 @@ static int ncp_arc_first(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
     if (rc != NCP_OK)
         return rc;
     double end[2], centre[2];
-    int st = ncp_comp_arc_entry(c->side, c->radius, s, m->end, arc.centre, arc.rotation,
+    int st = ncp_geom_comp_arc_entry(c->side, c->radius, s, m->end, arc.centre, arc.rotation,
                                 ncp_spiral_tol(c), end, centre);
     if (st != NCP_COMP_OK)
         return ncp_comp_fail(d, m->line, st);
@@ -620,7 +620,7 @@ static int ncp_arc_first(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
         ncp_set_endpoint(c, s[0], s[1]);
     }
     if (rc == NCP_OK)
-        rc = ncp_push_arc(c, ncp_comp_find_turn(s, arc.centre, arc.rotation, m->end), end,
+        rc = ncp_push_arc(c, ncp_geom_comp_find_turn(s, arc.centre, arc.rotation, m->end), end,
                           centre, arc.rotation, m->end[2], m->abc, d, m->line);
     ncp_comp_advance(c, end, m->end, m->end[2]);
     return rc;
@@ -640,7 +640,7 @@ static int ncp_arc_next(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
         return rc;
     struct ncp_comp_prev front = ncp_front(c);
     struct ncp_comp_corner_out out;
-    int st = ncp_comp_arc_next(c->side, c->radius, cur, op, m->end, arc.centre, m->motion == 3,
+    int st = ncp_geom_comp_arc_next(c->side, c->radius, cur, op, m->end, arc.centre, m->motion == 3,
                                arc.rotation, &front, &out);
     if (st != NCP_COMP_OK)
         return ncp_comp_fail(d, m->line, st);
@@ -660,7 +660,7 @@ static int ncp_arc_next(struct ncp_cutcomp *c, const struct ncp_comp_move *m,
     }
     if (rc != NCP_OK)
         return rc;
-    rc = ncp_push_arc(c, ncp_comp_find_turn(op, arc.centre, arc.rotation, m->end), out.end,
+    rc = ncp_push_arc(c, ncp_geom_comp_find_turn(op, arc.centre, arc.rotation, m->end), out.end,
                       arc.centre, arc.rotation, m->end[2], m->abc, d, m->line);
     ncp_comp_advance(c, out.end, m->end, m->end[2]);
     return rc;

@@ -7,7 +7,7 @@
  * keep their place after it. This module keeps that queue, so the analyzer
  * core hands it every move and canonical call while compensation is engaged
  * and it passes them on, finished, through a sink. Geometry per move is a few
- * atan2/hypot calls (src/executor/comp_geom.cpp).
+ * atan2/hypot calls (src/geom/comp.cpp).
  *
  * Plane coordinates: XY plane (G17) first=x second=y axis=z; XZ plane (G18)
  * first=z second=x axis=y, as rs274 and ARC_FEED order them. */

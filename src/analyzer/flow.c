@@ -127,7 +127,7 @@ struct ncp_flow {
     size_t label_len;
 };
 
-static void name_set(struct flow_name *n, const char *s, size_t len)
+static void ncp_flow_name_set(struct flow_name *n, const char *s, size_t len)
 {
     if (len >= sizeof n->s)
         len = sizeof n->s - 1;
@@ -137,34 +137,34 @@ static void name_set(struct flow_name *n, const char *s, size_t len)
     n->on = 1;
 }
 
-static int name_eq(const struct flow_name *n, const char *s, size_t len)
+static int ncp_flow_name_eq(const struct flow_name *n, const char *s, size_t len)
 {
     return n->on && n->len == len && memcmp(n->s, s, len) == 0;
 }
 
-static const struct ncp_source *file_src(const struct ncp_flow *f, uint32_t file)
+static const struct ncp_source *ncp_flow_file_src(const struct ncp_flow *f, uint32_t file)
 {
     return file == 0 ? f->prog : &f->files[file - 1].src;
 }
 
-static const char *file_name(const struct ncp_flow *f, uint32_t file)
+static const char *ncp_flow_file_name(const struct ncp_flow *f, uint32_t file)
 {
     const char *n = file == 0 ? f->prog->name : f->files[file - 1].name;
     return n ? n : "";
 }
 
 /* Every move of the position goes through here: it may change file. */
-static void go_to(struct ncp_flow *f, struct flow_pos p)
+static void ncp_flow_go_to(struct ncp_flow *f, struct flow_pos p)
 {
     f->cur = p;
-    f->src = file_src(f, p.file);
+    f->src = ncp_flow_file_src(f, p.file);
 }
 
 /* ======================================================================
  * Label table
  * ====================================================================== */
 
-static uint32_t flow_hash(const char *s, size_t n)
+static uint32_t ncp_flow_hash(const char *s, size_t n)
 {
     uint32_t h = 2166136261u;
     for (size_t i = 0; i < n; i++) {
@@ -174,12 +174,12 @@ static uint32_t flow_hash(const char *s, size_t n)
     return h;
 }
 
-static struct flow_label *labels_find(const struct flow_labels *t, const char *k,
+static struct flow_label *ncp_flow_labels_find(const struct flow_labels *t, const char *k,
                                       size_t len)
 {
     if (!t->cap)
         return NULL;
-    uint32_t h = flow_hash(k, len), mask = t->cap - 1;
+    uint32_t h = ncp_flow_hash(k, len), mask = t->cap - 1;
     for (uint32_t i = h & mask;; i = (i + 1) & mask) {
         struct flow_label *e = &t->slots[i];
         if (!e->key_len)
@@ -189,7 +189,7 @@ static struct flow_label *labels_find(const struct flow_labels *t, const char *k
     }
 }
 
-static int labels_grow(struct flow_labels *t)
+static int ncp_flow_labels_grow(struct flow_labels *t)
 {
     uint32_t ncap = t->cap ? t->cap * 2 : 64;
     struct flow_label *ns = calloc(ncap, sizeof *ns);
@@ -210,9 +210,9 @@ static int labels_grow(struct flow_labels *t)
 }
 
 /* Add a new key (the caller checked it is absent). NULL when out of memory. */
-static struct flow_label *labels_add(struct flow_labels *t, const char *k, size_t len)
+static struct flow_label *ncp_flow_labels_add(struct flow_labels *t, const char *k, size_t len)
 {
-    if ((t->count + 1) * 2 > t->cap && labels_grow(t) != 0)
+    if ((t->count + 1) * 2 > t->cap && ncp_flow_labels_grow(t) != 0)
         return NULL;
     if (t->used + len > t->acap) {
         size_t ncap = t->acap ? t->acap : 1024;
@@ -225,7 +225,7 @@ static struct flow_label *labels_add(struct flow_labels *t, const char *k, size_
         t->acap = ncap;
     }
     memcpy(t->arena + t->used, k, len);
-    uint32_t h = flow_hash(k, len), mask = t->cap - 1, i = h & mask;
+    uint32_t h = ncp_flow_hash(k, len), mask = t->cap - 1, i = h & mask;
     while (t->slots[i].key_len)
         i = (i + 1) & mask;
     struct flow_label *e = &t->slots[i];
@@ -236,7 +236,7 @@ static struct flow_label *labels_add(struct flow_labels *t, const char *k, size_
     return e;
 }
 
-static void labels_clear(struct flow_labels *t)
+static void ncp_flow_labels_clear(struct flow_labels *t)
 {
     if (t->count)
         memset(t->slots, 0, t->cap * sizeof *t->slots);
@@ -248,7 +248,7 @@ static void labels_clear(struct flow_labels *t)
  * Block source: the feed, or re-reading the text behind it
  * ====================================================================== */
 
-static void release_feed(struct ncp_flow *f)
+static void ncp_flow_release_feed(struct ncp_flow *f)
 {
     if (f->feed_held) {
         f->feed_held = 0;
@@ -258,12 +258,12 @@ static void release_feed(struct ncp_flow *f)
 }
 
 /* O-word lines, and M98 lines, which rs274 reads even where it skips */
-static int may_be_oword(const char *s, size_t n)
+static int ncp_flow_may_be_oword(const char *s, size_t n)
 {
     return memchr(s, 'o', n) || memchr(s, 'O', n) || memchr(s, 'm', n) || memchr(s, 'M', n);
 }
 
-static int from_feed(struct ncp_flow *f, const struct ncp_block **out)
+static int ncp_flow_from_feed(struct ncp_flow *f, const struct ncp_block **out)
 {
     if (f->feed_done)
         return NCP_END;
@@ -289,7 +289,7 @@ static int from_feed(struct ncp_flow *f, const struct ncp_block **out)
 
 /* Sets *out to NULL for a block skipped without lexing it (skipping, and its
  * text cannot hold an O-word). */
-static int from_text(struct ncp_flow *f, int skipping, const struct ncp_block **out,
+static int ncp_flow_from_text(struct ncp_flow *f, int skipping, const struct ncp_block **out,
                      struct ncp_diag *d)
 {
     if (!f->cache) {
@@ -312,7 +312,7 @@ static int from_text(struct ncp_flow *f, int skipping, const struct ncp_block **
     f->cur.off = sp.next;
     f->cur.line = sp.line + 1;
     const char *text = f->src->text + sp.off;
-    if (skipping && !may_be_oword(text, sp.len)) {
+    if (skipping && !ncp_flow_may_be_oword(text, sp.len)) {
         *out = NULL;
         return NCP_OK;
     }
@@ -324,20 +324,20 @@ static int from_text(struct ncp_flow *f, int skipping, const struct ncp_block **
     return NCP_OK;
 }
 
-static int fetch(struct ncp_flow *f, int skipping, const struct ncp_block **out,
+static int ncp_flow_fetch(struct ncp_flow *f, int skipping, const struct ncp_block **out,
                  struct ncp_diag *d)
 {
-    release_feed(f);
+    ncp_flow_release_feed(f);
     if (f->cur.file == 0 && f->cur.off >= f->feed_pos.off)
-        return from_feed(f, out);
-    return from_text(f, skipping, out, d);
+        return ncp_flow_from_feed(f, out);
+    return ncp_flow_from_text(f, skipping, out, d);
 }
 
 /* ======================================================================
  * Messages
  * ====================================================================== */
 
-static const char *kind_name(int kind)
+static const char *ncp_flow_kind_name(int kind)
 {
     static const char *const names[] = {
         [NCP_O_NONE] = "none", [NCP_O_SUB] = "sub", [NCP_O_ENDSUB] = "endsub",
@@ -354,7 +354,7 @@ static const char *kind_name(int kind)
 }
 
 /* The block's text as rs274 quotes it: trailing blanks cut, kept short. */
-static int line_text(const struct ncp_flow *f, const struct ncp_block *b,
+static int ncp_flow_line_text(const struct ncp_flow *f, const struct ncp_block *b,
                      const char **s)
 {
     size_t n = b->length;
@@ -366,35 +366,35 @@ static int line_text(const struct ncp_flow *f, const struct ncp_block *b,
     return n > 80 ? 80 : (int)n;
 }
 
-static int oword_error(const struct ncp_block *b, const char *what,
+static int ncp_flow_oword_error(const struct ncp_block *b, const char *what,
                        struct ncp_diag *d)
 {
     return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col, "%s", what);
 }
 
-static int err_undefined(struct ncp_flow *f, const struct ncp_block *b,
+static int ncp_flow_err_undefined(struct ncp_flow *f, const struct ncp_block *b,
                          struct ncp_diag *d)
 {
     const char *s;
-    int n = line_text(f, b, &s);
+    int n = ncp_flow_line_text(f, b, &s);
     return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                         "undefined O-word label: '%.*s'", n, s);
 }
 
 /* "found 'while' in line 3" */
-static int err_mismatch(struct ncp_flow *f, const struct ncp_block *b,
+static int ncp_flow_err_mismatch(struct ncp_flow *f, const struct ncp_block *b,
                         const char *what, const struct flow_label *op,
                         struct ncp_diag *d)
 {
     const char *s;
-    int n = line_text(f, b, &s);
+    int n = ncp_flow_line_text(f, b, &s);
     return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                         "%s: '%.*s' (found '%s' in line %u)", what, n, s,
-                        kind_name(op->type), op->line);
+                        ncp_flow_kind_name(op->type), op->line);
 }
 
 /* How a user wrote the O-word: o100 or o<name>. */
-static void display_name(const struct ncp_block *b, char *buf, size_t cap)
+static void ncp_flow_display_name(const struct ncp_block *b, char *buf, size_t cap)
 {
     const char *s = b->pool + b->oword.name_off;
     size_t n = b->oword.name_len, i = 0;
@@ -412,7 +412,7 @@ static void display_name(const struct ncp_block *b, char *buf, size_t cap)
  * The O-word state machine
  * ====================================================================== */
 
-static int is_global_kind(int kind)
+static int ncp_flow_is_global_kind(int kind)
 {
     return kind == NCP_O_SUB || kind == NCP_O_ENDSUB || kind == NCP_O_CALL ||
            kind == NCP_O_RETURN || kind >= NCP_O_FANUC;
@@ -420,7 +420,7 @@ static int is_global_kind(int kind)
 
 /* Subroutine names are global; other labels belong to the subroutine they are
  * written in (the called one, or the one being defined), as "sub#label". */
-static void make_label(struct ncp_flow *f, const struct ncp_block *b)
+static void ncp_flow_make_label(struct ncp_flow *f, const struct ncp_block *b)
 {
     const char *name = b->pool + b->oword.name_off;
     size_t len = b->oword.name_len, n = 0;
@@ -434,7 +434,7 @@ static void make_label(struct ncp_flow *f, const struct ncp_block *b)
     }
     if (len > FLOW_NAME_MAX)
         len = FLOW_NAME_MAX;
-    if (!is_global_kind(b->oword.kind)) {
+    if (!ncp_flow_is_global_kind(b->oword.kind)) {
         if (f->level > 0) {
             memcpy(f->label, f->frames[f->level].name, f->frames[f->level].name_len);
             n = f->frames[f->level].name_len;
@@ -449,18 +449,18 @@ static void make_label(struct ncp_flow *f, const struct ncp_block *b)
     f->label[f->label_len] = '\0';
 }
 
-static int skipping_other(const struct ncp_flow *f)
+static int ncp_flow_skipping_other(const struct ncp_flow *f)
 {
-    return f->skip.on && !name_eq(&f->skip, f->label, f->label_len);
+    return f->skip.on && !ncp_flow_name_eq(&f->skip, f->label, f->label_len);
 }
 
-static void skip_to_label(struct ncp_flow *f, const struct ncp_block *b)
+static void ncp_flow_skip_to_label(struct ncp_flow *f, const struct ncp_block *b)
 {
-    name_set(&f->skip, f->label, f->label_len);
+    ncp_flow_name_set(&f->skip, f->label, f->label_len);
     f->skip_start = b->line;
 }
 
-static int eval(struct ncp_flow *f, const struct ncp_block *b, const struct ncp_expr *e,
+static int ncp_flow_eval(struct ncp_flow *f, const struct ncp_block *b, const struct ncp_expr *e,
                 double *v, struct ncp_diag *d)
 {
     if (e->is_const) {
@@ -472,7 +472,7 @@ static int eval(struct ncp_flow *f, const struct ncp_block *b, const struct ncp_
 
 /* While rs274 skips over a subroutine definition it still evaluates the
  * endsub/return value, but an undefined named parameter reads as 0 there. */
-static int lenient_get_named(void *ctx, const char *name, size_t len, double *out,
+static int ncp_flow_lenient_get_named(void *ctx, const char *name, size_t len, double *out,
                              struct ncp_diag *d)
 {
     const struct ncp_params *p = ctx;
@@ -483,7 +483,7 @@ static int lenient_get_named(void *ctx, const char *name, size_t len, double *ou
     return ncp_params_get_named(p, name, len, out, d);
 }
 
-static int eval_lenient(struct ncp_flow *f, const struct ncp_block *b,
+static int ncp_flow_eval_lenient(struct ncp_flow *f, const struct ncp_block *b,
                         const struct ncp_expr *e, double *v, struct ncp_diag *d)
 {
     if (e->is_const) {
@@ -491,30 +491,30 @@ static int eval_lenient(struct ncp_flow *f, const struct ncp_block *b,
         return NCP_OK;
     }
     struct ncp_param_ops ops = ncp_params_ops(f->params);
-    ops.get_named = lenient_get_named;
+    ops.get_named = ncp_flow_lenient_get_named;
     return ncp_expr_eval(b, e, &ops, v, d);
 }
 
-static struct flow_label *find_label(struct ncp_flow *f)
+static struct flow_label *ncp_flow_find_label(struct ncp_flow *f)
 {
-    return labels_find(&f->labels, f->label, f->label_len);
+    return ncp_flow_labels_find(&f->labels, f->label, f->label_len);
 }
 
-static int save_label(struct ncp_flow *f, const struct ncp_block *b,
+static int ncp_flow_save_label(struct ncp_flow *f, const struct ncp_block *b,
                       struct flow_label **out, struct ncp_diag *d)
 {
-    const struct flow_label *old = find_label(f);
+    const struct flow_label *old = ncp_flow_find_label(f);
     if (old) {
-        const char *file = file_name(f, f->cur.file);
+        const char *file = ncp_flow_file_name(f, f->cur.file);
         if (old->line == b->line && old->file == f->cur.file)
             return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                                 "File:%s line:%u sub: o|%s| found in illegal location",
                                 file, b->line, f->label);
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                             "File:%s line:%u redefining sub: o|%s| already defined in "
-                            "file:%s", file, b->line, f->label, file_name(f, old->file));
+                            "file:%s", file, b->line, f->label, ncp_flow_file_name(f, old->file));
     }
-    struct flow_label *e = labels_add(&f->labels, f->label, f->label_len);
+    struct flow_label *e = ncp_flow_labels_add(&f->labels, f->label, f->label_len);
     if (!e)
         return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
     e->type = b->oword.kind;
@@ -526,9 +526,9 @@ static int save_label(struct ncp_flow *f, const struct ncp_block *b,
     return NCP_OK;
 }
 
-static void jump_to(struct ncp_flow *f, const struct flow_label *op)
+static void ncp_flow_jump_to(struct ncp_flow *f, const struct flow_label *op)
 {
-    go_to(f, (struct flow_pos){ op->off, op->line, op->file });
+    ncp_flow_go_to(f, (struct flow_pos){ op->off, op->line, op->file });
     f->jump_target = op->off;
 }
 
@@ -536,29 +536,29 @@ static void jump_to(struct ncp_flow *f, const struct flow_label *op)
  * reached by falling into it, not by a jump back: so a loop left by return
  * starts afresh next time, while rs274's leftover continue flag, which can
  * send an exhausted loop back to its start for ever, keeps counting. */
-static void loop_entered(const struct ncp_flow *f, struct flow_label *op)
+static void ncp_flow_loop_entered(const struct ncp_flow *f, struct flow_label *op)
 {
     if (!f->by_jump)
         op->iterations = op->idle_laps = 0;
 }
 
-static int runaway(const struct ncp_flow *f, const struct ncp_block *b,
+static int ncp_flow_runaway(const struct ncp_flow *f, const struct ncp_block *b,
                    const struct flow_label *op, struct ncp_diag *d)
 {
     char name[80];
-    display_name(b, name, sizeof name);
+    ncp_flow_display_name(b, name, sizeof name);
     return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
                         "loop %s at line %u repeated more than %u times: runaway loop? "
                         "(raise max_loop_iterations if intended)",
                         name, op->line, f->max_loops);
 }
 
-static int count_iteration(struct ncp_flow *f, const struct ncp_block *b,
+static int ncp_flow_count_iteration(struct ncp_flow *f, const struct ncp_block *b,
                            struct flow_label *op, struct ncp_diag *d)
 {
     if (++op->iterations <= f->max_loops)
         return NCP_OK;
-    return runaway(f, b, op, d);
+    return ncp_flow_runaway(f, b, op, d);
 }
 
 /* A loop head reached by a jump back whose test ends the loop: once per run
@@ -566,17 +566,17 @@ static int count_iteration(struct ncp_flow *f, const struct ncp_block *b,
  * the first) can send control back to it for ever, each lap running what
  * lies between the two and no iteration. rs274 loops; we count those laps
  * against the same limit. */
-static int count_idle_lap(struct ncp_flow *f, const struct ncp_block *b,
+static int ncp_flow_count_idle_lap(struct ncp_flow *f, const struct ncp_block *b,
                           struct flow_label *op, struct ncp_diag *d)
 {
     if (!f->by_jump || ++op->idle_laps <= f->max_loops)
         return NCP_OK;
-    return runaway(f, b, op, d);
+    return ncp_flow_runaway(f, b, op, d);
 }
 
 /* What rs274 does while reading an O-word line: evaluate its expressions unless
  * it is being skipped. *ignore = 1 when the block has no effect at all. */
-static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore,
+static int ncp_flow_read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore,
                       struct ncp_diag *d)
 {
     const struct ncp_oword *o = &b->oword;
@@ -587,12 +587,12 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
     case NCP_O_SUB:
     case NCP_O_FANUC:
         if (f->defining.on)
-            return oword_error(b, "Nested subroutine definition", d);
+            return ncp_flow_oword_error(b, "Nested subroutine definition", d);
         return NCP_OK;
     case NCP_O_M99: /* read as an O-word in a sub only (level > 0) */
         if (f->defining.on)
-            return oword_error(b, "Found 'M99' instead of 'O endsub' after 'O sub'", d);
-        if (skipping_other(f)) {
+            return ncp_flow_oword_error(b, "Found 'M99' instead of 'O endsub' after 'O sub'", d);
+        if (ncp_flow_skipping_other(f)) {
             *ignore = 1;
             return NCP_OK;
         }
@@ -604,7 +604,7 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
         return NCP_OK;
     case NCP_O_ENDSUB:
     case NCP_O_RETURN:
-        if (skipping_other(f)) {
+        if (ncp_flow_skipping_other(f)) {
             *ignore = 1;
             return NCP_OK;
         }
@@ -612,8 +612,8 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
             ncp_params_set_return(f->params, 0.0, 0);
             return NCP_OK;
         }
-        rc = f->defining.on && f->level == 0 ? eval_lenient(f, b, &o->cond, &v, d)
-                                              : eval(f, b, &o->cond, &v, d);
+        rc = f->defining.on && f->level == 0 ? ncp_flow_eval_lenient(f, b, &o->cond, &v, d)
+                                              : ncp_flow_eval(f, b, &o->cond, &v, d);
         if (rc == NCP_OK)
             ncp_params_set_return(f->params, v, 1);
         return rc;
@@ -632,7 +632,7 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
         }
         f->nargs = o->nargs > NCP_OWORD_MAX_ARGS ? NCP_OWORD_MAX_ARGS : o->nargs;
         for (int i = 0; i < f->nargs; i++) {
-            rc = eval(f, b, &o->args[i], &f->args[i], d);
+            rc = ncp_flow_eval(f, b, &o->args[i], &f->args[i], d);
             if (rc != NCP_OK)
                 return rc;
         }
@@ -641,16 +641,16 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
     case NCP_O_REPEAT:
     case NCP_O_IF:
     case NCP_O_ELSEIF:
-        if (skipping_other(f)) {
+        if (ncp_flow_skipping_other(f)) {
             *ignore = 1;
             return NCP_OK;
         }
         if (!o->has_cond) {
             char msg[64];
-            snprintf(msg, sizeof msg, "Left bracket missing after '%s'", kind_name(o->kind));
-            return oword_error(b, msg, d);
+            snprintf(msg, sizeof msg, "Left bracket missing after '%s'", ncp_flow_kind_name(o->kind));
+            return ncp_flow_oword_error(b, msg, d);
         }
-        return eval(f, b, &o->cond, &f->test_value, d);
+        return ncp_flow_eval(f, b, &o->cond, &f->test_value, d);
     default:
         return NCP_OK;
     }
@@ -658,10 +658,10 @@ static int read_oword(struct ncp_flow *f, const struct ncp_block *b, int *ignore
 
 /* A sub's first line (o-sub or Fanuc): where a call was skipping ahead to
  * it, it is defined from now on and the skipping ends. */
-static int reach_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_reach_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     if (f->skip.on) {
-        int rc = save_label(f, b, NULL, d);
+        int rc = ncp_flow_save_label(f, b, NULL, d);
         if (rc != NCP_OK)
             return rc;
         f->skip.on = 0;
@@ -670,20 +670,20 @@ static int reach_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
     return NCP_OK;
 }
 
-static int do_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     if (f->frames[f->level].call_type == FLOW_CT_M98)
-        return oword_error(b, "'O.... sub' subroutine must be called with 'O.... call'", d);
-    int reached = reach_sub(f, b, d);
+        return ncp_flow_oword_error(b, "'O.... sub' subroutine must be called with 'O.... call'", d);
+    int reached = ncp_flow_reach_sub(f, b, d);
     if (reached != NCP_OK)
         return reached;
     if (f->level > 0)
         return NCP_OK;           /* the called sub's own first line */
-    int rc = save_label(f, b, NULL, d);
+    int rc = ncp_flow_save_label(f, b, NULL, d);
     if (rc != NCP_OK)
         return rc;
-    skip_to_label(f, b);
-    name_set(&f->defining, f->label, f->label_len);
+    ncp_flow_skip_to_label(f, b);
+    ncp_flow_name_set(&f->defining, f->label, f->label_len);
     f->in_sub_context = 1;
     return NCP_OK;
 }
@@ -691,18 +691,18 @@ static int do_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag
 /* A bare "O100" line: where an M98 call was seeking it, the sub is defined
  * from here on; otherwise (at level 0, or further down in a sub) rs274 just
  * reads on into it, defining nothing. */
-static int do_fanuc(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_fanuc(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     if (f->frames[f->level].call_type == FLOW_CT_OWORD)
-        return oword_error(b, "Fanuc 'O....' subroutine must be called with 'M98'", d);
-    return reach_sub(f, b, d);
+        return ncp_flow_oword_error(b, "Fanuc 'O....' subroutine must be called with 'M98'", d);
+    return ncp_flow_reach_sub(f, b, d);
 }
 
-static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     if (f->level == 0 && !f->in_sub_context) {
         const char *s;
-        int n = line_text(f, b, &s);
+        int n = ncp_flow_line_text(f, b, &s);
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                             "not in a subroutine definition: '%.*s'", n, s);
     }
@@ -710,16 +710,16 @@ static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
         /* a sub is left the way it was entered */
         int ct = f->frames[f->level].call_type;
         if (ct == FLOW_CT_M98 && b->oword.kind != NCP_O_M99)
-            return oword_error(b, "Fanuc 'O....' subroutine definition must end with 'M99'", d);
+            return ncp_flow_oword_error(b, "Fanuc 'O....' subroutine definition must end with 'M99'", d);
         if (ct == FLOW_CT_OWORD && b->oword.kind == NCP_O_M99)
-            return oword_error(b, "'O.... endsub' or 'O.... return' must follow 'O.... sub' "
+            return ncp_flow_oword_error(b, "'O.... endsub' or 'O.... return' must follow 'O.... sub' "
                                   "subroutine definition", d);
     }
     if (f->skip.on && b->oword.kind == NCP_O_ENDSUB)
         f->skip.on = 0;
     if (f->level > 0) {
         ncp_params_pop_call(f->params);
-        go_to(f, f->frames[f->level].ret);
+        ncp_flow_go_to(f, f->frames[f->level].ret);
         f->level--;
         if (f->level == 0)
             f->in_sub_context = 1;
@@ -727,7 +727,7 @@ static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
             f->hooks.left(f->hooks.ctx, f->level + 1);
     } else if (b->oword.kind == NCP_O_ENDSUB) {
         if (!f->defining.on)
-            return oword_error(b, "Not in subroutine definition", d);
+            return ncp_flow_oword_error(b, "Not in subroutine definition", d);
         f->skip.on = 0;
         f->defining.on = 0;
         f->in_sub_context = 0;
@@ -735,7 +735,7 @@ static int do_return(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
     return NCP_OK;
 }
 
-static int grow_frames(struct ncp_flow *f)
+static int ncp_flow_grow_frames(struct ncp_flow *f)
 {
     if (f->level + 1 < f->frames_cap)
         return 0;
@@ -750,7 +750,7 @@ static int grow_frames(struct ncp_flow *f)
 
 /* A regular file that can be read: a folder of the name or no file at all
  * is not one (rs274 opens with fopen, which a folder does not pass for reading). */
-static int is_readable_file(const char *path)
+static int ncp_flow_is_readable_file(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0 && S_ISREG(st.st_mode);
@@ -760,7 +760,7 @@ static int is_readable_file(const char *path)
  * in each folder of the subroutine path; *file = 0 when there is none. A
  * file found is read whole, once: a second call of a sub it defines finds
  * the label. */
-static int open_sub_file(struct ncp_flow *f, const struct ncp_block *b, uint32_t *file,
+static int ncp_flow_open_sub_file(struct ncp_flow *f, const struct ncp_block *b, uint32_t *file,
                          struct ncp_diag *d)
 {
     char path[4096];
@@ -772,7 +772,7 @@ static int open_sub_file(struct ncp_flow *f, const struct ncp_block *b, uint32_t
         int n = dir_len ? snprintf(path, sizeof path, "%.*s/%.*s.ngc", (int)dir_len, dir,
                                    (int)f->label_len, f->label)
                         : snprintf(path, sizeof path, "%.*s.ngc", (int)f->label_len, f->label);
-        if (n > 0 && (size_t)n < sizeof path && is_readable_file(path))
+        if (n > 0 && (size_t)n < sizeof path && ncp_flow_is_readable_file(path))
             break;
         if (*dirs == '\0')
             return NCP_OK;
@@ -806,13 +806,13 @@ static int open_sub_file(struct ncp_flow *f, const struct ncp_block *b, uint32_t
 
 /* A new call level for the sub named by the label: a copy of the arguments
  * for o-word calls, the caller's #1..#30 for M98 (ct). */
-static int enter_call(struct ncp_flow *f, const struct ncp_block *b, int ct,
+static int ncp_flow_enter_call(struct ncp_flow *f, const struct ncp_block *b, int ct,
                       struct ncp_diag *d)
 {
     if ((uint32_t)f->level + 1 >= f->max_depth)
         return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, b->oword.col,
                             "Too many subroutine levels");
-    if (grow_frames(f) != 0)
+    if (ncp_flow_grow_frames(f) != 0)
         return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
     int rc = ct == FLOW_CT_M98 ? ncp_params_push_shared(f->params, d)
                                : ncp_params_push_call(f->params, f->args, f->nargs, d);
@@ -833,39 +833,39 @@ static int enter_call(struct ncp_flow *f, const struct ncp_block *b, int ct,
 /* Go to the called sub's definition: its recorded line, or, not seen yet,
  * rs274 looks for a file of its name first, and reads that from its start
  * for the definition; without one it reads on here. */
-static int go_to_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_go_to_sub(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     f->skip.on = 0;
-    const struct flow_label *op = find_label(f);
+    const struct flow_label *op = ncp_flow_find_label(f);
     if (op) {
-        jump_to(f, op);
+        ncp_flow_jump_to(f, op);
         return NCP_OK;
     }
     uint32_t file = 0;
-    int rc = open_sub_file(f, b, &file, d);
+    int rc = ncp_flow_open_sub_file(f, b, &file, d);
     if (rc != NCP_OK)
         return rc;
-    skip_to_label(f, b);
-    name_set(&f->seek_sub, f->label, f->label_len);
+    ncp_flow_skip_to_label(f, b);
+    ncp_flow_name_set(&f->seek_sub, f->label, f->label_len);
     if (file) {
-        const struct ncp_source *s = file_src(f, file);
-        go_to(f, (struct flow_pos){ s->begin, s->begin_line, file });
+        const struct ncp_source *s = ncp_flow_file_src(f, file);
+        ncp_flow_go_to(f, (struct flow_pos){ s->begin, s->begin_line, file });
         f->skip_start = 0; /* rs274 counts lines afresh in the new file */
     }
     return NCP_OK;
 }
 
-static int do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_call(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    int rc = enter_call(f, b, FLOW_CT_OWORD, d);
-    return rc == NCP_OK ? go_to_sub(f, b, d) : rc;
+    int rc = ncp_flow_enter_call(f, b, FLOW_CT_OWORD, d);
+    return rc == NCP_OK ? ncp_flow_go_to_sub(f, b, d) : rc;
 }
 
 /* M98 P.. [L..], as rs274's execute_call: with L, the calling level counts
  * the repeats down and, while some are left, returns to the M98 line itself,
  * which then runs again (its P read anew); L0 enters the call level and
  * reads on after the M98 line, without going to the sub. */
-static int do_m98(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_m98(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     if (f->m98_l > 0 && (uint32_t)f->m98_l > f->max_loops)
         return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, b->oword.col,
@@ -873,7 +873,7 @@ static int do_m98(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag
                             "(raise max_loop_iterations if intended)",
                             f->m98_l, f->max_loops);
     struct flow_pos here = { b->offset, b->line, f->cur.file };
-    int rc = enter_call(f, b, FLOW_CT_M98, d);
+    int rc = ncp_flow_enter_call(f, b, FLOW_CT_M98, d);
     if (rc != NCP_OK)
         return rc;
     if (f->m98_l >= 0) {
@@ -887,11 +887,11 @@ static int do_m98(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag
         if (f->m98_l == 0)
             return NCP_OK;
     }
-    return go_to_sub(f, b, d);
+    return ncp_flow_go_to_sub(f, b, d);
 }
 
 /* The M98 line's words, read before anything else is done with it. */
-static int read_m98(struct ncp_flow *f, const struct ncp_block *b, int skipping,
+static int ncp_flow_read_m98(struct ncp_flow *f, const struct ncp_block *b, int skipping,
                     struct ncp_diag *d)
 {
     f->m98_p = 0;
@@ -904,7 +904,7 @@ static int read_m98(struct ncp_flow *f, const struct ncp_block *b, int skipping,
         const struct ncp_word *w = &b->words[k];
         if (w->letter != 'P' && w->letter != 'L')
             continue;
-        int rc = eval(f, b, &w->v, &v, d);
+        int rc = ncp_flow_eval(f, b, &w->v, &v, d);
         if (rc != NCP_OK)
             return rc;
         if (w->letter == 'P') {
@@ -915,34 +915,34 @@ static int read_m98(struct ncp_flow *f, const struct ncp_block *b, int skipping,
         }
     }
     if (!has_p)
-        return oword_error(b, "Found 'm98' code with no P-word", d);
+        return ncp_flow_oword_error(b, "Found 'm98' code with no P-word", d);
     if (ncp_rs274_int(p, &f->m98_p) != 0)
-        return oword_error(b, "Non integer value for integer", d);
+        return ncp_flow_oword_error(b, "Non integer value for integer", d);
     return NCP_OK;
 }
 
 /* The label of a loop's opening line (repeat, while): saved the first time it is
  * reached; an error when the name already labels another line, except the `do`
  * that a while line may close (closes_do). */
-static int loop_label(struct ncp_flow *f, const struct ncp_block *b, int closes_do,
+static int ncp_flow_loop_label(struct ncp_flow *f, const struct ncp_block *b, int closes_do,
                       struct flow_label **out, struct ncp_diag *d)
 {
-    struct flow_label *op = find_label(f);
+    struct flow_label *op = ncp_flow_find_label(f);
     if (op && !(closes_do && op->type == NCP_O_DO) && op->line != b->line) {
         const char *s;
-        int n = line_text(f, b, &s);
+        int n = ncp_flow_line_text(f, b, &s);
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                             "duplicate O-word label: '%.*s' - defined in line %u", n, s,
                             op->line);
     }
     *out = op;
-    return op ? NCP_OK : save_label(f, b, out, d);
+    return op ? NCP_OK : ncp_flow_save_label(f, b, out, d);
 }
 
-static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     struct flow_label *op = NULL;
-    int rc = loop_label(f, b, 0, &op, d);
+    int rc = ncp_flow_loop_label(f, b, 0, &op, d);
     if (rc != NCP_OK || !op) /* op is set whenever rc is NCP_OK */
         return rc;
     f->skip.on = 0;
@@ -952,63 +952,63 @@ static int do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_d
         double r = floor(f->test_value + 0.5);
         op->repeat_count = r > INT32_MAX ? INT32_MAX : r < 0 ? 0 : (int32_t)r;
     }
-    loop_entered(f, op);
+    ncp_flow_loop_entered(f, op);
     if (op->repeat_count > 0) {
         op->repeat_count--;
-        return count_iteration(f, b, op, d);
+        return ncp_flow_count_iteration(f, b, op, d);
     }
-    skip_to_label(f, b);
+    ncp_flow_skip_to_label(f, b);
     op->repeat_count = -1;
-    return count_idle_lap(f, b, op, d);
+    return ncp_flow_count_idle_lap(f, b, op, d);
 }
 
-static int do_while(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_while(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     struct flow_label *op = NULL;
-    int rc = loop_label(f, b, 1, &op, d);
+    int rc = ncp_flow_loop_label(f, b, 1, &op, d);
     if (rc != NCP_OK || !op) /* op is set whenever rc is NCP_OK */
         return rc;
     f->skip.on = 0;
     if (op->type == NCP_O_WHILE) {
-        loop_entered(f, op);
+        ncp_flow_loop_entered(f, op);
         if (f->test_value != 0.0)
-            return count_iteration(f, b, op, d);
-        skip_to_label(f, b);
-        return count_idle_lap(f, b, op, d);
+            return ncp_flow_count_iteration(f, b, op, d);
+        ncp_flow_skip_to_label(f, b);
+        return ncp_flow_count_idle_lap(f, b, op, d);
     }
     /* the closing line of a do/while loop */
     if (f->test_value != 0.0 && !f->doing_break) {
-        rc = count_iteration(f, b, op, d);
+        rc = ncp_flow_count_iteration(f, b, op, d);
         if (rc == NCP_OK)
-            jump_to(f, op);
+            ncp_flow_jump_to(f, op);
         return rc;
     }
     f->doing_break = 0;
     return NCP_OK;
 }
 
-static int do_do(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_do(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    struct flow_label *op = find_label(f);
+    struct flow_label *op = ncp_flow_find_label(f);
     f->skip.on = 0;
     if (!op)
-        return save_label(f, b, NULL, d);
-    loop_entered(f, op);
+        return ncp_flow_save_label(f, b, NULL, d);
+    ncp_flow_loop_entered(f, op);
     return NCP_OK;
 }
 
-static int do_if(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_if(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    const struct flow_label *op = find_label(f);
+    const struct flow_label *op = ncp_flow_find_label(f);
     if (op && op->line != b->line) {
         const char *s;
-        int n = line_text(f, b, &s);
+        int n = ncp_flow_line_text(f, b, &s);
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                             "duplicate O-word label - already defined in line %u: '%.*s'",
                             op->line, n, s);
     }
     if (!op) {
-        int rc = save_label(f, b, NULL, d);
+        int rc = ncp_flow_save_label(f, b, NULL, d);
         if (rc != NCP_OK)
             return rc;
     }
@@ -1016,22 +1016,22 @@ static int do_if(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag 
         f->skip.on = 0;
         f->executed_if = 1;
     } else {
-        skip_to_label(f, b);
+        ncp_flow_skip_to_label(f, b);
         f->executed_if = 0;
     }
     return NCP_OK;
 }
 
 /* elseif / else: the label must be an if's. */
-static int do_else(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_else(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    const struct flow_label *op = find_label(f);
+    const struct flow_label *op = ncp_flow_find_label(f);
     if (!op)
-        return err_undefined(f, b, d);
+        return ncp_flow_err_undefined(f, b, d);
     if (op->type != NCP_O_IF)
-        return err_mismatch(f, b, "no matching 'if' label", op, d);
+        return ncp_flow_err_mismatch(f, b, "no matching 'if' label", op, d);
     if (f->executed_if) {
-        skip_to_label(f, b);
+        ncp_flow_skip_to_label(f, b);
         return NCP_OK;
     }
     if (b->oword.kind == NCP_O_ELSEIF) {
@@ -1039,24 +1039,24 @@ static int do_else(struct ncp_flow *f, const struct ncp_block *b, struct ncp_dia
             f->skip.on = 0;
             f->executed_if = 1;
         }
-    } else if (name_eq(&f->skip, f->label, f->label_len)) {
+    } else if (ncp_flow_name_eq(&f->skip, f->label, f->label_len)) {
         f->executed_if = 1;
         f->skip.on = 0;
     }
     return NCP_OK;
 }
 
-static int do_endif(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_endif(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    const struct flow_label *op = find_label(f);
+    const struct flow_label *op = ncp_flow_find_label(f);
     if (!op)
-        return err_undefined(f, b, d);
+        return ncp_flow_err_undefined(f, b, d);
     if (op->type != NCP_O_IF) {
         const char *s;
-        int n = line_text(f, b, &s);
+        int n = ncp_flow_line_text(f, b, &s);
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col,
                             "no matching label: '%s' (found '%s' in line %u): '%.*s'",
-                            f->label, kind_name(op->type), op->line, n, s);
+                            f->label, ncp_flow_kind_name(op->type), op->line, n, s);
     }
     f->skip.on = 0;
     f->executed_if = 1;
@@ -1064,95 +1064,95 @@ static int do_endif(struct ncp_flow *f, const struct ncp_block *b, struct ncp_di
 }
 
 /* break / continue: the label must be a while's or a do's. */
-static int do_break(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_break(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    const struct flow_label *op = find_label(f);
+    const struct flow_label *op = ncp_flow_find_label(f);
     if (!op)
-        return err_undefined(f, b, d);
+        return ncp_flow_err_undefined(f, b, d);
     if (op->type != NCP_O_WHILE && op->type != NCP_O_DO)
-        return err_mismatch(f, b, "no matching while/do label", op, d);
+        return ncp_flow_err_mismatch(f, b, "no matching while/do label", op, d);
     if (b->oword.kind == NCP_O_BREAK) {
         f->doing_break = 1;
     } else {
-        if (name_eq(&f->skip, f->label, f->label_len))
+        if (ncp_flow_name_eq(&f->skip, f->label, f->label_len))
             return NCP_OK;
         f->doing_continue = 1;
     }
-    skip_to_label(f, b);
+    ncp_flow_skip_to_label(f, b);
     return NCP_OK;
 }
 
-static int do_endloop(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_do_endloop(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
-    struct flow_label *op = find_label(f);
+    struct flow_label *op = ncp_flow_find_label(f);
     if (!op)
-        return err_undefined(f, b, d);
+        return ncp_flow_err_undefined(f, b, d);
     int want = b->oword.kind == NCP_O_ENDREPEAT ? NCP_O_REPEAT : NCP_O_WHILE;
     if (op->type != want)
-        return err_mismatch(f, b, "no matching label", op, d);
-    if (name_eq(&f->skip, f->label, f->label_len)) {
+        return ncp_flow_err_mismatch(f, b, "no matching label", op, d);
+    if (ncp_flow_name_eq(&f->skip, f->label, f->label_len)) {
         f->skip.on = 0;
         if (!f->doing_continue)
             return NCP_OK;
         f->doing_continue = 0;
     }
-    jump_to(f, op);
+    ncp_flow_jump_to(f, op);
     return NCP_OK;
 }
 
-static int run_oword(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
+static int ncp_flow_run_oword(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     int ignore;
     if (b->oword.kind == NCP_O_M98) {
-        int rc = read_m98(f, b, f->skip.on, d);
+        int rc = ncp_flow_read_m98(f, b, f->skip.on, d);
         if (rc != NCP_OK)
             return rc;
     }
-    make_label(f, b);
-    int rc = read_oword(f, b, &ignore, d);
-    if (rc != NCP_OK || ignore || skipping_other(f))
+    ncp_flow_make_label(f, b);
+    int rc = ncp_flow_read_oword(f, b, &ignore, d);
+    if (rc != NCP_OK || ignore || ncp_flow_skipping_other(f))
         return rc;
     if (f->seek_sub.on && b->oword.kind != NCP_O_SUB && b->oword.kind != NCP_O_FANUC)
         return NCP_OK;
     switch (b->oword.kind) {
     case NCP_O_SUB:
-        return do_sub(f, b, d);
+        return ncp_flow_do_sub(f, b, d);
     case NCP_O_FANUC:
-        return do_fanuc(f, b, d);
+        return ncp_flow_do_fanuc(f, b, d);
     case NCP_O_ENDSUB:
     case NCP_O_RETURN:
     case NCP_O_M99:
-        return do_return(f, b, d);
+        return ncp_flow_do_return(f, b, d);
     case NCP_O_CALL:
-        return do_call(f, b, d);
+        return ncp_flow_do_call(f, b, d);
     case NCP_O_M98:
-        return do_m98(f, b, d);
+        return ncp_flow_do_m98(f, b, d);
     case NCP_O_DO:
-        return do_do(f, b, d);
+        return ncp_flow_do_do(f, b, d);
     case NCP_O_REPEAT:
-        return do_repeat(f, b, d);
+        return ncp_flow_do_repeat(f, b, d);
     case NCP_O_WHILE:
-        return do_while(f, b, d);
+        return ncp_flow_do_while(f, b, d);
     case NCP_O_IF:
-        return do_if(f, b, d);
+        return ncp_flow_do_if(f, b, d);
     case NCP_O_ELSEIF:
     case NCP_O_ELSE:
-        return do_else(f, b, d);
+        return ncp_flow_do_else(f, b, d);
     case NCP_O_ENDIF:
-        return do_endif(f, b, d);
+        return ncp_flow_do_endif(f, b, d);
     case NCP_O_BREAK:
     case NCP_O_CONTINUE:
-        return do_break(f, b, d);
+        return ncp_flow_do_break(f, b, d);
     case NCP_O_ENDWHILE:
     case NCP_O_ENDREPEAT:
-        return do_endloop(f, b, d);
+        return ncp_flow_do_endloop(f, b, d);
     default:
-        return oword_error(b, "Unknown command in O-word line", d);
+        return ncp_flow_oword_error(b, "Unknown command in O-word line", d);
     }
 }
 
 /* End of the program body while still looking for a label. */
-static int at_end(struct ncp_flow *f, struct ncp_diag *d)
+static int ncp_flow_at_end(struct ncp_flow *f, struct ncp_diag *d)
 {
     if (f->skip.on && f->src->has_percent)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->cur.line, 0,
@@ -1160,7 +1160,7 @@ static int at_end(struct ncp_flow *f, struct ncp_diag *d)
     if (f->seek_sub.on)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->skip_start, 0,
                             "EOF in file:%s seeking o-word: o<%s> from line: %u",
-                            file_name(f, f->cur.file), f->seek_sub.s, f->skip_start);
+                            ncp_flow_file_name(f, f->cur.file), f->seek_sub.s, f->skip_start);
     /* a subroutine file read to its end without endsub or return: the
      * program has no end either */
     if (f->cur.file != 0)
@@ -1174,7 +1174,7 @@ static int at_end(struct ncp_flow *f, struct ncp_diag *d)
  * a 99 inside a sub, makes the line a Fanuc call or return, read again as
  * such; any other value, or one it cannot read, an ordinary line. Sets *kind,
  * and *b to the block to go on with (the line read again, or as it was). */
-static int resolve_m_value(struct ncp_flow *f, const struct ncp_block **b, int *kind,
+static int ncp_flow_resolve_m_value(struct ncp_flow *f, const struct ncp_block **b, int *kind,
                            struct ncp_diag *d)
 {
     const struct ncp_block *blk = *b;
@@ -1184,7 +1184,7 @@ static int resolve_m_value(struct ncp_flow *f, const struct ncp_block **b, int *
     double v;
     int m;
     struct ncp_diag unread;
-    if (eval(f, blk, &blk->words[0].v, &v, &unread) != NCP_OK ||
+    if (ncp_flow_eval(f, blk, &blk->words[0].v, &v, &unread) != NCP_OK ||
         ncp_rs274_int(v, &m) != 0 || !(m == 98 || (m == 99 && f->level > 0)))
         return NCP_OK;
     struct ncp_span sp;
@@ -1199,7 +1199,7 @@ static int resolve_m_value(struct ncp_flow *f, const struct ncp_block **b, int *
     return NCP_OK;
 }
 
-static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
+static int ncp_flow_step(struct ncp_flow *f, const struct ncp_block **out,
                      struct ncp_diag *d)
 {
     for (;;) {
@@ -1207,9 +1207,9 @@ static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
         const struct ncp_block *b = NULL;
         uint64_t target = f->jump_target;
         f->jump_target = UINT64_MAX;
-        int rc = fetch(f, skipping, &b, d);
+        int rc = ncp_flow_fetch(f, skipping, &b, d);
         if (rc == NCP_END)
-            return at_end(f, d);
+            return ncp_flow_at_end(f, d);
         if (rc != NCP_OK)
             return rc;
         if (!b || (FLOW_BLOCK_DELETE && b->block_delete))
@@ -1217,7 +1217,7 @@ static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
         f->by_jump = b->offset == target;
         int kind = b->oword.kind;
         if (kind != NCP_O_NONE) { /* one test on the plain path for the rare kinds */
-            if (kind == NCP_O_M_VALUE && (rc = resolve_m_value(f, &b, &kind, d)) != NCP_OK)
+            if (kind == NCP_O_M_VALUE && (rc = ncp_flow_resolve_m_value(f, &b, &kind, d)) != NCP_OK)
                 return rc;
             /* M99 first on a line returns from a sub; in the main program it
              * is an M code like M2 */
@@ -1245,7 +1245,7 @@ static int flow_step(struct ncp_flow *f, const struct ncp_block **out,
             *out = b;
             return NCP_OK;
         }
-        rc = run_oword(f, b, d);
+        rc = ncp_flow_run_oword(f, b, d);
         if (rc != NCP_OK)
             return rc;
         if (f->inline_level >= 0 && f->level == f->inline_level) {
@@ -1260,7 +1260,7 @@ int ncp_flow_call_inline(struct ncp_flow *f, const struct ncp_block *call,
                          struct ncp_diag *d)
 {
     int level = f->level;
-    int rc = run_oword(f, call, d);
+    int rc = ncp_flow_run_oword(f, call, d);
     if (rc == NCP_OK)
         f->inline_level = level;
     return rc;
@@ -1268,11 +1268,11 @@ int ncp_flow_call_inline(struct ncp_flow *f, const struct ncp_block *call,
 
 int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out, struct ncp_diag *d)
 {
-    int rc = flow_step(f, out, d);
+    int rc = ncp_flow_step(f, out, d);
     /* no block goes out with an end or an error: hand the last one back now,
      * while the feed surely still exists */
     if (rc != NCP_OK && rc != NCP_FLOW_RETURNED)
-        release_feed(f);
+        ncp_flow_release_feed(f);
     return rc;
 }
 
@@ -1299,7 +1299,7 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
     f->feed_pos = f->cur;
     f->jump_target = UINT64_MAX;
     f->inline_level = -1;
-    if (grow_frames(f) != 0) {
+    if (ncp_flow_grow_frames(f) != 0) {
         free(f);
         return NULL;
     }
@@ -1327,7 +1327,7 @@ void ncp_flow_free(struct ncp_flow *f)
 {
     if (!f)
         return;
-    release_feed(f);
+    ncp_flow_release_feed(f);
     for (uint32_t k = 0; k < f->n_files; k++)
         ncp_source_close(&f->files[k].src);
     free(f->files);
@@ -1371,5 +1371,5 @@ void ncp_flow_reset(struct ncp_flow *f)
     f->in_sub_context = 0;
     f->inline_level = -1;
     f->frames[0].m98_loops = -1;
-    labels_clear(&f->labels);
+    ncp_flow_labels_clear(&f->labels);
 }

@@ -4,10 +4,33 @@
  * coordinates (the canon rotates them later), but G53, G28/G30, G10, G43,
  * coordinate system changes and #<_abs_*> convert through the rotation. Each
  * helper keeps rs274's order of floating-point operations, even with no
- * rotation, so that the results agree to the last bit. */
+ * rotation, so that the results agree to the last bit. Also the unit
+ * conversions between the program's unit and rs274's user unit (inch). */
 #include "state.h"
 
 #include <math.h>
+
+/* rs274 -g converts through mm with its canon's inch-per-mm constant, which is
+ * not exactly 1/25.4: these keep its rounding (2 mm -> user unit -> mm is 2.0
+ * there, 1.9999999999999998 with a plain 25.4). */
+#define NCP_USER_PER_MM 0.03937007874016
+
+double ncp_user_len(const struct ncp_analyzer *a, double user)
+{
+    double mm = user / NCP_USER_PER_MM;
+    return a->st.m.inches ? mm / NCP_MM_PER_INCH : mm;
+}
+
+/* Tool table values are user-unit lengths like any other. */
+double ncp_tool_len(const struct ncp_analyzer *a, double user)
+{
+    return ncp_user_len(a, user);
+}
+
+double ncp_to_user_len(const struct ncp_analyzer *a, double prog)
+{
+    return (a->st.m.inches ? prog * NCP_MM_PER_INCH : prog) * NCP_USER_PER_MM;
+}
 
 void ncp_rotate(double *x, double *y, double deg)
 {

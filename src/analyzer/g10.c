@@ -2,6 +2,7 @@
  * write a tool table entry, L0 reloads the table. Stored values are in rs274's
  * user unit (inch). L20 and L10/L11 measure from the current point, which goes
  * through the rotation of the systems involved (see frames.c). */
+#include "floor.h"
 #include "state.h"
 
 #include <stdio.h>
@@ -55,12 +56,12 @@ static void ncp_g10_refresh(struct ncp_analyzer *a, int p, double r, const doubl
         s->pos[ax] -= nw[ax];
     }
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
-    op->i[0] = p;
-    memcpy(op->d, s->g5x, 6 * sizeof(double));
+    op->offset.index = p;
+    memcpy(op->offset.v, s->g5x, sizeof op->offset.v);
     ncp_sai_g5x(a, s->g5x);
     ncp_rotate(&s->pos[NCP_X], &s->pos[NCP_Y], -r);
     s->rotation = r;
-    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->d[0] = r;
+    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->rotation.degrees = r;
 }
 
 static int ncp_g10_origin(struct ncp_analyzer *a, int l)

@@ -13,6 +13,7 @@
  * mode is the last one used, and once the subroutine has been read the
  * block in hand is its return line, so the G7x line's own later steps (an M2
  * on it) are lost and errors of the passes name that return line. */
+#include "floor.h"
 #include "state.h"
 #include "g7x_path.h"
 

@@ -9,6 +9,7 @@
  * executor as any block. The lines run in place of the M72 block: rs274
  * reads them into the block it is executing, so what that block had left to
  * do (its G codes, its motion) is dropped, and so it is here. */
+#include "floor.h"
 #include "state.h"
 
 #include <stdio.h>
@@ -100,7 +101,7 @@ static int ncp_m7x_exec_line(struct ncp_analyzer *a, const char *text)
         a->err = b->err;
         return b->err.code;
     }
-    return ncp_an_execute(a, b);
+    return a->execute(a, b);
 }
 
 /* Appends what snprintf wrote (n) to a text of length *len in cap bytes. */

@@ -1,6 +1,7 @@
 /* Whole-block consistency checks, done once per block on the word bitmask:
  * which motion the block performs, axis words without a user, words without a
  * G/M code that uses them (rs274's enhance_block and check_* rules). */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>

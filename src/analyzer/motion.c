@@ -1,5 +1,6 @@
 /* G0/G1 (and G53), G2/G3 arc requests, G80 and the dispatch to canned cycles.
  * End points are in program coordinates; arcs are resolved by the executor. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
@@ -119,7 +120,7 @@ int ncp_motion_straight(struct ncp_analyzer *a, int motion)
                                     "F word missing with inverse time g1 move");
             double rate = ncp_straight_length(s->pos, end) * w->v[NCP_LETTER('F')];
             s->feed = rate < 0.1 ? 0.1 : rate; /* what #<_feed> reads afterwards */
-            ncp_an_emit(a, NCP_C_SET_FEED_RATE)->d[0] = s->feed;
+            ncp_an_emit(a, NCP_C_SET_FEED_RATE)->feed_rate.rate = s->feed;
         } else if (s->feed == 0.0) {
             return ncp_an_error(a, NCP_MOTION_COL(w),
                                 "Cannot do g1 with zero feed rate");
@@ -147,12 +148,13 @@ static const char *const ncp_plane_missing[3] = {
 
 /* Only for #<_feed> after a G93 arc (the executor computes the printed
  * rate): arc length as rs274 measures it, centre from IJK or R. */
-static double ncp_arc_length(const struct ncp_canon *q)
+static double ncp_request_arc_length(const struct ncp_canon *q)
 {
-    double x1 = q->d[0], y1 = q->d[1], x2 = q->d[2], y2 = q->d[3], cx, cy;
-    int ccw = q->i[0] > 0;
-    if (q->i[1]) {
-        double r = q->d[8], ar = fabs(r);
+    double x1 = q->arc.first_start, y1 = q->arc.second_start;
+    double x2 = q->arc.first_end, y2 = q->arc.second_end, cx, cy;
+    int ccw = q->arc.dir > 0;
+    if (q->arc.radius_form) {
+        double r = q->arc.radius, ar = fabs(r);
         double mx = (x1 + x2) / 2, my = (y1 + y2) / 2;
         double half = hypot(mx - x2, my - y2);
         if (ar == 0.0)
@@ -164,10 +166,10 @@ static double ncp_arc_length(const struct ncp_canon *q)
         cx = mx + off * cos(th);
         cy = my + off * sin(th);
     } else {
-        cx = q->d[8];
-        cy = q->d[9];
+        cx = q->arc.first_centre;
+        cy = q->arc.second_centre;
     }
-    int turn = (q->i[2] > 0 ? q->i[2] : 1) * (ccw ? 1 : -1);
+    int turn = (q->arc.turns > 0 ? q->arc.turns : 1) * (ccw ? 1 : -1);
     double alpha = atan2(y1 - cy, x1 - cx), beta = atan2(y2 - cy, x2 - cx), theta;
     if (turn > 0) {
         if (beta <= alpha)
@@ -210,22 +212,29 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
     if (s->m.feed_mode == 1) {
         struct ncp_canon *f = ncp_an_emit(a, NCP_C_SET_FEED_RATE);
         f->flags = NCP_FEED_F_INVERSE_ARC;
-        f->d[0] = w->v[NCP_LETTER('F')];
-        f->d[1] = s->pos[ax[2]];
+        f->feed_rate.rate = w->v[NCP_LETTER('F')];
+        f->feed_rate.arc_axis_start = s->pos[ax[2]];
     }
-    struct ncp_canon req = {.kind = NCP_C_ARC_REQUEST};
-    struct ncp_canon *op = &req;
-    op->d[0] = s->pos[ax[0]];
-    op->d[1] = s->pos[ax[1]];
-    op->d[2] = end[ax[0]];
-    op->d[3] = end[ax[1]];
-    op->d[4] = end[ax[2]];
-    op->d[5] = end[NCP_A];
-    op->d[6] = end[NCP_B];
-    op->d[7] = end[NCP_C];
+    /* the request is filled where it goes: the block's slot, or here for the
+     * compensation queue */
+    struct ncp_canon req;
+    int comp = ncp_cutcomp_engaged(&a->comp);
+    struct ncp_canon *op = comp ? &req : ncp_an_emit(a, NCP_C_ARC_REQUEST);
+    if (comp) {
+        memset(&req, 0, sizeof req);
+        req.kind = NCP_C_ARC_REQUEST;
+    }
+    op->arc.first_start = s->pos[ax[0]];
+    op->arc.second_start = s->pos[ax[1]];
+    op->arc.first_end = end[ax[0]];
+    op->arc.second_end = end[ax[1]];
+    op->arc.axis_end = end[ax[2]];
+    op->arc.abc[0] = end[NCP_A];
+    op->arc.abc[1] = end[NCP_B];
+    op->arc.abc[2] = end[NCP_C];
     if (has_r) {
-        op->d[8] = w->v[NCP_LETTER('R')];
-        op->i[1] = 1;
+        op->arc.radius = w->v[NCP_LETTER('R')];
+        op->arc.radius_form = 1;
     } else {
         double o1 = NCP_HAS(w, ncp_plane_ijk[pl][0]) ? w->v[NCP_LETTER(ncp_plane_ijk[pl][0])] : 0;
         double o2 = NCP_HAS(w, ncp_plane_ijk[pl][1]) ? w->v[NCP_LETTER(ncp_plane_ijk[pl][1])] : 0;
@@ -233,26 +242,25 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
             o1 += s->pos[ax[0]];
             o2 += s->pos[ax[1]];
         }
-        op->d[8] = o1;
-        op->d[9] = o2;
+        op->arc.first_centre = o1;
+        op->arc.second_centre = o2;
     }
-    op->i[0] = motion == 30 ? 1 : -1;
-    op->i[2] = NCP_HAS(w, 'P') ? ncp_trunc_int_round(w->v[NCP_LETTER('P')]) : 1;
-    op->i[3] = pl;
+    op->arc.dir = motion == 30 ? 1 : -1;
+    op->arc.turns = NCP_HAS(w, 'P') ? ncp_trunc_int_round(w->v[NCP_LETTER('P')]) : 1;
+    op->arc.plane = pl;
     op->flags = s->m.inches ? 1 : 0;
     if (s->m.feed_mode == 1) {
-        double len = ncp_arc_length(op), dz = end[ax[2]] - s->pos[ax[2]];
+        double len = ncp_request_arc_length(op), dz = end[ax[2]] - s->pos[ax[2]];
         if (dz != 0.0)
             len = hypot(len, dz);
         double rate = len * w->v[NCP_LETTER('F')];
         s->feed = rate < 0.1 ? 0.1 : rate;
     }
-    if (ncp_cutcomp_engaged(&a->comp)) {
+    if (comp) {
         int rc = ncp_comp_move_arc(a, op, end);
         if (rc != NCP_OK)
             return rc;
     } else {
-        *ncp_an_emit(a, NCP_C_ARC_REQUEST) = req;
         ncp_sai_move(a, end);
     }
     memcpy(s->pos, end, NCP_NAX * sizeof(double));
@@ -273,7 +281,7 @@ int ncp_motion_arc(struct ncp_analyzer *a, int motion)
  * release), G38.5 (away): rs274's checks, then the probe move between the
  * probe switching calls. rs274 leaves its current point alone here: it reads
  * the canon's (backed off, see sai.c) at the next block, with the results. */
-static int ncp_probe(struct ncp_analyzer *a, int motion)
+int ncp_motion_probe(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
     uint16_t col = NCP_MOTION_COL(&a->w);
@@ -296,7 +304,7 @@ static int ncp_probe(struct ncp_analyzer *a, int motion)
             return ncp_an_error(a, col, "Start point too close to probe point");
     }
     ncp_an_emit(a, NCP_C_TURN_PROBE_ON);
-    memcpy(ncp_an_emit(a, NCP_C_STRAIGHT_PROBE)->d, end, 6 * sizeof(double));
+    memcpy(ncp_an_emit(a, NCP_C_STRAIGHT_PROBE)->move.end, end, 6 * sizeof(double));
     ncp_sai_probe(a, end);
     ncp_an_emit(a, NCP_C_TURN_PROBE_OFF);
     s->m.motion = motion;
@@ -305,10 +313,10 @@ static int ncp_probe(struct ncp_analyzer *a, int motion)
 
 /* G33 (a straight feed locked to the spindle, K the distance per turn),
  * G33.1 (rigid tapping to the end and back: rs274 keeps its current point)
- * and G76 (the threading cycle: its checks here, its passes in thread.c).
+ * and G76 (the threading cycle: its checks here, its passes in g76.c).
  * Under cutter compensation rs274 hands all three to its compensation code,
  * which knows only G0 and G1 (see ncp_cutcomp_move). */
-static int ncp_synced(struct ncp_analyzer *a, int motion)
+int ncp_motion_synced(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
     double end[NCP_NAX];
@@ -331,15 +339,15 @@ static int ncp_synced(struct ncp_analyzer *a, int motion)
         for (int ax = NCP_A; ax < NCP_NAX; ax++)
             if (end[ax] != s->pos[ax])
                 return ncp_an_error(a, col, "Cannot move rotary axes with G76");
-        return ncp_thread_cycle(a, end);
+        return ncp_g76_cycle(a, end);
     }
     struct ncp_canon *sync = ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH);
-    sync->d[0] = a->w.v[NCP_LETTER('K')];
+    sync->synch.per_rev = a->w.v[NCP_LETTER('K')];
     if (motion == 330) {
         ncp_an_emit6(a, NCP_C_STRAIGHT_FEED, end);
         memcpy(s->pos, end, sizeof end);
     } else {
-        memcpy(ncp_an_emit(a, NCP_C_RIGID_TAP)->d, end, 3 * sizeof(double));
+        memcpy(ncp_an_emit(a, NCP_C_RIGID_TAP)->rigid_tap.bottom, end, 3 * sizeof(double));
     }
     ncp_an_emit(a, NCP_C_STOP_SPEED_FEED_SYNCH);
     return NCP_OK;
@@ -351,7 +359,7 @@ static int ncp_synced(struct ncp_analyzer *a, int motion)
  * end and the motion mode stays what it was; rs274's canon puts its own X
  * and Y at 0 (what a probe backs off from, or a tool change reads back,
  * shows it: measured with rs274 2.9 from several start and end points). */
-static int ncp_spline(struct ncp_analyzer *a, int motion)
+int ncp_motion_spline(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
@@ -383,57 +391,21 @@ static int ncp_spline(struct ncp_analyzer *a, int motion)
      * start + IJ, [end + PQ,] end; a G5 without I J continues the last G5's
      * direction (-P, -Q), as LinuxCNC draws it */
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_NURBS_FEED);
-    op->i[0] = motion == 51 ? 3 : 4;
-    memcpy(op->d, end, 3 * sizeof(double));
+    op->nurbs.n_points = motion == 51 ? 3 : 4;
+    memcpy(op->nurbs.end, end, sizeof op->nurbs.end);
     double i = NCP_HAS(w, 'I') ? w->v[NCP_LETTER('I')] : -s->g5_pq[0];
     double j = NCP_HAS(w, 'J') ? w->v[NCP_LETTER('J')] : -s->g5_pq[1];
-    op->d[3] = s->pos[NCP_X];
-    op->d[4] = s->pos[NCP_Y];
-    op->d[5] = s->pos[NCP_X] + i;
-    op->d[6] = s->pos[NCP_Y] + j;
+    op->nurbs.start[0] = s->pos[NCP_X];
+    op->nurbs.start[1] = s->pos[NCP_Y];
+    op->nurbs.ctrl[0][0] = s->pos[NCP_X] + i;
+    op->nurbs.ctrl[0][1] = s->pos[NCP_Y] + j;
     if (motion == 50) {
         s->g5_pq[0] = w->v[NCP_LETTER('P')];
         s->g5_pq[1] = w->v[NCP_LETTER('Q')];
-        op->d[7] = end[NCP_X] + s->g5_pq[0];
-        op->d[8] = end[NCP_Y] + s->g5_pq[1];
+        op->nurbs.ctrl[1][0] = end[NCP_X] + s->g5_pq[0];
+        op->nurbs.ctrl[1][1] = end[NCP_Y] + s->g5_pq[1];
     }
     a->sai.pos[NCP_X] = a->sai.pos[NCP_Y] = 0.0;
     memcpy(s->pos, end, sizeof end);
     return NCP_OK;
-}
-
-int ncp_motion_run(struct ncp_analyzer *a, int motion)
-{
-    if (!ncp_is_canned_cycle(motion))
-        a->st.cycle_il_flag = 0;
-    switch (motion) {
-    case 0: case 10:
-        return ncp_motion_straight(a, motion);
-    case 20: case 30:
-        return ncp_motion_arc(a, motion);
-    case 800:
-        a->st.m.motion = 800;
-        ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
-                         sizeof "interpreter: motion mode set to none" - 1);
-        return NCP_OK;
-    case 50: case 51:
-        return ncp_spline(a, motion);
-    case 52:
-        return ncp_nurbs_point(a);
-    case 330: case 331: case 760:
-        return ncp_synced(a, motion);
-    case 382: case 383: case 384: case 385:
-        return ncp_probe(a, motion);
-    case 700: case 710: case 711: case 712: case 720: case 721: case 722:
-        return ncp_g7x_run(a, motion);
-    case 730: case 740: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
-    case 890:
-        return ncp_canned_run(a, motion);
-    default: {
-        uint16_t col = NCP_MOTION_COL(&a->w);
-        if (motion % 10)
-            return ncp_an_error(a, col, "G%d.%d is not supported", motion / 10, motion % 10);
-        return ncp_an_error(a, col, "G%d is not supported", motion / 10);
-    }
-    }
 }

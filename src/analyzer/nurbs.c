@@ -10,6 +10,7 @@
  *   error, as after G80.
  * rs274 -g prints NURBS_FEED(count, ...) only; the points follow the call
  * as NURBS_POINTS ops, which print nothing and carry the curve to the NCK. */
+#include "floor.h"
 #include "state.h"
 
 #include <stdlib.h>
@@ -17,9 +18,9 @@
 
 #define NCP_NURBS_MAX_POINTS (1u << 20)
 
-static int ncp_nurbs_push(struct ncp_analyzer *a, double x, double y, double w)
+static int ncp_g52_push(struct ncp_analyzer *a, double x, double y, double w)
 {
-    struct ncp_nurbs_pts *nb = &a->nurbs;
+    struct ncp_g52_points *nb = &a->nurbs;
     if (nb->n == nb->cap) {
         if (nb->cap >= NCP_NURBS_MAX_POINTS)
             return ncp_an_error(a, a->w.line_col,
@@ -39,11 +40,11 @@ static int ncp_nurbs_push(struct ncp_analyzer *a, double x, double y, double w)
     return NCP_OK;
 }
 
-int ncp_nurbs_point(struct ncp_analyzer *a)
+int ncp_g52_point(struct ncp_analyzer *a)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
-    struct ncp_nurbs_pts *nb = &a->nurbs;
+    struct ncp_g52_points *nb = &a->nurbs;
     uint16_t col = NCP_MOTION_COL(w);
     int has_x = NCP_HAS(w, 'X'), has_y = NCP_HAS(w, 'Y');
     double p = NCP_HAS(w, 'P') ? w->v[NCP_LETTER('P')] : -1.0; /* rs274: no P is -1 */
@@ -60,7 +61,7 @@ int ncp_nurbs_point(struct ncp_analyzer *a)
         nb->n = 0;
     int rc;
     if (nb->n == 0) {
-        rc = ncp_nurbs_push(a, s->pos[NCP_X], s->pos[NCP_Y], !has_x && p > 0.0 ? p : 1.0);
+        rc = ncp_g52_push(a, s->pos[NCP_X], s->pos[NCP_Y], !has_x && p > 0.0 ? p : 1.0);
         if (rc != NCP_OK)
             return rc;
         nb->order = 3;
@@ -74,7 +75,7 @@ int ncp_nurbs_point(struct ncp_analyzer *a)
         double end[NCP_NAX];
         rc = ncp_motion_ends(a, w->g[NCP_GG_NONMODAL] == 530, end);
         if (rc == NCP_OK)
-            rc = ncp_nurbs_push(a, end[NCP_X], end[NCP_Y], p);
+            rc = ncp_g52_push(a, end[NCP_X], end[NCP_Y], p);
         if (rc != NCP_OK)
             return rc;
     }
@@ -82,10 +83,10 @@ int ncp_nurbs_point(struct ncp_analyzer *a)
     return NCP_OK;
 }
 
-int ncp_nurbs_draw(struct ncp_analyzer *a)
+int ncp_g52_draw(struct ncp_analyzer *a)
 {
     struct ncp_state *s = &a->st;
-    struct ncp_nurbs_pts *nb = &a->nurbs;
+    struct ncp_g52_points *nb = &a->nurbs;
     uint16_t col = a->w.gcol[NCP_GG_NONMODAL];
     if (s->m.motion != 52)
         return ncp_an_error(a, col, "Cannot use G5.3 without G5.2 first");
@@ -95,17 +96,17 @@ int ncp_nurbs_draw(struct ncp_analyzer *a)
                             nb->order);
     const double *last = nb->pt[nb->n - 1];
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_NURBS_FEED);
-    op->i[0] = (int32_t)nb->n;
-    op->i[1] = nb->order;
-    op->i[2] = NCP_NURBS_POINTS_FOLLOW;
-    op->d[0] = last[0];
-    op->d[1] = last[1];
-    op->d[2] = s->pos[NCP_Z];
+    op->nurbs.n_points = (int32_t)nb->n;
+    op->nurbs.order = nb->order;
+    op->nurbs.follow = NCP_NURBS_POINTS_FOLLOW;
+    op->nurbs.end[0] = last[0];
+    op->nurbs.end[1] = last[1];
+    op->nurbs.end[2] = s->pos[NCP_Z];
     for (uint32_t k = 0; k < nb->n; k += NCP_NURBS_POINTS_PER_OP) {
         uint32_t m = nb->n - k < NCP_NURBS_POINTS_PER_OP ? nb->n - k : NCP_NURBS_POINTS_PER_OP;
         op = ncp_an_emit(a, NCP_C_NURBS_POINTS);
-        op->i[0] = (int32_t)m;
-        memcpy(op->d, nb->pt[k], m * sizeof nb->pt[0]);
+        op->nurbs_points.n = (int32_t)m;
+        memcpy(op->nurbs_points.pt, nb->pt[k], m * sizeof nb->pt[0]);
     }
     /* rs274's canon reads the point after the last for its own X Y (past the
      * end of its vector; 0 here, as after G5 and G5.1: see motion.c) */
@@ -124,7 +125,7 @@ int ncp_nurbs_draw(struct ncp_analyzer *a)
     return NCP_OK;
 }
 
-void ncp_nurbs_free(struct ncp_analyzer *a)
+void ncp_g52_free(struct ncp_analyzer *a)
 {
     free(a->nurbs.pt);
     memset(&a->nurbs, 0, sizeof a->nurbs);

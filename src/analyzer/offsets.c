@@ -2,6 +2,7 @@
  * G52, G43/G43.1/G43.2/G49, G28/G30 and their .1 forms, and the numbered parameters
  * that mirror them. Parameters hold rs274's user unit (inch); the state holds
  * program units. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
@@ -11,28 +12,6 @@
 static int ncp_is_linear(int ax)
 {
     return ax < NCP_A || ax > NCP_C;
-}
-
-/* rs274 -g converts through mm with its canon's inch-per-mm constant, which is
- * not exactly 1/25.4: these keep its rounding (2 mm -> user unit -> mm is 2.0
- * there, 1.9999999999999998 with a plain 25.4). */
-#define NCP_USER_PER_MM 0.03937007874016
-
-double ncp_user_len(const struct ncp_analyzer *a, double user)
-{
-    double mm = user / NCP_USER_PER_MM;
-    return a->st.m.inches ? mm / NCP_MM_PER_INCH : mm;
-}
-
-/* Tool table values are user-unit lengths like any other. */
-double ncp_tool_len(const struct ncp_analyzer *a, double user)
-{
-    return ncp_user_len(a, user);
-}
-
-double ncp_to_user_len(const struct ncp_analyzer *a, double prog)
-{
-    return (a->st.m.inches ? prog * NCP_MM_PER_INCH : prog) * NCP_USER_PER_MM;
 }
 
 static double ncp_to_user(const struct ncp_analyzer *a, int ax, double v)
@@ -59,6 +38,37 @@ void ncp_offsets_sync_params(struct ncp_analyzer *a)
     *a->par_origin = a->st.m.origin;
 }
 
+/* rs274 reads back what the canon did before it reads the block after a
+ * probe (set_probe_data) or a tool change: the current point becomes the
+ * canon's (U, V, W read 0 there), and after a probe #5061-#5069 hold the
+ * tripped point and #5070 the probe input, which the stand-in reports as 0. */
+static void ncp_offsets_take_position(struct ncp_analyzer *a)
+{
+    memcpy(a->st.pos, a->sai.pos, sizeof a->sai.pos);
+    for (int ax = 6; ax < NCP_NAX; ax++)
+        a->st.pos[ax] = 0.0;
+}
+
+void ncp_offsets_resync(struct ncp_analyzer *a)
+{
+    if (!(a->st.toolchange_flag | a->sai.probe_flag))
+        return;
+    if (a->sai.probe_flag) {
+        a->sai.probe_flag = 0;
+        for (int k = 0; k <= 9; k++) {
+            double *par = ncp_params_slot(a->params, 5061 + k);
+            if (par)
+                *par = k < 6 ? a->sai.probed[k] : 0.0;
+        }
+    }
+    ncp_offsets_take_position(a);
+    ncp_offsets_sync_params(a); /* before this block's expressions read #5420.. */
+    if (a->st.toolchange_flag) {
+        a->st.toolchange_flag = 0;
+        ncp_tools_sync_params(a, 1);
+    }
+}
+
 static void ncp_emit_g92(struct ncp_analyzer *a)
 {
     ncp_an_emit6(a, NCP_C_SET_G92_OFFSET, a->st.g92);
@@ -67,12 +77,12 @@ static void ncp_emit_g92(struct ncp_analyzer *a)
 static void ncp_emit_tlo_values(struct ncp_analyzer *a, const double *v)
 {
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_USE_TOOL_LENGTH_OFFSET);
-    memcpy(op->d, v, NCP_NAX * sizeof(double));
+    memcpy(op->tool_length.v, v, NCP_NAX * sizeof(double));
 }
 
 int ncp_offsets_units(struct ncp_analyzer *a, int inches)
 {
-    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->i[0] = inches ? 0 : 1;
+    ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->units.mm = inches ? 0 : 1;
     ncp_sai_units(a, inches);
     if (inches == a->st.m.inches)
         return NCP_OK;
@@ -117,11 +127,11 @@ int ncp_offsets_coord(struct ncp_analyzer *a, int origin)
     s->rotation = ncp_frame_param(a, 5210 + 20 * origin);
     s->m.origin = origin;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
-    op->i[0] = origin;
-    memcpy(op->d, s->g5x, 6 * sizeof(double));
+    op->offset.index = origin;
+    memcpy(op->offset.v, s->g5x, sizeof op->offset.v);
     ncp_sai_g5x(a, s->g5x);
     ncp_emit_g92(a);
-    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->d[0] = s->rotation;
+    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->rotation.degrees = s->rotation;
     return NCP_OK;
 }
 

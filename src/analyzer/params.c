@@ -43,6 +43,7 @@ struct ncp_params {
     double ret_flag;           /* #<_value_returned> */
     ncp_predef_fn predef;
     void *predef_ctx;
+    double scratch;            /* where ncp_params_slot points for a bad index */
 };
 
 static uint32_t name_hash(const char *s, size_t n)
@@ -225,9 +226,8 @@ int ncp_params_set(struct ncp_params *p, int index, double v, struct ncp_diag *d
 
 double *ncp_params_slot(struct ncp_params *p, int index)
 {
-    static double scratch;
     if (index < 0 || index >= NCP_PARAMS_MAX)
-        return &scratch;
+        return &p->scratch; /* this table's own: tables of other threads are apart */
     return &p->num[index];
 }
 

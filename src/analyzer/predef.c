@@ -104,7 +104,7 @@ static int ncp_predef_catch_up(struct ncp_analyzer *a, struct ncp_diag *d)
     int rc = ncp_m7x_pending(a);
     if (rc != NCP_OK)
         return ncp_diag_set(d, (enum ncp_status)rc, 0, 0, "%s", a->err.msg);
-    ncp_sai_resync(a);
+    ncp_offsets_resync(a);
     return NCP_OK;
 }
 

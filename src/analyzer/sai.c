@@ -2,13 +2,11 @@
  * calls and by SET_G5X_OFFSET / SET_G92_OFFSET / USE_LENGTH_UNITS, never by
  * tool length offsets, backed off after a probe), and rs274 reloads its
  * current point from that copy at the block after a tool change or a probe.
- * We mirror it so that block matches. */
+ * We mirror it so that block matches (offsets.c reads it back). */
 #include "state.h"
 
 #include <math.h>
 #include <string.h>
-
-#include "params.h"
 
 void ncp_sai_move(struct ncp_analyzer *a, const double *end)
 {
@@ -71,37 +69,6 @@ void ncp_sai_probe(struct ncp_analyzer *a, const double *end)
     a->sai.probe_flag = 1;
 }
 
-/* rs274 reads back what the canon did before it reads the block after a
- * probe (set_probe_data) or a tool change: the current point becomes the
- * canon's (U, V, W read 0 there), and after a probe #5061-#5069 hold the
- * tripped point and #5070 the probe input, which the stand-in reports as 0. */
-static void ncp_sai_take_position(struct ncp_analyzer *a)
-{
-    memcpy(a->st.pos, a->sai.pos, sizeof a->sai.pos);
-    for (int ax = 6; ax < NCP_NAX; ax++)
-        a->st.pos[ax] = 0.0;
-}
-
-void ncp_sai_resync(struct ncp_analyzer *a)
-{
-    if (!(a->st.toolchange_flag | a->sai.probe_flag))
-        return;
-    if (a->sai.probe_flag) {
-        a->sai.probe_flag = 0;
-        for (int k = 0; k <= 9; k++) {
-            double *par = ncp_params_slot(a->params, 5061 + k);
-            if (par)
-                *par = k < 6 ? a->sai.probed[k] : 0.0;
-        }
-    }
-    ncp_sai_take_position(a);
-    ncp_offsets_sync_params(a); /* before this block's expressions read #5420.. */
-    if (a->st.toolchange_flag) {
-        a->st.toolchange_flag = 0;
-        ncp_tools_sync_params(a, 1);
-    }
-}
-
 /* A move finished by the comp queue: the canon's point is its end. */
 void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op)
 {
@@ -111,19 +78,19 @@ void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op)
     switch (op->kind) {
     case NCP_C_STRAIGHT_TRAVERSE:
     case NCP_C_STRAIGHT_FEED:
-        ncp_sai_move(a, op->d);
+        ncp_sai_move(a, op->move.end);
         break;
     case NCP_C_ARC_FEED:
-        a->sai.pos[axes[pl][0]] = op->d[0];
-        a->sai.pos[axes[pl][1]] = op->d[1];
-        a->sai.pos[axes[pl][2]] = op->d[4];
-        memcpy(a->sai.pos + NCP_A, op->d + 5, 3 * sizeof(double));
+        a->sai.pos[axes[pl][0]] = op->arc_feed.first_end;
+        a->sai.pos[axes[pl][1]] = op->arc_feed.second_end;
+        a->sai.pos[axes[pl][2]] = op->arc_feed.axis_end;
+        memcpy(a->sai.pos + NCP_A, op->arc_feed.abc, 3 * sizeof(double));
         break;
     case NCP_C_ARC_REQUEST:
-        a->sai.pos[axes[pl][0]] = op->d[2];
-        a->sai.pos[axes[pl][1]] = op->d[3];
-        a->sai.pos[axes[pl][2]] = op->d[4];
-        memcpy(a->sai.pos + NCP_A, op->d + 5, 3 * sizeof(double));
+        a->sai.pos[axes[pl][0]] = op->arc.first_end;
+        a->sai.pos[axes[pl][1]] = op->arc.second_end;
+        a->sai.pos[axes[pl][2]] = op->arc.axis_end;
+        memcpy(a->sai.pos + NCP_A, op->arc.abc, 3 * sizeof(double));
         break;
     default:
         break;

@@ -110,7 +110,7 @@ struct ncp_sai {
 };
 
 /* An op held back while cutter compensation has a move queued: it is handed
- * to the comp queue once the caller has filled it (see analyzer.c). */
+ * to the comp queue once the caller has filled it (see floor.c). */
 struct ncp_staged {
     int pending;
     struct ncp_canon op;
@@ -119,7 +119,7 @@ struct ncp_staged {
 };
 
 /* G5.2 control points until G5.3 draws them (nurbs.c): x y weight */
-struct ncp_nurbs_pts {
+struct ncp_g52_points {
     double (*pt)[3];
     uint32_t n, cap;
     int order;
@@ -146,6 +146,10 @@ struct ncp_analyzer {
     /* output */
     const struct ncp_cmd_sink *sink;
     struct ncp_cmd *cmd;
+    /* Ops go here once the sink has shut down, so callers need no NULL checks
+     * on the hot path: this analyzer's own, as analyzers of other threads
+     * write theirs at the same time. */
+    struct ncp_canon scratch;
     uint64_t next_id;
     uint32_t line;
     unsigned file_tag;           /* the block's subroutine file (NCP_CMD_FILE), 0 */
@@ -157,24 +161,12 @@ struct ncp_analyzer {
     int m7x_restore_from;         /* a return left an M73 level: restore from it, else -1 */
     int block_consumed;           /* an M72 ran restore lines in this block's place */
     struct ncp_block *m7x_block;  /* the restore line being run */
-    struct ncp_nurbs_pts nurbs;
+    struct ncp_g52_points nurbs;
+    /* How a handler runs a line of its own as a block (M72's restore lines):
+     * ncp_an_execute, handed down by the run loop so that no handler calls
+     * back up into the file that calls it. */
+    int (*execute)(struct ncp_analyzer *a, const struct ncp_block *b);
 };
-
-/* analyzer.c: append one op to the block's slot (opens/continues slots). */
-struct ncp_canon *ncp_an_emit(struct ncp_analyzer *a, enum ncp_canon_kind kind);
-struct ncp_canon *ncp_an_emit_text(struct ncp_analyzer *a, enum ncp_canon_kind kind,
-                                   const char *text, size_t len);
-void ncp_an_emit6(struct ncp_analyzer *a, enum ncp_canon_kind kind, const double *p);
-/* The block now answers for another line (a->line, set by the caller: a G7x
- * cycle's passes are its profile's return line's): later ops go to a new
- * slot of that line, so errors found when they execute name it. */
-void ncp_an_reline(struct ncp_analyzer *a);
-int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-
-/* analyzer.c: hand a staged op on (to the comp queue); the comp module's sink */
-int ncp_an_commit(struct ncp_analyzer *a);
-struct ncp_comp_sink ncp_an_comp_sink(struct ncp_analyzer *a);
 
 /* comp.c: the analyzer side of cutter compensation */
 int ncp_comp_gcode(struct ncp_analyzer *a, int g);
@@ -182,7 +174,9 @@ int ncp_comp_move_straight(struct ncp_analyzer *a, int motion, const double *end
 int ncp_comp_move_arc(struct ncp_analyzer *a, const struct ncp_canon *req, const double *end);
 int ncp_comp_stop(struct ncp_analyzer *a, int reset);
 
-/* words.c */
+/* words.c: ncp_words_init once before any analyzer reads a block (builds
+ * the G code table) */
+void ncp_words_init(void);
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
 /* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);
@@ -196,23 +190,25 @@ int ncp_words_assign(struct ncp_analyzer *a, const struct ncp_block *b);
 
 /* modal.c */
 int ncp_modal_check(struct ncp_analyzer *a);
-/* analyzer.c: read back what the canon did, then read and execute block b */
+/* steps.c: read back what the canon did, then read and execute block b (the
+ * whole block in rs274's order: ncp_an_steps) */
 int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b);
+int ncp_an_steps(struct ncp_analyzer *a);
 
-/* exec.c: the whole block in rs274's order */
-int ncp_exec_block(struct ncp_analyzer *a);
-
-/* motion.c / arcs.c / canned.c */
-int ncp_motion_run(struct ncp_analyzer *a, int motion);
+/* motion.c: the motions; steps.c picks the one the block's motion mode names */
 /* G0/G1 and G2/G3 to the block's words, in the current distance modes */
 int ncp_motion_straight(struct ncp_analyzer *a, int motion);
 int ncp_motion_arc(struct ncp_analyzer *a, int motion);
+/* G5, G5.1 splines; G33, G33.1, G76 (spindle-synchronised); G38.2-G38.5 probes */
+int ncp_motion_spline(struct ncp_analyzer *a, int motion);
+int ncp_motion_synced(struct ncp_analyzer *a, int motion);
+int ncp_motion_probe(struct ncp_analyzer *a, int motion);
 /* g7x.c: G70, G71, G71.1, G71.2, G72, G72.1, G72.2 (motion x10) */
 int ncp_g7x_run(struct ncp_analyzer *a, int motion);
 int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end);
 int ncp_canned_run(struct ncp_analyzer *a, int motion);
-/* thread.c: G76 from the current point to end (checked by motion.c) */
-int ncp_thread_cycle(struct ncp_analyzer *a, const double *end);
+/* g76.c: G76 from the current point to end (checked by motion.c) */
+int ncp_g76_cycle(struct ncp_analyzer *a, const double *end);
 /* m7x.c: M70-M73 (m is 70..73); the flow's frame hooks; a restore a return
  * left pending (before the next block, or a parameter read); teardown */
 int ncp_m7x_run(struct ncp_analyzer *a, int m);
@@ -223,9 +219,9 @@ void ncp_m7x_free(struct ncp_analyzer *a);
 int ncp_motion_ends(struct ncp_analyzer *a, int absolute53, double *end);
 
 /* nurbs.c: G5.2 (a control point, as the motion) and G5.3 (draw them) */
-int ncp_nurbs_point(struct ncp_analyzer *a);
-int ncp_nurbs_draw(struct ncp_analyzer *a);
-void ncp_nurbs_free(struct ncp_analyzer *a);
+int ncp_g52_point(struct ncp_analyzer *a);
+int ncp_g52_draw(struct ncp_analyzer *a);
+void ncp_g52_free(struct ncp_analyzer *a);
 
 /* offsets.c */
 int ncp_offsets_units(struct ncp_analyzer *a, int inches);
@@ -233,11 +229,15 @@ int ncp_offsets_coord(struct ncp_analyzer *a, int origin);
 int ncp_offsets_tlo(struct ncp_analyzer *a, int g);
 int ncp_offsets_modal0(struct ncp_analyzer *a, int g);
 void ncp_offsets_sync_params(struct ncp_analyzer *a);
+/* what the canon did since the last block (a probe, a tool change), read back
+ * into the state and the parameters before the next block reads them */
+void ncp_offsets_resync(struct ncp_analyzer *a);
+
+/* frames.c: rs274's conversions through the XY rotation, and between the
+ * program's unit and the user unit (parameters, tool table) */
 double ncp_user_len(const struct ncp_analyzer *a, double user);
 double ncp_to_user_len(const struct ncp_analyzer *a, double prog);
 double ncp_tool_len(const struct ncp_analyzer *a, double user);
-
-/* frames.c: rs274's conversions through the XY rotation */
 void ncp_rotate(double *x, double *y, double deg);
 double ncp_frame_param(const struct ncp_analyzer *a, int index);
 double ncp_frame_user(const struct ncp_analyzer *a, int ax, int index);
@@ -271,7 +271,6 @@ void ncp_sai_move(struct ncp_analyzer *a, const double *end);
 void ncp_sai_g5x(struct ncp_analyzer *a, const double *v);
 void ncp_sai_g92(struct ncp_analyzer *a, const double *v);
 void ncp_sai_units(struct ncp_analyzer *a, int inches);
-void ncp_sai_resync(struct ncp_analyzer *a);
 void ncp_sai_probe(struct ncp_analyzer *a, const double *end);
 void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op);
 

@@ -1,6 +1,7 @@
 /* Start-up state and the stop codes M0 M1 M60 M2 M30 (the end-of-program
  * reset rs274 performs: back to G54, XY plane, G90, G94, F0, spindle off,
  * coolant off, feed override on). */
+#include "floor.h"
 #include "state.h"
 
 #include <string.h>
@@ -47,10 +48,10 @@ static void ncp_stop_reset_origin(struct ncp_analyzer *a)
     if (p)
         *p = 1.0;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
-    op->i[0] = 1;
-    memcpy(op->d, s->g5x, 6 * sizeof(double));
+    op->offset.index = 1;
+    memcpy(op->offset.v, s->g5x, sizeof op->offset.v);
     ncp_sai_g5x(a, s->g5x);
-    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->d[0] = s->rotation;
+    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->rotation.degrees = s->rotation;
 }
 
 static int ncp_stop_end(struct ncp_analyzer *a, int m)

@@ -1,6 +1,7 @@
 /* Tool table (LinuxCNC .tbl format), T selection, M6 and M61. Entries keep
  * rs274's indexing: 0 is the spindle, 1..n the table lines in file order, and
  * offsets stay in the table's unit (inch), converted when used. */
+#include "floor.h"
 #include "state.h"
 
 #include <errno.h>
@@ -136,7 +137,7 @@ int ncp_tools_select(struct ncp_analyzer *a)
     if (idx < 0)
         return ncp_an_error(a, w->col[NCP_LETTER('T')],
                             "Requested tool %d not found in the tool table", t);
-    ncp_an_emit(a, NCP_C_SELECT_TOOL)->i[0] = t;
+    ncp_an_emit(a, NCP_C_SELECT_TOOL)->tool.tool = t;
     a->st.selected_pocket = idx;
     a->st.selected_tool = t;
     return NCP_OK;
@@ -155,7 +156,7 @@ static int ncp_tools_m61(struct ncp_analyzer *a)
     a->st.current_pocket = idx;
     a->st.current_tool = t;
     a->st.toolchange_flag = 1;
-    ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER)->i[0] = idx;
+    ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER)->tool.tool = idx;
     return NCP_OK;
 }
 
@@ -172,7 +173,7 @@ int ncp_tools_change(struct ncp_analyzer *a)
     ncp_an_emit(a, NCP_C_START_CHANGE);
     ncp_an_emit(a, NCP_C_STOP_SPINDLE_TURNING);
     s->m.spindle_dir = 0;
-    ncp_an_emit(a, NCP_C_CHANGE_TOOL)->i[0] = s->selected_pocket;
+    ncp_an_emit(a, NCP_C_CHANGE_TOOL)->tool.tool = s->selected_pocket;
     if (s->selected_pocket > 0)
         ncp_tools_copy(a, 0, s->selected_pocket);
     s->current_pocket = s->selected_pocket;

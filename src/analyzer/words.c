@@ -1,8 +1,10 @@
 /* A block's words -> evaluated values, a letter bitmask and G/M codes sorted
  * into their modal groups; parameter assignments with pre-block values. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
 
 const char ncp_axis_letter[NCP_NAX] = {'X', 'Y', 'Z', 'A', 'B', 'C', 'U', 'V', 'W'};
@@ -20,9 +22,9 @@ int ncp_axis_word(const struct ncp_words *w, int ax, double *v)
     return 1;
 }
 
-/* G code (x10) -> modal group; -1 unknown. Built once. */
+/* G code (x10) -> modal group; -1 unknown. Built once (ncp_words_init). */
 static int8_t ncp_g_group[1000];
-static int ncp_g_group_ready;
+static pthread_once_t ncp_g_group_once = PTHREAD_ONCE_INIT;
 
 static void ncp_g_table_init(void)
 {
@@ -62,7 +64,11 @@ static void ncp_g_table_init(void)
     memset(ncp_g_group, -1, sizeof ncp_g_group);
     for (size_t k = 0; k < sizeof tab / sizeof tab[0]; k++)
         ncp_g_group[tab[k].code] = tab[k].group;
-    ncp_g_group_ready = 1;
+}
+
+void ncp_words_init(void)
+{
+    pthread_once(&ncp_g_group_once, ncp_g_table_init);
 }
 
 static int ncp_m_group(int m)
@@ -222,8 +228,6 @@ static int ncp_declare_targets_before(struct ncp_analyzer *a, const struct ncp_b
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b)
 {
     struct ncp_words *w = &a->w;
-    if (!ncp_g_group_ready)
-        ncp_g_table_init();
     w->has = 0;
     w->n_m = 0;
     w->line_col = b->n_words ? b->words[0].col : 1;

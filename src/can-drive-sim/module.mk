@@ -1,11 +1,10 @@
 # cnc-drive-sim: a simulated CiA 402 drive on a (v)CAN interface. Linked from
-# the CAN objects, the sim plant and the INI reader only, so it builds even
-# while other modules are unfinished.
+# the CAN master's archive (src/can/module.mk), the sim plant and the INI
+# reader only, so it builds even while other modules are unfinished.
 all: $(BUILD)/cnc-drive-sim
 
 DRIVE_SIM_OBJS = $(patsubst %.c,$(BUILD)/%.o,$(wildcard src/can-drive-sim/*.c) \
-                   $(wildcard src/can/*.c) $(wildcard src/diag/*.c) \
                    src/backend/sim.c src/backend/scale.c src/motion/config.c)
 
-$(BUILD)/cnc-drive-sim: $(DRIVE_SIM_OBJS)
+$(BUILD)/cnc-drive-sim: $(DRIVE_SIM_OBJS) $(BUILD)/libncpar-can.a
 	$(Q)$(CC) $(ALL_CFLAGS) -o $@ $^ -lm -linih

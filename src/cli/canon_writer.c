@@ -1,11 +1,9 @@
 /* Canonical text through a 1 MB buffer: a write() per slot would dominate.
  *
- * The 1M-block benchmark writes about 65 MB. The write() calls stay in the
- * thread that emits. A writer thread of its own (an earlier version) made
- * the pipeline slower once the output thread could lex ahead when it had
- * nothing to write: on two CPUs a third busy thread takes time from both, and
- * the buffers it read crossed cores twice; interleaved runs of the 1M-block
- * program, det -j 0: 158 ms with the thread, 142 ms without. */
+ * The write() calls stay in the thread that emits. A writer thread of its
+ * own (an earlier version) made the pipeline slower once the output thread
+ * could lex ahead when it had nothing to write: on two CPUs a third busy
+ * thread takes time from both, and the buffers it read crossed cores twice. */
 #include "canon_writer.h"
 
 #include "ncpar/executor.h"
@@ -25,7 +23,7 @@
 
 /* Prefaulted before the run (ncpar/mem.h): touched page by page instead, the
  * buffer costs 256 page faults in the thread that emits, and in a virtual
- * machine a fault is microseconds (~7 ms per run here). */
+ * machine a fault is microseconds. */
 struct canon_writer {
     int fd;
     char *buf;
@@ -127,10 +125,10 @@ static void close_in_background(int fd)
     close(fd);
 }
 
-/* Rewriting a file that holds the last run's output (65 MB for the 1M-block
- * benchmark) with O_TRUNC costs twice: the truncation frees its page cache
- * (4-13 ms here), and ext4, seeing a file truncated to zero and written
- * again, starts its writeback when it is closed (12 ms). A new file under the
+/* Rewriting a file that holds the last run's output with O_TRUNC costs
+ * twice: the truncation frees its page cache in the call, and ext4, seeing a
+ * file truncated to zero and written again, starts its writeback when it is
+ * closed. A new file under the
  * old name has neither. Only a file the user could not tell from the one
  * O_TRUNC would leave is replaced: a regular file of ours that we may write,
  * one link, no extended attributes (ACLs, labels), whose mode carries over.
@@ -138,7 +136,7 @@ static void close_in_background(int fd)
  * foreign file) is opened with O_TRUNC as before. The old file's pages are
  * freed when its last descriptor closes, in a short thread of its own, so
  * the run does not wait for it (an unlink() of the last name frees them in
- * the call: 3-30 ms here). The serial reference gets the same thread: it is
+ * the call). The serial reference gets the same thread: it is
  * file-system housekeeping, not interpretation, and serial and parallel runs
  * must pay alike for their output. Returns the new descriptor or -1 (then the
  * caller truncates). */

@@ -199,8 +199,8 @@ static const struct ncp_tpl *ncp_tpl_for(const struct ncp_canon *op)
     const struct ncp_kind_fmt *f = &ncp_kind_fmts[op->kind];
     if (!f->fallback)
         return &ncp_tpls[op->kind][0];
-    if (op->i[0] >= 0 && op->i[0] < NCP_TPL_VARIANTS)
-        return &ncp_tpls[op->kind][op->i[0]];
+    if (op->raw.i[0] >= 0 && op->raw.i[0] < NCP_TPL_VARIANTS)
+        return &ncp_tpls[op->kind][op->raw.i[0]];
     return &ncp_tpls[op->kind][NCP_TPL_VARIANTS];
 }
 
@@ -308,25 +308,28 @@ static int ncp_format_hot(struct ncp_out *o, const struct ncp_canon *op)
                    kind == NCP_C_STRAIGHT_PROBE;
     if (!straight && kind != NCP_C_ARC_FEED)
         return 0;
+    /* The numbers in print order: move.end, or arc_feed's doubles and its
+     * rotation, which stand in print order in raw (canon.h asserts their
+     * places). */
     const struct ncp_seg *head = &ncp_tpls[kind][0].seg[0];
     if (o->full || o->end - o->p < NCP_HOT_LINE || !head->pooled ||
-        !ncp_hot_numbers(op->d, straight ? 6 : 8))
+        !ncp_hot_numbers(op->raw.d, straight ? 6 : 8))
         return 0;
     char *p = o->p;
     memcpy(p, head->lit, NCP_LIT_BLOCK);
     p += head->lit_len;
-    p += ncp_fmt_fixed4(p, op->d[0]);
+    p += ncp_fmt_fixed4(p, op->raw.d[0]);
     if (straight) {
         for (int k = 1; k < 6; k++)
-            p = ncp_hot_next(p, op->d[k]);
+            p = ncp_hot_next(p, op->raw.d[k]);
     } else {
         for (int k = 1; k < 4; k++)
-            p = ncp_hot_next(p, op->d[k]);
+            p = ncp_hot_next(p, op->raw.d[k]);
         memcpy(p, ncp_sep, sizeof ncp_sep);
         p += sizeof ncp_sep;
-        p += ncp_fmt_int(p, op->i[0]);
+        p += ncp_fmt_int(p, op->raw.i[0]);
         for (int k = 4; k < 8; k++)
-            p = ncp_hot_next(p, op->d[k]);
+            p = ncp_hot_next(p, op->raw.d[k]);
     }
     memcpy(p, ")\n", 2);
     o->p = p + 2;
@@ -346,13 +349,13 @@ static void ncp_format_op(struct ncp_out *o, const struct ncp_cmd *cmd,
             ncp_out_put(o, "\n", 1);
             return;
         case NCP_FLD_D4:
-            ncp_out_num(o, ncp_fmt_fixed4, op->d[s->idx]);
+            ncp_out_num(o, ncp_fmt_fixed4, op->raw.d[s->idx]);
             break;
         case NCP_FLD_F6:
-            ncp_out_num(o, ncp_fmt_fixed6, op->d[s->idx]);
+            ncp_out_num(o, ncp_fmt_fixed6, op->raw.d[s->idx]);
             break;
         case NCP_FLD_INT:
-            ncp_out_int(o, op->i[s->idx]);
+            ncp_out_int(o, op->raw.i[s->idx]);
             break;
         default: {
             const char *t;

@@ -2,7 +2,7 @@
  * analyzer knows the end point and the centre word or R, the executor finds
  * the centre, checks it the way rs274 does and reports its errors in rs274's
  * words. */
-#include "arc_geom.h"
+#include "ncpar/geom.h"
 #include "ncpar/executor.h"
 
 #include <math.h>
@@ -22,20 +22,21 @@
 static void ncp_arc_in_from_op(const struct ncp_canon *op, struct ncp_arc_in *in)
 {
     int inches = (op->flags & NCP_ARC_F_INCHES) != 0;
-    in->start[0] = op->d[0];
-    in->start[1] = op->d[1];
-    in->end[0] = op->d[2];
-    in->end[1] = op->d[3];
-    in->radius_form = op->i[1] != 0;
-    in->centre[0] = in->radius_form ? 0.0 : op->d[8];
-    in->centre[1] = in->radius_form ? 0.0 : op->d[9];
-    in->radius = in->radius_form ? op->d[8] : 0.0;
-    in->ccw = op->i[0] > 0;
-    in->turns = op->i[2] >= 1 ? op->i[2] : 1; /* zero means "no P word" */
+    const struct ncp_canon_arc *q = &op->arc;
+    in->start[0] = q->first_start;
+    in->start[1] = q->second_start;
+    in->end[0] = q->first_end;
+    in->end[1] = q->second_end;
+    in->radius_form = q->radius_form != 0;
+    in->centre[0] = in->radius_form ? 0.0 : q->first_centre;
+    in->centre[1] = in->radius_form ? 0.0 : q->second_centre;
+    in->radius = in->radius_form ? q->radius : 0.0;
+    in->ccw = q->dir > 0;
+    in->turns = q->turns >= 1 ? q->turns : 1; /* zero means "no P word" */
     in->radius_tol = inches ? NCP_RADIUS_TOL_INCH : NCP_RADIUS_TOL_MM;
-    in->spiral_abs_tol = op->d[10] > 0 ? op->d[10]
+    in->spiral_abs_tol = q->tol_abs > 0 ? q->tol_abs
                        : inches ? NCP_SPIRAL_ABS_TOL_INCH : NCP_SPIRAL_ABS_TOL_MM;
-    in->spiral_rel_tol = op->d[11] > 0 ? op->d[11] : NCP_SPIRAL_REL_TOL;
+    in->spiral_rel_tol = q->tol_rel > 0 ? q->tol_rel : NCP_SPIRAL_REL_TOL;
 }
 
 /* rs274 names the in-plane axes in its messages: XY, then YZ, then XZ as Z,X. */
@@ -51,8 +52,8 @@ static int ncp_arc_error(struct ncp_cmd *cmd, const struct ncp_canon *op, int st
                          const struct ncp_arc_out *out)
 {
     char a, b;
-    ncp_plane_axes(op->i[3], &a, &b);
-    const double *d = op->d;
+    ncp_plane_axes(op->arc.plane, &a, &b);
+    const struct ncp_canon_arc *q = &op->arc;
     struct ncp_diag *g = &cmd->diag;
     switch (status) {
     case NCP_ARC_SAME_POINT:
@@ -65,15 +66,17 @@ static int ncp_arc_error(struct ncp_cmd *cmd, const struct ncp_canon *op, int st
         return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
                             "Zero-radius arc: start=(%c%.4f,%c%.4f) center=(%c%.4f,%c%.4f) "
                             "end=(%c%.4f,%c%.4f) r1=%.4f r2=%.4f",
-                            a, d[0], b, d[1], a, out->centre[0], b, out->centre[1],
-                            a, d[2], b, d[3], out->r1, out->r2);
+                            a, q->first_start, b, q->second_start, a, out->centre[0],
+                            b, out->centre[1], a, q->first_end, b, q->second_end,
+                            out->r1, out->r2);
     default:
         return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
                             "Radius to end of arc differs from radius to start: "
                             "start=(%c%.4f,%c%.4f) center=(%c%.4f,%c%.4f) "
                             "end=(%c%.4f,%c%.4f) r1=%.4f r2=%.4f abs_err=%.4g rel_err=%.4f%%",
-                            a, d[0], b, d[1], a, out->centre[0], b, out->centre[1],
-                            a, d[2], b, d[3], out->r1, out->r2,
+                            a, q->first_start, b, q->second_start, a, out->centre[0],
+                            b, out->centre[1], a, q->first_end, b, q->second_end,
+                            out->r1, out->r2,
                             out->abs_err, out->rel_err * 100);
     }
 }
@@ -93,28 +96,31 @@ static int ncp_resolve_arc(struct ncp_cmd *cmd, struct ncp_canon *op, struct ncp
     struct ncp_arc_in in;
     struct ncp_arc_out out;
     ncp_arc_in_from_op(op, &in);
-    int status = ncp_arc_solve(&in, &out);
+    int status = ncp_geom_arc_solve(&in, &out);
     if (status != NCP_ARC_OK)
         return ncp_arc_error(cmd, op, status, &out);
 
-    double axis_end = op->d[4], a = op->d[5], b = op->d[6], c = op->d[7];
+    double axis_end = op->arc.axis_end;
+    double a = op->arc.abc[0], b = op->arc.abc[1], c = op->arc.abc[2];
     if (feed_op) {
-        double rate = ncp_arc_length(&in, &out, feed_op->d[1], axis_end) * feed_op->d[0];
-        feed_op->d[0] = rate > 0.1 ? rate : 0.1;
-        feed_op->d[1] = 0.0;
+        double rate = ncp_geom_arc_length(&in, &out, feed_op->feed_rate.arc_axis_start, axis_end) *
+                      feed_op->feed_rate.rate;
+        feed_op->feed_rate.rate = rate > 0.1 ? rate : 0.1;
+        feed_op->feed_rate.arc_axis_start = 0.0;
         feed_op->flags &= (uint16_t)~NCP_FEED_F_INVERSE_ARC;
     }
-    struct ncp_canon feed = {.kind = NCP_C_ARC_FEED};
-    feed.d[0] = in.end[0];
-    feed.d[1] = in.end[1];
-    feed.d[2] = out.centre[0];
-    feed.d[3] = out.centre[1];
-    feed.i[0] = out.rotation;
-    feed.d[4] = axis_end;
-    feed.d[5] = a;
-    feed.d[6] = b;
-    feed.d[7] = c;
-    *op = feed;
+    /* the request's numbers are all read: the call is written over it */
+    memset(op, 0, sizeof *op);
+    op->kind = NCP_C_ARC_FEED;
+    op->arc_feed.first_end = in.end[0];
+    op->arc_feed.second_end = in.end[1];
+    op->arc_feed.first_axis = out.centre[0];
+    op->arc_feed.second_axis = out.centre[1];
+    op->arc_feed.rotation = out.rotation;
+    op->arc_feed.axis_end = axis_end;
+    op->arc_feed.abc[0] = a;
+    op->arc_feed.abc[1] = b;
+    op->arc_feed.abc[2] = c;
     return NCP_OK;
 }
 

@@ -1,14 +1,13 @@
 /* Program text copied into anonymous memory on transparent huge pages
  * (module-internal header).
  *
- * A mapped file costs its first reader a fault per 4 KB page; under this
- * host's shadow paging that is ~1.5 us a page even after MAP_POPULATE, 11 ms
- * for a 28 MB program, and 2 ms more to unmap it at exit. read() into a region
- * on 2 MB pages (ncpar/mem.h) costs 6 ms for the same file (the copy and 14
- * zeroed 2 MB pages), then nothing to touch (0.25 ms) or to unmap (0.3 ms)
- * (bench/RESULTS.md, "Program text on huge pages"). The same read
- * into small anonymous pages took 100 ms here: a copy is only made where the
- * kernel offers huge pages (ncp_mem_huge_usable). */
+ * A mapped file costs its first reader a fault per 4 KB page (under a
+ * hypervisor's shadow paging even after MAP_POPULATE), and more to unmap it
+ * at exit. read() into a region on 2 MB pages (ncpar/mem.h) pays the copy
+ * and a few zeroed huge pages once, then nothing to touch or to unmap
+ * (bench/RESULTS.md, "Program text on huge pages"). The same read into small
+ * anonymous pages costs far more than the mapping: a copy is only made where
+ * the kernel offers huge pages (ncp_mem_huge_usable). */
 #ifndef NCP_FEEDER_TEXT_MEM_H
 #define NCP_FEEDER_TEXT_MEM_H
 

@@ -114,8 +114,8 @@ static const unsigned char *get(const unsigned char *p, void *dst, size_t n)
 
 /* Header and words are written field by field straight to their place: built
  * on the stack and copied whole, their mixed-width stores could not be
- * forwarded to the wide load of the copy, a stall per block and per word
- * (most of the packing time, measured). */
+ * forwarded to the wide load of the copy, a stall per block and per word,
+ * which cost more than the packing itself. */
 /* PUT_AT's ctype must be the field's type: with these sizes and no padding,
  * a wrong one would overlap its neighbour (and the round-trip tests fail). */
 _Static_assert(sizeof(struct packed_head) == 32, "packed_head: 8+4+6*2+8*1 bytes");

@@ -175,7 +175,7 @@ static int straight(struct ncp_canon_map *m, const struct ncp_canon *op, int tra
                     uint32_t line, struct ncp_seg *s, struct ncp_diag *d)
 {
     double end[NCP_AXES];
-    to_machine(m, op->d, end);
+    to_machine(m, op->move.end, end);
     return line_to(m, end, traverse, line, s, d);
 }
 
@@ -185,7 +185,7 @@ static int rigid_tap(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
 {
     double end[NCP_AXES];
     memcpy(m->more_back, m->pos, sizeof m->more_back);
-    to_machine(m, op->d, end);
+    to_machine(m, op->rigid_tap.bottom, end);
     int rc = line_to(m, end, 0, line, s, d);
     if (rc == 1) {
         m->more_left = 1;
@@ -230,11 +230,11 @@ static int nurbs_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_d
 static int nurbs_begin(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
                        struct ncp_diag *d)
 {
-    if (ncp_nurbs_stream_begin(&m->nurbs, (uint32_t)op->i[0], op->i[1]) != 0)
+    if (ncp_nurbs_stream_begin(&m->nurbs, (uint32_t)op->nurbs.n_points, op->nurbs.order) != 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
                              "NURBS of order L=%d with %d points: the NCK draws orders 3 to %d",
-                             op->i[1], op->i[0], NCP_NURBS_MAX_ORDER);
-    m->more_z = op->d[2];
+                             op->nurbs.order, op->nurbs.n_points, NCP_NURBS_MAX_ORDER);
+    m->more_z = op->nurbs.end[2];
     m->more_line = line;
     return 0;
 }
@@ -242,8 +242,9 @@ static int nurbs_begin(struct ncp_canon_map *m, const struct ncp_canon *op, uint
 static int nurbs_points(struct ncp_canon_map *m, const struct ncp_canon *op, struct ncp_seg *s,
                         struct ncp_diag *d)
 {
-    int n = op->i[0] < NCP_NURBS_POINTS_PER_OP ? op->i[0] : NCP_NURBS_POINTS_PER_OP;
-    int rc = ncp_nurbs_stream_add(&m->nurbs, op->d, n);
+    int n = op->nurbs_points.n < NCP_NURBS_POINTS_PER_OP ? op->nurbs_points.n
+                                                          : NCP_NURBS_POINTS_PER_OP;
+    int rc = ncp_nurbs_stream_add(&m->nurbs, &op->nurbs_points.pt[0][0], n);
     if (rc == -1)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, m->more_line, 0,
                              "NURBS control point with a weight P that is not above 0: "
@@ -267,22 +268,22 @@ int ncp_canon_map_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_
     return 0;
 }
 
-/* G5/G5.1: op->d[0..2] the end, d[3..4] the start, d[5..6] the first control
- * point, d[7..8] the second (G5) - program X Y. Their Bezier curve is the
+/* G5/G5.1: the end, the start and the control points (program X Y). Their Bezier curve is the
  * one-span B-spline of those points (order = count), drawn as a G5.3 NURBS
  * with weights 1. The first line now. */
 static int spline(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t line,
                   struct ncp_seg *s, struct ncp_diag *d)
 {
-    int n = op->i[0] == 4 ? 4 : 3;
-    double pts[4][3] = {{op->d[3], op->d[4], 1}, {op->d[5], op->d[6], 1},
-                        {op->d[7], op->d[8], 1}, {0, 0, 1}};
-    pts[n - 1][0] = op->d[0];
-    pts[n - 1][1] = op->d[1];
+    const struct ncp_canon_nurbs *q = &op->nurbs;
+    int n = q->n_points == 4 ? 4 : 3;
+    double pts[4][3] = {{q->start[0], q->start[1], 1}, {q->ctrl[0][0], q->ctrl[0][1], 1},
+                        {q->ctrl[1][0], q->ctrl[1][1], 1}, {0, 0, 1}};
+    pts[n - 1][0] = q->end[0];
+    pts[n - 1][1] = q->end[1];
     ncp_nurbs_stream_begin(&m->nurbs, (uint32_t)n, n);
     if (ncp_nurbs_stream_add(&m->nurbs, &pts[0][0], n) != 0)
         return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "move to a non-finite position");
-    m->more_z = op->d[2];
+    m->more_z = q->end[2];
     m->more_line = line;
     m->more_kind = NCP_C_NURBS_POINTS;
     return nurbs_more(m, s, d);
@@ -298,16 +299,16 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     s->kind = NCP_SEG_ARC;
     const int *ax = plane_axes[m->plane];
     double pe[3] = { 0, 0, 0 }, pc[3] = { 0, 0, 0 };
-    pe[ax[0]] = op->d[0];
-    pe[ax[1]] = op->d[1];
-    pe[ax[2]] = op->d[4];
-    pc[ax[0]] = op->d[2];
-    pc[ax[1]] = op->d[3];
-    pc[ax[2]] = op->d[4];
+    pe[ax[0]] = op->arc_feed.first_end;
+    pe[ax[1]] = op->arc_feed.second_end;
+    pe[ax[2]] = op->arc_feed.axis_end;
+    pc[ax[0]] = op->arc_feed.first_axis;
+    pc[ax[1]] = op->arc_feed.second_axis;
+    pc[ax[2]] = op->arc_feed.axis_end;
     double c[3], n[3] = { 0, 0, 0 }, origin[3] = { 0, 0, 0 }, nm[3];
     to_machine(m, pe, s->end);
     to_machine(m, pc, c);
-    if (!finite3(s->end, NCP_AXES) || !finite3(c, 3) || abs(op->i[0]) > 100000)
+    if (!finite3(s->end, NCP_AXES) || !finite3(c, 3) || abs(op->arc_feed.rotation) > 100000)
         return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "arc with a non-finite end or centre, or too many turns");
     /* the plane normal turns with the XY rotation like any direction does */
     n[ax[2]] = 1.0;
@@ -338,7 +339,7 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
         s->u[i] = rs[i] / s->r0;
     cross(s->normal, s->u, s->w);
     double a = atan2(dot(re, s->w), dot(re, s->u));
-    int rot = op->i[0];
+    int rot = op->arc_feed.rotation;
     if (rot > 0 && a <= 1e-12)
         a += 2 * M_PI;
     else if (rot < 0 && a >= -1e-12)
@@ -367,45 +368,46 @@ static int state_op(struct ncp_canon_map *m, const struct ncp_canon *op)
 {
     switch (op->kind) {
     case NCP_C_USE_LENGTH_UNITS:
-        m->scale = op->i[0] == 0 ? 25.4 : 1.0;
+        m->scale = op->units.mm == 0 ? 25.4 : 1.0;
         break;
     case NCP_C_SET_G5X_OFFSET:
-        set6(m->g5x, op->d, m->scale);
+        set6(m->g5x, op->offset.v, m->scale);
         break;
     case NCP_C_SET_G92_OFFSET:
-        set6(m->g92, op->d, m->scale);
+        set6(m->g92, op->offset.v, m->scale);
         break;
     case NCP_C_USE_TOOL_LENGTH_OFFSET:
-        set6(m->tool, op->d, m->scale);
+        set6(m->tool, op->tool_length.v, m->scale);
         break;
     case NCP_C_SET_XY_ROTATION:
-        m->rotation = op->d[0];
+        m->rotation = op->rotation.degrees;
         break;
     case NCP_C_SELECT_PLANE:
-        m->plane = op->i[0] >= 0 && op->i[0] <= 2 ? op->i[0] : 0;
+        m->plane = op->plane.plane >= 0 && op->plane.plane <= 2 ? op->plane.plane : 0;
         break;
     case NCP_C_SET_FEED_RATE:
-        m->feed = op->d[0] * m->scale;
+        m->feed = op->feed_rate.rate * m->scale;
         break;
     case NCP_C_SET_FEED_MODE:
-        m->per_rev = op->i[1] == 1;
+        m->per_rev = op->feed_mode.per_rev == 1;
         break;
     case NCP_C_SET_SPINDLE_SPEED:
-        m->speed = op->d[0];
+        m->speed = op->spindle_speed.speed;
         break;
     case NCP_C_SET_SPINDLE_MODE:
-        m->css_max = op->d[0] > 0 ? op->d[0] : 0.0;
+        m->css_max = op->spindle_mode.css_max > 0 ? op->spindle_mode.css_max : 0.0;
         break;
     case NCP_C_START_SPEED_FEED_SYNCH:
-        m->sync_pitch = op->d[0] * m->scale;
+        m->sync_pitch = op->synch.per_rev * m->scale;
         break;
     case NCP_C_STOP_SPEED_FEED_SYNCH:
         m->sync_pitch = 0.0;
         break;
     case NCP_C_SET_MOTION_CONTROL_MODE:
-        m->term = op->i[0] == 0 ? NCP_TERM_STOP
-                  : op->i[0] == 1 ? NCP_TERM_EXACT_PATH : NCP_TERM_CONTINUOUS;
-        m->tolerance = op->d[0] * m->scale;
+        m->term = op->motion_control.mode == 0   ? NCP_TERM_STOP
+                  : op->motion_control.mode == 1 ? NCP_TERM_EXACT_PATH
+                                                 : NCP_TERM_CONTINUOUS;
+        m->tolerance = op->motion_control.tolerance * m->scale;
         break;
     default:
         break;
@@ -427,7 +429,7 @@ int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
     case NCP_C_RIGID_TAP:
         return rigid_tap(m, op, line, seg, d);
     case NCP_C_NURBS_FEED:
-        if (op->i[2] == NCP_NURBS_POINTS_FOLLOW)
+        if (op->nurbs.follow == NCP_NURBS_POINTS_FOLLOW)
             return nurbs_begin(m, op, line, d);
         return spline(m, op, line, seg, d);
     case NCP_C_NURBS_POINTS:
@@ -436,7 +438,7 @@ int ncp_canon_map_op(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
         seg_common(m, seg, line);
         seg->kind = NCP_SEG_DWELL;
         seg->term = NCP_TERM_STOP;
-        seg->dwell = op->d[0] > 0 ? op->d[0] : 0;
+        seg->dwell = op->dwell.seconds > 0 ? op->dwell.seconds : 0;
         memcpy(seg->end, m->pos, sizeof seg->end);
         return 1;
     default:

@@ -129,7 +129,7 @@ void nck_note_state(struct nck *n, const struct ncp_canon *op)
     struct nck_io *io = &n->io;
     pthread_mutex_lock(&n->ev_lock);
     switch (op->kind) {
-    case NCP_C_SET_SPINDLE_SPEED: io->speed = op->d[0]; break;
+    case NCP_C_SET_SPINDLE_SPEED: io->speed = op->spindle_speed.speed; break;
     case NCP_C_START_SPINDLE_CLOCKWISE: io->dir = 1; break;
     case NCP_C_START_SPINDLE_COUNTERCLOCKWISE: io->dir = -1; break;
     case NCP_C_STOP_SPINDLE_TURNING: io->dir = 0; break;
@@ -138,11 +138,11 @@ void nck_note_state(struct nck *n, const struct ncp_canon *op)
     case NCP_C_FLOOD_ON: io->flood = 1; break;
     case NCP_C_FLOOD_OFF: io->flood = 0; break;
     case NCP_C_CHANGE_TOOL:
-    case NCP_C_CHANGE_TOOL_NUMBER: io->tool = op->i[0]; break;
+    case NCP_C_CHANGE_TOOL_NUMBER: io->tool = op->tool.tool; break;
     case NCP_C_SET_G5X_OFFSET:
-        io->g5x_index = op->i[0];
+        io->g5x_index = op->offset.index;
         for (int k = 0; k < 6; k++)
-            io->g5x[k] = op->d[k];
+            io->g5x[k] = op->offset.v[k];
         break;
     default: break;
     }

@@ -16,8 +16,8 @@ enum { AHEAD_OPEN = 0, AHEAD_HELPER = 1, AHEAD_READY = 2, AHEAD_ANALYZER = 3 };
 #define AHEAD_SPIN 256
 
 /* How far ahead (bytes) each side warms the slot buffer: the lines were last
- * in the other core's cache, and a transfer between two cores can take a
- * quarter of a microsecond (measured between this machine's two vCPUs). */
+ * in the other core's cache, and a transfer between two cores is slow enough
+ * to stall a reader that waits for it. */
 #define AHEAD_PREFETCH 768u
 
 /* A plain block of ~30 bytes of text packs to 96 bytes: room for the usual

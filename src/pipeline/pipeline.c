@@ -67,10 +67,8 @@ static void workers_reset(struct ncp_pipe *p);
 
 /* More stage threads than CPUs: a stage that polls an empty or full ring
  * holds a CPU that the stage it waits for may need, so it sleeps at once.
- * Measured on 2 CPUs, 1M-block program, interleaved runs: -j 1 (5 threads)
- * median 353 -> 291 ms and 419 -> 396 ms in a noisier hour, -j 2 (6) 360 ->
- * 324 ms. Without lexer threads the first thread is the prefaulter, done in
- * the first milliseconds: it does not count (-j 0 keeps its polling). */
+ * Without lexer threads the first thread is the prefaulter, done in the
+ * first milliseconds: it does not count (-j 0 keeps its polling). */
 static void set_spin(struct ncp_pipe *p)
 {
     struct ncp_pipe_stage st[NCP_PIPE_MAX_THREADS];
@@ -144,13 +142,12 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
             ncp_ring_set_batch(&p->parsed[i], 4096 / NCP_PACK_UNIT);
     }
     if (p->packed_out) {
-        /* cmd_slots of 4 KB (~28 plain commands each), never less than two of
-         * the largest. Lexing ahead lets the analyzer run through up to
-         * NCP_AHEAD_SLOTS chunks of ready blocks (~2,000 CAM blocks) faster
-         * than the output thread keeps up: a ring that holds fewer commands
-         * than that fills, and the analyzer sleeps until half of it is free.
-         * Interleaved on 1M CAM blocks, whole process: 1 KB rows 132.2 ms,
-         * 2 KB 130.4, 4 KB 128.9 (medians of 10). */
+        /* cmd_slots of 4 KB (a few dozen plain commands each), never less
+         * than two of the largest. Lexing ahead lets the analyzer run through
+         * up to NCP_AHEAD_SLOTS chunks of ready blocks faster than the output
+         * thread keeps up: a ring that holds fewer commands than that fills,
+         * and the analyzer sleeps until half of it is free. Rows smaller
+         * than 4 KB only add wake-ups. */
         bad |= ncp_ring_init(&p->cmds[0], NCP_PACK_UNIT,
                              record_ring_units(s, 4096, NCP_CMD_PACK_MAX));
         if (!bad)

@@ -2,8 +2,8 @@
  * of 8-byte units, one record after another (module-internal header).
  *
  * Going through the ring's calls for every record (room, wrap, reserve,
- * prefetch; then peek for the head, peek for the tail, pad test) cost the
- * two sides ~170 instructions a command, as much as packing it. Both ends
+ * prefetch; then peek for the head, peek for the tail, pad test) costs the
+ * two sides as much as packing the command. Both ends
  * here keep a run of the ring to themselves: the writer a run it reserved,
  * the reader a run it knows is published; the ring is asked only when a run
  * is used up. Every record is still committed and released on its own, so

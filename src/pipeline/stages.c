@@ -128,9 +128,9 @@ void *ncp_pipe_feeder(void *arg)
 /* Without lexer threads (-j 0) the feeder only brings the text into memory
  * ahead of the analyzer: it reads one byte of every page. The first access to
  * a page of a fresh mapping is what costs (page tables; in a virtual machine a
- * shadow-page fault, measured 12-16 ms for 28 MB even with MAP_POPULATE, a
- * second pass 1 ms), and this thread pays it off the analyzer's core, far
- * faster than the analyzer reads. It is done long before the analyzer is. */
+ * shadow-page fault, even with MAP_POPULATE), and this thread pays it off the
+ * analyzer's core, far faster than the analyzer reads. It is done long before
+ * the analyzer is. */
 void *ncp_pipe_prefaulter(void *arg)
 {
     struct ncp_pipe_worker *w = arg;

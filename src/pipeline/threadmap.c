@@ -13,21 +13,18 @@
 
 #define DEFAULT_STRING_ROWS 32 /* of n chunks of ~4 KB: 128 KB of text per lexer ahead */
 /* Deep rings: with more threads than cores every stage has to sleep now and
- * then, and a wake-up is paid per half ring, so on a 2-core machine 64/128
- * slots spent most of the run in futex calls (measured: 1M blocks, det -j 2,
- * context switches 92k -> 8.5k, wall time about halved). */
+ * then, and a wake-up is paid per half ring: shallow rings (64/128 slots)
+ * spend a 2-core run in futex calls and context switches. */
 #define DEFAULT_PARSED_ROWS 1024
 /* A command slot is 4 KB and the ring is prefaulted before the start: 256 of
  * them keep the start-up of a short program to a few milliseconds. */
 #define DEFAULT_CMD_SLOTS 256
 #define DEFAULT_START_TIMEOUT_US 1000
-/* 32 KB of CAM text is ~1100 blocks, ~80 us of lexing: fine enough to
- * balance, and the helper may run up to 8 chunks (256 KB) ahead, which rides
- * out the analyzer's and its own uneven spells. 8 KB chunks (64 KB ahead) left
- * the analyzer lexing ~50% of the blocks itself and the two threads 20 ms of
- * CPU apart; 32 KB: ~60-80%, within a few ms. Interleaved, 1M blocks, whole
- * process, 12 rounds: medians 114.2 (8 KB), 108.4 (16), 108.2 (32), 106.2 ms
- * (64) (bench/RESULTS.md). */
+/* A chunk of 32 KB of CAM text (about a thousand blocks) is fine enough to
+ * balance the two threads, and the helper may run up to 8 chunks ahead,
+ * which rides out the analyzer's and its own uneven spells; smaller chunks
+ * leave the analyzer lexing more of the blocks itself and the two threads'
+ * CPU time further apart (bench/RESULTS.md compares the sizes). */
 #define DEFAULT_LEX_AHEAD_BYTES 32768
 #define MAX_LEX_AHEAD_BYTES (1 << 20)
 #define MAX_ROWS (1 << 20)

@@ -136,7 +136,7 @@ static void test_preamble_and_end(void **state)
     assert_int_equal(r.c.n_ops, sizeof want / sizeof want[0]);
     for (unsigned k = 0; k < r.c.n_ops; k++)
         assert_int_equal(r.c.ops[k].kind, want[k]);
-    assert_int_equal(r.c.ops[0].i[0], 1); /* mm */
+    assert_int_equal(r.c.ops[0].units.mm, 1); /* mm */
     assert_true(r.last->flags & NCP_CMD_F_END);
     for (unsigned k = 0; k < r.c.n_slots; k++)
         assert_int_equal(r.c.slots[k].cmd_id, k);
@@ -181,14 +181,14 @@ static void test_straight_feed(void **state)
     assert_int_equal(r.rc, NCP_END);
     const struct ncp_canon *f = body_op(&r, 0);
     assert_int_equal(f->kind, NCP_C_SET_FEED_RATE);
-    assert_true(f->d[0] == 100.0);
+    assert_true(f->feed_rate.rate == 100.0);
     const struct ncp_canon *m = body_op(&r, 1);
     assert_int_equal(m->kind, NCP_C_STRAIGHT_FEED);
-    assert_true(m->d[0] == 1.234 && m->d[1] == 5.678 && m->d[2] == -1.0);
+    assert_true(m->move.end[0] == 1.234 && m->move.end[1] == 5.678 && m->move.end[2] == -1.0);
     assert_int_equal(body_op(&r, 2)->kind, NCP_C_COMMENT); /* distance mode comment */
     m = body_op(&r, 3);
     assert_int_equal(m->kind, NCP_C_STRAIGHT_FEED);
-    assert_true(fabs(m->d[0] - 2.234) < 1e-12);
+    assert_true(fabs(m->move.end[0] - 2.234) < 1e-12);
     run_free(&r);
 }
 
@@ -210,8 +210,8 @@ static void test_lathe_diameter_mode(void **state)
         if (op->kind != NCP_C_STRAIGHT_TRAVERSE)
             continue;
         assert_true(moves < sizeof want_x / sizeof want_x[0]);
-        if (op->d[0] != want_x[moves])
-            fail_msg("move %u: X %a, want %a", moves, op->d[0], want_x[moves]);
+        if (op->move.end[0] != want_x[moves])
+            fail_msg("move %u: X %a, want %a", moves, op->move.end[0], want_x[moves]);
         moves++;
     }
     assert_int_equal(moves, sizeof want_x / sizeof want_x[0]);
@@ -257,12 +257,12 @@ static void test_arc_request(void **state)
             a = &r.c.ops[k];
     assert_non_null(a);
     /* XZ plane: first axis Z, second X, helix Y; IJK incremental by default */
-    assert_true(a->d[0] == 0.0 && a->d[1] == 1.0);
-    assert_true(a->d[2] == 1.0 && a->d[3] == 0.0);
-    assert_true(a->d[8] == 0.0 && a->d[9] == 0.0);
-    assert_int_equal(a->i[0], 1);
-    assert_int_equal(a->i[1], 0);
-    assert_int_equal(a->i[3], 2);
+    assert_true(a->arc.first_start == 0.0 && a->arc.second_start == 1.0);
+    assert_true(a->arc.first_end == 1.0 && a->arc.second_end == 0.0);
+    assert_true(a->arc.first_centre == 0.0 && a->arc.second_centre == 0.0);
+    assert_int_equal(a->arc.dir, 1);
+    assert_int_equal(a->arc.radius_form, 0);
+    assert_int_equal(a->arc.plane, 2);
     run_free(&r);
 }
 
@@ -273,7 +273,7 @@ static void test_params_pre_block(void **state)
     run_program(&r, "#1=1\n#1=2 #2=#1\nG0 X#2 Y#1\nM2\n", 1);
     const struct ncp_canon *m = body_op(&r, 0);
     assert_int_equal(m->kind, NCP_C_STRAIGHT_TRAVERSE);
-    assert_true(m->d[0] == 1.0 && m->d[1] == 2.0);
+    assert_true(m->move.end[0] == 1.0 && m->move.end[1] == 2.0);
     run_free(&r);
 }
 
@@ -308,13 +308,13 @@ static void test_g92_and_coords(void **state)
     assert_int_equal(r.rc, NCP_END);
     const struct ncp_canon *g92 = body_op(&r, 1);
     assert_int_equal(g92->kind, NCP_C_SET_G92_OFFSET);
-    assert_true(g92->d[0] == 5.0);
+    assert_true(g92->offset.v[0] == 5.0);
     const struct ncp_canon *g5x = NULL;
     for (unsigned k = 6; k < r.c.n_ops; k++)
-        if (r.c.ops[k].kind == NCP_C_SET_G5X_OFFSET && r.c.ops[k].i[0] == 2)
+        if (r.c.ops[k].kind == NCP_C_SET_G5X_OFFSET && r.c.ops[k].offset.index == 2)
             g5x = &r.c.ops[k];
     assert_non_null(g5x);
-    assert_true(g5x->d[0] == 10.0);
+    assert_true(g5x->offset.v[0] == 10.0);
     run_free(&r);
 }
 
@@ -346,26 +346,26 @@ static void test_nurbs_points(void **state)
         k++;
     assert_true(k < r.c.n_ops);
     const struct ncp_canon *head = &r.c.ops[k];
-    assert_int_equal(head->i[0], 10);
-    assert_int_equal(head->i[1], 4);
-    assert_int_equal(head->i[2], NCP_NURBS_POINTS_FOLLOW);
-    assert_true(head->d[0] == 10 && head->d[1] == 6); /* the last point: start + (9, 4) */
+    assert_int_equal(head->nurbs.n_points, 10);
+    assert_int_equal(head->nurbs.order, 4);
+    assert_int_equal(head->nurbs.follow, NCP_NURBS_POINTS_FOLLOW);
+    assert_true(head->nurbs.end[0] == 10 && head->nurbs.end[1] == 6); /* the last point: start + (9, 4) */
     const double want[10][3] = {{1, 2, 2}, {3, 4, 0.5}, {2, 3, 1}, {3, 2, 3}, {1, 5, 1},
                                 {6, 7, 1}, {7, 3, 1}, {8, 4, 1}, {9, 2, 1}, {10, 6, 1}};
     unsigned got = 0;
     for (k++; k < r.c.n_ops && r.c.ops[k].kind == NCP_C_NURBS_POINTS; k++) {
         const struct ncp_canon *op = &r.c.ops[k];
-        assert_true(op->i[0] >= 1 && op->i[0] <= NCP_NURBS_POINTS_PER_OP);
-        for (int j = 0; j < op->i[0]; j++, got++) {
+        assert_true(op->nurbs_points.n >= 1 && op->nurbs_points.n <= NCP_NURBS_POINTS_PER_OP);
+        for (int j = 0; j < op->nurbs_points.n; j++, got++) {
             assert_true(got < 10);
-            assert_true(op->d[3 * j] == want[got][0] && op->d[3 * j + 1] == want[got][1] &&
-                        op->d[3 * j + 2] == want[got][2]);
+            assert_true(op->nurbs_points.pt[j][0] == want[got][0] && op->nurbs_points.pt[j][1] == want[got][1] &&
+                        op->nurbs_points.pt[j][2] == want[got][2]);
         }
     }
     assert_int_equal(got, 10);
     /* the next move starts from the curve's end: G91 X1 from (10, 6) */
     assert_int_equal(r.c.ops[k].kind, NCP_C_STRAIGHT_FEED);
-    assert_true(r.c.ops[k].d[0] == 11 && r.c.ops[k].d[1] == 6);
+    assert_true(r.c.ops[k].move.end[0] == 11 && r.c.ops[k].move.end[1] == 6);
     run_free(&r);
 
     /* 1 + 40 points from a loop: the call's points run on into continuation slots */
@@ -378,9 +378,9 @@ static void test_nurbs_points(void **state)
     for (k = 0; k < r.c.n_slots; k++)
         cont += (r.c.slots[k].flags & NCP_CMD_F_CONT) != 0;
     for (k = 0; k < r.c.n_ops; k++) {
-        heads += r.c.ops[k].kind == NCP_C_NURBS_FEED && r.c.ops[k].i[0] == 42;
+        heads += r.c.ops[k].kind == NCP_C_NURBS_FEED && r.c.ops[k].nurbs.n_points == 42;
         if (r.c.ops[k].kind == NCP_C_NURBS_POINTS)
-            pts += (unsigned)r.c.ops[k].i[0];
+            pts += (unsigned)r.c.ops[k].nurbs_points.n;
     }
     assert_int_equal(heads, 1);
     assert_int_equal(pts, 42);
@@ -397,8 +397,8 @@ static void test_rotation_g53(void **state)
     assert_int_equal(r.rc, NCP_END);
     const struct ncp_canon *m = last_op(&r, NCP_C_STRAIGHT_TRAVERSE);
     assert_non_null(m);
-    assert_true(fabs(m->d[0] - -11.160254037844387) < 1e-12);
-    assert_true(fabs(m->d[1] - 0.6698729810778055) < 1e-12);
+    assert_true(fabs(m->move.end[0] - -11.160254037844387) < 1e-12);
+    assert_true(fabs(m->move.end[1] - 0.6698729810778055) < 1e-12);
     run_free(&r);
 }
 
@@ -414,8 +414,8 @@ static void test_rotation_switch_and_abs(void **state)
     const struct ncp_canon *m = last_op(&r, NCP_C_STRAIGHT_TRAVERSE);
     assert_non_null(m);
     double t = 30.0 * M_PI / 180.0;
-    assert_true(fabs(m->d[0] - (3 * cos(t) - 4 * sin(t) + 10)) < 1e-9);
-    assert_true(fabs(m->d[1] - (3 * sin(t) + 4 * cos(t) + 5)) < 1e-9);
+    assert_true(fabs(m->move.end[0] - (3 * cos(t) - 4 * sin(t) + 10)) < 1e-9);
+    assert_true(fabs(m->move.end[1] - (3 * sin(t) + 4 * cos(t) + 5)) < 1e-9);
     run_free(&r);
 }
 
@@ -428,8 +428,8 @@ static void test_rotation_change_while_active(void **state)
     assert_int_equal(r.rc, NCP_END);
     const struct ncp_canon *m = last_op(&r, NCP_C_STRAIGHT_TRAVERSE);
     assert_non_null(m);
-    assert_true(fabs(m->d[0]) < 1e-12);
-    assert_true(fabs(m->d[1] - -10.0) < 1e-12);
+    assert_true(fabs(m->move.end[0]) < 1e-12);
+    assert_true(fabs(m->move.end[1] - -10.0) < 1e-12);
     run_free(&r);
 }
 

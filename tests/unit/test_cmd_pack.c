@@ -26,9 +26,9 @@ static void fill(struct ncp_cmd *c, uint64_t seed)
         c->ops[k].text_off = (uint16_t)k;
         c->ops[k].text_len = (uint16_t)(seed % 13u);
         for (int i = 0; i < NCP_CANON_NI; i++)
-            c->ops[k].i[i] = (int32_t)(seed * 31u + (uint64_t)i);
+            c->ops[k].raw.i[i] = (int32_t)(seed * 31u + (uint64_t)i);
         for (int d = 0; d < NCP_CANON_ND; d++)
-            c->ops[k].d[d] = (double)seed / (d + 1.5);
+            c->ops[k].raw.d[d] = (double)seed / (d + 1.5);
     }
     for (unsigned t = 0; t < c->text_used; t++)
         c->text[t] = (char)('a' + (seed + t) % 26u);

@@ -87,7 +87,7 @@ static int drv_plain_move(struct drv *d, const double end[3], int motion, double
     struct ncp_canon op = {0};
     if (motion <= 1) {
         op.kind = motion ? NCP_C_STRAIGHT_FEED : NCP_C_STRAIGHT_TRAVERSE;
-        memcpy(op.d, end, 3 * sizeof(double));
+        memcpy(op.move.end, end, 3 * sizeof(double));
         return ncp_cutcomp_other(&d->comp, &op, NULL, 0, &sink, &d->diag, line);
     }
     /* uncompensated arcs: centre form only, via the executor's resolver */
@@ -98,11 +98,15 @@ static int drv_plain_move(struct drv *d, const double end[3], int motion, double
     drv_plane(d, end, e);
     struct ncp_canon *a = &cmd.ops[0];
     a->kind = NCP_C_ARC_REQUEST;
-    a->d[0] = s[0]; a->d[1] = s[1]; a->d[2] = e[0]; a->d[3] = e[1]; a->d[4] = e[2];
-    a->d[8] = d->plane == 2 ? s[0] + ck : s[0] + ci;
-    a->d[9] = d->plane == 2 ? s[1] + ci : s[1] + cj;
-    a->i[0] = motion == 3 ? 1 : -1;
-    a->i[3] = d->plane;
+    a->arc.first_start = s[0];
+    a->arc.second_start = s[1];
+    a->arc.first_end = e[0];
+    a->arc.second_end = e[1];
+    a->arc.axis_end = e[2];
+    a->arc.first_centre = d->plane == 2 ? s[0] + ck : s[0] + ci;
+    a->arc.second_centre = d->plane == 2 ? s[1] + ci : s[1] + cj;
+    a->arc.dir = motion == 3 ? 1 : -1;
+    a->arc.plane = d->plane;
     a->flags = (uint16_t)d->inches;
     cmd.n_ops = 1;
     cmd.line = line;
@@ -172,13 +176,13 @@ static int drv_block(struct drv *d, const char *s, uint32_t line)
         return rc;
     if (w.has['F' - 'A']) {
         struct ncp_canon op = {.kind = NCP_C_SET_FEED_RATE};
-        op.d[0] = w.v['F' - 'A'];
+        op.feed_rate.rate = w.v['F' - 'A'];
         if ((rc = ncp_cutcomp_other(&d->comp, &op, NULL, 0, &sink, &d->diag, line)))
             return rc;
     }
     if (w.has['S' - 'A']) {
         struct ncp_canon op = {.kind = NCP_C_SET_SPINDLE_SPEED};
-        op.d[0] = w.v['S' - 'A'];
+        op.spindle_speed.speed = w.v['S' - 'A'];
         if ((rc = ncp_cutcomp_other(&d->comp, &op, NULL, 0, &sink, &d->diag, line)))
             return rc;
     }
@@ -191,7 +195,7 @@ static int drv_block(struct drv *d, const char *s, uint32_t line)
         if (w.g[k] != 40)
             continue;
         struct ncp_canon op = {.kind = NCP_C_DWELL};
-        op.d[0] = w.v['P' - 'A'];
+        op.dwell.seconds = w.v['P' - 'A'];
         if ((rc = ncp_cutcomp_other(&d->comp, &op, NULL, 0, &sink, &d->diag, line)))
             return rc;
     }
@@ -200,7 +204,7 @@ static int drv_block(struct drv *d, const char *s, uint32_t line)
         if (g == 170 || g == 180 || g == 190) {
             d->plane = g == 180 ? 2 : g == 190 ? 1 : 0;
             struct ncp_canon op = {.kind = NCP_C_SELECT_PLANE};
-            op.i[0] = d->plane;
+            op.plane.plane = d->plane;
             rc = ncp_cutcomp_other(&d->comp, &op, NULL, 0, &sink, &d->diag, line);
         } else if (g == 200 || g == 210) {
             if (d->inches != (g == 200)) {
@@ -211,7 +215,7 @@ static int drv_block(struct drv *d, const char *s, uint32_t line)
             }
             d->inches = g == 200;
             struct ncp_canon op = {.kind = NCP_C_USE_LENGTH_UNITS};
-            op.i[0] = !d->inches;
+            op.units.mm = !d->inches;
             rc = ncp_cutcomp_other(&d->comp, &op, NULL, 0, &sink, &d->diag, line);
         } else if (g <= 30 && g % 10 == 0) {
             d->motion = g / 10;

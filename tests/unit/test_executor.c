@@ -221,9 +221,9 @@ static void format_one(const struct kind_case *c, char *line, size_t cap)
 {
     cmd_clear();
     struct ncp_canon *op = add_op(c->kind);
-    op->i[0] = c->i0;
-    op->i[1] = c->i1;
-    memcpy(op->d, c->d, sizeof c->d);
+    op->raw.i[0] = c->i0;
+    op->raw.i[1] = c->i1;
+    memcpy(op->raw.d, c->d, sizeof c->d);
     if (c->text)
         add_text(op, c->text);
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_OK);
@@ -271,11 +271,15 @@ static size_t hot_expect(char *w, size_t cap, const struct ncp_canon *op)
 {
     static const char *const head[] = {"STRAIGHT_TRAVERSE", "STRAIGHT_FEED",
                                        "STRAIGHT_PROBE"};
-    const double *d = op->d;
-    if (op->kind == NCP_C_ARC_FEED)
+    if (op->kind == NCP_C_ARC_FEED) {
+        const struct ncp_canon *q = op;
         return (size_t)snprintf(w, cap, "ARC_FEED(%.4f, %.4f, %.4f, %.4f, %d, %.4f, %.4f, "
-                                "%.4f, %.4f)\n", d[0], d[1], d[2], d[3], op->i[0], d[4],
-                                d[5], d[6], d[7]);
+                                "%.4f, %.4f)\n", q->arc_feed.first_end, q->arc_feed.second_end,
+                                q->arc_feed.first_axis, q->arc_feed.second_axis,
+                                q->arc_feed.rotation, q->arc_feed.axis_end,
+                                q->arc_feed.abc[0], q->arc_feed.abc[1], q->arc_feed.abc[2]);
+    }
+    const double *d = op->move.end;
     return (size_t)snprintf(w, cap, "%s(%.4f, %.4f, %.4f, %.4f, %.4f, %.4f)\n",
                             head[op->kind - NCP_C_STRAIGHT_TRAVERSE], d[0], d[1], d[2],
                             d[3], d[4], d[5]);
@@ -296,9 +300,9 @@ static void test_motion_lines_random(void **state)
         int n_ops = (int)(rng() % NCP_CMD_MAX_OPS) + 1;
         for (int k = 0; k < n_ops; k++) {
             struct ncp_canon *op = add_op(kinds[rng() % 4]);
-            for (int j = 0; j < 8; j++)
-                op->d[j] = hot_value();
-            op->i[0] = (int)(rng() % 7) - 3;
+            for (int j = 0; j < 8; j++) /* move.end and arc_feed's doubles alike */
+                op->raw.d[j] = hot_value();
+            op->raw.i[0] = (int)(rng() % 7) - 3;
             len += hot_expect(want + len, sizeof want - len, op);
         }
         assert_int_equal(ncp_exec_cmd(&cmd), NCP_OK);
@@ -335,8 +339,8 @@ static void test_several_ops_and_silent_kinds(void **state)
     add_op(NCP_C_NONE);
     add_op(NCP_C_FLOOD_ON);
     struct ncp_canon *op = add_op(NCP_C_SET_FEED_RATE);
-    op->d[0] = 12.5;
-    add_op(NCP_C_NURBS_POINTS)->i[0] = 2;
+    op->feed_rate.rate = 12.5;
+    add_op(NCP_C_NURBS_POINTS)->nurbs_points.n = 2;
     add_op(9999); /* corrupt kind: skipped, never indexes past the table */
     add_op(NCP_C_PROGRAM_END);
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_OK);
@@ -378,8 +382,8 @@ static void test_output_overflow(void **state)
 
     cmd_clear();
     struct ncp_canon *op = add_op(NCP_C_ARC_FEED);
-    for (int k = 0; k < 8; k++)
-        op->d[k] = -DBL_MAX;
+    for (int k = 0; k < 8; k++) /* every double of arc_feed */
+        op->raw.d[k] = -DBL_MAX;
     for (int k = 1; k < 3; k++)
         cmd.ops[cmd.n_ops++] = *op;
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_ERR_LIMIT);
@@ -456,20 +460,24 @@ static const struct arc_case arc_cases[] = {
 static void arc_request(const struct arc_case *c)
 {
     cmd_clear();
-    add_op(NCP_C_SELECT_PLANE)->i[0] = c->plane;
+    add_op(NCP_C_SELECT_PLANE)->plane.plane = c->plane;
     struct ncp_canon *op = add_op(NCP_C_ARC_REQUEST);
-    op->d[0] = c->s1;
-    op->d[1] = c->s2;
-    op->d[2] = c->e1;
-    op->d[3] = c->e2;
-    op->d[4] = c->e3;
+    op->arc.first_start = c->s1;
+    op->arc.second_start = c->s2;
+    op->arc.first_end = c->e1;
+    op->arc.second_end = c->e2;
+    op->arc.axis_end = c->e3;
     /* The analyzer adds incremental IJK to the start, as rs274 does. */
-    op->d[8] = c->rform ? c->c1 : c->s1 + c->c1;
-    op->d[9] = c->rform ? 0.0 : c->s2 + c->c2;
-    op->i[0] = c->dir;
-    op->i[1] = c->rform;
-    op->i[2] = c->p;
-    op->i[3] = c->plane;
+    if (c->rform) {
+        op->arc.radius = c->c1;
+    } else {
+        op->arc.first_centre = c->s1 + c->c1;
+        op->arc.second_centre = c->s2 + c->c2;
+    }
+    op->arc.dir = c->dir;
+    op->arc.radius_form = c->rform;
+    op->arc.turns = c->p;
+    op->arc.plane = c->plane;
     op->flags = (uint16_t)c->inch;
     add_op(NCP_C_FLOOD_ON);
 }
@@ -519,18 +527,18 @@ static void test_arc_tolerance_from_op(void **state)
     arc_request(&c);
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_ERR_GEOMETRY); /* default 0.0283 mm */
     arc_request(&c);
-    cmd.ops[1].d[10] = 0.05;
+    cmd.ops[1].arc.tol_abs = 0.05;
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_OK);
     arc_request(&c);
-    cmd.ops[1].d[10] = 0.01;
+    cmd.ops[1].arc.tol_abs = 0.01;
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_ERR_GEOMETRY);
     arc_request(&c);
-    cmd.ops[1].d[10] = 0.01;
-    cmd.ops[1].d[11] = 0.01;
+    cmd.ops[1].arc.tol_abs = 0.01;
+    cmd.ops[1].arc.tol_rel = 0.01;
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_OK);
     arc_request(&c);
-    cmd.ops[1].d[10] = 0.0003; /* beyond 100x the absolute tolerance fails outright */
-    cmd.ops[1].d[11] = 0.01;
+    cmd.ops[1].arc.tol_abs = 0.0003; /* beyond 100x the absolute tolerance fails outright */
+    cmd.ops[1].arc.tol_rel = 0.01;
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_ERR_GEOMETRY);
 }
 
@@ -540,9 +548,9 @@ static void test_arc_rotary_passthrough(void **state)
     (void)state;
     const struct arc_case c = {"abc", 0, 1, 1, 0, 0, 3, 4, 5, 0, 1, -1.5, 0, 0, ""};
     arc_request(&c);
-    cmd.ops[1].d[5] = 10;
-    cmd.ops[1].d[6] = -20.00005;
-    cmd.ops[1].d[7] = 0.12344;
+    cmd.ops[1].arc.abc[0] = 10;
+    cmd.ops[1].arc.abc[1] = -20.00005;
+    cmd.ops[1].arc.abc[2] = 0.12344;
     assert_int_equal(ncp_exec_cmd(&cmd), NCP_OK);
     const char want[] = "SELECT_PLANE(CANON_PLANE_XY)\n"
                         "ARC_FEED(3.0000, 4.0000, -1.9641, 4.5981, 1, -1.5000, "
@@ -561,8 +569,8 @@ static void inverse_arc(const struct arc_case *c, double f, double axis_start)
     memset(feed, 0, sizeof *feed);
     feed->kind = NCP_C_SET_FEED_RATE;
     feed->flags = NCP_FEED_F_INVERSE_ARC;
-    feed->d[0] = f;
-    feed->d[1] = axis_start;
+    feed->feed_rate.rate = f;
+    feed->feed_rate.arc_axis_start = axis_start;
     cmd.ops[2] = arc;
     cmd.n_ops = 3;
 }

@@ -20,10 +20,10 @@ static struct ncp_canon op6(int kind, double x, double y, double z)
 {
     struct ncp_canon c;
     memset(&c, 0, sizeof c);
-    c.kind = (uint16_t)kind;
-    c.d[0] = x;
-    c.d[1] = y;
-    c.d[2] = z;
+    c.kind = (uint16_t)kind; /* the first three numbers of any kind, by position */
+    c.raw.d[0] = x;
+    c.raw.d[1] = y;
+    c.raw.d[2] = z;
     return c;
 }
 
@@ -35,7 +35,7 @@ static struct ncp_canon op_feed(double f)
 static struct ncp_canon op_mode(int mode)
 {
     struct ncp_canon c = op6(NCP_C_SET_MOTION_CONTROL_MODE, 0, 0, 0);
-    c.i[0] = mode;
+    c.motion_control.mode = mode;
     return c;
 }
 
@@ -43,9 +43,9 @@ static struct ncp_canon op_mode(int mode)
 static struct ncp_canon op_arc(double x, double y, double cx, double cy, int rot, double z)
 {
     struct ncp_canon c = op6(NCP_C_ARC_FEED, x, y, cx);
-    c.d[3] = cy;
-    c.d[4] = z;
-    c.i[0] = rot;
+    c.arc_feed.second_axis = cy;
+    c.arc_feed.axis_end = z;
+    c.arc_feed.rotation = rot;
     return c;
 }
 
@@ -300,7 +300,7 @@ static void test_g64_p_tolerance(void **state)
     struct ncp_canon ops[16];
     size_t n = 0;
     ops[n] = op_mode(2);
-    ops[n++].d[0] = tol;
+    ops[n++].motion_control.tolerance = tol;
     ops[n++] = op_feed(9000);
     for (size_t i = 1; i < np; i++)
         ops[n++] = op6(NCP_C_STRAIGHT_FEED, pts[i][0], pts[i][1], 0);
@@ -376,12 +376,12 @@ static void test_canon_units_offsets(void **state)
     struct ncp_seg s;
     struct ncp_diag d;
     struct ncp_canon u = op6(NCP_C_USE_LENGTH_UNITS, 0, 0, 0);
-    u.i[0] = 0; /* inches */
+    u.units.mm = 0; /* inches */
     assert_int_equal(ncp_canon_map_op(&m, &u, 1, &s, &d), 0);
     struct ncp_canon g5x = op6(NCP_C_SET_G5X_OFFSET, 1, 0, 0);
     assert_int_equal(ncp_canon_map_op(&m, &g5x, 2, &s, &d), 0);
     struct ncp_canon mm = u;
-    mm.i[0] = 1;
+    mm.units.mm = 1;
     assert_int_equal(ncp_canon_map_op(&m, &mm, 3, &s, &d), 0);
     struct ncp_canon g92 = op6(NCP_C_SET_G92_OFFSET, 0, 2, 0);
     assert_int_equal(ncp_canon_map_op(&m, &g92, 4, &s, &d), 0);
@@ -429,7 +429,7 @@ static void test_canon_spindle_feeds(void **state)
     struct map_fixture f;
     map_fixture_init(&f, 0.5); /* 50 % override */
     struct ncp_canon mode = op6(NCP_C_SET_FEED_MODE, 0, 0, 0);
-    mode.i[1] = 1; /* units per revolution */
+    mode.feed_mode.per_rev = 1; /* units per revolution */
     assert_int_equal(map_op(&f, mode, 1), 0);
     assert_int_equal(map_op(&f, op6(NCP_C_SET_SPINDLE_SPEED, 600, 0, 0), 2), 0);
     assert_int_equal(map_op(&f, op_feed(0.2), 3), 0);
@@ -457,9 +457,11 @@ static void test_canon_spindle_feeds(void **state)
 static struct ncp_canon op_spline(int order, const double end[2], const double pts[6])
 {
     struct ncp_canon c = op6(NCP_C_NURBS_FEED, end[0], end[1], 2);
-    c.i[0] = order;
-    for (int k = 0; k < 6; k++)
-        c.d[3 + k] = pts[k];
+    c.nurbs.n_points = order;
+    c.nurbs.start[0] = pts[0];
+    c.nurbs.start[1] = pts[1];
+    for (int k = 0; k < 4; k++)
+        c.nurbs.ctrl[k / 2][k % 2] = pts[2 + k];
     return c;
 }
 
@@ -541,17 +543,17 @@ static void ref_nurbs(const double (*p)[3], int count, int order, double t, doub
 static struct ncp_canon op_nurbs_head(int count, int order, double x, double y, double z)
 {
     struct ncp_canon c = op6(NCP_C_NURBS_FEED, x, y, z);
-    c.i[0] = count;
-    c.i[1] = order;
-    c.i[2] = NCP_NURBS_POINTS_FOLLOW;
+    c.nurbs.n_points = count;
+    c.nurbs.order = order;
+    c.nurbs.follow = NCP_NURBS_POINTS_FOLLOW;
     return c;
 }
 
 static struct ncp_canon op_nurbs_points(const double (*p)[3], int n)
 {
     struct ncp_canon c = op6(NCP_C_NURBS_POINTS, 0, 0, 0);
-    c.i[0] = n;
-    memcpy(c.d, p, (size_t)n * sizeof p[0]);
+    c.nurbs_points.n = n;
+    memcpy(c.nurbs_points.pt, p, (size_t)n * sizeof p[0]);
     return c;
 }
 

@@ -261,21 +261,21 @@ static struct ncp_cmd *add(struct prog *p, uint32_t line)
 static void op(struct ncp_cmd *c, int kind, double a, double b, double z)
 {
     struct ncp_canon *o = &c->ops[c->n_ops++];
-    o->kind = (uint16_t)kind;
-    o->d[0] = a;
-    o->d[1] = b;
-    o->d[2] = z;
+    o->kind = (uint16_t)kind; /* the first three numbers of any kind, by position */
+    o->raw.d[0] = a;
+    o->raw.d[1] = b;
+    o->raw.d[2] = z;
 }
 
 static void arc(struct ncp_cmd *c, double x, double y, double cx, double cy, int rot)
 {
     struct ncp_canon *o = &c->ops[c->n_ops++];
     o->kind = NCP_C_ARC_FEED;
-    o->d[0] = x;
-    o->d[1] = y;
-    o->d[2] = cx;
-    o->d[3] = cy;
-    o->i[0] = rot;
+    o->arc_feed.first_end = x;
+    o->arc_feed.second_end = y;
+    o->arc_feed.first_axis = cx;
+    o->arc_feed.second_axis = cy;
+    o->arc_feed.rotation = rot;
 }
 
 static int run(struct prog *p, struct ncp_machine_cfg *cfg, FILE *trace,

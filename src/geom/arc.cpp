@@ -3,7 +3,7 @@
 // long double quarter turn, and the centre offset via asin/cos. Any other
 // algebraically equal form drifts in the last bits and can flip a printed
 // fourth decimal.
-#include "arc_geom.h"
+#include "ncpar/geom.h"
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -88,7 +88,7 @@ double swept_angle(const Vec2 &start, const Vec2 &centre, const Vec2 &end, int r
 
 } // namespace
 
-extern "C" double ncp_arc_length(const ncp_arc_in *in, const ncp_arc_out *out,
+extern "C" double ncp_geom_arc_length(const ncp_arc_in *in, const ncp_arc_out *out,
                                  double axis_start, double axis_end)
 {
     const Vec2 start(in->start[0], in->start[1]);
@@ -101,7 +101,7 @@ extern "C" double ncp_arc_length(const ncp_arc_in *in, const ncp_arc_out *out,
     return std::hypot(radius * theta, axis_end - axis_start);
 }
 
-extern "C" int ncp_arc_solve(const ncp_arc_in *in, ncp_arc_out *out)
+extern "C" int ncp_geom_arc_solve(const ncp_arc_in *in, ncp_arc_out *out)
 {
     *out = ncp_arc_out{};
     out->rotation = in->ccw ? in->turns : -in->turns;

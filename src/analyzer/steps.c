@@ -1,6 +1,7 @@
 /* One block in rs274's execution order: comment, feed mode, F, S, T, M codes
  * by group, then G codes by group, motion, and the stop codes last. Each step
- * is a small function; the order lives in ncp_exec_block only. */
+ * is a small function; the order lives in ncp_an_steps only. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
@@ -8,7 +9,7 @@
 
 #define W(a, c) ((a)->w.v[NCP_LETTER(c)])
 
-static int ncp_exec_feed_mode(struct ncp_analyzer *a, int g)
+static int ncp_step_feed_mode(struct ncp_analyzer *a, int g)
 {
     static const char *const msg[] = {
         "interpreter: feed mode set to units per minute",
@@ -23,7 +24,7 @@ static int ncp_exec_feed_mode(struct ncp_analyzer *a, int g)
     ncp_an_emit_text(a, NCP_C_COMMENT, m, n);
     a->st.m.feed_mode = mode;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_FEED_MODE);
-    op->i[1] = mode == 2 ? 1 : 0;
+    op->feed_mode.per_rev = mode == 2 ? 1 : 0;
     if (mode != 1) {
         a->st.feed = 0.0;
         ncp_an_emit(a, NCP_C_SET_FEED_RATE);
@@ -31,7 +32,7 @@ static int ncp_exec_feed_mode(struct ncp_analyzer *a, int g)
     return NCP_OK;
 }
 
-static void ncp_exec_comment_lit(struct ncp_analyzer *a, const char *m)
+static void ncp_step_comment_lit(struct ncp_analyzer *a, const char *m)
 {
     size_t n = 0;
     while (m[n])
@@ -39,7 +40,7 @@ static void ncp_exec_comment_lit(struct ncp_analyzer *a, const char *m)
     ncp_an_emit_text(a, NCP_C_COMMENT, m, n);
 }
 
-static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
+static int ncp_step_spindle(struct ncp_analyzer *a, int m)
 {
     if (m >= 70)
         return ncp_m7x_run(a, m);
@@ -57,8 +58,8 @@ static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
         a->st.m.spindle_dir = 0;
         if (NCP_HAS(&a->w, 'R') || NCP_HAS(&a->w, 'P')) {
             struct ncp_canon *op = ncp_an_emit(a, NCP_C_ORIENT_SPINDLE);
-            op->d[0] = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
-            op->i[1] = NCP_HAS(&a->w, 'P') ? ncp_trunc_int_round(W(a, 'P')) : 0;
+            op->orient.angle = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
+            op->orient.direction = NCP_HAS(&a->w, 'P') ? ncp_trunc_int_round(W(a, 'P')) : 0;
         }
         if (NCP_HAS(&a->w, 'Q')) { /* wait for the orientation, Q seconds at most */
             if (W(a, 'Q') <= 0.0)
@@ -73,7 +74,7 @@ static int ncp_exec_spindle(struct ncp_analyzer *a, int m)
     return NCP_OK;
 }
 
-static int ncp_exec_coolant(struct ncp_analyzer *a, int m)
+static int ncp_step_coolant(struct ncp_analyzer *a, int m)
 {
     if (m == 7) {
         ncp_an_emit(a, NCP_C_MIST_ON);
@@ -89,7 +90,7 @@ static int ncp_exec_coolant(struct ncp_analyzer *a, int m)
     return NCP_OK;
 }
 
-static int ncp_exec_override(struct ncp_analyzer *a, int m)
+static int ncp_step_override(struct ncp_analyzer *a, int m)
 {
     int on = !NCP_HAS(&a->w, 'P') || W(a, 'P') != 0.0;
     switch (m) {
@@ -128,7 +129,7 @@ static int ncp_exec_override(struct ncp_analyzer *a, int m)
  * rs274 -g, whose stand-in returns the default: after a digital wait #5399
  * (the result) becomes 1 if it was not 0, else 0; after an analog one it
  * keeps its value. Nothing is printed (rs274 -g prints no call for it). */
-static int ncp_exec_wait_input(struct ncp_analyzer *a)
+static int ncp_step_wait_input(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     uint16_t col = w->mcol[NCP_MG_IO];
@@ -154,7 +155,7 @@ static int ncp_exec_wait_input(struct ncp_analyzer *a)
     return NCP_OK;
 }
 
-static int ncp_exec_io(struct ncp_analyzer *a, int m)
+static int ncp_step_io(struct ncp_analyzer *a, int m)
 {
     static const enum ncp_canon_kind bits[] = {
         NCP_C_SET_MOTION_OUTPUT_BIT, NCP_C_CLEAR_MOTION_OUTPUT_BIT,
@@ -163,7 +164,7 @@ static int ncp_exec_io(struct ncp_analyzer *a, int m)
     if (m >= 62 && m <= 65) {
         if (!NCP_HAS(&a->w, 'P'))
             return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "No valid P word with M%d", m);
-        ncp_an_emit(a, bits[m - 62])->i[0] = ncp_trunc_int_round(W(a, 'P'));
+        ncp_an_emit(a, bits[m - 62])->output.index = ncp_trunc_int_round(W(a, 'P'));
         return NCP_OK;
     }
     if (m == 67 || m == 68) {
@@ -171,40 +172,40 @@ static int ncp_exec_io(struct ncp_analyzer *a, int m)
             return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "Invalid analog index with M%d", m);
         struct ncp_canon *op = ncp_an_emit(a, m == 67 ? NCP_C_SET_MOTION_OUTPUT_VALUE
                                                       : NCP_C_SET_AUX_OUTPUT_VALUE);
-        op->i[0] = ncp_trunc_int_round(W(a, 'E'));
-        op->d[0] = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
+        op->output.index = ncp_trunc_int_round(W(a, 'E'));
+        op->output.value = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
         return NCP_OK;
     }
     if (m == 66)
-        return ncp_exec_wait_input(a);
+        return ncp_step_wait_input(a);
     return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "M%d is not supported", m);
 }
 
-static int ncp_exec_plane(struct ncp_analyzer *a, int g)
+static int ncp_step_plane(struct ncp_analyzer *a, int g)
 {
     if (g != 170 && g != 180 && g != 190)
         return ncp_an_error(a, a->w.gcol[NCP_GG_PLANE], "G%d.1 planes are not supported", g / 10);
     int p = g == 170 ? 0 : g == 190 ? 1 : 2;
-    ncp_an_emit(a, NCP_C_SELECT_PLANE)->i[0] = p;
+    ncp_an_emit(a, NCP_C_SELECT_PLANE)->plane.plane = p;
     a->st.m.plane = p;
     return NCP_OK;
 }
 
-static int ncp_exec_comp(struct ncp_analyzer *a, int g)
+static int ncp_step_comp(struct ncp_analyzer *a, int g)
 {
     return ncp_comp_gcode(a, g);
 }
 
-static int ncp_exec_control(struct ncp_analyzer *a, int g)
+static int ncp_step_control(struct ncp_analyzer *a, int g)
 {
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_MOTION_CONTROL_MODE);
     /* the canon keeps the naivecam tolerance across G61/G61.1 */
     if (g == 610) {
-        op->i[0] = 1;
+        op->motion_control.mode = 1;
         a->st.m.control = 1;
         a->st.m.p_tol = 0.0;
     } else if (g == 611) {
-        op->i[0] = 0;
+        op->motion_control.mode = 0;
         a->st.m.control = 0;
         a->st.m.p_tol = 0.0;
     } else {
@@ -213,87 +214,124 @@ static int ncp_exec_control(struct ncp_analyzer *a, int g)
         double q_in = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
         double p = p_in >= 0 ? p_in : 0.0;
         double q = q_in >= 0 ? q_in : p;
-        op->i[0] = 2;
-        op->d[0] = p;
+        op->motion_control.mode = 2;
+        op->motion_control.tolerance = p;
         a->st.m.control = 2;
         a->st.m.p_tol = p;
         a->st.m.q_tol = q;
         a->st.m.g64_p = p;
         a->st.m.g64_q = q;
-        ncp_an_emit(a, NCP_C_SET_NAIVECAM_TOLERANCE)->d[0] = q;
+        ncp_an_emit(a, NCP_C_SET_NAIVECAM_TOLERANCE)->naivecam.tolerance = q;
     }
     return NCP_OK;
 }
 
-static void ncp_exec_distance(struct ncp_analyzer *a, int g)
+static void ncp_step_distance(struct ncp_analyzer *a, int g)
 {
     int inc = g == 910;
     if (inc != a->st.m.incremental)
-        ncp_exec_comment_lit(a, inc ? "interpreter: distance mode changed to incremental"
+        ncp_step_comment_lit(a, inc ? "interpreter: distance mode changed to incremental"
                                     : "interpreter: distance mode changed to absolute");
     a->st.m.incremental = inc;
 }
 
-static void ncp_exec_arc_distance(struct ncp_analyzer *a, int g)
+static void ncp_step_arc_distance(struct ncp_analyzer *a, int g)
 {
     int inc = g == 911;
     if (inc != a->st.m.arc_incremental)
-        ncp_exec_comment_lit(a, inc ? "interpreter: IJK distance mode changed to incremental"
+        ncp_step_comment_lit(a, inc ? "interpreter: IJK distance mode changed to incremental"
                                     : "interpreter: IJK distance mode changed to absolute");
     a->st.m.arc_incremental = inc;
 }
 
-static void ncp_exec_retract(struct ncp_analyzer *a, int g)
+static void ncp_step_retract(struct ncp_analyzer *a, int g)
 {
     a->st.m.retract_r = g == 990;
-    ncp_exec_comment_lit(a, g == 990 ? "interpreter: retract mode set to r_plane"
+    ncp_step_comment_lit(a, g == 990 ? "interpreter: retract mode set to r_plane"
                                      : "interpreter: retract mode set to old_z");
 }
 
-static int ncp_exec_m_codes(struct ncp_analyzer *a)
+static int ncp_step_m_codes(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int rc = NCP_OK;
     if (w->m[NCP_MG_IO] != -1)
-        rc = ncp_exec_io(a, w->m[NCP_MG_IO]);
+        rc = ncp_step_io(a, w->m[NCP_MG_IO]);
     if (rc == NCP_OK && w->m[NCP_MG_TOOL] != -1)
         rc = ncp_tools_change(a);
     if (rc == NCP_OK && w->m[NCP_MG_SPINDLE] != -1)
-        rc = ncp_exec_spindle(a, w->m[NCP_MG_SPINDLE]);
-    if (a->block_consumed) /* see ncp_exec_block */
+        rc = ncp_step_spindle(a, w->m[NCP_MG_SPINDLE]);
+    if (a->block_consumed) /* see ncp_an_steps */
         return rc;
     if (rc == NCP_OK && w->m[NCP_MG_COOLANT] != -1)
-        rc = ncp_exec_coolant(a, w->m[NCP_MG_COOLANT]);
+        rc = ncp_step_coolant(a, w->m[NCP_MG_COOLANT]);
     if (rc == NCP_OK && w->m[NCP_MG_OVERRIDE] != -1)
-        rc = ncp_exec_override(a, w->m[NCP_MG_OVERRIDE]);
+        rc = ncp_step_override(a, w->m[NCP_MG_OVERRIDE]);
     return rc;
 }
 
 /* G7/G8. The block's X word was already scaled (analyzer.c, ncp_lathe_x_word);
  * rs274 says so only when the mode changes. */
-static void ncp_exec_lathe_mode(struct ncp_analyzer *a, int diameter)
+static void ncp_step_lathe_mode(struct ncp_analyzer *a, int diameter)
 {
     if (a->st.m.lathe_diameter == diameter)
         return;
     a->st.m.lathe_diameter = diameter;
-    ncp_exec_comment_lit(a, diameter ? "interpreter: Lathe diameter mode changed to diameter"
+    ncp_step_comment_lit(a, diameter ? "interpreter: Lathe diameter mode changed to diameter"
                                      : "interpreter: Lathe diameter mode changed to radius");
 }
 
-static int ncp_exec_g_codes(struct ncp_analyzer *a)
+/* The block's motion (G code x10) to its handler. */
+static int ncp_step_motion(struct ncp_analyzer *a, int motion)
+{
+    if (!ncp_is_canned_cycle(motion))
+        a->st.cycle_il_flag = 0;
+    switch (motion) {
+    case 0: case 10:
+        return ncp_motion_straight(a, motion);
+    case 20: case 30:
+        return ncp_motion_arc(a, motion);
+    case 800:
+        a->st.m.motion = 800;
+        ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
+                         sizeof "interpreter: motion mode set to none" - 1);
+        return NCP_OK;
+    case 50: case 51:
+        return ncp_motion_spline(a, motion);
+    case 52:
+        return ncp_g52_point(a);
+    case 330: case 331: case 760:
+        return ncp_motion_synced(a, motion);
+    case 382: case 383: case 384: case 385:
+        return ncp_motion_probe(a, motion);
+    case 700: case 710: case 711: case 712: case 720: case 721: case 722:
+        return ncp_g7x_run(a, motion);
+    case 730: case 740: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
+    case 890:
+        return ncp_canned_run(a, motion);
+    default: {
+        uint16_t col = NCP_MOTION_COL(&a->w);
+        if (motion % 10)
+            return ncp_an_error(a, col, "G%d.%d is not supported", motion / 10, motion % 10);
+        return ncp_an_error(a, col, "G%d is not supported", motion / 10);
+    }
+    }
+}
+
+static int ncp_step_g_codes(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int rc = NCP_OK;
     if (w->g[NCP_GG_NONMODAL] == 40)
-        ncp_an_emit(a, NCP_C_DWELL)->d[0] = W(a, 'P');
+        ncp_an_emit(a, NCP_C_DWELL)->dwell.seconds = W(a, 'P');
     if (w->g[NCP_GG_PLANE] != -1)
-        rc = ncp_exec_plane(a, w->g[NCP_GG_PLANE]);
+        rc = ncp_step_plane(a, w->g[NCP_GG_PLANE]);
     if (rc == NCP_OK && w->g[NCP_GG_UNITS] != -1)
         rc = ncp_offsets_units(a, w->g[NCP_GG_UNITS] == 200);
     if (rc == NCP_OK && w->g[NCP_GG_LATHE] != -1)
-        ncp_exec_lathe_mode(a, w->g[NCP_GG_LATHE] == 70);
+        ncp_step_lathe_mode(a, w->g[NCP_GG_LATHE] == 70);
     if (rc == NCP_OK && w->g[NCP_GG_COMP] != -1)
-        rc = ncp_exec_comp(a, w->g[NCP_GG_COMP]);
+        rc = ncp_step_comp(a, w->g[NCP_GG_COMP]);
     if (rc == NCP_OK && w->g[NCP_GG_TLO] != -1)
         rc = ncp_offsets_tlo(a, w->g[NCP_GG_TLO]);
     if (rc == NCP_OK && w->g[NCP_GG_COORD] != -1)
@@ -301,26 +339,26 @@ static int ncp_exec_g_codes(struct ncp_analyzer *a)
                                        ? 5 + w->g[NCP_GG_COORD] - 590
                                        : (w->g[NCP_GG_COORD] - 540) / 10));
     if (rc == NCP_OK && w->g[NCP_GG_CONTROL] != -1)
-        rc = ncp_exec_control(a, w->g[NCP_GG_CONTROL]);
+        rc = ncp_step_control(a, w->g[NCP_GG_CONTROL]);
     if (rc != NCP_OK)
         return rc;
     if (w->g[NCP_GG_DIST] != -1)
-        ncp_exec_distance(a, w->g[NCP_GG_DIST]);
+        ncp_step_distance(a, w->g[NCP_GG_DIST]);
     if (w->g[NCP_GG_ARCDIST] != -1)
-        ncp_exec_arc_distance(a, w->g[NCP_GG_ARCDIST]);
+        ncp_step_arc_distance(a, w->g[NCP_GG_ARCDIST]);
     if (w->g[NCP_GG_RETRACT] != -1)
-        ncp_exec_retract(a, w->g[NCP_GG_RETRACT]);
+        ncp_step_retract(a, w->g[NCP_GG_RETRACT]);
     if (w->g[NCP_GG_NONMODAL] == 53)
-        rc = ncp_nurbs_draw(a);
+        rc = ncp_g52_draw(a);
     else if (w->g[NCP_GG_NONMODAL] != -1 && w->g[NCP_GG_NONMODAL] != 40 &&
              w->g[NCP_GG_NONMODAL] != 530)
         rc = ncp_offsets_modal0(a, w->g[NCP_GG_NONMODAL]);
     if (rc == NCP_OK && w->motion_to_be != -1)
-        rc = ncp_motion_run(a, w->motion_to_be);
+        rc = ncp_step_motion(a, w->motion_to_be);
     return rc;
 }
 
-int ncp_exec_block(struct ncp_analyzer *a)
+int ncp_an_steps(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int rc = NCP_OK;
@@ -331,33 +369,73 @@ int ncp_exec_block(struct ncp_analyzer *a)
         struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_SPINDLE_MODE);
         a->st.m.css = w->g[NCP_GG_SPINDLE] == 960;
         if (w->g[NCP_GG_SPINDLE] == 960)
-            op->d[0] = NCP_HAS(w, 'D') ? W(a, 'D') : 1e30;
+            op->spindle_mode.css_max = NCP_HAS(w, 'D') ? W(a, 'D') : 1e30;
     }
     if (rc == NCP_OK && w->g[NCP_GG_FEEDMODE] != -1)
-        rc = ncp_exec_feed_mode(a, w->g[NCP_GG_FEEDMODE]);
+        rc = ncp_step_feed_mode(a, w->g[NCP_GG_FEEDMODE]);
     if (rc != NCP_OK)
         return rc;
     if (NCP_HAS(w, 'F') && a->st.m.feed_mode != 1) {
         a->st.feed = W(a, 'F');
-        ncp_an_emit(a, NCP_C_SET_FEED_RATE)->d[0] = a->st.feed;
+        ncp_an_emit(a, NCP_C_SET_FEED_RATE)->feed_rate.rate = a->st.feed;
     }
     if (NCP_HAS(w, 'S')) {
         a->st.speed = W(a, 'S');
-        ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->d[0] = a->st.speed;
+        ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->spindle_speed.speed = a->st.speed;
     }
     if (NCP_HAS(w, 'T'))
         rc = ncp_tools_select(a);
     if (rc == NCP_OK && w->n_m != 0) /* most blocks have none: skip the group tests */
-        rc = ncp_exec_m_codes(a);
+        rc = ncp_step_m_codes(a);
     if (a->block_consumed) { /* M72's restore lines ran in this block's place */
         a->block_consumed = 0;
         ncp_offsets_sync_params(a);
         return rc;
     }
     if (rc == NCP_OK)
-        rc = ncp_exec_g_codes(a);
+        rc = ncp_step_g_codes(a);
     if (rc == NCP_OK && w->m[NCP_MG_STOP] != -1)
         rc = ncp_stop_run(a, w->m[NCP_MG_STOP]);
     ncp_offsets_sync_params(a);
+    return rc;
+}
+
+/* G7 (lathe diameter mode): an X word is a diameter, so the axis moves half
+ * of it, whatever uses X (moves, G10, G92, G28, cycles). rs274 halves X as it
+ * reads the word when the mode is already on, then, if this block's G7 turns
+ * it on, halves it there, or, if its G8 turns it off, doubles it back: done
+ * in that order here, so every value (even a subnormal) comes out as rs274's.
+ * Before any step of the block uses X, after the checks that only look at
+ * whether it is there. */
+static void ncp_lathe_x_word(struct ncp_analyzer *a)
+{
+    struct ncp_words *w = &a->w;
+    if (!NCP_HAS(w, 'X'))
+        return;
+    int before = a->st.m.lathe_diameter, g = w->g[NCP_GG_LATHE];
+    double *x = &w->v[NCP_LETTER('X')];
+    if (before)
+        *x /= 2;
+    if (g == 70 && !before)
+        *x /= 2;
+    else if (g == 80 && before)
+        *x *= 2;
+}
+
+/* A block as rs274 reads and executes it: what the canon did since the last
+ * one read back, the words, their checks, then the steps in rs274's order. */
+int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b)
+{
+    a->blk = b;
+    ncp_offsets_resync(a);
+    int rc = ncp_words_collect(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_words_assign(a, b);
+    if (rc == NCP_OK)
+        rc = ncp_modal_check(a);
+    if (rc == NCP_OK) {
+        ncp_lathe_x_word(a);
+        rc = ncp_an_steps(a);
+    }
     return rc;
 }

@@ -2,7 +2,7 @@
 // operation, including where it mixes long double quarter turns into double
 // angles: printed coordinates must match its output to the last digit, so
 // "simplifying" any expression here changes results.
-#include "comp_geom.h"
+#include "ncpar/geom.h"
 
 #include <Eigen/Core>
 #include <cmath>
@@ -108,7 +108,7 @@ int arc_arc_meet(int side, double r, double arc_radius, const Vec2 &centre, int 
 
 extern "C" {
 
-const char *ncp_comp_strerror(int status)
+const char *ncp_geom_comp_strerror(int status)
 {
     switch (status) {
     case NCP_COMP_OK: return "";
@@ -140,7 +140,7 @@ const char *ncp_comp_strerror(int status)
     }
 }
 
-double ncp_comp_find_turn(const double p1[2], const double c[2], int turn, const double p2[2])
+double ncp_geom_comp_find_turn(const double p1[2], const double c[2], int turn, const double p2[2])
 {
     if (turn == 0)
         return 0.0;
@@ -156,7 +156,7 @@ double ncp_comp_find_turn(const double p1[2], const double c[2], int turn, const
     return (double)((beta - alpha) + (turn + 1) * (2 * kPi));
 }
 
-int ncp_comp_line_entry(int side, double r, const double cur[2], const double p[2],
+int ncp_geom_comp_line_entry(int side, double r, const double cur[2], const double p[2],
                         double end[2], double dir[2])
 {
     Vec2 c = vec(cur), pp = vec(p);
@@ -169,7 +169,7 @@ int ncp_comp_line_entry(int side, double r, const double cur[2], const double p[
     return NCP_COMP_OK;
 }
 
-int ncp_comp_arc_entry(int side, double r, const double cur[2], const double end[2],
+int ncp_geom_comp_arc_entry(int side, double r, const double cur[2], const double end[2],
                        const double centre[2], int turn, double spiral_abs_tol,
                        double new_end[2], double new_centre[2])
 {
@@ -192,7 +192,7 @@ int ncp_comp_arc_entry(int side, double r, const double cur[2], const double end
     return NCP_COMP_OK;
 }
 
-int ncp_comp_line_next(int side, double r, const double cur[2], const double op[2],
+int ncp_geom_comp_line_next(int side, double r, const double cur[2], const double op[2],
                        const double p[2], const struct ncp_comp_prev *front,
                        struct ncp_comp_corner_out *out)
 {
@@ -239,7 +239,7 @@ int ncp_comp_line_next(int side, double r, const double cur[2], const double op[
     return NCP_COMP_OK;
 }
 
-int ncp_comp_arc_next(int side, double r, const double cur[2], const double op[2],
+int ncp_geom_comp_arc_next(int side, double r, const double cur[2], const double op[2],
                       const double end[2], const double centre[2], int ccw, int turn,
                       const struct ncp_comp_prev *front, struct ncp_comp_corner_out *out)
 {

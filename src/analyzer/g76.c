@@ -4,11 +4,12 @@
  * from the start point; I < 0 cuts an outside thread, I > 0 bores. The
  * arithmetic follows rs274's line for line (its compound angle is scaled
  * in long double) so that every coordinate prints the same. */
+#include "floor.h"
 #include "state.h"
 
 #include <math.h>
 
-struct ncp_thread {
+struct ncp_g76 {
     int boring;
     double safe_x, start_y, start_z, target_z;
     double end_depth, full_threadheight;
@@ -17,59 +18,59 @@ struct ncp_thread {
     double abc[3];
 };
 
-static void ncp_thread_move(struct ncp_analyzer *a, const struct ncp_thread *t,
+static void ncp_g76_move(struct ncp_analyzer *a, const struct ncp_g76 *t,
                             enum ncp_canon_kind kind, double x, double z)
 {
     double p[6] = {x, t->start_y, z, t->abc[0], t->abc[1], t->abc[2]};
     ncp_an_emit6(a, kind, p);
 }
 
-static void ncp_thread_sync(struct ncp_analyzer *a, double pitch)
+static void ncp_g76_sync(struct ncp_analyzer *a, double pitch)
 {
-    ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH)->d[0] = pitch;
+    ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH)->synch.per_rev = pitch;
 }
 
 /* X at `depth` below the start (or above it, boring). */
-static double ncp_thread_x(const struct ncp_thread *t, double depth)
+static double ncp_g76_x(const struct ncp_g76 *t, double depth)
 {
     return t->boring ? t->safe_x + depth : t->safe_x - depth;
 }
 
-static void ncp_thread_pass(struct ncp_analyzer *a, const struct ncp_thread *t, double depth,
+static void ncp_g76_pass(struct ncp_analyzer *a, const struct ncp_g76 *t, double depth,
                             double zoff)
 {
     double back = t->boring ? t->safe_x + depth - t->end_depth : t->safe_x - depth + t->end_depth;
     double top = t->boring ? t->safe_x + depth - t->full_threadheight
                            : t->safe_x - depth + t->full_threadheight;
-    ncp_thread_move(a, t, NCP_C_STRAIGHT_TRAVERSE, back, t->start_z - zoff);
+    ncp_g76_move(a, t, NCP_C_STRAIGHT_TRAVERSE, back, t->start_z - zoff);
     if (t->taper_dist != 0.0 && t->entry_taper) {
         ncp_an_emit(a, NCP_C_DISABLE_FEED_OVERRIDE);
-        ncp_thread_sync(a, t->taper_pitch);
-        ncp_thread_move(a, t, NCP_C_STRAIGHT_FEED, top, t->start_z - zoff);
-        ncp_thread_move(a, t, NCP_C_STRAIGHT_FEED, ncp_thread_x(t, depth),
+        ncp_g76_sync(a, t->taper_pitch);
+        ncp_g76_move(a, t, NCP_C_STRAIGHT_FEED, top, t->start_z - zoff);
+        ncp_g76_move(a, t, NCP_C_STRAIGHT_FEED, ncp_g76_x(t, depth),
                         t->start_z - zoff - t->taper_dist);
-        ncp_thread_sync(a, t->pitch);
+        ncp_g76_sync(a, t->pitch);
     } else {
-        ncp_thread_move(a, t, NCP_C_STRAIGHT_TRAVERSE, ncp_thread_x(t, depth), t->start_z - zoff);
+        ncp_g76_move(a, t, NCP_C_STRAIGHT_TRAVERSE, ncp_g76_x(t, depth), t->start_z - zoff);
         ncp_an_emit(a, NCP_C_DISABLE_FEED_OVERRIDE);
-        ncp_thread_sync(a, t->pitch);
+        ncp_g76_sync(a, t->pitch);
     }
     if (t->taper_dist != 0.0 && t->exit_taper) {
-        ncp_thread_move(a, t, NCP_C_STRAIGHT_FEED, ncp_thread_x(t, depth),
+        ncp_g76_move(a, t, NCP_C_STRAIGHT_FEED, ncp_g76_x(t, depth),
                         t->target_z - zoff + t->taper_dist);
-        ncp_thread_sync(a, t->taper_pitch);
-        ncp_thread_move(a, t, NCP_C_STRAIGHT_FEED, top, t->target_z - zoff);
+        ncp_g76_sync(a, t->taper_pitch);
+        ncp_g76_move(a, t, NCP_C_STRAIGHT_FEED, top, t->target_z - zoff);
     } else {
-        ncp_thread_move(a, t, NCP_C_STRAIGHT_FEED, ncp_thread_x(t, depth), t->target_z - zoff);
+        ncp_g76_move(a, t, NCP_C_STRAIGHT_FEED, ncp_g76_x(t, depth), t->target_z - zoff);
     }
     ncp_an_emit(a, NCP_C_STOP_SPEED_FEED_SYNCH);
-    ncp_thread_move(a, t, NCP_C_STRAIGHT_TRAVERSE, back, t->target_z - zoff);
+    ncp_g76_move(a, t, NCP_C_STRAIGHT_TRAVERSE, back, t->target_z - zoff);
     ncp_an_emit(a, NCP_C_ENABLE_FEED_OVERRIDE);
 }
 
 /* Depth of cutting pass n (1, 2, ...): the first at J past I, the next ones
  * taking off ever less as the degression R grows. */
-static double ncp_thread_depth(double full_dia_depth, double cut_increment, double n,
+static double ncp_g76_depth(double full_dia_depth, double cut_increment, double n,
                                double degression)
 {
     return full_dia_depth + cut_increment * pow(n, 1.0 / degression);
@@ -80,7 +81,7 @@ static double ncp_word_or(const struct ncp_words *w, char c, double absent)
     return NCP_HAS(w, c) ? w->v[NCP_LETTER(c)] : absent;
 }
 
-int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
+int ncp_g76_cycle(struct ncp_analyzer *a, const double *end)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
@@ -100,7 +101,7 @@ int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
         j_number /= 2;
         k_number /= 2;
     }
-    struct ncp_thread t = {
+    struct ncp_g76 t = {
         .boring = i_number > 0.0,
         .safe_x = s->pos[NCP_X],
         .start_y = s->pos[NCP_Y],
@@ -147,7 +148,7 @@ int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
                                                 : NCP_DEFAULT_MAX_LOOPS;
     double passes = 0.0;
     for (double n = 1.0, d = start_depth; d < t.end_depth && passes <= limit;
-         d = ncp_thread_depth(full_dia_depth, cut_increment, ++n, degression))
+         d = ncp_g76_depth(full_dia_depth, cut_increment, ++n, degression))
         passes++;
     passes += (double)spring_cuts + 1.0;
     if (passes > limit)
@@ -160,14 +161,14 @@ int ncp_thread_cycle(struct ncp_analyzer *a, const double *end)
     double depth = start_depth;
     double zoff = (depth - full_dia_depth) * tan(compound_angle);
     while (depth < t.end_depth) {
-        ncp_thread_pass(a, &t, depth, zoff);
-        depth = ncp_thread_depth(full_dia_depth, cut_increment, ++pass, degression);
+        ncp_g76_pass(a, &t, depth, zoff);
+        depth = ncp_g76_depth(full_dia_depth, cut_increment, ++pass, degression);
         zoff = (depth - full_dia_depth) * tan(compound_angle);
     }
     depth = t.end_depth;
     zoff = (depth - full_dia_depth) * tan(compound_angle);
     for (int k = 0; k <= spring_cuts; k++)
-        ncp_thread_pass(a, &t, depth, zoff);
+        ncp_g76_pass(a, &t, depth, zoff);
     double last[6] = {end[NCP_X], end[NCP_Y], end[NCP_Z], t.abc[0], t.abc[1], t.abc[2]};
     ncp_an_emit6(a, NCP_C_STRAIGHT_TRAVERSE, last);
     s->pos[NCP_X] = end[NCP_X];
