@@ -17,6 +17,7 @@
 #ifndef NCPAR_NCK_H
 #define NCPAR_NCK_H
 
+#include <signal.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -42,6 +43,9 @@ struct ncp_nck_ctl {
      * time. INT64_MAX (the default) never pauses. */
     _Atomic int64_t pause_at_ns;
     _Atomic int rapid_permille;     /* rapid override of G0 moves, 0..1000 */
+    /* A batch run's controlled stop (SIGINT/SIGTERM): a feed hold along the
+     * path, then the run ends once the axes have settled. */
+    _Atomic int stop;
 };
 
 void ncp_nck_ctl_init(struct ncp_nck_ctl *c, double feed_override);
@@ -66,6 +70,9 @@ struct ncp_nck_opts {
     FILE *progress;          /* live progress line (a terminal) or NULL */
     uint32_t total_lines;    /* for the progress line */
     struct ncp_nck_ctl *ctl; /* live override / hold, or NULL */
+    /* polled while the run goes on: non-zero asks for a controlled stop
+     * (a signal handler's flag), or NULL */
+    volatile sig_atomic_t *interrupt;
 };
 
 enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };
@@ -79,6 +86,8 @@ struct ncp_nck_result {
     uint32_t fault_line;
     struct ncp_diag diag;    /* program error or soft-limit violation */
     int for_expired;
+    int interrupted;         /* stopped along the path on request (opts.interrupt) */
+    int trace_errno;         /* writing the trace failed (errno), 0 = it did not */
     double program_time, path_length;
     double ferr_max, ferr_avg, ferr_axis_max[3];
     double contour_max, contour_avg;

@@ -10,6 +10,7 @@
 #include "ncpar/nck.h"
 
 #include <errno.h>
+#include <signal.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -305,6 +306,25 @@ static int draw_plot(const struct run_opts *o, const char *trace, const struct n
     return 0;
 }
 
+/* SIGINT/SIGTERM: a controlled stop along the path, then the summary. */
+static volatile sig_atomic_t run_signal;
+
+static void on_signal(int sig)
+{
+    run_signal = sig;
+}
+
+static void catch_signals(void)
+{
+    /* an explicit handler: a SIGINT inherited as ignored must still stop a run */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
 {
@@ -316,6 +336,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .feed_override = o->feed_override, .trace = trace,
         .progress = isatty(2) && !o->virtual_clock ? stderr : NULL,
         .total_lines = count_lines(src),
+        .interrupt = &run_signal,
     };
     struct ncp_nck_result *res = malloc(sizeof *res);
     if (!res)
@@ -324,6 +345,12 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
     if (res->warning[0] && !no.progress)
         fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
     int rc = report(o, cfg, res);
+    if (res->trace_errno) {
+        fprintf(stderr, "cnc-run run: error writing the trace: %s\n", strerror(res->trace_errno));
+        rc = rc ? rc : RUN_FAULT;
+    }
+    if (rc == RUN_OK && res->interrupted)
+        rc = 128 + (int)run_signal;   /* as a shell reports a signal: 130, 143 */
     *lat = res->lat;
     free(res);
     return rc;
@@ -336,6 +363,7 @@ int ncp_cli_run(int argc, char **argv)
     o.mode = NCP_MODE_SERIAL;
     if (parse_opts(argc, argv, &o))
         return usage(stderr), RUN_USAGE;
+    catch_signals();
     struct ncp_machine_cfg cfg;
     if (load_config(&o, &cfg))
         return RUN_USAGE;

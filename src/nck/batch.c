@@ -82,6 +82,8 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o)
         int got = nck_read_cycles(n);
         if (!got && !atomic_load(&n->loop.running) && ncp_spsc_count(&n->fbs) == 0)
             break;
+        if (o->interrupt && *o->interrupt && !atomic_load(&n->ctl->stop))
+            atomic_store(&n->ctl->stop, 1);
         if (o->progress && mono_ns() - last_print > 200000000) {
             last_print = mono_ns();
             progress(n, o);
@@ -93,6 +95,8 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o)
     }
     if (o->progress && last_print)
         fputc('\n', o->progress);
+    if (o->trace)
+        nck_trace_flush(&n->sum, o->trace);
 }
 
 /* "node 2: EMCY (0x082): ... (last completed block: line 7)", at the line
@@ -134,6 +138,8 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
     memcpy(res->warning, n->loop.warning, sizeof res->warning);
     res->lat = n->loop.stats;
     res->for_expired = n->for_expired;
+    res->interrupted = atomic_load(&n->ctl->stop) && !n->ended;
+    res->trace_errno = n->sum.trace_errno;
     const struct nck_job *j = &n->job;
     int fault = atomic_load(&n->loop_fault);
     if (fault == NCK_LF_BACKEND) {
@@ -144,7 +150,7 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
         res->fault_err = n->fault_err;
         res->fault_line = n->fault_line;
         res->status = NCP_NCK_FAULT;
-    } else if (n->for_expired) {
+    } else if (n->for_expired || res->interrupted) {
         /* the interpreter was cut short by us: its "stopped" is no program error */
     } else if (j->map_failed || j->rc != NCP_OK) {
         res->diag = j->map_failed ? j->map_diag : j->diag;

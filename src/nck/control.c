@@ -674,6 +674,8 @@ void ncp_nck_free(struct ncp_nck *s)
     struct nck *n = &s->n;
     nck_finish(n);
     nck_read_cycles(n);
+    if (n->setup.trace)
+        nck_trace_flush(&n->sum, n->setup.trace);
     nck_release(n);
     ncp_analyzer_free(s->interp);
     if (s->have_prog)

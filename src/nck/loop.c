@@ -29,7 +29,8 @@ static int check_ferror(struct nck *n, const double act[NCP_AXES])
  * hold: a faster stream could exceed the acceleration limits. */
 static double feed_rate(struct nck *n)
 {
-    if (n->for_expired || atomic_load_explicit(&n->ctl->hold, memory_order_relaxed))
+    if (n->for_expired || atomic_load_explicit(&n->ctl->hold, memory_order_relaxed) ||
+        atomic_load_explicit(&n->ctl->stop, memory_order_relaxed))
         return 0.0;
     /* a serving NCK's rapids follow the rapid override, as LinuxCNC's (a
      * batch run's --feed-override and live override apply to all motion) */
@@ -235,7 +236,8 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
     if (n->batch) {
         if (n->for_s > 0 && (double)now_ns * 1e-9 >= n->for_s)
             n->for_expired = 1;
-        int done = n->ended || (n->for_expired && n->scaler.r == 0 && n->cur.v == 0);
+        int held = n->for_expired || atomic_load_explicit(&n->ctl->stop, memory_order_relaxed);
+        int done = n->ended || (held && n->scaler.r == 0 && n->cur.v == 0);
         if (done && ++n->settle >= SETTLE_CYCLES)
             return NCP_RT_STOP;
     } else if (virt && n->setup.virtual_pace > 0 && !rest) {

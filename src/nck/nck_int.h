@@ -47,6 +47,11 @@ struct nck_summary {
     double path;             /* length of the commanded path actually run */
     double last[NCP_AXES];
     double act[NCP_AXES];    /* the last cycle's actual position */
+    /* Trace rows are gathered here and written whole (write(2) of complete
+     * rows only), so that even a killed process leaves a parseable trace. */
+    char tbuf[1 << 16];
+    size_t tlen;
+    int trace_errno;         /* the first failed write's errno, 0 = none */
 };
 
 enum nck_loop_fault { NCK_LF_NONE, NCK_LF_FERROR, NCK_LF_BACKEND };
@@ -246,5 +251,7 @@ void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace);
 /* Reads every cycle the loop has written: trace, summary, last cycle. */
 int nck_read_cycles(struct nck *n);
 void nck_trace_header(FILE *trace);
+/* Writes the rows gathered so far. 0, or -1 when the write failed. */
+int nck_trace_flush(struct nck_summary *s, FILE *trace);
 
 #endif

@@ -3,8 +3,10 @@
  * caller's thread, never on the real-time one. */
 #include "nck_int.h"
 
+#include <errno.h>
 #include <math.h>
 #include <string.h>
+#include <unistd.h>
 
 static double dist_to_seg(const double p[NCP_AXES], const double a[NCP_AXES],
                           const double b[NCP_AXES])
@@ -73,15 +75,42 @@ void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
     memcpy(s->act, fb->act, sizeof s->act);
     s->t = fb->t;
     s->v = fb->v;
-    if (trace)
-        fprintf(trace, "%.6f,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%d\n", fb->t, fb->line,
-                fb->cmd[0], fb->cmd[1], fb->cmd[2], fb->act[0], fb->act[1], fb->act[2], fb->v,
-                nck_motion_column(fb->flags));
+    if (!trace)
+        return;
+    if (sizeof s->tbuf - s->tlen < 512)
+        nck_trace_flush(s, trace);
+    int k = snprintf(s->tbuf + s->tlen, sizeof s->tbuf - s->tlen,
+                     "%.6f,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%d\n", fb->t, fb->line,
+                     fb->cmd[0], fb->cmd[1], fb->cmd[2], fb->act[0], fb->act[1], fb->act[2],
+                     fb->v, nck_motion_column(fb->flags));
+    if (k > 0 && (size_t)k < sizeof s->tbuf - s->tlen)
+        s->tlen += (size_t)k;
 }
 
 void nck_trace_header(FILE *trace)
 {
     fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n", trace);
+    fflush(trace);
+}
+
+int nck_trace_flush(struct nck_summary *s, FILE *trace)
+{
+    const char *p = s->tbuf;
+    size_t left = s->tlen;
+    s->tlen = 0;
+    while (left > 0) {
+        ssize_t w = write(fileno(trace), p, left);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0) {
+            if (!s->trace_errno)
+                s->trace_errno = w < 0 ? errno : ENOSPC;
+            return -1;
+        }
+        p += w;
+        left -= (size_t)w;
+    }
+    return 0;
 }
 
 int nck_read_cycles(struct nck *n)
@@ -125,7 +154,10 @@ void ncp_nck_print_summary(const struct ncp_nck_result *r, const char *prog, FIL
     fprintf(f, "%s: position loop %s%s\n", prog, r->fifo ? "SCHED_FIFO" : "SCHED_OTHER",
             r->warning[0] ? " (no real-time permission)" : "");
     fprintf(f, "  program time %.3f s%s, path length %.3f mm, %llu segments\n",
-            r->program_time, r->for_expired ? " (--for: feed hold, braked along the path)" : "", r->path_length,
+            r->program_time,
+            r->interrupted ? " (interrupted: feed hold, braked along the path)"
+            : r->for_expired ? " (--for: feed hold, braked along the path)" : "",
+            r->path_length,
             (unsigned long long)r->segments);
     fprintf(f, "  following error: max %.4f mm (X %.4f, Y %.4f, Z %.4f), avg %.4f mm in motion\n",
             r->ferr_max, r->ferr_axis_max[0], r->ferr_axis_max[1], r->ferr_axis_max[2],
