@@ -65,7 +65,7 @@ static int emit(void *ctx, const struct ncp_cmd *cmd)
  * every thread of the application priority 90, the starting one included; that
  * also keeps the freshly created SCHED_FIFO threads from preempting it on its own
  * CPU while it creates the rest, which would count their work as start-up time. */
-static void place_self(const struct ncp_thread_spec *spec, int pin)
+static void place_self(const struct ncp_rt_place *spec, int pin)
 {
     if (pin && spec->cpu >= 0) {
         cpu_set_t set;

@@ -39,11 +39,6 @@ struct ncp_can_cfg {
     int sdo_timeout_ms;           /* SDO_TIMEOUT_MS: start-up SDO answer deadline */
 };
 
-/* One thread's placement: cpu < 0 lets the OS place it; priority 0 = SCHED_OTHER. */
-struct ncp_rt_place {
-    int cpu;
-    int priority;
-};
 
 struct ncp_machine_cfg {
     double servo_period;          /* s ([EMCMOT] SERVO_PERIOD is in ns) */

@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "ncpar/analyzer.h"
+#include "ncpar/rt.h"
 #include "ncpar/canon.h"
 #include "ncpar/diag.h"
 #include "ncpar/feeder.h"
@@ -17,11 +18,6 @@
 enum ncp_thread_mode { NCP_MODE_SERIAL, NCP_MODE_DET, NCP_MODE_ATT };
 
 /* Placement of one thread. cpu < 0: let the OS place it (DET). */
-struct ncp_thread_spec {
-    int cpu;
-    int policy;    /* SCHED_OTHER or SCHED_FIFO */
-    int priority;  /* SCHED_FIFO priority, ignored for SCHED_OTHER */
-};
 
 /* Thread map (an INI in rt-config/): which thread runs where, ring sizes. */
 struct ncp_thread_map {
@@ -43,9 +39,9 @@ struct ncp_thread_map {
      * to write, lexes chunks of about this many bytes of text ahead of the
      * analyzer (it balances the two threads); 0: never */
     int lex_ahead_bytes;
-    struct ncp_thread_spec feeder, analyzer, output;
-    struct ncp_thread_spec lexer[NCP_MAX_LEXERS];
-    struct ncp_thread_spec executor[NCP_MAX_EXECUTORS];
+    struct ncp_rt_place feeder, analyzer, output;
+    struct ncp_rt_place lexer[NCP_MAX_LEXERS];
+    struct ncp_rt_place executor[NCP_MAX_EXECUTORS];
 };
 
 /* "serial", "det" or "att" (any case) -> *mode; returns 0, or -1 if unknown. */
@@ -86,8 +82,8 @@ struct ncp_stage_stats {
 
 /* ncp_run_stats.warnings bits: the run went on with a weaker setting. */
 enum ncp_run_warning {
-    NCP_WARN_NO_FIFO = 1u << 0, /* SCHED_FIFO not permitted: ran SCHED_OTHER */
-    NCP_WARN_NO_CPU = 1u << 1   /* a map's cpu is not available: placed on another */
+    NCP_WARN_NO_FIFO = NCP_RT_WARN_NO_FIFO, /* SCHED_FIFO not permitted: ran SCHED_OTHER */
+    NCP_WARN_NO_CPU = NCP_RT_WARN_NO_CPU    /* a map's cpu is not available: placed on another */
 };
 
 struct ncp_run_stats {

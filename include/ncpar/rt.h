@@ -30,11 +30,29 @@ int ncp_spsc_pop(struct ncp_spsc *r, void *item);          /* 0 ok, -1 empty */
 size_t ncp_spsc_count(struct ncp_spsc *r);
 size_t ncp_spsc_capacity(const struct ncp_spsc *r);
 
-/* Starts a thread with the given placement: priority 1..99 asks for SCHED_FIFO
- * (falling back to SCHED_OTHER when refused, *fifo tells which), cpu >= 0 pins
- * it. Returns 0 or the pthread_create error. */
-int ncp_rt_spawn(pthread_t *t, void *(*fn)(void *), void *arg, int priority, int cpu,
-                 int *fifo);
+/* ---- threads ------------------------------------------------------------------ */
+
+/* Where a thread runs and how it is scheduled: the interpreter pipeline's
+ * threads (thread maps) and the NCK's (the machine INI's [RT]) alike. */
+struct ncp_rt_place {
+    int cpu;        /* < 0: the OS places it */
+    int policy;     /* SCHED_OTHER or SCHED_FIFO */
+    int priority;   /* SCHED_FIFO's priority, 1..99 */
+};
+
+/* What ncp_rt_start had to give up (bits of its warnings). */
+enum ncp_rt_warning {
+    NCP_RT_WARN_NO_FIFO = 1u << 0, /* SCHED_FIFO not permitted: runs SCHED_OTHER */
+    NCP_RT_WARN_NO_CPU = 1u << 1   /* the cpu is not one this process may use: another is */
+};
+
+/* Starts fn(arg) with the placement set on its attributes before it exists,
+ * so it never runs an instruction on the wrong CPU or policy. SCHED_FIFO
+ * refused (EPERM) falls back to SCHED_OTHER and a cpu this process may not use
+ * to another one it may; each adds its bit to *warnings (may be NULL).
+ * Returns 0 or the pthread_create error. */
+int ncp_rt_start(pthread_t *t, const struct ncp_rt_place *pl, void *(*fn)(void *), void *arg,
+                 uint32_t *warnings);
 
 /* ---- latency statistics ----------------------------------------------------- */
 

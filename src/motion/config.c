@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
+#include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,9 +32,9 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->kd = 0.46;
     c->ff1 = 0.1;
     c->ff2 = 0.004;
-    c->position = (struct ncp_rt_place){ -1, 90 };
-    c->planner = (struct ncp_rt_place){ -1, 0 };
-    c->interp = (struct ncp_rt_place){ -1, 0 };
+    c->position = (struct ncp_rt_place){ -1, SCHED_FIFO, 90 };
+    c->planner = (struct ncp_rt_place){ -1, SCHED_OTHER, 0 };
+    c->interp = (struct ncp_rt_place){ -1, SCHED_OTHER, 0 };
     c->backend = NCP_BACKEND_SIM;
     /* 10 heartbeats may go missing before the drive counts as lost; SDO
      * answers come within a few ms from any drive that is there at all */
@@ -105,8 +106,13 @@ static int rt_key(struct ncp_machine_cfg *c, const char *k, const char *v)
         size_t n = strlen(threads[i].prefix);
         if (strncasecmp(k, threads[i].prefix, n) != 0)
             continue;
-        if (!strcasecmp(k + n, "PRIORITY"))
-            return integer(v, 0, 99, &threads[i].pl->priority) ? -1 : 1;
+        if (!strcasecmp(k + n, "PRIORITY")) {
+            /* 0 is SCHED_OTHER, as in the thread maps' POLICY = other */
+            if (integer(v, 0, 99, &threads[i].pl->priority))
+                return -1;
+            threads[i].pl->policy = threads[i].pl->priority > 0 ? SCHED_FIFO : SCHED_OTHER;
+            return 1;
+        }
         if (!strcasecmp(k + n, "CPU"))
             return integer(v, -1, 1023, &threads[i].pl->cpu) ? -1 : 1;
     }

@@ -87,8 +87,7 @@ int nck_start(struct nck *n, const struct ncp_nck_setup *s, int batch, struct nc
         return -1;
     }
     const struct ncp_machine_cfg *c = n->cfg;
-    if (ncp_rt_spawn(&n->planner_thread, nck_planner_main, n, c->planner.priority,
-                     c->planner.cpu, NULL)) {
+    if (ncp_rt_start(&n->planner_thread, &c->planner, nck_planner_main, n, NULL)) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the planner thread");
         return -1;
     }
@@ -192,6 +191,7 @@ void ncp_nck_ctl_init(struct ncp_nck_ctl *c, double feed_override)
     atomic_store(&c->now_ns, 0);
     atomic_store(&c->pause_at_ns, INT64_MAX);
     atomic_store(&c->rapid_permille, 1000);
+    atomic_store(&c->stop, 0);
 }
 
 void ncp_nck_set_feed_override(struct ncp_nck_ctl *c, double ov)

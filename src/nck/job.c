@@ -268,7 +268,7 @@ int nck_job_start(struct nck *n)
     atomic_fetch_add_explicit(&n->marks_sent, 1, memory_order_release);
     void *(*fn)(void *) = j->kind == NCK_JOB_MOVE ? moves_main : interp_main;
     const struct ncp_rt_place *pl = &n->cfg->interp;
-    if (ncp_rt_spawn(&j->thread, fn, n, pl->priority, pl->cpu, NULL)) {
+    if (ncp_rt_start(&j->thread, pl, fn, n, NULL)) {
         atomic_fetch_sub(&n->marks_sent, 1);
         j->kind = NCK_JOB_NONE;
         return -1;

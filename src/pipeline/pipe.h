@@ -111,7 +111,7 @@ void ncp_pipe_wait_gate(struct ncp_pipe *p, int timeout_us);
 
 /* One stage thread of a run: where it runs, its code and its worker. */
 struct ncp_pipe_stage {
-    const struct ncp_thread_spec *spec;
+    const struct ncp_rt_place *spec;
     void *(*fn)(void *);
     struct ncp_pipe_worker *w;
     int is_lexer;                /* keeps the paper's start rule (the gate) */
@@ -133,7 +133,7 @@ struct ncp_starter {
 
 /* Start a thread running fn(arg) with spec's placement; its creation counts in
  * s->setup_ms. On failure s->failed is set and the pipe aborted. */
-void ncp_pipe_start_thread(struct ncp_starter *s, const struct ncp_thread_spec *spec,
+void ncp_pipe_start_thread(struct ncp_starter *s, const struct ncp_rt_place *spec,
                            void *(*fn)(void *), void *arg);
 
 /* The run's result in the serial reference's precedence, and its statistics

@@ -6,7 +6,6 @@
 
 #include "cmd_pack.h"
 #include "futex.h"
-#include "threads.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -227,7 +226,7 @@ void ncp_pipe_wait_gate(struct ncp_pipe *p, int timeout_us)
     }
 }
 
-void ncp_pipe_start_thread(struct ncp_starter *s, const struct ncp_thread_spec *spec,
+void ncp_pipe_start_thread(struct ncp_starter *s, const struct ncp_rt_place *spec,
                            void *(*fn)(void *), void *arg)
 {
     if (s->failed)
@@ -236,7 +235,10 @@ void ncp_pipe_start_thread(struct ncp_starter *s, const struct ncp_thread_spec *
     /* CPU time, not wall time: a new thread may preempt its creator, and
      * that time is the pipeline's work, not start-up. */
     double t0 = ncp_pipe_thread_cpu_ms();
-    int rc = ncp_thread_start(&s->tid[s->started], spec, pin, fn, arg, &s->warnings);
+    struct ncp_rt_place at = *spec;
+    if (!pin)
+        at.cpu = -1;
+    int rc = ncp_rt_start(&s->tid[s->started], &at, fn, arg, &s->warnings);
     s->setup_ms += ncp_pipe_thread_cpu_ms() - t0;
     if (rc != 0) {
         s->failed = 1;

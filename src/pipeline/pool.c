@@ -7,7 +7,6 @@
 #include "pipe.h"
 
 #include "futex.h"
-#include "threads.h"
 
 #include <stdlib.h>
 #include <string.h>

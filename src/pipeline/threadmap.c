@@ -35,9 +35,9 @@ static int clamp(int v, int lo, int hi)
     return v < lo ? lo : v > hi ? hi : v;
 }
 
-static struct ncp_thread_spec spec_on(int cpu)
+static struct ncp_rt_place spec_on(int cpu)
 {
-    struct ncp_thread_spec s = { cpu, SCHED_OTHER, 0 };
+    struct ncp_rt_place s = { cpu, SCHED_OTHER, 0 };
     return s;
 }
 
@@ -85,7 +85,7 @@ enum spec_key { KEY_CPU = 1, KEY_POLICY = 2, KEY_PRIORITY = 4 };
 
 /* What the file said, applied over the defaults once mode and counts are known. */
 struct loaded_spec {
-    struct ncp_thread_spec v;
+    struct ncp_rt_place v;
     unsigned set;       /* enum spec_key bits */
     int line;           /* first line of its section, for late checks */
 };
@@ -301,7 +301,7 @@ static char *read_line(char *str, int num, void *stream)
     return s;
 }
 
-static void apply(struct ncp_thread_spec *dst, const struct loaded_spec *s)
+static void apply(struct ncp_rt_place *dst, const struct loaded_spec *s)
 {
     if (s->set & KEY_CPU)
         dst->cpu = s->v.cpu;
@@ -311,7 +311,7 @@ static void apply(struct ncp_thread_spec *dst, const struct loaded_spec *s)
         dst->priority = s->v.priority;
 }
 
-static int check_spec(struct map_loader *L, const struct ncp_thread_spec *t,
+static int check_spec(struct map_loader *L, const struct ncp_rt_place *t,
                       const struct loaded_spec *s, const char *what)
 {
     if (t->policy == SCHED_FIFO && (t->priority < 1 || t->priority > 99))

@@ -138,8 +138,11 @@ int ncp_rt_loop_start(struct ncp_rt_loop *l)
         l->memlocked = lock_memory();
         l->dma_fd = hold_dma_latency();
     }
-    int rc = ncp_rt_spawn(&l->thread, loop_main, l, want_fifo ? l->cfg.priority : 0,
-                          l->cfg.cpu, &l->fifo);
+    struct ncp_rt_place at = { l->cfg.cpu, want_fifo ? SCHED_FIFO : SCHED_OTHER,
+                               want_fifo ? l->cfg.priority : 0 };
+    uint32_t warnings = 0;
+    int rc = ncp_rt_start(&l->thread, &at, loop_main, l, &warnings);
+    l->fifo = rc == 0 && want_fifo && !(warnings & NCP_RT_WARN_NO_FIFO);
     if (rc == 0 && (l->fifo || !want_fifo))
         return 0;
     if (want_fifo && rc == 0)
