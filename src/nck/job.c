@@ -126,6 +126,16 @@ static int approach(struct nck *n, uint32_t line)
 
 void nck_note_state(struct nck *n, const struct ncp_canon *op)
 {
+    /* most calls are motion: leave those without taking the lock */
+    switch (op->kind) {
+    case NCP_C_SET_SPINDLE_SPEED: case NCP_C_START_SPINDLE_CLOCKWISE:
+    case NCP_C_START_SPINDLE_COUNTERCLOCKWISE: case NCP_C_STOP_SPINDLE_TURNING:
+    case NCP_C_MIST_ON: case NCP_C_MIST_OFF: case NCP_C_FLOOD_ON: case NCP_C_FLOOD_OFF:
+    case NCP_C_CHANGE_TOOL: case NCP_C_CHANGE_TOOL_NUMBER: case NCP_C_SET_G5X_OFFSET:
+        break;
+    default:
+        return;
+    }
     struct nck_io *io = &n->io;
     pthread_mutex_lock(&n->ev_lock);
     switch (op->kind) {
@@ -209,9 +219,11 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
             return 1;
         }
     }
-    pthread_mutex_lock(&n->ev_lock);
-    n->io.interp_line = cmd->line;
-    pthread_mutex_unlock(&n->ev_lock);
+    if (n->post_prints) {   /* a serving NCK's status shows it */
+        pthread_mutex_lock(&n->ev_lock);
+        n->io.interp_line = cmd->line;
+        pthread_mutex_unlock(&n->ev_lock);
+    }
     int moved = j->seen_motion;
     j->seen_motion |= seen;
     if (moved && atomic_load(&j->step) && (!j->from_line || j->reached)) {
