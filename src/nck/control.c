@@ -707,8 +707,8 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     for (int j = 0; j < NCP_AXES; j++) {
         st->axes[j] = "XYZ"[j];
         st->homed[j] = s->homed[j];
-        st->pos_cmd[j] = n->have_fb ? n->last_fb.cmd[j] : n->cur.pos[j];
-        st->pos_act[j] = n->have_fb ? n->last_fb.act[j] : n->cur.pos[j];
+        st->pos_cmd[j] = n->have_fb ? n->last_fb.cmd[j] : n->start[j];
+        st->pos_act[j] = n->have_fb ? n->last_fb.act[j] : n->start[j];
     }
     st->vel = n->have_fb ? n->last_fb.v * 60.0 : 0;
     st->feed_override = atomic_load(&n->ctl->override_permille) / 10.0;
