@@ -149,7 +149,9 @@ sanitize: all
 	# the serving NCK under TSan, driven by the plain cnc-ctl (liblcm's glib is not
 	# instrumented, so an instrumented cnc-ctl reports glib's own locking)
 	mkdir -p build-tsan/service-bin && cp build-tsan/cnc-run $(BUILD)/cnc-ctl build-tsan/service-bin/
-	TSAN_OPTIONS=halt_on_error=1 tests/service/run build-tsan/service-bin build-tsan/service-work
+	TSAN_OPTIONS=halt_on_error=1 tests/service/run build-tsan/service-bin build-tsan/service-work \
+	    | tee build-tsan/service.log
+	! grep -q '^FAIL' build-tsan/service.log
 
 FUZZ_SECONDS ?= 600
 FUZZ_FLAGS = -O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all
