@@ -578,8 +578,12 @@ static void job_ended(struct ncp_nck *s)
         snprintf(s->error, sizeof s->error, "%s:%u:%u: %s", file, d->line,
                  d->col ? d->col : 1u, d->msg);
         nck_post(n, NCP_EV_ERROR, file, d->line, d->col, "%s", d->msg);
-        /* the machine stands at the end of the last good block */
-        reset_interp(s);
+        /* the machine stands at the end of the last good block; a program
+         * ends as at M2, a mistyped MDI line leaves the modal state as it was */
+        if (kind == NCK_JOB_PROGRAM)
+            reset_interp(s);
+        else
+            sync_interp(s);
     } else if (kind == NCK_JOB_PROGRAM) {
         nck_post(n, NCP_EV_INFO, s->program, 0, 0, "program finished");
     }

@@ -277,6 +277,13 @@ static void test_mdi_keeps_modal_state(void **state_)
     struct ncp_nck_snapshot st;
     ncp_nck_get_status(s.nck, &st);
     assert_true(st.error[0] != 0);
+    /* a mistyped line changes nothing else: still G55, still G90 */
+    assert_int_equal(st.g5x_index, 2);
+    assert_int_equal(cmd(&s, NCP_CMD_MDI, "G0 X1 Y1", 0, 0, why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    double p[3];
+    pos(&s, p);
+    assert_true(fabs(p[0] - 11) < 1e-6 && fabs(p[1] - 6) < 1e-6);
     stop(&s);
 }
 
