@@ -70,8 +70,6 @@ struct ncp_rt_stats {
 
 void ncp_rt_stats_reset(struct ncp_rt_stats *s);
 void ncp_rt_stats_add(struct ncp_rt_stats *s, int64_t latency_ns);
-/* Prints min/avg/max and the non-empty histogram rows. */
-void ncp_rt_stats_print(const struct ncp_rt_stats *s, FILE *f);
 
 /* ---- periodic thread ---------------------------------------------------------- */
 

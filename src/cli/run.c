@@ -2,6 +2,7 @@
  * loop) on the simulated machine. Option parsing, loading and reporting; the
  * runtime itself is ncp_nck_run (src/rt/). */
 #include "run.h"
+#include "signals.h"
 
 #include "ncpar/backend.h"
 #include "ncpar/feeder.h"
@@ -314,17 +315,6 @@ static void on_signal(int sig)
     run_signal = sig;
 }
 
-static void catch_signals(void)
-{
-    /* an explicit handler: a SIGINT inherited as ignored must still stop a run */
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-}
-
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
 {
@@ -363,7 +353,7 @@ int ncp_cli_run(int argc, char **argv)
     o.mode = NCP_MODE_SERIAL;
     if (parse_opts(argc, argv, &o))
         return usage(stderr), RUN_USAGE;
-    catch_signals();
+    ncp_cli_catch_stop_signals(on_signal);
     struct ncp_machine_cfg cfg;
     if (load_config(&o, &cfg))
         return RUN_USAGE;

@@ -1,6 +1,7 @@
 /* cnc-run serve: the NCK as a long-running service on LCM. Options, the
  * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
 #include "serve.h"
+#include "signals.h"
 
 #include "ncpar/nck.h"
 
@@ -113,13 +114,7 @@ int ncp_cli_serve(int argc, char **argv)
             fprintf(stderr, "error: %s\n", d.msg);
         return SERVE_USAGE;
     }
-    /* an explicit handler: a SIGINT inherited as ignored must still stop it */
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    ncp_cli_catch_stop_signals(on_signal);
     FILE *trace = NULL;
     if (a.trace && !(trace = fopen(a.trace, "w"))) {
         perror(a.trace);

@@ -27,26 +27,3 @@ void ncp_rt_stats_add(struct ncp_rt_stats *s, int64_t latency_ns)
     else
         s->overflow++;
 }
-
-void ncp_rt_stats_print(const struct ncp_rt_stats *s, FILE *f)
-{
-    if (!s->cycles) {
-        fprintf(f, "  loop latency: no cycles\n");
-        return;
-    }
-    fprintf(f, "  loop latency: min %.1f us, avg %.1f us, max %.1f us over %llu cycles\n",
-            (double)s->lat_min_ns / 1e3, s->lat_sum_ns / (double)s->cycles / 1e3,
-            (double)s->lat_max_ns / 1e3, (unsigned long long)s->cycles);
-    fprintf(f, "  latency histogram (us: cycles):");
-    int shown = 0;
-    for (int i = 0; i < NCP_RT_HIST_BINS; i++) {
-        if (!s->hist[i])
-            continue;
-        fprintf(f, "%s %d: %llu", shown++ % 8 ? "," : "\n   ", i,
-                (unsigned long long)s->hist[i]);
-    }
-    if (s->overflow)
-        fprintf(f, "%s >=%d: %llu", shown ? "," : "\n   ", NCP_RT_HIST_BINS,
-                (unsigned long long)s->overflow);
-    fputc('\n', f);
-}
