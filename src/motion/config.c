@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
 {
@@ -97,7 +98,21 @@ static int axis_key(struct ncp_axis_cfg *a, const char *k, const char *v)
     return 0;
 }
 
-static int rt_key(struct ncp_machine_cfg *c, const char *k, const char *v)
+/* A CPU this machine has (-1: the OS chooses): a placement on a CPU that is
+ * not there must not turn into a silent move to another one. */
+static int cpu_key(const char *v, int *cpu, char *why, size_t len)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    if (n < 1)
+        n = 1;
+    if (integer(v, -1, (int)n - 1, cpu) == 0)
+        return 1;
+    snprintf(why, len, "this machine has CPUs 0..%ld; -1 lets the OS choose", n - 1);
+    return -1;
+}
+
+static int rt_key(struct ncp_machine_cfg *c, const char *k, const char *v, char *why,
+                  size_t len)
 {
     const struct { const char *prefix; struct ncp_rt_place *pl; } threads[] = {
         { "POSITION_", &c->position }, { "PLANNER_", &c->planner }, { "INTERP_", &c->interp },
@@ -114,7 +129,7 @@ static int rt_key(struct ncp_machine_cfg *c, const char *k, const char *v)
             return 1;
         }
         if (!strcasecmp(k + n, "CPU"))
-            return integer(v, -1, 1023, &threads[i].pl->cpu) ? -1 : 1;
+            return cpu_key(v, &threads[i].pl->cpu, why, len);
     }
     return 0;
 }
@@ -191,7 +206,8 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v)
     return 0;
 }
 
-static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, const char *v)
+static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, const char *v,
+                    char *why, size_t len)
 {
     double x;
     if (!strcasecmp(sec, "EMCMOT")) {
@@ -233,7 +249,7 @@ static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, c
     if (!strcasecmp(sec, "SIM"))
         return sim_key(c, k, v);
     if (!strcasecmp(sec, "RT"))
-        return rt_key(c, k, v);
+        return rt_key(c, k, v, why, len);
     if (!strcasecmp(sec, "CAN"))
         return can_key(&c->can, k, v);
     return -2;
@@ -244,7 +260,8 @@ static int on_key(void *user, const char *sec, const char *k, const char *v)
     struct load_ctx *lc = user;
     if (lc->failed)
         return 0;
-    int r = dispatch(lc->c, sec, k, v);
+    char why[96] = "";
+    int r = dispatch(lc->c, sec, k, v, why, sizeof why);
     if (r == 1)
         return 1;
     lc->failed = 1;
@@ -253,8 +270,8 @@ static int on_key(void *user, const char *sec, const char *k, const char *v)
     else if (r == 0)
         snprintf(lc->d->msg, sizeof lc->d->msg, "%s: [%s] unknown key %s", lc->path, sec, k);
     else
-        snprintf(lc->d->msg, sizeof lc->d->msg, "%s: [%s] %s: bad value '%s'", lc->path, sec,
-                 k, v);
+        snprintf(lc->d->msg, sizeof lc->d->msg, "%s: [%s] %s: bad value '%s'%s%s%s", lc->path, sec,
+                 k, v, why[0] ? " (" : "", why, why[0] ? ")" : "");
     return 0;
 }
 
