@@ -549,7 +549,7 @@ static int ncp_flow_runaway(const struct ncp_flow *f, const struct ncp_block *b,
     ncp_flow_display_name(b, name, sizeof name);
     return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
                         "loop %s at line %u repeated more than %u times: runaway loop? "
-                        "(raise max_loop_iterations if intended)",
+                        "(raise the limit with --max-loops N if intended)",
                         name, op->line, f->max_loops);
 }
 
@@ -870,7 +870,7 @@ static int ncp_flow_do_m98(struct ncp_flow *f, const struct ncp_block *b, struct
     if (f->m98_l > 0 && (uint32_t)f->m98_l > f->max_loops)
         return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, b->oword.col,
                             "M98 L%d repeats a sub more than %u times: runaway loop? "
-                            "(raise max_loop_iterations if intended)",
+                            "(raise the limit with --max-loops N if intended)",
                             f->m98_l, f->max_loops);
     struct flow_pos here = { b->offset, b->line, f->cur.file };
     int rc = ncp_flow_enter_call(f, b, FLOW_CT_M98, d);

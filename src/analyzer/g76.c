@@ -154,8 +154,8 @@ int ncp_g76_cycle(struct ncp_analyzer *a, const double *end)
     if (passes > limit)
         return ncp_an_error(a, col,
                             "G76 would cut more than %u passes (J, K and R set the passes to "
-                            "depth, H the spring passes): runaway cycle? (raise "
-                            "max_loop_iterations if intended)", limit);
+                            "depth, H the spring passes): runaway cycle? (raise the "
+                            "limit with --max-loops N if intended)", limit);
 
     double pass = 1.0;
     double depth = start_depth;

@@ -13,6 +13,7 @@
 #include <errno.h>
 #include <signal.h>
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +29,7 @@ struct run_opts {
     int virtual_clock;
     enum ncp_thread_mode mode;
     const char *backend;        /* --backend as given, NULL = sim */
+    uint32_t max_loops;         /* --max-loops, 0 = the interpreter's default */
 };
 
 struct interp_ctx {
@@ -53,7 +55,7 @@ static void usage(FILE *f)
     fputs("usage: cnc-run run PROG [--config INI] [--trace CSV] [--plot PNG] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
           "                        [--mode serial|det|att] [--tool-table FILE]\n"
-          "                        [--subroutine-path DIR[:DIR...]]\n"
+          "                        [--subroutine-path DIR[:DIR...]] [--max-loops N]\n"
           "                        [--backend sim|socketcan[:IFACE]]\n"
           "Runs PROG on the simulated machine (or CiA 402 drives over CAN): interpreter ->\n"
           "look-ahead planner -> interpolator -> position loop (SCHED_FIFO when permitted).\n"
@@ -68,6 +70,8 @@ static void usage(FILE *f)
           "  --tool-table FILE   LinuxCNC tool table (default: rs274's built-in T1-T3)\n"
           "  --subroutine-path DIRS  where o<name> call finds name.ngc after the current\n"
           "                      folder (colon-separated, as rs274's SUBROUTINE_PATH)\n"
+          "  --max-loops N       a loop (while/do/repeat, M98 L, G76 passes) may repeat N\n"
+          "                      times before it counts as runaway (default 10000000)\n"
           "  --backend sim       the simulated machine (default)\n"
           "  --backend socketcan[:IFACE]  CiA 402 drives in CSP mode over SocketCAN on\n"
           "                      IFACE (default: the INI's [CAN] INTERFACE); each axis\n"
@@ -104,13 +108,14 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "tool-table", required_argument, 0, 'T' },
         { "subroutine-path", required_argument, 0, 'S' },
         { "backend", required_argument, 0, 'b' },
+        { "max-loops", required_argument, 0, 'L' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
     double pct;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': o->config = optarg; break;
         case 't': o->trace = optarg; break;
@@ -118,6 +123,11 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         case 'T': o->tool_table = optarg; break;
         case 'S': o->sub_path = optarg; break;
         case 'b': o->backend = optarg; break;
+        case 'L':
+            if (parse_num(optarg, 1, 2000000000, &pct) || pct != floor(pct))
+                return fprintf(stderr, "cnc-run run: --max-loops wants a positive count\n"), -1;
+            o->max_loops = (uint32_t)pct;
+            break;
         case 'f':
             if (parse_num(optarg, 1e-6, 1e9, &o->for_s))
                 return fprintf(stderr, "cnc-run run: --for wants a positive number of seconds\n"), -1;
@@ -318,7 +328,9 @@ static void on_signal(int sig)
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
 {
-    struct interp_ctx ic = { src, { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path },
+    struct interp_ctx ic = { src,
+                             { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path,
+                               .max_loop_iterations = o->max_loops },
                              o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = interpret, .interp_ctx = &ic,

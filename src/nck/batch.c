@@ -154,7 +154,10 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
         /* the interpreter was cut short by us: its "stopped" is no program error */
     } else if (j->map_failed || j->rc != NCP_OK) {
         res->diag = j->map_failed ? j->map_diag : j->diag;
-        res->status = res->diag.code == NCP_ERR_LIMIT ? NCP_NCK_FAULT : NCP_NCK_PROGRAM_ERROR;
+        /* a soft limit the map found is the machine's; a loop limit the
+         * interpreter hit is the program's */
+        res->status = j->map_failed && res->diag.code == NCP_ERR_LIMIT ? NCP_NCK_FAULT
+                                                                       : NCP_NCK_PROGRAM_ERROR;
     }
 }
 
