@@ -32,6 +32,16 @@ int ncp_nck_next_event(struct ncp_nck *s, struct ncp_nck_event *ev)
 {
     struct nck *n = &s->n;
     pthread_mutex_lock(&n->ev_lock);
+    if (n->ev_dropped) {
+        /* the reader learns that it missed some, rather than nothing */
+        memset(ev, 0, sizeof *ev);
+        ev->kind = NCP_EV_INFO;
+        snprintf(ev->text, sizeof ev->text, "%llu older events dropped (the NCK keeps %d)",
+                 (unsigned long long)n->ev_dropped, NCK_EVENTS);
+        n->ev_dropped = 0;
+        pthread_mutex_unlock(&n->ev_lock);
+        return 1;
+    }
     int got = n->ev_count > 0;
     if (got) {
         *ev = n->ev[n->ev_head];

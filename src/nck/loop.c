@@ -51,7 +51,7 @@ static int end_in_ring(const struct nck *n)
 /* Real clock: when the ring holds fewer setpoints than a stop along the path
  * needs, slow the stream down (an underrun in the making); speed up again
  * once it has refilled. The virtual clock never needs to: it waits instead. */
-double nck_rate_target(struct nck *n)
+static double rate_target(struct nck *n)
 {
     double feed = feed_rate(n);
     if (feed <= 0 || n->setup.virtual_clock || end_in_ring(n))
@@ -89,7 +89,7 @@ static int take_setpoint(struct nck *n)
         stream_expected(n))
         return NCP_RT_RETRY;
     n->cur = n->next;
-    if (!n->ended && ncp_scaler_step(&n->scaler, nck_rate_target(n), &n->sps, &n->next) != 0)
+    if (!n->ended && ncp_scaler_step(&n->scaler, rate_target(n), &n->sps, &n->next) != 0)
         n->dry++;
     if (n->scaler.ends != n->ends_seen) {
         atomic_fetch_add_explicit(&n->ends_taken, n->scaler.ends - n->ends_seen,

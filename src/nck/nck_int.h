@@ -228,7 +228,6 @@ int nck_motion_done(const struct nck *n);
 
 /* loop.c: the position cycle (real-time path) */
 int nck_position_cycle(void *ctx, int64_t now_ns);
-double nck_rate_target(struct nck *n);
 
 /* planner_thread.c */
 void *nck_planner_main(void *arg);
