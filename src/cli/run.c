@@ -2,6 +2,7 @@
  * loop) on the simulated machine. Option parsing, loading and reporting; the
  * runtime itself is ncp_nck_run (src/rt/). */
 #include "run.h"
+#include "machine.h"
 #include "signals.h"
 
 #include "ncpar/backend.h"
@@ -231,16 +232,7 @@ static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 
 static int load_config(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 {
-    struct ncp_diag d;
-    memset(&d, 0, sizeof d);
-    ncp_machine_cfg_default(cfg);
-    if (!o->config || ncp_machine_cfg_load(cfg, o->config, &d) == NCP_OK)
-        return apply_backend(o, cfg);
-    if (d.line)
-        fprintf(stderr, "%s:%u: error: %s\n", o->config, d.line, d.msg);
-    else
-        fprintf(stderr, "error: %s\n", d.msg);
-    return -1;
+    return ncp_cli_load_machine(o->config, cfg) ? -1 : apply_backend(o, cfg);
 }
 
 

@@ -1,6 +1,7 @@
 /* cnc-run serve: the NCK as a long-running service on LCM. Options, the
  * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
 #include "serve.h"
+#include "machine.h"
 #include "signals.h"
 
 #include "ncpar/nck.h"
@@ -104,16 +105,10 @@ int ncp_cli_serve(int argc, char **argv)
     if (parse(argc, argv, &a))
         return usage(stderr), SERVE_USAGE;
     struct ncp_machine_cfg cfg;
+    if (ncp_cli_load_machine(a.config, &cfg))
+        return SERVE_USAGE;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
-    ncp_machine_cfg_default(&cfg);
-    if (a.config && ncp_machine_cfg_load(&cfg, a.config, &d) != NCP_OK) {
-        if (d.line)
-            fprintf(stderr, "%s:%u: error: %s\n", a.config, d.line, d.msg);
-        else
-            fprintf(stderr, "error: %s\n", d.msg);
-        return SERVE_USAGE;
-    }
     ncp_cli_catch_stop_signals(on_signal);
     FILE *trace = NULL;
     if (a.trace && !(trace = fopen(a.trace, "w"))) {

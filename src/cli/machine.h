@@ -1,0 +1,11 @@
+/* The machine INI as the front ends load it. */
+#ifndef NCPAR_CLI_MACHINE_H
+#define NCPAR_CLI_MACHINE_H
+
+#include "ncpar/motion.h"
+
+/* The defaults, then path over them (NULL: the defaults alone). On an error
+ * prints PATH:LINE: error: ... and returns -1. */
+int ncp_cli_load_machine(const char *path, struct ncp_machine_cfg *cfg);
+
+#endif
