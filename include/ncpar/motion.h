@@ -14,6 +14,10 @@
 
 enum ncp_profile { NCP_PROFILE_TRAPEZOID, NCP_PROFILE_SCURVE };
 
+/* The largest feed override cnc-run takes (200 %). Corner blends are planned
+ * for it, as LinuxCNC plans them for its MAX_FEED_OVERRIDE. */
+#define NCP_FEED_OVERRIDE_MAX 2.0
+
 struct ncp_axis_cfg {
     double min_limit, max_limit;  /* soft limits, mm */
     double max_vel, max_acc, max_jerk;
@@ -92,6 +96,10 @@ struct ncp_seg {
     double start[NCP_AXES], end[NCP_AXES];
     double length;         /* path length (0 for dwell) */
     double feed;           /* requested path velocity (override applied), mm/s */
+    /* the path velocity a G64 corner's blend is sized for: the feed at
+     * NCP_FEED_OVERRIDE_MAX, so the path cut never depends on the override
+     * in force (0 = feed) */
+    double blend_feed;
     double tolerance;      /* G64 P, mm (0 = none) */
     double dwell;          /* s, NCP_SEG_DWELL only */
     /* arcs and helices: p(l) = c + r(l)(cos(A l) u + sin(A l) w) + n h l, l in [0,1] */

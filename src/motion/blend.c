@@ -1,8 +1,8 @@
 /* G64 corner blending: two lines meeting at a corner are joined by a circular
  * arc tangent to both, so the path keeps its tangent and the corner is taken at
- * speed. The arc stays within the tolerance P of the corner (P = 0: as large
- * as the lines allow) and uses at most half of either line, so neighbouring
- * blends never overlap. */
+ * speed. The arc stays within the tolerance P of the corner and uses at most
+ * half of either line, so neighbouring blends never overlap; the planner
+ * (try_blend) makes it no larger than the speed it is for needs. */
 #include "planner_int.h"
 
 #include <math.h>
@@ -26,8 +26,8 @@ static void direction(const struct ncp_seg *s, double u[3])
         u[i] = (s->end[i] - s->start[i]) / s->length;
 }
 
-int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, struct ncp_seg *arc,
-                     double *trim)
+int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,
+                     struct ncp_seg *arc, double *trim)
 {
     if (prev->kind != NCP_SEG_LINE || cur->kind != NCP_SEG_LINE ||
         prev->term != NCP_TERM_CONTINUOUS || prev->length <= 0 || cur->length <= 0)
@@ -40,7 +40,7 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, stru
     if (c > 1 - 1e-12 || c < -0.999)
         return 0;
     double phi = acos(c), th = tan(0.5 * phi);
-    double d = 0.5 * fmin(prev->length, cur->length);
+    double d = fmin(max_trim, 0.5 * fmin(prev->length, cur->length));
     if (prev->tolerance > 0) {
         double r_tol = prev->tolerance / (1.0 / cos(0.5 * phi) - 1.0);
         d = fmin(d, r_tol * th);
@@ -56,6 +56,8 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, stru
     arc->traverse = (uint8_t)(prev->traverse && cur->traverse);
     arc->line = cur->line;  /* the corner is where the next block's motion begins */
     arc->feed = fmin(prev->feed, cur->feed);
+    arc->blend_feed = fmin(prev->blend_feed > 0 ? prev->blend_feed : prev->feed,
+                           cur->blend_feed > 0 ? cur->blend_feed : cur->feed);
     double bis[3], bl = 0;
     for (int i = 0; i < 3; i++) {
         bis[i] = u2[i] - u1[i];

@@ -136,6 +136,15 @@ static double feed_at(const struct ncp_canon_map *m, double x_mm)
     return per_min / 60.0 * m->feed_override;
 }
 
+/* What a corner after a move ending at x_mm is blended for: its feed at the
+ * largest override, whatever the override now. */
+static double blend_feed_at(const struct ncp_canon_map *m, double x_mm)
+{
+    if (m->sync_pitch > 0)
+        return feed_at(m, x_mm);
+    return feed_at(m, x_mm) / m->feed_override * NCP_FEED_OVERRIDE_MAX;
+}
+
 static int finite3(const double *v, int n)
 {
     for (int i = 0; i < n; i++)
@@ -164,6 +173,7 @@ static int line_to(struct ncp_canon_map *m, const double end_mm[NCP_AXES], int t
         s->feed = m->cfg->max_linear_vel;
     else if ((s->feed = feed_at(m, s->end[0])) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "feed move with zero feed rate");
+    s->blend_feed = traverse ? s->feed : blend_feed_at(m, s->end[0]);
     int r = check_point(m, s->end, line, d);
     if (r)
         return -r;
@@ -351,6 +361,7 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     s->length = sqrt(arc_len * arc_len + s->axial * s->axial);
     if ((s->feed = feed_at(m, s->end[0])) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "arc move with zero feed rate");
+    s->blend_feed = blend_feed_at(m, s->end[0]);
     int r = check_arc(m, s, d);
     if (r)
         return -r;

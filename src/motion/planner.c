@@ -345,8 +345,55 @@ static int kink_harmless(const struct ncp_planner *p, const struct ncp_seg *a,
     return 1;
 }
 
+/* A line's cruise cap at the feed its corners are blended for. */
+static double blend_vmax(const struct ncp_planner *p, const struct ncp_seg *s)
+{
+    struct plan_seg ps;
+    memset(&ps, 0, sizeof ps);
+    ps.s = *s;
+    if (s->blend_feed > 0)
+        ps.s.feed = s->blend_feed;
+    line_limits(p, &ps);
+    return ps.vmax;
+}
+
+/* How fast a blend arc lets the corner be taken, feed aside. */
+static double arc_speed(const struct ncp_planner *p, const struct ncp_seg *arc)
+{
+    struct plan_seg ps;
+    memset(&ps, 0, sizeof ps);
+    ps.s = *arc;
+    ps.s.feed = INFINITY;
+    arc_limits(p, &ps);
+    return ps.vmax;
+}
+
+/* The smallest trim (and so the smallest arc) whose speed reaches v_goal,
+ * no more than the largest blend allowed: a blend departs from the
+ * programmed corner only as far as the speed it buys needs. The arc's speed
+ * grows with its radius, so a bisection finds it. */
+static int size_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
+                      const struct ncp_seg *s, double v_goal, struct ncp_seg *arc, double *d)
+{
+    if (!ncp_blend_corner(tol, s, INFINITY, arc, d))
+        return 0;
+    if (arc_speed(p, arc) <= v_goal)
+        return 1;
+    double lo = 0, hi = *d;
+    for (int i = 0; i < 40 && hi - lo > 1e-7 * hi; i++) {
+        double mid = 0.5 * (lo + hi);
+        if (ncp_blend_corner(tol, s, mid, arc, d) && arc_speed(p, arc) >= v_goal)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return ncp_blend_corner(tol, s, hi, arc, d);
+}
+
 /* Blends the corner between the queued tail and s when the tail may still
- * change: not executing, and not lowering speeds a frozen profile counts on. */
+ * change: not executing, and not lowering speeds a frozen profile counts on.
+ * The blend's size follows from the feed at the largest override, never the
+ * override in force, so the path cut is the same at any override. */
 static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
 {
     if (!p->count || (p->active && p->count == 1))
@@ -359,7 +406,8 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     struct ncp_seg tol = prev->s;
     if (tol.tolerance > 0)
         tol.tolerance = fmax(0.25 * tol.tolerance, tol.tolerance - p->chord);
-    if (kink_harmless(p, &prev->s, s, prev->vmax) || !ncp_blend_corner(&tol, s, &arc.s, &d))
+    double v_goal = fmin(blend_vmax(p, &prev->s), blend_vmax(p, s));
+    if (kink_harmless(p, &prev->s, s, v_goal) || !size_blend(p, &tol, s, v_goal, &arc.s, &d))
         return 0;
     arc_limits(p, &arc);
     double exit_lb = fmin(arc.vmax, plan_reach(p, arc.acc, arc.jerk, 0, arc.s.length));

@@ -64,9 +64,10 @@ static inline double plan_reach(const struct ncp_planner *p, double acc, double 
     return sqrt(v * v + 2 * acc * len);
 }
 
-/* blend.c: the arc joining prev's end to cur's start within prev's G64 P, and
- * the length trimmed off both lines. Returns 0 when the corner is not blended. */
-int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, struct ncp_seg *arc,
-                     double *trim);
+/* blend.c: the arc joining prev's end to cur's start within prev's G64 P,
+ * trimming at most max_trim off either line, and the length trimmed off both.
+ * Returns 0 when the corner is not blended. */
+int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,
+                     struct ncp_seg *arc, double *trim);
 
 #endif

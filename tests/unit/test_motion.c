@@ -66,12 +66,13 @@ static void trace_add(struct trace *t, const struct ncp_setpoint *s)
 
 /* Runs ops through canon map + planner like the runtime does (window filled
  * before each start), collecting every setpoint. Segment ends go to ends[]. */
-static struct trace run_ops(const struct ncp_machine_cfg *cfg, const struct ncp_canon *ops,
-                            size_t n, double ends[][NCP_AXES], size_t *n_ends)
+static struct trace run_ops_at(const struct ncp_machine_cfg *cfg, const struct ncp_canon *ops,
+                               size_t n, double ends[][NCP_AXES], size_t *n_ends,
+                               double feed_override)
 {
     struct ncp_canon_map m;
     double zero[NCP_AXES] = { 0 };
-    ncp_canon_map_init(&m, cfg, zero, 1.0);
+    ncp_canon_map_init(&m, cfg, zero, feed_override);
     struct ncp_planner *p = ncp_planner_new(cfg, zero);
     assert_non_null(p);
     struct trace t = { 0 };
@@ -102,6 +103,12 @@ static struct trace run_ops(const struct ncp_machine_cfg *cfg, const struct ncp_
         *n_ends = ne;
     ncp_planner_free(p);
     return t;
+}
+
+static struct trace run_ops(const struct ncp_machine_cfg *cfg, const struct ncp_canon *ops,
+                            size_t n, double ends[][NCP_AXES], size_t *n_ends)
+{
+    return run_ops_at(cfg, ops, n, ends, n_ends, 1.0);
 }
 
 /* Velocity and acceleration of every axis from first and second differences.
@@ -317,6 +324,107 @@ static void test_g64_p_tolerance(void **state)
     assert_true(worst > 0.5 * tol);  /* the corners really were rounded */
     for (size_t k = 1; k + 1 < t.n; k++)
         assert_true(t.sp[k].v > 0);   /* and taken without stopping */
+    free(t.sp);
+}
+
+static double dist_point_seg3(const double p[3], const double a[3], const double b[3])
+{
+    double ab[3], ap[3], l2 = 0, f = 0, d2 = 0;
+    for (int i = 0; i < 3; i++) {
+        ab[i] = b[i] - a[i];
+        ap[i] = p[i] - a[i];
+        l2 += ab[i] * ab[i];
+        f += ap[i] * ab[i];
+    }
+    f = l2 > 0 ? f / l2 : 0;
+    f = f < 0 ? 0 : f > 1 ? 1 : f;
+    for (int i = 0; i < 3; i++)
+        d2 += (a[i] + f * ab[i] - p[i]) * (a[i] + f * ab[i] - p[i]);
+    return sqrt(d2);
+}
+
+/* Farthest any sample of a lies from the polyline through b's samples. Both
+ * run along the same path in the same direction, so the nearest piece of b is
+ * searched near where the last one was. */
+static double path_distance(const struct trace *a, const struct trace *b)
+{
+    double worst = 0;
+    size_t at = 1;
+    for (size_t k = 0; k < a->n; k++) {
+        double best = INFINITY;
+        size_t best_at = at;
+        for (size_t i = at > 64 ? at - 64 : 1; i < b->n && i < at + 4096; i++) {
+            double d = dist_point_seg3(a->sp[k].pos, b->sp[i - 1].pos, b->sp[i].pos);
+            if (d < best) {
+                best = d;
+                best_at = i;
+            }
+        }
+        at = best_at;
+        worst = fmax(worst, best);
+    }
+    return worst;
+}
+
+/* Corners of every sharpness, with and without G64 P, at a slow and a fast
+ * feed: the path cut at 1 %, 50 % and 200 % override is the one cut at 100 %
+ * (the blends are sized for the largest override, not the one in force). */
+static void test_g64_path_independent_of_override(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    static const double pts[][2] = { { 10, 10 }, { 0, 10 }, { 5, 0 }, { 15, 2 }, { 30, 0 },
+                                     { 30, 12 }, { 18, 14 } };
+    const size_t np = sizeof pts / sizeof pts[0];
+    struct ncp_canon ops[64];
+    size_t n = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        ops[n] = op_mode(2);
+        ops[n++].motion_control.tolerance = pass ? 0.05 : 0;
+        ops[n++] = op_feed(pass ? 1000 : 6000);
+        ops[n++] = op6(NCP_C_STRAIGHT_FEED, 0, 0, pass ? -1.0 : 0);
+        for (size_t i = 0; i < np; i++)
+            ops[n++] = op6(NCP_C_STRAIGHT_FEED, pts[i][0], pts[i][1], pass ? -1.0 : 0);
+    }
+    struct trace ref = run_ops_at(&c, ops, n, NULL, NULL, 1.0);
+    static const double overrides[] = { 0.01, 0.5, 2.0 };
+    for (size_t i = 0; i < sizeof overrides / sizeof overrides[0]; i++) {
+        struct trace t = run_ops_at(&c, ops, n, NULL, NULL, overrides[i]);
+        double ab = path_distance(&t, &ref), ba = path_distance(&ref, &t);
+        if (ab > 1e-3 || ba > 1e-3) /* 1 um */
+            fail_msg("override %.0f %%: paths %.6f / %.6f mm apart", 100 * overrides[i], ab, ba);
+        free(t.sp);
+    }
+    free(ref.sp);
+}
+
+/* A blend leaves the programmed corner only as far as its speed needs: at
+ * F120 (4 mm/s at the largest override) a square's corners are cut by
+ * microns, though the lines would allow a blend of millimetres. */
+static void test_g64_blend_only_as_needed(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon ops[8];
+    size_t n = 0;
+    ops[n++] = op_mode(2);
+    ops[n++] = op_feed(120);
+    ops[n++] = op6(NCP_C_STRAIGHT_FEED, 4, 0, 0);
+    ops[n++] = op6(NCP_C_STRAIGHT_FEED, 4, 4, 0);
+    ops[n++] = op6(NCP_C_STRAIGHT_FEED, 0, 4, 0);
+    struct trace t = run_ops(&c, ops, n, NULL, NULL);
+    static const double corner[2][2] = { { 4, 0 }, { 4, 4 } };
+    for (int i = 0; i < 2; i++) {
+        double miss = INFINITY;
+        for (size_t k = 0; k < t.n; k++)
+            miss = fmin(miss, hypot(t.sp[k].pos[0] - corner[i][0], t.sp[k].pos[1] - corner[i][1]));
+        /* 4 mm/s with half of 2000 mm/s^2 for the turn: a radius of 16 um,
+         * which misses the corner by (sqrt 2 - 1) 16 = 6.6 um */
+        if (miss > 0.008)
+            fail_msg("corner %d cut by %.4f mm at 2 mm/s", i, miss);
+    }
+    for (size_t k = 1; k + 1 < t.n; k++)
+        assert_true(t.sp[k].v > 0);  /* still blended: no stop at the corners */
     free(t.sp);
 }
 
@@ -685,6 +793,8 @@ int main(void)
         cmocka_unit_test(test_g61_exact_stop_ends),
         cmocka_unit_test(test_g64_corners_within_limits),
         cmocka_unit_test(test_g64_p_tolerance),
+        cmocka_unit_test(test_g64_path_independent_of_override),
+        cmocka_unit_test(test_g64_blend_only_as_needed),
         cmocka_unit_test(test_arc_radius_and_helix),
         cmocka_unit_test(test_arc_centripetal_cap),
         cmocka_unit_test(test_canon_units_offsets),
