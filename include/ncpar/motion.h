@@ -101,6 +101,8 @@ struct ncp_seg {
      * in force (0 = feed) */
     double blend_feed;
     double tolerance;      /* G64 P, mm (0 = none) */
+    double merge_tol;      /* G64 Q, mm: the planner merges a run of nearly
+                              collinear feed lines into one (0 = off) */
     double dwell;          /* s, NCP_SEG_DWELL only */
     /* arcs and helices: p(l) = c + r(l)(cos(A l) u + sin(A l) w) + n h l, l in [0,1] */
     double center[3], normal[3], u[3], w[3];
@@ -150,6 +152,7 @@ struct ncp_canon_map {
     struct ncp_nurbs_stream nurbs; /* the curve, its points as they come */
     int term;               /* enum ncp_seg_term */
     double tolerance;       /* mm */
+    double merge_tol;       /* G64 Q, mm */
     double pos[NCP_AXES];   /* machine position at the end of the last segment */
 };
 
@@ -198,9 +201,12 @@ int ncp_planner_full(const struct ncp_planner *p);
 size_t ncp_planner_queued(const struct ncp_planner *p);
 /* No segment is executing: the machine is at rest (or about to start). */
 int ncp_planner_idle(const struct ncp_planner *p);
-/* Appends a segment and re-plans backwards until a velocity no longer changes. */
+/* Appends a segment and re-plans backwards until a velocity no longer changes.
+ * Under G64 Q a feed line may be held back to be joined with the lines after
+ * it; ncp_planner_finish lets it go. */
 void ncp_planner_push(struct ncp_planner *p, const struct ncp_seg *s);
-/* No more segments will come: the queue may be run to its end. */
+/* No more segments will come: the queue may be run to its end (a line held
+ * back for G64 Q included). */
 void ncp_planner_finish(struct ncp_planner *p);
 /* After a finished queue has run out (ncp_planner_step returned 0): take
  * segments again, the next one starting from rest (no blend with the last). */
@@ -214,6 +220,7 @@ int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out);
 
 struct ncp_planner_stats {
     uint64_t segments;      /* segments pushed */
+    uint64_t merged;        /* feed lines G64 Q joined to the one before */
     uint64_t replans;       /* segment entry velocities revised by backward passes */
     uint64_t starved;       /* cycles spent at rest waiting for segments */
     double path_length;     /* mm executed */

@@ -110,6 +110,7 @@ static void seg_common(const struct ncp_canon_map *m, struct ncp_seg *s, uint32_
     s->line = line;
     s->term = (uint8_t)m->term;
     s->tolerance = m->tolerance;
+    s->merge_tol = m->term == NCP_TERM_CONTINUOUS ? m->merge_tol : 0;
     memcpy(s->start, m->pos, sizeof s->start);
 }
 
@@ -419,6 +420,9 @@ static int state_op(struct ncp_canon_map *m, const struct ncp_canon *op)
                   : op->motion_control.mode == 1 ? NCP_TERM_EXACT_PATH
                                                  : NCP_TERM_CONTINUOUS;
         m->tolerance = op->motion_control.tolerance * m->scale;
+        break;
+    case NCP_C_SET_NAIVECAM_TOLERANCE:
+        m->merge_tol = op->naivecam.tolerance * m->scale;
         break;
     default:
         break;

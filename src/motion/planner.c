@@ -77,8 +77,9 @@ void ncp_planner_free(struct ncp_planner *p)
 
 int ncp_planner_full(const struct ncp_planner *p)
 {
-    /* a push may add a blend arc too; blends do not count against the window */
-    return p->programmed >= (size_t)p->cfg.lookahead || p->count + 2 > p->cap;
+    /* a push may add a blend arc too; blends do not count against the window,
+     * a chain of lines held back for G64 Q counts as the one it will become */
+    return p->programmed + (p->chain_n > 0) >= (size_t)p->cfg.lookahead || p->count + 2 > p->cap;
 }
 
 size_t ncp_planner_queued(const struct ncp_planner *p)
@@ -91,8 +92,11 @@ int ncp_planner_idle(const struct ncp_planner *p)
     return !p->active;
 }
 
+static void chain_flush(struct ncp_planner *p);
+
 void ncp_planner_finish(struct ncp_planner *p)
 {
+    chain_flush(p);
     p->finished = 1;
 }
 
@@ -113,6 +117,7 @@ void ncp_planner_reset(struct ncp_planner *p, const double pos[NCP_AXES])
     p->t = 0;
     p->dur = 0;
     p->v_now = 0;
+    p->chain_n = 0;
     memcpy(p->pos, pos, sizeof p->pos);
 }
 
@@ -424,11 +429,88 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     return 1;
 }
 
+static void push_blended(struct ncp_planner *p, const struct ncp_seg *s)
+{
+    struct ncp_seg cur = *s;
+    try_blend(p, &cur);
+    push_one(p, &cur, 0);
+}
+
+static int chain_may_start(const struct ncp_seg *s)
+{
+    return s->kind == NCP_SEG_LINE && !s->traverse && s->term == NCP_TERM_CONTINUOUS &&
+           s->merge_tol > 0 && s->length > 0;
+}
+
+/* Distance from q to the segment a-b. */
+static double dist_to_chord(const double q[NCP_AXES], const double a[NCP_AXES],
+                            const double b[NCP_AXES])
+{
+    double ab2 = 0, t = 0, d2 = 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        ab2 += (b[j] - a[j]) * (b[j] - a[j]);
+        t += (q[j] - a[j]) * (b[j] - a[j]);
+    }
+    t = ab2 > 0 ? fmin(1, fmax(0, t / ab2)) : 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        double e = a[j] + t * (b[j] - a[j]) - q[j];
+        d2 += e * e;
+    }
+    return sqrt(d2);
+}
+
+/* May s join the chain? It must continue it with the same feed and mode,
+ * and the line from the chain's start to s's end must pass within Q of every
+ * point programmed so far. */
+static int chain_takes(const struct ncp_planner *p, const struct ncp_seg *s)
+{
+    const struct ncp_seg *c = &p->chain;
+    if (!chain_may_start(s) || p->chain_n >= PLAN_CHAIN_MAX || s->merge_tol != c->merge_tol ||
+        s->feed != c->feed || s->blend_feed != c->blend_feed || s->tolerance != c->tolerance)
+        return 0;
+    for (int j = 0; j < NCP_AXES; j++)
+        if (fabs(s->start[j] - c->end[j]) > 1e-9)
+            return 0;
+    for (int i = 0; i < p->chain_n; i++)
+        if (dist_to_chord(p->chain_pt[i], c->start, s->end) > s->merge_tol)
+            return 0;
+    return 1;
+}
+
+static void chain_add(struct ncp_planner *p, const struct ncp_seg *s)
+{
+    if (!p->chain_n)
+        p->chain = *s;
+    memcpy(p->chain.end, s->end, sizeof p->chain.end);
+    p->chain.line = s->line;  /* the joined move is the last block's, as in LinuxCNC */
+    double l2 = 0;
+    for (int j = 0; j < NCP_AXES; j++)
+        l2 += (p->chain.end[j] - p->chain.start[j]) * (p->chain.end[j] - p->chain.start[j]);
+    p->chain.length = sqrt(l2);
+    memcpy(p->chain_pt[p->chain_n++], s->end, sizeof p->chain_pt[0]);
+}
+
+static void chain_flush(struct ncp_planner *p)
+{
+    if (!p->chain_n)
+        return;
+    p->st.merged += (uint64_t)(p->chain_n - 1);
+    p->chain_n = 0;
+    if (p->chain.length > 1e-9)
+        push_blended(p, &p->chain);
+}
+
 void ncp_planner_push(struct ncp_planner *p, const struct ncp_seg *s)
 {
     if (ncp_planner_full(p))
         return;
-    struct ncp_seg cur = *s;
-    try_blend(p, &cur);
-    push_one(p, &cur, 0);
+    if (p->chain_n && chain_takes(p, s)) {
+        chain_add(p, s);
+        return;
+    }
+    chain_flush(p);
+    if (chain_may_start(s))
+        chain_add(p, s);
+    else
+        push_blended(p, s);
 }

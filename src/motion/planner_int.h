@@ -18,6 +18,9 @@ struct plan_seg {
     int blend;      /* a G64 corner arc, not a programmed segment */
 };
 
+/* At most this many programmed lines are joined into one (LinuxCNC's bound). */
+#define PLAN_CHAIN_MAX 100
+
 struct ncp_planner {
     struct ncp_machine_cfg cfg;
     size_t cap;              /* look-ahead window */
@@ -36,6 +39,11 @@ struct ncp_planner {
     struct ncp_seg last_pushed;
     double last_vmax;        /* its cruise cap */
     double chord;            /* how far a servo chord of a blend arc cuts inside it, mm */
+    /* G64 Q (LinuxCNC's naive CAM detector): feed lines held back and joined
+     * into one while every programmed point stays within Q of it */
+    int chain_n;                        /* programmed points in the chain, 0 = none */
+    struct ncp_seg chain;               /* the joined line so far */
+    double chain_pt[PLAN_CHAIN_MAX][NCP_AXES];
     struct ncp_planner_stats st;
 };
 

@@ -68,7 +68,7 @@ static void trace_add(struct trace *t, const struct ncp_setpoint *s)
  * before each start), collecting every setpoint. Segment ends go to ends[]. */
 static struct trace run_ops_at(const struct ncp_machine_cfg *cfg, const struct ncp_canon *ops,
                                size_t n, double ends[][NCP_AXES], size_t *n_ends,
-                               double feed_override)
+                               double feed_override, struct ncp_planner_stats *st)
 {
     struct ncp_canon_map m;
     double zero[NCP_AXES] = { 0 };
@@ -101,6 +101,8 @@ static struct trace run_ops_at(const struct ncp_machine_cfg *cfg, const struct n
     }
     if (n_ends)
         *n_ends = ne;
+    if (st)
+        ncp_planner_get_stats(p, st);
     ncp_planner_free(p);
     return t;
 }
@@ -108,7 +110,7 @@ static struct trace run_ops_at(const struct ncp_machine_cfg *cfg, const struct n
 static struct trace run_ops(const struct ncp_machine_cfg *cfg, const struct ncp_canon *ops,
                             size_t n, double ends[][NCP_AXES], size_t *n_ends)
 {
-    return run_ops_at(cfg, ops, n, ends, n_ends, 1.0);
+    return run_ops_at(cfg, ops, n, ends, n_ends, 1.0, NULL);
 }
 
 /* Velocity and acceleration of every axis from first and second differences.
@@ -386,10 +388,10 @@ static void test_g64_path_independent_of_override(void **state)
         for (size_t i = 0; i < np; i++)
             ops[n++] = op6(NCP_C_STRAIGHT_FEED, pts[i][0], pts[i][1], pass ? -1.0 : 0);
     }
-    struct trace ref = run_ops_at(&c, ops, n, NULL, NULL, 1.0);
+    struct trace ref = run_ops_at(&c, ops, n, NULL, NULL, 1.0, NULL);
     static const double overrides[] = { 0.01, 0.5, 2.0 };
     for (size_t i = 0; i < sizeof overrides / sizeof overrides[0]; i++) {
-        struct trace t = run_ops_at(&c, ops, n, NULL, NULL, overrides[i]);
+        struct trace t = run_ops_at(&c, ops, n, NULL, NULL, overrides[i], NULL);
         double ab = path_distance(&t, &ref), ba = path_distance(&ref, &t);
         if (ab > 1e-3 || ba > 1e-3) /* 1 um */
             fail_msg("override %.0f %%: paths %.6f / %.6f mm apart", 100 * overrides[i], ab, ba);
@@ -426,6 +428,73 @@ static void test_g64_blend_only_as_needed(void **state)
     for (size_t k = 1; k + 1 < t.n; k++)
         assert_true(t.sp[k].v > 0);  /* still blended: no stop at the corners */
     free(t.sp);
+}
+
+/* G64 Q: CAM output's tiny, nearly collinear lines reach the interpolator
+ * as a few long ones, and the path still passes within Q (plus P at the
+ * corners) of every programmed point. Q0 merges nothing. */
+static void run_naivecam(double q, struct ncp_planner_stats *st, double *worst_prog,
+                         double *worst_path)
+{
+    struct ncp_machine_cfg c = test_cfg();
+    enum { N = 400 };
+    static struct ncp_canon ops[N + 8];
+    static double pts[N + 1][3];
+    size_t n = 0, np = 0;
+    const double p_tol = 0.01;
+    ops[n] = op_mode(2);
+    ops[n++].motion_control.tolerance = p_tol;
+    ops[n].kind = NCP_C_SET_NAIVECAM_TOLERANCE;
+    ops[n++].naivecam.tolerance = q;
+    ops[n++] = op_feed(3000);
+    pts[np][0] = pts[np][1] = pts[np][2] = 0;
+    np++;
+    for (int i = 1; i <= N; i++) {
+        /* 0.25 mm steps along X, then along Y, wobbling by +-0.01 mm */
+        double wob = 0.01 * sin(i * 2.3);
+        double x = i <= N / 2 ? 0.25 * i : 0.25 * (N / 2) + wob;
+        double y = i <= N / 2 ? wob : 0.25 * (i - N / 2);
+        ops[n++] = op6(NCP_C_STRAIGHT_FEED, x, y, 0);
+        pts[np][0] = x;
+        pts[np][1] = y;
+        pts[np][2] = 0;
+        np++;
+    }
+    struct trace t = run_ops_at(&c, ops, n, NULL, NULL, 1.0, st);
+    check_limits(&c, &t);
+    *worst_prog = *worst_path = 0;
+    for (size_t k = 0; k < t.n; k++) {
+        double best = INFINITY;
+        for (size_t i = 1; i < np; i++)
+            best = fmin(best, dist_point_seg3(t.sp[k].pos, pts[i - 1], pts[i]));
+        *worst_path = fmax(*worst_path, best);
+    }
+    for (size_t i = 0; i < np; i++) {
+        double best = INFINITY;
+        for (size_t k = 1; k < t.n; k++)
+            best = fmin(best, dist_point_seg3(pts[i], t.sp[k - 1].pos, t.sp[k].pos));
+        *worst_prog = fmax(*worst_prog, best);
+    }
+    free(t.sp);
+}
+
+static void test_g64_q_merges_collinear_lines(void **state)
+{
+    (void)state;
+    struct ncp_planner_stats st;
+    double worst_prog, worst_path;
+    run_naivecam(0.02, &st, &worst_prog, &worst_path);
+    /* 400 lines, two straight runs of them: a handful of segments */
+    if (st.segments > 20 || st.merged < 380)
+        fail_msg("G64 Q0.02: %llu segments planned, %llu lines merged", (unsigned long long)st.segments,
+                 (unsigned long long)st.merged);
+    /* every programmed point within Q of the path, the path within Q of the
+     * programmed lines, plus P at the one corner */
+    if (worst_prog > 0.02 + 0.01 || worst_path > 0.02 + 0.01)
+        fail_msg("G64 Q0.02: program %.4f / path %.4f mm apart", worst_prog, worst_path);
+    run_naivecam(0, &st, &worst_prog, &worst_path);
+    if (st.merged != 0 || st.segments < 400)
+        fail_msg("G64 Q0: %llu lines merged", (unsigned long long)st.merged);
 }
 
 static void test_arc_radius_and_helix(void **state)
@@ -795,6 +864,7 @@ int main(void)
         cmocka_unit_test(test_g64_p_tolerance),
         cmocka_unit_test(test_g64_path_independent_of_override),
         cmocka_unit_test(test_g64_blend_only_as_needed),
+        cmocka_unit_test(test_g64_q_merges_collinear_lines),
         cmocka_unit_test(test_arc_radius_and_helix),
         cmocka_unit_test(test_arc_centripetal_cap),
         cmocka_unit_test(test_canon_units_offsets),
