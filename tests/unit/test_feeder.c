@@ -212,7 +212,7 @@ static void test_read_stream_grows(void **state)
     fd = open(path, O_RDONLY);
     assert_true(fd >= 0);
     struct ncp_text_mem m;
-    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd, SIZE_MAX, NULL, NULL), 0);
     close(fd);
     assert_int_equal(m.len, n);
     assert_true(m.cap >= n && m.cap % ((size_t)2 << 20) == 0);
@@ -225,7 +225,7 @@ static void test_read_stream_grows(void **state)
     write_file(path, text, whole);
     fd = open(path, O_RDONLY);
     assert_true(fd >= 0);
-    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd, SIZE_MAX, NULL, NULL), 0);
     close(fd);
     assert_int_equal(m.len, whole);
     assert_memory_equal(m.text, text, whole);
@@ -235,7 +235,7 @@ static void test_read_stream_grows(void **state)
     write_file(path, text, 0);
     fd = open(path, O_RDONLY);
     assert_true(fd >= 0);
-    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd, SIZE_MAX, NULL, NULL), 0);
     close(fd);
     assert_int_equal(m.len, 0);
     ncp_text_mem_free(&m);
