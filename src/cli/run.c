@@ -288,8 +288,8 @@ static int write_latency(const char *path, const struct ncp_rt_stats *st)
 struct plot_job {
     struct ncp_outfile out;
     char script[4096];
-    char dir[64];
-    char trace[128], side[128], png[128];
+    char dir[512];
+    char trace[544], side[544], png[544];
 };
 
 static int plot_prepare(struct plot_job *pj, const char *path, const struct ncp_file_id *ids,
@@ -297,8 +297,11 @@ static int plot_prepare(struct plot_job *pj, const char *path, const struct ncp_
 {
     memset(pj, 0, sizeof *pj);
     pj->out.fd = -1;
+    if (ncp_outfile_open(&pj->out, path, ids, n_ids, NCP_OUT_SYNC) != 0)
+        return -1;
     if (find_plot_script(pj->script, sizeof pj->script)) {
         fprintf(stderr, "cnc-run run: --plot: cannot find tools/plot-trace.py (set NCPAR_PLOT_SCRIPT)\n");
+        ncp_outfile_discard(&pj->out);
         return -1;
     }
     /* the import is what fails on a machine without matplotlib: find out now */
@@ -312,12 +315,11 @@ static int plot_prepare(struct plot_job *pj, const char *path, const struct ncp_
     if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
         fprintf(stderr, "cnc-run run: --plot needs /usr/bin/python3 with matplotlib "
                         "(python3-matplotlib)\n");
+        ncp_outfile_discard(&pj->out);
         return -1;
     }
-    if (ncp_outfile_open(&pj->out, path, ids, n_ids, NCP_OUT_SYNC) != 0)
-        return -1;
     const char *tmp = getenv("TMPDIR");
-    if (!tmp || !*tmp || strlen(tmp) > 32)
+    if (!tmp || !*tmp || strlen(tmp) > 400)
         tmp = "/tmp";
     snprintf(pj->dir, sizeof pj->dir, "%s/cnc-run-plot-XXXXXX", tmp);
     if (!mkdtemp(pj->dir)) {
