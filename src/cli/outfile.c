@@ -136,6 +136,9 @@ static int open_beside(struct ncp_outfile *of, const struct stat *old)
         int e = errno;
         free(of->tmp);
         of->tmp = NULL;
+        /* a file we may write in a folder we may not: as O_TRUNC would */
+        if (old && e == EACCES)
+            return open_in_place(of, 0);
         return refuse(of->path, strerror(e));
     }
     remember(of->tmp);

@@ -8,8 +8,9 @@
  * file's mode, owner (as far as we may) and extended attributes carry over.
  * Written in place, as O_TRUNC does, and so not atomically: standard output
  * ("-"), devices, FIFOs and sockets (/dev/null, /dev/stdout), anything under
- * /dev or /proc, and a file with more than one hard link (a rename would
- * leave its other names on the old text). No output may be one of the
+ * /dev or /proc, a file with more than one hard link (a rename would
+ * leave its other names on the old text), and a file we may write in a
+ * folder we may not. No output may be one of the
  * run's input files (the same device and inode, whatever the name), and an
  * output that cannot be written is refused before anything runs. */
 #ifndef NCPAR_CLI_OUTFILE_H
