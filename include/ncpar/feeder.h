@@ -19,6 +19,9 @@ struct ncp_source {
     void *copy;         /* the anonymous mapping holding a copy of the text, or NULL */
     size_t copy_len;
     int has_percent;    /* program was delimited by '%' lines */
+    int fd;             /* a mapped file's, kept to tell whether it changed; else -1 */
+    uint64_t dev, ino;  /* the file read (0, 0 for memory and pipes): no output may be it */
+    int64_t file_size, mtime_ns;    /* the file as it was read */
 };
 
 /* A block's position: text[off .. off+len) excluding the line terminator;
@@ -34,6 +37,13 @@ struct ncp_span {
  * kernel cannot drop and re-read as it can a mapped file's pages. */
 #define NCP_SOURCE_COPY_MAX ((size_t)256 << 20)
 
+/* Standard input or another pipe is read up to the program's end (a closing
+ * '%', or an M2 or M30 the interpreter must reach), at most this much. */
+#define NCP_SOURCE_STREAM_MAX ((size_t)256 << 20)
+/* From this size on a file whose first line cannot be lexed is refused at
+ * once ("Command too long" at 1:1) instead of being read whole first. */
+#define NCP_SOURCE_LONG_LINE_CHECK ((size_t)1 << 20)
+
 /* Load a file or "-" (stdin). A regular file up to NCP_SOURCE_COPY_MAX bytes
  * is read into memory on huge pages where the kernel offers them, a larger one
  * is mapped; a pipe is read into memory. Fills d on failure. */
@@ -42,6 +52,10 @@ int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d
 int ncp_source_from_memory(struct ncp_source *src, const char *text, size_t len,
                            const char *name, struct ncp_diag *d);
 void ncp_source_close(struct ncp_source *src);
+/* 1 if the file behind src changed (size or modification time) since it was
+ * opened: a mapped file is read as long as the run lasts, a copy is checked
+ * when it is made ("input changed while reading" from ncp_source_open). */
+int ncp_source_changed(const struct ncp_source *src);
 
 /* A tape delimiter line: '%' first after blanks (what follows does not matter). */
 int ncp_source_percent_line(const char *s, size_t n);

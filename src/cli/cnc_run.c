@@ -4,7 +4,9 @@
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
 #include "canon_writer.h"
+#include "outfile.h"
 #include "run.h"
+#include "signals.h"
 #include "serve.h"
 
 #include <errno.h>
@@ -205,6 +207,21 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
     return 0;
 }
 
+/* The files a run reads: none of them may be an output. */
+static int program_ids(const struct ncp_source *src, const struct parse_opts *o,
+                       struct ncp_file_id *ids)
+{
+    int n = 0;
+    if (src->ino) {
+        ids[n].dev = src->dev;
+        ids[n].ino = src->ino;
+        ids[n++].what = "the program";
+    }
+    n = ncp_file_id_add(ids, n, o->config, "the thread map INI");
+    n = ncp_file_id_add(ids, n, o->acfg.tool_table_path, "the tool table");
+    return n;
+}
+
 static int cmd_parse(int argc, char **argv)
 {
     struct parse_opts o;
@@ -251,11 +268,14 @@ static int cmd_parse(int argc, char **argv)
         print_diag(o.prog, &d);
         return EXIT_PROGRAM;
     }
+    struct ncp_file_id inputs[4];
+    int n_inputs = program_ids(&src, &o, inputs);
     struct canon_writer *w = NULL;
-    if (o.canon && !(w = canon_writer_open(o.canon))) {
+    if (o.canon && !(w = canon_writer_open(o.canon, inputs, n_inputs))) {
         ncp_source_close(&src);
         return EXIT_USAGE;
     }
+    ncp_cli_catch_input_faults(o.prog, 1);
     struct ncp_output out = { w, canon_writer_emit, canon_writer_reserve, canon_writer_commit };
     struct ncp_run_stats st;
     memset(&st, 0, sizeof st);
@@ -267,7 +287,16 @@ static int cmd_parse(int argc, char **argv)
     const char *warning;
     while ((warning = ncp_run_warning_next(&warnings)) != NULL)
         fprintf(stderr, "cnc-run: warning: %s\n", warning);
-    int write_err = w ? canon_writer_close(w) : 0;
+    /* a program that changed under the run gives no output that could be
+     * taken for its own */
+    int changed = ncp_source_changed(&src);
+    int write_err = w ? canon_writer_close(w, !changed) : 0;
+    if (changed) {
+        fprintf(stderr, "%s: error: input changed while reading\n", o.prog);
+        status = EXIT_PROGRAM;
+        write_err = 0;
+        rc = NCP_OK;
+    }
     if (write_err) {
         /* the text could not be written (disk full, closed pipe): a fault of
          * the machine, not of the program, which stopped at that point */
@@ -300,6 +329,7 @@ static int cmd_check(int argc, char **argv)
         print_diag(o.prog, &d);
         return EXIT_PROGRAM;
     }
+    ncp_cli_catch_input_faults(o.prog, 0);
     struct ncp_run_stats st;
     int rc = ncp_serial_run(&src, &o.acfg, NULL, &st, &d);
     struct ncp_block *b = malloc(sizeof *b);
@@ -336,6 +366,10 @@ static int cmd_check(int argc, char **argv)
         errors++;
     }
     free(b);
+    if (ncp_source_changed(&src)) {
+        fprintf(stderr, "%s: error: input changed while reading\n", o.prog);
+        errors++;
+    }
     ncp_source_close(&src);
     return errors ? EXIT_PROGRAM : EXIT_OK;
 }

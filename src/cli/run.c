@@ -3,6 +3,7 @@
  * runtime itself is ncp_nck_run (src/rt/). */
 #include "run.h"
 #include "machine.h"
+#include "outfile.h"
 #include "signals.h"
 
 #include "ncpar/backend.h"
@@ -12,6 +13,7 @@
 #include "ncpar/nck.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <getopt.h>
 #include <math.h>
@@ -279,32 +281,133 @@ static int write_latency(const char *path, const struct ncp_rt_stats *st)
     return fclose(f) ? -1 : 0;
 }
 
-static int draw_plot(const struct run_opts *o, const char *trace, const struct ncp_rt_stats *lat)
+/* What --plot needs, known before anything moves: the place for the picture
+ * (plot->out, opened), the script, python3 with matplotlib, and a private
+ * folder for the files handed to it (the trace when --trace is not given,
+ * the latency sidecar, the picture), all removed afterwards. */
+struct plot_job {
+    struct ncp_outfile out;
+    char script[4096];
+    char dir[512];
+    char trace[544], side[544], png[544];
+};
+
+static int plot_prepare(struct plot_job *pj, const char *path, const struct ncp_file_id *ids,
+                        int n_ids)
 {
-    char script[4200], side[4200];
-    if (find_plot_script(script, sizeof script)) {
-        fprintf(stderr, "cnc-run run: cannot find tools/plot-trace.py (set NCPAR_PLOT_SCRIPT)\n");
+    memset(pj, 0, sizeof *pj);
+    pj->out.fd = -1;
+    if (ncp_outfile_open(&pj->out, path, ids, n_ids, NCP_OUT_SYNC) != 0)
+        return -1;
+    if (find_plot_script(pj->script, sizeof pj->script)) {
+        fprintf(stderr, "cnc-run run: --plot: cannot find tools/plot-trace.py (set NCPAR_PLOT_SCRIPT)\n");
+        ncp_outfile_discard(&pj->out);
         return -1;
     }
-    if (snprintf(side, sizeof side, "%s.latency.csv", trace) >= (int)sizeof side ||
-        write_latency(side, lat)) {
-        fprintf(stderr, "cnc-run run: cannot write the latency sidecar %s\n", side);
+    /* the import is what fails on a machine without matplotlib: find out now */
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        execl("/usr/bin/python3", "python3", "-c", "import matplotlib", (char *)NULL);
+        _exit(127);
+    }
+    int st = 0;
+    if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "cnc-run run: --plot needs /usr/bin/python3 with matplotlib "
+                        "(python3-matplotlib)\n");
+        ncp_outfile_discard(&pj->out);
+        return -1;
+    }
+    const char *tmp = getenv("TMPDIR");
+    if (!tmp || !*tmp || strlen(tmp) > 400)
+        tmp = "/tmp";
+    snprintf(pj->dir, sizeof pj->dir, "%s/cnc-run-plot-XXXXXX", tmp);
+    if (!mkdtemp(pj->dir)) {
+        fprintf(stderr, "cnc-run run: --plot: cannot make a folder in %s: %s\n", tmp,
+                strerror(errno));
+        ncp_outfile_discard(&pj->out);
+        pj->dir[0] = 0;
+        return -1;
+    }
+    snprintf(pj->trace, sizeof pj->trace, "%s/trace.csv", pj->dir);
+    snprintf(pj->side, sizeof pj->side, "%s/latency.csv", pj->dir);
+    /* ".png": the script's matplotlib then writes exactly this name */
+    snprintf(pj->png, sizeof pj->png, "%s/plot.png", pj->dir);
+    return 0;
+}
+
+static void plot_clean(struct plot_job *pj)
+{
+    if (pj->out.fd >= 0 || pj->out.tmp)
+        ncp_outfile_discard(&pj->out);
+    if (!pj->dir[0])
+        return;
+    unlink(pj->trace);
+    unlink(pj->side);
+    unlink(pj->png);
+    rmdir(pj->dir);
+    pj->dir[0] = 0;
+}
+
+/* 0, or the errno of the failed read or write. */
+static int copy_file(const char *from, int to)
+{
+    int in = open(from, O_RDONLY | O_CLOEXEC);
+    if (in < 0)
+        return errno;
+    char buf[65536];
+    int err = 0;
+    for (;;) {
+        ssize_t k = read(in, buf, sizeof buf);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0) {
+            err = k < 0 ? errno : 0;
+            break;
+        }
+        for (ssize_t off = 0; off < k && !err;) {
+            ssize_t w = write(to, buf + off, (size_t)(k - off));
+            if (w < 0 && errno == EINTR)
+                continue;
+            if (w <= 0)
+                err = w < 0 ? errno : EIO;
+            else
+                off += w;
+        }
+        if (err)
+            break;
+    }
+    close(in);
+    return err;
+}
+
+static int draw_plot(const struct run_opts *o, struct plot_job *pj, const char *trace,
+                     const struct ncp_rt_stats *lat)
+{
+    if (write_latency(pj->side, lat)) {
+        fprintf(stderr, "cnc-run run: --plot: cannot write %s: %s\n", pj->side, strerror(errno));
         return -1;
     }
     fflush(NULL);
     pid_t pid = fork();
     if (pid == 0) {
-        execl("/usr/bin/python3", "python3", script, trace, o->plot, side, "--title", o->prog,
-              (char *)NULL);
+        execl("/usr/bin/python3", "python3", pj->script, trace, pj->png, pj->side, "--title",
+              o->prog, (char *)NULL);
         _exit(127);
     }
     int st = 0;
     if (pid < 0 || waitpid(pid, &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        fprintf(stderr, "cnc-run run: plotting failed (needs /usr/bin/python3 with matplotlib)\n");
+        fprintf(stderr, "cnc-run run: plotting failed: %s exited %d (its message above)\n",
+                pj->script, WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st));
         return -1;
     }
-    if (!o->trace)
-        unlink(side);
+    int err = copy_file(pj->png, pj->out.fd);
+    if (!err)
+        err = ncp_outfile_commit(&pj->out);
+    if (err) {
+        fprintf(stderr, "cnc-run run: cannot write %s: %s\n", o->plot, strerror(err));
+        return -1;
+    }
     fprintf(stderr, "cnc-run run: wrote %s\n", o->plot);
     return 0;
 }
@@ -340,7 +443,9 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
     int rc = report(o, cfg, res);
     if (res->trace_errno) {
-        fprintf(stderr, "cnc-run run: error writing the trace: %s\n", strerror(res->trace_errno));
+        fprintf(stderr, "cnc-run run: error writing the trace%s%s: %s (the run stopped there)\n",
+                o->trace ? " " : " for --plot", o->trace ? o->trace : "",
+                strerror(res->trace_errno));
         rc = rc ? rc : RUN_FAULT;
     }
     if (rc == RUN_OK && res->interrupted)
@@ -365,35 +470,76 @@ int ncp_cli_run(int argc, char **argv)
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     if (ncp_source_open(&src, o.prog, &d) != NCP_OK) {
-        fprintf(stderr, "%s: error: %s\n", o.prog, d.msg);
+        if (d.line)
+            fprintf(stderr, "%s:%u:%u: error: %s\n", o.prog, d.line, d.col ? (unsigned)d.col : 1u,
+                    d.msg);
+        else
+            fprintf(stderr, "%s: error: %s\n", o.prog, d.msg);
         return RUN_PROGRAM;
     }
-    /* --plot alone still needs a trace: a temporary one, removed afterwards */
-    char tmp_trace[] = "/tmp/cnc-run-trace-XXXXXX";
-    const char *trace_path = o.trace;
-    FILE *trace = NULL;
-    if (!o.trace && o.plot) {
-        int fd = mkstemp(tmp_trace);
-        trace = fd >= 0 ? fdopen(fd, "w") : NULL;
-        trace_path = tmp_trace;
-    } else if (o.trace) {
-        trace = fopen(o.trace, "w");
+    ncp_cli_catch_input_faults(o.prog, 0);
+    /* every output is opened (or refused) before anything moves */
+    struct ncp_file_id ids[4];
+    int n_ids = 0;
+    if (src.ino) {
+        ids[0] = (struct ncp_file_id){ src.dev, src.ino, "the program" };
+        n_ids = 1;
     }
+    n_ids = ncp_file_id_add(ids, n_ids, o.config, "the machine INI");
+    n_ids = ncp_file_id_add(ids, n_ids, o.tool_table, "the tool table");
+    struct ncp_outfile trace_of = { .fd = -1, .old_fd = -1 };
+    struct plot_job *pj = o.plot ? calloc(1, sizeof *pj) : NULL;
+    if (o.trace && !strcmp(o.trace, "-")) {
+        fprintf(stderr, "cnc-run run: --trace wants a file (standard output is the summary's)\n");
+        free(pj);
+        ncp_source_close(&src);
+        return RUN_USAGE;
+    }
+    if ((o.trace && ncp_outfile_open(&trace_of, o.trace, ids, n_ids, NCP_OUT_LIVE) != 0) ||
+        (o.plot && (!pj || plot_prepare(pj, o.plot, ids, n_ids) != 0))) {
+        if (trace_of.fd >= 0)
+            ncp_outfile_discard(&trace_of);
+        if (pj)
+            plot_clean(pj);
+        free(pj);
+        ncp_source_close(&src);
+        return RUN_USAGE;
+    }
+    /* --plot alone still needs a trace: one in the plot's private folder */
+    const char *trace_path = o.trace ? o.trace : pj ? pj->trace : NULL;
+    FILE *trace = NULL;
+    if (o.trace)
+        trace = fdopen(trace_of.fd, "w");
+    else if (pj)
+        trace = fopen(pj->trace, "w");
     if (trace_path && !trace) {
         fprintf(stderr, "cnc-run run: cannot write %s: %s\n", trace_path, strerror(errno));
+        if (trace_of.fd >= 0)
+            ncp_outfile_discard(&trace_of);
+        if (pj)
+            plot_clean(pj);
+        free(pj);
         ncp_source_close(&src);
         return RUN_USAGE;
     }
     struct ncp_rt_stats *lat = calloc(1, sizeof *lat);
     int rc = lat ? run_program(&o, &cfg, &src, trace, lat) : RUN_FAULT;
     if (trace && fclose(trace) != 0) {
-        fprintf(stderr, "cnc-run run: error writing %s\n", trace_path);
+        fprintf(stderr, "cnc-run run: error writing %s: %s\n", trace_path, strerror(errno));
         rc = rc ? rc : RUN_FAULT;
     }
-    if (lat && o.plot && draw_plot(&o, trace_path, lat) != 0)
+    trace_of.fd = -1;   /* closed with its stream */
+    ncp_outfile_commit(&trace_of);
+    int changed = ncp_source_changed(&src);
+    if (changed) {
+        fprintf(stderr, "%s: error: input changed while reading\n", o.prog);
+        rc = RUN_PROGRAM;
+    }
+    if (lat && pj && !changed && draw_plot(&o, pj, trace_path, lat) != 0)
         rc = rc ? rc : RUN_FAULT;
-    if (!o.trace && o.plot)
-        unlink(tmp_trace);
+    if (pj)
+        plot_clean(pj);
+    free(pj);
     free(lat);
     ncp_source_close(&src);
     return rc;

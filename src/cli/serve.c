@@ -1,6 +1,7 @@
 /* cnc-run serve: the NCK as a long-running service on LCM. Options, the
  * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
 #include "serve.h"
+#include "outfile.h"
 #include "machine.h"
 #include "signals.h"
 
@@ -8,6 +9,7 @@
 
 #include <getopt.h>
 #include <signal.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -110,10 +112,22 @@ int ncp_cli_serve(int argc, char **argv)
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     ncp_cli_catch_stop_signals(on_signal);
+    /* the trace is a live record (outfile.h), never over an input */
+    struct ncp_file_id ids[2];
+    int n_ids = ncp_file_id_add(ids, 0, a.config, "the machine INI");
+    n_ids = ncp_file_id_add(ids, n_ids, a.tool_table, "the tool table");
+    struct ncp_outfile trace_of;
     FILE *trace = NULL;
-    if (a.trace && !(trace = fopen(a.trace, "w"))) {
-        perror(a.trace);
-        return SERVE_USAGE;
+    if (a.trace) {
+        if (!strcmp(a.trace, "-"))
+            return fprintf(stderr, "cnc-run serve: --trace wants a file\n"), SERVE_USAGE;
+        if (ncp_outfile_open(&trace_of, a.trace, ids, n_ids, NCP_OUT_LIVE) != 0)
+            return SERVE_USAGE;
+        if (!(trace = fdopen(trace_of.fd, "w"))) {
+            fprintf(stderr, "cnc-run serve: cannot write %s: %s\n", a.trace, strerror(errno));
+            ncp_outfile_discard(&trace_of);
+            return SERVE_USAGE;
+        }
     }
     struct ncp_nck_setup setup = {
         .cfg = &cfg, .virtual_clock = a.virtual_clock, .trace = trace, .mode = a.mode,
@@ -131,8 +145,12 @@ int ncp_cli_serve(int argc, char **argv)
     int rc = ncp_nck_serve(nck, &so, &d);
     ncp_nck_free(nck);
     if (trace && fclose(trace) != 0) {
-        fprintf(stderr, "cnc-run serve: error writing %s\n", a.trace);
+        fprintf(stderr, "cnc-run serve: error writing %s: %s\n", a.trace, strerror(errno));
         rc = rc < 0 ? rc : 1;
+    }
+    if (trace) {
+        trace_of.fd = -1;   /* closed with its stream */
+        ncp_outfile_commit(&trace_of);
     }
     if (rc < 0) {
         fprintf(stderr, "cnc-run serve: error: %s\n", d.msg);

@@ -1,7 +1,10 @@
 /* Program text loading and block splitting. The split is a pure function of the
  * text so the analyzer can re-read earlier blocks (loops, calls) without the file. */
 #include "ncpar/feeder.h"
+#include "stream_end.h"
 #include "text_mem.h"
+
+#include "ncpar/lex.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -125,44 +128,13 @@ int ncp_source_from_memory(struct ncp_source *src, const char *text, size_t len,
 {
     (void)d;
     memset(src, 0, sizeof *src);
+    src->fd = -1;
     src->text = text;
     src->len = len;
     src->name = name;
     src->end = len;
     find_body(src);
     return NCP_OK;
-}
-
-static int read_all(int fd, char **buf, size_t *len)
-{
-    size_t cap = 1 << 16, n = 0;
-    char *p = malloc(cap);
-    if (!p)
-        return -1;
-    for (;;) {
-        if (n == cap) {
-            char *q = realloc(p, cap * 2);
-            if (!q) {
-                free(p);
-                return -1;
-            }
-            p = q;
-            cap *= 2;
-        }
-        ssize_t r = read(fd, p + n, cap - n);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r < 0) {
-            free(p);
-            return -1;
-        }
-        if (r == 0)
-            break;
-        n += (size_t)r;
-    }
-    *buf = p;
-    *len = n;
-    return 0;
 }
 
 /* src takes over the copy in m. */
@@ -173,35 +145,77 @@ static void adopt_copy(struct ncp_source *src, struct ncp_text_mem *m)
     src->copy_len = m->mem.base_len;
 }
 
-/* A pipe's text: on huge pages where the kernel offers them, else on the heap. */
-static int read_stream(struct ncp_source *src, int fd)
+/* A pipe's text, up to the program's end (stream_end.h) and no more than
+ * NCP_SOURCE_STREAM_MAX bytes: a pipe need not end at all. */
+static int read_stream(struct ncp_source *src, int fd, const char *what, struct ncp_diag *d)
 {
-    if (ncp_mem_huge_usable()) {
-        struct ncp_text_mem m;
-        if (ncp_text_mem_read_stream(&m, fd) != 0)
-            return -1;
+    struct ncp_text_mem m;
+    struct ncp_stream_end e;
+    memset(&e, 0, sizeof e);
+    if (ncp_text_mem_read_stream(&m, fd, NCP_SOURCE_STREAM_MAX, ncp_stream_end_scan, &e) == 0) {
         adopt_copy(src, &m);
-        return 0;
+        return NCP_OK;
     }
-    char *buf;
-    size_t n;
-    if (read_all(fd, &buf, &n) != 0)
-        return -1;
-    ncp_source_from_memory(src, buf, n, NULL, NULL);
-    src->owned = 1;
-    return 0;
+    if (errno == EFBIG)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
+                            "%s gave more than %zu MB without the program's end (M2, M30 "
+                            "or a closing %%): give a program this long as a file",
+                            what, NCP_SOURCE_STREAM_MAX >> 20);
+    return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read %s: %s", what, strerror(errno));
+}
+
+/* A first line too long to lex, and long enough that reading it costs
+ * (a file of zeros): "Command too long" before the text is mapped or
+ * copied, as the lexer would report it at 1:1 (a '%' line is no command). */
+static int first_line_too_long(int fd, size_t size)
+{
+    char head[NCP_LINE_MAX];
+    if (size < NCP_SOURCE_LONG_LINE_CHECK)
+        return 0;
+    ssize_t k = pread(fd, head, sizeof head, 0);
+    if (k != (ssize_t)sizeof head || memchr(head, '\n', sizeof head))
+        return 0;
+    return !ncp_source_percent_line(head, sizeof head);
+}
+
+/* The file as fstat saw it when read, to notice a change later. */
+static void note_file(struct ncp_source *src, const struct stat *st)
+{
+    src->dev = (uint64_t)st->st_dev;
+    src->ino = (uint64_t)st->st_ino;
+    src->file_size = (int64_t)st->st_size;
+    src->mtime_ns = (int64_t)st->st_mtim.tv_sec * 1000000000 + st->st_mtim.tv_nsec;
+}
+
+static int same_file_state(const struct ncp_source *src, int fd)
+{
+    struct stat st;
+    if (fstat(fd, &st) != 0)
+        return 0;
+    return (int64_t)st.st_size == src->file_size &&
+           (int64_t)st.st_mtim.tv_sec * 1000000000 + st.st_mtim.tv_nsec == src->mtime_ns;
+}
+
+static int changed(struct ncp_diag *d)
+{
+    return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "input changed while reading");
 }
 
 int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d)
 {
     memset(src, 0, sizeof *src);
+    src->fd = -1;
     src->name = path;
     if (strcmp(path, "-") == 0) {
-        if (read_stream(src, 0) != 0)
-            return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read standard input: %s",
-                                strerror(errno));
+        struct stat st;
+        if (fstat(0, &st) == 0 && S_ISREG(st.st_mode))
+            note_file(src, &st);   /* `< file`: still the file the outputs must not be */
+        uint64_t dev = src->dev, ino = src->ino;
+        int rc = read_stream(src, 0, "standard input", d);
         src->name = path;
-        return NCP_OK;
+        src->dev = dev;
+        src->ino = ino;
+        return rc;
     }
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0)
@@ -210,20 +224,34 @@ int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d
     struct stat st;
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         /* not a regular file (a FIFO, a device): read it like a pipe */
-        int rc = read_stream(src, fd);
+        int rc = read_stream(src, fd, "the program", d);
         close(fd);
-        if (rc != 0)
-            return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read program: %s",
-                                strerror(errno));
         src->name = path;
-        return NCP_OK;
+        src->fd = -1;
+        return rc;
     }
     size_t size = (size_t)st.st_size;
+    if (first_line_too_long(fd, size)) {
+        close(fd);
+        return ncp_diag_set(d, NCP_ERR_SYNTAX, 1, 0, "Command too long");
+    }
     if (size > 0 && size <= NCP_SOURCE_COPY_MAX && ncp_mem_huge_usable()) {
         struct ncp_text_mem m;
         if (ncp_text_mem_read_file(&m, fd, size) == 0) {
+            /* the copy is ours from here on: only a change during the read
+             * can make it a mix of two versions */
+            struct ncp_source was;
+            memset(&was, 0, sizeof was);
+            note_file(&was, &st);
+            int same = m.len == size && same_file_state(&was, fd);
             close(fd);
+            if (!same) {
+                ncp_text_mem_free(&m);
+                return changed(d);
+            }
             adopt_copy(src, &m);
+            note_file(src, &st);
+            src->fd = -1;
             src->name = path;
             return NCP_OK;
         }
@@ -241,7 +269,13 @@ int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d
         text = m;
         src->mapped = 1;
     }
-    close(fd);
+    /* a mapped file is read as long as the run lasts: its descriptor stays
+     * to tell afterwards whether it changed meanwhile */
+    note_file(src, &st);
+    if (src->mapped)
+        src->fd = fd;
+    else
+        close(fd);
     src->text = text;
     src->len = size;
     src->end = size;
@@ -249,10 +283,18 @@ int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d
     return NCP_OK;
 }
 
+int ncp_source_changed(const struct ncp_source *src)
+{
+    return src->mapped && src->fd >= 0 && !same_file_state(src, src->fd);
+}
+
 void ncp_source_close(struct ncp_source *src)
 {
-    if (src->mapped)
+    if (src->mapped) {
         munmap((void *)src->text, src->len);
+        if (src->fd >= 0)
+            close(src->fd);
+    }
     else if (src->copy)
         munmap(src->copy, src->copy_len);
     else if (src->owned)

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #define FIRST_STREAM_BYTES ((size_t)2 << 20)
+#define FIRST_STREAM_MAX ((size_t)1 << 30)
 
 static int reserve(struct ncp_text_mem *m, size_t bytes)
 {
@@ -55,16 +56,37 @@ int ncp_text_mem_read_file(struct ncp_text_mem *m, int fd, size_t size)
     return 0;
 }
 
-int ncp_text_mem_read_stream(struct ncp_text_mem *m, int fd)
+/* One read(), EINTR retried: what a pipe has now, so that the end of the
+ * program is seen as soon as it arrives. */
+static ssize_t read_some(int fd, char *dst, size_t want)
 {
-    if (reserve(m, FIRST_STREAM_BYTES) != 0)
+    for (;;) {
+        ssize_t r = read(fd, dst, want);
+        if (r >= 0 || errno != EINTR)
+            return r;
+    }
+}
+
+int ncp_text_mem_read_stream(struct ncp_text_mem *m, int fd, size_t max,
+                             ncp_text_stop_fn stop, void *ctx)
+{
+    /* room for the whole limit at once: only what is read is touched, and
+     * no growth copies, which would hold the text twice */
+    if (reserve(m, max < FIRST_STREAM_MAX ? max + 1 : FIRST_STREAM_BYTES) != 0)
         return -1;
     for (;;) {
         if (m->len == m->cap) {
-            /* a new region twice the size: copying whole 2 MB pages is cheap
-             * next to reading, and the copy stays on huge pages */
+            /* a new region twice the size (no bigger than the limit needs):
+             * copying whole 2 MB pages is cheap next to reading, and the
+             * copy stays on huge pages */
             struct ncp_text_mem bigger;
-            if (m->cap > SIZE_MAX / 2 || reserve(&bigger, m->cap * 2) != 0) {
+            if (m->len > max) {
+                ncp_text_mem_free(m);
+                errno = EFBIG;
+                return -1;
+            }
+            size_t want = m->cap <= max / 2 ? m->cap * 2 : max + 1;
+            if (reserve(&bigger, want) != 0) {
                 ncp_text_mem_free(m);
                 errno = ENOMEM;
                 return -1;
@@ -74,15 +96,25 @@ int ncp_text_mem_read_stream(struct ncp_text_mem *m, int fd)
             ncp_text_mem_free(m);
             *m = bigger;
         }
-        size_t got;
-        if (read_into(fd, m->text + m->len, m->cap - m->len, &got) != 0) {
+        ssize_t got = read_some(fd, m->text + m->len, m->cap - m->len);
+        if (got < 0) {
             int e = errno;
             ncp_text_mem_free(m);
             errno = e;
             return -1;
         }
-        m->len += got;
-        if (m->len < m->cap)
-            return 0; /* the end came before the region was full */
+        if (got == 0)
+            return 0;
+        m->len += (size_t)got;
+        size_t keep = stop ? stop(ctx, m->text, m->len) : 0;
+        if (keep) {
+            m->len = keep;
+            return 0;
+        }
+        if (m->len > max) {
+            ncp_text_mem_free(m);
+            errno = EFBIG;
+            return -1;
+        }
     }
 }

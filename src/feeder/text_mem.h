@@ -25,8 +25,16 @@ struct ncp_text_mem {
 /* The first `size` (> 0) bytes of regular file fd (fewer if it is shorter
  * now). 0, or -1 with errno set and nothing held. */
 int ncp_text_mem_read_file(struct ncp_text_mem *m, int fd, size_t size);
-/* Everything fd gives until its end (a pipe). 0, or -1 with errno set. */
-int ncp_text_mem_read_stream(struct ncp_text_mem *m, int fd);
+/* What a stream reader is told after each read(): the text so far. It
+ * returns 0 to read on, or the length of text to keep when the rest is not
+ * wanted (the program has ended in it). */
+typedef size_t (*ncp_text_stop_fn)(void *ctx, const char *text, size_t len);
+
+/* What fd gives until its end (a pipe), until `stop` (may be NULL) has seen
+ * the program's end, or until more than `max` bytes came (then -1 with errno
+ * EFBIG and nothing held). 0, or -1 with errno set. */
+int ncp_text_mem_read_stream(struct ncp_text_mem *m, int fd, size_t max,
+                             ncp_text_stop_fn stop, void *ctx);
 void ncp_text_mem_free(struct ncp_text_mem *m);
 
 #endif

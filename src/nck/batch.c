@@ -3,6 +3,7 @@
  * after the program (or after --for's hold, or at a fault). */
 #include "nck_int.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -76,13 +77,21 @@ static void progress(const struct nck *n, const struct ncp_nck_opts *o)
 static void drain(struct nck *n, const struct ncp_nck_opts *o)
 {
     int64_t last_print = 0;
-    if (o->trace)
+    if (o->trace) {
+        errno = 0;
         nck_trace_header(o->trace);
+        if (ferror(o->trace))
+            n->sum.trace_errno = errno ? errno : EIO;
+    }
     for (;;) {
         int got = nck_read_cycles(n);
         if (!got && !atomic_load(&n->loop.running) && ncp_spsc_count(&n->fbs) == 0)
             break;
-        if (o->interrupt && *o->interrupt && !atomic_load(&n->ctl->stop))
+        /* a trace that cannot be written (a full disk) stops the run as a
+         * stop signal does: a run that was asked to be recorded is not
+         * worth going on unrecorded */
+        if (((o->interrupt && *o->interrupt) || n->sum.trace_errno) &&
+            !atomic_load(&n->ctl->stop))
             atomic_store(&n->ctl->stop, 1);
         if (o->progress && mono_ns() - last_print > 200000000) {
             last_print = mono_ns();

@@ -13,6 +13,7 @@
 
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
+#include "../../src/feeder/stream_end.h"
 #include "../../src/feeder/text_mem.h"
 
 #include <fcntl.h>
@@ -212,7 +213,7 @@ static void test_read_stream_grows(void **state)
     fd = open(path, O_RDONLY);
     assert_true(fd >= 0);
     struct ncp_text_mem m;
-    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd, SIZE_MAX, NULL, NULL), 0);
     close(fd);
     assert_int_equal(m.len, n);
     assert_true(m.cap >= n && m.cap % ((size_t)2 << 20) == 0);
@@ -225,7 +226,7 @@ static void test_read_stream_grows(void **state)
     write_file(path, text, whole);
     fd = open(path, O_RDONLY);
     assert_true(fd >= 0);
-    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd, SIZE_MAX, NULL, NULL), 0);
     close(fd);
     assert_int_equal(m.len, whole);
     assert_memory_equal(m.text, text, whole);
@@ -235,7 +236,7 @@ static void test_read_stream_grows(void **state)
     write_file(path, text, 0);
     fd = open(path, O_RDONLY);
     assert_true(fd >= 0);
-    assert_int_equal(ncp_text_mem_read_stream(&m, fd), 0);
+    assert_int_equal(ncp_text_mem_read_stream(&m, fd, SIZE_MAX, NULL, NULL), 0);
     close(fd);
     assert_int_equal(m.len, 0);
     ncp_text_mem_free(&m);
@@ -266,6 +267,42 @@ static void test_read_file_shorter_than_said(void **state)
     free(text);
 }
 
+/* Where a pipe's program certainly ends: the bytes to keep, 0 = read on. */
+static size_t stream_end_of(const char *text)
+{
+    struct ncp_stream_end e;
+    memset(&e, 0, sizeof e);
+    return ncp_stream_end_scan(&e, text, strlen(text));
+}
+
+static void test_stream_end(void **state)
+{
+    (void)state;
+    assert_int_equal(stream_end_of("G1 X1\nM2\nG1 X2\n"), 9);
+    assert_int_equal(stream_end_of("G1 X1\nN20 m030 (end)\nG1\n"), 21);
+    assert_int_equal(stream_end_of("G1 X1\nM2"), 0);            /* the line is not whole yet */
+    assert_int_equal(stream_end_of("G1 X1\nM21\nM3\n"), 0);    /* M21, M3: no end */
+    assert_int_equal(stream_end_of("(M2)\n#<m2> = 1\n"), 0);   /* a comment, a name */
+    assert_int_equal(stream_end_of("/M2\n"), 0);                /* block delete may skip it */
+    assert_int_equal(stream_end_of("\n%\nM2\nX1\n%\n"), 6);  /* M2 inside % still ends */
+    assert_int_equal(stream_end_of("%\nG1 X1\n%\nG1\n"), 10);
+    /* inside a block the M2 may never run; after it, it must */
+    assert_int_equal(stream_end_of("o1 if [#1]\nM2\no1 endif\nG1\n"), 0);
+    assert_int_equal(stream_end_of("o1 if [#1]\nM2\no1 endif\nM2\n"), 26);
+    assert_int_equal(stream_end_of("o2 do\nG1\no2 while [#1]\nM30\n"), 27);
+    assert_int_equal(stream_end_of("o<s> sub\nM2\no<s> endsub\nM2\n"), 27);
+    /* a call may find its sub below the M2 */
+    assert_int_equal(stream_end_of("o<s> call\nM2\n"), 0);
+    assert_int_equal(stream_end_of("M98 P100\nM30\n"), 0);
+    /* an unterminated line too long to lex ends it; a '%' first line does not */
+    char line[600];
+    memset(line, 'G', sizeof line - 1);
+    line[sizeof line - 1] = 0;
+    assert_int_equal(stream_end_of(line), sizeof line - 1);
+    line[0] = '%';
+    assert_int_equal(stream_end_of(line), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -275,6 +312,7 @@ int main(void)
         cmocka_unit_test(test_open_regular_file),
         cmocka_unit_test(test_read_stream_grows),
         cmocka_unit_test(test_read_file_shorter_than_said),
+        cmocka_unit_test(test_stream_end),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
