@@ -125,6 +125,8 @@ struct ncp_flow {
     int inline_level;                 /* an inline call returns to this level, or -1 */
     char label[FLOW_LABEL_MAX];       /* label of the block being run */
     size_t label_len;
+    const char *call_path;            /* a call's name as written (in its block): */
+    size_t call_path_len;             /* the path of the file it may be in */
 };
 
 static void ncp_flow_name_set(struct flow_name *n, const char *s, size_t len)
@@ -431,6 +433,17 @@ static void ncp_flow_make_label(struct ncp_flow *f, const struct ncp_block *b)
     } else if (b->oword.kind == NCP_O_M99) {  /* the sub it is in */
         name = f->frames[f->level].name;
         len = f->frames[f->level].name_len;
+    }
+    if (b->oword.kind == NCP_O_CALL) {
+        f->call_path = name;
+        f->call_path_len = len;
+        /* o<../lib/up> call: rs274 looks for the file by the whole path
+         * but calls the sub by the file's own name, "up" */
+        const char *slash = memrchr(name, '/', len);
+        if (slash) {
+            len -= (size_t)(slash + 1 - name);
+            name = slash + 1;
+        }
     }
     if (len > FLOW_NAME_MAX)
         len = FLOW_NAME_MAX;
@@ -764,14 +777,20 @@ static int ncp_flow_open_sub_file(struct ncp_flow *f, const struct ncp_block *b,
                          struct ncp_diag *d)
 {
     char path[4096];
+    const char *name = f->label;
+    size_t name_len = f->label_len;
+    if (b->oword.kind == NCP_O_CALL) {
+        name = f->call_path;
+        name_len = f->call_path_len;
+    }
     const char *dirs = f->sub_path ? f->sub_path : "";
     const char *dir = "";
     size_t dir_len = 0;
     *file = 0;
     for (;;) {
         int n = dir_len ? snprintf(path, sizeof path, "%.*s/%.*s.ngc", (int)dir_len, dir,
-                                   (int)f->label_len, f->label)
-                        : snprintf(path, sizeof path, "%.*s.ngc", (int)f->label_len, f->label);
+                                   (int)name_len, name)
+                        : snprintf(path, sizeof path, "%.*s.ngc", (int)name_len, name);
         if (n > 0 && (size_t)n < sizeof path && ncp_flow_is_readable_file(path))
             break;
         if (*dirs == '\0')
