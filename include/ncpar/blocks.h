@@ -27,7 +27,7 @@
  * reference does.
  * next() returns the next block in file order (or NULL at the end of the body)
  * and keeps it valid until release(). The analyzer re-reads earlier blocks for
- * loops and calls itself, from src->text, with ncp_source_span + ncp_lex_block,
+ * loops and calls itself, from src->text, through struct ncp_block_reread below,
  * and returns to next() once it is back at the block after the last one taken. */
 struct ncp_block_feed {
     void *ctx;
@@ -72,6 +72,22 @@ static inline void ncp_text_feed_release(void *ctx)
 {
     (void)ctx; /* the block is overwritten by the next one */
 }
+
+/* ---- any block again ---- */
+
+/* Blocks read again by position (loops and calls going back), lexed once and
+ * kept in a small cache keyed by file and offset. */
+struct ncp_block_reread;
+
+struct ncp_block_reread *ncp_block_reread_new(void); /* NULL: out of memory */
+void ncp_block_reread_free(struct ncp_block_reread *r);
+/* The block at *off (line number *line) of src, which is file number `file`
+ * of the run; *off and *line move on to the block after it. With skipping
+ * set, a line that cannot hold an O-word or an M98 line is not lexed: *out
+ * is NULL. 0, or 1 at the end of src. */
+int ncp_block_reread_at(struct ncp_block_reread *r, const struct ncp_source *src,
+                        uint32_t file, int skipping, uint64_t *off, uint32_t *line,
+                        const struct ncp_block **out);
 
 /* ---- text built by the interpreter ---- */
 

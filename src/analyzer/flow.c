@@ -9,6 +9,8 @@
  * of lexed blocks for loop bodies) until it is back at the feed's position. */
 #include "flow.h"
 
+#include "ncpar/blocks.h"
+
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -19,8 +21,6 @@
 /* rs274 -g runs with the block delete switch off: '/' blocks are executed. */
 #define FLOW_BLOCK_DELETE 0
 #define FLOW_DEFAULT_MAX_DEPTH 10u    /* rs274: INTERP_SUB_ROUTINE_LEVELS */
-#define FLOW_CACHE_BITS 8
-#define FLOW_CACHE_SLOTS (1u << FLOW_CACHE_BITS) /* re-read blocks kept lexed (~2 MB) */
 #define FLOW_NAME_MAX NCP_BLOCK_POOL
 #define FLOW_LABEL_MAX (2 * FLOW_NAME_MAX + 2)
 #define FLOW_MAX_FILES 64             /* the program and the subroutine files it calls */
@@ -70,13 +70,6 @@ struct flow_frame {
     char name[FLOW_NAME_MAX];         /* the called sub: scope of its labels */
 };
 
-struct flow_cached {
-    struct ncp_block blk;
-    uint64_t next;
-    uint32_t file;
-    int valid;
-};
-
 /* A subroutine file, read whole when first called. */
 struct flow_file {
     struct ncp_source src;
@@ -121,7 +114,7 @@ struct ncp_flow {
     struct flow_pos cur;              /* next block to execute */
     struct flow_pos feed_pos;         /* next block the feed will deliver */
     int feed_done, feed_held;
-    struct flow_cached *cache;
+    struct ncp_block_reread *reread; /* blocks read again, lexed once */
     struct ncp_block *fanuc_blk;      /* an M_VALUE line read again as M98/M99 */
 
     struct flow_labels labels;
@@ -283,12 +276,6 @@ static void ncp_flow_release_feed(struct ncp_flow *f)
     }
 }
 
-/* O-word lines, and M98 lines, which rs274 reads even where it skips */
-static int ncp_flow_may_be_oword(const char *s, size_t n)
-{
-    return memchr(s, 'o', n) || memchr(s, 'O', n) || memchr(s, 'm', n) || memchr(s, 'M', n);
-}
-
 static int ncp_flow_from_feed(struct ncp_flow *f, const struct ncp_block **out)
 {
     if (f->feed_done)
@@ -318,35 +305,11 @@ static int ncp_flow_from_feed(struct ncp_flow *f, const struct ncp_block **out)
 static int ncp_flow_from_text(struct ncp_flow *f, int skipping, const struct ncp_block **out,
                      struct ncp_diag *d)
 {
-    if (!f->cache) {
-        f->cache = calloc(FLOW_CACHE_SLOTS, sizeof *f->cache);
-        if (!f->cache)
-            return ncp_diag_set(d, NCP_ERR_IO, f->cur.line, 0, "out of memory");
-    }
-    uint64_t key = f->cur.off ^ (uint64_t)f->cur.file << 40;
-    struct flow_cached *c =
-        &f->cache[(key * 0x9E3779B97F4A7C15ull) >> (64 - FLOW_CACHE_BITS)];
-    if (c->valid && c->blk.offset == f->cur.off && c->file == f->cur.file) {
-        f->cur.off = c->next;
-        f->cur.line = c->blk.line + 1;
-        *out = &c->blk;
-        return NCP_OK;
-    }
-    struct ncp_span sp;
-    if (ncp_source_span(f->src, f->cur.off, f->cur.line, &sp) != 0)
+    if (!f->reread && !(f->reread = ncp_block_reread_new()))
+        return ncp_diag_set(d, NCP_ERR_IO, f->cur.line, 0, "out of memory");
+    if (ncp_block_reread_at(f->reread, f->src, f->cur.file, skipping, &f->cur.off,
+                            &f->cur.line, out) != 0)
         return NCP_END;
-    f->cur.off = sp.next;
-    f->cur.line = sp.line + 1;
-    const char *text = f->src->text + sp.off;
-    if (skipping && !ncp_flow_may_be_oword(text, sp.len)) {
-        *out = NULL;
-        return NCP_OK;
-    }
-    ncp_lex_block(text, sp.len, sp.line, sp.off, &c->blk);
-    c->next = sp.next;
-    c->file = f->cur.file;
-    c->valid = 1;
-    *out = &c->blk;
     return NCP_OK;
 }
 
@@ -1531,7 +1494,7 @@ void ncp_flow_free(struct ncp_flow *f)
     for (uint32_t k = 0; k < f->n_files; k++)
         ncp_source_close(&f->files[k].src);
     free(f->files);
-    free(f->cache);
+    ncp_block_reread_free(f->reread);
     free(f->fanuc_blk);
     free(f->scan.open);
     free(f->scan.arena);
