@@ -1089,12 +1089,10 @@ static int ncp_flow_skipped_oword(struct ncp_flow *f, const struct ncp_block *b)
         return 1;
     if (!f->scan.on)
         return 0;
-    if (f->scan.epoch != f->labels.epoch)
+    if (f->scan.epoch != f->labels.epoch || (other && !ncp_flow_scan_other(f, b)))
         f->scan.on = 0;
     else if (!other)
         ncp_flow_scan_end(f, b);
-    else if (!ncp_flow_scan_other(f, b))
-        f->scan.on = 0;
     return 0;
 }
 
