@@ -4,9 +4,9 @@
  *    (struct ncp_text_feed: the serial reference's feed, and the pipeline's
  *    with no lexer threads; the lexer threads lex the same lines);
  *  - any block again by its position, through a cache of lexed blocks
- *    (loops and calls going back; struct ncp_block_reread);
- *  - subroutine files, found by name on a search path and read whole once
- *    (struct ncp_sub_files);
+ *    (loops and calls going back; struct ncp_block_reread), and every block
+ *    of a subroutine file (the analyzer opens the file, numbers it, and reads
+ *    it through the same cache);
  *  - a line of text the interpreter builds itself (G70-G72's call line, M72's
  *    restore lines: ncp_blocks_lex_text);
  *  - every line of a source with what a reader finds wrong in it (check:
