@@ -6,23 +6,11 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "ncpar/blocks.h"
 #include "ncpar/canon.h"
 #include "ncpar/diag.h"
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
-
-/* Where the analyzer gets blocks in file order. The pipeline serves them from the
- * parsed ring (pre-lexed in parallel); the serial reference lexes on demand.
- * next() returns the next block in file order (or NULL at the end of the body)
- * and keeps it valid until release(). The analyzer re-reads earlier blocks for
- * loops and calls itself, from src->text, with ncp_source_span + ncp_lex_block,
- * and returns to next() once it is back at the block after the last one taken. */
-struct ncp_block_feed {
-    void *ctx;
-    const struct ncp_block *(*next)(void *ctx);
-    void (*release)(void *ctx);
-    const struct ncp_source *src;
-};
 
 /* Where command slots go, in cmd_id order. acquire() returns a slot whose header
  * (n_ops, flags, diag.code, text_used, out_len) is zeroed; ops are NOT cleared, so

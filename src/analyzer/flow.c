@@ -9,6 +9,8 @@
  * of lexed blocks for loop bodies) until it is back at the feed's position. */
 #include "flow.h"
 
+#include "ncpar/blocks.h"
+
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -19,8 +21,6 @@
 /* rs274 -g runs with the block delete switch off: '/' blocks are executed. */
 #define FLOW_BLOCK_DELETE 0
 #define FLOW_DEFAULT_MAX_DEPTH 10u    /* rs274: INTERP_SUB_ROUTINE_LEVELS */
-#define FLOW_CACHE_BITS 8
-#define FLOW_CACHE_SLOTS (1u << FLOW_CACHE_BITS) /* re-read blocks kept lexed (~2 MB) */
 #define FLOW_NAME_MAX NCP_BLOCK_POOL
 #define FLOW_LABEL_MAX (2 * FLOW_NAME_MAX + 2)
 #define FLOW_MAX_FILES 64             /* the program and the subroutine files it calls */
@@ -42,11 +42,18 @@ struct flow_label {
     uint64_t off;
     uint64_t iterations;              /* of the current run of the loop */
     uint64_t idle_laps;               /* jumps back to it that ran no iteration */
+    /* A loop's whole text, once a skip from its head to its end line found
+     * nothing in it that a skip would notice (see "Loop ends" below): a later
+     * skip over it goes straight past its end line. Valid while the table
+     * holds the same labels (region_epoch == labels.epoch). */
+    uint64_t end_next;                /* 0: not known */
+    uint32_t end_next_line, region_epoch;
 };
 
 struct flow_labels {
     struct flow_label *slots;
     uint32_t cap, count;
+    uint32_t epoch;                   /* bumped whenever a label is added or all go */
     char *arena;
     size_t used, acap;
 };
@@ -63,18 +70,25 @@ struct flow_frame {
     char name[FLOW_NAME_MAX];         /* the called sub: scope of its labels */
 };
 
-struct flow_cached {
-    struct ncp_block blk;
-    uint64_t next;
-    uint32_t file;
-    int valid;
-};
-
 /* A subroutine file, read whole when first called. */
 struct flow_file {
     struct ncp_source src;
     const char *name;                 /* ncp_diag_file_of_tag(tag) */
     unsigned tag;                     /* its ncp_diag_file_tag */
+};
+
+/* A skip from a loop's head to its end line, noting whether what lies
+ * between is only nested structure a skip passes over unchanged: every
+ * O-word line there closes or continues one opened there (a stack of their
+ * labels, in an arena), nothing else but calls. */
+struct flow_scan {
+    int on;
+    uint32_t epoch;                   /* labels.epoch when it started */
+    struct flow_label *op;            /* the loop (valid while epoch holds) */
+    struct { uint32_t off, len; uint8_t kind; } *open;
+    uint32_t n_open, open_cap;
+    char *arena;
+    size_t used, acap;
 };
 
 /* Text-valued state ("skip to label", "seeking sub", "defining sub"). */
@@ -100,7 +114,7 @@ struct ncp_flow {
     struct flow_pos cur;              /* next block to execute */
     struct flow_pos feed_pos;         /* next block the feed will deliver */
     int feed_done, feed_held;
-    struct flow_cached *cache;
+    struct ncp_block_reread *reread; /* blocks read again, lexed once */
     struct ncp_block *fanuc_blk;      /* an M_VALUE line read again as M98/M99 */
 
     struct flow_labels labels;
@@ -108,6 +122,7 @@ struct ncp_flow {
     int frames_cap, level;
 
     struct flow_name skip;            /* skipping forward to this label */
+    struct flow_scan scan;            /* ... from a loop's head, learning its end */
     struct flow_name seek_sub;        /* ... looking for this sub's definition */
     struct flow_name defining;        /* inside this sub's definition (level 0) */
     /* rs274 accepts a stray return at level 0 once any call has returned there
@@ -125,6 +140,8 @@ struct ncp_flow {
     int inline_level;                 /* an inline call returns to this level, or -1 */
     char label[FLOW_LABEL_MAX];       /* label of the block being run */
     size_t label_len;
+    const char *call_path;            /* a call's name as written (in its block): */
+    size_t call_path_len;             /* the path of the file it may be in */
 };
 
 static void ncp_flow_name_set(struct flow_name *n, const char *s, size_t len)
@@ -233,6 +250,7 @@ static struct flow_label *ncp_flow_labels_add(struct flow_labels *t, const char 
                               .key_len = (uint32_t)len, .repeat_count = -1 };
     t->used += len;
     t->count++;
+    t->epoch++;
     return e;
 }
 
@@ -242,6 +260,7 @@ static void ncp_flow_labels_clear(struct flow_labels *t)
         memset(t->slots, 0, t->cap * sizeof *t->slots);
     t->count = 0;
     t->used = 0;
+    t->epoch++;
 }
 
 /* ======================================================================
@@ -255,12 +274,6 @@ static void ncp_flow_release_feed(struct ncp_flow *f)
         if (f->feed.release)
             f->feed.release(f->feed.ctx);
     }
-}
-
-/* O-word lines, and M98 lines, which rs274 reads even where it skips */
-static int ncp_flow_may_be_oword(const char *s, size_t n)
-{
-    return memchr(s, 'o', n) || memchr(s, 'O', n) || memchr(s, 'm', n) || memchr(s, 'M', n);
 }
 
 static int ncp_flow_from_feed(struct ncp_flow *f, const struct ncp_block **out)
@@ -292,35 +305,11 @@ static int ncp_flow_from_feed(struct ncp_flow *f, const struct ncp_block **out)
 static int ncp_flow_from_text(struct ncp_flow *f, int skipping, const struct ncp_block **out,
                      struct ncp_diag *d)
 {
-    if (!f->cache) {
-        f->cache = calloc(FLOW_CACHE_SLOTS, sizeof *f->cache);
-        if (!f->cache)
-            return ncp_diag_set(d, NCP_ERR_IO, f->cur.line, 0, "out of memory");
-    }
-    uint64_t key = f->cur.off ^ (uint64_t)f->cur.file << 40;
-    struct flow_cached *c =
-        &f->cache[(key * 0x9E3779B97F4A7C15ull) >> (64 - FLOW_CACHE_BITS)];
-    if (c->valid && c->blk.offset == f->cur.off && c->file == f->cur.file) {
-        f->cur.off = c->next;
-        f->cur.line = c->blk.line + 1;
-        *out = &c->blk;
-        return NCP_OK;
-    }
-    struct ncp_span sp;
-    if (ncp_source_span(f->src, f->cur.off, f->cur.line, &sp) != 0)
+    if (!f->reread && !(f->reread = ncp_block_reread_new()))
+        return ncp_diag_set(d, NCP_ERR_IO, f->cur.line, 0, "out of memory");
+    if (ncp_block_reread_at(f->reread, f->src, f->cur.file, skipping, &f->cur.off,
+                            &f->cur.line, out) != 0)
         return NCP_END;
-    f->cur.off = sp.next;
-    f->cur.line = sp.line + 1;
-    const char *text = f->src->text + sp.off;
-    if (skipping && !ncp_flow_may_be_oword(text, sp.len)) {
-        *out = NULL;
-        return NCP_OK;
-    }
-    ncp_lex_block(text, sp.len, sp.line, sp.off, &c->blk);
-    c->next = sp.next;
-    c->file = f->cur.file;
-    c->valid = 1;
-    *out = &c->blk;
     return NCP_OK;
 }
 
@@ -432,6 +421,17 @@ static void ncp_flow_make_label(struct ncp_flow *f, const struct ncp_block *b)
         name = f->frames[f->level].name;
         len = f->frames[f->level].name_len;
     }
+    if (b->oword.kind == NCP_O_CALL) {
+        f->call_path = name;
+        f->call_path_len = len;
+        /* o<../lib/up> call: rs274 looks for the file by the whole path
+         * but calls the sub by the file's own name, "up" */
+        const char *slash = memrchr(name, '/', len);
+        if (slash) {
+            len -= (size_t)(slash + 1 - name);
+            name = slash + 1;
+        }
+    }
     if (len > FLOW_NAME_MAX)
         len = FLOW_NAME_MAX;
     if (!ncp_flow_is_global_kind(b->oword.kind)) {
@@ -458,6 +458,7 @@ static void ncp_flow_skip_to_label(struct ncp_flow *f, const struct ncp_block *b
 {
     ncp_flow_name_set(&f->skip, f->label, f->label_len);
     f->skip_start = b->line;
+    f->scan.on = 0;
 }
 
 static int ncp_flow_eval(struct ncp_flow *f, const struct ncp_block *b, const struct ncp_expr *e,
@@ -764,14 +765,20 @@ static int ncp_flow_open_sub_file(struct ncp_flow *f, const struct ncp_block *b,
                          struct ncp_diag *d)
 {
     char path[4096];
+    const char *name = f->label;
+    size_t name_len = f->label_len;
+    if (b->oword.kind == NCP_O_CALL) {
+        name = f->call_path;
+        name_len = f->call_path_len;
+    }
     const char *dirs = f->sub_path ? f->sub_path : "";
     const char *dir = "";
     size_t dir_len = 0;
     *file = 0;
     for (;;) {
         int n = dir_len ? snprintf(path, sizeof path, "%.*s/%.*s.ngc", (int)dir_len, dir,
-                                   (int)f->label_len, f->label)
-                        : snprintf(path, sizeof path, "%.*s.ngc", (int)f->label_len, f->label);
+                                   (int)name_len, name)
+                        : snprintf(path, sizeof path, "%.*s.ngc", (int)name_len, name);
         if (n > 0 && (size_t)n < sizeof path && ncp_flow_is_readable_file(path))
             break;
         if (*dirs == '\0')
@@ -939,6 +946,156 @@ static int ncp_flow_loop_label(struct ncp_flow *f, const struct ncp_block *b, in
     return op ? NCP_OK : ncp_flow_save_label(f, b, out, d);
 }
 
+/* ======================================================================
+ * Loop ends: a skip meets a nested loop it has gone through before and
+ * passes it in one step, so that N nested loops cost N steps, not N * N.
+ * ====================================================================== */
+
+static void ncp_flow_scan_start(struct ncp_flow *f, struct flow_label *op)
+{
+    f->scan = (struct flow_scan){ .on = 1, .epoch = f->labels.epoch, .op = op,
+                                  .open = f->scan.open, .open_cap = f->scan.open_cap,
+                                  .arena = f->scan.arena, .acap = f->scan.acap };
+}
+
+static int ncp_flow_scan_push(struct flow_scan *sc, const char *label, size_t len, int kind)
+{
+    if (sc->n_open == sc->open_cap) {
+        uint32_t ncap = sc->open_cap ? sc->open_cap * 2 : 64;
+        void *no = realloc(sc->open, ncap * sizeof *sc->open);
+        if (!no)
+            return -1;
+        sc->open = no;
+        sc->open_cap = ncap;
+    }
+    if (sc->used + len > sc->acap) {
+        size_t ncap = sc->acap ? sc->acap * 2 : 4096;
+        while (ncap < sc->used + len)
+            ncap *= 2;
+        char *na = realloc(sc->arena, ncap);
+        if (!na)
+            return -1;
+        sc->arena = na;
+        sc->acap = ncap;
+    }
+    memcpy(sc->arena + sc->used, label, len);
+    sc->open[sc->n_open].off = (uint32_t)sc->used;
+    sc->open[sc->n_open].len = (uint32_t)len;
+    sc->open[sc->n_open].kind = (uint8_t)kind;
+    sc->n_open++;
+    sc->used += len;
+    return 0;
+}
+
+/* Whether open entry k (from the bottom) has the current label, of one of the kinds. */
+static int ncp_flow_scan_is(const struct ncp_flow *f, uint32_t k, int kind1, int kind2)
+{
+    const struct flow_scan *sc = &f->scan;
+    return (sc->open[k].kind == kind1 || sc->open[k].kind == kind2) &&
+           sc->open[k].len == f->label_len &&
+           memcmp(sc->arena + sc->open[k].off, f->label, f->label_len) == 0;
+}
+
+static int ncp_flow_scan_pop(struct ncp_flow *f, int kind)
+{
+    struct flow_scan *sc = &f->scan;
+    if (!sc->n_open || !ncp_flow_scan_is(f, sc->n_open - 1, kind, kind))
+        return 0;
+    sc->n_open--;
+    sc->used = sc->open[sc->n_open].off;
+    return 1;
+}
+
+/* An O-word line of another label met by the scan: 0 when the loop's text
+ * is not one a skip passes unchanged. An opening line must be its label's
+ * only line in the table, so no label skipped to later hides in the loop. */
+static int ncp_flow_scan_other(struct ncp_flow *f, const struct ncp_block *b)
+{
+    struct flow_scan *sc = &f->scan;
+    int kind = b->oword.kind;
+    switch (kind) {
+    case NCP_O_CALL:                  /* a skip ignores calls */
+        return 1;
+    case NCP_O_WHILE:
+        if (ncp_flow_scan_pop(f, NCP_O_DO))
+            return 1;
+        /* fall through */ /* a while loop's head */
+    case NCP_O_DO:
+    case NCP_O_REPEAT:
+    case NCP_O_IF: {
+        const struct flow_label *op = ncp_flow_find_label(f);
+        if (op && (op->off != b->offset || op->file != f->cur.file))
+            return 0;
+        return ncp_flow_scan_push(sc, f->label, f->label_len, kind) == 0;
+    }
+    case NCP_O_ENDWHILE:
+        return ncp_flow_scan_pop(f, NCP_O_WHILE);
+    case NCP_O_ENDREPEAT:
+        return ncp_flow_scan_pop(f, NCP_O_REPEAT);
+    case NCP_O_ENDIF:
+        return ncp_flow_scan_pop(f, NCP_O_IF);
+    case NCP_O_ELSE:
+    case NCP_O_ELSEIF:
+        return sc->n_open && ncp_flow_scan_is(f, sc->n_open - 1, NCP_O_IF, NCP_O_IF);
+    case NCP_O_BREAK:
+    case NCP_O_CONTINUE:
+        /* of a loop opened in this one (looked for a few levels up only) */
+        for (uint32_t k = sc->n_open, seen = 0; k > 0 && seen < 16; k--, seen++)
+            if (ncp_flow_scan_is(f, k - 1, NCP_O_WHILE, NCP_O_DO))
+                return 1;
+        return 0;
+    default:                          /* subs, M98/M99: a skip reads them */
+        return 0;
+    }
+}
+
+/* The line the skip was going to: a loop's end line reached with nothing in
+ * between that a skip notices is where any later skip can pass it by. */
+static void ncp_flow_scan_end(struct ncp_flow *f, const struct ncp_block *b)
+{
+    struct flow_scan *sc = &f->scan;
+    sc->on = 0;
+    int want = sc->op->type == NCP_O_REPEAT ? NCP_O_ENDREPEAT : NCP_O_ENDWHILE;
+    if (sc->n_open || b->oword.kind != want)
+        return;
+    sc->op->end_next = f->cur.off;
+    sc->op->end_next_line = f->cur.line;
+    sc->op->region_epoch = sc->epoch;
+}
+
+/* Skipping to another label, at the head of a loop whose end is known: go
+ * past that end. The label skipped to must be known outside the loop: each
+ * label in the loop was unknown, or known at its own line there, when the
+ * end was learnt, and none has been added since. 1 when it went past. */
+static int ncp_flow_pass_loop(struct ncp_flow *f, const struct ncp_block *b)
+{
+    const struct flow_label *op = ncp_flow_find_label(f);
+    if (!op || !op->end_next || op->region_epoch != f->labels.epoch ||
+        op->off != b->offset || op->file != f->cur.file || op->type != b->oword.kind)
+        return 0;
+    const struct flow_label *to = ncp_flow_labels_find(&f->labels, f->skip.s, f->skip.len);
+    if (!to || (to->file == op->file && to->off >= op->off && to->off < op->end_next))
+        return 0;
+    ncp_flow_go_to(f, (struct flow_pos){ op->end_next, op->end_next_line, op->file });
+    return 1;
+}
+
+/* An O-word line read while skipping: 1 when it was a loop passed by. */
+static int ncp_flow_skipped_oword(struct ncp_flow *f, const struct ncp_block *b)
+{
+    int other = !ncp_flow_name_eq(&f->skip, f->label, f->label_len);
+    int kind = b->oword.kind;
+    if (other && (kind == NCP_O_WHILE || kind == NCP_O_REPEAT) && ncp_flow_pass_loop(f, b))
+        return 1;
+    if (!f->scan.on)
+        return 0;
+    if (f->scan.epoch != f->labels.epoch || (other && !ncp_flow_scan_other(f, b)))
+        f->scan.on = 0;
+    else if (!other)
+        ncp_flow_scan_end(f, b);
+    return 0;
+}
+
 static int ncp_flow_do_repeat(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     struct flow_label *op = NULL;
@@ -958,6 +1115,7 @@ static int ncp_flow_do_repeat(struct ncp_flow *f, const struct ncp_block *b, str
         return ncp_flow_count_iteration(f, b, op, d);
     }
     ncp_flow_skip_to_label(f, b);
+    ncp_flow_scan_start(f, op);
     op->repeat_count = -1;
     return ncp_flow_count_idle_lap(f, b, op, d);
 }
@@ -974,6 +1132,7 @@ static int ncp_flow_do_while(struct ncp_flow *f, const struct ncp_block *b, stru
         if (f->test_value != 0.0)
             return ncp_flow_count_iteration(f, b, op, d);
         ncp_flow_skip_to_label(f, b);
+        ncp_flow_scan_start(f, op);
         return ncp_flow_count_idle_lap(f, b, op, d);
     }
     /* the closing line of a do/while loop */
@@ -1109,6 +1268,8 @@ static int ncp_flow_run_oword(struct ncp_flow *f, const struct ncp_block *b, str
             return rc;
     }
     ncp_flow_make_label(f, b);
+    if (f->skip.on && ncp_flow_skipped_oword(f, b))
+        return NCP_OK;
     int rc = ncp_flow_read_oword(f, b, &ignore, d);
     if (rc != NCP_OK || ignore || ncp_flow_skipping_other(f))
         return rc;
@@ -1331,8 +1492,10 @@ void ncp_flow_free(struct ncp_flow *f)
     for (uint32_t k = 0; k < f->n_files; k++)
         ncp_source_close(&f->files[k].src);
     free(f->files);
-    free(f->cache);
+    ncp_block_reread_free(f->reread);
     free(f->fanuc_blk);
+    free(f->scan.open);
+    free(f->scan.arena);
     free(f->labels.slots);
     free(f->labels.arena);
     free(f->frames);
@@ -1366,6 +1529,7 @@ void ncp_flow_reset(struct ncp_flow *f)
         f->level--;
     }
     f->skip.on = 0;
+    f->scan.on = 0;
     f->seek_sub.on = 0;
     f->defining.on = 0;
     f->in_sub_context = 0;

@@ -3,7 +3,7 @@
  * it handles every O-word block itself (sub/endsub definitions are skipped and
  * indexed, call/return, if/elseif/else/endif, while/endwhile, do/while,
  * repeat/endrepeat, break, continue) and re-reads earlier blocks from the source
- * text (ncp_source_span + ncp_lex_block) when a loop or call goes back; it returns
+ * text (ncpar/blocks.h's ncp_block_reread) when a loop or call goes back; it returns
  * to the pre-lexed feed when execution reaches the block after the last one the
  * feed delivered. Subroutines may be defined after their call (it scans forward). */
 #ifndef NCP_ANALYZER_FLOW_H

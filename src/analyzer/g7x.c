@@ -15,6 +15,8 @@
  * on it) are lost and errors of the passes name that return line. */
 #include "floor.h"
 #include "state.h"
+
+#include "ncpar/blocks.h"
 #include "g7x_path.h"
 
 #include <math.h>
@@ -106,8 +108,7 @@ static int g7x_call(struct ncp_analyzer *a, const struct ncp_words *w)
     struct ncp_block *b = malloc(sizeof *b);
     if (!b)
         return ncp_an_error(a, col, "out of memory");
-    size_t next;
-    ncp_lex_line(text, (size_t)len, a->line, a->blk->offset, b, &next);
+    ncp_blocks_lex_text(text, (size_t)len, a->line, a->blk->offset, b);
     b->length = 0; /* not text of the program: nothing to quote */
     b->oword.col = col;
     rc = b->err.code;

@@ -12,6 +12,8 @@
 #include "floor.h"
 #include "state.h"
 
+#include "ncpar/blocks.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -95,8 +97,7 @@ static int ncp_m7x_exec_line(struct ncp_analyzer *a, const char *text)
             return ncp_an_error(a, 0, "out of memory");
     }
     struct ncp_block *b = a->m7x_block;
-    size_t next;
-    ncp_lex_line(text, strlen(text), a->line, a->blk ? a->blk->offset : 0, b, &next);
+    ncp_blocks_lex_text(text, strlen(text), a->line, a->blk ? a->blk->offset : 0, b);
     if (b->err.code != NCP_OK) {
         a->err = b->err;
         return b->err.code;

@@ -1,4 +1,5 @@
 /* cnc-run: command-line front end of ncpar. */
+#include "ncpar/blocks.h"
 #include "ncpar/executor.h"
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
@@ -333,33 +334,26 @@ static int cmd_check(int argc, char **argv)
     struct ncp_run_stats st;
     int rc = ncp_serial_run(&src, &o.acfg, NULL, &st, &d);
     struct ncp_block *b = malloc(sizeof *b);
+    struct ncp_blocks_lines lines;
     struct ncp_span sp;
-    uint64_t off = src.begin;
-    uint32_t line = src.begin_line;
-    int errors = 0, printed_run_error = 0;
-    while (b && ncp_source_span(&src, off, line, &sp) == 0) {
+    int errors = 0, printed_run_error = 0, bad;
+    ncp_blocks_lines_start(&lines, &src);
+    /* '%' lines are tape delimiters, not blocks: the customary one after M2
+     * is never read, one the run does read is its error; U and W words are
+     * good in a G70-G72 profile, and a bad character anywhere else: only the
+     * run knows, and reports that case */
+    while (b && ncp_blocks_check_next(&lines, &sp, b, &bad) == 0) {
         if (rc != NCP_OK && !printed_run_error && d.line <= sp.line) {
             print_diag(o.prog, &d);
             printed_run_error = 1;
             errors++;
-            if (d.line == sp.line) {
-                off = sp.next;
-                line++;
+            if (d.line == sp.line)
                 continue;
-            }
         }
-        /* '%' lines are tape delimiters, not blocks: the customary one after
-         * M2 is never read, one the run does read is its error above */
-        /* U and W words are good in a G70-G72 profile, and a bad character
-         * anywhere else: only the run knows, and reports that case above */
-        if (!ncp_source_percent_line(src.text + sp.off, sp.len) &&
-            ncp_lex_block(src.text + sp.off, sp.len, sp.line, sp.off, b) != NCP_OK &&
-            ncp_lex_block_profile(src.text + sp.off, sp.len, sp.line, sp.off, b) != NCP_OK) {
+        if (bad) {
             print_diag(o.prog, &b->err);
             errors++;
         }
-        off = sp.next;
-        line++;
     }
     if (rc != NCP_OK && !printed_run_error) {
         print_diag(o.prog, &d);

@@ -31,7 +31,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
 #include "ncpar/mem.h"
-#include "text_feed.h"
+#include "ncpar/blocks.h"
 
 #define NCP_AHEAD_SLOTS 8u
 

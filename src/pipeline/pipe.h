@@ -11,7 +11,7 @@
 #include "lex_ahead.h"
 #include "rec_stream.h"
 #include "ring.h"
-#include "text_feed.h"
+#include "ncpar/blocks.h"
 
 /* Stages of an executor's command ring: analyzer fills, executor completes in
  * place, output emits and hands the slot back. */

@@ -4,7 +4,7 @@
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
 #include "emit.h"
-#include "text_feed.h"
+#include "ncpar/blocks.h"
 
 #include <stdlib.h>
 #include <string.h>

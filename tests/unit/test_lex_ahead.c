@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include "../../src/pipeline/lex_ahead.h"
-#include "../../src/pipeline/text_feed.h"
+#include "ncpar/blocks.h"
 
 /* Lines of every kind the lexer knows, good and bad, CR/LF variants. */
 static const char *const kinds[] = {

@@ -1,0 +1,31 @@
+/* Blocks from text that is not read in file order by the feed: lines the
+ * interpreter builds, and every line for a syntax check (ncpar/blocks.h). */
+#include "ncpar/blocks.h"
+
+void ncp_blocks_lex_text(const char *text, size_t len, uint32_t line, uint64_t offset,
+                         struct ncp_block *out)
+{
+    size_t next;
+    ncp_lex_line(text, len, line, offset, out, &next);
+}
+
+void ncp_blocks_lines_start(struct ncp_blocks_lines *it, const struct ncp_source *src)
+{
+    it->src = src;
+    it->off = src->begin;
+    it->line = src->begin_line;
+}
+
+int ncp_blocks_check_next(struct ncp_blocks_lines *it, struct ncp_span *sp,
+                          struct ncp_block *b, int *bad)
+{
+    if (ncp_source_span(it->src, it->off, it->line, sp) != 0)
+        return 1;
+    it->off = sp->next;
+    it->line++;
+    const char *s = it->src->text + sp->off;
+    *bad = !ncp_source_percent_line(s, sp->len) &&
+           ncp_lex_block(s, sp->len, sp->line, sp->off, b) != NCP_OK &&
+           ncp_lex_block_profile(s, sp->len, sp->line, sp->off, b) != NCP_OK;
+    return 0;
+}
