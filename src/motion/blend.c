@@ -55,6 +55,7 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, stru
     arc->term = NCP_TERM_CONTINUOUS;
     arc->traverse = (uint8_t)(prev->traverse && cur->traverse);
     arc->line = cur->line;  /* the corner is where the next block's motion begins */
+    arc->aux = prev->aux;   /* what comes with the next block waits for its own segment */
     arc->feed = fmin(prev->feed, cur->feed);
     double bis[3], bl = 0;
     for (int i = 0; i < 3; i++) {
