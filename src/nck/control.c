@@ -713,6 +713,7 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->spindle_override = 100;
     s->acfg = setup->interp;
     s->acfg.resident = 1;
+    s->acfg.m66_on_machine = 1;   /* M66 waits on the machine's inputs */
     s->acfg.instance = NULL;
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
