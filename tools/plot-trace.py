@@ -3,7 +3,8 @@
 
 usage: plot-trace.py TRACE.csv OUT.png [LATENCY.csv] [--title TEXT]
 
-TRACE.csv   the per-cycle trace (t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion;
+TRACE.csv   the per-cycle trace (t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion,
+            then the machine functions spindle_rpm,spindle_deg,mist,flood,dout,tool,wait;
             motion: 0 rapid G0, 1 feed G1, 2 arc G2/G3; traces without it
             are drawn as feeds)
 LATENCY.csv optional sidecar written by `cnc-run run --plot`: the position
@@ -112,7 +113,10 @@ def plot(trace, out, lat_path, title):
         sys.exit("plot-trace: %s has no rows" % trace)
     step = max(1, len(t) // 20000)   # keep the PNG readable and the script fast
     fig = plt.figure(figsize=(14, 10), dpi=100)
-    gs = fig.add_gridspec(3, 2, width_ratios=[1.25, 1], hspace=0.45, wspace=0.22)
+    # traces with the machine functions (spindle_rpm and after) get a spindle panel
+    spindle = c.get("spindle_rpm")
+    gs = fig.add_gridspec(4 if spindle else 3, 2, width_ratios=[1.25, 1], hspace=0.55,
+                          wspace=0.22)
     fig.suptitle(title, fontsize=13)
 
     motion = c.get("motion") or [1.0] * len(t)
@@ -183,6 +187,21 @@ def plot(trace, out, lat_path, title):
         axh.text(0.5, 0.5, "no latency histogram given", ha="center", va="center",
                  transform=axh.transAxes)
         axh.set_axis_off()
+    if spindle:
+        axs = fig.add_subplot(gs[3, 1], sharex=axv)
+        axs.plot(thin(t, step), thin(spindle, step), color="tab:purple", lw=0.9,
+                 label="spindle (actual)")
+        for name, color in (("flood", "tab:blue"), ("mist", "tab:cyan")):
+            on = c.get(name)
+            if on and max(on) > 0:
+                top = max(1.0, max(abs(x) for x in spindle))
+                axs.fill_between(thin(t, step), 0, [x * top for x in thin(on, step)],
+                                 color=color, alpha=0.12, step="post", label=name)
+        axs.set_ylabel("spindle [rpm]")
+        axs.set_xlabel("time [s]")
+        axs.set_title("spindle speed (M4 negative), coolant shaded")
+        axs.grid(True, alpha=0.3)
+        axs.legend(loc="upper right", fontsize=8)
     fig.savefig(out)
     plt.close(fig)
 

@@ -50,6 +50,11 @@ struct ncp_analyzer_cfg {
     /* ncp_serial_run / ncp_pipeline_run: run on this analyzer (made with
      * resident set, owned by the caller) instead of a new one. */
     struct ncp_analyzer *instance;
+    /* The NCK: an M66 emits WAIT_INPUT for the machine, and its result
+     * (#5399) is not known to the interpreter, which runs ahead of motion:
+     * reading it is an error until the program sets it. 0 (parse, check):
+     * rs274 -g's stand-in value. */
+    int m66_on_machine;
 };
 
 struct ncp_analyzer;

@@ -77,6 +77,7 @@ enum ncp_canon_kind {
     NCP_C_NURBS_POINTS,          /* nurbs_points: prints nothing */
     NCP_C_RIGID_TAP,             /* rigid_tap (G33.1): back at the start after */
     NCP_C_RAW_TEXT,              /* text printed verbatim (for calls not modelled above) */
+    NCP_C_WAIT_INPUT,            /* wait_input: M66 for the NCK only, rs274 -g prints nothing */
     NCP_C__COUNT
 };
 
@@ -176,6 +177,8 @@ struct ncp_canon {
             double pt[NCP_NURBS_POINTS_PER_OP][3];          /* x y weight, program units */
         } nurbs_points;
         struct { NCP_CANON_IPAD(0); double bottom[3]; } rigid_tap; /* x y z of the hole's bottom */
+        /* M66: P (digital, analog 0) or E (analog 1), L the wait mode, Q the timeout */
+        struct { int32_t index, mode, analog; NCP_CANON_IPAD(3); double timeout; } wait_input;
     };
 };
 

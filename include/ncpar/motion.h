@@ -44,6 +44,26 @@ struct ncp_can_cfg {
 };
 
 
+/* The machine functions around the axes (src/motion/config_io.c): the
+ * simulated spindle, the tool changer's position and the simulated inputs.
+ * Every key is optional; the defaults are an ideal spindle (at any speed in
+ * one servo period), no tool change move and pauses that resume at once. */
+#define NCP_DIO_MAX 64  /* digital inputs and outputs, P0..P63 */
+#define NCP_AIO_MAX 16  /* analog inputs and outputs, E0..E15 */
+struct ncp_io_cfg {
+    double spindle_max_rpm;       /* [SPINDLE_0] MAX_RPM: S above it runs at it (0: no cap) */
+    double spindle_acc;           /* [SPINDLE_0] MAX_ACCELERATION, rpm/s (0: ideal) */
+    double orient_rpm;            /* [SPINDLE_0] ORIENT_RPM: M19's top speed (60) */
+    double at_speed_tol;          /* [SPINDLE_0] AT_SPEED_TOLERANCE: fraction of S (0.01) */
+    double auto_resume_s;         /* [SIM] AUTO_RESUME_S: cnc-run run's pauses last this
+                                     long (0); negative: until SIGUSR1 */
+    uint64_t din;                 /* [SIM] DIGITAL_IN_<n> = 0|1: cnc-run run's inputs */
+    double ain[NCP_AIO_MAX];      /* [SIM] ANALOG_IN_<n> */
+    int have_tc_pos;              /* [EMCIO] TOOL_CHANGE_POSITION = X Y Z given */
+    double tc_pos[3];             /* machine coordinates, mm */
+    int quill_up;                 /* [EMCIO] TOOL_CHANGE_QUILL_UP: Z to machine 0 first */
+};
+
 struct ncp_machine_cfg {
     double servo_period;          /* s ([EMCMOT] SERVO_PERIOD is in ns) */
     double max_linear_vel;        /* [TRAJ] MAX_LINEAR_VELOCITY */
@@ -72,12 +92,19 @@ struct ncp_machine_cfg {
         double status_hz;         /* STATUS_HZ, default 50; 0: only at state changes
                                      and after each command */
     } lcm;
+    struct ncp_io_cfg io;
 };
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c);
 /* Loads an INI over the defaults. On error d->msg names file, section and key,
  * d->line is the INI line. Returns NCP_OK or NCP_ERR_IO / NCP_ERR_SEMANTIC. */
 int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp_diag *d);
+/* config_io.c: the defaults of ncp_io_cfg, and one key of the sections it
+ * reads ([SPINDLE_0], [EMCIO], [SIM]'s input and pause keys): 1 taken, 0
+ * unknown key, -1 bad value (why says more), -2 not one of its sections. */
+void ncp_io_cfg_default(struct ncp_io_cfg *io);
+int ncp_io_cfg_key(struct ncp_io_cfg *io, const char *sec, const char *k, const char *v,
+                   char *why, size_t len);
 /* Servo periods per planning period (1 when planning_period is 0), or 0 when
  * planning_period is not a positive integer multiple of servo_period. */
 int ncp_machine_cfg_ipo_ratio(const struct ncp_machine_cfg *c);
@@ -93,6 +120,9 @@ struct ncp_seg {
     uint8_t term;          /* enum ncp_seg_term: how this segment ends */
     uint8_t traverse;      /* G0: runs at the machine's maximum velocity */
     uint32_t line;         /* source line */
+    /* The machine functions sent before this segment (NCK): the sequence
+     * number of the last, applied when its samples are reached. */
+    uint32_t aux;
     double start[NCP_AXES], end[NCP_AXES];
     double length;         /* path length (0 for dwell) */
     double feed;           /* requested path velocity (override applied), mm/s */
@@ -142,6 +172,8 @@ struct ncp_canon_map {
     double sync_pitch;      /* mm per turn; 0: not synchronised */
     double speed;           /* S as programmed */
     double css_max;         /* > 0: G96 (constant surface speed), rpm cap */
+    int spindle_dir;        /* M3 1, M4 -1, M5/M19 0: a feed tied to a stopped spindle
+                               would never move, so it is refused */
     /* A call that makes several segments, what ncp_canon_map_more has left:
      * more_left 1, a rigid tap's way back out; more_kind NCP_C_NURBS_POINTS,
      * the rest of a curve (G5, G5.1, G5.3) in lines. */
@@ -183,6 +215,7 @@ struct ncp_setpoint {
     double dir[NCP_AXES];   /* unit tangent (for contour error), 0 at rest */
     uint32_t line;
     uint32_t flags;         /* enum ncp_sp_flags */
+    uint32_t aux;           /* the segment's aux: machine functions due by this sample */
 };
 
 enum ncp_sp_flags { NCP_SP_END = 1u, NCP_SP_STARVED = 2u };

@@ -46,6 +46,13 @@ struct ncp_nck_ctl {
     /* A batch run's controlled stop (SIGINT/SIGTERM): a feed hold along the
      * path, then the run ends once the axes have settled. */
     _Atomic int stop;
+    /* Program pauses (M0, M1, M60) and tool changes (M6) go on when these
+     * counters move: resume and tool-changed (cnc-run run: after [SIM]
+     * AUTO_RESUME_S, or SIGUSR1). */
+    _Atomic uint64_t resume_go, tool_go;
+    _Atomic int optional_stop;      /* M1 pauses: 1 (the default, as LinuxCNC) */
+    _Atomic int spindle_permille;   /* spindle override, 0..2000 */
+    _Atomic uint64_t din;           /* digital inputs P0..P63, a bit each */
 };
 
 void ncp_nck_ctl_init(struct ncp_nck_ctl *c, double feed_override);
@@ -80,6 +87,7 @@ enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT =
 struct ncp_nck_result {
     int status;              /* enum ncp_nck_status */
     int limit_violation;     /* soft limit found before motion (diag says where) */
+    int refused;             /* a call the machine cannot act on, found before motion */
     int fault;               /* following-error fault */
     int fault_axis;
     double fault_err;
@@ -95,6 +103,9 @@ struct ncp_nck_result {
     uint64_t underruns;      /* setpoint ring ran low: slowed down along the path */
     uint64_t dry;            /* cycles it ran empty in motion anyway (held position) */
     int fifo;
+    uint64_t calls_in, calls_acted, calls_refused; /* canonical calls the NCK took */
+    double spindle_rpm_max;  /* the spindle's highest actual speed */
+    uint64_t pauses;         /* program pauses and tool changes waited for */
     char warning[200];
     struct ncp_rt_stats lat;
 };
@@ -142,7 +153,10 @@ enum ncp_nck_cmd_kind {
     NCP_CMD_RESET,
     NCP_CMD_SHUTDOWN,
     NCP_CMD_KEEPALIVE,
-    NCP_CMD_KIND_MAX = NCP_CMD_KEEPALIVE
+    NCP_CMD_TOOL_CHANGED,
+    NCP_CMD_OPTIONAL_STOP,
+    NCP_CMD_SET_INPUT,
+    NCP_CMD_KIND_MAX = NCP_CMD_SET_INPUT
 };
 
 #define NCP_NCK_TEXT_MAX 512

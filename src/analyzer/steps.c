@@ -148,6 +148,15 @@ static int ncp_step_wait_input(struct ncp_analyzer *a)
     if (a->st.m.comp_side != 0)
         return ncp_an_error(a, col, has_p ? "Cannot wait for digital input with cutter radius compensation on"
                                           : "Cannot wait for analog input with cutter radius compensation on");
+    if (a->cfg.m66_on_machine) {
+        struct ncp_canon *op = ncp_an_emit(a, NCP_C_WAIT_INPUT);
+        op->wait_input.analog = !has_p;
+        op->wait_input.index = ncp_trunc_int_round(has_p ? W(a, 'P') : W(a, 'E'));
+        op->wait_input.mode = l;
+        op->wait_input.timeout = q > 0 ? q : 0;
+        ncp_params_set_unknown(a->params, 5399, a->line);
+        return NCP_OK;
+    }
     if (has_p) {
         double *result = ncp_params_slot(a->params, 5399);
         *result = *result != 0.0 ? 1.0 : 0.0;

@@ -178,6 +178,12 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                 res->diag.line, res->diag.msg);
         return RUN_FAULT;
     }
+    if (res->refused) {
+        fprintf(stderr, "%s:%u:%u: error: %s (refused before motion: nothing moved)\n",
+                res->diag.file ? res->diag.file : o->prog, res->diag.line,
+                res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
+        return RUN_PROGRAM;
+    }
     int drive_fault = res->status == RUN_FAULT && res->diag.code == NCP_ERR_IO && !res->fault;
     if (drive_fault && res->lat.cycles == 0) {
         fprintf(stderr, "%s: error: drive start-up failed: %s (nothing moved)\n", o->prog,
@@ -425,7 +431,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
 {
     struct interp_ctx ic = { src,
                              { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path,
-                               .max_loop_iterations = o->max_loops },
+                               .max_loop_iterations = o->max_loops, .m66_on_machine = 1 },
                              o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = interpret, .interp_ctx = &ic,

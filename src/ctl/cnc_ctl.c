@@ -65,6 +65,7 @@ static const char global_usage[] =
     "  home AXIS|all                      override feed|rapid|spindle PCT\n"
     "  jog AXIS +|- [--speed MM_PER_MIN] [--distance MM]      jog AXIS stop\n"
     "  estop   reset   shutdown           wait STATE [--timeout S]\n"
+    "  tool-changed   optional-stop on|off   set-input N 0|1\n"
     "\n"
     "Exit status: 0 accepted (wait: reached), 1 usage, 2 rejected (the reason on\n"
     "stderr), 3 the NCK is in fault, 4 no answer within the timeout.\n";
@@ -274,6 +275,37 @@ static int run_run(struct ctl *c, const struct args *a)
     return ctl_command(c, &cmd);
 }
 
+static int run_tool_changed(struct ctl *c, const struct args *a)
+{
+    (void)a;
+    return simple(c, NCP_COMMAND_T_TOOL_CHANGED);
+}
+
+static int run_optional_stop(struct ctl *c, const struct args *a)
+{
+    ncp_command_t cmd;
+    init_cmd(&cmd, NCP_COMMAND_T_OPTIONAL_STOP);
+    if (strcmp(a->words[0], "on") == 0)
+        cmd.ivalue[0] = 1;
+    else if (strcmp(a->words[0], "off") != 0)
+        return usage_error("optional-stop: on or off, not '%s'", a->words[0]);
+    return ctl_command(c, &cmd);
+}
+
+static int run_set_input(struct ctl *c, const struct args *a)
+{
+    ncp_command_t cmd;
+    long i, v;
+    init_cmd(&cmd, NCP_COMMAND_T_SET_INPUT);
+    if (parse_long(a->words[0], 0, 63, &i) != 0)
+        return usage_error("set-input: a digital input 0..63, not '%s'", a->words[0]);
+    if (parse_long(a->words[1], 0, 1, &v) != 0)
+        return usage_error("set-input: the value is 0 or 1, not '%s'", a->words[1]);
+    cmd.ivalue[0] = (int32_t)i;
+    cmd.ivalue[1] = (int32_t)v;
+    return ctl_command(c, &cmd);
+}
+
 static int run_step(struct ctl *c, const struct args *a)
 {
     ncp_command_t cmd;
@@ -437,6 +469,12 @@ static const struct command commands[] = {
     {"pause", "", "Feed hold: the path stops where it is.", 0, 0, 0, run_pause},
     {"resume", "", "Continues after pause (or the next block in step mode).", 0, 0, 0,
      run_resume},
+    {"tool-changed", "", "The tool an M6 waits for is in the spindle: the program goes on.",
+     0, 0, 0, run_tool_changed},
+    {"optional-stop", "on|off", "Whether M1 pauses the program (on by default).", 0, 1, 1,
+     run_optional_stop},
+    {"set-input", "N 0|1", "Sets digital input N (what M66 P<N> waits on).", 0, 2, 2,
+     run_set_input},
     {"stop", "", "Stops the program with a controlled stop.", 0, 0, 0, run_stop},
     {"abort", "", "Abandons the program and motion at once.", 0, 0, 0, run_abort},
     {"step", "on|off", "Single-block mode on or off.", 0, 1, 1, run_step},

@@ -127,6 +127,20 @@ static double spindle_rpm(const struct ncp_canon_map *m, double x_mm)
     return rpm < m->css_max ? rpm : m->css_max;
 }
 
+/* A feed per turn (G95) or a synchronised move (G33, G33.1, G76) with the
+ * spindle stopped: LinuxCNC's motion would wait for ever; refused instead. */
+static int spindle_needed(const struct ncp_canon_map *m, uint32_t line, struct ncp_diag *d)
+{
+    if (m->spindle_dir != 0 || (m->sync_pitch <= 0 && !m->per_rev))
+        return 0;
+    return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
+                         m->sync_pitch > 0
+                             ? "spindle-synchronised move (G33/G33.1/G76) with the spindle "
+                               "stopped: start it with M3 or M4 first"
+                             : "feed per revolution (G95) with the spindle stopped: start it "
+                               "with M3 or M4 first, or use G94");
+}
+
 /* Feed in mm/s of a move ending at machine X = x_mm. A synchronised move
  * runs at its pitch whatever the override (rs274 turns it off around them). */
 static double feed_at(const struct ncp_canon_map *m, double x_mm)
@@ -170,6 +184,8 @@ static int line_to(struct ncp_canon_map *m, const double end_mm[NCP_AXES], int t
     s->length = sqrt(l2);
     if (s->length < 1e-9)
         return 0;  /* A/B/C-only or null move: nothing for a 3-axis machine to do */
+    if (!traverse && spindle_needed(m, line, d))
+        return -NCP_ERR_SEMANTIC;
     if (traverse)
         s->feed = m->cfg->max_linear_vel;
     else if ((s->feed = feed_at(m, s->end[0])) <= 0)
@@ -360,6 +376,8 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     s->angle = a;
     double arc_len = fabs(a) * 0.5 * (s->r0 + s->r1);
     s->length = sqrt(arc_len * arc_len + s->axial * s->axial);
+    if (spindle_needed(m, line, d))
+        return -NCP_ERR_SEMANTIC;
     if ((s->feed = feed_at(m, s->end[0])) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "arc move with zero feed rate");
     s->blend_feed = blend_feed_at(m, s->end[0]);
@@ -405,6 +423,16 @@ static int state_op(struct ncp_canon_map *m, const struct ncp_canon *op)
         break;
     case NCP_C_SET_SPINDLE_SPEED:
         m->speed = op->spindle_speed.speed;
+        break;
+    case NCP_C_START_SPINDLE_CLOCKWISE:
+        m->spindle_dir = 1;
+        break;
+    case NCP_C_START_SPINDLE_COUNTERCLOCKWISE:
+        m->spindle_dir = -1;
+        break;
+    case NCP_C_STOP_SPINDLE_TURNING:
+    case NCP_C_ORIENT_SPINDLE:
+        m->spindle_dir = 0;
         break;
     case NCP_C_SET_SPINDLE_MODE:
         m->css_max = op->spindle_mode.css_max > 0 ? op->spindle_mode.css_max : 0.0;

@@ -43,6 +43,7 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->can.heartbeat_timeout_ms = 500;
     c->can.sdo_timeout_ms = 200;
     c->default_linear_vel = 10.0;
+    ncp_io_cfg_default(&c->io);
     snprintf(c->lcm.prefix, sizeof c->lcm.prefix, "NCP_");
     c->lcm.status_hz = 50.0;
 }
@@ -246,13 +247,15 @@ static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, c
     }
     if (!strcasecmp(sec, "PLANNER"))
         return planner_key(c, k, v);
-    if (!strcasecmp(sec, "SIM"))
-        return sim_key(c, k, v);
+    if (!strcasecmp(sec, "SIM")) {
+        int r = sim_key(c, k, v);
+        return r ? r : ncp_io_cfg_key(&c->io, sec, k, v, why, len);
+    }
     if (!strcasecmp(sec, "RT"))
         return rt_key(c, k, v, why, len);
     if (!strcasecmp(sec, "CAN"))
         return can_key(&c->can, k, v);
-    return -2;
+    return ncp_io_cfg_key(&c->io, sec, k, v, why, len);
 }
 
 static int on_key(void *user, const char *sec, const char *k, const char *v)

@@ -29,6 +29,7 @@ static void start_head(struct ncp_planner *p)
     }
     p->active = 1;
     p->line = ps->s.line;
+    p->aux = ps->s.aux;
 }
 
 static void sample(struct ncp_planner *p, struct ncp_setpoint *out)
@@ -67,6 +68,7 @@ int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out)
             hold(p, out);
             memcpy(out->pos, p->pos, sizeof out->pos);
             out->line = p->line;
+            out->aux = p->aux;
             if (p->finished) {
                 out->flags = NCP_SP_END;
                 return 0;
@@ -94,6 +96,7 @@ int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out)
     sample(p, out);
     memcpy(out->pos, p->pos, sizeof out->pos);
     out->line = p->line;
+    out->aux = p->aux;
     if (stopped_at_end) {
         ncp_planner_pop(p);
         p->active = 0;

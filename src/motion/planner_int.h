@@ -35,6 +35,7 @@ struct ncp_planner {
     double v_now;            /* path speed at the end of the last sample */
     double pos[NCP_AXES];
     uint32_t line;
+    uint32_t aux;            /* the executing segment's machine functions (ncp_seg.aux) */
     int have_last;           /* last_pushed valid: junctions need the previous segment */
     struct ncp_seg last_pushed;
     double last_vmax;        /* its cruise cap */

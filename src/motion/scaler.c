@@ -427,6 +427,8 @@ int ncp_scaler_step(struct ncp_scaler *s, double target, struct ncp_spsc *ring,
     out->v = s->r * (s->a.v + f * (s->b.v - s->a.v));
     const struct ncp_setpoint *near = f < 0.5 ? &s->a : &s->b;
     out->line = near->line;
+    /* machine functions are due once the read position leaves a towards b */
+    out->aux = f <= 0 ? s->a.aux : s->b.aux;
     out->flags = (f <= 0 ? s->a.flags : f >= 1 ? s->b.flags : 0) & ~(uint32_t)NCP_SP_MOTION_MASK;
     out->flags |= near->flags & NCP_SP_RAPID;
     /* on an arc only between two samples of the same arc: across a segment

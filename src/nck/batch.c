@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -22,11 +23,20 @@ static int emit_check(void *ctx, const struct ncp_cmd *cmd)
     struct precheck *pc = ctx;
     struct ncp_seg s;
     for (unsigned i = 0; i < cmd->n_ops; i++) {
+        /* a call the machine cannot act on is refused before anything moves */
+        if (nck_check_call(cmd, &cmd->ops[i], &pc->d)) {
+            pc->d.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
+            pc->failed = 2;
+            return 1;
+        }
         int rc = ncp_canon_map_op(&pc->map, &cmd->ops[i], cmd->line, &s, &pc->d);
         while (rc == 1)
             rc = ncp_canon_map_more(&pc->map, &s, &pc->d);
         if (rc < 0) {
-            pc->failed = pc->d.code == NCP_ERR_LIMIT;
+            pc->failed = pc->d.code == NCP_ERR_LIMIT ? 1 : pc->d.code == NCP_ERR_SEMANTIC &&
+                                                               strstr(pc->d.msg, "spindle") ? 2 : 0;
+            if (pc->failed)
+                pc->d.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
             return 1;
         }
     }
@@ -34,8 +44,10 @@ static int emit_check(void *ctx, const struct ncp_cmd *cmd)
 }
 
 /* The program is interpreted once without motion: a soft-limit violation
- * anywhere stops the run before the machine moves. Program errors are left to
- * the real run, which moves up to the last good block. */
+ * anywhere stops the run before the machine moves (1), and so does a call
+ * the machine cannot act on, or an M66 result the program reads (2).
+ * Other program errors are left to the real run, which moves up to the last
+ * good block. */
 static int precheck_limits(const struct ncp_nck_opts *o, const double start[NCP_AXES],
                            struct ncp_diag *d)
 {
@@ -45,7 +57,12 @@ static int precheck_limits(const struct ncp_nck_opts *o, const double start[NCP_
     ncp_canon_map_init(&pc->map, o->cfg, start, o->feed_override);
     struct ncp_output out = { .ctx = pc, .emit = emit_check };
     struct ncp_diag ignored;
+    memset(&ignored, 0, sizeof ignored);
     o->interpret(o->interp_ctx, &out, &ignored);
+    if (!pc->failed && ignored.code && strstr(ignored.msg, "result of the M66")) {
+        pc->failed = 2;
+        pc->d = ignored;
+    }
     int failed = pc->failed;
     if (failed)
         *d = pc->d;
@@ -73,6 +90,24 @@ static void progress(const struct nck *n, const struct ncp_nck_opts *o)
     fflush(o->progress);
 }
 
+/* [SIM] AUTO_RESUME_S < 0: a pause goes on at SIGUSR1. */
+static volatile sig_atomic_t usr1;
+static void on_usr1(int sig)
+{
+    (void)sig;
+    usr1 = 1;
+}
+
+static void watch_usr1(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_usr1;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    sigaction(SIGUSR1, &sa, NULL);
+}
+
 /* Reads the loop's cycles until the loop has ended and its ring is empty. */
 static void drain(struct nck *n, const struct ncp_nck_opts *o)
 {
@@ -93,6 +128,11 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o)
         if (((o->interrupt && *o->interrupt) || n->sum.trace_errno) &&
             !atomic_load(&n->ctl->stop))
             atomic_store(&n->ctl->stop, 1);
+        if (usr1) {
+            usr1 = 0;
+            atomic_fetch_add(&n->ctl->resume_go, 1);
+            atomic_fetch_add(&n->ctl->tool_go, 1);
+        }
         if (o->progress && mono_ns() - last_print > 200000000) {
             last_print = mono_ns();
             progress(n, o);
@@ -149,6 +189,13 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
     res->for_expired = n->for_expired;
     res->interrupted = atomic_load(&n->ctl->stop) && !n->ended;
     res->trace_errno = n->sum.trace_errno;
+    res->spindle_rpm_max = s->rpm_max;
+    res->pauses = n->pauses;
+    for (int k = 0; k < NCP_C__COUNT; k++) {
+        res->calls_in += n->calls_in[k];
+        res->calls_acted += n->calls_acted[k];
+        res->calls_refused += n->calls_refused[k];
+    }
     const struct nck_job *j = &n->job;
     int fault = atomic_load(&n->loop_fault);
     if (fault == NCK_LF_BACKEND) {
@@ -191,9 +238,12 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
             res->diag.code = NCP_ERR_IO;
         res->status = NCP_NCK_FAULT;
     } else if ((res->limit_violation = precheck_limits(o, n->start, &res->diag)) != 0) {
-        res->limit_violation = res->limit_violation > 0;
-        res->status = NCP_NCK_FAULT;
+        res->status = res->limit_violation == 2 ? NCP_NCK_PROGRAM_ERROR : NCP_NCK_FAULT;
+        res->refused = res->limit_violation == 2;
+        res->limit_violation = res->limit_violation == 1;
     } else {
+        if (o->cfg->io.auto_resume_s < 0)
+            watch_usr1();
         n->job.kind = NCK_JOB_PROGRAM;
         n->job.interpret = o->interpret;
         n->job.interp_ctx = o->interp_ctx;

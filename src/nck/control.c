@@ -141,6 +141,7 @@ static void reset_interp(struct ncp_nck *s)
 
 static void begin_drop(struct ncp_nck *s, int hold, int full, int after, int reset)
 {
+    s->machine_pause = 0;
     struct nck *n = &s->n;
     if (hold) {
         atomic_store(&n->full_decel, full);
@@ -414,6 +415,7 @@ static int cmd_override(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *wh
         if (pct > 200)
             return refuse(why, len, "spindle override is 0..200 %%");
         s->spindle_override = pct;
+        atomic_store(&s->n.ctl->spindle_permille, (int)lround(pct * 10));
         return 0;
     default:
         return refuse(why, len, "override is feed, rapid or spindle");
@@ -430,8 +432,21 @@ static int cmd_pause(struct ncp_nck *s, char *why, size_t len)
     return 0;
 }
 
+/* The program paused the machine (M0 M1 M60 M6): what it waits for. */
+static int machine_wait(const struct ncp_nck *s)
+{
+    return s->machine_pause && s->n.have_fb ? s->n.last_fb.wait : NCK_WAIT_NONE;
+}
+
 static int cmd_resume(struct ncp_nck *s, char *why, size_t len)
 {
+    if (s->state == NCP_ST_PAUSED && machine_wait(s) == NCK_WAIT_TOOL)
+        return refuse(why, len, "the M6 on line %u waits for the tool: cnc-ctl tool-changed "
+                      "once it is in the spindle", s->n.last_fb.wait_line);
+    if (s->state == NCP_ST_PAUSED && s->machine_pause) {
+        atomic_fetch_add(&s->n.ctl->resume_go, 1);
+        s->machine_pause = 0;
+    }
     if (s->state == NCP_ST_PAUSED) {
         ncp_nck_feed_hold(s->n.ctl, 0);
         set_state(s, s->resume_state);
@@ -442,6 +457,29 @@ static int cmd_resume(struct ncp_nck *s, char *why, size_t len)
         return 0;
     }
     return refuse(why, len, "nothing to resume while %s", ncp_nck_state_name(s->state));
+}
+
+static int cmd_tool_changed(struct ncp_nck *s, char *why, size_t len)
+{
+    if (s->state != NCP_ST_PAUSED || machine_wait(s) != NCK_WAIT_TOOL)
+        return refuse(why, len, "no M6 waits for a tool (%s)", ncp_nck_state_name(s->state));
+    atomic_fetch_add(&s->n.ctl->tool_go, 1);
+    s->machine_pause = 0;
+    ncp_nck_feed_hold(s->n.ctl, 0);
+    set_state(s, s->resume_state);
+    return 0;
+}
+
+static int cmd_set_input(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    int i = c->ivalue[0], v = c->ivalue[1];
+    if (i < 0 || i >= NCP_DIO_MAX || (v != 0 && v != 1))
+        return refuse(why, len, "set-input: digital input 0..%d, value 0 or 1", NCP_DIO_MAX - 1);
+    if (v)
+        atomic_fetch_or(&s->n.ctl->din, 1ull << i);
+    else
+        atomic_fetch_and(&s->n.ctl->din, ~(1ull << i));
+    return 0;
 }
 
 static int cmd_step(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
@@ -523,6 +561,11 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     case NCP_CMD_SHUTDOWN: ncp_nck_request_shutdown(s); rc = 0; break;
     case NCP_CMD_OVERRIDE: rc = cmd_override(s, c, why, len); break;
     case NCP_CMD_STEP: rc = cmd_step(s, c, why, len); break;
+    case NCP_CMD_OPTIONAL_STOP:
+        atomic_store(&s->n.ctl->optional_stop, c->ivalue[0] != 0);
+        rc = 0;
+        break;
+    case NCP_CMD_SET_INPUT: rc = cmd_set_input(s, c, why, len); break;
     case NCP_CMD_KEEPALIVE:
         s->jog_last_ns = mono_ns();
         rc = 0;
@@ -538,6 +581,7 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
         case NCP_CMD_RUN: rc = cmd_run(s, c, why, len); break;
         case NCP_CMD_PAUSE: rc = cmd_pause(s, why, len); break;
         case NCP_CMD_RESUME: rc = cmd_resume(s, why, len); break;
+        case NCP_CMD_TOOL_CHANGED: rc = cmd_tool_changed(s, why, len); break;
         case NCP_CMD_STOP: rc = cmd_stop(s, 0, why, len); break;
         case NCP_CMD_ABORT: rc = cmd_stop(s, 1, why, len); break;
         case NCP_CMD_MDI: rc = cmd_mdi(s, c, why, len); break;
@@ -587,6 +631,9 @@ static void job_ended(struct ncp_nck *s)
     } else if (kind == NCK_JOB_PROGRAM) {
         nck_post(n, NCP_EV_INFO, s->program, 0, 0, "program finished");
     }
+    /* the whole job in the trace once it is over, not at the next 64 KiB */
+    if (n->setup.trace)
+        nck_trace_flush(&n->sum, n->setup.trace);
     set_state(s, NCP_ST_IDLE);
 }
 
@@ -624,6 +671,17 @@ int ncp_nck_poll(struct ncp_nck *s)
          st == NCP_ST_JOGGING || st == NCP_ST_HOMING) &&
         atomic_load(&n->job.finished) && nck_motion_done(n))
         job_ended(s);
+    /* the program paused the machine: PAUSED until resume (tool-changed) */
+    if (n->have_fb && n->last_fb.waits != s->waits_seen) {
+        st = s->state;
+        if (nck_wait_operator(n->last_fb.wait) && s->drop == NCK_DROP_NONE &&
+            (st == NCP_ST_RUNNING || st == NCP_ST_STEPPING || st == NCP_ST_MDI)) {
+            s->resume_state = st;
+            s->machine_pause = 1;
+            set_state(s, NCP_ST_PAUSED);
+        }
+        s->waits_seen = n->last_fb.waits;
+    }
     if (s->state == NCP_ST_JOGGING && s->jog_continuous && s->drop == NCK_DROP_NONE) {
         double limit = n->setup.jog_keepalive_s > 0 ? n->setup.jog_keepalive_s : 0.5;
         if ((double)(mono_ns() - s->jog_last_ns) * 1e-9 > limit) {
@@ -655,6 +713,7 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->spindle_override = 100;
     s->acfg = setup->interp;
     s->acfg.resident = 1;
+    s->acfg.m66_on_machine = 1;   /* M66 waits on the machine's inputs */
     s->acfg.instance = NULL;
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
@@ -722,11 +781,13 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     pthread_mutex_lock(lock);
     st->line = moving_state(s->state) && n->have_fb && n->last_fb.line ? n->last_fb.line
                                                                        : n->io.interp_line;
-    st->spindle_speed = n->io.dir ? n->io.speed * s->spindle_override / 100.0 : 0;
-    st->spindle_dir = n->io.dir;
-    st->mist = n->io.mist;
-    st->flood = n->io.flood;
-    st->tool = n->io.tool;
+    /* the machine as it is (the interpreter runs ahead of it) */
+    const struct nck_fb *fb = &n->last_fb;
+    st->spindle_speed = n->have_fb ? fabs(fb->rpm) : 0;
+    st->spindle_dir = fb->rpm > 0 ? 1 : fb->rpm < 0 ? -1 : 0;
+    st->mist = fb->mist;
+    st->flood = fb->flood;
+    st->tool = fb->tool;
     st->g5x_index = n->io.g5x_index ? n->io.g5x_index : 1;
     for (int k = 0; k < 6 && k < NCP_NCK_AXES_MAX; k++)
         st->g5x_offset[k] = n->io.g5x[k];

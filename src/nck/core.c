@@ -58,8 +58,12 @@ static int init_motion(struct nck *n)
     n->planner = ncp_planner_new(c, n->start);
     if (!n->planner || ncp_spsc_init(&n->segs, sizeof(struct nck_seg_msg), SEG_RING) ||
         ncp_spsc_init(&n->sps, sizeof(struct ncp_setpoint), (size_t)c->setpoint_ring) ||
-        ncp_spsc_init(&n->fbs, sizeof(struct nck_fb), FB_RING))
+        ncp_spsc_init(&n->fbs, sizeof(struct nck_fb), FB_RING) ||
+        ncp_spsc_init(&n->auxq, sizeof(struct nck_aux_pack), NCK_AUX_RING))
         return -1;
+    for (int k = 0; k < 4; k++)
+        n->mach.en[k] = 1;
+    atomic_store(&n->ctl->din, c->io.din);
     n->loop.cfg = (struct ncp_rt_loop_cfg){ (int64_t)llround(c->servo_period * 1e9),
                                             c->position.priority, c->position.cpu,
                                             n->setup.virtual_clock };
@@ -134,6 +138,7 @@ void nck_release(struct nck *n)
     ncp_spsc_destroy(&n->segs);
     ncp_spsc_destroy(&n->sps);
     ncp_spsc_destroy(&n->fbs);
+    ncp_spsc_destroy(&n->auxq);
     ncp_planner_free(n->planner);
     n->planner = NULL;
     pthread_mutex_destroy(&n->ev_lock);
@@ -192,6 +197,11 @@ void ncp_nck_ctl_init(struct ncp_nck_ctl *c, double feed_override)
     atomic_store(&c->pause_at_ns, INT64_MAX);
     atomic_store(&c->rapid_permille, 1000);
     atomic_store(&c->stop, 0);
+    atomic_store(&c->resume_go, 0);
+    atomic_store(&c->tool_go, 0);
+    atomic_store(&c->optional_stop, 1);
+    atomic_store(&c->spindle_permille, 1000);
+    atomic_store(&c->din, 0);
 }
 
 void ncp_nck_set_feed_override(struct ncp_nck_ctl *c, double ov)

@@ -28,13 +28,62 @@ static int push_wait(struct nck *n, const struct nck_seg_msg *m)
     return 0;
 }
 
+static int take_seg(struct nck *n, const struct ncp_seg *s);
+
+/* ---- machine functions ------------------------------------------------------------ */
+
+/* The pack gathered so far goes to the position loop; one that waits for
+ * motion is announced by an AUX stop, one that goes with motion rides on the
+ * next segment (push_seg numbers it). */
+static int aux_flush(struct nck *n)
+{
+    struct nck_job *j = &n->job;
+    if (j->aux.n == 0)
+        return 0;
+    j->aux.seq = ++n->aux_seq;
+    while (ncp_spsc_push(&n->auxq, &j->aux) != 0) {
+        if (atomic_load(&j->abort))
+            return -1;
+        nap_us(100);
+    }
+    j->aux.n = 0;
+    if (!j->aux_stop)
+        return 0;
+    j->aux_stop = 0;
+    struct nck_seg_msg m;
+    memset(&m, 0, sizeof m);
+    m.kind = NCK_MSG_AUX;
+    m.aux = n->aux_seq;
+    return push_wait(n, &m);
+}
+
+static int aux_add(struct nck *n, int kind, int idx, int32_t i, double v, uint32_t line,
+                   int stop)
+{
+    struct nck_job *j = &n->job;
+    if (j->aux.n == NCK_AUX_PACK && aux_flush(n))
+        return -1;
+    struct nck_aux *a = &j->aux.a[j->aux.n++];
+    memset(a, 0, sizeof *a);
+    a->kind = (uint8_t)kind;
+    a->idx = (int16_t)idx;
+    a->i = i;
+    a->v = v;
+    a->line = line;
+    j->aux_stop |= stop;
+    return 0;
+}
+
 /* END or SYNC: the planner brings what it has to a stop. marks_sent already
  * counts the stretch this message closes; after a SYNC the next one opens. */
 static int push_mark(struct nck *n, int kind)
 {
+    if (aux_flush(n))
+        return -1;
     struct nck_seg_msg m;
     memset(&m, 0, sizeof m);
     m.kind = kind;
+    m.aux = n->aux_seq;
     if (push_wait(n, &m))
         return -1;
     n->job.marks++;
@@ -45,10 +94,21 @@ static int push_mark(struct nck *n, int kind)
 
 static int push_seg(struct nck *n, const struct ncp_seg *s)
 {
+    struct nck_job *j = &n->job;
+    /* LinuxCNC's at-speed: the first feed after a spindle start or speed
+     * change starts once the spindle has reached its speed */
+    if (j->need_at_speed && !s->traverse && s->kind != NCP_SEG_DWELL) {
+        j->need_at_speed = 0;
+        if (aux_add(n, NCK_AUX_AT_SPEED, 0, 0, 0, s->line, 1))
+            return -1;
+    }
+    if (aux_flush(n))
+        return -1;
     struct nck_seg_msg m;
     memset(&m, 0, sizeof m);
     m.kind = NCK_MSG_SEG;
     m.seg = *s;
+    m.seg.aux = n->aux_seq;
     n->job.seen_motion = 1;
     return push_wait(n, &m);
 }
@@ -170,6 +230,199 @@ static void post_text(struct nck *n, const struct ncp_cmd *cmd, const struct ncp
     nck_post(n, kind, NULL, cmd->line, 0, "%.*s", (int)len, cmd->text + off);
 }
 
+/* M6: the spindle was stopped by the interpreter's own call before it;
+ * Z to machine 0 first with TOOL_CHANGE_QUILL_UP, then to
+ * TOOL_CHANGE_POSITION (Z first when that is up), then wait for the change. */
+static int tool_change(struct nck *n, const struct ncp_canon *op, uint32_t line)
+{
+    const struct ncp_io_cfg *io = &n->cfg->io;
+    double at[NCP_AXES], pts[3][NCP_AXES];
+    int k = 0;
+    memcpy(at, n->map.pos, sizeof at);
+    if (io->quill_up) {
+        memcpy(pts[k], at, sizeof at);
+        pts[k++][2] = 0;
+    }
+    if (io->have_tc_pos) {
+        const double *last = k ? pts[k - 1] : at;
+        if (io->tc_pos[2] > last[2]) {
+            memcpy(pts[k], last, sizeof at);
+            pts[k++][2] = io->tc_pos[2];
+        }
+        memcpy(pts[k++], io->tc_pos, sizeof at);
+    }
+    for (int p = 0; p < k; p++) {
+        struct ncp_seg s;
+        nck_line(n, &s, p ? pts[p - 1] : at, pts[p], 0, 1);
+        s.line = line;
+        if (s.length > 1e-9 && take_seg(n, &s))
+            return -1;
+    }
+    if (k)
+        memcpy(n->map.pos, pts[k - 1], sizeof n->map.pos);
+    /* the change itself with the spindle at rest (rs274 stopped it) */
+    return aux_add(n, NCK_AUX_AT_SPEED, 0, 0, 0, line, 1) ||
+           aux_add(n, NCK_AUX_TOOL, 0, op->tool.tool, 0, line, 1);
+}
+
+static int spindle_cmd(struct nck *n, uint32_t line)
+{
+    double s = n->map.speed;
+    if (n->map.css_max > 0 && s > n->map.css_max)
+        s = n->map.css_max;
+    n->job.need_at_speed = n->map.spindle_dir != 0;
+    return aux_add(n, NCK_AUX_SPINDLE, 0, 0, n->map.spindle_dir * s, line, 1);
+}
+
+/* A call that is a machine function: into the pack. M62/M63/M67 go with the
+ * next motion; everything else waits for motion, as in LinuxCNC. Called
+ * after the map took the call (its spindle state is the new one). */
+static int take_aux(struct nck *n, const struct ncp_cmd *cmd, const struct ncp_canon *op,
+                    int after_pallet)
+{
+    uint32_t line = cmd->line;
+    int idx = op->output.index;
+    switch (op->kind) {
+    case NCP_C_SET_SPINDLE_SPEED:
+    case NCP_C_START_SPINDLE_CLOCKWISE:
+    case NCP_C_START_SPINDLE_COUNTERCLOCKWISE:
+    case NCP_C_STOP_SPINDLE_TURNING:
+        return spindle_cmd(n, line);
+    case NCP_C_ORIENT_SPINDLE:
+        n->job.need_at_speed = 0;
+        return aux_add(n, NCK_AUX_ORIENT, 0, op->orient.direction, op->orient.angle, line, 1);
+    case NCP_C_FLOOD_ON: case NCP_C_FLOOD_OFF:
+        return aux_add(n, NCK_AUX_FLOOD, 0, op->kind == NCP_C_FLOOD_ON, 0, line, 1);
+    case NCP_C_MIST_ON: case NCP_C_MIST_OFF:
+        return aux_add(n, NCK_AUX_MIST, 0, op->kind == NCP_C_MIST_ON, 0, line, 1);
+    case NCP_C_SELECT_TOOL:
+        return aux_add(n, NCK_AUX_PREPARE, 0, op->tool.tool, 0, line, 0);
+    case NCP_C_CHANGE_TOOL:
+        return tool_change(n, op, line);
+    case NCP_C_CHANGE_TOOL_NUMBER:  /* M61: the tool is in the spindle already */
+        return aux_add(n, NCK_AUX_PREPARE, 1, op->tool.tool, 0, line, 1);
+    case NCP_C_ENABLE_FEED_OVERRIDE: case NCP_C_DISABLE_FEED_OVERRIDE:
+        return aux_add(n, NCK_AUX_ENABLE, 0, NCK_EN_FEED_OVERRIDE,
+                       op->kind == NCP_C_ENABLE_FEED_OVERRIDE, line, 1);
+    case NCP_C_ENABLE_SPEED_OVERRIDE: case NCP_C_DISABLE_SPEED_OVERRIDE:
+        return aux_add(n, NCK_AUX_ENABLE, 0, NCK_EN_SPEED_OVERRIDE,
+                       op->kind == NCP_C_ENABLE_SPEED_OVERRIDE, line, 1);
+    case NCP_C_ENABLE_FEED_HOLD: case NCP_C_DISABLE_FEED_HOLD:
+        return aux_add(n, NCK_AUX_ENABLE, 0, NCK_EN_FEED_HOLD,
+                       op->kind == NCP_C_ENABLE_FEED_HOLD, line, 1);
+    case NCP_C_ENABLE_ADAPTIVE_FEED: case NCP_C_DISABLE_ADAPTIVE_FEED:
+        return aux_add(n, NCK_AUX_ENABLE, 0, NCK_EN_ADAPTIVE,
+                       op->kind == NCP_C_ENABLE_ADAPTIVE_FEED, line, 1);
+    case NCP_C_PROGRAM_STOP:
+        return aux_add(n, NCK_AUX_PAUSE, 0, after_pallet ? NCK_WAIT_M60 : NCK_WAIT_M0, 0, line, 1);
+    case NCP_C_OPTIONAL_PROGRAM_STOP:
+        return aux_add(n, NCK_AUX_PAUSE, 0, NCK_WAIT_M1, 0, line, 1);
+    case NCP_C_PALLET_SHUTTLE:    /* no pallets: the PROGRAM_STOP after it pauses */
+        return 0;
+    case NCP_C_SET_AUX_OUTPUT_BIT: case NCP_C_CLEAR_AUX_OUTPUT_BIT:
+    case NCP_C_SET_MOTION_OUTPUT_BIT: case NCP_C_CLEAR_MOTION_OUTPUT_BIT:
+        return aux_add(n, NCK_AUX_DOUT, idx,
+                       op->kind == NCP_C_SET_AUX_OUTPUT_BIT ||
+                           op->kind == NCP_C_SET_MOTION_OUTPUT_BIT,
+                       0, line,
+                       op->kind == NCP_C_SET_AUX_OUTPUT_BIT ||
+                           op->kind == NCP_C_CLEAR_AUX_OUTPUT_BIT);
+    case NCP_C_SET_AUX_OUTPUT_VALUE: case NCP_C_SET_MOTION_OUTPUT_VALUE:
+        return aux_add(n, NCK_AUX_AOUT, idx, 0, op->output.value, line,
+                       op->kind == NCP_C_SET_AUX_OUTPUT_VALUE);
+    case NCP_C_WAIT_INPUT: {
+        int r = aux_add(n, NCK_AUX_WAIT_INPUT, op->wait_input.index, op->wait_input.mode,
+                        op->wait_input.timeout, line, 1);
+        if (!r)
+            n->job.aux.a[n->job.aux.n - 1].a = (uint8_t)op->wait_input.analog;
+        return r;
+    }
+    default:
+        return 0;   /* RAW_TEXT's orient wait: the orient itself waits */
+    }
+}
+
+/* Outputs and inputs the simulated machine has: anything else is refused. */
+static int aux_range(const struct ncp_canon *op, uint32_t line, struct ncp_diag *d)
+{
+    int digital = op->kind == NCP_C_SET_AUX_OUTPUT_BIT || op->kind == NCP_C_CLEAR_AUX_OUTPUT_BIT ||
+                  op->kind == NCP_C_SET_MOTION_OUTPUT_BIT ||
+                  op->kind == NCP_C_CLEAR_MOTION_OUTPUT_BIT;
+    int analog = op->kind == NCP_C_SET_AUX_OUTPUT_VALUE ||
+                 op->kind == NCP_C_SET_MOTION_OUTPUT_VALUE;
+    if (op->kind == NCP_C_WAIT_INPUT) {
+        analog = op->wait_input.analog;
+        digital = !analog;
+        if ((digital && op->wait_input.index >= NCP_DIO_MAX) ||
+            (analog && op->wait_input.index >= NCP_AIO_MAX))
+            return ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
+                                "M66 %c%d: this machine has %s inputs %c0..%c%d", analog ? 'E' : 'P',
+                                op->wait_input.index, analog ? "analog" : "digital",
+                                analog ? 'E' : 'P', analog ? 'E' : 'P',
+                                (analog ? NCP_AIO_MAX : NCP_DIO_MAX) - 1);
+        return 0;
+    }
+    if (digital && (op->output.index < 0 || op->output.index >= NCP_DIO_MAX))
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
+                            "digital output P%d: this machine has P0..P%d", op->output.index,
+                            NCP_DIO_MAX - 1);
+    if (analog && (op->output.index < 0 || op->output.index >= NCP_AIO_MAX))
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
+                            "analog output E%d: this machine has E0..E%d", op->output.index,
+                            NCP_AIO_MAX - 1);
+    return 0;
+}
+
+int nck_check_call(const struct ncp_cmd *cmd, const struct ncp_canon *op, struct ncp_diag *d)
+{
+    const char *text = NULL;
+    char buf[64];
+    if (op->kind == NCP_C_RAW_TEXT) {
+        size_t off = op->text_off, len = op->text_len;
+        if (off <= NCP_CMD_TEXT_POOL && len <= NCP_CMD_TEXT_POOL - off) {
+            snprintf(buf, sizeof buf, "%.*s", (int)len, cmd->text + off);
+            text = buf;
+        }
+    }
+    if (nck_call_class(op, text) == NCK_CALL_REFUSED) {
+        if (op->kind == NCP_C_RAW_TEXT)
+            return ncp_diag_set(d, NCP_ERR_SEMANTIC, cmd->line, 0,
+                                "%s: a call this machine cannot act on", text ? text : "?");
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, cmd->line, 0, "%s", nck_call_what(op->kind));
+    }
+    return aux_range(op, cmd->line, d);
+}
+
+/* (LOGOPEN,...) and the rest: LinuxCNC writes them to a log file; the NCK
+ * shows them to the operator instead (an event, or stderr in a batch run)
+ * and writes no file on a program's say-so. */
+static void log_text(struct nck *n, const struct ncp_cmd *cmd, const struct ncp_canon *op)
+{
+    if (n->post_prints) {
+        post_text(n, cmd, op, NCP_EV_INFO);
+        return;
+    }
+    size_t off = op->text_off, len = op->text_len;
+    if (off > NCP_CMD_TEXT_POOL || len > NCP_CMD_TEXT_POOL - off)
+        return;
+    static const char *const what[] = { "LOGOPEN", "LOGAPPEND", "LOGCLOSE", "LOG" };
+    fprintf(stderr, "line %u: %s: %.*s\n", cmd->line, what[op->kind - NCP_C_LOGOPEN], (int)len,
+            cmd->text + off);
+}
+
+/* Run from line: the spindle and coolant the skipped part left on come on
+ * before the approach, as on a controller that restores the modal state. */
+static int restore_machine(struct nck *n, uint32_t line)
+{
+    pthread_mutex_lock(&n->ev_lock);
+    int mist = n->io.mist, flood = n->io.flood;
+    pthread_mutex_unlock(&n->ev_lock);
+    if (aux_add(n, NCK_AUX_MIST, 0, mist, 0, line, 1) ||
+        aux_add(n, NCK_AUX_FLOOD, 0, flood, 0, line, 1))
+        return -1;
+    return n->map.spindle_dir ? spindle_cmd(n, line) : 0;
+}
+
 /* A segment of a run from line N: before N it only moves the map along. */
 static int take_seg(struct nck *n, const struct ncp_seg *s)
 {
@@ -194,7 +447,7 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
         double target[NCP_AXES];
         memcpy(target, n->map.pos, sizeof target);
         j->reached = 1;
-        if (approach(n, cmd->line))
+        if (restore_machine(n, cmd->line) || approach(n, cmd->line))
             return 1;
         memcpy(n->map.pos, target, sizeof n->map.pos);
     }
@@ -203,10 +456,19 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
     struct ncp_seg seg;
     for (unsigned i = 0; i < cmd->n_ops; i++) {
         const struct ncp_canon *op = &cmd->ops[i];
+        unsigned kind = op->kind < NCP_C__COUNT ? op->kind : NCP_C_NONE;
+        n->calls_in[kind]++;
+        if (nck_check_call(cmd, op, &j->map_diag)) {
+            n->calls_refused[kind]++;
+            j->map_failed = 1;
+            return 1;
+        }
         if (n->post_prints && op->kind == NCP_C_PRINT)
             post_text(n, cmd, op, NCP_EV_PRINT);
         else if (n->post_prints && op->kind == NCP_C_MESSAGE)
             post_text(n, cmd, op, NCP_EV_MSG);
+        else if (op->kind >= NCP_C_LOGOPEN && op->kind <= NCP_C_LOG)
+            log_text(n, cmd, op);
         nck_note_state(n, op);
         int rc = ncp_canon_map_op(&n->map, op, cmd->line, &seg, &j->map_diag);
         while (rc == 1) {
@@ -215,9 +477,14 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
             rc = ncp_canon_map_more(&n->map, &seg, &j->map_diag);
         }
         if (rc < 0) {
+            n->calls_refused[kind]++;
             j->map_failed = 1;
             return 1;
         }
+        int after_pallet = i > 0 && cmd->ops[i - 1].kind == NCP_C_PALLET_SHUTTLE;
+        if ((!j->from_line || j->reached) && take_aux(n, cmd, op, after_pallet))
+            return 1;
+        n->calls_acted[kind]++;
     }
     if (n->post_prints) {   /* a serving NCK's status shows it */
         pthread_mutex_lock(&n->ev_lock);
@@ -271,6 +538,9 @@ int nck_job_start(struct nck *n)
     j->rc = NCP_OK;
     j->reached = 0;
     j->seen_motion = 0;
+    j->aux.n = 0;
+    j->aux_stop = 0;
+    j->need_at_speed = 0;
     j->step_used = atomic_load(&j->step_go);
     j->max_z = n->map.pos[2];
     memset(&j->map_diag, 0, sizeof j->map_diag);

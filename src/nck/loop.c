@@ -29,15 +29,20 @@ static int check_ferror(struct nck *n, const double act[NCP_AXES])
  * hold: a faster stream could exceed the acceleration limits. */
 static double feed_rate(struct nck *n)
 {
-    if (n->for_expired || atomic_load_explicit(&n->ctl->hold, memory_order_relaxed) ||
-        atomic_load_explicit(&n->ctl->stop, memory_order_relaxed))
+    /* M53 P0 turns the feed hold off (not the controlled stop) */
+    int hold = n->mach.en[NCK_EN_FEED_HOLD] &&
+               atomic_load_explicit(&n->ctl->hold, memory_order_relaxed);
+    if (n->for_expired || hold || atomic_load_explicit(&n->ctl->stop, memory_order_relaxed))
         return 0.0;
     /* a serving NCK's rapids follow the rapid override, as LinuxCNC's (a
      * batch run's --feed-override and live override apply to all motion) */
     if (!n->batch && (n->cur.flags & NCP_SP_RAPID))
         return fmin(1.0, atomic_load_explicit(&n->ctl->rapid_permille, memory_order_relaxed) /
                              1000.0);
-    double ov = atomic_load_explicit(&n->ctl->override_permille, memory_order_relaxed) / 1000.0;
+    /* M48/M49/M50: with the override off the program's feed holds */
+    double ov = n->mach.en[NCK_EN_FEED_OVERRIDE]
+                    ? atomic_load_explicit(&n->ctl->override_permille, memory_order_relaxed) / 1000.0
+                    : 1.0;
     return fmin(1.0, ov / n->plan_override);
 }
 
@@ -84,6 +89,12 @@ static int stream_expected(const struct nck *n)
  * its feed-forward uses the velocity of the interval it is about to drive. */
 static int take_setpoint(struct nck *n)
 {
+    /* a machine function waits (spindle, operator, input): hold where the
+     * stream stopped for it */
+    if (nck_aux_cycle(n)) {
+        n->cur = n->next;
+        return NCP_RT_CONTINUE;
+    }
     if (!n->ended && n->setup.virtual_clock &&
         ncp_spsc_count(&n->sps) < ncp_scaler_wants(&n->scaler, ncp_spsc_capacity(&n->sps)) &&
         stream_expected(n))
@@ -91,6 +102,8 @@ static int take_setpoint(struct nck *n)
     n->cur = n->next;
     if (!n->ended && ncp_scaler_step(&n->scaler, rate_target(n), &n->sps, &n->next) != 0)
         n->dry++;
+    if (n->next.aux > n->mach.seq_reached)
+        n->mach.seq_reached = n->next.aux;
     if (n->scaler.ends != n->ends_seen) {
         atomic_fetch_add_explicit(&n->ends_taken, n->scaler.ends - n->ends_seen,
                                   memory_order_release);
@@ -125,6 +138,7 @@ static void discard(struct nck *n, const double act[NCP_AXES])
     memcpy(at, atomic_load_explicit(&n->discard_to_actual, memory_order_relaxed) ? act : n->cur.pos,
            sizeof at);
     memcpy(n->rest, at, sizeof n->rest);
+    nck_aux_discard(n);
     ncp_scaler_rebase(&n->scaler, at);
     n->scaler.decel = n->decel_normal;
     memset(&n->cur, 0, sizeof n->cur);
@@ -150,6 +164,16 @@ static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES]
     fb.flags = n->cur.flags;
     memcpy(fb.cmd, n->cur.pos, sizeof fb.cmd);
     memcpy(fb.act, act, sizeof fb.act);
+    const struct nck_mach *m = &n->mach;
+    fb.rpm = m->rpm;
+    fb.rev = m->rev;
+    fb.dout = m->dout;
+    fb.mist = (uint8_t)m->mist;
+    fb.flood = (uint8_t)m->flood;
+    fb.wait = (uint8_t)m->wait;
+    fb.waits = m->waits;
+    fb.tool = m->tool;
+    fb.wait_line = m->wait_line;
     if (ncp_spsc_push(&n->fbs, &fb) != 0)
         n->fb_dropped++;
 }
@@ -177,6 +201,8 @@ static int frozen_cycle(struct nck *n, int64_t now_ns)
     }
     double act[NCP_AXES];
     n->be.ops->cycle(&n->be, n->cur.pos, n->cur.pos, act);
+    n->mach.rpm_cmd = 0;   /* E-stop and faults stop the spindle too */
+    (void)nck_aux_cycle(n);
     if (atomic_load_explicit(&n->discard_req, memory_order_acquire) !=
         atomic_load_explicit(&n->discard_ack, memory_order_relaxed))
         discard(n, act);
@@ -245,6 +271,9 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
         clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, NULL);
     } else if (virt && rest &&
                (atomic_load_explicit(&n->ctl->hold, memory_order_relaxed) ||
+                /* waiting for the operator or an input: at the real rate */
+                (n->mach.wait != NCK_WAIT_NONE && n->mach.wait != NCK_WAIT_SPINDLE &&
+                 n->mach.wait != NCK_WAIT_ORIENT) ||
                 (!stream_expected(n) && ncp_spsc_count(&n->sps) == 0))) {
         idle_nap(n);
     }

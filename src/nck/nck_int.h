@@ -21,11 +21,81 @@
 #define NCK_CONTOUR_HISTORY 64
 
 /* The segment ring's messages. END closes a job's motion; SYNC makes the
- * planner run what it has to a stop without ending the job (single block). */
-enum { NCK_MSG_SEG, NCK_MSG_END, NCK_MSG_SYNC };
+ * planner run what it has to a stop without ending the job (single block);
+ * AUX too, and the stop's sample carries the machine functions (aux) that
+ * wait for motion, as LinuxCNC's task waits for motion before them. */
+enum { NCK_MSG_SEG, NCK_MSG_END, NCK_MSG_SYNC, NCK_MSG_AUX };
 struct nck_seg_msg {
     int kind;
+    uint32_t aux;              /* END/SYNC/AUX: machine functions due at the stop */
     struct ncp_seg seg;
+};
+
+/* ---- machine functions (aux.c, applied by the position loop) -----------------
+ * The job thread turns the non-motion calls into aux actions, in packs
+ * numbered 1, 2, ... (seq) on their own ring to the position loop. Samples
+ * carry the seq of the last pack due by them (ncp_setpoint.aux): the loop
+ * applies the packs up to it when it reaches the sample, so a spindle start
+ * or an M0 happens where it stands in the program, not when interpreted. A
+ * pack that waits for motion is sent after an AUX stop; one that goes with
+ * motion (M62/M63/M67) rides on the next segment. */
+enum nck_aux_kind {
+    NCK_AUX_SPINDLE,       /* v: rpm, signed (M3 +, M4 -, 0 stop) */
+    NCK_AUX_ORIENT,        /* v: angle in degrees, i: M19's P; waits until oriented */
+    NCK_AUX_AT_SPEED,      /* waits until the spindle is at its speed */
+    NCK_AUX_MIST, NCK_AUX_FLOOD,  /* i: on */
+    NCK_AUX_DOUT,          /* idx, i: on */
+    NCK_AUX_AOUT,          /* idx, v */
+    NCK_AUX_WAIT_INPUT,    /* idx, i: mode (L), v: timeout s; a: 1 analog */
+    NCK_AUX_PAUSE,         /* i: enum nck_wait (M0, M1, M60); waits for resume */
+    NCK_AUX_TOOL,          /* i: the tool; waits for the change */
+    NCK_AUX_PREPARE,       /* i: the tool (T) */
+    NCK_AUX_ENABLE,        /* i: enum nck_enable, a: on */
+};
+enum nck_enable { NCK_EN_FEED_OVERRIDE, NCK_EN_SPEED_OVERRIDE, NCK_EN_FEED_HOLD,
+                  NCK_EN_ADAPTIVE };
+/* What the loop waits for (nck_fb.wait): 0 nothing. */
+enum nck_wait { NCK_WAIT_NONE, NCK_WAIT_M0, NCK_WAIT_M1, NCK_WAIT_M60, NCK_WAIT_TOOL,
+                NCK_WAIT_SPINDLE, NCK_WAIT_ORIENT, NCK_WAIT_INPUT };
+struct nck_aux {
+    uint8_t kind, a;
+    int16_t idx;
+    int32_t i;
+    uint32_t line;
+    double v;
+};
+#define NCK_AUX_PACK 6
+struct nck_aux_pack {
+    uint32_t seq;
+    int n;
+    struct nck_aux a[NCK_AUX_PACK];
+};
+#define NCK_AUX_RING 256
+
+/* The machine as the position loop drives it (its thread only). */
+struct nck_mach {
+    double rpm_cmd;            /* the program's: signed, before the override */
+    double rpm;                /* actual, signed */
+    double rev;                /* spindle angle in turns since start */
+    int orienting;             /* 1 braking, 2 turning to the angle */
+    double orient_to;          /* turns, 0..1 */
+    int orient_dir, orient_sign;
+    int mist, flood, tool, prepared;
+    uint64_t dout;
+    double aout[NCP_AIO_MAX];
+    int en[4];                 /* enum nck_enable: 1 enabled (the default) */
+    uint32_t seq_reached;      /* the highest aux of the samples taken */
+    struct nck_aux_pack pack;  /* the pack being applied */
+    int have_pack, at;         /* and its next action */
+    struct nck_aux_pack ahead; /* the next pack, taken off the ring, not due yet */
+    int have_ahead;
+    int wait;                  /* enum nck_wait */
+    uint32_t waits;            /* waits begun */
+    uint32_t wait_line;
+    int64_t wait_since;
+    uint64_t resume_used;
+    int in_last;               /* M66 L1/L2: the input's previous value */
+    double m66_result;         /* #5399 as the machine found it */
 };
 
 /* One servo cycle as the position loop saw it. */
@@ -34,6 +104,13 @@ struct nck_fb {
     double cmd[NCP_AXES], act[NCP_AXES];
     uint32_t line;
     uint32_t flags;          /* the setpoint's (NCP_SP_RAPID / NCP_SP_ARC for the trace) */
+    /* the machine functions */
+    double rpm, rev;         /* spindle: actual rpm (signed), angle in turns */
+    uint64_t dout;
+    uint8_t mist, flood, wait;  /* wait: enum nck_wait */
+    uint32_t waits;             /* waits begun so far */
+    int32_t tool;
+    uint32_t wait_line;
 };
 
 struct nck_summary {
@@ -47,6 +124,7 @@ struct nck_summary {
     double path;             /* length of the commanded path actually run */
     double last[NCP_AXES];
     double act[NCP_AXES];    /* the last cycle's actual position */
+    double rpm_max;          /* the spindle's highest actual speed */
     /* Trace rows are gathered here and written whole (write(2) of complete
      * rows only), so that even a killed process leaves a parseable trace. */
     char tbuf[1 << 16];
@@ -87,6 +165,12 @@ struct nck_job {
     struct ncp_seg moves[NCK_JOB_MOVES];
     int n_moves;
     uint64_t marks;              /* END/SYNC messages this job pushed */
+    /* machine functions not sent yet (they go out before the next segment
+     * or mark) and whether they wait for motion */
+    struct nck_aux_pack aux;
+    int aux_stop;
+    int need_at_speed;           /* a spindle start or S: the next feed waits */
+    int spindle_dir;             /* as the program has set it */
     double origin[NCP_AXES];     /* where the machine was when the job started */
 };
 
@@ -111,6 +195,12 @@ struct nck {
     struct ncp_backend be;
     int be_open, be_started;
     struct ncp_spsc segs, sps, fbs;
+    struct ncp_spsc auxq;            /* machine function packs, job -> position loop */
+    uint32_t aux_seq;                /* the last pack numbered (job threads, in turn) */
+    struct nck_mach mach;            /* position loop only */
+    /* canonical calls the jobs took, acted on and refused, per kind (job
+     * threads, in turn; read after the job) */
+    uint64_t calls_in[NCP_C__COUNT], calls_acted[NCP_C__COUNT], calls_refused[NCP_C__COUNT];
     struct ncp_planner *planner;
     struct ncp_canon_map map;
     struct ncp_rt_loop loop;
@@ -163,6 +253,7 @@ struct nck {
     uint64_t ev_dropped;
     int post_prints;                 /* service: PRINT/MSG/DEBUG as events, not stderr */
     struct nck_io io;
+    uint64_t pauses;                 /* operator waits begun (caller's thread) */
 
     /* the caller's thread */
     struct nck_job job;
@@ -205,6 +296,8 @@ struct ncp_nck {
     char error[256];
     uint64_t rejected;
     int shutdown, shutdown_pending;
+    uint32_t waits_seen;             /* the loop's wait count the state machine has seen */
+    int machine_pause;               /* PAUSED by the program (M0 M1 M60 M6), not by pause */
     int changed;
 };
 
@@ -240,6 +333,23 @@ void nck_line(const struct nck *n, struct ncp_seg *s, const double from[NCP_AXES
               const double to[NCP_AXES], double feed, int traverse);
 /* what the status shows of an interpreter op: spindle, coolant, tool, G5x */
 void nck_note_state(struct nck *n, const struct ncp_canon *op);
+
+/* aux.c: the machine functions on the position loop. 1 while the loop must
+ * hold where it is (a pack waits), else 0. */
+int nck_aux_cycle(struct nck *n);
+void nck_aux_discard(struct nck *n);
+/* the job side: how the NCK takes a call (enum nck_call), and the queueing */
+enum nck_call { NCK_CALL_MOTION, NCK_CALL_STATE, NCK_CALL_AUX, NCK_CALL_INFO, NCK_CALL_REFUSED };
+int nck_call_class(const struct ncp_canon *op, const char *text);
+const char *nck_call_what(int kind);
+/* A call refused (d filled, its code returned) or taken (0), as the job will
+ * take it: the batch run's pass before motion asks the same. */
+int nck_check_call(const struct ncp_cmd *cmd, const struct ncp_canon *op, struct ncp_diag *d);
+
+/* pauses.c: the operator is told of a wait the loop began (stats.c) */
+void nck_wait_began(struct nck *n, const struct nck_fb *fb);
+const char *nck_wait_name(int wait);
+int nck_wait_operator(int wait);
 
 /* events.c */
 void nck_post(struct nck *n, int kind, const char *file, uint32_t line, uint32_t col,

@@ -24,7 +24,7 @@ static int64_t mono_ns(void)
 
 /* END and SYNC both make the planner run what it has to a stop; after the
  * END setpoint the next job starts afresh (no blend with what went before). */
-static void pull_segments(struct nck *n, int *finishing)
+static void pull_segments(struct nck *n, int *finishing, uint32_t *stop_aux, int *aux_stop)
 {
     struct nck_seg_msg m;
     while (!*finishing && !ncp_planner_full(n->planner) && ncp_spsc_pop(&n->segs, &m) == 0) {
@@ -32,6 +32,8 @@ static void pull_segments(struct nck *n, int *finishing)
             ncp_planner_push(n->planner, &m.seg);
         } else {
             *finishing = 1;
+            *stop_aux = m.aux;
+            *aux_stop = m.kind == NCK_MSG_AUX;
             ncp_planner_finish(n->planner);
         }
     }
@@ -63,7 +65,7 @@ static int may_step(struct nck *n, int finishing, int64_t *wait_since)
 /* Parked (a drop in progress): the segment ring is emptied (its producer has
  * been stopped) and nothing is planned until the loop has rested and the
  * service thread says where. */
-static void parked(struct nck *n, int *finishing)
+static void parked(struct nck *n, int *finishing, int *aux_stop)
 {
     struct nck_seg_msg m;
     while (ncp_spsc_pop(&n->segs, &m) == 0)
@@ -75,22 +77,24 @@ static void parked(struct nck *n, int *finishing)
         nap_ns(200000);
     ncp_planner_reset(n->planner, n->rest);
     *finishing = 0;
+    *aux_stop = 0;
     atomic_store_explicit(&n->unpark_ack, atomic_load(&n->unpark_req), memory_order_release);
 }
 
 void *nck_planner_main(void *arg)
 {
     struct nck *n = arg;
-    int finishing = 0;
+    int finishing = 0, aux_stop = 0;
+    uint32_t stop_aux = 0;
     int64_t wait_since = 0;
     long nap = (long)(n->cfg->servo_period * ncp_machine_cfg_ipo_ratio(n->cfg) * 1e9 / 4) + 1000;
     while (!atomic_load(&n->quit)) {
         if (atomic_load_explicit(&n->park_req, memory_order_acquire) !=
             atomic_load_explicit(&n->park_ack, memory_order_relaxed)) {
-            parked(n, &finishing);
+            parked(n, &finishing, &aux_stop);
             continue;
         }
-        pull_segments(n, &finishing);
+        pull_segments(n, &finishing, &stop_aux, &aux_stop);
         if (ncp_spsc_count(&n->sps) >= ncp_spsc_capacity(&n->sps) ||
             !may_step(n, finishing, &wait_since)) {
             int idle = ncp_planner_idle(n->planner) && ncp_planner_queued(n->planner) == 0;
@@ -102,11 +106,21 @@ void *nck_planner_main(void *arg)
         }
         struct ncp_setpoint sp;
         int more = ncp_planner_step(n->planner, &sp);
+        if (!more) {
+            /* the stop's sample: the machine functions due there; an AUX
+             * stop is no end of the job's motion */
+            if (stop_aux > sp.aux)
+                sp.aux = stop_aux;
+            if (aux_stop)
+                sp.flags &= ~(uint32_t)NCP_SP_END;
+        }
         ncp_spsc_push(&n->sps, &sp);
         if (!more) {
-            atomic_fetch_add_explicit(&n->ends_pushed, 1, memory_order_release);
+            if (!aux_stop)
+                atomic_fetch_add_explicit(&n->ends_pushed, 1, memory_order_release);
             ncp_planner_restart(n->planner);
             finishing = 0;
+            aux_stop = 0;
         }
     }
     return NULL;

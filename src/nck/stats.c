@@ -72,6 +72,7 @@ void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
         s->contour_sum += c;
     }
     s->line = fb->line;
+    s->rpm_max = fmax(s->rpm_max, fabs(fb->rpm));
     memcpy(s->act, fb->act, sizeof s->act);
     s->t = fb->t;
     s->v = fb->v;
@@ -79,17 +80,22 @@ void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
         return;
     if (sizeof s->tbuf - s->tlen < 512)
         nck_trace_flush(s, trace);
+    /* the machine functions after the axes: readers of the first ten
+     * columns keep working */
+    double deg = 360 * (fb->rev - floor(fb->rev));
     int k = snprintf(s->tbuf + s->tlen, sizeof s->tbuf - s->tlen,
-                     "%.6f,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%d\n", fb->t, fb->line,
-                     fb->cmd[0], fb->cmd[1], fb->cmd[2], fb->act[0], fb->act[1], fb->act[2],
-                     fb->v, nck_motion_column(fb->flags));
+                     "%.6f,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%d,%.3f,%.3f,%d,%d,%llu,%d,%d\n",
+                     fb->t, fb->line, fb->cmd[0], fb->cmd[1], fb->cmd[2], fb->act[0], fb->act[1],
+                     fb->act[2], fb->v, nck_motion_column(fb->flags), fb->rpm, deg, fb->mist,
+                     fb->flood, (unsigned long long)fb->dout, fb->tool, fb->wait);
     if (k > 0 && (size_t)k < sizeof s->tbuf - s->tlen)
         s->tlen += (size_t)k;
 }
 
 void nck_trace_header(FILE *trace)
 {
-    fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n", trace);
+    fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion,spindle_rpm,spindle_deg,mist,"
+          "flood,dout,tool,wait\n", trace);
     fflush(trace);
 }
 
@@ -119,6 +125,8 @@ int nck_read_cycles(struct nck *n)
     int got = 0;
     while (ncp_spsc_pop(&n->fbs, &fb) == 0) {
         nck_account(&n->sum, &fb, n->setup.trace);
+        if (fb.waits != n->last_fb.waits && fb.wait != NCK_WAIT_NONE)
+            nck_wait_began(n, &fb);
         n->last_fb = fb;
         n->have_fb = 1;
         got++;
@@ -164,6 +172,11 @@ void ncp_nck_print_summary(const struct ncp_nck_result *r, const char *prog, FIL
             r->ferr_avg);
     fprintf(f, "  contour error: max %.4f mm, avg %.4f mm in motion\n", r->contour_max,
             r->contour_avg);
+    fprintf(f, "  canonical calls: %llu in, %llu acted on, %llu refused; spindle max %.0f rpm; "
+               "%llu pauses\n",
+            (unsigned long long)r->calls_in, (unsigned long long)r->calls_acted,
+            (unsigned long long)r->calls_refused, r->spindle_rpm_max,
+            (unsigned long long)r->pauses);
     print_latency(&r->lat, f);
     fprintf(f, "  deadline misses %llu (periods skipped %llu), underruns %llu (slowed along the path; "
                "%llu cycles held empty), planner waited %llu cycles\n",

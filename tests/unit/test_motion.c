@@ -610,6 +610,10 @@ static void test_canon_spindle_feeds(void **state)
     assert_int_equal(map_op(&f, mode, 1), 0);
     assert_int_equal(map_op(&f, op6(NCP_C_SET_SPINDLE_SPEED, 600, 0, 0), 2), 0);
     assert_int_equal(map_op(&f, op_feed(0.2), 3), 0);
+    /* per turn of a stopped spindle: refused (it would never move) */
+    assert_true(map_op(&f, op6(NCP_C_STRAIGHT_FEED, 10, 0, -5), 4) < 0);
+    assert_non_null(strstr(f.d.msg, "spindle stopped"));
+    assert_int_equal(map_op(&f, op6(NCP_C_START_SPINDLE_CLOCKWISE, 0, 0, 0), 4), 0);
     assert_int_equal(map_op(&f, op6(NCP_C_STRAIGHT_FEED, 10, 0, -5), 4), 1);
     assert_true(fabs(f.s.feed - 0.2 * 600 / 60.0 * 0.5) < 1e-12);
     /* G96 S180 (m/min) D2500: at X 10 mm 180000 / (2 pi 10) = 2864.8 rpm, capped */
