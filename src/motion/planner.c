@@ -460,13 +460,14 @@ static double dist_to_chord(const double q[NCP_AXES], const double a[NCP_AXES],
 }
 
 /* May s join the chain? It must continue it with the same feed and mode,
- * and the line from the chain's start to s's end must pass within Q of every
+ * with no machine function (M62, M67, ...) sent between them, and the line from the chain's start to s's end must pass within Q of every
  * point programmed so far. */
 static int chain_takes(const struct ncp_planner *p, const struct ncp_seg *s)
 {
     const struct ncp_seg *c = &p->chain;
     if (!chain_may_start(s) || p->chain_n >= PLAN_CHAIN_MAX || s->merge_tol != c->merge_tol ||
-        s->feed != c->feed || s->blend_feed != c->blend_feed || s->tolerance != c->tolerance)
+        s->feed != c->feed || s->blend_feed != c->blend_feed || s->tolerance != c->tolerance ||
+        s->aux != c->aux)  /* a machine function between them keeps its place */
         return 0;
     for (int j = 0; j < NCP_AXES; j++)
         if (fabs(s->start[j] - c->end[j]) > 1e-9)
