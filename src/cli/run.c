@@ -176,6 +176,17 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                 res->diag.line, res->diag.msg);
         return RUN_FAULT;
     }
+    if (res->refused) {
+        fprintf(stderr, "%s:%u:%u: error: %s (found before motion: nothing moved)\n",
+                res->diag.file ? res->diag.file : o->prog, res->diag.line,
+                res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
+        return RUN_PROGRAM;
+    }
+    if (res->interrupted && res->lat.cycles == 0) {
+        fprintf(stderr, "%s: stopped while checking the program before motion (nothing moved)\n",
+                o->prog);
+        return RUN_OK;
+    }
     int drive_fault = res->status == RUN_FAULT && res->diag.code == NCP_ERR_IO && !res->fault;
     if (drive_fault && res->lat.cycles == 0) {
         fprintf(stderr, "%s: error: drive start-up failed: %s (nothing moved)\n", o->prog,
@@ -330,6 +341,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .feed_override = o->feed_override, .trace = trace,
         .progress = isatty(2) && !o->virtual_clock ? stderr : NULL,
         .total_lines = count_lines(src),
+        .notes = stderr,
         .interrupt = &run_signal,
     };
     struct ncp_nck_result *res = malloc(sizeof *res);
