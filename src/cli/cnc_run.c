@@ -4,6 +4,7 @@
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
 #include "canon_writer.h"
+#include "machine.h"
 #include "run.h"
 #include "serve.h"
 
@@ -214,6 +215,8 @@ static int cmd_parse(int argc, char **argv)
     o.mode = NCP_MODE_DET;
     if (parse_args(argc, argv, &o))
         return usage(stderr), EXIT_USAGE;
+    if (ncp_cli_check_tool_table(o.acfg.tool_table_path))
+        return EXIT_USAGE;
 
     struct ncp_thread_map map;
     struct ncp_diag d;
@@ -293,6 +296,8 @@ static int cmd_check(int argc, char **argv)
     memset(&o, 0, sizeof o);
     if (parse_args(argc, argv, &o))
         return usage(stderr), EXIT_USAGE;
+    if (ncp_cli_check_tool_table(o.acfg.tool_table_path))
+        return EXIT_USAGE;
     struct ncp_source src;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);

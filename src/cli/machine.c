@@ -1,6 +1,8 @@
 /* The machine INI as the front ends load it (run, serve). */
 #include "machine.h"
 
+#include "ncpar/analyzer.h"
+
 #include <stdio.h>
 #include <string.h>
 
@@ -21,5 +23,15 @@ int ncp_cli_load_machine(const char *path, struct ncp_machine_cfg *cfg)
         fprintf(stderr, "%s:%u: error: %s\n", path, d.line, msg);
     else
         fprintf(stderr, "%s: error: %s\n", path, msg);
+    return -1;
+}
+
+int ncp_cli_check_tool_table(const char *path)
+{
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (!path || ncp_tool_table_check(path, stderr, &d) == NCP_OK)
+        return 0;
+    fprintf(stderr, "%s: error: %s\n", path, d.msg);
     return -1;
 }

@@ -371,7 +371,7 @@ int ncp_cli_run(int argc, char **argv)
         return usage(stderr), RUN_USAGE;
     ncp_cli_catch_stop_signals(on_signal);
     struct ncp_machine_cfg cfg;
-    if (load_config(&o, &cfg))
+    if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
         return RUN_USAGE;
     struct ncp_source src;
     struct ncp_diag d;
