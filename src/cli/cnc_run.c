@@ -223,7 +223,10 @@ static int cmd_parse(int argc, char **argv)
     memset(&d, 0, sizeof d);
     if (o.config) {
         if (ncp_thread_map_load(&map, o.config, &d) != NCP_OK) {
-            fprintf(stderr, "%s:%u: error: %s\n", o.config, d.line, d.msg);
+            if (d.line)
+                fprintf(stderr, "%s:%u: error: %s\n", o.config, d.line, d.msg);
+            else
+                fprintf(stderr, "%s: error: %s\n", o.config, d.msg);
             return EXIT_USAGE;
         }
         if (o.mode_given)
