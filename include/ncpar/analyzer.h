@@ -6,6 +6,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include "ncpar/blocks.h"
 #include "ncpar/canon.h"
 #include "ncpar/diag.h"
@@ -29,6 +30,12 @@ struct ncp_tool_entry {
 };
 
 #define NCP_MAX_TOOLS 1000
+
+/* Reads a LinuxCNC tool table as the interpreter will and writes a warning
+ * "PATH:LINE: warning: ..." to warn (if not NULL) for each line the
+ * interpreter skips (rs274: "Unrecognized line skipped"). A table that cannot
+ * be read (missing, a directory) is an error in d. */
+int ncp_tool_table_check(const char *path, FILE *warn, struct ncp_diag *d);
 
 #define NCP_DEFAULT_MAX_LOOPS 10000000u
 

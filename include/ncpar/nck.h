@@ -76,6 +76,7 @@ struct ncp_nck_opts {
     FILE *trace;             /* per-cycle CSV or NULL */
     FILE *progress;          /* live progress line (a terminal) or NULL */
     uint32_t total_lines;    /* for the progress line */
+    FILE *notes;             /* the check before motion says how far it is, or NULL */
     struct ncp_nck_ctl *ctl; /* live override / hold, or NULL */
     /* polled while the run goes on: non-zero asks for a controlled stop
      * (a signal handler's flag), or NULL */
@@ -87,7 +88,8 @@ enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT =
 struct ncp_nck_result {
     int status;              /* enum ncp_nck_status */
     int limit_violation;     /* soft limit found before motion (diag says where) */
-    int refused;             /* a call the machine cannot act on, found before motion */
+    int refused;             /* refused before motion, nothing moved: a program error or
+                                a call the machine cannot act on (diag says where) */
     int fault;               /* following-error fault */
     int fault_axis;
     double fault_err;

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* What rs274 loads when started without -t (LinuxCNC's sample tool.tbl). */
 static const char ncp_default_table[] =
@@ -64,6 +65,110 @@ static int ncp_tool_line(const char *s, const char *end, struct ncp_tool_entry *
     return *toolno >= 0;
 }
 
+/* What the loader skips in silence, as rs274 does ("Unrecognized line
+ * skipped"): a word that is no tool table letter with a number, or a line
+ * without a tool number. Returns 1 for a tool line, 0 for a blank or comment
+ * line, -1 (why filled) for a line the loader skips. */
+static int ncp_tool_line_check(const char *s, const char *end, char *why, size_t len)
+{
+    int has_t = 0, words = 0;
+    while (s < end && *s != ';') {
+        unsigned char c = (unsigned char)*s;
+        if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
+            s++;
+            continue;
+        }
+        char up = (char)(c >= 'a' && c <= 'z' ? c - 32 : c);
+        if (!(up >= 'A' && up <= 'Z')) {
+            if (c >= 0x20 && c < 0x7f)
+                snprintf(why, len, "unexpected '%c'", c);
+            else
+                snprintf(why, len, "unexpected byte 0x%02x", c);
+            return -1;
+        }
+        if (!strchr("TPXYZABCUVWDIJQ", up)) {
+            snprintf(why, len, "unknown word '%c'", c);
+            return -1;
+        }
+        const char *num = ++s;
+        while (s < end && strchr("+-.0123456789eE", *s) != NULL && *s)
+            s++;
+        char buf[64], *stop;
+        size_t n = (size_t)(s - num);
+        if (n == 0 || n >= sizeof buf) {
+            snprintf(why, len, "'%c' without a number", c);
+            return -1;
+        }
+        memcpy(buf, num, n);
+        buf[n] = '\0';
+        double v = strtod(buf, &stop);
+        if (*stop || !isfinite(v)) {
+            snprintf(why, len, "'%c' with a bad number '%s'", c, buf);
+            return -1;
+        }
+        words++;
+        if (up == 'T') {
+            if (v < 0) {
+                snprintf(why, len, "negative tool number");
+                return -1;
+            }
+            has_t = 1;
+        }
+    }
+    if (words && !has_t) {
+        snprintf(why, len, "no T word (tool number)");
+        return -1;
+    }
+    return words > 0;
+}
+
+int ncp_tool_table_check(const char *path, FILE *warn, struct ncp_diag *d)
+{
+    enum { SHOWN_MAX = 20 }; /* random bytes make hundreds of lines */
+    FILE *f = fopen(path, "rb");
+    struct stat st;
+    if (!f || fstat(fileno(f), &st) != 0) {
+        int e = errno;
+        if (f)
+            fclose(f);
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read tool table %s: %s", path,
+                            strerror(e));
+    }
+    if (S_ISDIR(st.st_mode)) {
+        fclose(f);
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read tool table %s: %s", path,
+                            strerror(EISDIR));
+    }
+    char line[4096];
+    unsigned no = 0, bad = 0;
+    int partial = 0;
+    while (fgets(line, sizeof line, f)) {
+        size_t n = strlen(line);
+        int whole = n && line[n - 1] == '\n';
+        if (!partial)
+            no++;
+        /* the rest of an overlong line was judged with its start */
+        if (partial) {
+            partial = !whole;
+            continue;
+        }
+        partial = !whole;
+        char why[64];
+        if (ncp_tool_line_check(line, line + n, why, sizeof why) >= 0)
+            continue;
+        if (++bad <= SHOWN_MAX && warn)
+            fprintf(warn, "%s:%u: warning: tool table line skipped: %s\n", path, no, why);
+    }
+    int err = ferror(f) ? errno : 0;
+    fclose(f);
+    if (err)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read tool table %s: %s", path,
+                            strerror(err));
+    if (bad > SHOWN_MAX && warn)
+        fprintf(warn, "%s: warning: %u more tool table lines skipped\n", path, bad - SHOWN_MAX);
+    return NCP_OK;
+}
+
 static void ncp_tools_parse(struct ncp_analyzer *a, const char *text, size_t len)
 {
     const char *p = text, *end = text + len;
@@ -75,7 +180,9 @@ static void ncp_tools_parse(struct ncp_analyzer *a, const char *text, size_t len
         const char *nl = memchr(p, '\n', (size_t)(end - p));
         const char *le = nl ? nl : end;
         int no;
-        if (ncp_tool_line(p, le, &a->tools[a->n_tools], a->tool_more[a->n_tools], &no))
+        char why[64];
+        if (ncp_tool_line_check(p, le, why, sizeof why) > 0 &&
+            ncp_tool_line(p, le, &a->tools[a->n_tools], a->tool_more[a->n_tools], &no))
             a->tool_no[a->n_tools++] = no;
         p = nl ? nl + 1 : end;
     }

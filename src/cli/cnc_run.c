@@ -5,6 +5,7 @@
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
 #include "canon_writer.h"
+#include "machine.h"
 #include "outfile.h"
 #include "run.h"
 #include "signals.h"
@@ -232,13 +233,18 @@ static int cmd_parse(int argc, char **argv)
     o.mode = NCP_MODE_DET;
     if (parse_args(argc, argv, &o))
         return usage(stderr), EXIT_USAGE;
+    if (ncp_cli_check_tool_table(o.acfg.tool_table_path))
+        return EXIT_USAGE;
 
     struct ncp_thread_map map;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     if (o.config) {
         if (ncp_thread_map_load(&map, o.config, &d) != NCP_OK) {
-            fprintf(stderr, "%s:%u: error: %s\n", o.config, d.line, d.msg);
+            if (d.line)
+                fprintf(stderr, "%s:%u: error: %s\n", o.config, d.line, d.msg);
+            else
+                fprintf(stderr, "%s: error: %s\n", o.config, d.msg);
             return EXIT_USAGE;
         }
         if (o.mode_given)
@@ -323,6 +329,8 @@ static int cmd_check(int argc, char **argv)
     memset(&o, 0, sizeof o);
     if (parse_args(argc, argv, &o))
         return usage(stderr), EXIT_USAGE;
+    if (ncp_cli_check_tool_table(o.acfg.tool_table_path))
+        return EXIT_USAGE;
     struct ncp_source src;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);

@@ -179,10 +179,15 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
         return RUN_FAULT;
     }
     if (res->refused) {
-        fprintf(stderr, "%s:%u:%u: error: %s (refused before motion: nothing moved)\n",
+        fprintf(stderr, "%s:%u:%u: error: %s (found before motion: nothing moved)\n",
                 res->diag.file ? res->diag.file : o->prog, res->diag.line,
                 res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
         return RUN_PROGRAM;
+    }
+    if (res->interrupted && res->lat.cycles == 0) {
+        fprintf(stderr, "%s: stopped while checking the program before motion (nothing moved)\n",
+                o->prog);
+        return RUN_OK;
     }
     int drive_fault = res->status == RUN_FAULT && res->diag.code == NCP_ERR_IO && !res->fault;
     if (drive_fault && res->lat.cycles == 0) {
@@ -439,6 +444,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .feed_override = o->feed_override, .trace = trace,
         .progress = isatty(2) && !o->virtual_clock ? stderr : NULL,
         .total_lines = count_lines(src),
+        .notes = stderr,
         .interrupt = &run_signal,
     };
     struct ncp_nck_result *res = malloc(sizeof *res);
@@ -470,7 +476,7 @@ int ncp_cli_run(int argc, char **argv)
         return usage(stderr), RUN_USAGE;
     ncp_cli_catch_stop_signals(on_signal);
     struct ncp_machine_cfg cfg;
-    if (load_config(&o, &cfg))
+    if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
         return RUN_USAGE;
     struct ncp_source src;
     struct ncp_diag d;

@@ -107,7 +107,7 @@ int ncp_cli_serve(int argc, char **argv)
     if (parse(argc, argv, &a))
         return usage(stderr), SERVE_USAGE;
     struct ncp_machine_cfg cfg;
-    if (ncp_cli_load_machine(a.config, &cfg))
+    if (ncp_cli_load_machine(a.config, &cfg) || ncp_cli_check_tool_table(a.tool_table))
         return SERVE_USAGE;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);

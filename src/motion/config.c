@@ -1,15 +1,18 @@
 /* Machine INI (LinuxCNC style) read with libinih. Every key is known: a typo in a
  * machine file must not silently fall back to a default. */
 #include "ncpar/motion.h"
+#include "ini_num.h"
 
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
 #include <sched.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
@@ -48,24 +51,116 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->lcm.status_hz = 50.0;
 }
 
+/* The safety keys every axis must state: a machine must never run on a limit
+ * nobody wrote down. MAX_JERK joins them under PROFILE = scurve. */
+enum { AK_MIN_LIMIT, AK_MAX_LIMIT, AK_MAX_VELOCITY, AK_MAX_ACCELERATION, AK_MAX_JERK, AK_FERROR,
+       AK_COUNT };
+static const char *const axis_required[] = { "MIN_LIMIT", "MAX_LIMIT", "MAX_VELOCITY",
+                                             "MAX_ACCELERATION", "FERROR" };
+
+#define MAX_SEEN 128 /* more than there are known keys: an unknown one stops the load */
+
 struct load_ctx {
     struct ncp_machine_cfg *c;
     const char *path;
     struct ncp_diag *d;
+    FILE *f;
     int failed;
+    unsigned line;              /* lines read so far: the handler's key is on this one */
+    unsigned axis_line[NCP_AXES]; /* line of [AXIS_n], 0 = not in the file */
+    unsigned axis_set[NCP_AXES];  /* AK_* bits given */
+    unsigned profile_line;
+    struct seen { char sec[16], key[32]; unsigned line; } seen[MAX_SEEN];
+    int n_seen;
+    struct { char name[16]; unsigned line; } sections[16];
+    int n_sections;
 };
+
+__attribute__((format(printf, 3, 4)))
+static int fail_at(struct load_ctx *lc, unsigned line, const char *fmt, ...)
+{
+    if (lc->failed)
+        return 0;
+    lc->failed = 1;
+    char msg[NCP_DIAG_MSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    va_end(ap);
+    ncp_diag_set(lc->d, NCP_ERR_SEMANTIC, line, 0, "%s: %s", lc->path, msg);
+    return 0;
+}
+
+int ncp_ini_decimal(const char *v)
+{
+    const char *p = v;
+    if (*p == '+' || *p == '-')
+        p++;
+    size_t digits = strspn(p, "0123456789");
+    p += digits;
+    if (*p == '.') {
+        size_t frac = strspn(p + 1, "0123456789");
+        digits += frac;
+        p += 1 + frac;
+    }
+    if (!digits)
+        return 0;
+    if (*p == 'e' || *p == 'E') {
+        p++;
+        if (*p == '+' || *p == '-')
+            p++;
+        size_t e = strspn(p, "0123456789");
+        if (!e)
+            return 0;
+        p += e;
+    }
+    p += strspn(p, " \t");
+    return *p == '\0';
+}
+
+/* x as the INI would write it: no exponent, no trailing zeros */
+static void plain(char *buf, size_t len, double x)
+{
+    snprintf(buf, len, "%.9f", x);
+    char *dot = strchr(buf, '.');
+    if (!dot)
+        return;
+    char *e = buf + strlen(buf) - 1;
+    while (e > dot && *e == '0')
+        *e-- = '\0';
+    if (e == dot)
+        *e = '\0';
+}
+
+/* The range a key takes, for its error message: "UNIT from LO to HI". */
+static void range(char *why, size_t len, const char *unit, double lo, double hi)
+{
+    char a[48], b[48];
+    plain(a, sizeof a, lo);
+    plain(b, sizeof b, hi);
+    snprintf(why, len, "%s%sfrom %s to %s", unit, *unit ? " " : "", a, b);
+}
 
 static int num(const char *v, double lo, double hi, double *out)
 {
+    if (!ncp_ini_decimal(v))
+        return -1;
     char *end;
     errno = 0;
     double x = strtod(v, &end);
-    while (*end == ' ' || *end == '\t')
-        end++;
-    if (errno || end == v || *end || !isfinite(x) || x < lo || x > hi)
+    if (errno || end == v || !isfinite(x) || x < lo || x > hi)
         return -1;
     *out = x;
     return 0;
+}
+
+static int real(const char *v, double lo, double hi, double *out, const char *unit, char *why,
+                size_t len)
+{
+    if (num(v, lo, hi, out) == 0)
+        return 1;
+    range(why, len, unit, lo, hi);
+    return -1;
 }
 
 static int integer(const char *v, int lo, int hi, int *out)
@@ -77,25 +172,39 @@ static int integer(const char *v, int lo, int hi, int *out)
     return 0;
 }
 
-/* An axis key: returns 1 if known and set, 0 if unknown, -1 if the value is bad. */
-static int axis_key(struct ncp_axis_cfg *a, const char *k, const char *v)
+static int whole(const char *v, int lo, int hi, int *out, const char *unit, char *why, size_t len)
 {
-    const struct { const char *name; double *dst; double lo, hi; } keys[] = {
-        { "MIN_LIMIT", &a->min_limit, -1e6, 1e6 },
-        { "MAX_LIMIT", &a->max_limit, -1e6, 1e6 },
-        { "MAX_VELOCITY", &a->max_vel, 1e-6, 1e6 },
-        { "MAX_ACCELERATION", &a->max_acc, 1e-6, 1e8 },
-        { "MAX_JERK", &a->max_jerk, 0, 1e12 },
-        { "FERROR", &a->ferror, 1e-9, 1e6 },
-        { "COUNTS_PER_MM", &a->counts_per_mm, 1e-3, 1e9 },
-        { "HOME", &a->home, -1e6, 1e6 },
-        { "HOME_SEARCH_VEL", &a->home_vel, 0, 1e6 },
+    if (integer(v, lo, hi, out) == 0)
+        return 1;
+    snprintf(why, len, "%s%sa whole number from %d to %d", unit, *unit ? ", " : "", lo, hi);
+    return -1;
+}
+
+/* An axis key: returns 1 if known and set (*bit: its AK_* bit, 0 for the
+ * others), 0 if unknown, -1 if the value is bad. */
+static int axis_key(struct ncp_axis_cfg *a, const char *k, const char *v, unsigned *bit,
+                    char *why, size_t len)
+{
+    const struct { const char *name; double *dst; double lo, hi; const char *unit; int ak; } keys[] = {
+        { "MIN_LIMIT", &a->min_limit, -1e6, 1e6, "mm", AK_MIN_LIMIT },
+        { "MAX_LIMIT", &a->max_limit, -1e6, 1e6, "mm", AK_MAX_LIMIT },
+        { "MAX_VELOCITY", &a->max_vel, 1e-6, 1e6, "mm/s", AK_MAX_VELOCITY },
+        { "MAX_ACCELERATION", &a->max_acc, 1e-6, 1e8, "mm/s^2", AK_MAX_ACCELERATION },
+        { "MAX_JERK", &a->max_jerk, 0, 1e12, "mm/s^3", AK_MAX_JERK },
+        { "FERROR", &a->ferror, 1e-9, 1e6, "mm", AK_FERROR },
+        { "COUNTS_PER_MM", &a->counts_per_mm, 1e-3, 1e9, "counts/mm", -1 },
+        { "HOME", &a->home, -1e6, 1e6, "mm", -1 },
+        { "HOME_SEARCH_VEL", &a->home_vel, 0, 1e6, "mm/s (0: half of MAX_VELOCITY)", -1 },
     };
+    *bit = 0;
     if (!strcasecmp(k, "NODE_ID"))
-        return integer(v, 1, 127, &a->node_id) ? -1 : 1;
-    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
-        if (!strcasecmp(k, keys[i].name))
-            return num(v, keys[i].lo, keys[i].hi, keys[i].dst) ? -1 : 1;
+        return whole(v, 1, 127, &a->node_id, "CANopen node", why, len);
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+        if (strcasecmp(k, keys[i].name) != 0)
+            continue;
+        *bit = keys[i].ak >= 0 ? 1u << keys[i].ak : 0;
+        return real(v, keys[i].lo, keys[i].hi, keys[i].dst, keys[i].unit, why, len);
+    }
     return 0;
 }
 
@@ -124,7 +233,8 @@ static int rt_key(struct ncp_machine_cfg *c, const char *k, const char *v, char 
             continue;
         if (!strcasecmp(k + n, "PRIORITY")) {
             /* 0 is SCHED_OTHER, as in the thread maps' POLICY = other */
-            if (integer(v, 0, 99, &threads[i].pl->priority))
+            if (whole(v, 0, 99, &threads[i].pl->priority, "0: SCHED_OTHER, 1..99: SCHED_FIFO",
+                      why, len) < 0)
                 return -1;
             threads[i].pl->policy = threads[i].pl->priority > 0 ? SCHED_FIFO : SCHED_OTHER;
             return 1;
@@ -135,42 +245,45 @@ static int rt_key(struct ncp_machine_cfg *c, const char *k, const char *v, char 
     return 0;
 }
 
-static int planner_key(struct ncp_machine_cfg *c, const char *k, const char *v)
+static int planner_key(struct ncp_machine_cfg *c, const char *k, const char *v, char *why,
+                       size_t len)
 {
     if (!strcasecmp(k, "LOOKAHEAD"))
-        return integer(v, 2, 100000, &c->lookahead) ? -1 : 1;
+        return whole(v, 2, 100000, &c->lookahead, "segments", why, len);
     if (!strcasecmp(k, "SETPOINT_RING"))
-        return integer(v, 4, 1 << 20, &c->setpoint_ring) ? -1 : 1;
+        return whole(v, 4, 1 << 20, &c->setpoint_ring, "planning periods", why, len);
     if (!strcasecmp(k, "PROFILE")) {
         if (!strcasecmp(v, "trapezoid"))
             c->profile = NCP_PROFILE_TRAPEZOID;
         else if (!strcasecmp(v, "scurve"))
             c->profile = NCP_PROFILE_SCURVE;
         else
-            return -1;
+            return snprintf(why, len, "trapezoid or scurve"), -1;
         return 1;
     }
     return 0;
 }
 
-static int sim_key(struct ncp_machine_cfg *c, const char *k, const char *v)
+static int sim_key(struct ncp_machine_cfg *c, const char *k, const char *v, char *why,
+                   size_t len)
 {
     const struct { const char *name; double *dst; } keys[] = {
         { "KP", &c->kp }, { "KI", &c->ki }, { "KD", &c->kd }, { "FF1", &c->ff1 }, { "FF2", &c->ff2 },
     };
     for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
         if (!strcasecmp(k, keys[i].name))
-            return num(v, 0, 1e9, keys[i].dst) ? -1 : 1;
+            return real(v, 0, 1e9, keys[i].dst, "", why, len);
     return 0;
 }
 
-static int can_key(struct ncp_can_cfg *c, const char *k, const char *v)
+static int can_key(struct ncp_can_cfg *c, const char *k, const char *v, char *why, size_t len)
 {
     if (!strcasecmp(k, "INTERFACE")) {
         /* what the kernel accepts as an interface name (IFNAMSIZ) */
         size_t n = strlen(v);
         if (n == 0 || n >= sizeof c->interface || strpbrk(v, " \t/:"))
-            return -1;
+            return snprintf(why, len, "an interface name of 1 to %zu characters without "
+                                      "blanks, / or :", sizeof c->interface - 1), -1;
         memcpy(c->interface, v, n + 1);
         return 1;
     }
@@ -181,16 +294,16 @@ static int can_key(struct ncp_can_cfg *c, const char *k, const char *v)
     };
     for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
         if (!strcasecmp(k, keys[i].name))
-            return integer(v, keys[i].lo, keys[i].hi, keys[i].dst) ? -1 : 1;
+            return whole(v, keys[i].lo, keys[i].hi, keys[i].dst, "ms", why, len);
     return 0;
 }
 
-static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v)
+static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v, char *why, size_t len)
 {
     if (!strcasecmp(k, "URL")) {
         size_t n = strlen(v);
         if (n == 0 || n >= sizeof l->url)
-            return -1;
+            return snprintf(why, len, "1 to %zu characters", sizeof l->url - 1), -1;
         memcpy(l->url, v, n + 1);
         return 1;
     }
@@ -198,64 +311,114 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v)
         /* LCM channel names: letters, digits and _ keep lcm-spy's filters simple */
         size_t n = strlen(v);
         if (n >= sizeof l->prefix || strspn(v, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_") != n)
-            return -1;
+            return snprintf(why, len, "letters, digits and _, up to %zu of them",
+                            sizeof l->prefix - 1), -1;
         memcpy(l->prefix, v, n + 1);
         return 1;
     }
     if (!strcasecmp(k, "STATUS_HZ"))
-        return num(v, 0, 1000, &l->status_hz) ? -1 : 1;
+        return real(v, 0, 1000, &l->status_hz, "Hz (0: only at changes)", why, len);
     return 0;
 }
 
-static int dispatch(struct ncp_machine_cfg *c, const char *sec, const char *k, const char *v,
-                    char *why, size_t len)
+static int traj_key(struct ncp_machine_cfg *c, const char *k, const char *v, char *why,
+                    size_t len)
 {
     double x;
+    if (!strcasecmp(k, "MAX_LINEAR_VELOCITY"))
+        return real(v, 1e-6, 1e6, &c->max_linear_vel, "mm/s", why, len);
+    if (!strcasecmp(k, "PLANNING_PERIOD")) {
+        if (real(v, 125000, 100000000, &x, "ns", why, len) < 0)
+            return -1;
+        c->planning_period = x * 1e-9;
+        return 1;
+    }
+    if (!strcasecmp(k, "DEFAULT_LINEAR_ACCELERATION"))
+        return real(v, 0, 1e8, &c->default_linear_acc, "mm/s^2 (0: the axes' limits)", why, len);
+    if (!strcasecmp(k, "DEFAULT_LINEAR_VELOCITY"))
+        return real(v, 1e-6, 1e6, &c->default_linear_vel, "mm/s", why, len);
+    if (!strcasecmp(k, "NO_FORCE_HOMING"))
+        return integer(v, 0, 1, &c->no_force_homing) ? snprintf(why, len, "0 or 1"), -1 : 1;
+    return 0;
+}
+
+/* [AXIS_X] -> 0 .. [AXIS_Z] -> 2, else -1 */
+static int axis_index(const char *sec)
+{
+    if (strncasecmp(sec, "AXIS_", 5) != 0 || strlen(sec) != 6)
+        return -1;
+    const char *p = strchr("XYZ", sec[5] & ~0x20);
+    return p && *p ? (int)(p - "XYZ") : -1;
+}
+
+static int known_section(const char *sec)
+{
+    static const char *const names[] = { "EMCMOT", "TRAJ",   "LCM",   "PLANNER",
+                                         "SIM",    "RT",     "CAN",   "SPINDLE_0",
+                                         "EMCIO" };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (!strcasecmp(sec, names[i]))
+            return 1;
+    return axis_index(sec) >= 0;
+}
+
+static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const char *v,
+                    char *why, size_t len)
+{
+    struct ncp_machine_cfg *c = lc->c;
     if (!strcasecmp(sec, "EMCMOT")) {
         if (strcasecmp(k, "SERVO_PERIOD") != 0)
             return 0;
         /* 125 us .. 10 ms: outside that the plant model and the loop make no sense */
-        if (num(v, 125000, 10000000, &x))
+        double x;
+        if (real(v, 125000, 10000000, &x, "ns", why, len) < 0)
             return -1;
         c->servo_period = x * 1e-9;
         return 1;
     }
-    if (!strcasecmp(sec, "TRAJ")) {
-        if (!strcasecmp(k, "MAX_LINEAR_VELOCITY"))
-            return num(v, 1e-6, 1e6, &c->max_linear_vel) ? -1 : 1;
-        if (!strcasecmp(k, "PLANNING_PERIOD")) {
-            if (num(v, 125000, 100000000, &x))
-                return -1;
-            c->planning_period = x * 1e-9;
-            return 1;
-        }
-        if (!strcasecmp(k, "DEFAULT_LINEAR_ACCELERATION"))
-            return num(v, 0, 1e8, &c->default_linear_acc) ? -1 : 1;
-        if (!strcasecmp(k, "DEFAULT_LINEAR_VELOCITY"))
-            return num(v, 1e-6, 1e6, &c->default_linear_vel) ? -1 : 1;
-        if (!strcasecmp(k, "NO_FORCE_HOMING"))
-            return integer(v, 0, 1, &c->no_force_homing) ? -1 : 1;
-        return 0;
-    }
+    if (!strcasecmp(sec, "TRAJ"))
+        return traj_key(c, k, v, why, len);
     if (!strcasecmp(sec, "LCM"))
-        return lcm_key(&c->lcm, k, v);
-    if (!strncasecmp(sec, "AXIS_", 5) && strlen(sec) == 6) {
-        const char *p = strchr("XYZ", sec[5] & ~0x20);
-        if (!p || !*p)
-            return -2;
-        return axis_key(&c->axis[p - "XYZ"], k, v);
+        return lcm_key(&c->lcm, k, v, why, len);
+    int ax = axis_index(sec);
+    if (ax >= 0) {
+        unsigned bit;
+        int r = axis_key(&c->axis[ax], k, v, &bit, why, len);
+        if (r == 1)
+            lc->axis_set[ax] |= bit;
+        return r;
     }
-    if (!strcasecmp(sec, "PLANNER"))
-        return planner_key(c, k, v);
+    if (!strcasecmp(sec, "PLANNER")) {
+        if (!strcasecmp(k, "PROFILE"))
+            lc->profile_line = lc->line;
+        return planner_key(c, k, v, why, len);
+    }
     if (!strcasecmp(sec, "SIM")) {
-        int r = sim_key(c, k, v);
+        int r = sim_key(c, k, v, why, len);
         return r ? r : ncp_io_cfg_key(&c->io, sec, k, v, why, len);
     }
     if (!strcasecmp(sec, "RT"))
         return rt_key(c, k, v, why, len);
     if (!strcasecmp(sec, "CAN"))
-        return can_key(&c->can, k, v);
+        return can_key(&c->can, k, v, why, len);
     return ncp_io_cfg_key(&c->io, sec, k, v, why, len);
+}
+
+/* A key given twice would leave only its last value in force, whichever the
+ * writer meant: refused, naming both lines. */
+static int duplicate(struct load_ctx *lc, const char *sec, const char *k)
+{
+    for (int i = 0; i < lc->n_seen; i++)
+        if (!strcasecmp(lc->seen[i].sec, sec) && !strcasecmp(lc->seen[i].key, k))
+            return fail_at(lc, lc->line, "[%s] %s given twice (first on line %u); each key "
+                                         "once", sec, k, lc->seen[i].line), 1;
+    if (lc->n_seen < MAX_SEEN) {
+        struct seen *s = &lc->seen[lc->n_seen++];
+        snprintf(s->sec, sizeof s->sec, "%s", sec);
+        snprintf(s->key, sizeof s->key, "%s", k);
+        s->line = lc->line;
+    }
+    return 0;
 }
 
 static int on_key(void *user, const char *sec, const char *k, const char *v)
@@ -263,19 +426,60 @@ static int on_key(void *user, const char *sec, const char *k, const char *v)
     struct load_ctx *lc = user;
     if (lc->failed)
         return 0;
-    char why[96] = "";
-    int r = dispatch(lc->c, sec, k, v, why, sizeof why);
+    if (!*sec)
+        return fail_at(lc, lc->line, "%s outside of a [section]", k);
+    char why[112] = "";
+    int r = dispatch(lc, sec, k, v, why, sizeof why);
     if (r == 1)
-        return 1;
-    lc->failed = 1;
+        return duplicate(lc, sec, k) ? 0 : 1;
     if (r == -2)
-        snprintf(lc->d->msg, sizeof lc->d->msg, "%s: unknown section [%s]", lc->path, sec);
-    else if (r == 0)
-        snprintf(lc->d->msg, sizeof lc->d->msg, "%s: [%s] unknown key %s", lc->path, sec, k);
-    else
-        snprintf(lc->d->msg, sizeof lc->d->msg, "%s: [%s] %s: bad value '%s'%s%s%s", lc->path, sec,
-                 k, v, why[0] ? " (" : "", why, why[0] ? ")" : "");
-    return 0;
+        return fail_at(lc, lc->line, "unknown section [%s]", sec);
+    if (r == 0)
+        return fail_at(lc, lc->line, "[%s] unknown key %s", sec, k);
+    return fail_at(lc, lc->line, "[%s] %s: bad value '%s'%s%s%s", sec, k, v, why[0] ? " (" : "",
+                   why, why[0] ? ")" : "");
+}
+
+/* inih hands over one line per call: counting them here gives each key its
+ * line, and section headers are checked even when no key follows them. */
+static char *read_line(char *str, int n, void *stream)
+{
+    struct load_ctx *lc = stream;
+    char *s = fgets(str, n, lc->f);
+    if (!s)
+        return NULL;
+    lc->line++;
+    const char *p = s + strspn(s, " \t");
+    const char *close = *p == '[' ? strchr(p, ']') : NULL;
+    if (!close || lc->failed)
+        return s;
+    char name[32];
+    size_t len = (size_t)(close - p - 1);
+    if (len >= sizeof name) {
+        fail_at(lc, lc->line, "unknown section [%.*s]", (int)len, p + 1);
+        return s;
+    }
+    memcpy(name, p + 1, len);
+    name[len] = '\0';
+    if (!known_section(name)) {
+        fail_at(lc, lc->line, "unknown section [%s]", name);
+        return s;
+    }
+    for (int i = 0; i < lc->n_sections; i++)
+        if (!strcasecmp(lc->sections[i].name, name)) {
+            fail_at(lc, lc->line, "[%s] given twice (first on line %u); each section once",
+                    name, lc->sections[i].line);
+            return s;
+        }
+    /* known sections are fewer than the slots */
+    if (lc->n_sections < (int)(sizeof lc->sections / sizeof lc->sections[0])) {
+        snprintf(lc->sections[lc->n_sections].name, sizeof lc->sections[0].name, "%s", name);
+        lc->sections[lc->n_sections++].line = lc->line;
+    }
+    int ax = axis_index(name);
+    if (ax >= 0)
+        lc->axis_line[ax] = lc->line;
+    return s;
 }
 
 int ncp_machine_cfg_ipo_ratio(const struct ncp_machine_cfg *c)
@@ -290,30 +494,67 @@ int ncp_machine_cfg_ipo_ratio(const struct ncp_machine_cfg *c)
     return (int)r;
 }
 
-static int check_cfg(const struct ncp_machine_cfg *c, const char *path, struct ncp_diag *d)
+/* Every axis states its limits: the built-in values are a simulated mill's,
+ * never a guess for a real machine. */
+static int check_axes(struct load_ctx *lc)
 {
+    unsigned need = (1u << AK_MIN_LIMIT) | (1u << AK_MAX_LIMIT) | (1u << AK_MAX_VELOCITY) |
+                    (1u << AK_MAX_ACCELERATION) | (1u << AK_FERROR);
+    if (lc->c->profile == NCP_PROFILE_SCURVE)
+        need |= 1u << AK_MAX_JERK;
+    for (int i = 0; i < NCP_AXES; i++) {
+        if (!lc->axis_line[i])
+            return fail_at(lc, 0, "[AXIS_%c] missing: every axis (X, Y, Z) needs MIN_LIMIT, "
+                                  "MAX_LIMIT, MAX_VELOCITY, MAX_ACCELERATION and FERROR",
+                           "XYZ"[i]), -1;
+        unsigned missing = need & ~lc->axis_set[i];
+        if (!missing)
+            continue;
+        int k = 0;
+        while (!(missing & (1u << k)))
+            k++;
+        if (k == AK_MAX_JERK)
+            return fail_at(lc, lc->axis_line[i], "[AXIS_%c] MAX_JERK missing: PROFILE = scurve "
+                                                 "(line %u) limits every axis's jerk",
+                           "XYZ"[i], lc->profile_line), -1;
+        return fail_at(lc, lc->axis_line[i], "[AXIS_%c] %s missing: every axis needs MIN_LIMIT, "
+                                             "MAX_LIMIT, MAX_VELOCITY, MAX_ACCELERATION and FERROR",
+                       "XYZ"[i], axis_required[k > AK_MAX_JERK ? k - 1 : k]), -1;
+    }
+    return 0;
+}
+
+/* Where the file gave [sec] key (0: it did not), for the checks across keys. */
+static unsigned key_line(const struct load_ctx *lc, const char *sec, const char *k)
+{
+    for (int i = 0; i < lc->n_seen; i++)
+        if (!strcasecmp(lc->seen[i].sec, sec) && !strcasecmp(lc->seen[i].key, k))
+            return lc->seen[i].line;
+    return 0;
+}
+
+static int check_cfg(struct load_ctx *lc)
+{
+    const struct ncp_machine_cfg *c = lc->c;
     int ratio = ncp_machine_cfg_ipo_ratio(c);
     if (ratio == 0)
-        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "%s: [TRAJ] PLANNING_PERIOD %.0f ns must be a whole multiple of "
-                            "[EMCMOT] SERVO_PERIOD %.0f ns",
-                            path, c->planning_period * 1e9, c->servo_period * 1e9);
+        return fail_at(lc, key_line(lc, "TRAJ", "PLANNING_PERIOD"), "[TRAJ] PLANNING_PERIOD %.0f ns must be a whole multiple of "
+                              "[EMCMOT] SERVO_PERIOD %.0f ns",
+                       c->planning_period * 1e9, c->servo_period * 1e9), -1;
     for (int i = 0; i < NCP_AXES; i++) {
         if (c->axis[i].min_limit >= c->axis[i].max_limit)
-            return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                                "%s: [AXIS_%c] MIN_LIMIT must be below MAX_LIMIT", path,
-                                "XYZ"[i]);
+            return fail_at(lc, lc->axis_line[i], "[AXIS_%c] MIN_LIMIT must be below MAX_LIMIT",
+                           "XYZ"[i]), -1;
         for (int j = 0; j < i; j++)
             if (c->axis[i].node_id && c->axis[i].node_id == c->axis[j].node_id)
-                return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                                    "%s: [AXIS_%c] NODE_ID %d is already the node of [AXIS_%c]",
-                                    path, "XYZ"[i], c->axis[i].node_id, "XYZ"[j]);
+                return fail_at(lc, lc->axis_line[i],
+                               "[AXIS_%c] NODE_ID %d is already the node of [AXIS_%c]", "XYZ"[i],
+                               c->axis[i].node_id, "XYZ"[j]), -1;
     }
     if (c->can.heartbeat_timeout_ms <= c->can.heartbeat_period_ms)
-        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "%s: [CAN] HEARTBEAT_TIMEOUT_MS %d must be longer than "
-                            "HEARTBEAT_PERIOD_MS %d",
-                            path, c->can.heartbeat_timeout_ms, c->can.heartbeat_period_ms);
+        return fail_at(lc, key_line(lc, "CAN", "HEARTBEAT_TIMEOUT_MS"), "[CAN] HEARTBEAT_TIMEOUT_MS %d must be longer than "
+                              "HEARTBEAT_PERIOD_MS %d",
+                       c->can.heartbeat_timeout_ms, c->can.heartbeat_period_ms), -1;
     /* a late planner thread makes the position loop slow down along the path
      * on what is left in the ring (src/rt/nck.c): half a stop from the top
      * speed at half the weakest axis's acceleration has to fit */
@@ -322,28 +563,46 @@ static int check_cfg(const struct ncp_machine_cfg *c, const char *path, struct n
         a_min = fmin(a_min, c->axis[i].max_acc);
     double need = c->max_linear_vel / (a_min * c->servo_period) / ratio + 8;
     if ((double)c->setpoint_ring < need)
-        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "%s: [PLANNER] SETPOINT_RING %d is too small to stop along the path "
-                            "from MAX_LINEAR_VELOCITY: at least %.0f planning periods",
-                            path, c->setpoint_ring, ceil(need));
-    return NCP_OK;
+        return fail_at(lc, key_line(lc, "PLANNER", "SETPOINT_RING"), "[PLANNER] SETPOINT_RING %d is too small to stop along the path "
+                              "from MAX_LINEAR_VELOCITY: at least %.0f planning periods "
+                              "(up to 1048576)",
+                       c->setpoint_ring, ceil(need)), -1;
+    return 0;
 }
 
 int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp_diag *d)
 {
     memset(d, 0, sizeof *d);
-    struct load_ctx lc = { c, path, d, 0 };
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "%s: cannot open: %s", path, strerror(errno));
-    int r = ini_parse_file(f, on_key, &lc);
-    fclose(f);
-    if (r != 0) {
-        d->code = NCP_ERR_SEMANTIC;
-        d->line = r > 0 ? (uint32_t)r : 0;
-        if (!lc.failed)
-            snprintf(d->msg, sizeof d->msg, "%s: malformed line", path);
-        return d->code;
+    struct load_ctx *lc = calloc(1, sizeof *lc);
+    if (!lc)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "%s: out of memory", path);
+    lc->c = c;
+    lc->path = path;
+    lc->d = d;
+    int rc = NCP_OK;
+    struct stat st;
+    memset(&st, 0, sizeof st);
+    lc->f = fopen(path, "r");
+    if (!lc->f) {
+        rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "%s: cannot open: %s", path, strerror(errno));
+    } else if (fstat(fileno(lc->f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "%s: not a regular file%s", path,
+                          S_ISDIR(st.st_mode) ? " (a directory)" : "");
+    } else if (st.st_size == 0) {
+        rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "%s: empty file: a machine INI states at least "
+                                               "every axis's limits", path);
+    } else {
+        int r = ini_parse_stream(read_line, lc, on_key, lc);
+        if (r > 0 && !lc->failed)
+            fail_at(lc, (unsigned)r, "expected 'KEY = VALUE' or '[SECTION]'");
+        else if (r < 0 || (!lc->failed && ferror(lc->f)))
+            fail_at(lc, 0, "cannot read: %s", strerror(errno));
+        if (!lc->failed && check_axes(lc) == 0)
+            check_cfg(lc);
+        rc = lc->failed ? d->code : NCP_OK;
     }
-    return check_cfg(c, path, d);
+    if (lc->f)
+        fclose(lc->f);
+    free(lc);
+    return rc;
 }

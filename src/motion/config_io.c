@@ -3,6 +3,7 @@
  * simulated inputs and pause behaviour of a batch run ([SIM]). Every key is
  * optional: a machine file written before these existed keeps its meaning. */
 #include "ncpar/motion.h"
+#include "ini_num.h"
 
 #include <errno.h>
 #include <math.h>
@@ -20,6 +21,8 @@ void ncp_io_cfg_default(struct ncp_io_cfg *io)
 
 static int number(const char *v, double lo, double hi, double *out)
 {
+    if (!ncp_ini_decimal(v))
+        return -1;
     char *end;
     errno = 0;
     double x = strtod(v, &end);

@@ -6,71 +6,28 @@
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-/* ---- soft limits, before any motion ---------------------------------------------- */
+/* ---- the program checked whole, before any motion -------------------------------- */
+
+enum precheck_end { PC_OK, PC_LIMIT, PC_PROGRAM, PC_INTERRUPTED };
 
 struct precheck {
     struct ncp_canon_map map;
+    const struct ncp_nck_opts *o;
     struct ncp_diag d;
-    int failed;
+    int failed;             /* the map refused a move: d says why */
+    int stopped;            /* bounded or interrupted: the rest goes unchecked */
+    int interrupted;
+    double v_top;           /* no path moves faster: all axes at their limits */
+    double t;               /* machine time the moves so far take at least */
+    double t_bound;         /* past this the run never gets (0: no bound) */
+    uint64_t blocks;
+    int64_t t0, next_note;
 };
-
-static int emit_check(void *ctx, const struct ncp_cmd *cmd)
-{
-    struct precheck *pc = ctx;
-    struct ncp_seg s;
-    for (unsigned i = 0; i < cmd->n_ops; i++) {
-        /* a call the machine cannot act on is refused before anything moves */
-        if (nck_check_call(cmd, &cmd->ops[i], &pc->d)) {
-            pc->d.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
-            pc->failed = 2;
-            return 1;
-        }
-        int rc = ncp_canon_map_op(&pc->map, &cmd->ops[i], cmd->line, &s, &pc->d);
-        while (rc == 1)
-            rc = ncp_canon_map_more(&pc->map, &s, &pc->d);
-        if (rc < 0) {
-            pc->failed = pc->d.code == NCP_ERR_LIMIT ? 1 : pc->d.code == NCP_ERR_SEMANTIC &&
-                                                               strstr(pc->d.msg, "spindle") ? 2 : 0;
-            if (pc->failed)
-                pc->d.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
-            return 1;
-        }
-    }
-    return 0;
-}
-
-/* The program is interpreted once without motion: a soft-limit violation
- * anywhere stops the run before the machine moves (1), and so does a call
- * the machine cannot act on, or an M66 result the program reads (2).
- * Other program errors are left to the real run, which moves up to the last
- * good block. */
-static int precheck_limits(const struct ncp_nck_opts *o, const double start[NCP_AXES],
-                           struct ncp_diag *d)
-{
-    struct precheck *pc = calloc(1, sizeof *pc);
-    if (!pc)
-        return -1;
-    ncp_canon_map_init(&pc->map, o->cfg, start, o->feed_override);
-    struct ncp_output out = { .ctx = pc, .emit = emit_check };
-    struct ncp_diag ignored;
-    memset(&ignored, 0, sizeof ignored);
-    o->interpret(o->interp_ctx, &out, &ignored);
-    if (!pc->failed && ignored.code && strstr(ignored.msg, "result of the M66")) {
-        pc->failed = 2;
-        pc->d = ignored;
-    }
-    int failed = pc->failed;
-    if (failed)
-        *d = pc->d;
-    free(pc);
-    return failed;
-}
-
-/* ---- the run ------------------------------------------------------------------------- */
 
 static int64_t mono_ns(void)
 {
@@ -78,6 +35,102 @@ static int64_t mono_ns(void)
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
 }
+
+/* A lower bound on the time a segment takes: blending may shorten a path a
+ * little, which t_bound's margin covers. */
+static double seg_time(const struct precheck *pc, const struct ncp_seg *s)
+{
+    if (s->kind == NCP_SEG_DWELL)
+        return s->dwell;
+    double v = s->traverse || s->feed <= 0 ? pc->v_top : fmin(s->feed, pc->v_top);
+    return v > 0 ? s->length / v : 0;
+}
+
+/* A long check says how far it is, once a second, so that a program of a
+ * billion moves does not look like a hang. */
+static void note_progress(struct precheck *pc, uint32_t line)
+{
+    if ((pc->blocks & 1023) != 0 || !pc->o->notes)
+        return;
+    int64_t now = mono_ns();
+    if (now < pc->next_note)
+        return;
+    pc->next_note = now + 1000000000LL;
+    fprintf(pc->o->notes, "checking the program before motion: line %u, %llu blocks, %.1f s "
+                          "of motion so far%s\n",
+            line, (unsigned long long)pc->blocks, pc->t,
+            pc->t_bound > 0 ? "" : " (--for SECONDS limits the check)");
+    fflush(pc->o->notes);
+}
+
+static int emit_check(void *ctx, const struct ncp_cmd *cmd)
+{
+    struct precheck *pc = ctx;
+    struct ncp_seg s;
+    pc->blocks++;
+    for (unsigned i = 0; i < cmd->n_ops; i++) {
+        /* a call the machine cannot act on is refused before anything moves */
+        int rc = nck_check_call(cmd, &cmd->ops[i], &pc->d) ? -1
+                 : ncp_canon_map_op(&pc->map, &cmd->ops[i], cmd->line, &s, &pc->d);
+        while (rc == 1) {
+            pc->t += seg_time(pc, &s);
+            rc = ncp_canon_map_more(&pc->map, &s, &pc->d);
+        }
+        if (rc < 0) {
+            pc->d.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
+            pc->failed = 1;
+            return 1;
+        }
+    }
+    if (pc->o->interrupt && *pc->o->interrupt) {
+        pc->stopped = pc->interrupted = 1;
+        return 1;
+    }
+    if (pc->t_bound > 0 && pc->t > pc->t_bound) {
+        pc->stopped = 1;
+        return 1;
+    }
+    note_progress(pc, cmd->line);
+    return 0;
+}
+
+/* The program is interpreted once without motion: a soft-limit violation or
+ * a program error anywhere refuses the run before the machine moves. With
+ * --for only what can run in that time is checked, with a margin: the moves
+ * beyond it never run. */
+static enum precheck_end precheck(const struct ncp_nck_opts *o, const double start[NCP_AXES],
+                                  struct ncp_diag *d)
+{
+    struct precheck *pc = calloc(1, sizeof *pc);
+    if (!pc)
+        return PC_OK;
+    pc->o = o;
+    ncp_canon_map_init(&pc->map, o->cfg, start, o->feed_override);
+    for (int j = 0; j < NCP_AXES; j++)
+        pc->v_top += o->cfg->axis[j].max_vel * o->cfg->axis[j].max_vel;
+    pc->v_top = sqrt(pc->v_top);
+    pc->t_bound = o->for_s > 0 ? 2 * o->for_s + 1 : 0;
+    pc->t0 = mono_ns();
+    pc->next_note = pc->t0 + 1000000000LL;
+    struct ncp_output out = { .ctx = pc, .emit = emit_check };
+    struct ncp_diag id;
+    memset(&id, 0, sizeof id);
+    int rc = o->interpret(o->interp_ctx, &out, &id);
+    enum precheck_end end = PC_OK;
+    if (pc->interrupted) {
+        end = PC_INTERRUPTED;
+    } else if (pc->failed) {
+        *d = pc->d;
+        end = pc->d.code == NCP_ERR_LIMIT ? PC_LIMIT : PC_PROGRAM;
+    } else if (!pc->stopped && rc != NCP_OK) {
+        *d = id;
+        end = PC_PROGRAM;
+    }
+    free(pc);
+    return end;
+}
+
+/* ---- the run ------------------------------------------------------------------------- */
 
 static void progress(const struct nck *n, const struct ncp_nck_opts *o)
 {
@@ -229,6 +282,7 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     n->plan_override = o->feed_override > 0 ? o->feed_override : 1.0;
     n->for_s = o->for_s;
     n->ctl = o->ctl;
+    enum precheck_end pre = PC_OK;
     struct ncp_nck_setup setup = { .cfg = o->cfg, .virtual_clock = o->virtual_clock,
                                    .trace = o->trace };
     /* the soft limits are checked from where the machine is, before it moves:
@@ -237,10 +291,12 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
         if (!res->diag.code)
             res->diag.code = NCP_ERR_IO;
         res->status = NCP_NCK_FAULT;
-    } else if ((res->limit_violation = precheck_limits(o, n->start, &res->diag)) != 0) {
-        res->status = res->limit_violation == 2 ? NCP_NCK_PROGRAM_ERROR : NCP_NCK_FAULT;
-        res->refused = res->limit_violation == 2;
-        res->limit_violation = res->limit_violation == 1;
+    } else if ((pre = precheck(o, n->start, &res->diag)) != PC_OK) {
+        res->limit_violation = pre == PC_LIMIT;
+        res->refused = pre == PC_PROGRAM;
+        res->interrupted = pre == PC_INTERRUPTED;
+        res->status = pre == PC_LIMIT ? NCP_NCK_FAULT
+                      : pre == PC_PROGRAM ? NCP_NCK_PROGRAM_ERROR : NCP_NCK_OK;
     } else {
         if (o->cfg->io.auto_resume_s < 0)
             watch_usr1();
@@ -257,7 +313,7 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
         }
     }
     nck_finish(n);
-    if (res->status == NCP_NCK_OK)
+    if (res->status == NCP_NCK_OK && pre == PC_OK)
         collect(n, res);
     nck_release(n);
     free(n);

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define DEFAULT_STRING_ROWS 32 /* of n chunks of ~4 KB: 128 KB of text per lexer ahead */
@@ -103,6 +104,9 @@ struct map_loader {
     unsigned pipe_set;
     struct loaded_spec feeder, analyzer, output;
     struct loaded_spec lexer[NCP_MAX_LEXERS], executor[NCP_MAX_EXECUTORS];
+    /* keys given so far: a second one would silently win */
+    struct { char section[24], key[24]; int line; } seen[128];
+    int n_seen;
 };
 
 __attribute__((format(printf, 3, 4)))
@@ -262,6 +266,16 @@ static int on_key(void *user, const char *section, const char *name, const char 
     struct map_loader *L = user;
     if (L->failed)
         return 0;
+    for (int i = 0; i < L->n_seen; i++)
+        if (!strcmp(L->seen[i].section, section) && !strcmp(L->seen[i].key, name))
+            return fail(L, L->line, "[%s] %s given twice (first on line %d); each key once",
+                        section, name, L->seen[i].line);
+    /* known keys are fewer than the slots: an unknown one stops the load */
+    if (L->n_seen < (int)(sizeof L->seen / sizeof L->seen[0])) {
+        snprintf(L->seen[L->n_seen].section, sizeof L->seen[0].section, "%s", section);
+        snprintf(L->seen[L->n_seen].key, sizeof L->seen[0].key, "%s", name);
+        L->seen[L->n_seen++].line = L->line;
+    }
     if (!strcmp(section, "pipeline"))
         return pipeline_key(L, name, value);
     struct loaded_spec *s = spec_section(L, section);
@@ -382,6 +396,14 @@ int ncp_thread_map_load(struct ncp_thread_map *m, const char *path, struct ncp_d
     if (!L->f) {
         rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot open thread map: %s",
                           strerror(errno));
+        goto done;
+    }
+    struct stat st;
+    memset(&st, 0, sizeof st);
+    if (fstat(fileno(L->f), &st) != 0 || !S_ISREG(st.st_mode) || st.st_size == 0) {
+        rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "thread map: %s",
+                          S_ISDIR(st.st_mode) ? "a directory, not a file"
+                                              : "not a regular, non-empty file");
         goto done;
     }
     int bad = ini_parse_stream(read_line, L, on_key, L);

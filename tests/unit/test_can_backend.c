@@ -24,6 +24,10 @@
 
 /* ---- INI ------------------------------------------------------------------ */
 
+/* what every machine INI states for each axis */
+#define LIMITS "MIN_LIMIT = -500\nMAX_LIMIT = 500\nMAX_VELOCITY = 200\nMAX_ACCELERATION = 2000\nFERROR = 1\n"
+#define AXES "[AXIS_X]\n" LIMITS "[AXIS_Y]\n" LIMITS "[AXIS_Z]\n" LIMITS
+
 static char ini_path[64];
 
 static int load_ini(const char *text, struct ncp_machine_cfg *c, struct ncp_diag *d)
@@ -48,8 +52,9 @@ static void test_ini_can_section(void **state)
     struct ncp_diag d;
     assert_int_equal(load_ini("[CAN]\nINTERFACE = can1\nHEARTBEAT_PERIOD_MS = 20\n"
                               "HEARTBEAT_TIMEOUT_MS = 300\nSDO_TIMEOUT_MS = 150\n"
-                              "[AXIS_X]\nNODE_ID = 4\nCOUNTS_PER_MM = 1000\n"
-                              "[AXIS_Z]\nnode_id = 127\nCOUNTS_PER_MM = 2.5\n",
+                              "[AXIS_X]\nNODE_ID = 4\nCOUNTS_PER_MM = 1000\n" LIMITS
+                              "[AXIS_Y]\n" LIMITS
+                              "[AXIS_Z]\nnode_id = 127\nCOUNTS_PER_MM = 2.5\n" LIMITS,
                               &c, &d),
                      NCP_OK);
     assert_string_equal(c.can.interface, "can1");
@@ -62,7 +67,7 @@ static void test_ini_can_section(void **state)
     assert_int_equal(c.axis[2].node_id, 127);
     assert_true(c.axis[2].counts_per_mm == 2.5);
     /* an INI saying nothing of CAN keeps the defaults and the sim backend */
-    assert_int_equal(load_ini("[AXIS_X]\nFERROR = 2\n", &c, &d), NCP_OK);
+    assert_int_equal(load_ini(AXES, &c, &d), NCP_OK);
     assert_int_equal(c.backend, NCP_BACKEND_SIM);
     assert_string_equal(c.can.interface, "");
     assert_int_equal(c.can.heartbeat_timeout_ms, 500);
@@ -90,9 +95,9 @@ static void test_ini_can_errors(void **state)
     expect_error("[AXIS_Y]\nNODE_ID = 0\n", "[AXIS_Y] NODE_ID: bad value '0'");
     expect_error("[AXIS_X]\nCOUNTS_PER_MM = -5\n", "[AXIS_X] COUNTS_PER_MM: bad value '-5'");
     expect_error("[AXIS_X]\nCOUNTS_PER_MM = lots\n", "[AXIS_X] COUNTS_PER_MM: bad value 'lots'");
-    expect_error("[AXIS_X]\nNODE_ID = 3\n[AXIS_Z]\nNODE_ID = 3\n",
+    expect_error("[AXIS_X]\nNODE_ID = 3\n" LIMITS "[AXIS_Y]\n" LIMITS "[AXIS_Z]\nNODE_ID = 3\n" LIMITS,
                  "[AXIS_Z] NODE_ID 3 is already the node of [AXIS_X]");
-    expect_error("[CAN]\nHEARTBEAT_PERIOD_MS = 100\nHEARTBEAT_TIMEOUT_MS = 100\n",
+    expect_error("[CAN]\nHEARTBEAT_PERIOD_MS = 100\nHEARTBEAT_TIMEOUT_MS = 100\n" AXES,
                  "HEARTBEAT_TIMEOUT_MS 100 must be longer than HEARTBEAT_PERIOD_MS 100");
 }
 

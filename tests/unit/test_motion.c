@@ -157,6 +157,10 @@ static char *write_tmp(const char *text)
     return path;
 }
 
+/* what every machine INI states for each axis */
+#define LIMITS "MIN_LIMIT = -500\nMAX_LIMIT = 500\nMAX_VELOCITY = 200\nMAX_ACCELERATION = 2000\nFERROR = 1\n"
+#define AXES "[AXIS_X]\n" LIMITS "[AXIS_Y]\n" LIMITS "[AXIS_Z]\n" LIMITS
+
 static void test_config_shipped(void **state)
 {
     (void)state;
@@ -194,13 +198,45 @@ static void test_config_errors(void **state)
     assert_non_null(strstr(d.msg, "AXIS_Q"));
 
     ncp_machine_cfg_default(&c);
-    p = write_tmp("[PLANNER]\nSETPOINT_RING = 16\n");
+    p = write_tmp("[PLANNER]\nSETPOINT_RING = 16\n" AXES);
     assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
     assert_non_null(strstr(d.msg, "SETPOINT_RING"));
 
     p = write_tmp("[PLANNER]\nPROFILE = wobbly\n");
     assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
     assert_non_null(strstr(d.msg, "PROFILE"));
+
+    /* never a silent default for a machine: */
+    static const struct { const char *text, *want; unsigned line; } strict[] = {
+        { "", "empty file", 0 },
+        { "[AXIS_X]\nMIN_LIMIT = -1\n", "[AXIS_X] MAX_LIMIT missing", 1 },
+        { AXES "[AXIS_Q]\n", "unknown section [AXIS_Q]", 19 },
+        { "[TRAJ]\nMAX_LINEAR_VELOCITY = 100\n", "[AXIS_X] missing", 0 },
+        { "[AXIS_X]\n" LIMITS "MAX_VELOCITY = 20\n", "MAX_VELOCITY given twice (first on line 4)", 7 },
+        { "[AXIS_X]\nMAX_VELOCITY = 0x10\n", "bad value '0x10' (mm/s from 0.000001 to 1000000)", 2 },
+        { "[AXIS_X]\nFERROR = nan\n", "bad value 'nan'", 2 },
+        { "[AXIS_X]\nFERROR = 1mm\n", "bad value '1mm'", 2 },
+        { AXES "[AXIS_Y]\n", "[AXIS_Y] given twice (first on line 7)", 19 },
+        { AXES "[PLANNER]\nPROFILE = scurve\n", "[AXIS_X] MAX_JERK missing: PROFILE = scurve (line 20)", 1 },
+        { "[PLANNER]\nSETPOINT_RING = 2\n", "(planning periods, a whole number from 4 to 1048576)", 2 },
+    };
+    for (size_t i = 0; i < sizeof strict / sizeof strict[0]; i++) {
+        ncp_machine_cfg_default(&c);
+        p = write_tmp(strict[i].text);
+        assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+        if (!strstr(d.msg, strict[i].want) || d.line != strict[i].line)
+            fail_msg("case %zu: line %u '%s', wanted line %u '%s'", i, d.line, d.msg,
+                     strict[i].line, strict[i].want);
+    }
+    ncp_machine_cfg_default(&c);
+    assert_int_not_equal(ncp_machine_cfg_load(&c, "rt-config", &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "not a regular file (a directory)"));
+    p = write_tmp(AXES "[AXIS_Z]\n");
+    ncp_machine_cfg_default(&c);
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    p = write_tmp("; a comment\n" AXES);
+    ncp_machine_cfg_default(&c);
+    assert_int_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
     unlink(p);
 }
 

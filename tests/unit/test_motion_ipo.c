@@ -82,6 +82,10 @@ static char *write_tmp(const char *text)
     return path;
 }
 
+/* what every machine INI states for each axis */
+#define LIMITS "MIN_LIMIT = -500\nMAX_LIMIT = 500\nMAX_VELOCITY = 200\nMAX_ACCELERATION = 2000\nFERROR = 1\n"
+#define AXES "[AXIS_X]\n" LIMITS "[AXIS_Y]\n" LIMITS "[AXIS_Z]\n" LIMITS
+
 static void test_ini_planning_period(void **state)
 {
     (void)state;
@@ -89,18 +93,18 @@ static void test_ini_planning_period(void **state)
     struct ncp_diag d;
     ncp_machine_cfg_default(&c);
     assert_int_equal(ncp_machine_cfg_ipo_ratio(&c), 1);
-    char *p = write_tmp("[EMCMOT]\nSERVO_PERIOD = 250000\n[TRAJ]\nPLANNING_PERIOD = 1000000\n");
+    char *p = write_tmp("[EMCMOT]\nSERVO_PERIOD = 250000\n[TRAJ]\nPLANNING_PERIOD = 1000000\n" AXES);
     assert_int_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
     assert_int_equal(ncp_machine_cfg_ipo_ratio(&c), 4);
 
     ncp_machine_cfg_default(&c);
-    p = write_tmp("[EMCMOT]\nSERVO_PERIOD = 1000000\n[TRAJ]\nPLANNING_PERIOD = 2500000\n");
+    p = write_tmp("[EMCMOT]\nSERVO_PERIOD = 1000000\n[TRAJ]\nPLANNING_PERIOD = 2500000\n" AXES);
     assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
     assert_non_null(strstr(d.msg, "PLANNING_PERIOD"));
     assert_non_null(strstr(d.msg, "multiple"));
 
     ncp_machine_cfg_default(&c);
-    p = write_tmp("[TRAJ]\nPLANNING_PERIOD = 500000\n");  /* shorter than the servo period */
+    p = write_tmp("[TRAJ]\nPLANNING_PERIOD = 500000\n" AXES);  /* shorter than the servo period */
     assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
     assert_non_null(strstr(d.msg, "PLANNING_PERIOD"));
 

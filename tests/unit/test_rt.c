@@ -234,13 +234,17 @@ struct prog {
     struct ncp_cmd *cmds;
     size_t n;
     size_t error_at;      /* slot index that carries an error, or SIZE_MAX */
+    /* the error only in this run of the program (1: the check before
+     * motion, 2: the run itself), 0: in every run */
+    unsigned error_in_run, runs;
 };
 
 static int prog_run(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
 {
-    const struct prog *p = ctx;
+    struct prog *p = ctx;
+    p->runs++;
     for (size_t i = 0; i < p->n; i++) {
-        if (i == p->error_at)
+        if (i == p->error_at && (!p->error_in_run || p->error_in_run == p->runs))
             return ncp_diag_set(d, NCP_ERR_SEMANTIC, p->cmds[i].line, 3, "bad word");
         if (out->emit(out->ctx, &p->cmds[i]))
             break;
@@ -291,7 +295,7 @@ static void test_run_long_line_time(void **state)
     (void)state;
     struct ncp_machine_cfg cfg;
     ncp_machine_cfg_default(&cfg);
-    struct prog p = { NULL, 0, SIZE_MAX };
+    struct prog p = { NULL, 0, SIZE_MAX, 0, 0 };
     struct ncp_cmd *c = add(&p, 1);
     op(c, NCP_C_SET_FEED_RATE, 9000, 0, 0);
     op(c, NCP_C_STRAIGHT_FEED, 300, 200, 0);
@@ -321,7 +325,7 @@ static void test_run_arc_radius_in_trace(void **state)
     (void)state;
     struct ncp_machine_cfg cfg;
     ncp_machine_cfg_default(&cfg);
-    struct prog p = { NULL, 0, SIZE_MAX };
+    struct prog p = { NULL, 0, SIZE_MAX, 0, 0 };
     struct ncp_cmd *c = add(&p, 1);
     op(c, NCP_C_SET_FEED_RATE, 6000, 0, 0);
     op(c, NCP_C_STRAIGHT_FEED, 40, 0, 0);
@@ -360,7 +364,7 @@ static void test_run_following_fault(void **state)
     struct ncp_machine_cfg cfg;
     ncp_machine_cfg_default(&cfg);
     cfg.axis[1].ferror = 0.0005;
-    struct prog p = { NULL, 0, SIZE_MAX };
+    struct prog p = { NULL, 0, SIZE_MAX, 0, 0 };
     struct ncp_cmd *c = add(&p, 10);
     op(c, NCP_C_SET_FEED_RATE, 6000, 0, 0);
     op(c, NCP_C_STRAIGHT_FEED, 20, 0, 0);
@@ -380,7 +384,7 @@ static void test_run_soft_limit_before_motion(void **state)
     (void)state;
     struct ncp_machine_cfg cfg;
     ncp_machine_cfg_default(&cfg);
-    struct prog p = { NULL, 0, SIZE_MAX };
+    struct prog p = { NULL, 0, SIZE_MAX, 0, 0 };
     struct ncp_cmd *c = add(&p, 1);
     op(c, NCP_C_SET_FEED_RATE, 6000, 0, 0);
     for (uint32_t i = 0; i < 500; i++) {
@@ -405,7 +409,7 @@ static void test_run_program_error_stops_cleanly(void **state)
     (void)state;
     struct ncp_machine_cfg cfg;
     ncp_machine_cfg_default(&cfg);
-    struct prog p = { NULL, 0, 3 };
+    struct prog p = { NULL, 0, 3, 0, 0 };
     struct ncp_cmd *c = add(&p, 1);
     op(c, NCP_C_SET_FEED_RATE, 6000, 0, 0);
     op(c, NCP_C_STRAIGHT_FEED, 10, 0, 0);
@@ -416,8 +420,20 @@ static void test_run_program_error_stops_cleanly(void **state)
     c = add(&p, 4);
     op(c, NCP_C_STRAIGHT_FEED, 50, 50, -5);
     struct ncp_nck_result res;
+    /* found by the check before motion: refused, not a single cycle ran */
     FILE *f = tmpfile();
     assert_int_equal(run(&p, &cfg, f, &res), NCP_NCK_PROGRAM_ERROR);
+    assert_true(res.refused);
+    assert_int_equal(res.diag.line, 4);
+    fseek(f, 0, SEEK_END);
+    assert_int_equal(ftell(f), 0);
+    fclose(f);
+    /* an error only the run meets (a check cut short by --for) */
+    p.error_in_run = 2;
+    p.runs = 0;
+    f = tmpfile();
+    assert_int_equal(run(&p, &cfg, f, &res), NCP_NCK_PROGRAM_ERROR);
+    assert_false(res.refused);
     assert_int_equal(res.diag.line, 4);
     size_t n;
     struct row *r = read_trace(f, &n);
@@ -437,7 +453,7 @@ static void test_run_for_seconds(void **state)
     (void)state;
     struct ncp_machine_cfg cfg;
     ncp_machine_cfg_default(&cfg);
-    struct prog p = { NULL, 0, SIZE_MAX };
+    struct prog p = { NULL, 0, SIZE_MAX, 0, 0 };
     struct ncp_cmd *c = add(&p, 1);
     op(c, NCP_C_SET_FEED_RATE, 6000, 0, 0);
     op(c, NCP_C_STRAIGHT_FEED, 300, 0, 0);

@@ -1,0 +1,10 @@
+/* Numbers in the machine INI, shared by its readers (config.c, config_io.c). */
+#ifndef NCPAR_MOTION_INI_NUM_H
+#define NCPAR_MOTION_INI_NUM_H
+
+/* 1 if v is a plain decimal number (sign, digits, point, exponent, trailing
+ * blanks): hex, inf, nan or a trailing unit are not what a machinist reading
+ * the file would take them for. */
+int ncp_ini_decimal(const char *v);
+
+#endif
