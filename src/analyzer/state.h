@@ -181,6 +181,7 @@ int ncp_comp_stop(struct ncp_analyzer *a, int reset);
  * the G code table) */
 void ncp_words_init(void);
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
+int ncp_words_fault_before(struct ncp_analyzer *a, const struct ncp_block *b, uint16_t col);
 /* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);
 /* Axis ax (enum ncp_axis)'s letter, and its slot in struct ncp_words: a table,
