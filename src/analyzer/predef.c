@@ -32,11 +32,14 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
 {
     const struct ncp_state *s = &a->st;
     const struct ncp_modal *m = &s->m;
-    if (k <= P_W || k >= P_ABS_X) {
-        double pos[NCP_NAX], mach[NCP_NAX];
+    double pos[NCP_NAX];
+    if (k <= P_W) {
         ncp_comp_reported_pos(a, pos);
-        if (k <= P_W)
-            return pos[k];
+        return pos[k];
+    }
+    if (k >= P_ABS_X) {
+        double mach[NCP_NAX];
+        ncp_comp_reported_pos(a, pos);
         ncp_frame_absolute_of(a, pos, mach);
         return mach[k - P_ABS_X];
     }
