@@ -148,6 +148,11 @@ static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
     a->line = b->line;
     a->file_tag = ncp_flow_file_tag(a->flow);
     if (b->err.code != NCP_OK) {
+        /* rs274 meets the faults of the words left of the lexer's first */
+        memset(&a->err, 0, sizeof a->err);
+        int rc = b->err.col > 0 ? ncp_words_fault_before(a, b, b->err.col) : NCP_OK;
+        if (rc != NCP_OK)
+            return rc;
         a->err = b->err;
         return b->err.code;
     }

@@ -109,7 +109,9 @@ static void ncp_cyc_body(struct ncp_cyc *c, int motion, double x, double y, doub
     case 840:
     case 740: {
         /* tapping, right hand (G84) or left hand (G74): overrides off, the
-         * spindle reversed to come out, then turned back and restored */
+         * spindle reversed to come out, then turned back and restored. In
+         * G18/G19 at the hole, where rs274 2.9 feeds to the plane's
+         * coordinates taken as X Y Z (README: deliberate differences). */
         enum ncp_canon_kind in = motion == 840 ? NCP_C_START_SPINDLE_CLOCKWISE
                                                : NCP_C_START_SPINDLE_COUNTERCLOCKWISE;
         enum ncp_canon_kind out = motion == 840 ? NCP_C_START_SPINDLE_COUNTERCLOCKWISE
@@ -203,9 +205,13 @@ static int ncp_cyc_tap_check(struct ncp_analyzer *a, int motion)
     return NCP_OK;
 }
 
-/* G87's I J (offset in the plane) and K (middle level), sticky; K is
- * absolute even in G91 (rs274 adds the bottom level there). */
-static int ncp_cyc_g87_words(struct ncp_analyzer *a, double bottom, double *ijk)
+/* G87's I J K, sticky, each bound to its own axis (I to X, J to Y, K to Z)
+ * in every plane, as rs274 binds them: the two of the plane's axes offset
+ * the point, the normal axis's one is the middle level, absolute even in G91
+ * (rs274 adds the bottom level there). ijk[] comes back in the cycle's axis
+ * order: first, second, normal. */
+static int ncp_cyc_g87_words(struct ncp_analyzer *a, const int *ax, double bottom,
+                             double *ijk)
 {
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
@@ -213,12 +219,15 @@ static int ncp_cyc_g87_words(struct ncp_analyzer *a, double bottom, double *ijk)
     static const char l[3] = {'I', 'J', 'K'};
     static const char *const miss[3] = {"I word missing with g87", "J word missing with g87",
                                         "K word missing with g87"};
+    double by_letter[3];
     for (int k = 0; k < 3; k++) {
         if (s->m.motion != 870 && !NCP_HAS(w, l[k]))
             return ncp_an_error(a, col, "%s", miss[k]);
-        ijk[k] = NCP_HAS(w, l[k]) ? w->v[NCP_LETTER(l[k])] : s->cycle_ijk[k];
-        s->cycle_ijk[k] = ijk[k];
+        by_letter[k] = NCP_HAS(w, l[k]) ? w->v[NCP_LETTER(l[k])] : s->cycle_ijk[k];
+        s->cycle_ijk[k] = by_letter[k];
     }
+    for (int k = 0; k < 3; k++)
+        ijk[k] = by_letter[ax[k]]; /* ax[] holds NCP_X..NCP_Z only */
     if (s->m.incremental)
         ijk[2] += bottom;
     return NCP_OK;
@@ -338,7 +347,7 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
     if (rc == NCP_OK)
         rc = ncp_cyc_spindle_check(a, motion);
     if (rc == NCP_OK && motion == 870)
-        rc = ncp_cyc_g87_words(a, cc, ijk);
+        rc = ncp_cyc_g87_words(a, ax, cc, ijk);
     if (rc != NCP_OK)
         return rc;
     for (int rep = l; rep > 0; rep--) {

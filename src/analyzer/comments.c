@@ -7,10 +7,14 @@
 
 #include <ctype.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
 #define NCP_EXPAND_MAX 512
+/* The longest value text rs274 puts in a message: longer ones (a %f of
+ * -1e21, a %d of 1e30) come out as ######, whatever the sign. */
+#define NCP_VALUE_TEXT_MAX 29
 
 struct ncp_expand {
     char buf[NCP_EXPAND_MAX];
@@ -63,10 +67,20 @@ static size_t ncp_param_ref(struct ncp_analyzer *a, const char *s, const char *e
     double v = 0.0;
     int found = 0;
     if (p < end && isdigit((unsigned char)*p)) {
-        int idx = 0;
-        while (p < end && isdigit((unsigned char)*p) && idx < 100000)
-            idx = idx * 10 + (*p++ - '0');
-        double *slot = idx < NCP_PARAMS_MAX ? ncp_params_slot(a->params, idx) : NULL;
+        /* rs274 takes every digit and converts them as atoi does: a long
+         * (saturating past 2^63-1) cut to its low 32 bits, so #4294967297
+         * reads #1, while #2147483648 and longer runs read nothing. */
+        uint64_t big = 0;
+        int sat = 0;
+        while (p < end && isdigit((unsigned char)*p)) {
+            unsigned dg = (unsigned)(*p++ - '0');
+            if (big > ((uint64_t)INT64_MAX - dg) / 10)
+                sat = 1;
+            else
+                big = big * 10 + dg;
+        }
+        uint32_t low = sat ? UINT32_MAX : (uint32_t)big;
+        double *slot = low < NCP_PARAMS_MAX ? ncp_params_slot(a->params, (int)low) : NULL;
         if (slot) {
             v = *slot;
             found = 1;
@@ -88,10 +102,10 @@ static size_t ncp_param_ref(struct ncp_analyzer *a, const char *s, const char *e
         ncp_put(e, "#", 1);
         return 1;
     }
-    char val[64];
+    char val[NCP_VALUE_TEXT_MAX + 1];
     /* rs274 prints anything within its equality tolerance of zero as 0 */
     int n = found ? snprintf(val, sizeof val, fmt, fabs(v) < 0.0001 ? 0.0 : v) : -1;
-    if (n < 0 || n >= (int)sizeof val)
+    if (n < 0 || n > NCP_VALUE_TEXT_MAX)
         ncp_put(e, "######", 6);
     else
         ncp_put(e, val, (size_t)n);

@@ -110,3 +110,22 @@ int ncp_comp_stop(struct ncp_analyzer *a, int reset)
     }
     return rc;
 }
+
+/* The current point as rs274 reports it (#<_x>, #5420..): while compensation
+ * moves the tool, the compensated point of the plane, where the tool is,
+ * not the programmed one; before the first move after G41/G42 nothing is
+ * compensated yet. */
+void ncp_comp_reported_pos(const struct ncp_analyzer *a, double *pos)
+{
+    const struct ncp_cutcomp *c = &a->comp;
+    memcpy(pos, a->st.pos, sizeof a->st.pos);
+    if (!ncp_cutcomp_engaged(c) || c->firstmove)
+        return;
+    if (c->plane == 2) {
+        pos[NCP_Z] = c->cur[0];
+        pos[NCP_X] = c->cur[1];
+    } else {
+        pos[NCP_X] = c->cur[0];
+        pos[NCP_Y] = c->cur[1];
+    }
+}

@@ -1393,7 +1393,9 @@ static int ncp_flow_step(struct ncp_flow *f, const struct ncp_block **out,
             if (kind == NCP_O_M99 && b->oword.tail_col)
                 return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.tail_col,
                                     "Unexpected character after O-word");
-            if (f->inline_level >= 0) { /* a G7x profile: the caller reads it its way */
+            /* a G7x profile: the caller reads it its way; a plain line: the
+             * caller reports the faults left of the lexer's first */
+            if (f->inline_level >= 0 || kind == NCP_O_NONE) {
                 *out = b;
                 return NCP_OK;
             }

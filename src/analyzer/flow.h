@@ -47,8 +47,10 @@ void ncp_flow_set_m98_reader(struct ncp_flow *f, struct ncp_flow_m98_reader r);
 
 /* Next non-O-word block to interpret. Returns NCP_OK and sets *out (valid until
  * the next call), NCP_END at the end of the program body, or an error with *d
- * filled (file order line/col). A block with a syntax error comes back as that
- * error in *d (its err), except where rs274 would not read it (skipped text).
+ * filled (file order line/col). A plain block with a syntax error comes back
+ * as a block (its err set), for the caller to report after the faults of the
+ * words left of it, which rs274 reads first; an O-word line's, as that error
+ * in *d; neither where rs274 would not read it (skipped text).
  * Block delete ('/') is off, as in rs274 -g: such blocks are served as usual. */
 int ncp_flow_next(struct ncp_flow *f, const struct ncp_block **out,
                   struct ncp_diag *d);

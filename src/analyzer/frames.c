@@ -101,13 +101,19 @@ void ncp_frame_relative(const struct ncp_analyzer *a, const double *abs, double 
 /* The current point in machine coordinates (#<_abs_x>.., G28.1/G30.1). */
 void ncp_frame_absolute(const struct ncp_analyzer *a, double *out)
 {
+    ncp_frame_absolute_of(a, a->st.pos, out);
+}
+
+/* The same for any point `pos` of the active system. */
+void ncp_frame_absolute_of(const struct ncp_analyzer *a, const double *pos, double *out)
+{
     const struct ncp_state *s = &a->st;
-    double x = s->pos[NCP_X] + s->g92[NCP_X], y = s->pos[NCP_Y] + s->g92[NCP_Y];
+    double x = pos[NCP_X] + s->g92[NCP_X], y = pos[NCP_Y] + s->g92[NCP_Y];
     ncp_rotate(&x, &y, s->rotation);
     out[NCP_X] = x + s->g5x[NCP_X] + s->tlo[NCP_X];
     out[NCP_Y] = y + s->g5x[NCP_Y] + s->tlo[NCP_Y];
     for (int ax = NCP_Z; ax < NCP_NAX; ax++)
-        out[ax] = s->pos[ax] + s->g92[ax] + s->g5x[ax] + s->tlo[ax];
+        out[ax] = pos[ax] + s->g92[ax] + s->g5x[ax] + s->tlo[ax];
 }
 
 /* The G53 end point: given axes are machine coordinates, the others keep

@@ -24,18 +24,17 @@ static double *ncp_par(struct ncp_analyzer *a, int index)
     return ncp_params_slot(a->params, index);
 }
 
-/* #5420.. current position and #5220 system: kept after each block (#5400
- * follows the spindle's tool table entry, see ncp_tools_sync_params). */
+/* #5420.. current position: kept after each block (#5400 follows the
+ * spindle's tool table entry, see ncp_tools_sync_params). #5220 is written
+ * only where the system changes, as rs274 writes it, so a program's own
+ * `#5220 = 3` reads back until the next G54..G59.3 or program end. */
 void ncp_offsets_sync_params(struct ncp_analyzer *a)
 {
-    if (!a->par_pos) {
+    if (!a->par_pos)
         a->par_pos = ncp_par(a, 5420);
-        a->par_origin = ncp_par(a, 5220);
-    }
     /* numbered parameters are one array: #5420..#5428 are one copy */
     _Static_assert(5420 + NCP_NAX <= NCP_PARAMS_MAX, "#5420.. are numbered parameters");
-    memcpy(a->par_pos, a->st.pos, sizeof a->st.pos);
-    *a->par_origin = a->st.m.origin;
+    ncp_comp_reported_pos(a, a->par_pos);
 }
 
 /* rs274 reads back what the canon did before it reads the block after a
@@ -126,6 +125,7 @@ int ncp_offsets_coord(struct ncp_analyzer *a, int origin)
     ncp_load_origin(a, origin, s->g5x);
     s->rotation = ncp_frame_param(a, 5210 + 20 * origin);
     s->m.origin = origin;
+    *ncp_par(a, 5220) = origin;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
     op->offset.index = origin;
     memcpy(op->offset.v, s->g5x, sizeof op->offset.v);

@@ -11,7 +11,7 @@ enum ncp_predef {
     P_IJK_ABS, P_SPINDLE_ON, P_SPINDLE_CW, P_MIST, P_FLOOD, P_SPEED_OVR, P_FEED_OVR,
     P_ADAPTIVE, P_FEED_HOLD, P_FEED, P_RPM, P_CUR_TOOL, P_CUR_POCKET, P_SEL_TOOL,
     P_SEL_POCKET, P_RPM_MODE, P_CSS_MODE, P_LATHE_DIA, P_LATHE_RAD, P_CALL_LEVEL,
-    P_VMAJOR, P_VMINOR, P_TASK, P_ABS_X, P_ABS_Y, P_ABS_Z, P_ABS_A, P_ABS_B, P_ABS_C, P__N
+    P_VMAJOR, P_VMINOR, P_TASK, P_REMAP_LEVEL, P_METRIC_MACHINE, P_ABS_X, P_ABS_Y, P_ABS_Z, P_ABS_A, P_ABS_B, P_ABS_C, P__N
 };
 
 static const char *const ncp_predef_names[P__N] = {
@@ -23,7 +23,8 @@ static const char *const ncp_predef_names[P__N] = {
     "_speed_override", "_feed_override", "_adaptive_feed", "_feed_hold", "_feed", "_rpm",
     "_current_tool", "_current_pocket", "_selected_tool", "_selected_pocket",
     "_spindle_rpm_mode", "_spindle_css_mode", "_lathe_diameter_mode",
-    "_lathe_radius_mode", "_call_level", "_vmajor", "_vminor", "_task",
+    "_lathe_radius_mode", "_call_level", "_vmajor", "_vminor", "_task", "_remap_level",
+    "_metric_machine",
     "_abs_x", "_abs_y", "_abs_z", "_abs_a", "_abs_b", "_abs_c",
 };
 
@@ -31,11 +32,15 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
 {
     const struct ncp_state *s = &a->st;
     const struct ncp_modal *m = &s->m;
-    if (k <= P_W)
-        return s->pos[k];
+    double pos[NCP_NAX];
+    if (k <= P_W) {
+        ncp_comp_reported_pos(a, pos);
+        return pos[k];
+    }
     if (k >= P_ABS_X) {
         double mach[NCP_NAX];
-        ncp_frame_absolute(a, mach);
+        ncp_comp_reported_pos(a, pos);
+        ncp_frame_absolute_of(a, pos, mach);
         return mach[k - P_ABS_X];
     }
     switch (k) {
@@ -66,15 +71,18 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     case P_FEED: return s->feed;
     case P_RPM: return s->speed;
     case P_CUR_TOOL: return ncp_frame_param(a, 5400); /* the spindle entry's tool */
-    case P_CUR_POCKET: return s->current_pocket;
+    case P_CUR_POCKET: return s->current_pocket_no;
     case P_SEL_TOOL: return s->selected_tool;
-    case P_SEL_POCKET: return s->selected_pocket;
-    case P_RPM_MODE: return 1;
-    case P_CSS_MODE: return 0;
+    case P_SEL_POCKET: return s->selected_pocket_no;
+    case P_RPM_MODE: return !m->css;
+    case P_CSS_MODE: return m->css;
     case P_LATHE_DIA: return m->lathe_diameter;
     case P_LATHE_RAD: return !m->lathe_diameter;
     case P_CALL_LEVEL: return a->flow ? ncp_flow_call_depth(a->flow) : 0;
     case P_VMAJOR: return 2.9;
+    case P_REMAP_LEVEL: return 0; /* no remapping here, the top level */
+    /* rs274 without a machine behind it: the canon answers no unit */
+    case P_METRIC_MACHINE: return -1;
     case P_VMINOR: /* 2.9.0: 0, as for names not listed */
     default: return 0;
     }

@@ -93,7 +93,10 @@ struct ncp_state {
     double rotation;
     double feed, speed;
     struct ncp_modal m;
-    int selected_tool, selected_pocket, current_tool, current_pocket;
+    int selected_tool, selected_pocket, current_tool, current_pocket; /* pockets: entries */
+    /* the table's P of those entries, which #<_selected_pocket> and
+     * #<_current_pocket> read (the empty spindle's is -1) */
+    int selected_pocket_no, current_pocket_no;
     int toolchange_flag;
     double g5_pq[2];              /* the last G5's P Q: where a G5 without I J starts off */
     /* canned cycle sticky values */
@@ -137,7 +140,7 @@ struct ncp_analyzer {
     const struct ncp_block *blk;
     const struct ncp_source *src;
     struct ncp_param_ops pops;
-    double *par_pos, *par_origin; /* #5420..#5428 (adjacent slots), #5220 */
+    double *par_pos;              /* #5420..#5428 (adjacent slots) */
     /* tool table: entry[i] for pocket-ordered tools as rs274 loads them */
     int n_tools;
     int tool_no[NCP_MAX_TOOLS];
@@ -178,6 +181,7 @@ int ncp_comp_stop(struct ncp_analyzer *a, int reset);
  * the G code table) */
 void ncp_words_init(void);
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
+int ncp_words_fault_before(struct ncp_analyzer *a, const struct ncp_block *b, uint16_t col);
 /* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);
 /* Axis ax (enum ncp_axis)'s letter, and its slot in struct ncp_words: a table,
@@ -229,6 +233,7 @@ int ncp_offsets_coord(struct ncp_analyzer *a, int origin);
 int ncp_offsets_tlo(struct ncp_analyzer *a, int g);
 int ncp_offsets_modal0(struct ncp_analyzer *a, int g);
 void ncp_offsets_sync_params(struct ncp_analyzer *a);
+void ncp_comp_reported_pos(const struct ncp_analyzer *a, double *pos);
 /* what the canon did since the last block (a probe, a tool change), read back
  * into the state and the parameters before the next block reads them */
 void ncp_offsets_resync(struct ncp_analyzer *a);
@@ -240,6 +245,7 @@ double ncp_to_user_len(const struct ncp_analyzer *a, double prog);
 double ncp_tool_len(const struct ncp_analyzer *a, double user);
 void ncp_rotate(double *x, double *y, double deg);
 double ncp_frame_param(const struct ncp_analyzer *a, int index);
+void ncp_frame_absolute_of(const struct ncp_analyzer *a, const double *pos, double *out);
 double ncp_frame_user(const struct ncp_analyzer *a, int ax, int index);
 void ncp_frame_current_in(const struct ncp_analyzer *a, int sys, int with_tlo, double *out);
 void ncp_frame_relative(const struct ncp_analyzer *a, const double *abs, double *out);

@@ -18,9 +18,11 @@ void ncp_state_init(struct ncp_analyzer *a)
     s->m.feed_override = 1;
     s->m.speed_override = 1;
     s->m.feed_hold = 1;
-    s->selected_pocket = 0;
-    s->selected_tool = -1;
+    s->selected_pocket = 0; /* rs274: tool 0 (the spindle's entry) selected */
+    s->selected_pocket_no = -1;
+    s->selected_tool = 0;
     s->current_pocket = 1; /* rs274 -g starts with pocket 1 as the current one */
+    s->current_pocket_no = 1;
     s->current_tool = 0;
     double *p = ncp_params_slot(a->params, 5599);
     if (p)

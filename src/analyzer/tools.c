@@ -174,6 +174,7 @@ static void ncp_tools_parse(struct ncp_analyzer *a, const char *text, size_t len
     const char *p = text, *end = text + len;
     a->n_tools = 1;
     memset(&a->tools[0], 0, sizeof a->tools[0]);
+    a->tools[0].pocket = -1; /* the empty spindle's, as rs274 reports it */
     a->tool_no[0] = 0;
     memset(a->tool_more[0], 0, sizeof a->tool_more[0]);
     while (p < end && a->n_tools < NCP_MAX_TOOLS) {
@@ -246,6 +247,7 @@ int ncp_tools_select(struct ncp_analyzer *a)
                             "Requested tool %d not found in the tool table", t);
     ncp_an_emit(a, NCP_C_SELECT_TOOL)->tool.tool = t;
     a->st.selected_pocket = idx;
+    a->st.selected_pocket_no = a->tools[idx].pocket; /* T0: the spindle's */
     a->st.selected_tool = t;
     return NCP_OK;
 }
@@ -261,6 +263,7 @@ static int ncp_tools_m61(struct ncp_analyzer *a)
     if (idx < 0)
         return ncp_an_error(a, col, "Requested tool %d not found in the tool table", t);
     a->st.current_pocket = idx;
+    a->st.current_pocket_no = a->tools[idx].pocket;
     a->st.current_tool = t;
     a->st.toolchange_flag = 1;
     ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER)->tool.tool = idx;
@@ -272,8 +275,8 @@ int ncp_tools_change(struct ncp_analyzer *a)
     struct ncp_state *s = &a->st;
     if (a->w.m[NCP_MG_TOOL] == 61)
         return ncp_tools_m61(a);
-    if (s->selected_pocket < 0)
-        return ncp_an_error(a, a->w.mcol[NCP_MG_TOOL], "Need tool prepared -Txx- for toolchange");
+    /* No "Txx missing" check: rs274 starts with tool 0 selected, so an M6
+     * before any T empties the spindle as T0 M6 does. */
     if (s->m.comp_side != 0)
         return ncp_an_error(a, a->w.mcol[NCP_MG_TOOL],
                             "Cannot change tools with cutter radius compensation on");
@@ -284,6 +287,7 @@ int ncp_tools_change(struct ncp_analyzer *a)
     if (s->selected_pocket > 0)
         ncp_tools_copy(a, 0, s->selected_pocket);
     s->current_pocket = s->selected_pocket;
+    s->current_pocket_no = s->selected_pocket_no;
     s->current_tool = s->selected_tool;
     s->toolchange_flag = 1;
     return NCP_OK;

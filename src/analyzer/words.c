@@ -225,7 +225,68 @@ static int ncp_declare_targets_before(struct ncp_analyzer *a, const struct ncp_b
     return NCP_OK;
 }
 
+/* rs274 reads a line left to right and stops at the first fault, evaluating
+ * each assignment's target and value where it stands. Our words come before
+ * the assignments, so a fault found among the words at column `col` gives way
+ * to an earlier assignment's: its target's or value's error is the one rs274
+ * meets first. The values are only evaluated here, never written. */
+static int ncp_assign_fault_before(struct ncp_analyzer *a, const struct ncp_block *b,
+                                   uint16_t col)
+{
+    unsigned n = b->n_assign < NCP_BLOCK_MAX_ASSIGN ? b->n_assign : NCP_BLOCK_MAX_ASSIGN;
+    /* cppcheck follows a caller's block with no assignments and calls the
+     * loop dead; other blocks have them */
+    // cppcheck-suppress knownConditionTrueFalse
+    for (unsigned k = 0; k < n; k++) {
+        const struct ncp_assign *as = &b->assign[k];
+        if (as->col >= col)
+            break;
+        double v;
+        int rc = ncp_declare_targets_before(a, b, (uint16_t)(as->col + 1));
+        if (rc == NCP_OK && as->kind == NCP_ASSIGN_NUMBERED) {
+            rc = ncp_eval(a, b, &as->index, &v);
+            if (rc == NCP_OK && ncp_param_readonly(ncp_trunc_int_round(v)))
+                return ncp_an_error(a, as->col, "Parameter is readonly");
+        }
+        if (rc == NCP_OK)
+            rc = ncp_eval(a, b, &as->value, &v);
+        if (rc != NCP_OK)
+            return rc;
+    }
+    return NCP_OK;
+}
+
+static int ncp_words_collect_upto(struct ncp_analyzer *a, const struct ncp_block *b,
+                                  uint16_t limit);
+
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b)
+{
+    int rc = ncp_words_collect_upto(a, b, UINT16_MAX);
+    if (rc != NCP_OK && b->n_assign && a->err.col > 0) {
+        struct ncp_diag words_err = a->err;
+        if (ncp_assign_fault_before(a, b, words_err.col) == NCP_OK)
+            a->err = words_err;
+    }
+    return rc;
+}
+
+/* A block the lexer refused at column `col`: the reader's faults of what
+ * stands left of it (two codes of one modal group, a negative F, a division
+ * by zero...) come first, as rs274 meets them first. NCP_OK when there are
+ * none, and the lexer's error stands. */
+int ncp_words_fault_before(struct ncp_analyzer *a, const struct ncp_block *b, uint16_t col)
+{
+    int rc = ncp_words_collect_upto(a, b, col);
+    uint16_t at = rc == NCP_OK ? col : a->err.col;
+    struct ncp_diag words_err = a->err;
+    if (b->n_assign && ncp_assign_fault_before(a, b, at) != NCP_OK)
+        return a->err.code ? a->err.code : NCP_ERR_SEMANTIC;
+    a->err = words_err;
+    return rc;
+}
+
+static int ncp_words_collect_upto(struct ncp_analyzer *a, const struct ncp_block *b,
+                                  uint16_t limit)
 {
     struct ncp_words *w = &a->w;
     w->has = 0;
@@ -238,6 +299,8 @@ int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b)
         n = NCP_BLOCK_MAX_WORDS;
     for (unsigned k = 0; k < n; k++) {
         const struct ncp_word *wd = &b->words[k];
+        if (wd->col >= limit)
+            break;
         double v;
         int rc = b->n_assign ? ncp_declare_targets_before(a, b, wd->col) : NCP_OK;
         if (rc == NCP_OK)

@@ -120,6 +120,11 @@ static void run_cfg(const char *text, const struct ncp_analyzer_cfg *cfg, struct
         r->rc = ncp_flow_next(f, &b, &r->d);
         if (r->rc != NCP_OK)
             break;
+        if (b->err.code != NCP_OK) { /* a plain line the lexer refused: ours to report */
+            r->rc = b->err.code;
+            r->d = b->err;
+            break;
+        }
         r->blocks++;
         if (used + 12 < sizeof r->trace)
             used += (size_t)snprintf(r->trace + used, sizeof r->trace - used, "%s%u",
