@@ -28,13 +28,12 @@ static double *ncp_par(struct ncp_analyzer *a, int index)
  * spindle's tool table entry, see ncp_tools_sync_params). #5220 is written
  * only where the system changes, as rs274 writes it, so a program's own
  * `#5220 = 3` reads back until the next G54..G59.3 or program end. */
-void ncp_offsets_sync_params(struct ncp_analyzer *a)
+double *ncp_offsets_param_pos(struct ncp_analyzer *a)
 {
-    if (!a->par_pos)
-        a->par_pos = ncp_par(a, 5420);
     /* numbered parameters are one array: #5420..#5428 are one copy */
     _Static_assert(5420 + NCP_NAX <= NCP_PARAMS_MAX, "#5420.. are numbered parameters");
-    ncp_comp_reported_pos(a, a->par_pos);
+    a->par_pos = ncp_par(a, 5420);
+    return a->par_pos;
 }
 
 /* rs274 reads back what the canon did before it reads the block after a

@@ -5,6 +5,7 @@
 #define NCP_ANALYZER_STATE_H
 
 #include <stdint.h>
+#include <string.h>
 #include "ncpar/analyzer.h"
 #include "cutcomp.h"
 #include "flow.h"
@@ -232,8 +233,19 @@ int ncp_offsets_units(struct ncp_analyzer *a, int inches);
 int ncp_offsets_coord(struct ncp_analyzer *a, int origin);
 int ncp_offsets_tlo(struct ncp_analyzer *a, int g);
 int ncp_offsets_modal0(struct ncp_analyzer *a, int g);
-void ncp_offsets_sync_params(struct ncp_analyzer *a);
 void ncp_comp_reported_pos(const struct ncp_analyzer *a, double *pos);
+double *ncp_offsets_param_pos(struct ncp_analyzer *a);
+/* #5420..#5428 (and #<_x>...) read where the tool is: the current point, or
+ * under cutter compensation the compensated one. Every block ends here, so
+ * the common case (no compensation) stays one copy. */
+static inline void ncp_offsets_sync_params(struct ncp_analyzer *a)
+{
+    double *p = a->par_pos ? a->par_pos : ncp_offsets_param_pos(a);
+    if (a->comp.side != 0)
+        ncp_comp_reported_pos(a, p);
+    else
+        memcpy(p, a->st.pos, sizeof a->st.pos);
+}
 /* what the canon did since the last block (a probe, a tool change), read back
  * into the state and the parameters before the next block reads them */
 void ncp_offsets_resync(struct ncp_analyzer *a);

@@ -297,10 +297,16 @@ static int ncp_words_collect_upto(struct ncp_analyzer *a, const struct ncp_block
     unsigned n = b->n_words;
     if (n > NCP_BLOCK_MAX_WORDS)
         n = NCP_BLOCK_MAX_WORDS;
+    /* the words left of a lexer error only; counted apart so that the
+     * loop every block runs stays as it was */
+    if (limit != UINT16_MAX) {
+        unsigned left = 0;
+        while (left < n && b->words[left].col < limit)
+            left++;
+        n = left;
+    }
     for (unsigned k = 0; k < n; k++) {
         const struct ncp_word *wd = &b->words[k];
-        if (wd->col >= limit)
-            break;
         double v;
         int rc = b->n_assign ? ncp_declare_targets_before(a, b, wd->col) : NCP_OK;
         if (rc == NCP_OK)
