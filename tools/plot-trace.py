@@ -6,7 +6,8 @@ usage: plot-trace.py TRACE.csv OUT.png [LATENCY.csv] [--title TEXT]
 TRACE.csv   the per-cycle trace (t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion,
             then the machine functions spindle_rpm,spindle_deg,mist,flood,dout,tool,wait;
             motion: 0 rapid G0, 1 feed G1, 2 arc G2/G3; traces without it
-            are drawn as feeds)
+            are drawn as feeds); then a_cmd,a_act,... for each axis the
+            machine has beyond X Y Z)
 LATENCY.csv optional sidecar written by `cnc-run run --plot`: the position
             loop's wake-up latency histogram, one row per non-empty 1 us bin,
             header "latency_us,cycles" (the last row may be ">=1000" for the
@@ -14,7 +15,8 @@ LATENCY.csv optional sidecar written by `cnc-run run --plot`: the position
 
 Panels: commanded vs actual XY toolpath (equal aspect; rapids dashed grey,
 feeds solid blue, arcs solid purple), path velocity (rapids grey) and
-acceleration over time, loop-latency histogram. Needs python3-matplotlib.
+acceleration over time, loop-latency histogram, spindle speed, rotary axes
+A B C over time (degrees) when the machine has them. Needs python3-matplotlib.
 """
 import csv
 import sys
@@ -115,7 +117,8 @@ def plot(trace, out, lat_path, title):
     fig = plt.figure(figsize=(14, 10), dpi=100)
     # traces with the machine functions (spindle_rpm and after) get a spindle panel
     spindle = c.get("spindle_rpm")
-    gs = fig.add_gridspec(4 if spindle else 3, 2, width_ratios=[1.25, 1], hspace=0.55,
+    rotary = [n for n in "abc" if n + "_cmd" in c]
+    gs = fig.add_gridspec(3 + bool(spindle) + bool(rotary), 2, width_ratios=[1.25, 1], hspace=0.55,
                           wspace=0.22)
     fig.suptitle(title, fontsize=13)
 
@@ -202,6 +205,15 @@ def plot(trace, out, lat_path, title):
         axs.set_title("spindle speed (M4 negative), coolant shaded")
         axs.grid(True, alpha=0.3)
         axs.legend(loc="upper right", fontsize=8)
+    if rotary:
+        axr = fig.add_subplot(gs[3 + bool(spindle), 1], sharex=axv)
+        for n in rotary:
+            axr.plot(thin(t, step), thin(c[n + "_cmd"], step), lw=0.9, label=n.upper())
+        axr.set_ylabel("angle [deg]")
+        axr.set_xlabel("time [s]")
+        axr.set_title("rotary axes (commanded; a wrapped axis counts on past 360)")
+        axr.grid(True, alpha=0.3)
+        axr.legend(loc="upper right", fontsize=8)
     fig.savefig(out)
     plt.close(fig)
 

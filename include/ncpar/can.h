@@ -175,7 +175,7 @@ int ncp_co_check_heartbeat(const struct ncp_co_node *node, int64_t now_ms,
                            int64_t since_ms, int timeout_ms, struct ncp_diag *d);
 
 /* ---- the master of a set of CSP drives ------------------------------ */
-#define NCP_CO_MAX_NODES 8
+#define NCP_CO_MAX_NODES 9 /* one per axis, X Y Z A B C U V W */
 
 /* 0x60C2 interpolation time period: value * 10^index s. Picks the coarsest
  * exact unit for period_us; -1 when none fits a byte. */

@@ -10,7 +10,22 @@
 #include "ncpar/diag.h"
 #include "ncpar/rt.h"
 
-#define NCP_AXES 3  /* X Y Z; the canon stream's A B C are carried but not moved */
+/* The machine's axes, in LinuxCNC's order X Y Z A B C U V W. A machine has
+ * the ones its [TRAJ] COORDINATES names (ncp_machine_cfg.axis_mask); the
+ * others are absent: they never move and the trace leaves them out. Lengths
+ * of A B C are degrees (velocities deg/s, accelerations deg/s^2).
+ * A joint layer (kinematics) will sit between these planned axes and the
+ * servo loop (src/nck/loop.c); with trivial kinematics joints are axes. */
+#define NCP_AXES 9
+#define NCP_AXIS_LETTERS "XYZABCUVW"
+#define NCP_AXIS_A 3
+#define NCP_AXIS_U 6
+#define NCP_AXIS_BIT(i) (1u << (i))
+#define NCP_AXES_XYZ 0x7u
+/* The canonical calls carry X Y Z A B C: U V W of a program never reach the
+ * NCK (rs274's calls have no U V W either). */
+#define NCP_CANON_AXES 6
+static inline int ncp_axis_rotary(int i) { return i >= 3 && i < 6; }
 
 enum ncp_profile { NCP_PROFILE_TRAPEZOID, NCP_PROFILE_SCURVE };
 
@@ -29,6 +44,10 @@ struct ncp_axis_cfg {
     /* homing (cnc-run serve): where the axis homes to, mm, and how fast, mm/s
      * (HOME, HOME_SEARCH_VEL; 0 = half of MAX_VELOCITY) */
     double home, home_vel;
+    /* A B C: WRAPPED_ROTARY = 1, the axis turns without end: a move takes the
+     * shorter way round to its target modulo 360 and the soft limits do not
+     * apply */
+    int wrapped;
 };
 
 /* What the position loop drives (backend.h): the simulated machine, or CiA 402
@@ -69,6 +88,8 @@ struct ncp_machine_cfg {
     double max_linear_vel;        /* [TRAJ] MAX_LINEAR_VELOCITY */
     double default_linear_acc;    /* [TRAJ] DEFAULT_LINEAR_ACCELERATION, 0 = axis limits */
     struct ncp_axis_cfg axis[NCP_AXES];
+    /* [TRAJ] COORDINATES: the axes the machine has (NCP_AXIS_BIT), XYZ by default */
+    unsigned axis_mask;
     int lookahead;                /* [PLANNER] LOOKAHEAD, segments */
     enum ncp_profile profile;     /* [PLANNER] PROFILE */
     int setpoint_ring;            /* [PLANNER] SETPOINT_RING, servo cycles buffered (1024) */
@@ -119,12 +140,15 @@ struct ncp_seg {
     uint8_t kind;          /* enum ncp_seg_kind */
     uint8_t term;          /* enum ncp_seg_term: how this segment ends */
     uint8_t traverse;      /* G0: runs at the machine's maximum velocity */
+    /* length (and feed) measured along A B C, in degrees: a move of rotary
+     * axes only (LinuxCNC's rule: along X Y Z when they move) */
+    uint8_t angular;
     uint32_t line;         /* source line */
     /* The machine functions sent before this segment (NCK): the sequence
      * number of the last, applied when its samples are reached. */
     uint32_t aux;
     double start[NCP_AXES], end[NCP_AXES];
-    double length;         /* path length (0 for dwell) */
+    double length;         /* path length (0 for dwell): along X Y Z, else A B C */
     double feed;           /* requested path velocity (override applied), mm/s */
     /* the path velocity a G64 corner's blend is sized for: the feed at
      * NCP_FEED_OVERRIDE_MAX, so the path cut never depends on the override
@@ -134,12 +158,20 @@ struct ncp_seg {
     double merge_tol;      /* G64 Q, mm: the planner merges a run of nearly
                               collinear feed lines into one (0 = off) */
     double dwell;          /* s, NCP_SEG_DWELL only */
-    /* arcs and helices: p(l) = c + r(l)(cos(A l) u + sin(A l) w) + n h l, l in [0,1] */
+    /* arcs and helices: p(l) = c + r(l)(cos(A l) u + sin(A l) w) + n h l, l in [0,1],
+     * in X Y Z; the other axes move linearly in l from start to end */
     double center[3], normal[3], u[3], w[3];
     double r0, r1, angle, axial;
 };
 
-/* Position at path distance s (0..length) and the unit tangent there (may be NULL). */
+/* A line's length as LinuxCNC measures a path: along X Y Z when they move,
+ * else along A B C in degrees (s->angular). */
+void ncp_seg_set_length(struct ncp_seg *s);
+/* Does s move any axis but X Y Z? (Corners of such moves are not blended.) */
+int ncp_seg_moves_other(const struct ncp_seg *s);
+/* Position at path distance s (0..length) and the tangent there (may be NULL):
+ * per axis its change per unit of path length, so the X Y Z part is a unit
+ * vector when the path runs along X Y Z. */
 void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                   double tangent[NCP_AXES]);
 
@@ -163,6 +195,7 @@ struct ncp_canon_map {
     double rotation;        /* XY rotation, degrees */
     int plane;              /* 0 XY, 1 YZ, 2 XZ */
     double feed;            /* F in mm: per minute, or per turn under G95 */
+    double feed_deg;        /* F as degrees, for moves of rotary axes only */
     double feed_override;   /* 1.0 = 100 % */
     /* Feeds tied to the spindle: G95 (F per turn), G33/G33.1/G76 (the pitch
      * per turn, while synchronised), at the spindle's speed: S in rpm, or

@@ -99,7 +99,8 @@ struct ncp_nck_result {
     int interrupted;         /* stopped along the path on request (opts.interrupt) */
     int trace_errno;         /* writing the trace failed (errno), 0 = it did not */
     double program_time, path_length;
-    double ferr_max, ferr_avg, ferr_axis_max[3];
+    unsigned axis_mask;      /* the machine's axes (ncp_machine_cfg.axis_mask) */
+    double ferr_max, ferr_avg, ferr_axis_max[NCP_AXES]; /* mm, or degrees for A B C */
     double contour_max, contour_avg;
     uint64_t segments, starved, trace_dropped, replans;
     uint64_t underruns;      /* setpoint ring ran low: slowed down along the path */

@@ -25,8 +25,10 @@ int ncp_socketcan_check_cfg(const struct ncp_machine_cfg *cfg, struct ncp_diag *
                             "socketcan backend: no CAN interface ([CAN] INTERFACE or "
                             "--backend socketcan:IFACE)");
     for (int j = 0; j < NCP_AXES; j++) {
+        if (!(cfg->axis_mask & NCP_AXIS_BIT(j)))
+            continue;
         const struct ncp_axis_cfg *a = &cfg->axis[j];
-        char ax = "XYZ"[j];
+        char ax = NCP_AXIS_LETTERS[j];
         int32_t c;
         if (a->node_id < 1 || a->node_id > 127)
             return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,

@@ -19,9 +19,13 @@
 
 #define POLL_MAX 64 /* frames taken in per period: a backlog drains over a few */
 
+/* The master's nodes are the configured axes in order: node k drives axis
+ * ax[k]. (With a joint layer these become the joints.) */
 struct sc {
     struct ncp_co_master m;
     double cpm[NCP_AXES];
+    int ax[NCP_AXES];
+    int n;
 };
 
 static int sc_start(struct ncp_backend *b, double pos[NCP_AXES])
@@ -35,9 +39,9 @@ static int sc_start(struct ncp_backend *b, double pos[NCP_AXES])
         }
         return -1;
     }
-    for (int j = 0; j < NCP_AXES; j++) {
-        s->m.cw[j] = NCP_402_CW_ENABLE;
-        pos[j] = ncp_counts_to_mm(s->m.node[j].actual, s->cpm[j]);
+    for (int k = 0; k < s->n; k++) {
+        s->m.cw[k] = NCP_402_CW_ENABLE;
+        pos[s->ax[k]] = ncp_counts_to_mm(s->m.node[k].actual, s->cpm[k]);
     }
     return 0;
 }
@@ -50,12 +54,12 @@ static int sc_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const dou
     struct ncp_co_master *m = &s->m;
     int64_t now = ncp_co_now_ms();
     int bad = ncp_co_master_poll(m, now, POLL_MAX) || ncp_co_master_check(m, now);
-    for (int j = 0; j < NCP_AXES; j++)
-        act[j] = ncp_counts_to_mm(m->node[j].actual, s->cpm[j]);
+    for (int k = 0; k < s->n; k++)
+        act[s->ax[k]] = ncp_counts_to_mm(m->node[k].actual, s->cpm[k]);
     if (bad)
         return -1;
-    for (int j = 0; j < NCP_AXES; j++)
-        if (ncp_mm_to_counts(next[j], s->cpm[j], &m->target[j]))
+    for (int k = 0; k < s->n; k++)
+        if (ncp_mm_to_counts(next[s->ax[k]], s->cpm[k], &m->target[k]))
             return -1; /* cannot happen within the checked soft limits */
     return ncp_co_master_send(m);
 }
@@ -94,8 +98,11 @@ int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_c
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the CAN master");
     uint8_t nodes[NCP_AXES];
     for (int j = 0; j < NCP_AXES; j++) {
-        nodes[j] = (uint8_t)cfg->axis[j].node_id;
-        s->cpm[j] = cfg->axis[j].counts_per_mm;
+        if (!(cfg->axis_mask & NCP_AXIS_BIT(j)))
+            continue;
+        nodes[s->n] = (uint8_t)cfg->axis[j].node_id;
+        s->cpm[s->n] = cfg->axis[j].counts_per_mm;
+        s->ax[s->n++] = j;
     }
     struct ncp_co_master_cfg mc = {
         .period_us = (long)(cfg->servo_period * 1e6 + 0.5),
@@ -103,7 +110,7 @@ int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_c
         .hb_period_ms = cfg->can.heartbeat_period_ms,
         .hb_timeout_ms = cfg->can.heartbeat_timeout_ms,
     };
-    if (ncp_co_master_open(&s->m, cfg->can.interface, nodes, NCP_AXES, &mc, d) != NCP_OK) {
+    if (ncp_co_master_open(&s->m, cfg->can.interface, nodes, s->n, &mc, d) != NCP_OK) {
         free(s);
         return d->code;
     }

@@ -202,7 +202,7 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
     } else if (res->fault) {
         fprintf(stderr,
                 "%s:%u: error: following error on %c: %.4f mm exceeds FERROR %.4f mm; servo stopped\n",
-                o->prog, res->fault_line, "XYZ"[res->fault_axis], res->fault_err,
+                o->prog, res->fault_line, NCP_AXIS_LETTERS[res->fault_axis], res->fault_err,
                 cfg->axis[res->fault_axis].ferror);
     } else if (res->status != RUN_OK && res->diag.line) {
         fprintf(stderr, "%s:%u:%u: error: %s (motion stopped after the last good block)\n",

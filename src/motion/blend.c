@@ -29,8 +29,11 @@ static void direction(const struct ncp_seg *s, double u[3])
 int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,
                      struct ncp_seg *arc, double *trim)
 {
+    /* the blend arc is drawn in X Y Z: a corner where another axis moves
+     * is a kink instead */
     if (prev->kind != NCP_SEG_LINE || cur->kind != NCP_SEG_LINE ||
-        prev->term != NCP_TERM_CONTINUOUS || prev->length <= 0 || cur->length <= 0)
+        prev->term != NCP_TERM_CONTINUOUS || prev->length <= 0 || cur->length <= 0 ||
+        ncp_seg_moves_other(prev) || ncp_seg_moves_other(cur))
         return 0;
     double u1[3], u2[3], n[3];
     direction(prev, u1);
@@ -65,6 +68,8 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
         bl += bis[i] * bis[i];
     }
     bl = sqrt(bl);
+    for (int i = 3; i < NCP_AXES; i++)
+        arc->start[i] = arc->end[i] = prev->end[i];
     for (int i = 0; i < 3; i++) {
         arc->start[i] = prev->end[i] - u1[i] * d;
         arc->end[i] = prev->end[i] + u2[i] * d;

@@ -1,6 +1,7 @@
 /* Canonical calls (program coordinates and units) -> machine-space segments (mm).
  * machine = rotate_xy(program * scale + g92) + g5x + tool, offsets converted to mm
- * with the units in force when they were issued (as LinuxCNC's canon layer). */
+ * with the units in force when they were issued (as LinuxCNC's canon layer).
+ * A B C are degrees in every unit system; U V W do not come in the calls. */
 #include "ncpar/motion.h"
 #include "nurbs_eval.h"
 
@@ -49,6 +50,44 @@ void ncp_canon_map_to_program(const struct ncp_canon_map *m, const double machin
         prog[i] = (q[i] - m->g92[i]) / m->scale;
 }
 
+/* The whole target: X Y Z from p, A B C from abc (NULL: where they are), the
+ * rest where they are. */
+static void to_machine_all(const struct ncp_canon_map *m, const double p[3], const double *abc,
+                           double out[NCP_AXES])
+{
+    to_machine(m, p, out);
+    for (int i = 3; i < NCP_AXES; i++)
+        out[i] = m->pos[i];
+    if (abc)
+        for (int i = 3; i < NCP_CANON_AXES; i++)
+            out[i] = abc[i - 3] + m->g92[i] + m->g5x[i] + m->tool[i];
+}
+
+/* A wrapped rotary axis turns the shorter way to its target modulo 360; its
+ * position counts on across whole turns. (LinuxCNC's interpreter picks the
+ * way from the sign of a G90 word; the calls carry no distance mode, so
+ * the NCK takes the shorter one.) */
+static void unwrap(const struct ncp_canon_map *m, double end[NCP_AXES])
+{
+    for (int i = 3; i < 6; i++)
+        if (m->cfg->axis[i].wrapped)
+            end[i] = m->pos[i] + remainder(end[i] - m->pos[i], 360.0);
+}
+
+/* A move of an axis the machine lacks is refused (before any motion, by
+ * the batch check): the part would be cut without it. */
+static int absent_axis(const struct ncp_canon_map *m, const double end[NCP_AXES], uint32_t line,
+                       struct ncp_diag *d)
+{
+    for (int i = 0; i < NCP_AXES; i++)
+        if (!(m->cfg->axis_mask & NCP_AXIS_BIT(i)) && fabs(end[i] - m->pos[i]) > 1e-9)
+            return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
+                                 "this move needs axis %c, which this machine does not have "
+                                 "([TRAJ] COORDINATES lists the machine's axes)",
+                                 NCP_AXIS_LETTERS[i]);
+    return 0;
+}
+
 static double dot(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -66,15 +105,18 @@ static int check_point(const struct ncp_canon_map *m, const double p[NCP_AXES],
 {
     for (int i = 0; i < NCP_AXES; i++) {
         const struct ncp_axis_cfg *a = &m->cfg->axis[i];
+        if (!(m->cfg->axis_mask & NCP_AXIS_BIT(i)) || a->wrapped)
+            continue;  /* absent axes never move; a wrapped one has no end */
+        const char *u = ncp_axis_rotary(i) ? "deg" : "mm";
         /* a nanometre of slack: arc extremes are computed, not given */
         if (p[i] < a->min_limit - 1e-6)
             return ncp_diag_set(d, NCP_ERR_LIMIT, line, 0,
-                                "soft limit: %c would go to %.4f mm, below its minimum %.4f mm",
-                                "XYZ"[i], p[i], a->min_limit);
+                                "soft limit: %c would go to %.4f %s, below its minimum %.4f %s",
+                                NCP_AXIS_LETTERS[i], p[i], u, a->min_limit, u);
         if (p[i] > a->max_limit + 1e-6)
             return ncp_diag_set(d, NCP_ERR_LIMIT, line, 0,
-                                "soft limit: %c would go to %.4f mm, above its maximum %.4f mm",
-                                "XYZ"[i], p[i], a->max_limit);
+                                "soft limit: %c would go to %.4f %s, above its maximum %.4f %s",
+                                NCP_AXIS_LETTERS[i], p[i], u, a->max_limit, u);
     }
     return NCP_OK;
 }
@@ -84,7 +126,7 @@ static int check_point(const struct ncp_canon_map *m, const double p[NCP_AXES],
 static int check_arc(const struct ncp_canon_map *m, const struct ncp_seg *s, struct ncp_diag *d)
 {
     double lo = fmin(0, s->angle), hi = fmax(0, s->angle);
-    for (int i = 0; i < NCP_AXES; i++) {
+    for (int i = 0; i < 3; i++) {
         double base = atan2(s->w[i], s->u[i]);
         for (int half = 0; half < 2; half++) {
             double b = base + half * M_PI;
@@ -141,23 +183,39 @@ static int spindle_needed(const struct ncp_canon_map *m, uint32_t line, struct n
                                "with M3 or M4 first, or use G94");
 }
 
-/* Feed in mm/s of a move ending at machine X = x_mm. A synchronised move
- * runs at its pitch whatever the override (rs274 turns it off around them). */
-static double feed_at(const struct ncp_canon_map *m, double x_mm)
+/* Feed in mm/s of a move ending at machine X = x_mm (deg/s for a move of
+ * rotary axes only: F is then degrees per minute, LinuxCNC's rule). A
+ * synchronised move runs at its pitch whatever the override (rs274 turns it
+ * off around them). G93's inverse time needs nothing here: the interpreter
+ * sends it as the feed that makes the move take 1/F minutes, along the
+ * length measured as here. */
+static double feed_at(const struct ncp_canon_map *m, double x_mm, int angular)
 {
     if (m->sync_pitch > 0)
         return m->sync_pitch * spindle_rpm(m, x_mm) / 60.0;
-    double per_min = m->per_rev ? m->feed * spindle_rpm(m, x_mm) : m->feed;
+    double f = angular ? m->feed_deg : m->feed;
+    double per_min = m->per_rev ? f * spindle_rpm(m, x_mm) : f;
     return per_min / 60.0 * m->feed_override;
 }
 
 /* What a corner after a move ending at x_mm is blended for: its feed at the
  * largest override, whatever the override now. */
-static double blend_feed_at(const struct ncp_canon_map *m, double x_mm)
+static double blend_feed_at(const struct ncp_canon_map *m, double x_mm, int angular)
 {
     if (m->sync_pitch > 0)
-        return feed_at(m, x_mm);
-    return feed_at(m, x_mm) / m->feed_override * NCP_FEED_OVERRIDE_MAX;
+        return feed_at(m, x_mm, angular);
+    return feed_at(m, x_mm, angular) / m->feed_override * NCP_FEED_OVERRIDE_MAX;
+}
+
+/* A rapid of rotary axes only: as fast as the slowest of them allows (the
+ * planner's per-axis caps do the rest). */
+static double rotary_rapid(const struct ncp_canon_map *m, const struct ncp_seg *s)
+{
+    double v = INFINITY;
+    for (int i = 3; i < 6; i++)
+        if (s->end[i] != s->start[i])
+            v = fmin(v, m->cfg->axis[i].max_vel);
+    return isfinite(v) ? v : m->cfg->max_linear_vel;
 }
 
 static int finite3(const double *v, int n)
@@ -178,19 +236,20 @@ static int line_to(struct ncp_canon_map *m, const double end_mm[NCP_AXES], int t
     memcpy(s->end, end_mm, sizeof s->end);
     if (!finite3(s->end, NCP_AXES))
         return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "move to a non-finite position");
-    double l2 = 0;
-    for (int i = 0; i < NCP_AXES; i++)
-        l2 += (s->end[i] - s->start[i]) * (s->end[i] - s->start[i]);
-    s->length = sqrt(l2);
+    unwrap(m, s->end);
+    int rc = absent_axis(m, s->end, line, d);
+    if (rc)
+        return rc;
+    ncp_seg_set_length(s);
     if (s->length < 1e-9)
-        return 0;  /* A/B/C-only or null move: nothing for a 3-axis machine to do */
+        return 0;  /* a null move: nothing to do */
     if (!traverse && spindle_needed(m, line, d))
         return -NCP_ERR_SEMANTIC;
     if (traverse)
-        s->feed = m->cfg->max_linear_vel;
-    else if ((s->feed = feed_at(m, s->end[0])) <= 0)
+        s->feed = s->angular ? rotary_rapid(m, s) : m->cfg->max_linear_vel;
+    else if ((s->feed = feed_at(m, s->end[0], s->angular)) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "feed move with zero feed rate");
-    s->blend_feed = traverse ? s->feed : blend_feed_at(m, s->end[0]);
+    s->blend_feed = traverse ? s->feed : blend_feed_at(m, s->end[0], s->angular);
     int r = check_point(m, s->end, line, d);
     if (r)
         return -r;
@@ -202,7 +261,7 @@ static int straight(struct ncp_canon_map *m, const struct ncp_canon *op, int tra
                     uint32_t line, struct ncp_seg *s, struct ncp_diag *d)
 {
     double end[NCP_AXES];
-    to_machine(m, op->move.end, end);
+    to_machine_all(m, op->move.end, op->move.end + 3, end);
     return line_to(m, end, traverse, line, s, d);
 }
 
@@ -212,7 +271,7 @@ static int rigid_tap(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
 {
     double end[NCP_AXES];
     memcpy(m->more_back, m->pos, sizeof m->more_back);
-    to_machine(m, op->rigid_tap.bottom, end);
+    to_machine_all(m, op->rigid_tap.bottom, NULL, end);
     int rc = line_to(m, end, 0, line, s, d);
     if (rc == 1) {
         m->more_left = 1;
@@ -238,7 +297,7 @@ static int nurbs_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_d
         double p[3], end[NCP_AXES];
         ncp_nurbs_stream_point(nb, span, t, p);
         p[2] = m->more_z;
-        to_machine(m, p, end);
+        to_machine_all(m, p, NULL, end);
         int rc = line_to(m, end, 0, m->more_line, seg, d);
         if (rc != 0) {
             if (rc < 0) { /* the run stops: nothing more of this curve */
@@ -333,10 +392,14 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     pc[ax[1]] = op->arc_feed.second_axis;
     pc[ax[2]] = op->arc_feed.axis_end;
     double c[3], n[3] = { 0, 0, 0 }, origin[3] = { 0, 0, 0 }, nm[3];
-    to_machine(m, pe, s->end);
+    to_machine_all(m, pe, op->arc_feed.abc, s->end);
     to_machine(m, pc, c);
     if (!finite3(s->end, NCP_AXES) || !finite3(c, 3) || abs(op->arc_feed.rotation) > 100000)
         return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "arc with a non-finite end or centre, or too many turns");
+    unwrap(m, s->end);
+    int absent = absent_axis(m, s->end, line, d);
+    if (absent)
+        return absent;
     /* the plane normal turns with the XY rotation like any direction does */
     n[ax[2]] = 1.0;
     to_machine(m, n, nm);
@@ -376,11 +439,19 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     s->angle = a;
     double arc_len = fabs(a) * 0.5 * (s->r0 + s->r1);
     s->length = sqrt(arc_len * arc_len + s->axial * s->axial);
+    /* the arc sweeps its plane: both of the plane's axes must be there */
+    for (int i = 0; i < 3; i++)
+        if (!(m->cfg->axis_mask & NCP_AXIS_BIT(i)) && (fabs(s->u[i]) > 1e-12 ||
+                                                        fabs(s->w[i]) > 1e-12))
+            return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
+                                 "this arc needs axis %c, which this machine does not have "
+                                 "([TRAJ] COORDINATES lists the machine's axes)",
+                                 NCP_AXIS_LETTERS[i]);
     if (spindle_needed(m, line, d))
         return -NCP_ERR_SEMANTIC;
-    if ((s->feed = feed_at(m, s->end[0])) <= 0)
+    if ((s->feed = feed_at(m, s->end[0], 0)) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "arc move with zero feed rate");
-    s->blend_feed = blend_feed_at(m, s->end[0]);
+    s->blend_feed = blend_feed_at(m, s->end[0], 0);
     int r = check_arc(m, s, d);
     if (r)
         return -r;
@@ -388,10 +459,11 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     return 1;
 }
 
+/* Lengths X Y Z in mm; A B C are degrees whatever the units. */
 static void set6(double dst[6], const double src[6], double scale)
 {
     for (int i = 0; i < 6; i++)
-        dst[i] = src[i] * scale;
+        dst[i] = src[i] * (i < 3 ? scale : 1.0);
 }
 
 static int state_op(struct ncp_canon_map *m, const struct ncp_canon *op)
@@ -417,6 +489,7 @@ static int state_op(struct ncp_canon_map *m, const struct ncp_canon *op)
         break;
     case NCP_C_SET_FEED_RATE:
         m->feed = op->feed_rate.rate * m->scale;
+        m->feed_deg = op->feed_rate.rate;
         break;
     case NCP_C_SET_FEED_MODE:
         m->per_rev = op->feed_mode.per_rev == 1;

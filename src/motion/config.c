@@ -21,10 +21,11 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->servo_period = 1e-3;
     c->max_linear_vel = 200.0;
     for (int i = 0; i < NCP_AXES; i++) {
-        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 100000.0, 1.0, 0, 0, 0, 0 };
+        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 100000.0, 1.0, 0, 0, 0, 0, 0 };
     }
     c->axis[2].min_limit = -250.0;
     c->axis[2].max_limit = 50.0;
+    c->axis_mask = NCP_AXES_XYZ;
     c->lookahead = 200;
     c->profile = NCP_PROFILE_TRAPEZOID;
     c->setpoint_ring = 1024;
@@ -70,9 +71,11 @@ struct load_ctx {
     unsigned axis_line[NCP_AXES]; /* line of [AXIS_n], 0 = not in the file */
     unsigned axis_set[NCP_AXES];  /* AK_* bits given */
     unsigned profile_line;
+    unsigned coords_line;       /* [TRAJ] COORDINATES, 0 = not given (XYZ) */
+    char coords[16];            /* as the file wrote it */
     struct seen { char sec[16], key[32]; unsigned line; } seen[MAX_SEEN];
     int n_seen;
-    struct { char name[16]; unsigned line; } sections[16];
+    struct { char name[16]; unsigned line; } sections[24];
     int n_sections;
 };
 
@@ -342,13 +345,39 @@ static int traj_key(struct ncp_machine_cfg *c, const char *k, const char *v, cha
     return 0;
 }
 
-/* [AXIS_X] -> 0 .. [AXIS_Z] -> 2, else -1 */
+/* [AXIS_X] -> 0 .. [AXIS_W] -> 8, else -1 */
 static int axis_index(const char *sec)
 {
     if (strncasecmp(sec, "AXIS_", 5) != 0 || strlen(sec) != 6)
         return -1;
-    const char *p = strchr("XYZ", sec[5] & ~0x20);
-    return p && *p ? (int)(p - "XYZ") : -1;
+    const char *p = strchr(NCP_AXIS_LETTERS, sec[5] & ~0x20);
+    return p && *p ? (int)(p - NCP_AXIS_LETTERS) : -1;
+}
+
+/* [TRAJ] COORDINATES: each of X Y Z A B C U V W at most once (LinuxCNC
+ * repeats a letter for a gantry's second joint: that needs a joint layer
+ * this machine model does not have yet). */
+static int coordinates_key(struct load_ctx *lc, const char *v, char *why, size_t len)
+{
+    unsigned mask = 0;
+    size_t n = 0;
+    for (const char *p = v; *p; p++) {
+        if (*p == ' ' || *p == '\t')
+            continue;
+        const char *q = strchr(NCP_AXIS_LETTERS, *p & ~0x20);
+        if (!q || !*q || (mask & NCP_AXIS_BIT(q - NCP_AXIS_LETTERS)))
+            return snprintf(why, len, "axis letters from XYZABCUVW, each once, e.g. XYZ or XYZA"),
+                   -1;
+        mask |= NCP_AXIS_BIT(q - NCP_AXIS_LETTERS);
+        if (n + 1 < sizeof lc->coords)
+            lc->coords[n++] = (char)(*p & ~0x20);
+    }
+    if (!mask)
+        return snprintf(why, len, "at least one axis letter, e.g. XYZ"), -1;
+    lc->coords[n] = '\0';
+    lc->c->axis_mask = mask;
+    lc->coords_line = lc->line;
+    return 1;
 }
 
 static int known_section(const char *sec)
@@ -377,10 +406,16 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
         return 1;
     }
     if (!strcasecmp(sec, "TRAJ"))
-        return traj_key(c, k, v, why, len);
+        return !strcasecmp(k, "COORDINATES") ? coordinates_key(lc, v, why, len)
+                                             : traj_key(c, k, v, why, len);
     if (!strcasecmp(sec, "LCM"))
         return lcm_key(&c->lcm, k, v, why, len);
     int ax = axis_index(sec);
+    if (ax >= 0 && !strcasecmp(k, "WRAPPED_ROTARY")) {
+        if (!ncp_axis_rotary(ax))
+            return snprintf(why, len, "only the rotary axes A, B and C wrap"), -1;
+        return integer(v, 0, 1, &c->axis[ax].wrapped) ? snprintf(why, len, "0 or 1"), -1 : 1;
+    }
     if (ax >= 0) {
         unsigned bit;
         int r = axis_key(&c->axis[ax], k, v, &bit, why, len);
@@ -502,11 +537,24 @@ static int check_axes(struct load_ctx *lc)
                     (1u << AK_MAX_ACCELERATION) | (1u << AK_FERROR);
     if (lc->c->profile == NCP_PROFILE_SCURVE)
         need |= 1u << AK_MAX_JERK;
+    const char *coords = lc->coords_line ? lc->coords : "XYZ";
+    char where[48] = "(the default)";
+    if (lc->coords_line)
+        snprintf(where, sizeof where, "(line %u)", lc->coords_line);
     for (int i = 0; i < NCP_AXES; i++) {
+        int want = (lc->c->axis_mask & NCP_AXIS_BIT(i)) != 0;
+        if (!want && lc->axis_line[i])
+            return fail_at(lc, lc->axis_line[i], "[AXIS_%c] is for an axis [TRAJ] COORDINATES = "
+                                                 "%s %s does not name: add %c to COORDINATES "
+                                                 "or remove the section",
+                           NCP_AXIS_LETTERS[i], coords, where, NCP_AXIS_LETTERS[i]), -1;
+        if (!want)
+            continue;
         if (!lc->axis_line[i])
-            return fail_at(lc, 0, "[AXIS_%c] missing: every axis (X, Y, Z) needs MIN_LIMIT, "
+            return fail_at(lc, lc->coords_line, "[AXIS_%c] missing: [TRAJ] COORDINATES = %s %s "
+                                  "names %c, and every axis needs MIN_LIMIT, "
                                   "MAX_LIMIT, MAX_VELOCITY, MAX_ACCELERATION and FERROR",
-                           "XYZ"[i]), -1;
+                           NCP_AXIS_LETTERS[i], coords, where, NCP_AXIS_LETTERS[i]), -1;
         unsigned missing = need & ~lc->axis_set[i];
         if (!missing)
             continue;
@@ -516,10 +564,10 @@ static int check_axes(struct load_ctx *lc)
         if (k == AK_MAX_JERK)
             return fail_at(lc, lc->axis_line[i], "[AXIS_%c] MAX_JERK missing: PROFILE = scurve "
                                                  "(line %u) limits every axis's jerk",
-                           "XYZ"[i], lc->profile_line), -1;
+                           NCP_AXIS_LETTERS[i], lc->profile_line), -1;
         return fail_at(lc, lc->axis_line[i], "[AXIS_%c] %s missing: every axis needs MIN_LIMIT, "
                                              "MAX_LIMIT, MAX_VELOCITY, MAX_ACCELERATION and FERROR",
-                       "XYZ"[i], axis_required[k > AK_MAX_JERK ? k - 1 : k]), -1;
+                       NCP_AXIS_LETTERS[i], axis_required[k > AK_MAX_JERK ? k - 1 : k]), -1;
     }
     return 0;
 }
@@ -542,14 +590,17 @@ static int check_cfg(struct load_ctx *lc)
                               "[EMCMOT] SERVO_PERIOD %.0f ns",
                        c->planning_period * 1e9, c->servo_period * 1e9), -1;
     for (int i = 0; i < NCP_AXES; i++) {
+        if (!(c->axis_mask & NCP_AXIS_BIT(i)))
+            continue;
         if (c->axis[i].min_limit >= c->axis[i].max_limit)
             return fail_at(lc, lc->axis_line[i], "[AXIS_%c] MIN_LIMIT must be below MAX_LIMIT",
-                           "XYZ"[i]), -1;
+                           NCP_AXIS_LETTERS[i]), -1;
         for (int j = 0; j < i; j++)
-            if (c->axis[i].node_id && c->axis[i].node_id == c->axis[j].node_id)
+            if ((c->axis_mask & NCP_AXIS_BIT(j)) && c->axis[i].node_id &&
+                c->axis[i].node_id == c->axis[j].node_id)
                 return fail_at(lc, lc->axis_line[i],
-                               "[AXIS_%c] NODE_ID %d is already the node of [AXIS_%c]", "XYZ"[i],
-                               c->axis[i].node_id, "XYZ"[j]), -1;
+                               "[AXIS_%c] NODE_ID %d is already the node of [AXIS_%c]",
+                               NCP_AXIS_LETTERS[i], c->axis[i].node_id, NCP_AXIS_LETTERS[j]), -1;
     }
     if (c->can.heartbeat_timeout_ms <= c->can.heartbeat_period_ms)
         return fail_at(lc, key_line(lc, "CAN", "HEARTBEAT_TIMEOUT_MS"), "[CAN] HEARTBEAT_TIMEOUT_MS %d must be longer than "
@@ -558,9 +609,10 @@ static int check_cfg(struct load_ctx *lc)
     /* a late planner thread makes the position loop slow down along the path
      * on what is left in the ring (src/rt/nck.c): half a stop from the top
      * speed at half the weakest axis's acceleration has to fit */
-    double a_min = c->axis[0].max_acc;
-    for (int i = 1; i < NCP_AXES; i++)
-        a_min = fmin(a_min, c->axis[i].max_acc);
+    double a_min = INFINITY;
+    for (int i = 0; i < NCP_AXES; i++)
+        if (c->axis_mask & NCP_AXIS_BIT(i))
+            a_min = fmin(a_min, c->axis[i].max_acc);
     double need = c->max_linear_vel / (a_min * c->servo_period) / ratio + 8;
     if ((double)c->setpoint_ring < need)
         return fail_at(lc, key_line(lc, "PLANNER", "SETPOINT_RING"), "[PLANNER] SETPOINT_RING %d is too small to stop along the path "

@@ -138,7 +138,9 @@ void ncp_planner_pop(struct ncp_planner *p)
 static void line_limits(const struct ncp_planner *p, struct plan_seg *ps)
 {
     const struct ncp_seg *s = &ps->s;
-    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY, jerk = INFINITY;
+    /* a rotary-only move's path is in degrees: only its axes' limits apply */
+    double vmax = s->angular ? s->feed : fmin(s->feed, p->cfg.max_linear_vel);
+    double acc = INFINITY, jerk = INFINITY;
     for (int j = 0; j < NCP_AXES; j++) {
         double u = fabs(s->end[j] - s->start[j]) / s->length;
         if (u < 1e-12)
@@ -179,7 +181,18 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
     double pitch = s->axial / fabs(s->angle);
     double kappa = r / (r * r + pitch * pitch);
     double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY, jerk = INFINITY;
-    for (int j = 0; j < NCP_AXES; j++) {
+    /* the axes beyond X Y Z move linearly along the arc: a line's caps */
+    for (int j = 3; j < NCP_AXES; j++) {
+        double u = fabs(s->end[j] - s->start[j]) / s->length;
+        if (u < 1e-12)
+            continue;
+        const struct ncp_axis_cfg *a = &p->cfg.axis[j];
+        vmax = fmin(vmax, a->max_vel / u);
+        acc = fmin(acc, a->max_acc / u);
+        if (a->max_jerk > 0)
+            jerk = fmin(jerk, 0.5 * a->max_jerk / u);
+    }
+    for (int j = 0; j < 3; j++) {
         double m = sqrt(s->u[j] * s->u[j] + s->w[j] * s->w[j]);
         double share = f_plane * m + f_axis * fabs(s->normal[j]);
         if (share < 1e-12)
@@ -196,7 +209,7 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
     ps->acc = acc;
     ps->jerk = jerk;
     /* tangential acceleration turns with the tangent: its jerk is 3 v a kappa */
-    for (int j = 0; j < NCP_AXES && plan_scurve(p); j++) {
+    for (int j = 0; j < 3 && plan_scurve(p); j++) {
         double m = sqrt(s->u[j] * s->u[j] + s->w[j] * s->w[j]);
         if (p->cfg.axis[j].max_jerk > 0 && m > 1e-12 && vmax > 0)
             ps->acc = fmin(ps->acc, p->cfg.axis[j].max_jerk / (6 * 3 * vmax * kappa * m));
@@ -438,8 +451,9 @@ static void push_blended(struct ncp_planner *p, const struct ncp_seg *s)
 
 static int chain_may_start(const struct ncp_seg *s)
 {
+    /* Q is a distance in X Y Z: lines that turn another axis are not joined */
     return s->kind == NCP_SEG_LINE && !s->traverse && s->term == NCP_TERM_CONTINUOUS &&
-           s->merge_tol > 0 && s->length > 0;
+           s->merge_tol > 0 && s->length > 0 && !ncp_seg_moves_other(s);
 }
 
 /* Distance from q to the segment a-b. */

@@ -23,6 +23,28 @@ static void eval_line(const struct ncp_seg *s, double dist, double pos[NCP_AXES]
     }
 }
 
+void ncp_seg_set_length(struct ncp_seg *s)
+{
+    double xyz = 0, abc = 0;
+    for (int i = 0; i < 6; i++) {
+        double d = (s->end[i] - s->start[i]) * (s->end[i] - s->start[i]);
+        if (i < 3)
+            xyz += d;
+        else
+            abc += d;
+    }
+    s->angular = xyz < 1e-18 && abc > 0;
+    s->length = sqrt(s->angular ? abc : xyz);
+}
+
+int ncp_seg_moves_other(const struct ncp_seg *s)
+{
+    for (int i = 3; i < NCP_AXES; i++)
+        if (s->end[i] != s->start[i])
+            return 1;
+    return 0;
+}
+
 static void eval_arc(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                      double tan[NCP_AXES])
 {
@@ -32,16 +54,24 @@ static void eval_arc(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
         dist = s->length;
     }
     double l = s->length > 0 ? dist / s->length : 1.0;
+    /* the axes beyond X Y Z follow the arc linearly */
+    for (int i = 3; i < NCP_AXES; i++) {
+        double d = s->end[i] - s->start[i];
+        if (dist < s->length)
+            pos[i] = s->start[i] + d * l;
+        if (tan)
+            tan[i] = s->length > 0 ? d / s->length : 0;
+    }
     double phi = s->angle * l;
     double r = s->r0 + (s->r1 - s->r0) * l;
     double c = cos(phi), sn = sin(phi);
     if (dist < s->length) {
-        for (int i = 0; i < NCP_AXES; i++)
+        for (int i = 0; i < 3; i++)
             pos[i] = s->center[i] + r * (c * s->u[i] + sn * s->w[i]) + s->normal[i] * s->axial * l;
     }
     if (tan) {
         double dr = s->r1 - s->r0;
-        for (int i = 0; i < NCP_AXES; i++)
+        for (int i = 0; i < 3; i++)
             tan[i] = dr * (c * s->u[i] + sn * s->w[i]) +
                      r * s->angle * (-sn * s->u[i] + c * s->w[i]) + s->normal[i] * s->axial;
         unit(tan);

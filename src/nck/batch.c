@@ -167,7 +167,7 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o)
     int64_t last_print = 0;
     if (o->trace) {
         errno = 0;
-        nck_trace_header(o->trace);
+        nck_trace_header(o->trace, n->cfg->axis_mask);
         if (ferror(o->trace))
             n->sum.trace_errno = errno ? errno : EIO;
     }
@@ -231,6 +231,7 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
                    "result arrays follow the axis count");
     for (int j = 0; j < NCP_AXES; j++)
         res->ferr_axis_max[j] = s->ferr_axis_max[j];
+    res->axis_mask = n->cfg->axis_mask;
     res->contour_max = s->contour_max;
     res->contour_avg = s->moving ? s->contour_sum / (double)s->moving : 0;
     res->underruns = n->underruns;

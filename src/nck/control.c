@@ -62,14 +62,14 @@ static int axis_index(const char *text)
 {
     if (!text[0] || text[1])
         return -1;
-    const char *p = strchr("xyz", tolower((unsigned char)text[0]));
-    return p ? (int)(p - "xyz") : -1;
+    const char *p = strchr("xyzabcuvw", tolower((unsigned char)text[0]));
+    return p ? (int)(p - "xyzabcuvw") : -1;
 }
 
 static int all_homed(const struct ncp_nck *s)
 {
     for (int j = 0; j < NCP_AXES; j++)
-        if (!s->homed[j])
+        if ((s->n.cfg->axis_mask & NCP_AXIS_BIT(j)) && !s->homed[j])
             return 0;
     return 1;
 }
@@ -320,8 +320,17 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
     if (s->state != NCP_ST_IDLE)
         return refuse(why, len, "cannot jog while %s", ncp_nck_state_name(s->state));
     int j = axis_index(c->text);
-    if (j < 0)
-        return refuse(why, len, "no axis '%s' on this machine (it has X Y Z)", c->text);
+    if (j < 0 || !(n->cfg->axis_mask & NCP_AXIS_BIT(j))) {
+        char have[2 * NCP_AXES + 1];
+        size_t k = 0;
+        for (int i = 0; i < NCP_AXES; i++)
+            if (n->cfg->axis_mask & NCP_AXIS_BIT(i)) {
+                have[k++] = NCP_AXIS_LETTERS[i];
+                have[k++] = ' ';
+            }
+        have[k ? k - 1 : 0] = '\0';
+        return refuse(why, len, "no axis '%s' on this machine (it has %s)", c->text, have);
+    }
     int dir = c->ivalue[0] > 0 ? 1 : c->ivalue[0] < 0 ? -1 : 0;
     if (!dir)
         return refuse(why, len, "jog wants a direction, + or -");
@@ -337,7 +346,7 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
     target[j] = dist > 0 ? target[j] + dir * dist : limit;
     target[j] = dir > 0 ? fmin(target[j], limit) : fmax(target[j], limit);
     if (fabs(target[j] - n->map.pos[j]) < 1e-9)
-        return refuse(why, len, "%c is at its soft limit %.4f mm", "XYZ"[j], limit);
+        return refuse(why, len, "%c is at its soft limit %.4f", NCP_AXIS_LETTERS[j], limit);
     struct ncp_seg seg;
     n->job.step_line = 0;
     nck_line(n, &seg, n->map.pos, target, speed, 0);
@@ -360,9 +369,10 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
         return refuse(why, len, "cannot home while %s", ncp_nck_state_name(s->state));
     int all = !strcasecmp(c->text, "all");
     int j = all ? -1 : axis_index(c->text);
-    if (!all && j < 0)
-        return refuse(why, len, "home takes an axis letter (X Y Z) or all, not '%s'", c->text);
-    static const int order[NCP_AXES] = { 2, 0, 1 };
+    if (!all && (j < 0 || !(n->cfg->axis_mask & NCP_AXIS_BIT(j))))
+        return refuse(why, len, "home takes one of the machine's axis letters or all, not '%s'",
+                      c->text);
+    static const int order[NCP_AXES] = { 2, 0, 1, 3, 4, 5, 6, 7, 8 };
     struct ncp_seg moves[NCP_AXES];
     int count = 0, mask = 0;
     double at[NCP_AXES];
@@ -370,7 +380,7 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     n->job.step_line = 0;
     for (int k = 0; k < NCP_AXES; k++) {
         int ax = order[k];
-        if (!all && ax != j)
+        if ((!all && ax != j) || !(n->cfg->axis_mask & NCP_AXIS_BIT(ax)))
             continue;
         const struct ncp_axis_cfg *a = &n->cfg->axis[ax];
         double to[NCP_AXES];
@@ -647,7 +657,7 @@ static void check_fault(struct ncp_nck *s)
     if (f == NCK_LF_FERROR)
         snprintf(s->error, sizeof s->error,
                  "following error on %c: %.4f mm exceeds FERROR %.4f mm (line %u); drives off",
-                 "XYZ"[n->fault_axis], n->fault_err, n->cfg->axis[n->fault_axis].ferror,
+                 NCP_AXIS_LETTERS[n->fault_axis], n->fault_err, n->cfg->axis[n->fault_axis].ferror,
                  n->fault_line);
     else {
         char why[NCP_DIAG_MSG_MAX];
@@ -718,7 +728,7 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
     if (setup->trace)
-        nck_trace_header(setup->trace);
+        nck_trace_header(setup->trace, setup->cfg->axis_mask);
     if (!s->interp || nck_start(n, setup, 0, d) || nck_start_loop(n, d)) {
         ncp_nck_free(s);
         return NULL;
@@ -766,12 +776,16 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     memset(st, 0, sizeof *st);
     st->state = s->state;
     snprintf(st->program, sizeof st->program, "%s", s->program);
-    st->n_axes = NCP_AXES;
-    for (int j = 0; j < NCP_AXES; j++) {
-        st->axes[j] = "XYZ"[j];
-        st->homed[j] = s->homed[j];
-        st->pos_cmd[j] = n->have_fb ? n->last_fb.cmd[j] : n->start[j];
-        st->pos_act[j] = n->have_fb ? n->last_fb.act[j] : n->start[j];
+    /* the machine's axes only, in their order */
+    st->n_axes = 0;
+    for (int j = 0; j < NCP_AXES && st->n_axes < NCP_NCK_AXES_MAX; j++) {
+        if (!(n->cfg->axis_mask & NCP_AXIS_BIT(j)))
+            continue;
+        int k = st->n_axes++;
+        st->axes[k] = NCP_AXIS_LETTERS[j];
+        st->homed[k] = s->homed[j];
+        st->pos_cmd[k] = n->have_fb ? n->last_fb.cmd[j] : n->start[j];
+        st->pos_act[k] = n->have_fb ? n->last_fb.act[j] : n->start[j];
     }
     st->vel = n->have_fb ? n->last_fb.v * 60.0 : 0;
     st->feed_override = atomic_load(&n->ctl->override_permille) / 10.0;

@@ -42,9 +42,10 @@ static int init_motion(struct nck *n)
     ncp_canon_map_init(&n->map, c, n->start, n->plan_override);
     memcpy(n->next.pos, n->start, sizeof n->next.pos);
     n->cur = n->next;
-    double a_min = c->axis[0].max_acc;
-    for (int j = 1; j < NCP_AXES; j++)
-        a_min = fmin(a_min, c->axis[j].max_acc);
+    double a_min = INFINITY;
+    for (int j = 0; j < NCP_AXES; j++)
+        if (c->axis_mask & NCP_AXIS_BIT(j))
+            a_min = fmin(a_min, c->axis[j].max_acc);
     /* half the weakest axis: the stream may itself be accelerating meanwhile;
      * an abort brakes with all of it */
     n->decel_normal = 0.5 * a_min;

@@ -123,10 +123,7 @@ void nck_line(const struct nck *n, struct ncp_seg *s, const double from[NCP_AXES
     s->line = n->job.step_line;
     memcpy(s->start, from, sizeof s->start);
     memcpy(s->end, to, sizeof s->end);
-    double l2 = 0;
-    for (int j = 0; j < NCP_AXES; j++)
-        l2 += (to[j] - from[j]) * (to[j] - from[j]);
-    s->length = sqrt(l2);
+    ncp_seg_set_length(s);
     s->feed = traverse ? n->cfg->max_linear_vel : feed;
 }
 

@@ -356,10 +356,12 @@ void nck_post(struct nck *n, int kind, const char *file, uint32_t line, uint32_t
               const char *fmt, ...) __attribute__((format(printf, 6, 7)));
 
 /* stats.c */
-void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace);
+void nck_account(struct nck_summary *s, unsigned axis_mask, const struct nck_fb *fb, FILE *trace);
 /* Reads every cycle the loop has written: trace, summary, last cycle. */
 int nck_read_cycles(struct nck *n);
-void nck_trace_header(FILE *trace);
+/* The trace's first row: the fixed columns, then cmd and act of each of
+ * the machine's axes beyond X Y Z (axis_mask). */
+void nck_trace_header(FILE *trace, unsigned axis_mask);
 /* Writes the rows gathered so far. 0, or -1 when the write failed. */
 int nck_trace_flush(struct nck_summary *s, FILE *trace);
 

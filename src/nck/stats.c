@@ -12,19 +12,20 @@ static double dist_to_seg(const double p[NCP_AXES], const double a[NCP_AXES],
                           const double b[NCP_AXES])
 {
     double ab2 = 0, ap_ab = 0, d2 = 0;
-    for (int j = 0; j < NCP_AXES; j++) {
+    for (int j = 0; j < 3; j++) {
         ab2 += (b[j] - a[j]) * (b[j] - a[j]);
         ap_ab += (p[j] - a[j]) * (b[j] - a[j]);
     }
     double f = ab2 > 0 ? fmin(1, fmax(0, ap_ab / ab2)) : 0;
-    for (int j = 0; j < NCP_AXES; j++) {
+    for (int j = 0; j < 3; j++) {
         double q = a[j] + f * (b[j] - a[j]) - p[j];
         d2 += q * q;
     }
     return sqrt(d2);
 }
 
-/* Distance from the actual point to the commanded path, taken as the polyline
+/* Distance from the actual point to the commanded path in X Y Z (the tool
+ * tip on a machine with trivial kinematics), taken as the polyline
  * of the recent commanded samples (its chord error is v^2 T^2 / 8r). */
 static double contour_error(struct nck_summary *s, const struct nck_fb *fb)
 {
@@ -50,18 +51,41 @@ static int nck_motion_column(uint32_t flags)
     return flags & NCP_SP_RAPID ? 0 : flags & NCP_SP_ARC ? 2 : 1;
 }
 
-void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
+/* The rows' columns for the axes beyond X Y Z the machine has, after all
+ * the others, so that readers of the fixed columns keep working. */
+static int trace_more_axes(char *buf, size_t len, unsigned mask, const struct nck_fb *fb)
+{
+    size_t at = 0;
+    for (int j = 3; j < NCP_AXES; j++) {
+        if (!(mask & NCP_AXIS_BIT(j)))
+            continue;
+        int k = snprintf(buf + at, len - at, ",%.6f,%.6f", fb->cmd[j], fb->act[j]);
+        if (k < 0 || (size_t)k >= len - at)
+            return -1;
+        at += (size_t)k;
+    }
+    return (int)at;
+}
+
+void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, FILE *trace)
 {
     double e2 = 0;
     for (int j = 0; j < NCP_AXES; j++) {
         double e = fb->cmd[j] - fb->act[j];
-        e2 += e * e;
+        if (j < 3)   /* mm: the tool's following error */
+            e2 += e * e;
         s->ferr_axis_max[j] = fmax(s->ferr_axis_max[j], fabs(e));
     }
-    double e = sqrt(e2), c = contour_error(s, fb), step = 0;
-    for (int j = 0; j < NCP_AXES && s->rows; j++)
-        step += (fb->cmd[j] - s->last[j]) * (fb->cmd[j] - s->last[j]);
-    s->path += sqrt(step);
+    /* the path as LinuxCNC measures it: along X Y Z, else along A B C */
+    double e = sqrt(e2), c = contour_error(s, fb), step = 0, turn = 0;
+    for (int j = 0; j < 6 && s->rows; j++) {
+        double d = (fb->cmd[j] - s->last[j]) * (fb->cmd[j] - s->last[j]);
+        if (j < 3)
+            step += d;
+        else
+            turn += d;
+    }
+    s->path += step > 0 ? sqrt(step) : sqrt(turn);
     memcpy(s->last, fb->cmd, sizeof s->last);
     s->rows++;
     s->ferr_max = fmax(s->ferr_max, e);
@@ -88,14 +112,27 @@ void nck_account(struct nck_summary *s, const struct nck_fb *fb, FILE *trace)
                      fb->t, fb->line, fb->cmd[0], fb->cmd[1], fb->cmd[2], fb->act[0], fb->act[1],
                      fb->act[2], fb->v, nck_motion_column(fb->flags), fb->rpm, deg, fb->mist,
                      fb->flood, (unsigned long long)fb->dout, fb->tool, fb->wait);
-    if (k > 0 && (size_t)k < sizeof s->tbuf - s->tlen)
-        s->tlen += (size_t)k;
+    if (k > 0 && (size_t)k < sizeof s->tbuf - s->tlen) {
+        size_t at = s->tlen + (size_t)k - 1;   /* the row's newline */
+        int m = (mask & ~NCP_AXES_XYZ) ? trace_more_axes(s->tbuf + at, sizeof s->tbuf - at - 1,
+                                                         mask, fb)
+                                       : 0;
+        if (m >= 0) {
+            s->tbuf[at + (size_t)m] = '\n';
+            s->tlen = at + (size_t)m + 1;
+        }
+    }
 }
 
-void nck_trace_header(FILE *trace)
+void nck_trace_header(FILE *trace, unsigned mask)
 {
     fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion,spindle_rpm,spindle_deg,mist,"
-          "flood,dout,tool,wait\n", trace);
+          "flood,dout,tool,wait", trace);
+    for (int j = 3; j < NCP_AXES; j++)
+        if (mask & NCP_AXIS_BIT(j))
+            fprintf(trace, ",%c_cmd,%c_act", NCP_AXIS_LETTERS[j] | 0x20,
+                    NCP_AXIS_LETTERS[j] | 0x20);
+    fputc('\n', trace);
     fflush(trace);
 }
 
@@ -124,7 +161,7 @@ int nck_read_cycles(struct nck *n)
     struct nck_fb fb;
     int got = 0;
     while (ncp_spsc_pop(&n->fbs, &fb) == 0) {
-        nck_account(&n->sum, &fb, n->setup.trace);
+        nck_account(&n->sum, n->cfg->axis_mask, &fb, n->setup.trace);
         if (fb.waits != n->last_fb.waits && fb.wait != NCK_WAIT_NONE)
             nck_wait_began(n, &fb);
         n->last_fb = fb;
@@ -170,6 +207,14 @@ void ncp_nck_print_summary(const struct ncp_nck_result *r, const char *prog, FIL
     fprintf(f, "  following error: max %.4f mm (X %.4f, Y %.4f, Z %.4f), avg %.4f mm in motion\n",
             r->ferr_max, r->ferr_axis_max[0], r->ferr_axis_max[1], r->ferr_axis_max[2],
             r->ferr_avg);
+    if (r->axis_mask & ~NCP_AXES_XYZ) {
+        fprintf(f, "  following error of the other axes:");
+        for (int j = 3; j < NCP_AXES; j++)
+            if (r->axis_mask & NCP_AXIS_BIT(j))
+                fprintf(f, " %c %.4f %s", NCP_AXIS_LETTERS[j], r->ferr_axis_max[j],
+                        ncp_axis_rotary(j) ? "deg" : "mm");
+        fputc('\n', f);
+    }
     fprintf(f, "  contour error: max %.4f mm, avg %.4f mm in motion\n", r->contour_max,
             r->contour_avg);
     fprintf(f, "  canonical calls: %llu in, %llu acted on, %llu refused; spindle max %.0f rpm; "

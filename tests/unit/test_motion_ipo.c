@@ -46,7 +46,7 @@ static void worst_ratios(const struct row *r, size_t n, const struct ncp_machine
     *vel = *acc = 0;
     for (size_t k = 2; k < n; k++) {
         assert_true(fabs(r[k].t - r[k - 1].t - T) < 1e-7);
-        for (int j = 0; j < NCP_AXES; j++) {
+        for (int j = 0; j < 3; j++) {
             double p1 = r[k - 2].cmd[j], p2 = r[k - 1].cmd[j], p3 = r[k].cmd[j];
             double v = fabs(p3 - p2) / T, a = fabs(p3 - 2 * p2 + p1) / (T * T);
             *vel = fmax(*vel, (v - 2 * PRINT_Q / T) / c->axis[j].max_vel);

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 
 struct row {
-    double t, cmd[3], act[3], v;
+    double t, cmd[3], act[3], v;  /* the X Y Z columns; other axes come after all others */
     unsigned line;
     int motion;   /* 0 rapid, 1 feed, 2 arc (G2/G3) */
 };
