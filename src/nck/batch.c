@@ -45,7 +45,8 @@ static int emit_check(void *ctx, const struct ncp_cmd *cmd)
 
 /* The program is interpreted once without motion: a soft-limit violation
  * anywhere stops the run before the machine moves (1), and so does a call
- * the machine cannot act on, or an M66 result the program reads (2).
+ * the machine cannot act on (2). Queue busters (probes, M66) read rs274
+ * -g's stand-in values here: this pass has no machine to wait for.
  * Other program errors are left to the real run, which moves up to the last
  * good block. */
 static int precheck_limits(const struct ncp_nck_opts *o, const double start[NCP_AXES],
@@ -59,10 +60,6 @@ static int precheck_limits(const struct ncp_nck_opts *o, const double start[NCP_
     struct ncp_diag ignored;
     memset(&ignored, 0, sizeof ignored);
     o->interpret(o->interp_ctx, &out, &ignored);
-    if (!pc->failed && ignored.code && strstr(ignored.msg, "result of the M66")) {
-        pc->failed = 2;
-        pc->d = ignored;
-    }
     int failed = pc->failed;
     if (failed)
         *d = pc->d;
