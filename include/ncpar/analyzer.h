@@ -50,10 +50,9 @@ struct ncp_analyzer_cfg {
     /* ncp_serial_run / ncp_pipeline_run: run on this analyzer (made with
      * resident set, owned by the caller) instead of a new one. */
     struct ncp_analyzer *instance;
-    /* The NCK: an M66 emits WAIT_INPUT for the machine, and its result
-     * (#5399) is not known to the interpreter, which runs ahead of motion:
-     * reading it is an error until the program sets it. 0 (parse, check):
-     * rs274 -g's stand-in value. */
+    /* The NCK: an M66 emits WAIT_INPUT for the machine, whose result
+     * (#5399) the interpreter reads back at a queue buster (see
+     * ncp_machine_sync). 0 (parse, check): no call, rs274 -g's stand-in. */
     int m66_on_machine;
 };
 

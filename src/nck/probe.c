@@ -107,6 +107,8 @@ void nck_probe_cycle(struct nck *n, const double act[NCP_AXES])
     uint32_t aux = 0;
     if (p->state == NCK_PROBE_DROPPING && drop_to_stop(n, &aux)) {
         ncp_scaler_rebase(&n->scaler, n->cur.pos);
+        /* the trace keeps the probe's line while the interpreter catches up */
+        n->scaler.a.line = n->scaler.b.line = n->cur.line;
         n->next = n->cur;
         n->ends_seen = n->scaler.ends;
         if (aux > n->mach.seq_reached)

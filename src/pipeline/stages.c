@@ -374,7 +374,7 @@ void *ncp_pipe_analyzer(void *arg)
             ncp_rec_writer_start(&p->cmd_out, &p->cmds[0], &cmd_stream);
             sink = (struct ncp_cmd_sink){ p, packed_acquire, packed_publish };
         }
-        ncp_analyzer_set_sync(an, p->out->sync ? pipe_sync : NULL, p);
+        ncp_analyzer_set_sync(an, p->out && p->out->sync ? pipe_sync : NULL, p);
         p->an_rc = ncp_analyzer_run(an, &feed, &sink);
         ncp_analyzer_set_sync(an, NULL, NULL);
         if (p->ahead) {
