@@ -57,12 +57,31 @@ struct ncp_analyzer_cfg {
     /* ncp_serial_run / ncp_pipeline_run: run on this analyzer (made with
      * resident set, owned by the caller) instead of a new one. */
     struct ncp_analyzer *instance;
-    /* The NCK: an M66 emits WAIT_INPUT for the machine, and its result
-     * (#5399) is not known to the interpreter, which runs ahead of motion:
-     * reading it is an error until the program sets it. 0 (parse, check):
-     * rs274 -g's stand-in value. */
+    /* The NCK: an M66 emits WAIT_INPUT for the machine, whose result
+     * (#5399) the interpreter reads back at a queue buster (see
+     * ncp_machine_sync). 0 (parse, check): no call, rs274 -g's stand-in. */
     int m66_on_machine;
 };
+
+/* Queue busters. The interpreter runs far ahead of motion; after a G38.x
+ * probe or an M66 it cannot know the machine's result. When the run's
+ * output is a machine (ncp_output.sync), the analyzer stops at the first
+ * read after such a call (the next block, or a parameter read on an O-word
+ * line), hands on every command made so far and asks the machine, which
+ * answers once its motion up to the call has finished. Without a machine
+ * (parse, check) nothing waits and rs274 -g's stand-in values hold. */
+enum ncp_sync_what { NCP_SYNC_PROBE = 1, NCP_SYNC_INPUT = 2 };
+struct ncp_machine_sync {
+    int what;                  /* enum ncp_sync_what bits the machine filled */
+    /* a probe, in program coordinates and units: the trip point (#5061..),
+     * whether it tripped (#5070) and where the axes came to rest */
+    double probed[6];
+    int tripped;
+    double pos[3];
+    double input;              /* M66: #5399 */
+};
+/* Returns 0 with ms filled, or non-zero when the run is being stopped. */
+typedef int (*ncp_machine_sync_fn)(void *ctx, struct ncp_machine_sync *ms);
 
 struct ncp_analyzer;
 
@@ -80,5 +99,9 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
  * stopped program, a jog, homing), so its current point becomes pos (X Y Z in
  * program coordinates and units: see ncp_canon_map_to_program). */
 void ncp_analyzer_set_position(struct ncp_analyzer *a, const double pos[3]);
+
+/* The machine a run's busters wait for (the pipeline sets it for a run whose
+ * output has one; NULL: none, rs274 -g's stand-ins). */
+void ncp_analyzer_set_sync(struct ncp_analyzer *a, ncp_machine_sync_fn fn, void *ctx);
 
 #endif

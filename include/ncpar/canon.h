@@ -29,7 +29,7 @@ enum ncp_canon_kind {
     NCP_C_ON_RESET,
     NCP_C_STRAIGHT_TRAVERSE,     /* move (program coordinates) */
     NCP_C_STRAIGHT_FEED,         /* move */
-    NCP_C_STRAIGHT_PROBE,        /* move */
+    NCP_C_STRAIGHT_PROBE,        /* move; flags: NCP_PROBE_F_* */
     NCP_C_SET_FEED_RATE,         /* feed_rate */
     NCP_C_SET_FEED_MODE,         /* feed_mode */
     NCP_C_SET_TRAVERSE_RATE,     /* feed_rate (rate only) */
@@ -95,6 +95,10 @@ enum ncp_canon_kind {
  * doubles after them, so all kinds share one layout (raw) and an op is the
  * same 120 bytes whatever its kind: a kind with fewer ints pads up to the
  * doubles with NCP_CANON_IPAD. */
+/* STRAIGHT_PROBE's flags (rs274 -g prints neither): G38.4/G38.5 wait for
+ * the contact to open; G38.2/G38.4 make a move that ends without it an error */
+enum { NCP_PROBE_F_AWAY = 1, NCP_PROBE_F_ERROR = 2 };
+
 #define NCP_CANON_IPAD(n) int32_t ipad_[NCP_CANON_NI - (n)]
 
 struct ncp_canon {

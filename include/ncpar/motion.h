@@ -81,6 +81,12 @@ struct ncp_io_cfg {
     int have_tc_pos;              /* [EMCIO] TOOL_CHANGE_POSITION = X Y Z given */
     double tc_pos[3];             /* machine coordinates, mm */
     int quill_up;                 /* [EMCIO] TOOL_CHANGE_QUILL_UP: Z to machine 0 first */
+    /* The simulated workpiece a G38.x probe touches (machine coordinates,
+     * mm): the probe is in contact inside the box or below the plane. */
+    int have_probe_box;           /* [SIM] PROBE_BOX = xmin ymin zmin xmax ymax zmax */
+    double probe_box[6];
+    int have_probe_plane;         /* [SIM] PROBE_PLANE_Z = z */
+    double probe_plane_z;
 };
 
 struct ncp_machine_cfg {

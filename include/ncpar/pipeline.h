@@ -69,6 +69,12 @@ struct ncp_output {
      * written there, in place of emit. Spares copying every line. */
     char *(*reserve)(void *ctx);
     int (*commit)(void *ctx, const struct ncp_cmd *cmd);
+    /* Optional: the output is a machine, which the analyzer waits for at a
+     * queue buster (see ncp_machine_sync in analyzer.h). Called on the
+     * analyzer's thread once every command before the buster has been handed
+     * on (the pipeline publishes what its stages hold back first), so it
+     * may wait until emit has taken them. NULL: rs274 -g's stand-ins. */
+    ncp_machine_sync_fn sync;
 };
 
 /* Per-stage counters, each written by its own thread only (read after join). */

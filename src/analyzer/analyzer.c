@@ -248,3 +248,9 @@ void ncp_analyzer_set_position(struct ncp_analyzer *a, const double pos[3])
         a->sai.pos[k] = pos[k];
     }
 }
+
+void ncp_analyzer_set_sync(struct ncp_analyzer *a, ncp_machine_sync_fn fn, void *ctx)
+{
+    a->sai.sync = fn;
+    a->sai.sync_ctx = ctx;
+}

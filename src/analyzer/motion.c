@@ -304,7 +304,10 @@ int ncp_motion_probe(struct ncp_analyzer *a, int motion)
             return ncp_an_error(a, col, "Start point too close to probe point");
     }
     ncp_an_emit(a, NCP_C_TURN_PROBE_ON);
-    memcpy(ncp_an_emit(a, NCP_C_STRAIGHT_PROBE)->move.end, end, 6 * sizeof(double));
+    struct ncp_canon *op = ncp_an_emit(a, NCP_C_STRAIGHT_PROBE);
+    memcpy(op->move.end, end, 6 * sizeof(double));
+    op->flags = (uint16_t)((motion >= 384 ? NCP_PROBE_F_AWAY : 0) |
+                           (errors_if_missed ? NCP_PROBE_F_ERROR : 0));
     ncp_sai_probe(a, end);
     ncp_an_emit(a, NCP_C_TURN_PROBE_OFF);
     s->m.motion = motion;

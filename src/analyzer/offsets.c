@@ -47,16 +47,49 @@ static void ncp_offsets_take_position(struct ncp_analyzer *a)
         a->st.pos[ax] = 0.0;
 }
 
-void ncp_offsets_resync(struct ncp_analyzer *a)
+/* A queue buster on a machine: wait for its answer and take the machine's
+ * results in place of the stand-in's (the trip point, the probe input, where
+ * the axes stopped, M66's #5399). */
+static int ncp_offsets_ask_machine(struct ncp_analyzer *a, int *tripped)
 {
+    struct ncp_machine_sync ms;
+    memset(&ms, 0, sizeof ms);
+    if (a->sai.sync(a->sai.sync_ctx, &ms) != 0)
+        return ncp_an_error(a, 0, "the run was stopped while the interpreter waited for "
+                                  "the machine");
+    if (ms.what & NCP_SYNC_PROBE) {
+        memcpy(a->sai.probed, ms.probed, sizeof a->sai.probed);
+        for (int k = 0; k < 3; k++)
+            a->sai.pos[k] = ms.pos[k];
+    }
+    if (ms.what & NCP_SYNC_INPUT) {
+        double *result = ncp_params_slot(a->params, 5399);
+        if (result)
+            *result = ms.input;
+    }
+    *tripped = ms.tripped;
+    return NCP_OK;
+}
+
+int ncp_offsets_resync(struct ncp_analyzer *a)
+{
+    if (!(a->st.toolchange_flag | a->sai.probe_flag | a->sai.input_flag))
+        return NCP_OK;
+    int tripped = 0;
+    if ((a->sai.probe_flag | a->sai.input_flag) && a->sai.sync) {
+        int rc = ncp_offsets_ask_machine(a, &tripped);
+        if (rc != NCP_OK)
+            return rc;
+    }
+    a->sai.input_flag = 0;
     if (!(a->st.toolchange_flag | a->sai.probe_flag))
-        return;
+        return NCP_OK;   /* M66 alone: rs274 reads no position back */
     if (a->sai.probe_flag) {
         a->sai.probe_flag = 0;
         for (int k = 0; k <= 9; k++) {
             double *par = ncp_params_slot(a->params, 5061 + k);
             if (par)
-                *par = k < 6 ? a->sai.probed[k] : 0.0;
+                *par = k < 6 ? a->sai.probed[k] : k == 9 ? tripped : 0.0;
         }
     }
     ncp_offsets_take_position(a);
@@ -65,6 +98,7 @@ void ncp_offsets_resync(struct ncp_analyzer *a)
         a->st.toolchange_flag = 0;
         ncp_tools_sync_params(a, 1);
     }
+    return NCP_OK;
 }
 
 static void ncp_emit_g92(struct ncp_analyzer *a)

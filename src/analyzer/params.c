@@ -44,8 +44,6 @@ struct ncp_params {
     ncp_predef_fn predef;
     void *predef_ctx;
     double scratch;            /* where ncp_params_slot points for a bad index */
-    int unknown;               /* a parameter whose value only motion can give (0: none) */
-    uint32_t unknown_line;     /* the M66 that left it so */
 };
 
 static uint32_t name_hash(const char *s, size_t n)
@@ -214,20 +212,8 @@ int ncp_params_get(const struct ncp_params *p, int index, double *out,
     if (rc != NCP_OK)
         return rc;
     *out = 0.0;
-    if (index == p->unknown)
-        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "#%d is the result of the M66 on line %u, which the machine only "
-                            "knows once motion gets there; this NCK cannot read it back into the "
-                            "program yet (the program was refused before it moved)",
-                            index, p->unknown_line);
     *out = p->num[index];
     return NCP_OK;
-}
-
-void ncp_params_set_unknown(struct ncp_params *p, int index, uint32_t line)
-{
-    p->unknown = index;
-    p->unknown_line = line;
 }
 
 int ncp_params_set(struct ncp_params *p, int index, double v, struct ncp_diag *d)
@@ -235,8 +221,6 @@ int ncp_params_set(struct ncp_params *p, int index, double v, struct ncp_diag *d
     int rc = check_index(index, d);
     if (rc != NCP_OK)
         return rc;
-    if (index == p->unknown)
-        p->unknown = 0;  /* the program's own value from here on */
     p->num[index] = v;
     return NCP_OK;
 }

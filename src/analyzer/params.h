@@ -30,9 +30,6 @@ int ncp_params_set(struct ncp_params *p, int index, double v, struct ncp_diag *d
 /* Raw access for the core to keep #5420.. etc. current (no checks, no errors).
  * In-range indices are one array: index + 1's slot follows index's. */
 double *ncp_params_slot(struct ncp_params *p, int index);
-/* index (0: none) holds a value only the machine knows (M66's #5399 in the
- * NCK): reading it is an error naming line, until the program sets it. */
-void ncp_params_set_unknown(struct ncp_params *p, int index, uint32_t line);
 
 int ncp_params_get_named(const struct ncp_params *p, const char *name, size_t len,
                          double *out, struct ncp_diag *d);

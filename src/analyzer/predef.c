@@ -112,7 +112,9 @@ static int ncp_predef_catch_up(struct ncp_analyzer *a, struct ncp_diag *d)
     int rc = ncp_m7x_pending(a);
     if (rc != NCP_OK)
         return ncp_diag_set(d, (enum ncp_status)rc, 0, 0, "%s", a->err.msg);
-    ncp_offsets_resync(a);
+    rc = ncp_offsets_resync(a);
+    if (rc != NCP_OK)
+        return ncp_diag_set(d, (enum ncp_status)rc, 0, 0, "%s", a->err.msg);
     return NCP_OK;
 }
 

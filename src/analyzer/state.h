@@ -111,6 +111,9 @@ struct ncp_sai {
     int inches;
     int probe_flag;               /* a G38.x ran: rs274 reads its results at the next block */
     double probed[6];             /* where the probe tripped: its programmed end */
+    int input_flag;               /* an M66 ran on a machine: #5399 is read back too */
+    ncp_machine_sync_fn sync;     /* the machine the busters wait for, or NULL */
+    void *sync_ctx;
 };
 
 /* An op held back while cutter compensation has a move queued: it is handed
@@ -248,7 +251,7 @@ static inline void ncp_offsets_sync_params(struct ncp_analyzer *a)
 }
 /* what the canon did since the last block (a probe, a tool change), read back
  * into the state and the parameters before the next block reads them */
-void ncp_offsets_resync(struct ncp_analyzer *a);
+int ncp_offsets_resync(struct ncp_analyzer *a);
 
 /* frames.c: rs274's conversions through the XY rotation, and between the
  * program's unit and the user unit (parameters, tool table) */

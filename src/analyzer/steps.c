@@ -128,7 +128,8 @@ static int ncp_step_override(struct ncp_analyzer *a, int m)
  * timeout; rs274's checks in its order. There is no input here, as in
  * rs274 -g, whose stand-in returns the default: after a digital wait #5399
  * (the result) becomes 1 if it was not 0, else 0; after an analog one it
- * keeps its value. Nothing is printed (rs274 -g prints no call for it). */
+ * keeps its value. Nothing is printed (rs274 -g prints no call for it). On
+ * the NCK the call goes to the machine and #5399 is read back from it. */
 static int ncp_step_wait_input(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
@@ -154,8 +155,9 @@ static int ncp_step_wait_input(struct ncp_analyzer *a)
         op->wait_input.index = ncp_trunc_int_round(has_p ? W(a, 'P') : W(a, 'E'));
         op->wait_input.mode = l;
         op->wait_input.timeout = q > 0 ? q : 0;
-        ncp_params_set_unknown(a->params, 5399, a->line);
-        return NCP_OK;
+        /* the machine's result replaces the stand-in's at the next read
+         * when the run has a machine to wait for (a queue buster) */
+        a->sai.input_flag = 1;
     }
     if (has_p) {
         double *result = ncp_params_slot(a->params, 5399);
@@ -436,8 +438,9 @@ static void ncp_lathe_x_word(struct ncp_analyzer *a)
 int ncp_an_execute(struct ncp_analyzer *a, const struct ncp_block *b)
 {
     a->blk = b;
-    ncp_offsets_resync(a);
-    int rc = ncp_words_collect(a, b);
+    int rc = ncp_offsets_resync(a);
+    if (rc == NCP_OK)
+        rc = ncp_words_collect(a, b);
     if (rc == NCP_OK)
         rc = ncp_words_assign(a, b);
     if (rc == NCP_OK)

@@ -283,7 +283,8 @@ static int cmd_parse(int argc, char **argv)
         return EXIT_USAGE;
     }
     ncp_cli_catch_input_faults(o.prog, 1);
-    struct ncp_output out = { w, canon_writer_emit, canon_writer_reserve, canon_writer_commit };
+    struct ncp_output out = { .ctx = w, .emit = canon_writer_emit,
+                              .reserve = canon_writer_reserve, .commit = canon_writer_commit };
     struct ncp_run_stats st;
     memset(&st, 0, sizeof st);
     int rc = map.mode == NCP_MODE_SERIAL

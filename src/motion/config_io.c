@@ -89,6 +89,34 @@ static int emcio_key(struct ncp_io_cfg *io, const char *k, const char *v, char *
     return 0;
 }
 
+/* The simulated workpiece of the probe. */
+static int probe_key(struct ncp_io_cfg *io, const char *k, const char *v, char *why, size_t len)
+{
+    if (!strcasecmp(k, "PROBE_PLANE_Z")) {
+        if (number(v, -1e6, 1e6, &io->probe_plane_z) < 0)
+            return -1;
+        io->have_probe_plane = 1;
+        return 1;
+    }
+    if (strcasecmp(k, "PROBE_BOX"))
+        return 0;
+    double b[6];
+    char extra;
+    int n = sscanf(v, "%lf %lf %lf %lf %lf %lf %c", &b[0], &b[1], &b[2], &b[3], &b[4], &b[5],
+                   &extra);
+    int ok = n == 6;
+    for (int i = 0; ok && i < 3; i++)
+        ok = isfinite(b[i]) && isfinite(b[i + 3]) && b[i] < b[i + 3];
+    if (!ok) {
+        snprintf(why, len, "xmin ymin zmin xmax ymax zmax in machine coordinates, mm, "
+                           "each min below its max");
+        return -1;
+    }
+    memcpy(io->probe_box, b, sizeof b);
+    io->have_probe_box = 1;
+    return 1;
+}
+
 static int sim_key(struct ncp_io_cfg *io, const char *k, const char *v)
 {
     if (!strcasecmp(k, "AUTO_RESUME_S"))
@@ -116,7 +144,9 @@ int ncp_io_cfg_key(struct ncp_io_cfg *io, const char *sec, const char *k, const 
         return spindle_key(io, k, v);
     if (!strcasecmp(sec, "EMCIO"))
         return emcio_key(io, k, v, why, len);
-    if (!strcasecmp(sec, "SIM"))
-        return sim_key(io, k, v);
+    if (!strcasecmp(sec, "SIM")) {
+        int rc = probe_key(io, k, v, why, len);
+        return rc ? rc : sim_key(io, k, v);
+    }
     return -2;
 }

@@ -184,6 +184,7 @@ static int act(struct nck *n, const struct nck_aux *a)
             m->tool = a->i;
         return 0;
     case NCK_AUX_ENABLE: m->en[a->i & 3] = a->v != 0; return 0;
+    case NCK_AUX_PROBE: nck_probe_arm(n, a->i); return 0;
     case NCK_AUX_WAIT_INPUT: return input_wait(n, a);
     case NCK_AUX_PAUSE:
         if (a->i == NCK_WAIT_M1 && !atomic_load_explicit(&n->ctl->optional_stop,

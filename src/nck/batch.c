@@ -95,7 +95,9 @@ static int emit_check(void *ctx, const struct ncp_cmd *cmd)
 }
 
 /* The program is interpreted once without motion: a soft-limit violation or
- * a program error anywhere refuses the run before the machine moves. With
+ * a program error anywhere refuses the run before the machine moves. Queue
+ * busters (probes, M66) read rs274 -g's stand-in values here: this pass has
+ * no machine to wait for. With
  * --for only what can run in that time is checked, with a margin: the moves
  * beyond it never run. */
 static enum precheck_end precheck(const struct ncp_nck_opts *o, const double start[NCP_AXES],

@@ -26,6 +26,7 @@ int nck_call_class(const struct ncp_canon *op, const char *text)
     switch ((enum ncp_canon_kind)op->kind) {
     case NCP_C_STRAIGHT_TRAVERSE: case NCP_C_STRAIGHT_FEED: case NCP_C_ARC_FEED:
     case NCP_C_DWELL: case NCP_C_NURBS_FEED: case NCP_C_NURBS_POINTS: case NCP_C_RIGID_TAP:
+    case NCP_C_STRAIGHT_PROBE:   /* against [SIM]'s workpiece; a queue buster (job.c) */
         return NCK_CALL_MOTION;
     case NCP_C_USE_LENGTH_UNITS: case NCP_C_SET_G5X_OFFSET: case NCP_C_SET_G92_OFFSET:
     case NCP_C_SET_XY_ROTATION: case NCP_C_SET_FEED_REFERENCE: case NCP_C_ON_RESET:
@@ -52,12 +53,12 @@ int nck_call_class(const struct ncp_canon *op, const char *text)
         return NCK_CALL_AUX;
     case NCP_C_COMMENT: case NCP_C_MESSAGE: case NCP_C_LOGOPEN: case NCP_C_LOGAPPEND:
     case NCP_C_LOGCLOSE: case NCP_C_LOG: case NCP_C_PRINT:
-    /* the probe input is switched around G38 moves, which are refused */
+    /* the probe move itself arms the simulated probe */
     case NCP_C_TURN_PROBE_ON: case NCP_C_TURN_PROBE_OFF:
         return NCK_CALL_INFO;
     case NCP_C_RAW_TEXT:
         return raw_class(text);
-    case NCP_C_STRAIGHT_PROBE: case NCP_C_SPINDLE_RETRACT_TRAVERSE: case NCP_C_ARC_REQUEST:
+    case NCP_C_SPINDLE_RETRACT_TRAVERSE: case NCP_C_ARC_REQUEST:
     case NCP_C_NONE: case NCP_C__COUNT:
         break;
     }
@@ -68,9 +69,6 @@ int nck_call_class(const struct ncp_canon *op, const char *text)
 const char *nck_call_what(int kind)
 {
     switch (kind) {
-    case NCP_C_STRAIGHT_PROBE:
-        return "G38.x probing: this machine has no probe input yet; the move would "
-               "\"trip\" at its end point, so the program is refused";
     case NCP_C_SPINDLE_RETRACT_TRAVERSE:
         return "SPINDLE_RETRACT_TRAVERSE: this machine has no spindle retract";
     default:

@@ -41,6 +41,7 @@ static int init_motion(struct nck *n)
     const struct ncp_machine_cfg *c = n->cfg;
     ncp_canon_map_init(&n->map, c, n->start, n->plan_override);
     memcpy(n->next.pos, n->start, sizeof n->next.pos);
+    memcpy(n->probe.last, n->start, sizeof n->probe.last);
     n->cur = n->next;
     double a_min = INFINITY;
     for (int j = 0; j < NCP_AXES; j++)

@@ -84,11 +84,13 @@ static int push_mark(struct nck *n, int kind)
     memset(&m, 0, sizeof m);
     m.kind = kind;
     m.aux = n->aux_seq;
+    /* the stretch after a SYNC is open before its stop can be reached: a
+     * batch run's loop ends only at a stop with no stretch open after it */
+    if (kind == NCK_MSG_SYNC)
+        atomic_fetch_add_explicit(&n->marks_sent, 1, memory_order_release);
     if (push_wait(n, &m))
         return -1;
     n->job.marks++;
-    if (kind == NCK_MSG_SYNC)
-        atomic_fetch_add_explicit(&n->marks_sent, 1, memory_order_release);
     return 0;
 }
 
@@ -431,6 +433,89 @@ static int take_seg(struct nck *n, const struct ncp_seg *s)
     return push_seg(n, s);
 }
 
+/* ---- queue busters ----------------------------------------------------------------- */
+
+/* A probe move or an M66 was sent: run the motion so far to a stop, wait
+ * until the machine is there, and answer the interpreter with what the
+ * machine found. The interpreter makes no command after the buster until
+ * it has the answer, so this thread waits for nothing it has yet to send. */
+static int buster(struct nck *n, const struct ncp_cmd *cmd, const struct ncp_canon *op)
+{
+    struct nck_job *j = &n->job;
+    if (push_mark(n, NCK_MSG_SYNC))
+        return -1;
+    uint64_t base = n->marks_base;
+    while (!reached(n, base)) {
+        if (atomic_load(&j->abort))
+            return -1;
+        nap_us(200);
+    }
+    struct ncp_machine_sync *ms = &j->answer;
+    if (op->kind == NCP_C_WAIT_INPUT) {
+        ms->what |= NCP_SYNC_INPUT;
+        ms->input = n->mach.m66_result;
+        return 0;
+    }
+    const struct nck_probe *p = &n->probe;
+    if (p->error != NCK_PROBE_OK) {
+        ncp_diag_set(&j->map_diag, NCP_ERR_SEMANTIC, cmd->line, 0, "%s",
+                     p->error == NCK_PROBE_TRIPPED_AT_START
+                         ? "Probe is already tripped when starting G38.2 or G38.3 move"
+                         : "Probe is not tripped when starting G38.4 or G38.5 move");
+        return -1;
+    }
+    if (!p->tripped && (op->flags & NCP_PROBE_F_ERROR)) {
+        ncp_diag_set(&j->map_diag, NCP_ERR_SEMANTIC, cmd->line, 0,
+                     "G38.%d probe move finished without contact",
+                     op->flags & NCP_PROBE_F_AWAY ? 4 : 2);
+        return -1;
+    }
+    /* the trip point, or where a move without contact ended (LinuxCNC) */
+    double prog[3];
+    ncp_canon_map_to_program(&n->map, p->tripped ? p->trip : n->map.pos, prog);
+    memcpy(ms->probed, op->move.end, sizeof ms->probed);
+    memcpy(ms->probed, prog, sizeof prog);
+    ms->tripped = p->tripped;
+    if (p->tripped)   /* the next move starts where the axes stopped */
+        memcpy(n->map.pos, p->rest, sizeof n->map.pos);
+    ncp_canon_map_to_program(&n->map, n->map.pos, ms->pos);
+    ms->what |= NCP_SYNC_PROBE;
+    return 0;
+}
+
+/* The interpreter's side (its thread): wait for the job thread's answer. */
+static int machine_sync(void *ctx, struct ncp_machine_sync *ms)
+{
+    struct nck *n = ctx;
+    struct nck_job *j = &n->job;
+    j->busters_asked++;
+    while (atomic_load_explicit(&j->busters_done, memory_order_acquire) < j->busters_asked) {
+        if (atomic_load(&j->abort) || atomic_load(&j->emit_stopped))
+            return -1;
+        nap_us(200);
+    }
+    *ms = j->answer;
+    memset(&j->answer, 0, sizeof j->answer);
+    return 0;
+}
+
+static int is_buster(const struct ncp_canon *op)
+{
+    return op->kind == NCP_C_STRAIGHT_PROBE || op->kind == NCP_C_WAIT_INPUT;
+}
+
+static int emit_segments(void *ctx, const struct ncp_cmd *cmd);
+
+/* Whatever stops the emit, the interpreter must not wait for an answer. */
+static int emit_job(void *ctx, const struct ncp_cmd *cmd)
+{
+    struct nck *n = ctx;
+    int rc = emit_segments(ctx, cmd);
+    if (rc)
+        atomic_store(&n->job.emit_stopped, 1);
+    return rc;
+}
+
 static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
 {
     struct nck *n = ctx;
@@ -467,6 +552,10 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
         else if (op->kind >= NCP_C_LOGOPEN && op->kind <= NCP_C_LOG)
             log_text(n, cmd, op);
         nck_note_state(n, op);
+        int skipping = j->from_line && !j->reached;
+        if (op->kind == NCP_C_STRAIGHT_PROBE && !skipping &&
+            aux_add(n, NCK_AUX_PROBE, 0, op->flags, 0, cmd->line, 0))
+            return 1;
         int rc = ncp_canon_map_op(&n->map, op, cmd->line, &seg, &j->map_diag);
         while (rc == 1) {
             if (take_seg(n, &seg))
@@ -481,6 +570,17 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
         int after_pallet = i > 0 && cmd->ops[i - 1].kind == NCP_C_PALLET_SHUTTLE;
         if ((!j->from_line || j->reached) && take_aux(n, cmd, op, after_pallet))
             return 1;
+        if (is_buster(op)) {
+            /* skipped lines (run from line) get the stand-in's answer */
+            if (!skipping && buster(n, cmd, op)) {
+                if (j->map_diag.code != NCP_OK) {
+                    n->calls_refused[kind]++;
+                    j->map_failed = 1;
+                }
+                return 1;
+            }
+            atomic_fetch_add_explicit(&j->busters_done, 1, memory_order_release);
+        }
         n->calls_acted[kind]++;
     }
     if (n->post_prints) {   /* a serving NCK's status shows it */
@@ -502,7 +602,7 @@ static void *interp_main(void *arg)
 {
     struct nck *n = arg;
     struct nck_job *j = &n->job;
-    struct ncp_output out = { .ctx = n, .emit = emit_segments };
+    struct ncp_output out = { .ctx = n, .emit = emit_job, .sync = machine_sync };
     memset(&j->diag, 0, sizeof j->diag);
     j->rc = j->interpret(j->interp_ctx, &out, &j->diag);
     push_mark(n, NCK_MSG_END);
@@ -538,6 +638,10 @@ int nck_job_start(struct nck *n)
     j->aux.n = 0;
     j->aux_stop = 0;
     j->need_at_speed = 0;
+    atomic_store(&j->busters_done, 0);
+    j->busters_asked = 0;
+    atomic_store(&j->emit_stopped, 0);
+    memset(&j->answer, 0, sizeof j->answer);
     j->step_used = atomic_load(&j->step_go);
     j->max_z = n->map.pos[2];
     memset(&j->map_diag, 0, sizeof j->map_diag);

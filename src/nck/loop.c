@@ -32,7 +32,8 @@ static double feed_rate(struct nck *n)
     /* M53 P0 turns the feed hold off (not the controlled stop) */
     int hold = n->mach.en[NCK_EN_FEED_HOLD] &&
                atomic_load_explicit(&n->ctl->hold, memory_order_relaxed);
-    if (n->for_expired || hold || atomic_load_explicit(&n->ctl->stop, memory_order_relaxed))
+    if (n->for_expired || hold || nck_probe_braking(n) ||
+        atomic_load_explicit(&n->ctl->stop, memory_order_relaxed))
         return 0.0;
     /* a serving NCK's rapids follow the rapid override, as LinuxCNC's (a
      * batch run's --feed-override and live override apply to all motion) */
@@ -109,9 +110,12 @@ static int take_setpoint(struct nck *n)
                                   memory_order_release);
         n->ends_seen = n->scaler.ends;
     }
-    /* a batch run ends with the period that commands its END sample */
+    /* a batch run ends with the period that commands its END sample (a
+     * queue buster's stop is one too, but more motion is expected after it) */
     n->end_seen = (n->cur.flags & NCP_SP_END) != 0;
-    if (n->batch && n->end_seen && !n->ended) {
+    if (n->batch && n->end_seen && !n->ended &&
+        atomic_load_explicit(&n->ends_taken, memory_order_relaxed) >=
+            atomic_load_explicit(&n->marks_sent, memory_order_acquire)) {
         n->ended = 1;
         n->end_ns = n->now_ns;
     }
@@ -139,6 +143,7 @@ static void discard(struct nck *n, const double act[NCP_AXES])
            sizeof at);
     memcpy(n->rest, at, sizeof n->rest);
     nck_aux_discard(n);
+    n->probe.state = NCK_PROBE_OFF;
     ncp_scaler_rebase(&n->scaler, at);
     n->scaler.decel = n->decel_normal;
     memset(&n->cur, 0, sizeof n->cur);
@@ -237,6 +242,7 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
         return NCP_RT_RETRY;
     double act[NCP_AXES];
     int be_rc = n->be.ops->cycle(&n->be, n->cur.pos, n->next.pos, act);
+    nck_probe_cycle(n, act);
     track_blocks(n);
     push_cycle(n, now_ns, act);
     int rest = n->cur.v == 0 && n->next.v == 0 && (n->scaler.r == 0 || n->end_seen ||

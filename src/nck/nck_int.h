@@ -51,6 +51,7 @@ enum nck_aux_kind {
     NCK_AUX_TOOL,          /* i: the tool; waits for the change */
     NCK_AUX_PREPARE,       /* i: the tool (T) */
     NCK_AUX_ENABLE,        /* i: enum nck_enable, a: on */
+    NCK_AUX_PROBE,         /* i: NCP_PROBE_F_*; rides on the probe move, arms the probe */
 };
 enum nck_enable { NCK_EN_FEED_OVERRIDE, NCK_EN_SPEED_OVERRIDE, NCK_EN_FEED_HOLD,
                   NCK_EN_ADAPTIVE };
@@ -96,6 +97,19 @@ struct nck_mach {
     uint64_t resume_used;
     int in_last;               /* M66 L1/L2: the input's previous value */
     double m66_result;         /* #5399 as the machine found it */
+};
+
+/* The probe (probe.c): the position loop writes it; the job thread reads
+ * the result once the probe move's stop was reached (ends_taken). */
+enum nck_probe_state { NCK_PROBE_OFF, NCK_PROBE_ARMED, NCK_PROBE_STOPPING, NCK_PROBE_DROPPING };
+enum nck_probe_error { NCK_PROBE_OK, NCK_PROBE_TRIPPED_AT_START, NCK_PROBE_NOT_TRIPPED_AT_START };
+struct nck_probe {
+    int state, flags;
+    double last[NCP_AXES];     /* the previous period's actual position */
+    uint64_t ends_at_trip;
+    int tripped, error;
+    double trip[NCP_AXES];     /* machine coordinates */
+    double rest[NCP_AXES];     /* where the axes stopped after a trip */
 };
 
 /* One servo cycle as the position loop saw it. */
@@ -172,6 +186,12 @@ struct nck_job {
     int need_at_speed;           /* a spindle start or S: the next feed waits */
     int spindle_dir;             /* as the program has set it */
     double origin[NCP_AXES];     /* where the machine was when the job started */
+    /* queue busters: the job thread answers each once the machine got
+     * there (busters_done, release); the analyzer's thread waits for it */
+    _Atomic uint32_t busters_done;
+    uint32_t busters_asked;      /* the analyzer's thread */
+    _Atomic int emit_stopped;    /* emit refused or failed: no answer will come */
+    struct ncp_machine_sync answer;
 };
 
 /* What the interpreter last set that the machine does not act on yet, for
@@ -198,6 +218,7 @@ struct nck {
     struct ncp_spsc auxq;            /* machine function packs, job -> position loop */
     uint32_t aux_seq;                /* the last pack numbered (job threads, in turn) */
     struct nck_mach mach;            /* position loop only */
+    struct nck_probe probe;          /* position loop; the result for the job (probe.c) */
     /* canonical calls the jobs took, acted on and refused, per kind (job
      * threads, in turn; read after the job) */
     uint64_t calls_in[NCP_C__COUNT], calls_acted[NCP_C__COUNT], calls_refused[NCP_C__COUNT];
@@ -345,6 +366,11 @@ const char *nck_call_what(int kind);
 /* A call refused (d filled, its code returned) or taken (0), as the job will
  * take it: the batch run's pass before motion asks the same. */
 int nck_check_call(const struct ncp_cmd *cmd, const struct ncp_canon *op, struct ncp_diag *d);
+
+/* probe.c (real-time path) */
+void nck_probe_arm(struct nck *n, int flags);
+void nck_probe_cycle(struct nck *n, const double act[NCP_AXES]);
+int nck_probe_braking(const struct nck *n);
 
 /* pauses.c: the operator is told of a wait the loop began (stats.c) */
 void nck_wait_began(struct nck *n, const struct nck_fb *fb);

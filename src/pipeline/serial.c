@@ -89,7 +89,10 @@ int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *
     }
     struct ncp_block_feed bf = { feed, ncp_text_feed_next, ncp_text_feed_release, src };
     struct ncp_cmd_sink cs = { sink, serial_acquire, serial_publish };
+    /* each command is emitted as it is published: nothing to hand on first */
+    ncp_analyzer_set_sync(an, out ? out->sync : NULL, out ? out->ctx : NULL);
     rc = ncp_analyzer_run(an, &bf, &cs);
+    ncp_analyzer_set_sync(an, NULL, NULL);
     if (sink->err.code != NCP_OK) {
         *d = sink->err;
         rc = d->code;

@@ -335,6 +335,16 @@ static void packed_publish(void *ctx, struct ncp_cmd *c)
     ncp_rec_commit(&p->cmd_out, (uint32_t)(ncp_cmd_pack_in_place(c) / NCP_PACK_UNIT));
 }
 
+/* A queue buster: the commands before it must reach the machine, so the
+ * positions this thread holds back in its rings are published first; the
+ * executors and the output thread then run them out while it waits. */
+static int pipe_sync(void *ctx, struct ncp_machine_sync *ms)
+{
+    const struct ncp_pipe *p = ctx;
+    ncp_ring_wake_owed();
+    return p->out->sync(p->out->ctx, ms);
+}
+
 void *ncp_pipe_analyzer(void *arg)
 {
     struct ncp_pipe *p = ((struct ncp_pipe_worker *)arg)->p;
@@ -364,7 +374,9 @@ void *ncp_pipe_analyzer(void *arg)
             ncp_rec_writer_start(&p->cmd_out, &p->cmds[0], &cmd_stream);
             sink = (struct ncp_cmd_sink){ p, packed_acquire, packed_publish };
         }
+        ncp_analyzer_set_sync(an, p->out && p->out->sync ? pipe_sync : NULL, p);
         p->an_rc = ncp_analyzer_run(an, &feed, &sink);
+        ncp_analyzer_set_sync(an, NULL, NULL);
         if (p->ahead) {
             ncp_lex_ahead_finish(p->ahead);
             p->taken = p->ahead->feed.blocks;
