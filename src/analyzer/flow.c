@@ -140,6 +140,8 @@ struct ncp_flow {
     int inline_level;                 /* an inline call returns to this level, or -1 */
     char label[FLOW_LABEL_MAX];       /* label of the block being run */
     size_t label_len;
+    char number[16];                  /* its O number when computed ("o#1"), as text */
+    int ended_at_percent;             /* the closing '%' ended a search for a sub */
     const char *call_path;            /* a call's name as written (in its block): */
     size_t call_path_len;             /* the path of the file it may be in */
 };
@@ -382,11 +384,25 @@ static int ncp_flow_err_mismatch(struct ncp_flow *f, const struct ncp_block *b,
                         ncp_flow_kind_name(op->type), op->line);
 }
 
-/* How a user wrote the O-word: o100 or o<name>. */
-static void ncp_flow_display_name(const struct ncp_block *b, char *buf, size_t cap)
+/* The O-word's name as text: a computed number ("o#1") is the one
+ * ncp_flow_read_number last read. */
+static const char *ncp_flow_oword_name(const struct ncp_flow *f, const struct ncp_block *b,
+                                       size_t *len)
 {
-    const char *s = b->pool + b->oword.name_off;
-    size_t n = b->oword.name_len, i = 0;
+    if (b->oword.name_computed) {
+        *len = strlen(f->number);
+        return f->number;
+    }
+    *len = b->oword.name_len;
+    return b->pool + b->oword.name_off;
+}
+
+/* How a user wrote the O-word: o100 or o<name>. */
+static void ncp_flow_display_name(const struct ncp_flow *f, const struct ncp_block *b,
+                                  char *buf, size_t cap)
+{
+    size_t n, i = 0;
+    const char *s = ncp_flow_oword_name(f, b, &n);
     if (n > 60)
         n = 60;
     while (i < n && s[i] >= '0' && s[i] <= '9')
@@ -411,8 +427,8 @@ static int ncp_flow_is_global_kind(int kind)
  * written in (the called one, or the one being defined), as "sub#label". */
 static void ncp_flow_make_label(struct ncp_flow *f, const struct ncp_block *b)
 {
-    const char *name = b->pool + b->oword.name_off;
-    size_t len = b->oword.name_len, n = 0;
+    size_t len, n = 0;
+    const char *name = ncp_flow_oword_name(f, b, &len);
     char num[16];
     if (b->oword.kind == NCP_O_M98) {         /* the sub's number from P */
         len = (size_t)snprintf(num, sizeof num, "%d", f->m98_p);
@@ -547,7 +563,7 @@ static int ncp_flow_runaway(const struct ncp_flow *f, const struct ncp_block *b,
                    const struct flow_label *op, struct ncp_diag *d)
 {
     char name[80];
-    ncp_flow_display_name(b, name, sizeof name);
+    ncp_flow_display_name(f, b, name, sizeof name);
     return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
                         "loop %s at line %u repeated more than %u times: runaway loop? "
                         "(raise the limit with --max-loops N if intended)",
@@ -1259,11 +1275,35 @@ static int ncp_flow_do_endloop(struct ncp_flow *f, const struct ncp_block *b, st
     return NCP_OK;
 }
 
+/* An O number computed from parameters ("o#1 call", "o[#1+1] sub"): rs274
+ * reads it whenever it reads the line, skipping or not, so a label's name is
+ * the value its parameters have then; inside a sub being defined an undefined
+ * named parameter reads as 0, as everywhere there. */
+static int ncp_flow_read_number(struct ncp_flow *f, const struct ncp_block *b,
+                                struct ncp_diag *d)
+{
+    double v;
+    int n;
+    int rc = f->defining.on && f->level == 0 ? ncp_flow_eval_lenient(f, b, &b->oword.num, &v, d)
+                                              : ncp_flow_eval(f, b, &b->oword.num, &v, d);
+    if (rc != NCP_OK)
+        return rc;
+    if (ncp_rs274_int(v, &n) != 0)
+        return ncp_flow_oword_error(b, "Non integer value for integer", d);
+    snprintf(f->number, sizeof f->number, "%d", n);
+    return NCP_OK;
+}
+
 static int ncp_flow_run_oword(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     int ignore;
     if (b->oword.kind == NCP_O_M98) {
         int rc = ncp_flow_read_m98(f, b, f->skip.on, d);
+        if (rc != NCP_OK)
+            return rc;
+    }
+    if (b->oword.name_computed) {
+        int rc = ncp_flow_read_number(f, b, d);
         if (rc != NCP_OK)
             return rc;
     }
@@ -1315,9 +1355,11 @@ static int ncp_flow_run_oword(struct ncp_flow *f, const struct ncp_block *b, str
 /* End of the program body while still looking for a label. */
 static int ncp_flow_at_end(struct ncp_flow *f, struct ncp_diag *d)
 {
-    if (f->skip.on && f->src->has_percent)
+    if (f->skip.on && f->src->has_percent) {
+        f->ended_at_percent = 1;
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->cur.line, 0,
                             "Failed to find sub 'O%s' before EOF", f->skip.s);
+    }
     if (f->seek_sub.on)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->skip_start, 0,
                             "EOF in file:%s seeking o-word: o<%s> from line: %u",
@@ -1515,6 +1557,11 @@ const char *ncp_flow_file(const struct ncp_flow *f)
 unsigned ncp_flow_file_tag(const struct ncp_flow *f)
 {
     return f->cur.file == 0 ? 0 : f->files[f->cur.file - 1].tag;
+}
+
+int ncp_flow_ended_at_percent(const struct ncp_flow *f)
+{
+    return f->ended_at_percent;
 }
 
 int ncp_flow_call_depth(const struct ncp_flow *f)
