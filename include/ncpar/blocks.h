@@ -5,8 +5,10 @@
  *    with no lexer threads; the lexer threads lex the same lines);
  *  - any block again by its position, through a cache of lexed blocks
  *    (loops and calls going back; struct ncp_block_reread), and every block
- *    of a subroutine file (the analyzer opens the file, numbers it, and reads
- *    it through the same cache);
+ *    of a subroutine file (found, opened and numbered here: struct
+ *    ncp_sub_files; read through the same cache);
+ *  - a block read again another way: an M#1 line once its M is known to be
+ *    98 or 99, a line of a G70-G72 profile (U and W are words there);
  *  - a line of text the interpreter builds itself (G70-G72's call line, M72's
  *    restore lines: ncp_blocks_lex_text);
  *  - every line of a source with what a reader finds wrong in it (check:
@@ -88,6 +90,39 @@ void ncp_block_reread_free(struct ncp_block_reread *r);
 int ncp_block_reread_at(struct ncp_block_reread *r, const struct ncp_source *src,
                         uint32_t file, int skipping, uint64_t *off, uint32_t *line,
                         const struct ncp_block **out);
+
+/* ---- subroutine files ---- */
+
+/* The subroutine files a run has opened, numbered from 1 (0 is the program). */
+#define NCP_SUB_FILES_MAX 64
+struct ncp_sub_files;
+
+struct ncp_sub_files *ncp_sub_files_new(void); /* NULL: out of memory */
+void ncp_sub_files_free(struct ncp_sub_files *t);
+/* name.ngc (name_len bytes of name, a path as written in the call) in the
+ * current folder, then in each folder of sub_path (colon-separated, may be
+ * NULL), as rs274 looks for a called sub: *file = its number, opened and
+ * read whole the first time, or 0 when there is none. Errors (too many
+ * files, one that cannot be read) name line and col. */
+int ncp_sub_files_open(struct ncp_sub_files *t, const char *name, size_t name_len,
+                       const char *sub_path, uint32_t line, uint16_t col, uint32_t *file,
+                       struct ncp_diag *d);
+const struct ncp_source *ncp_sub_files_src(const struct ncp_sub_files *t, uint32_t file);
+const char *ncp_sub_files_name(const struct ncp_sub_files *t, uint32_t file);
+unsigned ncp_sub_files_tag(const struct ncp_sub_files *t, uint32_t file);
+
+/* ---- a block read another way ---- */
+
+/* Block b of src (an NCP_O_M_VALUE line whose M turned out to be m, 98 or
+ * 99) read again as rs274 reads such a line (ncp_lex_block_fanuc). 0, or 1
+ * when b is not a line of src. */
+int ncp_blocks_relex_fanuc(const struct ncp_source *src, const struct ncp_block *b, int m,
+                           struct ncp_block *out);
+/* Block b of src read again as rs274 reads a line of a G70-G72 profile, where
+ * U and W are words (ncp_lex_block_profile). 0, or 1 when b is not a line of
+ * src. */
+int ncp_blocks_relex_profile(const struct ncp_source *src, const struct ncp_block *b,
+                             struct ncp_block *out);
 
 /* ---- text built by the interpreter ---- */
 

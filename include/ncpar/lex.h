@@ -34,7 +34,8 @@ enum ncp_bc_op {
     /* unary functions */
     NCP_BC_ABS, NCP_BC_ACOS, NCP_BC_ASIN, NCP_BC_ATAN2 /* binary: ATAN[a]/[b] */,
     NCP_BC_COS, NCP_BC_EXP, NCP_BC_FIX, NCP_BC_FUP, NCP_BC_LN, NCP_BC_ROUND,
-    NCP_BC_SIN, NCP_BC_SQRT, NCP_BC_TAN
+    NCP_BC_SIN, NCP_BC_SQRT, NCP_BC_TAN,
+    NCP_BC_EXISTS_NUM /* unary: 1/0, EXISTS[#n] with n computed: n a valid number */
 };
 
 struct ncp_bc_ins {
@@ -96,10 +97,14 @@ struct ncp_oword {
     uint16_t tail_col;        /* M99: column of the first thing after "m99" that
                                  is no comment (an error there in a sub), 0 none */
     /* the O-word's name: numeric ("o100" -> "100", leading zeros stripped) or
-     * named ("o<foo>" -> "foo", lower-cased), always as text in the pool */
+     * named ("o<foo>" -> "foo", lower-cased), as text in the pool; a number
+     * that reads parameters ("o#1", "o[#1+1]") is num instead (name_computed,
+     * name_len 0): rs274 evaluates it each time it reads the line */
     uint16_t name_off, name_len;
     struct ncp_expr cond;     /* IF/ELSEIF/WHILE/REPEAT count/RETURN value/ENDSUB value */
     uint8_t has_cond;
+    uint8_t name_computed;
+    struct ncp_expr num;
     struct ncp_expr args[NCP_OWORD_MAX_ARGS];
 };
 

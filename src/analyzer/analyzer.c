@@ -216,6 +216,8 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
             break;
         }
         if (rc != NCP_OK) {
+            if (ncp_flow_ended_at_percent(a->flow))
+                ncp_an_emit_text(a, NCP_C_RAW_TEXT, "FINISH()", 8);
             a->err = d;
             break;
         }

@@ -16,14 +16,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 /* rs274 -g runs with the block delete switch off: '/' blocks are executed. */
 #define FLOW_BLOCK_DELETE 0
 #define FLOW_DEFAULT_MAX_DEPTH 10u    /* rs274: INTERP_SUB_ROUTINE_LEVELS */
 #define FLOW_NAME_MAX NCP_BLOCK_POOL
 #define FLOW_LABEL_MAX (2 * FLOW_NAME_MAX + 2)
-#define FLOW_MAX_FILES 64             /* the program and the subroutine files it calls */
 
 /* file 0 is the program; others are subroutine files (o<name> call finds
  * name.ngc when no sub of that name was defined yet, as rs274 does) */
@@ -70,13 +68,6 @@ struct flow_frame {
     char name[FLOW_NAME_MAX];         /* the called sub: scope of its labels */
 };
 
-/* A subroutine file, read whole when first called. */
-struct flow_file {
-    struct ncp_source src;
-    const char *name;                 /* ncp_diag_file_of_tag(tag) */
-    unsigned tag;                     /* its ncp_diag_file_tag */
-};
-
 /* A skip from a loop's head to its end line, noting whether what lies
  * between is only nested structure a skip passes over unchanged: every
  * O-word line there closes or continues one opened there (a stack of their
@@ -102,8 +93,7 @@ struct ncp_flow {
     struct ncp_block_feed feed;
     const struct ncp_source *src;     /* the file the current block is in */
     const struct ncp_source *prog;    /* the program's own (file 0) */
-    struct flow_file *files;          /* [1 .. n_files] */
-    uint32_t n_files;
+    struct ncp_sub_files *files;      /* subroutine files, 1 .. (made at the first) */
     const char *sub_path;             /* colon-separated folders, after the current one */
     struct ncp_params *params;
     struct ncp_param_ops pops;
@@ -140,6 +130,8 @@ struct ncp_flow {
     int inline_level;                 /* an inline call returns to this level, or -1 */
     char label[FLOW_LABEL_MAX];       /* label of the block being run */
     size_t label_len;
+    char number[16];                  /* its O number when computed ("o#1"), as text */
+    int ended_at_percent;             /* the closing '%' ended a search for a sub */
     const char *call_path;            /* a call's name as written (in its block): */
     size_t call_path_len;             /* the path of the file it may be in */
 };
@@ -161,12 +153,12 @@ static int ncp_flow_name_eq(const struct flow_name *n, const char *s, size_t len
 
 static const struct ncp_source *ncp_flow_file_src(const struct ncp_flow *f, uint32_t file)
 {
-    return file == 0 ? f->prog : &f->files[file - 1].src;
+    return file == 0 ? f->prog : ncp_sub_files_src(f->files, file);
 }
 
 static const char *ncp_flow_file_name(const struct ncp_flow *f, uint32_t file)
 {
-    const char *n = file == 0 ? f->prog->name : f->files[file - 1].name;
+    const char *n = file == 0 ? f->prog->name : ncp_sub_files_name(f->files, file);
     return n ? n : "";
 }
 
@@ -382,11 +374,25 @@ static int ncp_flow_err_mismatch(struct ncp_flow *f, const struct ncp_block *b,
                         ncp_flow_kind_name(op->type), op->line);
 }
 
-/* How a user wrote the O-word: o100 or o<name>. */
-static void ncp_flow_display_name(const struct ncp_block *b, char *buf, size_t cap)
+/* The O-word's name as text: a computed number ("o#1") is the one
+ * ncp_flow_read_number last read. */
+static const char *ncp_flow_oword_name(const struct ncp_flow *f, const struct ncp_block *b,
+                                       size_t *len)
 {
-    const char *s = b->pool + b->oword.name_off;
-    size_t n = b->oword.name_len, i = 0;
+    if (b->oword.name_computed) {
+        *len = strlen(f->number);
+        return f->number;
+    }
+    *len = b->oword.name_len;
+    return b->pool + b->oword.name_off;
+}
+
+/* How a user wrote the O-word: o100 or o<name>. */
+static void ncp_flow_display_name(const struct ncp_flow *f, const struct ncp_block *b,
+                                  char *buf, size_t cap)
+{
+    size_t n, i = 0;
+    const char *s = ncp_flow_oword_name(f, b, &n);
     if (n > 60)
         n = 60;
     while (i < n && s[i] >= '0' && s[i] <= '9')
@@ -411,8 +417,8 @@ static int ncp_flow_is_global_kind(int kind)
  * written in (the called one, or the one being defined), as "sub#label". */
 static void ncp_flow_make_label(struct ncp_flow *f, const struct ncp_block *b)
 {
-    const char *name = b->pool + b->oword.name_off;
-    size_t len = b->oword.name_len, n = 0;
+    size_t len, n = 0;
+    const char *name = ncp_flow_oword_name(f, b, &len);
     char num[16];
     if (b->oword.kind == NCP_O_M98) {         /* the sub's number from P */
         len = (size_t)snprintf(num, sizeof num, "%d", f->m98_p);
@@ -547,7 +553,7 @@ static int ncp_flow_runaway(const struct ncp_flow *f, const struct ncp_block *b,
                    const struct flow_label *op, struct ncp_diag *d)
 {
     char name[80];
-    ncp_flow_display_name(b, name, sizeof name);
+    ncp_flow_display_name(f, b, name, sizeof name);
     return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
                         "loop %s at line %u repeated more than %u times: runaway loop? "
                         "(raise the limit with --max-loops N if intended)",
@@ -749,66 +755,21 @@ static int ncp_flow_grow_frames(struct ncp_flow *f)
     return 0;
 }
 
-/* A regular file that can be read: a folder of the name or no file at all
- * is not one (rs274 opens with fopen, which a folder does not pass for reading). */
-static int ncp_flow_is_readable_file(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
-}
-
-/* folder/name.ngc for the called name, searched in the current folder, then
- * in each folder of the subroutine path; *file = 0 when there is none. A
- * file found is read whole, once: a second call of a sub it defines finds
- * the label. */
+/* The called name's file (the block source looks for it as rs274 does);
+ * *file = 0 when there is none. */
 static int ncp_flow_open_sub_file(struct ncp_flow *f, const struct ncp_block *b, uint32_t *file,
                          struct ncp_diag *d)
 {
-    char path[4096];
     const char *name = f->label;
     size_t name_len = f->label_len;
     if (b->oword.kind == NCP_O_CALL) {
         name = f->call_path;
         name_len = f->call_path_len;
     }
-    const char *dirs = f->sub_path ? f->sub_path : "";
-    const char *dir = "";
-    size_t dir_len = 0;
-    *file = 0;
-    for (;;) {
-        int n = dir_len ? snprintf(path, sizeof path, "%.*s/%.*s.ngc", (int)dir_len, dir,
-                                   (int)name_len, name)
-                        : snprintf(path, sizeof path, "%.*s.ngc", (int)name_len, name);
-        if (n > 0 && (size_t)n < sizeof path && ncp_flow_is_readable_file(path))
-            break;
-        if (*dirs == '\0')
-            return NCP_OK;
-        dir = dirs;
-        const char *colon = strchr(dirs, ':');
-        dir_len = colon ? (size_t)(colon - dirs) : strlen(dirs);
-        dirs = colon ? colon + 1 : dirs + dir_len;
-    }
-    for (uint32_t k = 1; k <= f->n_files; k++)
-        if (strcmp(f->files[k - 1].name, path) == 0) {
-            *file = k;
-            return NCP_OK;
-        }
-    if (f->n_files >= FLOW_MAX_FILES)
-        return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, b->oword.col,
-                            "more than %d subroutine files called", FLOW_MAX_FILES);
-    if (!f->files && !(f->files = calloc(FLOW_MAX_FILES, sizeof *f->files)))
+    if (!f->files && !(f->files = ncp_sub_files_new()))
         return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
-    struct flow_file *nf = &f->files[f->n_files];
-    nf->tag = ncp_diag_file_tag(path);
-    nf->name = ncp_diag_file_of_tag(nf->tag);
-    if (!nf->name)
-        return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
-    struct ncp_diag od;
-    if (ncp_source_open(&nf->src, nf->name, &od) != NCP_OK)
-        return ncp_diag_set(d, NCP_ERR_IO, b->line, b->oword.col, "Unable to open file <%s>: %s",
-                            nf->name, od.msg);
-    *file = ++f->n_files;
-    return NCP_OK;
+    return ncp_sub_files_open(f->files, name, name_len, f->sub_path, b->line, b->oword.col,
+                              file, d);
 }
 
 /* A new call level for the sub named by the label: a copy of the arguments
@@ -1259,11 +1220,35 @@ static int ncp_flow_do_endloop(struct ncp_flow *f, const struct ncp_block *b, st
     return NCP_OK;
 }
 
+/* An O number computed from parameters ("o#1 call", "o[#1+1] sub"): rs274
+ * reads it whenever it reads the line, skipping or not, so a label's name is
+ * the value its parameters have then; inside a sub being defined an undefined
+ * named parameter reads as 0, as everywhere there. */
+static int ncp_flow_read_number(struct ncp_flow *f, const struct ncp_block *b,
+                                struct ncp_diag *d)
+{
+    double v;
+    int n;
+    int rc = f->defining.on && f->level == 0 ? ncp_flow_eval_lenient(f, b, &b->oword.num, &v, d)
+                                              : ncp_flow_eval(f, b, &b->oword.num, &v, d);
+    if (rc != NCP_OK)
+        return rc;
+    if (ncp_rs274_int(v, &n) != 0)
+        return ncp_flow_oword_error(b, "Non integer value for integer", d);
+    snprintf(f->number, sizeof f->number, "%d", n);
+    return NCP_OK;
+}
+
 static int ncp_flow_run_oword(struct ncp_flow *f, const struct ncp_block *b, struct ncp_diag *d)
 {
     int ignore;
     if (b->oword.kind == NCP_O_M98) {
         int rc = ncp_flow_read_m98(f, b, f->skip.on, d);
+        if (rc != NCP_OK)
+            return rc;
+    }
+    if (b->oword.name_computed) {
+        int rc = ncp_flow_read_number(f, b, d);
         if (rc != NCP_OK)
             return rc;
     }
@@ -1315,9 +1300,11 @@ static int ncp_flow_run_oword(struct ncp_flow *f, const struct ncp_block *b, str
 /* End of the program body while still looking for a label. */
 static int ncp_flow_at_end(struct ncp_flow *f, struct ncp_diag *d)
 {
-    if (f->skip.on && f->src->has_percent)
+    if (f->skip.on && f->src->has_percent) {
+        f->ended_at_percent = 1;
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->cur.line, 0,
                             "Failed to find sub 'O%s' before EOF", f->skip.s);
+    }
     if (f->seek_sub.on)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->skip_start, 0,
                             "EOF in file:%s seeking o-word: o<%s> from line: %u",
@@ -1348,13 +1335,10 @@ static int ncp_flow_resolve_m_value(struct ncp_flow *f, const struct ncp_block *
     if (ncp_flow_eval(f, blk, &blk->words[0].v, &v, &unread) != NCP_OK ||
         ncp_rs274_int(v, &m) != 0 || !(m == 98 || (m == 99 && f->level > 0)))
         return NCP_OK;
-    struct ncp_span sp;
-    if (ncp_source_span(f->src, blk->offset, blk->line, &sp) != 0)
-        return NCP_OK;
     if (!f->fanuc_blk && !(f->fanuc_blk = malloc(sizeof *f->fanuc_blk)))
         return ncp_diag_set(d, NCP_ERR_IO, blk->line, 0, "out of memory");
-    ncp_lex_block_fanuc(f->src->text + sp.off, sp.len, blk->line, blk->offset, m,
-                        f->fanuc_blk);
+    if (ncp_blocks_relex_fanuc(f->src, blk, m, f->fanuc_blk) != 0)
+        return NCP_OK;
     *b = f->fanuc_blk;
     *kind = f->fanuc_blk->oword.kind;
     return NCP_OK;
@@ -1491,9 +1475,7 @@ void ncp_flow_free(struct ncp_flow *f)
     if (!f)
         return;
     ncp_flow_release_feed(f);
-    for (uint32_t k = 0; k < f->n_files; k++)
-        ncp_source_close(&f->files[k].src);
-    free(f->files);
+    ncp_sub_files_free(f->files);
     ncp_block_reread_free(f->reread);
     free(f->fanuc_blk);
     free(f->scan.open);
@@ -1511,12 +1493,17 @@ const struct ncp_source *ncp_flow_source(const struct ncp_flow *f)
 
 const char *ncp_flow_file(const struct ncp_flow *f)
 {
-    return f->cur.file == 0 ? NULL : f->files[f->cur.file - 1].name;
+    return f->cur.file == 0 ? NULL : ncp_sub_files_name(f->files, f->cur.file);
 }
 
 unsigned ncp_flow_file_tag(const struct ncp_flow *f)
 {
-    return f->cur.file == 0 ? 0 : f->files[f->cur.file - 1].tag;
+    return f->cur.file == 0 ? 0 : ncp_sub_files_tag(f->files, f->cur.file);
+}
+
+int ncp_flow_ended_at_percent(const struct ncp_flow *f)
+{
+    return f->ended_at_percent;
 }
 
 int ncp_flow_call_depth(const struct ncp_flow *f)

@@ -72,6 +72,11 @@ const struct ncp_source *ncp_flow_source(const struct ncp_flow *f);
 const char *ncp_flow_file(const struct ncp_flow *f);
 unsigned ncp_flow_file_tag(const struct ncp_flow *f); /* its ncp_diag_file_tag, 0 */
 
+/* The error ncp_flow_next returned came from the program's closing '%',
+ * reached while looking for a sub: rs274 ends the program there (FINISH)
+ * before it reports the sub missing. */
+int ncp_flow_ended_at_percent(const struct ncp_flow *f);
+
 /* Current subroutine call depth (0 = main program): an M99 not first on its
  * line inside a sub is an error rs274 reports as a bug of its own. */
 int ncp_flow_call_depth(const struct ncp_flow *f);

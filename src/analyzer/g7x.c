@@ -238,14 +238,10 @@ static int g7x_record(struct ncp_analyzer *a, struct g7x_rec *r, struct ncp_g7x_
             return rc;
         }
         const struct ncp_source *src = ncp_flow_source(a->flow);
-        if (b->err.code != NCP_OK && relex && b->length < 0xffff &&
-            b->offset + b->length <= src->len) {
-            /* it may be a U or W word, which rs274 takes here */
-            ncp_lex_block_profile(src->text + b->offset, b->length, b->line, b->offset,
-                                  relex);
-            if (relex->err.code != NCP_OK || relex->oword.kind == NCP_O_NONE)
-                b = relex;
-        }
+        /* it may be a U or W word, which rs274 takes here */
+        if (b->err.code != NCP_OK && relex && ncp_blocks_relex_profile(src, b, relex) == 0 &&
+            (relex->err.code != NCP_OK || relex->oword.kind == NCP_O_NONE))
+            b = relex;
         a->blk = b;
         a->line = b->line;
         a->file_tag = ncp_flow_file_tag(a->flow);

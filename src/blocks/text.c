@@ -29,3 +29,22 @@ int ncp_blocks_check_next(struct ncp_blocks_lines *it, struct ncp_span *sp,
            ncp_lex_block_profile(s, sp->len, sp->line, sp->off, b) != NCP_OK;
     return 0;
 }
+
+int ncp_blocks_relex_fanuc(const struct ncp_source *src, const struct ncp_block *b, int m,
+                           struct ncp_block *out)
+{
+    struct ncp_span sp;
+    if (ncp_source_span(src, b->offset, b->line, &sp) != 0)
+        return 1;
+    ncp_lex_block_fanuc(src->text + sp.off, sp.len, b->line, b->offset, m, out);
+    return 0;
+}
+
+int ncp_blocks_relex_profile(const struct ncp_source *src, const struct ncp_block *b,
+                             struct ncp_block *out)
+{
+    if (b->length >= 0xffff || b->offset + b->length > src->len)
+        return 1;
+    ncp_lex_block_profile(src->text + b->offset, b->length, b->line, b->offset, out);
+    return 0;
+}

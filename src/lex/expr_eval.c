@@ -86,7 +86,7 @@ int ncp_expr_eval(const struct ncp_block *b, const struct ncp_expr *e,
             sp++;
             continue;
         }
-        if (op == NCP_BC_NOT || op > NCP_BC_TAN || sp < 1)
+        if (op == NCP_BC_NOT || op > NCP_BC_EXISTS_NUM || sp < 1)
             return fail(d, b, ins, "Bad expression code");
         if ((op >= NCP_BC_POW && op <= NCP_BC_XOR) || op == NCP_BC_ATAN2) {
             if (sp < 2)

@@ -276,11 +276,15 @@ static int exists_arg(struct ncp_lexer *lx, int fpos, struct ncp_lex_val *v)
     } else {
         if ((rc = ncp_lex_real_value(lx, v)))
             return rc;
-        if (!v->is_const)
-            return ncp_lex_fail(lx, pos, "EXISTS of a computed parameter number is not supported");
-        if ((rc = const_index(lx, pos + 1, v->k, &index)))
+        /* rs274 reads the number as any parameter's, computed or not, and
+         * asks only whether it is a valid one */
+        if (!v->is_const) {
+            if ((rc = emit(lx, NCP_BC_EXISTS_NUM, pos + 1, 0.0)))
+                return rc;
+        } else if ((rc = const_index(lx, pos + 1, v->k, &index)))
             return rc;
-        v->k = (index >= 1 && index < NCP_LEX_PARAM_MAX) ? 1.0 : 0.0;
+        else
+            v->k = (index >= 1 && index < NCP_LEX_PARAM_MAX) ? 1.0 : 0.0;
     }
     if (lx->buf[lx->pos] != ']')
         return ncp_lex_fail(lx, lx->pos, "Expected ] reading bracketed parameter");

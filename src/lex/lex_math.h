@@ -134,6 +134,14 @@ static inline const char *ncp_math_unary(int op, double *v)
             return "Negative argument to sqrt";
         x = sqrt(x);
         break;
+    case NCP_BC_EXISTS_NUM: {
+        int index;
+        const char *err = ncp_math_to_int(x, &index);
+        if (err)
+            return err;
+        x = (index >= 1 && index < NCP_LEX_PARAM_MAX) ? 1.0 : 0.0;
+        break;
+    }
     default:
         return "Unknown operation";
     }

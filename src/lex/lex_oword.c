@@ -1,5 +1,5 @@
 /* O-word lines, as rs274's read_o(): o<name> or o<number> (the number may be
- * any constant integer value, kept as its decimal text: "o0100" is "100"),
+ * any integer value, kept as its decimal text when constant: "o0100" is "100"),
  * then a control keyword, then the keyword's bracketed expressions. Only
  * comments may follow. The kind and name are stored before anything that can
  * fail, so a block with an error still says which O-word it was (rs274 does
@@ -39,14 +39,14 @@ static int read_number_name(struct ncp_lexer *lx, struct ncp_oword *o)
     struct ncp_block *b = lx->b;
     struct ncp_lex_val v;
     int pos = lx->pos, rc, len;
-    uint16_t code_mark = b->n_code;
     char tmp[16];
 
     if ((rc = ncp_lex_integer_value(lx, &v)))
         return rc;
     if (!v.is_const) {
-        b->n_code = code_mark;
-        return ncp_lex_fail(lx, pos, "O-word number must not depend on parameters");
+        ncp_lex_to_expr(lx, &v, &o->num);
+        o->name_computed = 1;
+        return NCP_OK;
     }
     len = snprintf(tmp, sizeof tmp, "%d", ncp_trunc_int(v.k));
     if (b->pool_used + len + 1 > NCP_BLOCK_POOL)
@@ -138,6 +138,7 @@ int ncp_lex_oword(struct ncp_lexer *lx)
     o->nargs = 0;
     o->has_cond = 0;
     o->name_off = o->name_len = 0;
+    o->name_computed = 0;
     lx->pos++;
     if (lx->buf[lx->pos] == '<')
         rc = ncp_lex_read_name(lx, &o->name_off, &o->name_len);

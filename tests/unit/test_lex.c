@@ -611,6 +611,14 @@ static void test_owords(void **state)
     assert_true(blk.oword.has_cond);
     assert_true(eval_ok(&blk.oword.cond) == 1.0);
     assert_int_equal(blk.comment_kind, NCP_CMT_NONE);
+    /* a number from parameters is read when the line runs, as rs274 reads it */
+    assert_int_equal(lex("o[#3*2] call"), NCP_OK);
+    assert_int_equal(blk.oword.kind, NCP_O_CALL);
+    assert_true(blk.oword.name_computed);
+    assert_int_equal(blk.oword.name_len, 0);
+    assert_true(eval_ok(&blk.oword.num) == 3.0);
+    assert_int_equal(lex("o100 sub"), NCP_OK);
+    assert_false(blk.oword.name_computed);
     assert_int_equal(lex("o100elseif[1]"), NCP_OK);
     assert_int_equal(blk.oword.kind, NCP_O_ELSEIF);
     assert_int_equal(lex("o100 else"), NCP_OK);
@@ -663,7 +671,6 @@ static void test_oword_errors(void **state)
     expect_error("o100 if [1] [2]", "Unexpected character after O-word", 13);
     expect_error("o100 if [1] G1", "Unexpected character after O-word", 13);
     expect_error("o100 (a) if [1]", "Unexpected character after O-word", 10);
-    expect_error("o#1 sub", "O-word number must not depend on parameters", 2);
     expect_error("o<abc sub", "Named parameter not terminated", 2);
     /* the kind is known even when the condition is bad */
     expect_error("o7 while [1/0]", "Attempt to divide by zero", 12);
