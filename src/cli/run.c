@@ -467,6 +467,18 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
     return rc;
 }
 
+/* An output refused before the run: nothing of it is left behind. */
+static int drop_outputs(struct ncp_outfile *trace_of, struct plot_job *pj, struct ncp_source *src)
+{
+    if (trace_of->fd >= 0)
+        ncp_outfile_discard(trace_of);
+    if (pj)
+        plot_clean(pj);
+    free(pj);
+    ncp_source_close(src);
+    return RUN_USAGE;
+}
+
 int ncp_cli_run(int argc, char **argv)
 {
     struct run_opts o = { 0 };
@@ -508,15 +520,8 @@ int ncp_cli_run(int argc, char **argv)
         return RUN_USAGE;
     }
     if ((o.trace && ncp_outfile_open(&trace_of, o.trace, ids, n_ids, NCP_OUT_LIVE) != 0) ||
-        (o.plot && (!pj || plot_prepare(pj, o.plot, ids, n_ids) != 0))) {
-        if (trace_of.fd >= 0)
-            ncp_outfile_discard(&trace_of);
-        if (pj)
-            plot_clean(pj);
-        free(pj);
-        ncp_source_close(&src);
-        return RUN_USAGE;
-    }
+        (o.plot && (!pj || plot_prepare(pj, o.plot, ids, n_ids) != 0)))
+        return drop_outputs(&trace_of, pj, &src);
     /* --plot alone still needs a trace: one in the plot's private folder */
     const char *trace_path = o.trace ? o.trace : pj ? pj->trace : NULL;
     FILE *trace = NULL;
@@ -526,13 +531,7 @@ int ncp_cli_run(int argc, char **argv)
         trace = fopen(pj->trace, "w");
     if (trace_path && !trace) {
         fprintf(stderr, "cnc-run run: cannot write %s: %s\n", trace_path, strerror(errno));
-        if (trace_of.fd >= 0)
-            ncp_outfile_discard(&trace_of);
-        if (pj)
-            plot_clean(pj);
-        free(pj);
-        ncp_source_close(&src);
-        return RUN_USAGE;
+        return drop_outputs(&trace_of, pj, &src);
     }
     struct ncp_rt_stats *lat = calloc(1, sizeof *lat);
     int rc = lat ? run_program(&o, &cfg, &src, trace, lat) : RUN_FAULT;
