@@ -248,7 +248,9 @@ static int tool_change(struct nck *n, const struct ncp_canon *op, uint32_t line)
             memcpy(pts[k], last, sizeof at);
             pts[k++][2] = io->tc_pos[2];
         }
-        memcpy(pts[k++], io->tc_pos, sizeof at);
+        /* the change position is X Y Z: the other axes stay where they are */
+        memcpy(pts[k], k ? pts[k - 1] : at, sizeof at);
+        memcpy(pts[k++], io->tc_pos, sizeof io->tc_pos);
     }
     for (int p = 0; p < k; p++) {
         struct ncp_seg s;
