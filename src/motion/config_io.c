@@ -98,13 +98,16 @@ static int probe_key(struct ncp_io_cfg *io, const char *k, const char *v, char *
         io->have_probe_plane = 1;
         return 1;
     }
-    if (strcasecmp(k, "PROBE_BOX"))
+    if (strcasecmp(k, "PROBE_BOX") != 0)
         return 0;
-    double b[6];
-    char extra;
-    int n = sscanf(v, "%lf %lf %lf %lf %lf %lf %c", &b[0], &b[1], &b[2], &b[3], &b[4], &b[5],
-                   &extra);
-    int ok = n == 6;
+    /* six plain decimals, as every other number of the file */
+    double b[6] = { 0 };
+    char buf[256], *save = NULL;
+    snprintf(buf, sizeof buf, "%s", v);
+    int n = 0, ok = strlen(v) < sizeof buf;
+    for (char *t = strtok_r(buf, " \t", &save); ok && t; t = strtok_r(NULL, " \t", &save))
+        ok = n < 6 && number(t, -1e6, 1e6, &b[n++]) > 0;
+    ok = ok && n == 6;
     for (int i = 0; ok && i < 3; i++)
         ok = isfinite(b[i]) && isfinite(b[i + 3]) && b[i] < b[i + 3];
     if (!ok) {
