@@ -85,3 +85,132 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
     *trim = d;
     return 1;
 }
+
+/* The same segment run backwards (lines, and arcs without axial travel). */
+static void reverse(const struct ncp_seg *s, struct ncp_seg *o)
+{
+    *o = *s;
+    memcpy(o->start, s->end, sizeof o->start);
+    memcpy(o->end, s->start, sizeof o->end);
+    if (s->kind != NCP_SEG_ARC)
+        return;
+    double c = cos(s->angle), sn = sin(s->angle);
+    for (int i = 0; i < 3; i++) {
+        o->u[i] = c * s->u[i] + sn * s->w[i];
+        o->w[i] = c * s->w[i] - sn * s->u[i];
+    }
+    o->angle = -s->angle;
+    o->r0 = s->r1;
+    o->r1 = s->r0;
+}
+
+static int plane_arc(const struct ncp_seg *s)
+{
+    /* a programmed arc's radii differ by the rounding of its end and centre */
+    return s->kind == NCP_SEG_ARC && fabs(s->axial) < 1e-12 &&
+           fabs(s->r1 - s->r0) < 1e-3 * fmax(s->r0, s->r1) && s->length > 0;
+}
+
+/* An arc (prev) running into a line (cur) in its plane: the arc's last
+ * arc_trim of length is given up; the tangent at the cut meets the line at X,
+ * and the blend is the circle tangent to both at equal distance e from X.
+ * Its distance from the programmed path is at most the circle's from X plus
+ * X's from the corner plus the arc's sagitta over the cut. Returns 0 when
+ * the cut gives no proper blend. */
+static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, double arc_trim,
+                    struct ncp_seg *arc, struct ncp_seg *prev_out, struct ncp_seg *cur_out,
+                    double *dev)
+{
+    double q1[NCP_AXES], t1[NCP_AXES], t2[3], n[3], d[3], a[3], b[3];
+    double r_arc = fmax(prev->r0, prev->r1);
+    if (arc_trim <= 0 || arc_trim > 0.5 * prev->length)
+        return 0;
+    ncp_seg_eval(prev, prev->length - arc_trim, q1, t1);
+    direction(cur, t2);
+    if (fabs(dot3(t2, prev->normal)) > 1e-9)
+        return 0;  /* the line leaves the arc's plane */
+    cross3(t1, t2, n);
+    double nn = dot3(n, n), c = dot3(t1, t2);
+    if (nn < 1e-18 || c < -0.999)
+        return 0;
+    for (int i = 0; i < 3; i++)
+        d[i] = prev->end[i] - q1[i];
+    cross3(d, t2, a);
+    cross3(d, t1, b);
+    double s = dot3(a, n) / nn, q = dot3(b, n) / nn;
+    if (s <= 0 || q < 0 || q + s > 0.5 * cur->length)
+        return 0;
+    double phi = acos(c), r = s / tan(0.5 * phi);
+    double xc = 0, nin[3], nl = 0;
+    for (int i = 0; i < 3; i++) {
+        double x = q1[i] + s * t1[i];
+        xc += (x - prev->end[i]) * (x - prev->end[i]);
+        nin[i] = t2[i] - c * t1[i];
+        nl += nin[i] * nin[i];
+    }
+    nl = sqrt(nl);
+    *dev = r * (1.0 / cos(0.5 * phi) - 1.0) + sqrt(xc) +
+           r_arc * (1 - cos(arc_trim / r_arc));
+    *prev_out = *prev;
+    prev_out->angle = prev->angle * (1 - arc_trim / prev->length);
+    prev_out->length = prev->length - arc_trim;
+    prev_out->r1 = prev->r0 + (prev->r1 - prev->r0) * (1 - arc_trim / prev->length);
+    memcpy(prev_out->end, q1, sizeof prev_out->end);
+    *cur_out = *cur;
+    cur_out->length = cur->length - (q + s);
+    memset(arc, 0, sizeof *arc);
+    arc->kind = NCP_SEG_ARC;
+    arc->term = NCP_TERM_CONTINUOUS;
+    arc->line = cur->line;
+    arc->aux = prev->aux;
+    arc->feed = fmin(prev->feed, cur->feed);
+    arc->blend_feed = fmin(prev->blend_feed > 0 ? prev->blend_feed : prev->feed,
+                           cur->blend_feed > 0 ? cur->blend_feed : cur->feed);
+    for (int i = 0; i < 3; i++) {
+        cur_out->start[i] = q1[i] + s * t1[i] + s * t2[i];
+        arc->start[i] = q1[i];
+        arc->end[i] = cur_out->start[i];
+        arc->center[i] = q1[i] + r * nin[i] / nl;
+        arc->u[i] = -nin[i] / nl;
+        arc->normal[i] = n[i] / sqrt(nn);
+    }
+    for (int i = 3; i < NCP_AXES; i++) {
+        arc->start[i] = q1[i];
+        arc->end[i] = cur_out->start[i] = cur->start[i];
+    }
+    cross3(arc->normal, arc->u, arc->w);
+    arc->r0 = arc->r1 = r;
+    arc->angle = phi;
+    arc->length = r * phi;
+    return 1;
+}
+
+int ncp_blend_arc_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double arc_trim,
+                         struct ncp_seg *arc, struct ncp_seg *prev_out, struct ncp_seg *cur_out)
+{
+    /* drawn in X Y Z, as the line-line blend: a corner where another axis
+     * moves stays a kink */
+    if (prev->term != NCP_TERM_CONTINUOUS || prev->traverse || cur->traverse ||
+        ncp_seg_moves_other(prev) || ncp_seg_moves_other(cur))
+        return 0;
+    double dev = 0;
+    if (plane_arc(prev) && cur->kind == NCP_SEG_LINE && cur->length > 0) {
+        if (!arc_line(prev, cur, arc_trim, arc, prev_out, cur_out, &dev))
+            return 0;
+    } else if (prev->kind == NCP_SEG_LINE && prev->length > 0 && plane_arc(cur)) {
+        struct ncp_seg ra, rl, rarc, ro_a, ro_l;
+        reverse(cur, &ra);
+        reverse(prev, &rl);
+        if (!arc_line(&ra, &rl, arc_trim, &rarc, &ro_a, &ro_l, &dev))
+            return 0;
+        reverse(&ro_l, prev_out);
+        reverse(&ro_a, cur_out);
+        reverse(&rarc, arc);
+        arc->line = cur->line;
+        arc->aux = prev->aux;
+        prev_out->kind = NCP_SEG_LINE;
+    } else {
+        return 0;
+    }
+    return prev->tolerance <= 0 || dev <= prev->tolerance;
+}

@@ -45,15 +45,16 @@ struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
     if (!p)
         return NULL;
     p->cfg = *cfg;
-    /* a blend arc's speed keeps its centripetal acceleration a_c below 0.62 of
-     * the largest axis limit a (arc_limits), so a servo step's chord lies at
-     * most a_c T^2 / 8 inside it; read at a fraction of a sample (after a rate
+    /* a blend arc's speed keeps its centripetal acceleration a_c below 0.95 of
+     * its bound (arc_limits), at most 1.23 times the largest axis limit a (some
+     * axis holds sqrt(2/3) of any plane), so a servo step's chord lies at most
+     * a_c T^2 / 8 inside it; read at a fraction of a sample (after a rate
      * change, src/rt/scaler.c) a step across a sample cuts in up to twice
-     * that again: a T^2 / 4 covers both */
+     * that again: 0.3 a T^2 covers both */
     double a_max = 0;
     for (int j = 0; j < NCP_AXES; j++)
         a_max = fmax(a_max, cfg->axis[j].max_acc);
-    p->chord = a_max * cfg->servo_period * cfg->servo_period / 4;
+    p->chord = 0.3 * a_max * cfg->servo_period * cfg->servo_period;
     fine_ipo_margins(&p->cfg);
     /* room for a blend arc per programmed segment: the window is LOOKAHEAD blocks */
     p->cap = 2 * (size_t)(cfg->lookahead > 1 ? cfg->lookahead : 1) + 2;
@@ -170,17 +171,40 @@ static void scurve_arc_caps(const struct ncp_planner *p, double jmax, double sha
     }
 }
 
-/* Along a helix every axis sees at most its share of the tangential
- * acceleration plus its share of the centripetal one; half of each axis's limit
- * goes to either, so their sum never exceeds it. */
-static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
+/* Along a helix the path acceleration is the tangential a_t along the tangent T
+ * plus the centripetal a_n = v^2 kappa along the in-plane normal N, at right
+ * angles: axis j feels a_t T_j + a_n N_j, at most sqrt(a_t^2 + a_n^2) times
+ * sqrt(T_j^2 + N_j^2) (Cauchy-Schwarz), and T_j^2 + N_j^2 is at most
+ * m^2 + f_a c (2 f_p m + f_a c) (m: axis j's share of the plane, c: of the
+ * axis, f_p, f_a: the plane's and the axis's share of the motion; exactly m^2
+ * on a plane arc). So every axis stays within its limit while the vector
+ * stays within a_eff, the least limit over that bound; the cruise cap leaves
+ * a_n at most an_share of it and the rest goes to a_t, as LinuxCNC's arcs
+ * (0.866 / 0.5 at worst) rather than half of each axis's limit to either. */
+static double arc_accel_bound(const struct ncp_planner *p, const struct ncp_seg *s,
+                              double *kappa)
+{
+    double r = 0.5 * (s->r0 + s->r1);
+    double f_plane = fabs(s->angle) * r / s->length, f_axis = fabs(s->axial) / s->length;
+    double pitch = s->axial / fabs(s->angle);
+    double a_eff = INFINITY;
+    *kappa = r / (r * r + pitch * pitch);
+    for (int j = 0; j < 3; j++) {  /* the arc's own axes: the others move as on a line */
+        double m = sqrt(s->u[j] * s->u[j] + s->w[j] * s->w[j]), c = fabs(s->normal[j]);
+        double b2 = m * m + f_axis * c * (2 * f_plane * m + f_axis * c);
+        if (b2 > 1e-24)
+            a_eff = fmin(a_eff, p->cfg.axis[j].max_acc / sqrt(b2));
+    }
+    return a_eff;
+}
+
+static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps, double an_share)
 {
     const struct ncp_seg *s = &ps->s;
     double r = 0.5 * (s->r0 + s->r1);
     double f_plane = fabs(s->angle) * r / s->length, f_axis = fabs(s->axial) / s->length;
-    double pitch = s->axial / fabs(s->angle);
-    double kappa = r / (r * r + pitch * pitch);
-    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY, jerk = INFINITY;
+    double kappa, a_eff = arc_accel_bound(p, s, &kappa);
+    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc_lin = INFINITY, jerk = INFINITY;
     /* the axes beyond X Y Z move linearly along the arc: a line's caps */
     for (int j = 3; j < NCP_AXES; j++) {
         double u = fabs(s->end[j] - s->start[j]) / s->length;
@@ -188,7 +212,7 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
             continue;
         const struct ncp_axis_cfg *a = &p->cfg.axis[j];
         vmax = fmin(vmax, a->max_vel / u);
-        acc = fmin(acc, a->max_acc / u);
+        acc_lin = fmin(acc_lin, a->max_acc / u);
         if (a->max_jerk > 0)
             jerk = fmin(jerk, 0.5 * a->max_jerk / u);
     }
@@ -199,14 +223,14 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
             continue;
         const struct ncp_axis_cfg *a = &p->cfg.axis[j];
         vmax = fmin(vmax, a->max_vel / share);
-        acc = fmin(acc, 0.5 * a->max_acc / share);
-        if (m > 1e-12)
-            vmax = fmin(vmax, sqrt(0.5 * a->max_acc / (kappa * m)));
         if (plan_scurve(p) && a->max_jerk > 0)
             scurve_arc_caps(p, a->max_jerk, share, kappa * m, &vmax, &jerk);
     }
+    if (kappa > 1e-12)
+        vmax = fmin(vmax, sqrt(an_share * a_eff / kappa));
+    double an = vmax * vmax * kappa;
     ps->vmax = vmax;
-    ps->acc = acc;
+    ps->acc = fmin(acc_lin, sqrt(fmax(0, a_eff * a_eff - an * an)));
     ps->jerk = jerk;
     /* tangential acceleration turns with the tangent: its jerk is 3 v a kappa */
     for (int j = 0; j < 3 && plan_scurve(p); j++) {
@@ -216,14 +240,34 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps)
     }
 }
 
+/* Programmed arcs keep LinuxCNC's split (half the vector for a_t even at full
+ * speed); a blend arc is so short that its speed hardly changes on it, so the
+ * speed through the corner gets nearly all of it. */
+#define ARC_AN_SHARE 0.866
+#define BLEND_AN_SHARE 0.95
+
 /* A corner (kink) turns the velocity vector within one servo period. A servo
  * sample's second difference is a weighted mean of the continuous acceleration
  * plus the kink's velocity jump over one period, so the kink gets a share beta
  * of each axis's limit and the segments on both sides keep their continuous
- * acceleration within 1 - beta (halved: lines 0.5, arcs 0.5 normal + 0.25). */
+ * acceleration within 1 - beta (halved: lines 0.5; arcs 0.5 tangential, and
+ * kink_arc_cap keeps their centripetal part within 0.25 near the corner). */
 static double kink_share(const struct ncp_seg *a, const struct ncp_seg *b)
 {
     return a->kind == NCP_SEG_ARC || b->kind == NCP_SEG_ARC ? 0.25 : 0.5;
+}
+
+/* The speed at a kink into or out of an arc that keeps the arc's centripetal
+ * acceleration within a quarter of its bound for the two samples around it. */
+static double kink_arc_cap(const struct ncp_planner *p, const struct ncp_seg *s)
+{
+    double kappa, a_eff;
+    if (s->kind != NCP_SEG_ARC)
+        return INFINITY;
+    a_eff = arc_accel_bound(p, s, &kappa);
+    if (kappa <= 1e-12)
+        return INFINITY;
+    return fmax(0, sqrt(0.25 * a_eff / kappa) - 2 * a_eff * p->cfg.servo_period);
 }
 
 static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
@@ -253,7 +297,7 @@ static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
     if (prev->term == NCP_TERM_EXACT_PATH)
         return 0;
     *kink = 1;
-    return v;
+    return fmin(v, fmin(kink_arc_cap(p, prev), kink_arc_cap(p, &cur->s)));
 }
 
 /* Would lowering the tail's entry speed to v_tail (with the backward pass
@@ -283,7 +327,7 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
         ps->vmax = 0;
         ps->acc = 1;
     } else if (ps->s.kind == NCP_SEG_ARC) {
-        arc_limits(p, ps);
+        arc_limits(p, ps, ps->blend ? BLEND_AN_SHARE : ARC_AN_SHARE);
     } else {
         line_limits(p, ps);
     }
@@ -382,7 +426,7 @@ static double arc_speed(const struct ncp_planner *p, const struct ncp_seg *arc)
     memset(&ps, 0, sizeof ps);
     ps.s = *arc;
     ps.s.feed = INFINITY;
-    arc_limits(p, &ps);
+    arc_limits(p, &ps, BLEND_AN_SHARE);
     return ps.vmax;
 }
 
@@ -408,6 +452,54 @@ static int size_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
     return ncp_blend_corner(tol, s, hi, arc, d);
 }
 
+/* The same where an arc meets a line: the arc's cut is searched instead. */
+static int size_arc_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
+                          const struct ncp_seg *s, double v_goal, struct ncp_seg *arc,
+                          struct ncp_seg *prev_out, struct ncp_seg *cur_out)
+{
+    const struct ncp_seg *a = tol->kind == NCP_SEG_ARC ? tol : s;
+    double lo = 0, hi = 0.5 * a->length;
+    /* the largest cut within P: the deviation grows with the cut */
+    if (!ncp_blend_arc_corner(tol, s, hi, arc, prev_out, cur_out)) {
+        for (int i = 0; i < 40 && hi - lo > 1e-7 * hi; i++) {
+            double mid = 0.5 * (lo + hi);
+            if (ncp_blend_arc_corner(tol, s, mid, arc, prev_out, cur_out))
+                lo = mid;
+            else
+                hi = mid;
+        }
+        hi = lo;
+        if (hi <= 0 || !ncp_blend_arc_corner(tol, s, hi, arc, prev_out, cur_out))
+            return 0;
+    }
+    if (arc_speed(p, arc) <= v_goal)
+        return 1;
+    lo = 0;
+    for (int i = 0; i < 40 && hi - lo > 1e-7 * hi; i++) {
+        double mid = 0.5 * (lo + hi);
+        if (ncp_blend_arc_corner(tol, s, mid, arc, prev_out, cur_out) &&
+            arc_speed(p, arc) >= v_goal)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return ncp_blend_arc_corner(tol, s, hi, arc, prev_out, cur_out);
+}
+
+/* A segment's cruise cap at the feed its corners are blended for. */
+static double blend_vmax_any(const struct ncp_planner *p, const struct ncp_seg *s)
+{
+    if (s->kind == NCP_SEG_LINE)
+        return blend_vmax(p, s);
+    struct plan_seg ps;
+    memset(&ps, 0, sizeof ps);
+    ps.s = *s;
+    if (s->blend_feed > 0)
+        ps.s.feed = s->blend_feed;
+    arc_limits(p, &ps, ARC_AN_SHARE);
+    return ps.vmax;
+}
+
 /* Blends the corner between the queued tail and s when the tail may still
  * change: not executing, and not lowering speeds a frozen profile counts on.
  * The blend's size follows from the feed at the largest override, never the
@@ -418,26 +510,44 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
         return 0;
     struct plan_seg *prev = plan_at(p, p->count - 1);
     struct plan_seg arc;
+    struct ncp_seg prev_out, cur_out;
     double d;
     memset(&arc, 0, sizeof arc);
     /* G64 P bounds what the servo gets: its chords across the arc too */
     struct ncp_seg tol = prev->s;
     if (tol.tolerance > 0)
         tol.tolerance = fmax(0.25 * tol.tolerance, tol.tolerance - p->chord);
-    double v_goal = fmin(blend_vmax(p, &prev->s), blend_vmax(p, s));
-    if (kink_harmless(p, &prev->s, s, v_goal) || !size_blend(p, &tol, s, v_goal, &arc.s, &d))
+    double v_goal = fmin(blend_vmax_any(p, &prev->s), blend_vmax_any(p, s));
+    if (kink_harmless(p, &prev->s, s, v_goal))
         return 0;
-    arc_limits(p, &arc);
+    if (prev->s.kind == NCP_SEG_LINE && s->kind == NCP_SEG_LINE) {
+        if (!size_blend(p, &tol, s, v_goal, &arc.s, &d))
+            return 0;
+        prev_out = prev->s;
+        prev_out.length -= d;
+        memcpy(prev_out.end, arc.s.start, sizeof prev_out.end);
+        cur_out = *s;
+        cur_out.length -= d;
+        memcpy(cur_out.start, arc.s.end, sizeof cur_out.start);
+    } else if (!size_arc_blend(p, &tol, s, v_goal, &arc.s, &prev_out, &cur_out)) {
+        return 0;
+    }
+    prev_out.tolerance = prev->s.tolerance;
+    arc.blend = 1;
+    arc_limits(p, &arc, BLEND_AN_SHARE);
     double exit_lb = fmin(arc.vmax, plan_reach(p, arc.acc, arc.jerk, 0, arc.s.length));
-    double vin = fmin(prev->vjunc, plan_reach(p, prev->acc, prev->jerk, exit_lb, prev->s.length - d));
+    struct plan_seg cut = *prev;
+    cut.s = prev_out;
+    if (cut.s.kind == NCP_SEG_ARC)
+        arc_limits(p, &cut, ARC_AN_SHARE);
+    double vin = fmin(prev->vjunc, plan_reach(p, fmin(prev->acc, cut.acc), prev->jerk, exit_lb,
+                                              prev_out.length));
     if (!lowering_safe(p, vin))
         return 0;
-    prev->s.length -= d;
-    memcpy(prev->s.end, arc.s.start, sizeof prev->s.end);
+    prev->s = prev_out;
     p->last_pushed = prev->s;
     push_one(p, &arc.s, 1);
-    s->length -= d;
-    memcpy(s->start, arc.s.end, sizeof s->start);
+    *s = cur_out;
     p->st.segments--;  /* the arc is not a programmed segment */
     return 1;
 }

@@ -79,4 +79,11 @@ static inline double plan_reach(const struct ncp_planner *p, double acc, double 
 int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,
                      struct ncp_seg *arc, double *trim);
 
+/* blend.c: the same where one side is an arc in a plane and the other a line
+ * in it: the arc gives up arc_trim of its length, the line what the blend
+ * needs; prev_out and cur_out are the trimmed segments. 0 when the cut gives
+ * no blend or leaves prev's G64 P. */
+int ncp_blend_arc_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double arc_trim,
+                         struct ncp_seg *arc, struct ncp_seg *prev_out, struct ncp_seg *cur_out);
+
 #endif
