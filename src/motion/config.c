@@ -144,7 +144,7 @@ static void range(char *why, size_t len, const char *unit, double lo, double hi)
     snprintf(why, len, "%s%sfrom %s to %s", unit, *unit ? " " : "", a, b);
 }
 
-static int num(const char *v, double lo, double hi, double *out)
+int ncp_ini_number(const char *v, double lo, double hi, double *out)
 {
     if (!ncp_ini_decimal(v))
         return -1;
@@ -160,7 +160,7 @@ static int num(const char *v, double lo, double hi, double *out)
 static int real(const char *v, double lo, double hi, double *out, const char *unit, char *why,
                 size_t len)
 {
-    if (num(v, lo, hi, out) == 0)
+    if (ncp_ini_number(v, lo, hi, out) == 0)
         return 1;
     range(why, len, unit, lo, hi);
     return -1;
@@ -169,7 +169,7 @@ static int real(const char *v, double lo, double hi, double *out, const char *un
 static int integer(const char *v, int lo, int hi, int *out)
 {
     double x;
-    if (num(v, lo, hi, &x) || x != floor(x))
+    if (ncp_ini_number(v, lo, hi, &x) || x != floor(x))
         return -1;
     *out = (int)x;
     return 0;

@@ -5,7 +5,6 @@
 #include "ncpar/motion.h"
 #include "ini_num.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,19 +18,10 @@ void ncp_io_cfg_default(struct ncp_io_cfg *io)
     io->at_speed_tol = 0.01;
 }
 
+/* 1 taken, -1 bad value: what a key reader returns */
 static int number(const char *v, double lo, double hi, double *out)
 {
-    if (!ncp_ini_decimal(v))
-        return -1;
-    char *end;
-    errno = 0;
-    double x = strtod(v, &end);
-    while (*end == ' ' || *end == '\t')
-        end++;
-    if (end == v || *end || errno || !isfinite(x) || x < lo || x > hi)
-        return -1;
-    *out = x;
-    return 1;
+    return ncp_ini_number(v, lo, hi, out) == 0 ? 1 : -1;
 }
 
 /* <prefix><n> with n in 0..max-1: n, or -1 */

@@ -6,5 +6,7 @@
  * blanks): hex, inf, nan or a trailing unit are not what a machinist reading
  * the file would take them for. */
 int ncp_ini_decimal(const char *v);
+/* A plain decimal from lo to hi into *out: 0, or -1 (out untouched). */
+int ncp_ini_number(const char *v, double lo, double hi, double *out);
 
 #endif
