@@ -18,13 +18,13 @@ static void start_head(struct ncp_planner *p)
         p->dur = ps->s.dwell;
     } else {
         double next = p->count > 1 ? plan_at(p, 1)->v_in : 0;
-        double reach = plan_reach(p, ps->acc, ps->jerk, v0, ps->s.length);
+        double v1 = fmin(next, ncp_plan_seg_reach(p, ps, v0, ps->s.length));
+        double vmax = fmax(ps->vmax, v0);
         if (plan_scurve(p) && ps->jerk > 0 && isfinite(ps->jerk))
-            ncp_scurve_plan(&p->trap, ps->s.length, v0, fmin(next, reach), fmax(ps->vmax, v0),
-                            ps->acc, ps->jerk);
+            ncp_scurve_plan(&p->trap, ps->s.length, v0, v1, vmax, ps->acc, ps->jerk);
         else
-            ncp_trap_plan(&p->trap, ps->s.length, v0, fmin(next, reach), fmax(ps->vmax, v0),
-                          ps->acc);
+            ncp_trap_plan(&p->trap, ps->s.length, v0, v1, vmax,
+                          ncp_plan_seg_profile_acc(p, ps, v0, v1, vmax));
         p->dur = ncp_trap_duration(&p->trap);
     }
     p->active = 1;

@@ -232,6 +232,10 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps, double 
     ps->vmax = vmax;
     ps->acc = fmin(acc_lin, sqrt(fmax(0, a_eff * a_eff - an * an)));
     ps->jerk = jerk;
+    /* the S-curve's jerk caps assume the acceleration at the cruise cap */
+    ps->a_eff = a_eff;
+    ps->kappa = plan_scurve(p) ? 0 : kappa;
+    ps->a_cap = acc_lin;
     /* tangential acceleration turns with the tangent: its jerk is 3 v a kappa */
     for (int j = 0; j < 3 && plan_scurve(p); j++) {
         double m = sqrt(s->u[j] * s->u[j] + s->w[j] * s->w[j]);
@@ -270,10 +274,30 @@ static double kink_arc_cap(const struct ncp_planner *p, const struct ncp_seg *s)
     return fmax(0, sqrt(0.25 * a_eff / kappa) - 2 * a_eff * p->cfg.servo_period);
 }
 
+/* A kink whose velocity step at the segments' cruise speed needs at most
+ * this share of any axis's acceleration (a CAM program's tangent moves
+ * written with four decimals) is taken at that speed: the kink gets just the
+ * share it needs and the segments keep the rest (kink_factor). */
+#define KINK_SMALL 0.5
+
+/* The share of its acceleration a segment keeps beside a kink that takes
+ * beta of every axis's limit: a line 1 - beta; on an arc the centripetal
+ * part stays at most c of the bound (c at its cruise cap) and the tangent
+ * gets f with f^2 (1 - c^2) + c^2 <= (1 - beta)^2. Negative: none left. */
+static double kink_factor(const struct plan_seg *ps, double beta)
+{
+    double c = ps->kappa > 0 && ps->a_eff > 0 ? fmin(1, ps->vmax * ps->vmax * ps->kappa / ps->a_eff)
+                                              : 0;
+    double room = (1 - beta) * (1 - beta) - c * c;
+    return room > 0 && c < 1 ? sqrt(room / (1 - c * c)) : -1;
+}
+
 static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
-                       const struct plan_seg *cur, int *kink)
+                       const struct plan_seg *cur, double v_cruise, int *kink,
+                       double *beta_small)
 {
     *kink = 0;
+    *beta_small = -1;
     if (prev->kind == NCP_SEG_DWELL || cur->s.kind == NCP_SEG_DWELL ||
         prev->term == NCP_TERM_STOP)
         return 0;
@@ -297,6 +321,16 @@ static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
     if (prev->term == NCP_TERM_EXACT_PATH)
         return 0;
     *kink = 1;
+    if (!plan_scurve(p) && v >= v_cruise) {
+        double need = 0;
+        for (int j = 0; j < NCP_AXES; j++)
+            need = fmax(need, v_cruise * fabs(t2[j] - t1[j]) /
+                                  (p->cfg.axis[j].max_acc * p->cfg.servo_period));
+        if (need <= KINK_SMALL) {
+            *beta_small = need;
+            return v_cruise;
+        }
+    }
     return fmin(v, fmin(kink_arc_cap(p, prev), kink_arc_cap(p, &cur->s)));
 }
 
@@ -317,7 +351,7 @@ static int lowering_safe(const struct ncp_planner *p, double v_tail)
             return v >= p->trap.v1;
         k--;
         ps = &p->q[(p->head + k) % p->cap];
-        v = fmin(ps->vjunc, plan_reach(p, ps->acc, ps->jerk, v, ps->s.length));
+        v = fmin(ps->vjunc, ncp_plan_seg_reach(p, ps, v, ps->s.length));
     }
 }
 
@@ -331,30 +365,96 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
     } else {
         line_limits(p, ps);
     }
-    if (p->cfg.default_linear_acc > 0)
+    if (p->cfg.default_linear_acc > 0) {
         ps->acc = fmin(ps->acc, p->cfg.default_linear_acc);
+        ps->a_cap = fmin(ps->a_cap, p->cfg.default_linear_acc);
+    }
     ps->acc_full = ps->acc;
     ps->vjunc = 0;
     if (!p->have_last)
         return;
     int kink;
+    double beta_small;
     /* a junction belongs to both segments: neither's cruise cap may be exceeded */
-    double v = fmin(fmin(ps->vmax, p->last_vmax), junction(p, &p->last_pushed, ps, &kink));
+    double v_cruise = fmin(ps->vmax, p->last_vmax);
+    double v = fmin(v_cruise, junction(p, &p->last_pushed, ps, v_cruise, &kink, &beta_small));
     if (kink) {
         /* The previous segment gives up acceleration for the kink, unless that
-         * would cut into a profile already frozen: then stop at the corner. */
+         * would cut into a profile already frozen: then stop at the corner.
+         * Half each side, or for a small kink only what it needs. */
         struct plan_seg *prev = p->count ? plan_at(p, p->count - 1) : NULL;
-        double a_half = prev ? 0.5 * prev->acc_full : 0;
-        double exit_lb = fmin(v, plan_reach(p, 0.5 * ps->acc_full, ps->jerk, 0, ps->s.length));
-        if (!prev || !lowering_safe(p, fmin(prev->vjunc, plan_reach(p, a_half, prev->jerk, exit_lb,
-                                                                    prev->s.length)))) {
+        double f_cur = 0.5, f_prev = 0.5;
+        if (prev && beta_small >= 0) {
+            f_cur = kink_factor(ps, beta_small);
+            f_prev = kink_factor(prev, beta_small);
+            if (f_cur < 0.5 || f_prev < 0.5) {  /* not worth it: the usual caps */
+                f_cur = f_prev = 0.5;
+                v = fmin(v, junction(p, &p->last_pushed, ps, INFINITY, &kink, &beta_small));
+            }
+        }
+        struct plan_seg cur_half = *ps, prev_half;
+        cur_half.acc = fmin(ps->acc, f_cur * ps->acc_full);
+        double exit_lb = fmin(v, ncp_plan_seg_reach(p, &cur_half, 0, ps->s.length));
+        if (prev) {
+            prev_half = *prev;
+            prev_half.acc = fmin(prev->acc, f_prev * prev->acc_full);
+        }
+        if (!prev || !lowering_safe(p, fmin(prev->vjunc, ncp_plan_seg_reach(p, &prev_half, exit_lb,
+                                                                            prev->s.length)))) {
             v = 0;
         } else {
-            prev->acc = a_half;
-            ps->acc = 0.5 * ps->acc_full;
+            prev->acc = prev_half.acc;
+            ps->acc = cur_half.acc;
         }
     }
     ps->vjunc = v;
+}
+
+double ncp_plan_seg_reach(const struct ncp_planner *p, const struct plan_seg *ps, double v,
+                          double len)
+{
+    double lo = plan_reach(p, ps->acc, ps->jerk, v, len);
+    if (ps->kappa <= 0 || plan_scurve(p))
+        return lo;
+    /* the move's top speed x is the end reached: x^2 = v^2 + 2 len acc(x),
+     * acc falling with x, so the largest such x is found by bisection
+     * between the cruise cap's acceleration and the one at v */
+    double hi = plan_reach(p, plan_acc_at(ps, v), ps->jerk, v, len);
+    for (int i = 0; i < 40 && hi - lo > 1e-9 * hi; i++) {
+        double mid = 0.5 * (lo + hi);
+        if (mid * mid <= v * v + 2 * len * plan_acc_at(ps, mid))
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The peak of a trapezoid from v0 to v1 over len at acceleration a. */
+static double trap_peak(double a, double len, double v0, double v1, double vmax)
+{
+    double vp = fmin(vmax, sqrt(a * len + 0.5 * (v0 * v0 + v1 * v1)));
+    return fmax(vp, fmax(v0, v1));
+}
+
+double ncp_plan_seg_profile_acc(const struct ncp_planner *p, const struct plan_seg *ps, double v0,
+                                double v1, double vmax)
+{
+    double len = ps->s.length;
+    if (ps->kappa <= 0 || plan_scurve(p) || len <= 0)
+        return ps->acc;
+    double lo = ps->acc, hi = plan_acc_at(ps, fmax(v0, v1));
+    if (hi <= plan_acc_at(ps, trap_peak(hi, len, v0, v1, vmax)))
+        return hi;
+    /* a harder acceleration reaches a higher peak, where less is left */
+    for (int i = 0; i < 40 && hi - lo > 1e-9 * hi; i++) {
+        double mid = 0.5 * (lo + hi);
+        if (mid <= plan_acc_at(ps, trap_peak(mid, len, v0, v1, vmax)))
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
 }
 
 /* Raise entry speeds from the tail backwards until one does not change: the
@@ -365,7 +465,7 @@ static void backward_pass(struct ncp_planner *p)
     double exit_v = 0;
     for (size_t k = p->count; k-- > first;) {
         struct plan_seg *ps = plan_at(p, k);
-        double v = fmin(ps->vjunc, plan_reach(p, ps->acc, ps->jerk, exit_v, ps->s.length));
+        double v = fmin(ps->vjunc, ncp_plan_seg_reach(p, ps, exit_v, ps->s.length));
         if (k + 1 < p->count && v == ps->v_in)
             break;
         if (k + 1 < p->count)
@@ -535,13 +635,16 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     prev_out.tolerance = prev->s.tolerance;
     arc.blend = 1;
     arc_limits(p, &arc, BLEND_AN_SHARE);
-    double exit_lb = fmin(arc.vmax, plan_reach(p, arc.acc, arc.jerk, 0, arc.s.length));
+    arc.acc_full = arc.acc;
+    double exit_lb = fmin(arc.vmax, ncp_plan_seg_reach(p, &arc, 0, arc.s.length));
     struct plan_seg cut = *prev;
     cut.s = prev_out;
-    if (cut.s.kind == NCP_SEG_ARC)
+    if (cut.s.kind == NCP_SEG_ARC) {
         arc_limits(p, &cut, ARC_AN_SHARE);
-    double vin = fmin(prev->vjunc, plan_reach(p, fmin(prev->acc, cut.acc), prev->jerk, exit_lb,
-                                              prev_out.length));
+        cut.acc_full = cut.acc;
+        cut.acc = fmin(prev->acc, cut.acc);
+    }
+    double vin = fmin(prev->vjunc, ncp_plan_seg_reach(p, &cut, exit_lb, prev_out.length));
     if (!lowering_safe(p, vin))
         return 0;
     prev->s = prev_out;

@@ -13,6 +13,10 @@ struct plan_seg {
     double acc;     /* path acceleration that keeps every axis within its limit */
     double acc_full;/* the same before a corner (kink) took its share */
     double jerk;    /* path jerk that keeps every axis within its limit (S-curve) */
+    /* An arc's acceleration vector bound and curvature: below its cruise cap the
+     * centripetal part v^2 kappa is smaller and leaves more for the tangent
+     * (plan_acc_at); a_cap bounds what the other axes and caps allow. */
+    double a_eff, kappa, a_cap;
     double vjunc;   /* entry speed cap from the junction with the previous segment */
     double v_in;    /* planned entry speed (backward pass: can still stop at the end) */
     int blend;      /* a G64 corner arc, not a programmed segment */
@@ -72,6 +76,29 @@ static inline double plan_reach(const struct ncp_planner *p, double acc, double 
         return ncp_scurve_reach(v, len, acc, jerk);
     return sqrt(v * v + 2 * acc * len);
 }
+
+/* The path acceleration ps allows at speeds up to v: an arc's centripetal
+ * acceleration v^2 kappa takes less of its bound a_eff below the cruise cap,
+ * so the tangent gets the rest, scaled as a corner scaled acc. Never below
+ * acc, the value at the cruise cap. */
+static inline double plan_acc_at(const struct plan_seg *ps, double v)
+{
+    if (ps->kappa <= 0 || ps->acc_full <= 0)
+        return ps->acc;
+    double an = v * v * ps->kappa;
+    double at = ps->a_eff > an ? sqrt(ps->a_eff * ps->a_eff - an * an) : 0;
+    return ps->acc / ps->acc_full * fmax(ps->acc_full, fmin(ps->a_cap, at));
+}
+
+/* planner.c: plan_reach for a queued segment, its acceleration taken at the
+ * highest speed of the move (the arc's tangential share grows as it slows). */
+double ncp_plan_seg_reach(const struct ncp_planner *p, const struct plan_seg *ps, double v,
+                          double len);
+
+/* planner.c: the largest constant acceleration for ps's profile from v0 to v1
+ * whose peak speed (capped at vmax) still allows it. */
+double ncp_plan_seg_profile_acc(const struct ncp_planner *p, const struct plan_seg *ps, double v0,
+                                double v1, double vmax);
 
 /* blend.c: the arc joining prev's end to cur's start within prev's G64 P,
  * trimming at most max_trim off either line, and the length trimmed off both.
