@@ -54,6 +54,14 @@ const char *ncp_thread_mode_name(enum ncp_thread_mode m);
  * analyzer, or with no executors on the next CPU). */
 void ncp_thread_map_default(struct ncp_thread_map *m, enum ncp_thread_mode mode,
                             int n_lexers, int n_executors);
+/* The layout for a program of `bytes` bytes of text on `cpus` CPUs when the
+ * user names none: serial below ncp_auto_parallel_bytes(cpus), where starting
+ * threads costs more than they save, det threads from there on. */
+void ncp_thread_map_auto(struct ncp_thread_map *m, size_t bytes, int cpus);
+/* Program size from which ncp_thread_map_auto runs threads; SIZE_MAX: never. */
+size_t ncp_auto_parallel_bytes(int cpus);
+/* CPUs this process may run on (its affinity mask), at least 1. */
+int ncp_cpus_usable(void);
 /* Load an INI thread map; fills d (file:line) on error. */
 int ncp_thread_map_load(struct ncp_thread_map *m, const char *path, struct ncp_diag *d);
 

@@ -98,6 +98,19 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
     fputc('\n', stderr);
 }
 
+/* Why the run had the layout it had, when no flag chose it. */
+static void print_choice(const struct ncp_thread_map *map, size_t bytes, int cpus)
+{
+    size_t from = ncp_auto_parallel_bytes(cpus);
+    fprintf(stderr, "cnc-run: layout %s: %zu bytes of program on %d CPU%s; ",
+            map->mode == NCP_MODE_SERIAL ? "serial" : "parallel", bytes, cpus,
+            cpus == 1 ? "" : "s");
+    if (from == SIZE_MAX)
+        fputs("threads need 2 CPUs\n", stderr);
+    else
+        fprintf(stderr, "threads from %zu bytes on\n", from);
+}
+
 static void usage(FILE *f)
 {
     fputs("usage: cnc-run parse PROG [-j N] [--executors M] [--mode serial|det|att]\n"
@@ -114,7 +127,11 @@ static void usage(FILE *f)
           "       --executors 0: the output thread executes; with --inline-output the\n"
           "       analyzer executes and writes each command itself (no output thread).\n"
           "       -j 0: no lexer threads, the analyzer lexes the text itself.\n"
-          "       Default: -j 2 --executors 1; with 2 CPUs or fewer, -j 0 --executors 0.\n"
+          "       Default (none of -j, --executors, --mode, --config, --inline-output):\n"
+          "       serial for a program too short to pay for starting threads (and on\n"
+          "       1 CPU), else det -j 0 --executors 0 on 2 CPUs, -j 2 --executors 1\n"
+          "       on more; --stats says which and from what size. --mode det|att\n"
+          "       alone: -j 2 --executors 1, on 2 CPUs or fewer -j 0 --executors 0.\n"
           "       `o<name> call` of a sub not defined yet reads name.ngc from the\n"
           "       current folder, then from the --subroutine-path folders (as rs274).\n"
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
@@ -239,6 +256,10 @@ static int cmd_parse(int argc, char **argv)
     struct ncp_thread_map map;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
+    int cpus = ncp_cpus_usable();
+    /* no flag names a layout: it is chosen from the program's size once the
+     * program is read (a pipe is read to its end before the run) */
+    int automatic = !o.config && !o.mode_given && !o.counts_given && !o.inline_output;
     if (o.config) {
         if (ncp_thread_map_load(&map, o.config, &d) != NCP_OK) {
             if (d.line)
@@ -249,20 +270,16 @@ static int cmd_parse(int argc, char **argv)
         }
         if (o.mode_given)
             map.mode = o.mode;
-    } else {
-        /* Two CPUs or fewer: two busy threads, the analyzer lexing the text
-         * itself and interpreting it, the output thread executing and writing.
-         * More stage threads than cores only adds hand-offs, and a lexer
-         * thread's blocks cost the analyzer about as much to take over from
-         * the other core as to lex them itself (bench/RESULTS.md). */
-        long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-        if (!o.counts_given && ncpu > 0 && ncpu <= 2) {
+    } else if (!automatic) {
+        /* --mode without counts on two CPUs or fewer: the two-thread layout
+         * of ncp_thread_map_auto */
+        if (!o.counts_given && cpus <= 2) {
             o.lexers = 0;
             o.executors = 0;
         }
         ncp_thread_map_default(&map, o.mode, o.lexers, o.executors);
     }
-    if (o.inline_output) {
+    if (!automatic && o.inline_output) {
         if (map.n_executors > 0) {
             fprintf(stderr, "cnc-run: --inline-output needs --executors 0 (the analyzer then executes)\n");
             return EXIT_USAGE;
@@ -275,6 +292,9 @@ static int cmd_parse(int argc, char **argv)
         print_diag(o.prog, &d);
         return EXIT_PROGRAM;
     }
+    size_t prog_bytes = src.end - src.begin;
+    if (automatic)
+        ncp_thread_map_auto(&map, prog_bytes, cpus);
     struct ncp_file_id inputs[4];
     int n_inputs = program_ids(&src, &o, inputs);
     struct canon_writer *w = NULL;
@@ -315,8 +335,11 @@ static int cmd_parse(int argc, char **argv)
         print_diag(o.prog, &d);
         status = EXIT_PROGRAM;
     }
-    if (o.stats)
+    if (o.stats) {
         print_stats(&st, &map);
+        if (automatic)
+            print_choice(&map, prog_bytes, cpus);
+    }
     ncp_source_close(&src);
     return status;
 }
