@@ -107,7 +107,7 @@ static int one(struct ncp_inject_cfg *c, const char *s, size_t n, char *why, siz
         const char *colon = memchr(v, ':', vl);
         size_t nl = colon ? (size_t)(colon - v) : vl;
         if (number(v, nl, 0, US_MAX, &x) ||
-            (colon && (vl - nl - 1 != 6 || strncmp(colon + 1, "normal", 6))))
+            (colon && (vl - nl - 1 != 6 || strncmp(colon + 1, "normal", 6) != 0)))
             return bad(why, len, s, n, "jitter=US (uniform) or jitter=US:normal, in microseconds");
         c->jitter_s = x * 1e-6;
         c->jitter_normal = colon != NULL;
