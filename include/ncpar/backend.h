@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "ncpar/inject.h"
 #include "ncpar/motion.h"
 
 struct ncp_sim_axis {
@@ -33,6 +34,24 @@ void ncp_sim_init(struct ncp_sim *s, const struct ncp_machine_cfg *cfg,
  * of the interval being driven, not the one just past. */
 void ncp_sim_step(struct ncp_sim *s, const double cmd[NCP_AXES], const double next[NCP_AXES],
                   double act[NCP_AXES]);
+
+/* The same plant with the timing of one period injected (ncpar/inject.h): the
+ * servo samples at ev->sample_s into the period, its feedback ev->delay_fb_s
+ * older than that (or the last sample again when lost), and its output acts
+ * ev->io_s after the sample; until then the previous output drives the
+ * plant. The plant's recent periods are kept to serve a delayed feedback. */
+struct ncp_sim_period {
+    double x0, v0;       /* state at the period's start */
+    double ua, tsw, ub;  /* output ua until tsw into the period, ub after */
+};
+struct ncp_sim_timed {
+    uint64_t k;                          /* periods stepped */
+    double u_prev[NCP_AXES], fb[NCP_AXES];
+    struct ncp_sim_period hist[NCP_INJECT_FB_HISTORY][NCP_AXES];
+};
+void ncp_sim_step_timed(struct ncp_sim *s, struct ncp_sim_timed *tm,
+                        const struct ncp_inject_ev *ev, const double cmd[NCP_AXES],
+                        const double next[NCP_AXES], double act[NCP_AXES]);
 
 /* ---- the interface the position loop drives ------------------------------ */
 
@@ -64,6 +83,9 @@ struct ncp_backend {
     const struct ncp_backend_ops *ops;
     void *impl;
     int real_clock_only;   /* real drives: the virtual clock cannot drive them */
+    /* Injected timing of the coming cycle (set by the position loop, NULL =
+     * none): the simulated plant models it; real drives have their own. */
+    const struct ncp_inject_ev *timing;
 };
 
 /* Opens what cfg->backend names (not started yet). log gets start-up

@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include "ncpar/canon.h"
 #include "ncpar/diag.h"
+#include "ncpar/inject.h"
 #include "ncpar/rt.h"
 
 /* The machine's axes, in LinuxCNC's order X Y Z A B C U V W. A machine has
@@ -120,6 +121,8 @@ struct ncp_machine_cfg {
                                      and after each command */
     } lcm;
     struct ncp_io_cfg io;
+    /* [INJECT] and [RT]'s miss keys: timing faults, setpoint policy, miss limits */
+    struct ncp_inject_cfg inject;
 };
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c);

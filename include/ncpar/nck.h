@@ -111,6 +111,10 @@ struct ncp_nck_result {
     uint64_t pauses;         /* program pauses and tool changes waited for */
     char warning[200];
     struct ncp_rt_stats lat;
+    /* timing faults injected ([INJECT], --inject) and a miss limit that
+     * stopped the run (inject.trip: exit 3) */
+    struct ncp_inject_report inject;
+    char inject_summary[256];
 };
 
 /* Runs the whole chain. Returns res->status. */

@@ -4,9 +4,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The plant and, for injected timing, its recent periods. */
+struct sim_be {
+    struct ncp_sim s;
+    struct ncp_sim_timed t;
+};
+
 static int sim_start(struct ncp_backend *b, double pos[NCP_AXES])
 {
-    struct ncp_sim *s = b->impl;
+    struct ncp_sim *s = &((struct sim_be *)b->impl)->s;
     for (int j = 0; j < NCP_AXES; j++)
         pos[j] = s->ax[j].x;
     return 0;
@@ -15,7 +21,11 @@ static int sim_start(struct ncp_backend *b, double pos[NCP_AXES])
 static int sim_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const double next[NCP_AXES],
                      double act[NCP_AXES])
 {
-    ncp_sim_step(b->impl, cmd, next, act);
+    struct sim_be *sb = b->impl;
+    if (b->timing)
+        ncp_sim_step_timed(&sb->s, &sb->t, b->timing, cmd, next, act);
+    else
+        ncp_sim_step(&sb->s, cmd, next, act);
     return 0;
 }
 
@@ -39,7 +49,7 @@ static void sim_close(struct ncp_backend *b)
 
 static void sim_enable(struct ncp_backend *b, int on)
 {
-    struct ncp_sim *s = b->impl;
+    struct ncp_sim *s = &((struct sim_be *)b->impl)->s;
     s->disabled = !on;
 }
 
@@ -51,12 +61,12 @@ int ncp_backend_open_sim(struct ncp_backend *b, const struct ncp_machine_cfg *cf
                          struct ncp_diag *d)
 {
     static const double origin[NCP_AXES];
-    struct ncp_sim *s = malloc(sizeof *s);
-    if (!s)
+    struct sim_be *sb = calloc(1, sizeof *sb);
+    if (!sb)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the simulated machine");
-    ncp_sim_init(s, cfg, origin);
+    ncp_sim_init(&sb->s, cfg, origin);
     memset(b, 0, sizeof *b);
     b->ops = &sim_ops;
-    b->impl = s;
+    b->impl = sb;
     return NCP_OK;
 }

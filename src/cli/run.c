@@ -2,6 +2,7 @@
  * loop) on the simulated machine. Option parsing, loading and reporting; the
  * runtime itself is ncp_nck_run (src/rt/). */
 #include "run.h"
+#include "inject_opts.h"
 #include "machine.h"
 #include "outfile.h"
 #include "signals.h"
@@ -33,6 +34,7 @@ struct run_opts {
     enum ncp_thread_mode mode;
     const char *backend;        /* --backend as given, NULL = sim */
     uint32_t max_loops;         /* --max-loops, 0 = the interpreter's default */
+    const char *inject, *seed;  /* --inject SPECS, --seed N (NULL: the INI's) */
 };
 
 struct interp_ctx {
@@ -60,6 +62,7 @@ static void usage(FILE *f)
           "                        [--mode serial|det|att] [--tool-table FILE]\n"
           "                        [--subroutine-path DIR[:DIR...]] [--max-loops N]\n"
           "                        [--backend sim|socketcan[:IFACE]]\n"
+          "                        [--inject SPEC[,SPEC...]] [--seed N]\n"
           "Runs PROG on the simulated machine (or CiA 402 drives over CAN): interpreter ->\n"
           "look-ahead planner -> interpolator -> position loop (SCHED_FIFO when permitted).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill)\n"
@@ -83,6 +86,13 @@ static void usage(FILE *f)
           "                      Operation enabled, SDO failure) stops all axes: exit 3.\n"
           "                      The trace's actual positions are then the drives' TPDOs,\n"
           "                      one servo period old\n"
+          "  --inject SPECS      timing faults in the position loop (over the INI's [INJECT]\n"
+          "                      SPEC): miss=RATIO, miss@CYCLE, latency=US, latency=MIN-MAX,\n"
+          "                      io-latency=US, jitter=US[:normal], lose-setpoint=RATIO,\n"
+          "                      lose-feedback=RATIO, delay-feedback=US; the trace gets an\n"
+          "                      inject column. [RT] MISS_POLICY says what a servo runs on\n"
+          "                      when its setpoint is late or lost\n"
+          "  --seed N            the faults' random seed (default: the INI's SEED, or 1)\n"
           "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault / soft limit\n",
           f);
 }
@@ -112,13 +122,15 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "subroutine-path", required_argument, 0, 'S' },
         { "backend", required_argument, 0, 'b' },
         { "max-loops", required_argument, 0, 'L' },
+        { "inject", required_argument, 0, 'I' },
+        { "seed", required_argument, 0, 'R' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
     double pct;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:I:R:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': o->config = optarg; break;
         case 't': o->trace = optarg; break;
@@ -126,6 +138,8 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         case 'T': o->tool_table = optarg; break;
         case 'S': o->sub_path = optarg; break;
         case 'b': o->backend = optarg; break;
+        case 'I': o->inject = optarg; break;
+        case 'R': o->seed = optarg; break;
         case 'L':
             if (parse_num(optarg, 1, 2000000000, &pct) || pct != floor(pct))
                 return fprintf(stderr, "cnc-run run: --max-loops wants a positive count\n"), -1;
@@ -204,6 +218,10 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                 "%s:%u: error: following error on %c: %.4f mm exceeds FERROR %.4f mm; servo stopped\n",
                 o->prog, res->fault_line, NCP_AXIS_LETTERS[res->fault_axis], res->fault_err,
                 cfg->axis[res->fault_axis].ferror);
+    } else if (res->inject.trip) {
+        char why[300];
+        ncp_inject_trip_text(&cfg->inject, &res->inject, cfg->servo_period, why, sizeof why);
+        fprintf(stderr, "%s:%u: error: %s\n", o->prog, res->inject.trip_line, why);
     } else if (res->status != RUN_OK && res->diag.line) {
         fprintf(stderr, "%s:%u:%u: error: %s (motion stopped after the last good block)\n",
                 res->diag.file ? res->diag.file : o->prog, res->diag.line, res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
@@ -245,7 +263,10 @@ static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 
 static int load_config(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 {
-    return ncp_cli_load_machine(o->config, cfg) ? -1 : apply_backend(o, cfg);
+    return ncp_cli_load_machine(o->config, cfg) || apply_backend(o, cfg) ||
+                   ncp_cli_apply_inject("cnc-run run", o->inject, o->seed, cfg)
+               ? -1
+               : 0;
 }
 
 

@@ -1,6 +1,7 @@
 /* cnc-run serve: the NCK as a long-running service on LCM. Options, the
  * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
 #include "serve.h"
+#include "inject_opts.h"
 #include "outfile.h"
 #include "machine.h"
 #include "signals.h"
@@ -41,6 +42,7 @@ static void usage(FILE *f)
     fputs("usage: cnc-run serve [--config INI] [--lcm-url URL] [--prefix P]\n"
           "                     [--clock real|virtual] [--trace CSV] [--mode serial|det|att]\n"
           "                     [--tool-table FILE] [--subroutine-path DIR[:DIR...]]\n"
+          "                     [--inject SPEC[,SPEC...]] [--seed N]\n"
           "Runs the NCK as a service on the simulated machine: it holds the axes where they\n"
           "are and waits for commands on LCM (cnc-ctl is its command-line client).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill); [LCM] URL,\n"
@@ -51,13 +53,15 @@ static void usage(FILE *f)
           "  --clock virtual     simulated clock: as fast as the CPU allows while moving,\n"
           "                      real time while idle\n"
           "  --trace CSV         per-cycle trace of the whole service life\n"
+          "  --inject SPECS      timing faults in the position loop, as cnc-run run's;\n"
+          "  --seed N            their seed\n"
           "SIGINT/SIGTERM: a controlled stop along the path, then shutdown.\n"
           "exit status: 0 ok, 1 usage or set-up, 3 a fault happened while serving\n",
           f);
 }
 
 struct serve_args {
-    const char *config, *url, *prefix, *trace, *tool_table, *sub_path;
+    const char *config, *url, *prefix, *trace, *tool_table, *sub_path, *inject, *seed;
     int virtual_clock;
     enum ncp_thread_mode mode;
 };
@@ -70,11 +74,12 @@ static int parse(int argc, char **argv, struct serve_args *a)
         { "trace", required_argument, 0, 't' }, { "mode", required_argument, 0, 'm' },
         { "tool-table", required_argument, 0, 'T' },
         { "subroutine-path", required_argument, 0, 'S' }, { "help", no_argument, 0, 'h' },
+        { "inject", required_argument, 0, 'I' }, { "seed", required_argument, 0, 'R' },
         { 0, 0, 0, 0 },
     };
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:u:P:k:t:m:T:S:h", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:u:P:k:t:m:T:S:hI:R:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': a->config = optarg; break;
         case 'u': a->url = optarg; break;
@@ -82,6 +87,8 @@ static int parse(int argc, char **argv, struct serve_args *a)
         case 't': a->trace = optarg; break;
         case 'T': a->tool_table = optarg; break;
         case 'S': a->sub_path = optarg; break;
+        case 'I': a->inject = optarg; break;
+        case 'R': a->seed = optarg; break;
         case 'k':
             if (strcmp(optarg, "real") != 0 && strcmp(optarg, "virtual") != 0)
                 return fprintf(stderr, "cnc-run serve: --clock is real or virtual\n"), -1;
@@ -107,7 +114,8 @@ int ncp_cli_serve(int argc, char **argv)
     if (parse(argc, argv, &a))
         return usage(stderr), SERVE_USAGE;
     struct ncp_machine_cfg cfg;
-    if (ncp_cli_load_machine(a.config, &cfg) || ncp_cli_check_tool_table(a.tool_table))
+    if (ncp_cli_load_machine(a.config, &cfg) || ncp_cli_check_tool_table(a.tool_table) ||
+        ncp_cli_apply_inject("cnc-run serve", a.inject, a.seed, &cfg))
         return SERVE_USAGE;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);

@@ -48,6 +48,7 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->can.sdo_timeout_ms = 200;
     c->default_linear_vel = 10.0;
     ncp_io_cfg_default(&c->io);
+    ncp_inject_cfg_default(&c->inject);
     snprintf(c->lcm.prefix, sizeof c->lcm.prefix, "NCP_");
     c->lcm.status_hz = 50.0;
 }
@@ -384,7 +385,7 @@ static int known_section(const char *sec)
 {
     static const char *const names[] = { "EMCMOT", "TRAJ",   "LCM",   "PLANNER",
                                          "SIM",    "RT",     "CAN",   "SPINDLE_0",
-                                         "EMCIO" };
+                                         "EMCIO",  "INJECT" };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcasecmp(sec, names[i]))
             return 1;
@@ -432,8 +433,12 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
         int r = sim_key(c, k, v, why, len);
         return r ? r : ncp_io_cfg_key(&c->io, sec, k, v, why, len);
     }
-    if (!strcasecmp(sec, "RT"))
-        return rt_key(c, k, v, why, len);
+    if (!strcasecmp(sec, "RT")) {
+        int r = rt_key(c, k, v, why, len);
+        return r ? r : ncp_inject_ini_key(&c->inject, sec, k, v, why, len);
+    }
+    if (!strcasecmp(sec, "INJECT"))
+        return ncp_inject_ini_key(&c->inject, sec, k, v, why, len);
     if (!strcasecmp(sec, "CAN"))
         return can_key(&c->can, k, v, why, len);
     return ncp_io_cfg_key(&c->io, sec, k, v, why, len);

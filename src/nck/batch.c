@@ -169,7 +169,7 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o)
     int64_t last_print = 0;
     if (o->trace) {
         errno = 0;
-        nck_trace_header(o->trace, n->cfg->axis_mask);
+        nck_trace_header(o->trace, n->cfg);
         if (ferror(o->trace))
             n->sum.trace_errno = errno ? errno : EIO;
     }
@@ -252,6 +252,9 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
         res->calls_acted += n->calls_acted[k];
         res->calls_refused += n->calls_refused[k];
     }
+    res->inject = n->inj_rep;
+    ncp_inject_summary(&n->cfg->inject, &n->inj_rep, res->inject_summary,
+                       sizeof res->inject_summary);
     const struct nck_job *j = &n->job;
     int fault = atomic_load(&n->loop_fault);
     if (fault == NCK_LF_BACKEND) {
@@ -261,6 +264,9 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
         res->fault_axis = n->fault_axis;
         res->fault_err = n->fault_err;
         res->fault_line = n->fault_line;
+        res->status = NCP_NCK_FAULT;
+    } else if (n->inj_rep.trip) {
+        /* a miss limit stopped the machine along the path */
         res->status = NCP_NCK_FAULT;
     } else if (n->for_expired || res->interrupted) {
         /* the interpreter was cut short by us: its "stopped" is no program error */

@@ -92,6 +92,7 @@ int nck_start(struct nck *n, const struct ncp_nck_setup *s, int batch, struct nc
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot set up the runtime (out of memory?)");
         return -1;
     }
+    nck_inject_setup(n);
     const struct ncp_machine_cfg *c = n->cfg;
     if (ncp_rt_start(&n->planner_thread, &c->planner, nck_planner_main, n, NULL)) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the planner thread");

@@ -32,7 +32,7 @@ static double feed_rate(struct nck *n)
     /* M53 P0 turns the feed hold off (not the controlled stop) */
     int hold = n->mach.en[NCK_EN_FEED_HOLD] &&
                atomic_load_explicit(&n->ctl->hold, memory_order_relaxed);
-    if (n->for_expired || hold || nck_probe_braking(n) ||
+    if (n->for_expired || hold || nck_probe_braking(n) || n->timing_stop ||
         atomic_load_explicit(&n->ctl->stop, memory_order_relaxed))
         return 0.0;
     /* a serving NCK's rapids follow the rapid override, as LinuxCNC's (a
@@ -169,6 +169,8 @@ static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES]
     fb.flags = n->cur.flags;
     memcpy(fb.cmd, n->cur.pos, sizeof fb.cmd);
     memcpy(fb.act, act, sizeof fb.act);
+    fb.inj = n->inj_ev;
+    memset(&n->inj_ev, 0, sizeof n->inj_ev);
     const struct nck_mach *m = &n->mach;
     fb.rpm = m->rpm;
     fb.rev = m->rev;
@@ -205,7 +207,9 @@ static int frozen_cycle(struct nck *n, int64_t now_ns)
         n->drives_on = 0;
     }
     double act[NCP_AXES];
+    n->be.timing = NULL;
     n->be.ops->cycle(&n->be, n->cur.pos, n->cur.pos, act);
+    nck_inject_clear(n);
     n->mach.rpm_cmd = 0;   /* E-stop and faults stop the spindle too */
     (void)nck_aux_cycle(n);
     if (atomic_load_explicit(&n->discard_req, memory_order_acquire) !=
@@ -241,7 +245,7 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
     if (take_setpoint(n) == NCP_RT_RETRY)
         return NCP_RT_RETRY;
     double act[NCP_AXES];
-    int be_rc = n->be.ops->cycle(&n->be, n->cur.pos, n->next.pos, act);
+    int be_rc = nck_servo_cycle(n, act);
     nck_probe_cycle(n, act);
     track_blocks(n);
     push_cycle(n, now_ns, act);
@@ -265,10 +269,12 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
         atomic_store_explicit(&n->frozen, 1, memory_order_release);
         return NCP_RT_CONTINUE;
     }
+    nck_inject_rest(n);
     if (n->batch) {
         if (n->for_s > 0 && (double)now_ns * 1e-9 >= n->for_s)
             n->for_expired = 1;
-        int held = n->for_expired || atomic_load_explicit(&n->ctl->stop, memory_order_relaxed);
+        int held = n->for_expired || n->timing_stop ||
+                   atomic_load_explicit(&n->ctl->stop, memory_order_relaxed);
         int done = n->ended || (held && n->scaler.r == 0 && n->cur.v == 0);
         if (done && ++n->settle >= SETTLE_CYCLES)
             return NCP_RT_STOP;

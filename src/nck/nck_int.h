@@ -125,6 +125,7 @@ struct nck_fb {
     uint32_t waits;             /* waits begun so far */
     int32_t tool;
     uint32_t wait_line;
+    struct ncp_inject_ev inj;   /* the timing faults of the cycle (trace column inject) */
 };
 
 struct nck_summary {
@@ -144,9 +145,10 @@ struct nck_summary {
     char tbuf[1 << 16];
     size_t tlen;
     int trace_errno;         /* the first failed write's errno, 0 = none */
+    int inject_col;          /* the trace has the inject column */
 };
 
-enum nck_loop_fault { NCK_LF_NONE, NCK_LF_FERROR, NCK_LF_BACKEND };
+enum nck_loop_fault { NCK_LF_NONE, NCK_LF_FERROR, NCK_LF_BACKEND, NCK_LF_TIMING };
 
 enum nck_job_kind { NCK_JOB_NONE, NCK_JOB_PROGRAM, NCK_JOB_MDI, NCK_JOB_MOVE };
 
@@ -266,6 +268,17 @@ struct nck {
     _Atomic uint64_t pub_misses;
     _Atomic int64_t pub_lat_max_ns;
 
+    /* timing faults (inject.c, position loop only; the report is read once
+     * the loop has ended, or by the service after loop_fault) */
+    int inj_on, inj_timed;           /* anything configured; the plant models timing */
+    struct ncp_inject inj;
+    struct ncp_inject_rx rx;
+    struct ncp_inject_guard guard;
+    struct ncp_inject_ev inj_ev;
+    uint64_t real_misses_seen;
+    int timing_stop;                 /* a miss limit tripped: stop along the path */
+    struct ncp_inject_report inj_rep;
+
     /* events, oldest first (job thread and caller's thread post them) */
 #define NCK_EVENTS 256
     pthread_mutex_t ev_lock;
@@ -343,6 +356,16 @@ int nck_motion_done(const struct nck *n);
 /* loop.c: the position cycle (real-time path) */
 int nck_position_cycle(void *ctx, int64_t now_ns);
 
+/* inject.c: the servo's part of the position cycle under injected timing
+ * faults and the miss limits (real-time path) */
+void nck_inject_setup(struct nck *n);
+int nck_servo_cycle(struct nck *n, double act[NCP_AXES]);
+/* a stop for a miss limit is complete (the machine rests): serving NCK's fault */
+void nck_inject_rest(struct nck *n);
+void nck_inject_clear(struct nck *n);
+/* the serving NCK's error text for NCK_LF_TIMING */
+void nck_inject_describe(const struct nck *n, char *buf, size_t len);
+
 /* planner_thread.c */
 void *nck_planner_main(void *arg);
 
@@ -387,7 +410,7 @@ void nck_account(struct nck_summary *s, unsigned axis_mask, const struct nck_fb 
 int nck_read_cycles(struct nck *n);
 /* The trace's first row: the fixed columns, then cmd and act of each of
  * the machine's axes beyond X Y Z (axis_mask). */
-void nck_trace_header(FILE *trace, unsigned axis_mask);
+void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg);
 /* Writes the rows gathered so far. 0, or -1 when the write failed. */
 int nck_trace_flush(struct nck_summary *s, FILE *trace);
 

@@ -117,6 +117,11 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
         int m = (mask & ~NCP_AXES_XYZ) ? trace_more_axes(s->tbuf + at, sizeof s->tbuf - at - 1,
                                                          mask, fb)
                                        : 0;
+        if (m >= 0 && s->inject_col) {
+            at += (size_t)m;
+            s->tbuf[at++] = ',';
+            m = ncp_inject_format(&fb->inj, s->tbuf + at, sizeof s->tbuf - at - 1);
+        }
         if (m >= 0) {
             s->tbuf[at + (size_t)m] = '\n';
             s->tlen = at + (size_t)m + 1;
@@ -124,14 +129,18 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
     }
 }
 
-void nck_trace_header(FILE *trace, unsigned mask)
+void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg)
 {
+    unsigned mask = cfg->axis_mask;
     fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion,spindle_rpm,spindle_deg,mist,"
           "flood,dout,tool,wait", trace);
     for (int j = 3; j < NCP_AXES; j++)
         if (mask & NCP_AXIS_BIT(j))
             fprintf(trace, ",%c_cmd,%c_act", NCP_AXIS_LETTERS[j] | 0x20,
                     NCP_AXIS_LETTERS[j] | 0x20);
+    /* what was injected in the period: "-", or e.g. "miss+jit=12.500" */
+    if (cfg->inject.kinds)
+        fputs(",inject", trace);
     fputc('\n', trace);
     fflush(trace);
 }
@@ -228,6 +237,8 @@ void ncp_nck_print_summary(const struct ncp_nck_result *r, const char *prog, FIL
             (unsigned long long)r->lat.misses, (unsigned long long)r->lat.skipped,
             (unsigned long long)r->underruns, (unsigned long long)r->dry,
             (unsigned long long)r->starved);
+    if (r->inject_summary[0])
+        fprintf(f, "  %s\n", r->inject_summary);
     if (r->trace_dropped)
         fprintf(f, "  trace: %llu cycles dropped (the writer fell behind)\n",
                 (unsigned long long)r->trace_dropped);
