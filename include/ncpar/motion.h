@@ -9,14 +9,16 @@
 #include "ncpar/canon.h"
 #include "ncpar/diag.h"
 #include "ncpar/inject.h"
+#include "ncpar/kins.h"
 #include "ncpar/rt.h"
 
 /* The machine's axes, in LinuxCNC's order X Y Z A B C U V W. A machine has
  * the ones its [TRAJ] COORDINATES names (ncp_machine_cfg.axis_mask); the
  * others are absent: they never move and the trace leaves them out. Lengths
  * of A B C are degrees (velocities deg/s, accelerations deg/s^2).
- * A joint layer (kinematics) will sit between these planned axes and the
- * servo loop (src/nck/loop.c); with trivial kinematics joints are axes. */
+ * The joints (what the servos drive) come from the axes through the
+ * machine's kinematics (ncpar/kins.h, [KINS]) in the position loop; with
+ * trivial kinematics joints are axes. */
 #define NCP_AXES 9
 #define NCP_AXIS_LETTERS "XYZABCUVW"
 #define NCP_AXIS_A 3
@@ -90,6 +92,16 @@ struct ncp_io_cfg {
     double probe_plane_z;
 };
 
+/* [JOINT_n] (n: the place of the joint's letter in COORDINATES, from 0):
+ * the limits of what a servo drives, checked after the inverse kinematics.
+ * A joint without its section, or a key it leaves out, takes its axis's
+ * value. Stored by axis index (joint i drives axis i's letter). */
+struct ncp_joint_cfg {
+    double min_limit, max_limit;  /* mm (deg for A B C) */
+    double max_vel, max_acc;      /* mm/s, mm/s^2 */
+    double ferror;                /* following-error fault limit */
+};
+
 struct ncp_machine_cfg {
     double servo_period;          /* s ([EMCMOT] SERVO_PERIOD is in ns) */
     double max_linear_vel;        /* [TRAJ] MAX_LINEAR_VELOCITY */
@@ -123,6 +135,8 @@ struct ncp_machine_cfg {
     struct ncp_io_cfg io;
     /* [INJECT] and [RT]'s miss keys: timing faults, setpoint policy, miss limits */
     struct ncp_inject_cfg inject;
+    struct ncp_kins kins;         /* [KINS] KINEMATICS and the pivot offsets */
+    struct ncp_joint_cfg joint[NCP_AXES];
 };
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c);
@@ -167,6 +181,8 @@ struct ncp_seg {
     double merge_tol;      /* G64 Q, mm: the planner merges a run of nearly
                               collinear feed lines into one (0 = off) */
     double dwell;          /* s, NCP_SEG_DWELL only */
+    double tool_z;         /* G43's tool length (Z) in force, mm: the kinematics' tool
+                              offset for this segment's samples */
     /* arcs and helices: p(l) = c + r(l)(cos(A l) u + sin(A l) w) + n h l, l in [0,1],
      * in X Y Z; the other axes move linearly in l from start to end */
     double center[3], normal[3], u[3], w[3];
@@ -183,6 +199,34 @@ int ncp_seg_moves_other(const struct ncp_seg *s);
  * vector when the path runs along X Y Z. */
 void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                   double tangent[NCP_AXES]);
+
+/* ---- kinematics along segments (kins_seg.c) -------------------------------
+ * The planner works on axes; the joints follow through cfg->kins. These keep
+ * the joints within their [JOINT_n] limits along the path. */
+
+/* Every joint's limits from its axis's (the start of an INI load, and the
+ * built-in machine). */
+void ncp_machine_joints_from_axes(struct ncp_machine_cfg *c);
+/* Does the machine have non-trivial kinematics? */
+static inline int ncp_kins_active(const struct ncp_machine_cfg *c)
+{
+    return c->kins.type != NCP_KINS_TRIVIAL;
+}
+/* Samples s through the inverse kinematics: a joint beyond its MIN_LIMIT or
+ * MAX_LIMIT anywhere along it is -NCP_ERR_LIMIT with d naming joint, value
+ * and limit at s->line; else 0. */
+int ncp_kins_seg_check(const struct ncp_machine_cfg *c, const struct ncp_seg *s,
+                       struct ncp_diag *d);
+/* Lowers the path speed cap *vmax and acceleration *acc so that every
+ * joint keeps its MAX_VELOCITY and MAX_ACCELERATION along s (a quarter of
+ * the acceleration for the path's curvature in joint space, half for the
+ * path acceleration, the rest for corners: ncp_kins_junction_cap). */
+void ncp_kins_seg_caps(const struct ncp_machine_cfg *c, const struct ncp_seg *s, double *vmax,
+                       double *acc);
+/* The speed at the junction of a and b at which each joint's velocity step
+ * stays within share of its acceleration over one period. */
+double ncp_kins_junction_cap(const struct ncp_machine_cfg *c, const struct ncp_seg *a,
+                             const struct ncp_seg *b, double share, double period);
 
 /* ---- canonical calls -> segments ------------------------------------------- */
 
@@ -258,6 +302,7 @@ struct ncp_setpoint {
     uint32_t line;
     uint32_t flags;         /* enum ncp_sp_flags */
     uint32_t aux;           /* the segment's aux: machine functions due by this sample */
+    double tool_z;          /* the segment's tool_z */
 };
 
 enum ncp_sp_flags { NCP_SP_END = 1u, NCP_SP_STARVED = 2u };

@@ -188,8 +188,10 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                   const struct ncp_nck_result *res)
 {
     if (res->limit_violation) {
-        fprintf(stderr, "%s:%u: error: %s (checked before motion: nothing moved)\n", o->prog,
-                res->diag.line, res->diag.msg);
+        /* the machine's limits are a block's, not a word's: column 1 */
+        fprintf(stderr, "%s:%u:%u: error: %s (checked before motion: nothing moved)\n",
+                res->diag.file ? res->diag.file : o->prog, res->diag.line,
+                res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
         return RUN_FAULT;
     }
     if (res->refused) {

@@ -58,6 +58,7 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
     arc->term = NCP_TERM_CONTINUOUS;
     arc->traverse = (uint8_t)(prev->traverse && cur->traverse);
     arc->line = cur->line;  /* the corner is where the next block's motion begins */
+    arc->tool_z = prev->tool_z;
     arc->aux = prev->aux;   /* what comes with the next block waits for its own segment */
     arc->feed = fmin(prev->feed, cur->feed);
     arc->blend_feed = fmin(prev->blend_feed > 0 ? prev->blend_feed : prev->feed,

@@ -154,6 +154,7 @@ static void seg_common(const struct ncp_canon_map *m, struct ncp_seg *s, uint32_
     s->tolerance = m->tolerance;
     s->merge_tol = m->term == NCP_TERM_CONTINUOUS ? m->merge_tol : 0;
     memcpy(s->start, m->pos, sizeof s->start);
+    s->tool_z = m->tool[2];
 }
 
 /* The spindle's speed (rpm) with the tool at machine X = x_mm: under G96 the
@@ -253,6 +254,8 @@ static int line_to(struct ncp_canon_map *m, const double end_mm[NCP_AXES], int t
     int r = check_point(m, s->end, line, d);
     if (r)
         return -r;
+    if ((r = ncp_kins_seg_check(m->cfg, s, d)) != 0)
+        return r;
     memcpy(m->pos, s->end, sizeof m->pos);
     return 1;
 }
@@ -455,6 +458,8 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     int r = check_arc(m, s, d);
     if (r)
         return -r;
+    if ((r = ncp_kins_seg_check(m->cfg, s, d)) != 0)
+        return r;
     memcpy(m->pos, s->end, sizeof m->pos);
     return 1;
 }

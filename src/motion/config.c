@@ -2,6 +2,7 @@
  * machine file must not silently fall back to a default. */
 #include "ncpar/motion.h"
 #include "ini_num.h"
+#include "kins_cfg.h"
 
 #include <errno.h>
 #include <ini.h>
@@ -51,6 +52,7 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     ncp_inject_cfg_default(&c->inject);
     snprintf(c->lcm.prefix, sizeof c->lcm.prefix, "NCP_");
     c->lcm.status_hz = 50.0;
+    ncp_machine_joints_from_axes(c);
 }
 
 /* The safety keys every axis must state: a machine must never run on a limit
@@ -74,9 +76,10 @@ struct load_ctx {
     unsigned profile_line;
     unsigned coords_line;       /* [TRAJ] COORDINATES, 0 = not given (XYZ) */
     char coords[16];            /* as the file wrote it */
+    struct kins_load kl;        /* [KINS], [JOINT_n] */
     struct seen { char sec[16], key[32]; unsigned line; } seen[MAX_SEEN];
     int n_seen;
-    struct { char name[16]; unsigned line; } sections[24];
+    struct { char name[16]; unsigned line; } sections[40];
     int n_sections;
 };
 
@@ -389,7 +392,7 @@ static int known_section(const char *sec)
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcasecmp(sec, names[i]))
             return 1;
-    return axis_index(sec) >= 0;
+    return axis_index(sec) >= 0 || !strcasecmp(sec, "KINS") || ncp_kins_joint_section(sec) >= 0;
 }
 
 static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const char *v,
@@ -441,6 +444,9 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
         return ncp_inject_ini_key(&c->inject, sec, k, v, why, len);
     if (!strcasecmp(sec, "CAN"))
         return can_key(&c->can, k, v, why, len);
+    int r = ncp_kins_cfg_key(&lc->kl, c, sec, k, v, lc->line, why, len);
+    if (r != -2)
+        return r;
     return ncp_io_cfg_key(&c->io, sec, k, v, why, len);
 }
 
@@ -627,6 +633,16 @@ static int check_cfg(struct load_ctx *lc)
     return 0;
 }
 
+static int check_kins(struct load_ctx *lc)
+{
+    char msg[NCP_DIAG_MSG_MAX - 64];
+    unsigned line = 0;
+    if (ncp_kins_cfg_finish(&lc->kl, lc->c, lc->coords_line ? lc->coords : "XYZ", msg,
+                            sizeof msg, &line) == 0)
+        return 0;
+    return fail_at(lc, line, "%s", msg), -1;
+}
+
 int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp_diag *d)
 {
     memset(d, 0, sizeof *d);
@@ -654,8 +670,8 @@ int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp
             fail_at(lc, (unsigned)r, "expected 'KEY = VALUE' or '[SECTION]'");
         else if (r < 0 || (!lc->failed && ferror(lc->f)))
             fail_at(lc, 0, "cannot read: %s", strerror(errno));
-        if (!lc->failed && check_axes(lc) == 0)
-            check_cfg(lc);
+        if (!lc->failed && check_axes(lc) == 0 && check_cfg(lc) == 0)
+            check_kins(lc);
         rc = lc->failed ? d->code : NCP_OK;
     }
     if (lc->f)

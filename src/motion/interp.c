@@ -30,6 +30,7 @@ static void start_head(struct ncp_planner *p)
     p->active = 1;
     p->line = ps->s.line;
     p->aux = ps->s.aux;
+    p->tool_z = ps->s.tool_z;
 }
 
 static void sample(struct ncp_planner *p, struct ncp_setpoint *out)
@@ -69,6 +70,7 @@ int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out)
             memcpy(out->pos, p->pos, sizeof out->pos);
             out->line = p->line;
             out->aux = p->aux;
+            out->tool_z = p->tool_z;
             if (p->finished) {
                 out->flags = NCP_SP_END;
                 return 0;
@@ -97,6 +99,7 @@ int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out)
     memcpy(out->pos, p->pos, sizeof out->pos);
     out->line = p->line;
     out->aux = p->aux;
+    out->tool_z = p->tool_z;
     if (stopped_at_end) {
         ncp_planner_pop(p);
         p->active = 0;

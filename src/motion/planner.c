@@ -316,6 +316,8 @@ static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
             v = fmin(v, 0.5 * p->cfg.axis[j].max_jerk * p->cfg.servo_period *
                             p->cfg.servo_period / dj);
     }
+    /* the joints turn their own corners under non-trivial kinematics */
+    v = fmin(v, ncp_kins_junction_cap(&p->cfg, prev, &cur->s, beta, p->cfg.servo_period));
     if (dmax <= 1e-9)
         return v;
     if (prev->term == NCP_TERM_EXACT_PATH)
@@ -369,6 +371,10 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
         ps->acc = fmin(ps->acc, p->cfg.default_linear_acc);
         ps->a_cap = fmin(ps->a_cap, p->cfg.default_linear_acc);
     }
+    double acc_axes = ps->acc;
+    ncp_kins_seg_caps(&p->cfg, &ps->s, &ps->vmax, &ps->acc);
+    if (ps->acc < acc_axes)  /* the joints' limit: no speed-dependent share above it */
+        ps->a_cap = fmin(ps->a_cap, ps->acc);
     ps->acc_full = ps->acc;
     ps->vjunc = 0;
     if (!p->have_last)

@@ -40,6 +40,7 @@ struct ncp_planner {
     double pos[NCP_AXES];
     uint32_t line;
     uint32_t aux;            /* the executing segment's machine functions (ncp_seg.aux) */
+    double tool_z;           /* and its tool length (ncp_seg.tool_z) */
     int have_last;           /* last_pushed valid: junctions need the previous segment */
     struct ncp_seg last_pushed;
     double last_vmax;        /* its cruise cap */

@@ -427,6 +427,7 @@ int ncp_scaler_step(struct ncp_scaler *s, double target, struct ncp_spsc *ring,
     out->v = s->r * (s->a.v + f * (s->b.v - s->a.v));
     const struct ncp_setpoint *near = f < 0.5 ? &s->a : &s->b;
     out->line = near->line;
+    out->tool_z = near->tool_z;
     /* machine functions are due once the read position leaves a towards b */
     out->aux = f <= 0 ? s->a.aux : s->b.aux;
     out->flags = (f <= 0 ? s->a.flags : f >= 1 ? s->b.flags : 0) & ~(uint32_t)NCP_SP_MOTION_MASK;

@@ -169,7 +169,8 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o)
     int64_t last_print = 0;
     if (o->trace) {
         errno = 0;
-        nck_trace_header(o->trace, n->cfg);
+        n->sum.joints = ncp_kins_active(n->cfg);
+        nck_trace_header(o->trace, n->cfg, n->sum.joints);
         if (ferror(o->trace))
             n->sum.trace_errno = errno ? errno : EIO;
     }
@@ -264,6 +265,12 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
         res->fault_axis = n->fault_axis;
         res->fault_err = n->fault_err;
         res->fault_line = n->fault_line;
+        res->status = NCP_NCK_FAULT;
+    } else if (fault == NCK_LF_JOINT) {
+        ncp_diag_set(&res->diag, NCP_ERR_LIMIT, n->fault_line, 0,
+                     "joint limit: the %c joint was commanded to %.4f, beyond [%.4f, %.4f]; "
+                     "servo stopped", NCP_AXIS_LETTERS[n->fault_axis], n->fault_err,
+                     n->cfg->joint[n->fault_axis].min_limit, n->cfg->joint[n->fault_axis].max_limit);
         res->status = NCP_NCK_FAULT;
     } else if (n->inj_rep.trip) {
         /* a miss limit stopped the machine along the path */

@@ -661,6 +661,12 @@ static void check_fault(struct ncp_nck *s)
                  n->fault_line);
     else if (f == NCK_LF_TIMING)
         nck_inject_describe(n, s->error, sizeof s->error);
+    else if (f == NCK_LF_JOINT)
+        snprintf(s->error, sizeof s->error,
+                 "joint limit: the %c joint was commanded to %.4f, beyond [%.4f, %.4f] (line %u); "
+                 "drives off", NCP_AXIS_LETTERS[n->fault_axis], n->fault_err,
+                 n->cfg->joint[n->fault_axis].min_limit, n->cfg->joint[n->fault_axis].max_limit,
+                 n->fault_line);
     else {
         char why[NCP_DIAG_MSG_MAX];
         n->be.ops->describe_fault(&n->be, why, sizeof why);
@@ -729,8 +735,9 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->acfg.instance = NULL;
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
+    n->sum.joints = ncp_kins_active(setup->cfg);
     if (setup->trace)
-        nck_trace_header(setup->trace, setup->cfg);
+        nck_trace_header(setup->trace, setup->cfg, n->sum.joints);
     if (!s->interp || nck_start(n, setup, 0, d) || nck_start_loop(n, d)) {
         ncp_nck_free(s);
         return NULL;

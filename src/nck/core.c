@@ -24,13 +24,17 @@ static int start_backend(struct nck *n, struct ncp_diag *d)
                      n->be.ops->name);
         return -1;
     }
-    if (n->be.ops->start(&n->be, n->start) != 0) {
+    /* the backend reports its joints; the machine starts from the tool tip
+     * they put in the work (no tool length yet) */
+    double joints[NCP_AXES];
+    if (n->be.ops->start(&n->be, joints) != 0) {
         char why[NCP_DIAG_MSG_MAX];
         n->be.ops->describe_fault(&n->be, why, sizeof why);
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "%s", why);
         n->be.ops->stop(&n->be);
         return -1;
     }
+    ncp_kins_forward(&n->cfg->kins, 0.0, joints, n->start);
     n->be_started = 1;
     n->drives_on = n->be.ops->enable == NULL;
     return 0;

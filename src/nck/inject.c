@@ -38,10 +38,11 @@ static void trip(struct nck *n, int why, uint64_t k)
     n->inj_rep.trip_in_window = n->guard.in_window;
 }
 
-int nck_servo_cycle(struct nck *n, double act[NCP_AXES])
+int nck_servo_cycle(struct nck *n, const double cmd[NCP_AXES], const double next[NCP_AXES],
+                    double act[NCP_AXES])
 {
     if (!n->inj_on)
-        return n->be.ops->cycle(&n->be, n->cur.pos, n->next.pos, act);
+        return n->be.ops->cycle(&n->be, cmd, next, act);
     uint64_t k = (uint64_t)llround((double)n->now_ns / (double)n->loop.cfg.period_ns);
     struct ncp_inject_ev *ev = &n->inj_ev;
     ncp_inject_period(&n->inj, k, ev);
@@ -52,7 +53,7 @@ int nck_servo_cycle(struct nck *n, double act[NCP_AXES])
         n->inj_rep.count[b] += (ev->what >> b) & 1u;
     int arrived = !(ev->what & (NCP_INJ_MISS | NCP_INJ_LOSE_SP));
     double use[NCP_AXES], use_next[NCP_AXES];
-    ncp_inject_rx_take(&n->rx, (int64_t)k, arrived, n->cur.pos, n->next.pos,
+    ncp_inject_rx_take(&n->rx, (int64_t)k, arrived, cmd, next,
                        ev->sample_s / n->cfg->servo_period, NCP_AXES, use, use_next);
     n->be.timing = n->inj_timed ? ev : NULL;
     int rc = n->be.ops->cycle(&n->be, use, use_next, act);

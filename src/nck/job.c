@@ -127,6 +127,7 @@ void nck_line(const struct nck *n, struct ncp_seg *s, const double from[NCP_AXES
     memcpy(s->end, to, sizeof s->end);
     ncp_seg_set_length(s);
     s->feed = traverse ? n->cfg->max_linear_vel : feed;
+    s->tool_z = n->map.tool[2];
 }
 
 /* ---- single block ------------------------------------------------------------- */

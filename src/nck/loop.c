@@ -10,11 +10,14 @@
 
 #define SETTLE_CYCLES 100          /* batch: hold after the end so the plant settles */
 
-static int check_ferror(struct nck *n, const double act[NCP_AXES])
+/* Each servo's following error: per joint (the axes are joints under
+ * trivkins, and keep their own FERROR there). */
+static int check_ferror(struct nck *n)
 {
+    int kins = ncp_kins_active(n->cfg);
     for (int j = 0; j < NCP_AXES; j++) {
-        double e = fabs(n->cur.pos[j] - act[j]);
-        if (e > n->cfg->axis[j].ferror) {
+        double e = fabs(n->jcmd[j] - n->jact[j]);
+        if (e > (kins ? n->cfg->joint[j].ferror : n->cfg->axis[j].ferror)) {
             n->fault_axis = j;
             n->fault_err = e;
             n->fault_line = n->cur.line;
@@ -22,6 +25,42 @@ static int check_ferror(struct nck *n, const double act[NCP_AXES])
         }
     }
     return 0;
+}
+
+/* The guard behind the check before motion: a joint commanded beyond its
+ * limit (a path the sampling missed, a jog) stops the machine. */
+static int check_joint_limits(struct nck *n)
+{
+    if (!ncp_kins_active(n->cfg))
+        return 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        const struct ncp_joint_cfg *jc = &n->cfg->joint[j];
+        if (!(n->cfg->axis_mask & NCP_AXIS_BIT(j)) || n->cfg->axis[j].wrapped)
+            continue;
+        /* the check before motion samples the path: allow its chord */
+        if (n->jcmd[j] < jc->min_limit - 1e-3 || n->jcmd[j] > jc->max_limit + 1e-3) {
+            n->fault_axis = j;
+            n->fault_err = n->jcmd[j];
+            n->fault_line = n->cur.line;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* The servos drive joints: this period's and the next one's axes through
+ * the inverse kinematics, the actual joints back through the forward one
+ * (the probe, the trace's axes and the contour error see the tool tip). */
+static int drive(struct nck *n, double act[NCP_AXES], int with_faults)
+{
+    const struct ncp_kins *k = &n->cfg->kins;
+    ncp_kins_inverse(k, n->cur.tool_z, n->cur.pos, n->jcmd);
+    ncp_kins_inverse(k, n->next.tool_z, n->next.pos, n->jnext);
+    /* timing faults act on what the servos get: the joints */
+    int rc = with_faults ? nck_servo_cycle(n, n->jcmd, n->jnext, n->jact)
+                         : n->be.ops->cycle(&n->be, n->jcmd, n->jnext, n->jact);
+    ncp_kins_forward(k, n->cur.tool_z, n->jact, act);
+    return rc;
 }
 
 /* Live feed override relative to the override the plan was made at; feed hold
@@ -171,6 +210,9 @@ static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES]
     memcpy(fb.act, act, sizeof fb.act);
     fb.inj = n->inj_ev;
     memset(&n->inj_ev, 0, sizeof n->inj_ev);
+    memcpy(fb.jcmd, n->jcmd, sizeof fb.jcmd);
+    memcpy(fb.jact, n->jact, sizeof fb.jact);
+    fb.tool_z = n->cur.tool_z;
     const struct nck_mach *m = &n->mach;
     fb.rpm = m->rpm;
     fb.rev = m->rev;
@@ -208,7 +250,8 @@ static int frozen_cycle(struct nck *n, int64_t now_ns)
     }
     double act[NCP_AXES];
     n->be.timing = NULL;
-    n->be.ops->cycle(&n->be, n->cur.pos, n->cur.pos, act);
+    n->next = n->cur;
+    (void)drive(n, act, 0);
     nck_inject_clear(n);
     n->mach.rpm_cmd = 0;   /* E-stop and faults stop the spindle too */
     (void)nck_aux_cycle(n);
@@ -245,7 +288,7 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
     if (take_setpoint(n) == NCP_RT_RETRY)
         return NCP_RT_RETRY;
     double act[NCP_AXES];
-    int be_rc = nck_servo_cycle(n, act);
+    int be_rc = drive(n, act, 1);
     nck_probe_cycle(n, act);
     track_blocks(n);
     push_cycle(n, now_ns, act);
@@ -259,7 +302,8 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
      * ends motion: a batch run's loop stops (the backend's stop() then brings
      * every axis to a controlled stop); a serving NCK freezes its setpoints
      * and turns its drives off until reset, as LinuxCNC does. */
-    int fault = be_rc != 0 ? NCK_LF_BACKEND : check_ferror(n, act) ? NCK_LF_FERROR : NCK_LF_NONE;
+    int fault = be_rc != 0 ? NCK_LF_BACKEND : check_ferror(n) ? NCK_LF_FERROR
+                : check_joint_limits(n) ? NCK_LF_JOINT : NCK_LF_NONE;
     if (fault) {
         if (fault == NCK_LF_BACKEND)
             n->fault_line = n->cur.line;

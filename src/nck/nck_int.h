@@ -116,6 +116,8 @@ struct nck_probe {
 struct nck_fb {
     double t, v;
     double cmd[NCP_AXES], act[NCP_AXES];
+    double jcmd[NCP_AXES], jact[NCP_AXES];  /* the joints (= cmd, act under trivkins) */
+    double tool_z;                          /* the kinematics' tool length */
     uint32_t line;
     uint32_t flags;          /* the setpoint's (NCP_SP_RAPID / NCP_SP_ARC for the trace) */
     /* the machine functions */
@@ -146,9 +148,12 @@ struct nck_summary {
     size_t tlen;
     int trace_errno;         /* the first failed write's errno, 0 = none */
     int inject_col;          /* the trace has the inject column */
+    int joints;              /* the trace has joint columns (non-trivial kinematics) */
 };
 
-enum nck_loop_fault { NCK_LF_NONE, NCK_LF_FERROR, NCK_LF_BACKEND, NCK_LF_TIMING };
+/* NCK_LF_TIMING: a miss limit tripped; NCK_LF_JOINT: a joint commanded
+ * beyond its limit (fault_axis the joint, fault_err the position) */
+enum nck_loop_fault { NCK_LF_NONE, NCK_LF_FERROR, NCK_LF_BACKEND, NCK_LF_TIMING, NCK_LF_JOINT };
 
 enum nck_job_kind { NCK_JOB_NONE, NCK_JOB_PROGRAM, NCK_JOB_MDI, NCK_JOB_MOVE };
 
@@ -250,6 +255,7 @@ struct nck {
 
     /* position loop: its thread only, except the atomics */
     struct ncp_setpoint cur, next;
+    double jcmd[NCP_AXES], jnext[NCP_AXES], jact[NCP_AXES];  /* cur, next, actual as joints */
     struct ncp_scaler scaler;
     double decel_normal, decel_full;
     int slowing;
@@ -359,7 +365,8 @@ int nck_position_cycle(void *ctx, int64_t now_ns);
 /* inject.c: the servo's part of the position cycle under injected timing
  * faults and the miss limits (real-time path) */
 void nck_inject_setup(struct nck *n);
-int nck_servo_cycle(struct nck *n, double act[NCP_AXES]);
+int nck_servo_cycle(struct nck *n, const double cmd[NCP_AXES], const double next[NCP_AXES],
+                    double act[NCP_AXES]);
 /* a stop for a miss limit is complete (the machine rests): serving NCK's fault */
 void nck_inject_rest(struct nck *n);
 void nck_inject_clear(struct nck *n);
@@ -410,7 +417,7 @@ void nck_account(struct nck_summary *s, unsigned axis_mask, const struct nck_fb 
 int nck_read_cycles(struct nck *n);
 /* The trace's first row: the fixed columns, then cmd and act of each of
  * the machine's axes beyond X Y Z (axis_mask). */
-void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg);
+void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints);
 /* Writes the rows gathered so far. 0, or -1 when the write failed. */
 int nck_trace_flush(struct nck_summary *s, FILE *trace);
 

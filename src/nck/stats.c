@@ -67,6 +67,26 @@ static int trace_more_axes(char *buf, size_t len, unsigned mask, const struct nc
     return (int)at;
 }
 
+/* The joints, after everything else, under non-trivial kinematics: the
+ * tool length the transform used, then what the servos were told and did,
+ * to compute the tool tip back from. */
+static int trace_joints(char *buf, size_t len, unsigned mask, const struct nck_fb *fb)
+{
+    int k0 = snprintf(buf, len, ",%.6f", fb->tool_z);
+    if (k0 < 0 || (size_t)k0 >= len)
+        return -1;
+    size_t at = (size_t)k0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        if (!(mask & NCP_AXIS_BIT(j)))
+            continue;
+        int k = snprintf(buf + at, len - at, ",%.6f,%.6f", fb->jcmd[j], fb->jact[j]);
+        if (k < 0 || (size_t)k >= len - at)
+            return -1;
+        at += (size_t)k;
+    }
+    return (int)at;
+}
+
 void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, FILE *trace)
 {
     double e2 = 0;
@@ -117,6 +137,12 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
         int m = (mask & ~NCP_AXES_XYZ) ? trace_more_axes(s->tbuf + at, sizeof s->tbuf - at - 1,
                                                          mask, fb)
                                        : 0;
+        if (m >= 0 && s->joints) {
+            int mj = trace_joints(s->tbuf + at + (size_t)m, sizeof s->tbuf - at - (size_t)m - 1,
+                                  mask, fb);
+            m = mj < 0 ? -1 : m + mj;
+        }
+        /* the inject column comes last */
         if (m >= 0 && s->inject_col) {
             at += (size_t)m;
             s->tbuf[at++] = ',';
@@ -129,7 +155,7 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
     }
 }
 
-void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg)
+void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints)
 {
     unsigned mask = cfg->axis_mask;
     fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion,spindle_rpm,spindle_deg,mist,"
@@ -137,6 +163,12 @@ void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg)
     for (int j = 3; j < NCP_AXES; j++)
         if (mask & NCP_AXIS_BIT(j))
             fprintf(trace, ",%c_cmd,%c_act", NCP_AXIS_LETTERS[j] | 0x20,
+                    NCP_AXIS_LETTERS[j] | 0x20);
+    if (joints)
+        fputs(",tool_z", trace);
+    for (int j = 0; j < NCP_AXES && joints; j++)
+        if (mask & NCP_AXIS_BIT(j))
+            fprintf(trace, ",j%c_cmd,j%c_act", NCP_AXIS_LETTERS[j] | 0x20,
                     NCP_AXIS_LETTERS[j] | 0x20);
     /* what was injected in the period: "-", or e.g. "miss+jit=12.500" */
     if (cfg->inject.kinds)
