@@ -35,9 +35,13 @@ static int take_seg(struct nck *n, const struct ncp_seg *s);
 /* The pack gathered so far goes to the position loop; one that waits for
  * motion is announced by an AUX stop, one that goes with motion rides on the
  * next segment (push_seg numbers it). */
+static int sync_flush(struct nck *n);
+
 static int aux_flush(struct nck *n)
 {
     struct nck_job *j = &n->job;
+    if (sync_flush(n))
+        return -1;
     if (j->aux.n == 0)
         return 0;
     j->aux.seq = ++n->aux_seq;
@@ -61,7 +65,7 @@ static int aux_add(struct nck *n, int kind, int idx, int32_t i, double v, uint32
                    int stop)
 {
     struct nck_job *j = &n->job;
-    if (j->aux.n == NCK_AUX_PACK && aux_flush(n))
+    if ((j->aux.n == NCK_AUX_PACK || j->run.n > 0) && aux_flush(n))
         return -1;
     struct nck_aux *a = &j->aux.a[j->aux.n++];
     memset(a, 0, sizeof *a);
@@ -94,9 +98,79 @@ static int push_mark(struct nck *n, int kind)
     return 0;
 }
 
+/* ---- spindle-synchronised runs ----------------------------------------------------- */
+
+/* The run gathered so far goes to the position loop (sync ring), with the
+ * action that starts it after a stop at its start; the planner goes on
+ * from its end. */
+static int sync_flush(struct nck *n)
+{
+    struct nck_job *j = &n->job;
+    if (j->run.n == 0)
+        return 0;
+    while (ncp_spsc_push(&n->syncq, &j->run) != 0) {
+        if (atomic_load(&j->abort))
+            return -1;
+        nap_us(100);
+    }
+    const struct nck_sync_run *r = &j->run;
+    double end[NCP_AXES];
+    memcpy(end, r->tap ? r->start : r->l[r->n - 1].end, sizeof end);
+    uint32_t line = r->l[0].line;
+    j->run.n = 0;
+    /* what was gathered before the run happens before it */
+    if (j->aux.n == NCK_AUX_PACK && aux_flush(n))
+        return -1;
+    struct nck_aux *a = &j->aux.a[j->aux.n++];
+    memset(a, 0, sizeof *a);
+    a->kind = NCK_AUX_SYNC;
+    a->line = line;
+    j->aux.seq = ++n->aux_seq;
+    while (ncp_spsc_push(&n->auxq, &j->aux) != 0) {
+        if (atomic_load(&j->abort))
+            return -1;
+        nap_us(100);
+    }
+    j->aux.n = 0;
+    j->aux_stop = 0;
+    struct nck_seg_msg m;
+    memset(&m, 0, sizeof m);
+    m.kind = NCK_MSG_AUX;
+    m.aux = n->aux_seq;
+    m.jump = 1;
+    memcpy(m.seg.end, end, sizeof m.seg.end);
+    n->job.seen_motion = 1;
+    return push_wait(n, &m);
+}
+
+/* A synchronised line joins the run being gathered (a rigid tap is a run
+ * of its own; its way out is the loop's). */
+static int sync_add(struct nck *n, const struct ncp_seg *s)
+{
+    struct nck_job *j = &n->job;
+    if (s->sync == NCP_SYNC_TAP_OUT)
+        return 0;
+    if ((j->run.n == NCK_SYNC_LINES || j->run.tap || s->sync == NCP_SYNC_TAP) && sync_flush(n))
+        return -1;
+    /* the run waits for the spindle itself (at speed, then the index) */
+    j->need_at_speed = 0;
+    if (j->run.n == 0) {
+        memcpy(j->run.start, s->start, sizeof j->run.start);
+        j->run.tap = s->sync == NCP_SYNC_TAP;
+    }
+    struct nck_sync_line *l = &j->run.l[j->run.n++];
+    memcpy(l->end, s->end, sizeof l->end);
+    l->len = s->length;
+    l->pitch = s->pitch;
+    l->line = s->line;
+    return 0;
+}
+
 static int push_seg(struct nck *n, const struct ncp_seg *s)
 {
     struct nck_job *j = &n->job;
+    if (s->sync)
+        return sync_add(n, s);
     /* LinuxCNC's at-speed: the first feed after a spindle start or speed
      * change starts once the spindle has reached its speed */
     if (j->need_at_speed && !s->traverse && s->kind != NCP_SEG_DWELL) {
@@ -569,6 +643,8 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
             j->map_failed = 1;
             return 1;
         }
+        if (op->kind == NCP_C_STOP_SPEED_FEED_SYNCH && sync_flush(n))
+            return 1;
         int after_pallet = i > 0 && cmd->ops[i - 1].kind == NCP_C_PALLET_SHUTTLE;
         if ((!j->from_line || j->reached) && take_aux(n, cmd, op, after_pallet))
             return 1;
@@ -640,6 +716,7 @@ int nck_job_start(struct nck *n)
     j->aux.n = 0;
     j->aux_stop = 0;
     j->need_at_speed = 0;
+    j->run.n = 0;
     atomic_store(&j->busters_done, 0);
     j->busters_asked = 0;
     atomic_store(&j->emit_stopped, 0);
