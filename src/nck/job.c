@@ -511,7 +511,7 @@ static int take_seg(struct nck *n, const struct ncp_seg *s)
 
 /* ---- queue busters ----------------------------------------------------------------- */
 
-/* A probe move or an M66 was sent: run the motion so far to a stop, wait
+/* A probe move, an M66 or an M6 was sent: run the motion so far to a stop, wait
  * until the machine is there, and answer the interpreter with what the
  * machine found. The interpreter makes no command after the buster until
  * it has the answer, so this thread waits for nothing it has yet to send. */
@@ -527,6 +527,13 @@ static int buster(struct nck *n, const struct ncp_cmd *cmd, const struct ncp_can
         nap_us(200);
     }
     struct ncp_machine_sync *ms = &j->answer;
+    if (op->kind == NCP_C_CHANGE_TOOL) {
+        /* where the change left the axes (the change position, or where
+         * they were): the next block's position and #5420.. */
+        ncp_canon_map_to_program(&n->map, n->map.pos, ms->pos);
+        ms->what |= NCP_SYNC_POSITION;
+        return 0;
+    }
     if (op->kind == NCP_C_WAIT_INPUT) {
         ms->what |= NCP_SYNC_INPUT;
         ms->input = n->mach.m66_result;
@@ -577,7 +584,8 @@ static int machine_sync(void *ctx, struct ncp_machine_sync *ms)
 
 static int is_buster(const struct ncp_canon *op)
 {
-    return op->kind == NCP_C_STRAIGHT_PROBE || op->kind == NCP_C_WAIT_INPUT;
+    return op->kind == NCP_C_STRAIGHT_PROBE || op->kind == NCP_C_WAIT_INPUT ||
+           op->kind == NCP_C_CHANGE_TOOL;
 }
 
 static int emit_segments(void *ctx, const struct ncp_cmd *cmd);
@@ -611,6 +619,7 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
     }
     int seen = j->seen_motion;
     j->seen_motion = 0;
+    int busted = 0;
     struct ncp_seg seg;
     for (unsigned i = 0; i < cmd->n_ops; i++) {
         const struct ncp_canon *op = &cmd->ops[i];
@@ -657,10 +666,13 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
                 }
                 return 1;
             }
-            atomic_fetch_add_explicit(&j->busters_done, 1, memory_order_release);
+            busted = 1;
         }
         n->calls_acted[kind]++;
     }
+    /* the interpreter asks once for a block's busters, whatever their number */
+    if (busted)
+        atomic_fetch_add_explicit(&j->busters_done, 1, memory_order_release);
     if (n->post_prints) {   /* a serving NCK's status shows it */
         pthread_mutex_lock(&n->ev_lock);
         n->io.interp_line = cmd->line;
