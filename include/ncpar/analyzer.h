@@ -64,20 +64,21 @@ struct ncp_analyzer_cfg {
 };
 
 /* Queue busters. The interpreter runs far ahead of motion; after a G38.x
- * probe or an M66 it cannot know the machine's result. When the run's
+ * probe, an M66 or an M6 (which may move to the tool change position) it
+ * cannot know the machine's result. When the run's
  * output is a machine (ncp_output.sync), the analyzer stops at the first
  * read after such a call (the next block, or a parameter read on an O-word
  * line), hands on every command made so far and asks the machine, which
  * answers once its motion up to the call has finished. Without a machine
  * (parse, check) nothing waits and rs274 -g's stand-in values hold. */
-enum ncp_sync_what { NCP_SYNC_PROBE = 1, NCP_SYNC_INPUT = 2 };
+enum ncp_sync_what { NCP_SYNC_PROBE = 1, NCP_SYNC_INPUT = 2, NCP_SYNC_POSITION = 4 };
 struct ncp_machine_sync {
     int what;                  /* enum ncp_sync_what bits the machine filled */
     /* a probe, in program coordinates and units: the trip point (#5061..),
      * whether it tripped (#5070) and where the axes came to rest */
     double probed[6];
     int tripped;
-    double pos[3];
+    double pos[3];             /* (and after an M6: NCP_SYNC_POSITION) */
     double input;              /* M66: #5399 */
 };
 /* Returns 0 with ms filled, or non-zero when the run is being stopped. */

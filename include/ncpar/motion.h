@@ -159,6 +159,12 @@ enum ncp_seg_kind { NCP_SEG_LINE, NCP_SEG_ARC, NCP_SEG_DWELL };
 
 enum ncp_seg_term { NCP_TERM_STOP, NCP_TERM_EXACT_PATH, NCP_TERM_CONTINUOUS };
 
+/* Spindle-synchronised moves: a thread line (G33, G76), a rigid tap's way
+ * in (G33.1) and its way back out (the NCK's position loop reverses the
+ * spindle and follows it back; the map makes the segment for the path's
+ * sake: soft limits, the time estimate). */
+enum ncp_seg_sync { NCP_SYNC_NONE, NCP_SYNC_THREAD, NCP_SYNC_TAP, NCP_SYNC_TAP_OUT };
+
 struct ncp_seg {
     uint8_t kind;          /* enum ncp_seg_kind */
     uint8_t term;          /* enum ncp_seg_term: how this segment ends */
@@ -166,6 +172,9 @@ struct ncp_seg {
     /* length (and feed) measured along A B C, in degrees: a move of rotary
      * axes only (LinuxCNC's rule: along X Y Z when they move) */
     uint8_t angular;
+    /* enum ncp_seg_sync: a move tied to the spindle's angle (G33, G76's
+     * passes, G33.1), which the position loop runs itself */
+    uint8_t sync;
     uint32_t line;         /* source line */
     /* The machine functions sent before this segment (NCK): the sequence
      * number of the last, applied when its samples are reached. */
@@ -183,6 +192,10 @@ struct ncp_seg {
     double dwell;          /* s, NCP_SEG_DWELL only */
     double tool_z;         /* G43's tool length (Z) in force, mm: the kinematics' tool
                               offset for this segment's samples */
+    double pitch;          /* sync: mm along the path per spindle turn */
+    /* G95: the spindle speed (rpm) feed was planned for; the position loop
+     * scales the path speed by the actual speed over it (0: not per turn) */
+    double rev_rpm;
     /* arcs and helices: p(l) = c + r(l)(cos(A l) u + sin(A l) w) + n h l, l in [0,1],
      * in X Y Z; the other axes move linearly in l from start to end */
     double center[3], normal[3], u[3], w[3];
@@ -303,12 +316,16 @@ struct ncp_setpoint {
     uint32_t flags;         /* enum ncp_sp_flags */
     uint32_t aux;           /* the segment's aux: machine functions due by this sample */
     double tool_z;          /* the segment's tool_z */
+    double rev_rpm;         /* the segment's (G95: the speed the feed was planned for) */
 };
 
 enum ncp_sp_flags { NCP_SP_END = 1u, NCP_SP_STARVED = 2u };
 /* What kind of move a setpoint lies on (trace column `motion`, the plot):
  * neither bit = a feed (G1, a G64 corner blend, a dwell, rest). */
 enum ncp_sp_motion { NCP_SP_RAPID = 4u, NCP_SP_ARC = 8u };
+/* A sample the position loop made itself, following the spindle (G33,
+ * G33.1, G76): never in the planner's stream. */
+#define NCP_SP_SYNC 16u
 #define NCP_SP_MOTION_MASK (NCP_SP_RAPID | NCP_SP_ARC)
 
 struct ncp_planner;
@@ -416,6 +433,11 @@ void ncp_scaler_rebase(struct ncp_scaler *s, const double pos[NCP_AXES]);
 /* The stream comes every ratio periods: read it through quintic Hermite
  * interpolation on the samples' velocities and accelerations (see scaler.c). */
 void ncp_scaler_set_ratio(struct ncp_scaler *s, int ratio);
+/* The stream jumps by delta at the stop the read position sits on (a run
+ * the position loop moved itself, src/nck/sync.c, ends there): that sample,
+ * those before it and the outputs remembered move by delta, the samples
+ * after it (planned from the new place) stay. */
+void ncp_scaler_jump(struct ncp_scaler *s, const double delta[NCP_AXES]);
 /* How many samples the ring should hold for a full look-ahead (1 without
  * the S-curve): a virtual clock waits for them, a real one cannot. */
 size_t ncp_scaler_wants(const struct ncp_scaler *s, size_t capacity);

@@ -57,11 +57,11 @@ static int ncp_offsets_ask_machine(struct ncp_analyzer *a, int *tripped)
     if (a->sai.sync(a->sai.sync_ctx, &ms) != 0)
         return ncp_an_error(a, 0, "the run was stopped while the interpreter waited for "
                                   "the machine");
-    if (ms.what & NCP_SYNC_PROBE) {
+    if (ms.what & NCP_SYNC_PROBE)
         memcpy(a->sai.probed, ms.probed, sizeof a->sai.probed);
+    if (ms.what & (NCP_SYNC_PROBE | NCP_SYNC_POSITION))
         for (int k = 0; k < 3; k++)
             a->sai.pos[k] = ms.pos[k];
-    }
     if (ms.what & NCP_SYNC_INPUT) {
         double *result = ncp_params_slot(a->params, 5399);
         if (result)
@@ -76,12 +76,13 @@ int ncp_offsets_resync(struct ncp_analyzer *a)
     if (!(a->st.toolchange_flag | a->sai.probe_flag | a->sai.input_flag))
         return NCP_OK;
     int tripped = 0;
-    if ((a->sai.probe_flag | a->sai.input_flag) && a->sai.sync) {
+    if ((a->sai.probe_flag | a->sai.input_flag | a->sai.change_flag) && a->sai.sync) {
         int rc = ncp_offsets_ask_machine(a, &tripped);
         if (rc != NCP_OK)
             return rc;
     }
     a->sai.input_flag = 0;
+    a->sai.change_flag = 0;
     if (!(a->st.toolchange_flag | a->sai.probe_flag))
         return NCP_OK;   /* M66 alone: rs274 reads no position back */
     if (a->sai.probe_flag) {

@@ -112,6 +112,7 @@ struct ncp_sai {
     int probe_flag;               /* a G38.x ran: rs274 reads its results at the next block */
     double probed[6];             /* where the probe tripped: its programmed end */
     int input_flag;               /* an M66 ran on a machine: #5399 is read back too */
+    int change_flag;              /* an M6 ran: on a machine the position is read back */
     ncp_machine_sync_fn sync;     /* the machine the busters wait for, or NULL */
     void *sync_ctx;
 };

@@ -290,6 +290,7 @@ int ncp_tools_change(struct ncp_analyzer *a)
     s->current_pocket_no = s->selected_pocket_no;
     s->current_tool = s->selected_tool;
     s->toolchange_flag = 1;
+    a->sai.change_flag = 1;   /* a queue buster on a machine (the change position move) */
     return NCP_OK;
 }
 

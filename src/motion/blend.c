@@ -60,6 +60,7 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
     arc->line = cur->line;  /* the corner is where the next block's motion begins */
     arc->tool_z = prev->tool_z;
     arc->aux = prev->aux;   /* what comes with the next block waits for its own segment */
+    arc->rev_rpm = prev->rev_rpm;
     arc->feed = fmin(prev->feed, cur->feed);
     arc->blend_feed = fmin(prev->blend_feed > 0 ? prev->blend_feed : prev->feed,
                            cur->blend_feed > 0 ? cur->blend_feed : cur->feed);
@@ -164,6 +165,7 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
     arc->term = NCP_TERM_CONTINUOUS;
     arc->line = cur->line;
     arc->aux = prev->aux;
+    arc->rev_rpm = prev->rev_rpm;
     arc->feed = fmin(prev->feed, cur->feed);
     arc->blend_feed = fmin(prev->blend_feed > 0 ? prev->blend_feed : prev->feed,
                            cur->blend_feed > 0 ? cur->blend_feed : cur->feed);

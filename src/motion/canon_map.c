@@ -251,6 +251,12 @@ static int line_to(struct ncp_canon_map *m, const double end_mm[NCP_AXES], int t
     else if ((s->feed = feed_at(m, s->end[0], s->angular)) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "feed move with zero feed rate");
     s->blend_feed = traverse ? s->feed : blend_feed_at(m, s->end[0], s->angular);
+    if (!traverse && m->sync_pitch > 0) {
+        s->sync = NCP_SYNC_THREAD;
+        s->pitch = m->sync_pitch;
+    } else if (!traverse && m->per_rev) {
+        s->rev_rpm = spindle_rpm(m, s->end[0]);
+    }
     int r = check_point(m, s->end, line, d);
     if (r)
         return -r;
@@ -277,6 +283,8 @@ static int rigid_tap(struct ncp_canon_map *m, const struct ncp_canon *op, uint32
     to_machine_all(m, op->rigid_tap.bottom, NULL, end);
     int rc = line_to(m, end, 0, line, s, d);
     if (rc == 1) {
+        if (s->sync)
+            s->sync = NCP_SYNC_TAP;
         m->more_left = 1;
         m->more_line = line;
     }
@@ -352,7 +360,10 @@ int ncp_canon_map_more(struct ncp_canon_map *m, struct ncp_seg *seg, struct ncp_
         return nurbs_more(m, seg, d);
     if (m->more_left > 0) { /* the tap's way back out */
         m->more_left = 0;
-        return line_to(m, m->more_back, 0, m->more_line, seg, d);
+        int rc = line_to(m, m->more_back, 0, m->more_line, seg, d);
+        if (rc == 1 && seg->sync)
+            seg->sync = NCP_SYNC_TAP_OUT;
+        return rc;
     }
     return 0;
 }

@@ -51,12 +51,14 @@ static void sample(struct ncp_planner *p, struct ncp_setpoint *out)
     }
     p->v_now = v;
     out->v = v;
+    out->rev_rpm = ps->s.rev_rpm;
 }
 
 static void hold(struct ncp_planner *p, struct ncp_setpoint *out)
 {
     memset(out->dir, 0, sizeof out->dir);
     out->v = 0;
+    out->rev_rpm = 0;
     p->v_now = 0;
 }
 

@@ -428,6 +428,7 @@ int ncp_scaler_step(struct ncp_scaler *s, double target, struct ncp_spsc *ring,
     const struct ncp_setpoint *near = f < 0.5 ? &s->a : &s->b;
     out->line = near->line;
     out->tool_z = near->tool_z;
+    out->rev_rpm = near->rev_rpm;
     /* machine functions are due once the read position leaves a towards b */
     out->aux = f <= 0 ? s->a.aux : s->b.aux;
     out->flags = (f <= 0 ? s->a.flags : f >= 1 ? s->b.flags : 0) & ~(uint32_t)NCP_SP_MOTION_MASK;
@@ -451,4 +452,18 @@ void ncp_scaler_rebase(struct ncp_scaler *s, const double pos[NCP_AXES])
     s->tp = keep.tp;
     memcpy(s->amax, keep.amax, sizeof s->amax);
     memcpy(s->jmax, keep.jmax, sizeof s->jmax);
+}
+
+void ncp_scaler_jump(struct ncp_scaler *s, const double delta[NCP_AXES])
+{
+    /* the stop is landed on: a (read position 0) or b (1) */
+    int b_before = s->f >= 1.0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        s->z.pos[j] += delta[j];
+        s->a.pos[j] += delta[j];
+        if (b_before)
+            s->b.pos[j] += delta[j];
+        for (int k = 0; k < 3; k++)
+            s->last[k][j] += delta[j];
+    }
 }

@@ -76,7 +76,7 @@ static void spindle_step(struct nck *n)
     m->rev += m->rpm / 60 * dt;
 }
 
-static int at_speed(const struct nck *n)
+int nck_spindle_at_speed(const struct nck *n)
 {
     double t = speed_target(n);
     return fabs(n->mach.rpm - t) <= fmax(1e-6, n->cfg->io.at_speed_tol * fabs(t));
@@ -162,7 +162,7 @@ static int act(struct nck *n, const struct nck_aux *a)
         }
         return m->orienting != 0;
     case NCK_AUX_AT_SPEED:
-        if (at_speed(n))
+        if (nck_spindle_at_speed(n))
             return 0;
         if (m->wait != NCK_WAIT_SPINDLE)
             m->waits++;
@@ -185,6 +185,7 @@ static int act(struct nck *n, const struct nck_aux *a)
         return 0;
     case NCK_AUX_ENABLE: m->en[a->i & 3] = a->v != 0; return 0;
     case NCK_AUX_PROBE: nck_probe_arm(n, a->i); return 0;
+    case NCK_AUX_SYNC: return nck_sync_cycle(n);
     case NCK_AUX_WAIT_INPUT: return input_wait(n, a);
     case NCK_AUX_PAUSE:
         if (a->i == NCK_WAIT_M1 && !atomic_load_explicit(&n->ctl->optional_stop,
@@ -204,7 +205,12 @@ static int act(struct nck *n, const struct nck_aux *a)
 int nck_aux_cycle(struct nck *n)
 {
     struct nck_mach *m = &n->mach;
-    spindle_step(n);
+    /* once per instant: a virtual clock's retry is the same period again */
+    if (!m->spun || m->spun_at != n->now_ns) {
+        spindle_step(n);
+        m->spun = 1;
+        m->spun_at = n->now_ns;
+    }
     for (;;) {
         if (!m->have_pack) {
             if (!m->have_ahead)
@@ -217,7 +223,10 @@ int nck_aux_cycle(struct nck *n)
             m->at = 0;
         }
         while (m->at < m->pack.n) {
-            if (act(n, &m->pack.a[m->at]))
+            int r = act(n, &m->pack.a[m->at]);
+            if (r == 2)        /* a synchronised run: the stream is still on its way */
+                return 0;
+            if (r)
                 return 1;
             m->wait = NCK_WAIT_NONE;
             m->at++;
@@ -234,6 +243,7 @@ void nck_aux_discard(struct nck *n)
     while (ncp_spsc_pop(&n->auxq, &m->ahead) == 0)
         ;
     m->have_ahead = m->have_pack = 0;
+    nck_sync_discard(n);
     m->wait = NCK_WAIT_NONE;
     m->rpm_cmd = 0;
     m->orienting = 0;

@@ -65,7 +65,8 @@ static int init_motion(struct nck *n)
     if (!n->planner || ncp_spsc_init(&n->segs, sizeof(struct nck_seg_msg), SEG_RING) ||
         ncp_spsc_init(&n->sps, sizeof(struct ncp_setpoint), (size_t)c->setpoint_ring) ||
         ncp_spsc_init(&n->fbs, sizeof(struct nck_fb), FB_RING) ||
-        ncp_spsc_init(&n->auxq, sizeof(struct nck_aux_pack), NCK_AUX_RING))
+        ncp_spsc_init(&n->auxq, sizeof(struct nck_aux_pack), NCK_AUX_RING) ||
+        ncp_spsc_init(&n->syncq, sizeof(struct nck_sync_run), NCK_SYNC_RING))
         return -1;
     for (int k = 0; k < 4; k++)
         n->mach.en[k] = 1;
@@ -146,6 +147,7 @@ void nck_release(struct nck *n)
     ncp_spsc_destroy(&n->sps);
     ncp_spsc_destroy(&n->fbs);
     ncp_spsc_destroy(&n->auxq);
+    ncp_spsc_destroy(&n->syncq);
     ncp_planner_free(n->planner);
     n->planner = NULL;
     pthread_mutex_destroy(&n->ev_lock);

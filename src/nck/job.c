@@ -35,9 +35,13 @@ static int take_seg(struct nck *n, const struct ncp_seg *s);
 /* The pack gathered so far goes to the position loop; one that waits for
  * motion is announced by an AUX stop, one that goes with motion rides on the
  * next segment (push_seg numbers it). */
+static int sync_flush(struct nck *n);
+
 static int aux_flush(struct nck *n)
 {
     struct nck_job *j = &n->job;
+    if (sync_flush(n))
+        return -1;
     if (j->aux.n == 0)
         return 0;
     j->aux.seq = ++n->aux_seq;
@@ -61,7 +65,7 @@ static int aux_add(struct nck *n, int kind, int idx, int32_t i, double v, uint32
                    int stop)
 {
     struct nck_job *j = &n->job;
-    if (j->aux.n == NCK_AUX_PACK && aux_flush(n))
+    if ((j->aux.n == NCK_AUX_PACK || j->run.n > 0) && aux_flush(n))
         return -1;
     struct nck_aux *a = &j->aux.a[j->aux.n++];
     memset(a, 0, sizeof *a);
@@ -94,9 +98,79 @@ static int push_mark(struct nck *n, int kind)
     return 0;
 }
 
+/* ---- spindle-synchronised runs ----------------------------------------------------- */
+
+/* The run gathered so far goes to the position loop (sync ring), with the
+ * action that starts it after a stop at its start; the planner goes on
+ * from its end. */
+static int sync_flush(struct nck *n)
+{
+    struct nck_job *j = &n->job;
+    if (j->run.n == 0)
+        return 0;
+    while (ncp_spsc_push(&n->syncq, &j->run) != 0) {
+        if (atomic_load(&j->abort))
+            return -1;
+        nap_us(100);
+    }
+    const struct nck_sync_run *r = &j->run;
+    double end[NCP_AXES];
+    memcpy(end, r->tap ? r->start : r->l[r->n - 1].end, sizeof end);
+    uint32_t line = r->l[0].line;
+    j->run.n = 0;
+    /* what was gathered before the run happens before it */
+    if (j->aux.n == NCK_AUX_PACK && aux_flush(n))
+        return -1;
+    struct nck_aux *a = &j->aux.a[j->aux.n++];
+    memset(a, 0, sizeof *a);
+    a->kind = NCK_AUX_SYNC;
+    a->line = line;
+    j->aux.seq = ++n->aux_seq;
+    while (ncp_spsc_push(&n->auxq, &j->aux) != 0) {
+        if (atomic_load(&j->abort))
+            return -1;
+        nap_us(100);
+    }
+    j->aux.n = 0;
+    j->aux_stop = 0;
+    struct nck_seg_msg m;
+    memset(&m, 0, sizeof m);
+    m.kind = NCK_MSG_AUX;
+    m.aux = n->aux_seq;
+    m.jump = 1;
+    memcpy(m.seg.end, end, sizeof m.seg.end);
+    n->job.seen_motion = 1;
+    return push_wait(n, &m);
+}
+
+/* A synchronised line joins the run being gathered (a rigid tap is a run
+ * of its own; its way out is the loop's). */
+static int sync_add(struct nck *n, const struct ncp_seg *s)
+{
+    struct nck_job *j = &n->job;
+    if (s->sync == NCP_SYNC_TAP_OUT)
+        return 0;
+    if ((j->run.n == NCK_SYNC_LINES || j->run.tap || s->sync == NCP_SYNC_TAP) && sync_flush(n))
+        return -1;
+    /* the run waits for the spindle itself (at speed, then the index) */
+    j->need_at_speed = 0;
+    if (j->run.n == 0) {
+        memcpy(j->run.start, s->start, sizeof j->run.start);
+        j->run.tap = s->sync == NCP_SYNC_TAP;
+    }
+    struct nck_sync_line *l = &j->run.l[j->run.n++];
+    memcpy(l->end, s->end, sizeof l->end);
+    l->len = s->length;
+    l->pitch = s->pitch;
+    l->line = s->line;
+    return 0;
+}
+
 static int push_seg(struct nck *n, const struct ncp_seg *s)
 {
     struct nck_job *j = &n->job;
+    if (s->sync)
+        return sync_add(n, s);
     /* LinuxCNC's at-speed: the first feed after a spindle start or speed
      * change starts once the spindle has reached its speed */
     if (j->need_at_speed && !s->traverse && s->kind != NCP_SEG_DWELL) {
@@ -438,7 +512,7 @@ static int take_seg(struct nck *n, const struct ncp_seg *s)
 
 /* ---- queue busters ----------------------------------------------------------------- */
 
-/* A probe move or an M66 was sent: run the motion so far to a stop, wait
+/* A probe move, an M66 or an M6 was sent: run the motion so far to a stop, wait
  * until the machine is there, and answer the interpreter with what the
  * machine found. The interpreter makes no command after the buster until
  * it has the answer, so this thread waits for nothing it has yet to send. */
@@ -454,6 +528,13 @@ static int buster(struct nck *n, const struct ncp_cmd *cmd, const struct ncp_can
         nap_us(200);
     }
     struct ncp_machine_sync *ms = &j->answer;
+    if (op->kind == NCP_C_CHANGE_TOOL) {
+        /* where the change left the axes (the change position, or where
+         * they were): the next block's position and #5420.. */
+        ncp_canon_map_to_program(&n->map, n->map.pos, ms->pos);
+        ms->what |= NCP_SYNC_POSITION;
+        return 0;
+    }
     if (op->kind == NCP_C_WAIT_INPUT) {
         ms->what |= NCP_SYNC_INPUT;
         ms->input = n->mach.m66_result;
@@ -504,7 +585,8 @@ static int machine_sync(void *ctx, struct ncp_machine_sync *ms)
 
 static int is_buster(const struct ncp_canon *op)
 {
-    return op->kind == NCP_C_STRAIGHT_PROBE || op->kind == NCP_C_WAIT_INPUT;
+    return op->kind == NCP_C_STRAIGHT_PROBE || op->kind == NCP_C_WAIT_INPUT ||
+           op->kind == NCP_C_CHANGE_TOOL;
 }
 
 static int emit_segments(void *ctx, const struct ncp_cmd *cmd);
@@ -538,6 +620,7 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
     }
     int seen = j->seen_motion;
     j->seen_motion = 0;
+    int busted = 0;
     struct ncp_seg seg;
     for (unsigned i = 0; i < cmd->n_ops; i++) {
         const struct ncp_canon *op = &cmd->ops[i];
@@ -570,6 +653,8 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
             j->map_failed = 1;
             return 1;
         }
+        if (op->kind == NCP_C_STOP_SPEED_FEED_SYNCH && sync_flush(n))
+            return 1;
         int after_pallet = i > 0 && cmd->ops[i - 1].kind == NCP_C_PALLET_SHUTTLE;
         if ((!j->from_line || j->reached) && take_aux(n, cmd, op, after_pallet))
             return 1;
@@ -582,10 +667,13 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
                 }
                 return 1;
             }
-            atomic_fetch_add_explicit(&j->busters_done, 1, memory_order_release);
+            busted = 1;
         }
         n->calls_acted[kind]++;
     }
+    /* the interpreter asks once for a block's busters, whatever their number */
+    if (busted)
+        atomic_fetch_add_explicit(&j->busters_done, 1, memory_order_release);
     if (n->post_prints) {   /* a serving NCK's status shows it */
         pthread_mutex_lock(&n->ev_lock);
         n->io.interp_line = cmd->line;
@@ -641,6 +729,7 @@ int nck_job_start(struct nck *n)
     j->aux.n = 0;
     j->aux_stop = 0;
     j->need_at_speed = 0;
+    j->run.n = 0;
     atomic_store(&j->busters_done, 0);
     j->busters_asked = 0;
     atomic_store(&j->emit_stopped, 0);

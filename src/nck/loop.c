@@ -83,7 +83,12 @@ static double feed_rate(struct nck *n)
     double ov = n->mach.en[NCK_EN_FEED_OVERRIDE]
                     ? atomic_load_explicit(&n->ctl->override_permille, memory_order_relaxed) / 1000.0
                     : 1.0;
-    return fmin(1.0, ov / n->plan_override);
+    double f = fmin(1.0, ov / n->plan_override);
+    /* G95 (LinuxCNC's velocity mode): the feed per turn at the spindle's
+     * actual speed; above the speed planned for, the plan's caps hold */
+    if (n->cur.rev_rpm > 0)
+        f *= fmin(1.0, fabs(n->mach.rpm) / n->cur.rev_rpm);
+    return f;
 }
 
 /* The end of the stream is in the ring: running it down is no underrun. */
@@ -131,8 +136,9 @@ static int take_setpoint(struct nck *n)
 {
     /* a machine function waits (spindle, operator, input): hold where the
      * stream stopped for it */
+    struct ncp_setpoint before = n->next;
     if (nck_aux_cycle(n)) {
-        n->cur = n->next;
+        n->cur = before;   /* a synchronised run writes the next itself */
         return NCP_RT_CONTINUE;
     }
     if (!n->ended && n->setup.virtual_clock &&
@@ -329,7 +335,7 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
                (atomic_load_explicit(&n->ctl->hold, memory_order_relaxed) ||
                 /* waiting for the operator or an input: at the real rate */
                 (n->mach.wait != NCK_WAIT_NONE && n->mach.wait != NCK_WAIT_SPINDLE &&
-                 n->mach.wait != NCK_WAIT_ORIENT) ||
+                 n->mach.wait != NCK_WAIT_ORIENT && n->mach.wait != NCK_WAIT_INDEX) ||
                 (!stream_expected(n) && ncp_spsc_count(&n->sps) == 0))) {
         idle_nap(n);
     }

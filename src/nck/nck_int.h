@@ -28,6 +28,9 @@ enum { NCK_MSG_SEG, NCK_MSG_END, NCK_MSG_SYNC, NCK_MSG_AUX };
 struct nck_seg_msg {
     int kind;
     uint32_t aux;              /* END/SYNC/AUX: machine functions due at the stop */
+    /* AUX: after the stop the stream goes on from seg.end (a spindle-
+     * synchronised run the position loop moves itself ends there) */
+    int jump;
     struct ncp_seg seg;
 };
 
@@ -52,12 +55,13 @@ enum nck_aux_kind {
     NCK_AUX_PREPARE,       /* i: the tool (T) */
     NCK_AUX_ENABLE,        /* i: enum nck_enable, a: on */
     NCK_AUX_PROBE,         /* i: NCP_PROBE_F_*; rides on the probe move, arms the probe */
+    NCK_AUX_SYNC,          /* the next run of the sync ring; waits until it has run */
 };
 enum nck_enable { NCK_EN_FEED_OVERRIDE, NCK_EN_SPEED_OVERRIDE, NCK_EN_FEED_HOLD,
                   NCK_EN_ADAPTIVE };
 /* What the loop waits for (nck_fb.wait): 0 nothing. */
 enum nck_wait { NCK_WAIT_NONE, NCK_WAIT_M0, NCK_WAIT_M1, NCK_WAIT_M60, NCK_WAIT_TOOL,
-                NCK_WAIT_SPINDLE, NCK_WAIT_ORIENT, NCK_WAIT_INPUT };
+                NCK_WAIT_SPINDLE, NCK_WAIT_ORIENT, NCK_WAIT_INPUT, NCK_WAIT_INDEX };
 struct nck_aux {
     uint8_t kind, a;
     int16_t idx;
@@ -72,6 +76,42 @@ struct nck_aux_pack {
     struct nck_aux a[NCK_AUX_PACK];
 };
 #define NCK_AUX_RING 256
+
+/* ---- spindle-synchronised motion (sync.c, the position loop) -----------------
+ * G33, G76's passes and G33.1 do not go through the planner: their position
+ * along the path is pitch x the spindle's turns since its index, which only
+ * the position loop knows. The job thread gathers a run of consecutive
+ * synchronised lines (one START_SPEED_FEED_SYNCH .. STOP stretch; the pitch
+ * may change between lines, as at G76's tapers) and sends it on the sync
+ * ring; an NCK_AUX_SYNC action after an AUX stop at the run's start makes
+ * the loop run it, and the planner goes on from the run's end. */
+#define NCK_SYNC_LINES 8
+#define NCK_SYNC_RING 16
+struct nck_sync_run {
+    int n;
+    int tap;                   /* G33.1: in, spindle reversed, back out */
+    double start[NCP_AXES];
+    struct nck_sync_line {
+        double end[NCP_AXES];
+        double len, pitch;     /* mm, mm per turn along the line */
+        uint32_t line;
+    } l[NCK_SYNC_LINES];
+};
+enum nck_sync_phase { NCK_SYNC_IDLE, NCK_SYNC_ARRIVE, NCK_SYNC_AT_SPEED, NCK_SYNC_INDEX,
+                      NCK_SYNC_FOLLOW, NCK_SYNC_TAP_IN, NCK_SYNC_TAP_OUT, NCK_SYNC_TAP_TURN,
+                      NCK_SYNC_PLACE, NCK_SYNC_DONE };
+/* The loop's state of the run it moves (its thread only). */
+struct nck_sync_state {
+    int phase;                 /* enum nck_sync_phase */
+    struct nck_sync_run run;
+    double total;              /* the run's length, mm */
+    double s, v;               /* distance along the run and its speed */
+    double acc, vmax;          /* along the path, within every axis's limits */
+    double index;              /* the spindle turn (whole) its index came at */
+    double rev_last;           /* the spindle angle the period before, turns */
+    int sgn;                   /* the spindle's direction at the start: turns count this way */
+    double rpm_cmd;            /* G33.1: the speed the tap went in at */
+};
 
 /* The machine as the position loop drives it (its thread only). */
 struct nck_mach {
@@ -97,6 +137,8 @@ struct nck_mach {
     uint64_t resume_used;
     int in_last;               /* M66 L1/L2: the input's previous value */
     double m66_result;         /* #5399 as the machine found it */
+    int spun;                  /* the spindle was stepped at spun_at */
+    int64_t spun_at;
 };
 
 /* The probe (probe.c): the position loop writes it; the job thread reads
@@ -191,6 +233,7 @@ struct nck_job {
     struct nck_aux_pack aux;
     int aux_stop;
     int need_at_speed;           /* a spindle start or S: the next feed waits */
+    struct nck_sync_run run;     /* synchronised lines gathered, not sent yet */
     int spindle_dir;             /* as the program has set it */
     double origin[NCP_AXES];     /* where the machine was when the job started */
     /* queue busters: the job thread answers each once the machine got
@@ -223,6 +266,8 @@ struct nck {
     int be_open, be_started;
     struct ncp_spsc segs, sps, fbs;
     struct ncp_spsc auxq;            /* machine function packs, job -> position loop */
+    struct ncp_spsc syncq;           /* synchronised runs, job -> position loop */
+    struct nck_sync_state sync;      /* position loop only */
     uint32_t aux_seq;                /* the last pack numbered (job threads, in turn) */
     struct nck_mach mach;            /* position loop only */
     struct nck_probe probe;          /* position loop; the result for the job (probe.c) */
@@ -389,6 +434,13 @@ void nck_note_state(struct nck *n, const struct ncp_canon *op);
  * hold where it is (a pack waits), else 0. */
 int nck_aux_cycle(struct nck *n);
 void nck_aux_discard(struct nck *n);
+int nck_spindle_at_speed(const struct nck *n);
+
+/* sync.c (real-time path): one period of the run an NCK_AUX_SYNC starts; 1
+ * while it runs (it writes n->next itself) or waits, 0 once done, 2 while
+ * the stream has yet to reach the run's start (the loop reads on). */
+int nck_sync_cycle(struct nck *n);
+void nck_sync_discard(struct nck *n);
 /* the job side: how the NCK takes a call (enum nck_call), and the queueing */
 enum nck_call { NCK_CALL_MOTION, NCK_CALL_STATE, NCK_CALL_AUX, NCK_CALL_INFO, NCK_CALL_REFUSED };
 int nck_call_class(const struct ncp_canon *op, const char *text);

@@ -16,6 +16,7 @@ const char *nck_wait_name(int wait)
     case NCK_WAIT_SPINDLE: return "spindle to reach its speed";
     case NCK_WAIT_ORIENT: return "M19 spindle orientation";
     case NCK_WAIT_INPUT: return "M66 wait on an input";
+    case NCK_WAIT_INDEX: return "spindle index (synchronised motion)";
     default: return "nothing";
     }
 }

@@ -24,7 +24,8 @@ static int64_t mono_ns(void)
 
 /* END and SYNC both make the planner run what it has to a stop; after the
  * END setpoint the next job starts afresh (no blend with what went before). */
-static void pull_segments(struct nck *n, int *finishing, uint32_t *stop_aux, int *aux_stop)
+static void pull_segments(struct nck *n, int *finishing, uint32_t *stop_aux, int *aux_stop,
+                          struct nck_seg_msg *jump)
 {
     struct nck_seg_msg m;
     while (!*finishing && !ncp_planner_full(n->planner) && ncp_spsc_pop(&n->segs, &m) == 0) {
@@ -34,6 +35,8 @@ static void pull_segments(struct nck *n, int *finishing, uint32_t *stop_aux, int
             *finishing = 1;
             *stop_aux = m.aux;
             *aux_stop = m.kind == NCK_MSG_AUX;
+            jump->jump = m.jump;
+            memcpy(jump->seg.end, m.seg.end, sizeof jump->seg.end);
             ncp_planner_finish(n->planner);
         }
     }
@@ -87,14 +90,17 @@ void *nck_planner_main(void *arg)
     int finishing = 0, aux_stop = 0;
     uint32_t stop_aux = 0;
     int64_t wait_since = 0;
+    struct nck_seg_msg jump;   /* the stop's jump, if it has one */
+    memset(&jump, 0, sizeof jump);
     long nap = (long)(n->cfg->servo_period * ncp_machine_cfg_ipo_ratio(n->cfg) * 1e9 / 4) + 1000;
     while (!atomic_load(&n->quit)) {
         if (atomic_load_explicit(&n->park_req, memory_order_acquire) !=
             atomic_load_explicit(&n->park_ack, memory_order_relaxed)) {
             parked(n, &finishing, &aux_stop);
+            jump.jump = 0;
             continue;
         }
-        pull_segments(n, &finishing, &stop_aux, &aux_stop);
+        pull_segments(n, &finishing, &stop_aux, &aux_stop, &jump);
         if (ncp_spsc_count(&n->sps) >= ncp_spsc_capacity(&n->sps) ||
             !may_step(n, finishing, &wait_since)) {
             int idle = ncp_planner_idle(n->planner) && ncp_planner_queued(n->planner) == 0;
@@ -119,6 +125,11 @@ void *nck_planner_main(void *arg)
             if (!aux_stop)
                 atomic_fetch_add_explicit(&n->ends_pushed, 1, memory_order_release);
             ncp_planner_restart(n->planner);
+            /* a synchronised run the position loop moves starts here: the
+             * next segment is planned from its end */
+            if (jump.jump)
+                ncp_planner_reset(n->planner, jump.seg.end);
+            jump.jump = 0;
             finishing = 0;
             aux_stop = 0;
         }

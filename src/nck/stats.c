@@ -45,10 +45,10 @@ static double contour_error(struct nck_summary *s, const struct nck_fb *fb)
 }
 
 /* Trace column `motion`: 0 rapid (G0), 1 feed (G1, corner blends, rest),
- * 2 arc (G2/G3, helices). */
+ * 2 arc (G2/G3, helices), 3 synchronised with the spindle (G33, G33.1, G76). */
 static int nck_motion_column(uint32_t flags)
 {
-    return flags & NCP_SP_RAPID ? 0 : flags & NCP_SP_ARC ? 2 : 1;
+    return flags & NCP_SP_SYNC ? 3 : flags & NCP_SP_RAPID ? 0 : flags & NCP_SP_ARC ? 2 : 1;
 }
 
 /* The rows' columns for the axes beyond X Y Z the machine has, after all
@@ -137,6 +137,13 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
         int m = (mask & ~NCP_AXES_XYZ) ? trace_more_axes(s->tbuf + at, sizeof s->tbuf - at - 1,
                                                          mask, fb)
                                        : 0;
+        /* the spindle's angle in turns, counted on (not wrapped): the
+         * synchronised moves are checked against it */
+        if (m >= 0) {
+            int t = snprintf(s->tbuf + at + m, sizeof s->tbuf - at - (size_t)m - 1, ",%.9f",
+                             fb->rev);
+            m = t > 0 && (size_t)t < sizeof s->tbuf - at - (size_t)m - 1 ? m + t : -1;
+        }
         if (m >= 0 && s->joints) {
             int mj = trace_joints(s->tbuf + at + (size_t)m, sizeof s->tbuf - at - (size_t)m - 1,
                                   mask, fb);
@@ -164,6 +171,7 @@ void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints
         if (mask & NCP_AXIS_BIT(j))
             fprintf(trace, ",%c_cmd,%c_act", NCP_AXIS_LETTERS[j] | 0x20,
                     NCP_AXIS_LETTERS[j] | 0x20);
+    fputs(",spindle_turns", trace);
     if (joints)
         fputs(",tool_z", trace);
     for (int j = 0; j < NCP_AXES && joints; j++)
