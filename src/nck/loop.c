@@ -160,9 +160,11 @@ static void discard(struct nck *n, const double act[NCP_AXES])
                           memory_order_release);
 }
 
-static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES])
+static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES],
+                       uint64_t home)
 {
     struct nck_fb fb;
+    fb.home = home;
     fb.t = (double)now_ns * 1e-9;
     fb.v = n->cur.v;
     fb.line = n->cur.line;
@@ -204,15 +206,16 @@ static int frozen_cycle(struct nck *n, int64_t now_ns)
         n->be.ops->enable(&n->be, 0);
         n->drives_on = 0;
     }
+    nck_home_cancel(n);
     double act[NCP_AXES];
-    n->be.ops->cycle(&n->be, n->cur.pos, n->cur.pos, act);
+    nck_home_be_cycle(n, n->cur.pos, n->cur.pos, act);
     n->mach.rpm_cmd = 0;   /* E-stop and faults stop the spindle too */
     (void)nck_aux_cycle(n);
     if (atomic_load_explicit(&n->discard_req, memory_order_acquire) !=
         atomic_load_explicit(&n->discard_ack, memory_order_relaxed))
         discard(n, act);
     n->cur.v = 0;
-    push_cycle(n, now_ns, act);
+    push_cycle(n, now_ns, act, 0);
     atomic_store_explicit(&n->at_rest, 1, memory_order_relaxed);
     if (n->setup.virtual_clock)
         idle_nap(n);
@@ -238,15 +241,25 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
     }
     n->scaler.decel = atomic_load_explicit(&n->full_decel, memory_order_relaxed)
                           ? n->decel_full : n->decel_normal;
-    if (take_setpoint(n) == NCP_RT_RETRY)
-        return NCP_RT_RETRY;
+    /* homing drives the axes itself, the planner's stream waits */
+    if (!nck_home_take(n)) {
+        if (atomic_load_explicit(&n->job_pending, memory_order_acquire)) {
+            if (virt)
+                return NCP_RT_RETRY;
+            n->cur = n->next;
+        } else if (take_setpoint(n) == NCP_RT_RETRY) {
+            return NCP_RT_RETRY;
+        }
+    }
+    uint64_t home = nck_home_phases(n);   /* the row shows the phase the period ran in */
     double act[NCP_AXES];
-    int be_rc = n->be.ops->cycle(&n->be, n->cur.pos, n->next.pos, act);
+    int be_rc = nck_home_be_cycle(n, n->cur.pos, n->next.pos, act);
     nck_probe_cycle(n, act);
+    nck_home_sense(n, act);
     track_blocks(n);
-    push_cycle(n, now_ns, act);
-    int rest = n->cur.v == 0 && n->next.v == 0 && (n->scaler.r == 0 || n->end_seen ||
-                                                   ncp_spsc_count(&n->sps) == 0);
+    push_cycle(n, now_ns, act, home);
+    int rest = !nck_home_active(n) && n->cur.v == 0 && n->next.v == 0 &&
+               (n->scaler.r == 0 || n->end_seen || ncp_spsc_count(&n->sps) == 0);
     atomic_store_explicit(&n->at_rest, rest, memory_order_relaxed);
     if (atomic_load_explicit(&n->discard_req, memory_order_acquire) !=
         atomic_load_explicit(&n->discard_ack, memory_order_relaxed))

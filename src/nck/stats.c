@@ -67,6 +67,20 @@ static int trace_more_axes(char *buf, size_t len, unsigned mask, const struct nc
     return (int)at;
 }
 
+/* The last column, `home`: one digit per machine axis, in COORDINATES
+ * order, the homing phase it is in (enum nck_home_phase, 0 not homing). */
+static int trace_home(char *buf, size_t len, unsigned mask, uint64_t home)
+{
+    size_t at = 0;
+    if (len < 2 + NCP_AXES)
+        return -1;
+    buf[at++] = ',';
+    for (int j = 0; j < NCP_AXES; j++)
+        if (mask & NCP_AXIS_BIT(j))
+            buf[at++] = (char)('0' + ((home >> (4 * j)) & 0xf));
+    return (int)at;
+}
+
 void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, FILE *trace)
 {
     double e2 = 0;
@@ -117,6 +131,10 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
         int m = (mask & ~NCP_AXES_XYZ) ? trace_more_axes(s->tbuf + at, sizeof s->tbuf - at - 1,
                                                          mask, fb)
                                        : 0;
+        int h = m >= 0 ? trace_home(s->tbuf + at + m, sizeof s->tbuf - at - (size_t)m - 1, mask,
+                                    fb->home)
+                       : -1;
+        m = h >= 0 ? m + h : -1;
         if (m >= 0) {
             s->tbuf[at + (size_t)m] = '\n';
             s->tlen = at + (size_t)m + 1;
@@ -132,7 +150,7 @@ void nck_trace_header(FILE *trace, unsigned mask)
         if (mask & NCP_AXIS_BIT(j))
             fprintf(trace, ",%c_cmd,%c_act", NCP_AXIS_LETTERS[j] | 0x20,
                     NCP_AXIS_LETTERS[j] | 0x20);
-    fputc('\n', trace);
+    fputs(",home\n", trace);
     fflush(trace);
 }
 
