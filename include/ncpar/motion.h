@@ -44,9 +44,20 @@ struct ncp_axis_cfg {
      * position scaling, encoder counts per mm (0 = not set) */
     int node_id;
     double counts_per_mm;
-    /* homing (cnc-run serve): where the axis homes to, mm, and how fast, mm/s
-     * (HOME, HOME_SEARCH_VEL; 0 = half of MAX_VELOCITY) */
-    double home, home_vel;
+    /* homing, LinuxCNC's keys (src/motion/config_home.c, src/nck/homing.c):
+     * HOME_SEARCH_VEL signed, 0 = no switch (the axis is homed where it
+     * stands); HOME_LATCH_VEL signed (same sign: latch moving onto the
+     * switch, opposite: moving off it); HOME_FINAL_VEL 0 = MAX_VELOCITY;
+     * HOME_OFFSET the switch's position once homed; HOME where the axis
+     * goes then. home_sequence: HOME_SEQUENCE (have_home_sequence 0: not
+     * given); negative = the group's final moves start together. */
+    double home, home_offset, home_search_vel, home_latch_vel, home_final_vel;
+    int home_sequence, have_home_sequence, home_ignore_limits;
+    /* [SIM] HOME_SWITCH_<axis>: where the simulated switch is, in the
+     * simulated machine's own coordinates (have_home_switch 0: at
+     * HOME_OFFSET, as LinuxCNC's sim configs place it) */
+    double home_switch;
+    int have_home_switch;
     /* A B C: WRAPPED_ROTARY = 1, the axis turns without end: a move takes the
      * shorter way round to its target modulo 360 and the soft limits do not
      * apply */
@@ -149,6 +160,15 @@ int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp
 void ncp_io_cfg_default(struct ncp_io_cfg *io);
 int ncp_io_cfg_key(struct ncp_io_cfg *io, const char *sec, const char *k, const char *v,
                    char *why, size_t len);
+/* config_home.c: one [AXIS_L] homing key (1 taken, 0 unknown, -1 bad
+ * value), one [SIM] HOME_SWITCH_<L> key (same, -2 not such a key), and the
+ * checks across an axis's homing keys once the file is read (0, or -1 with
+ * why filled). */
+int ncp_home_cfg_key(struct ncp_axis_cfg *a, const char *k, const char *v, char *why,
+                     size_t len);
+int ncp_home_switch_key(struct ncp_machine_cfg *c, const char *k, const char *v, char *why,
+                        size_t len);
+int ncp_home_cfg_check(const struct ncp_machine_cfg *c, int axis, char *why, size_t len);
 /* Servo periods per planning period (1 when planning_period is 0), or 0 when
  * planning_period is not a positive integer multiple of servo_period. */
 int ncp_machine_cfg_ipo_ratio(const struct ncp_machine_cfg *c);

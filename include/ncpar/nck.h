@@ -81,6 +81,9 @@ struct ncp_nck_opts {
     /* polled while the run goes on: non-zero asks for a controlled stop
      * (a signal handler's flag), or NULL */
     volatile sig_atomic_t *interrupt;
+    /* home every axis of the home-all list first (as cnc-ctl home all), then
+     * run the program from HOME; 0: the machine starts homed where it is */
+    int home;
 };
 
 enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };
@@ -98,6 +101,7 @@ struct ncp_nck_result {
     int for_expired;
     int interrupted;         /* stopped along the path on request (opts.interrupt) */
     int trace_errno;         /* writing the trace failed (errno), 0 = it did not */
+    int home_failed;         /* --home: homing failed (diag says why), the program never ran */
     double program_time, path_length;
     unsigned axis_mask;      /* the machine's axes (ncp_machine_cfg.axis_mask) */
     double ferr_max, ferr_avg, ferr_axis_max[NCP_AXES]; /* mm, or degrees for A B C */

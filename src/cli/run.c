@@ -35,6 +35,7 @@ struct run_opts {
     const char *backend;        /* --backend as given, NULL = sim */
     uint32_t max_loops;         /* --max-loops, 0 = the interpreter's default */
     const char *inject, *seed;  /* --inject SPECS, --seed N (NULL: the INI's) */
+    int home;                   /* --home: home the machine before the program */
 };
 
 struct interp_ctx {
@@ -62,7 +63,7 @@ static void usage(FILE *f)
           "                        [--mode serial|det|att] [--tool-table FILE]\n"
           "                        [--subroutine-path DIR[:DIR...]] [--max-loops N]\n"
           "                        [--backend sim|socketcan[:IFACE]]\n"
-          "                        [--inject SPEC[,SPEC...]] [--seed N]\n"
+          "                        [--inject SPEC[,SPEC...]] [--seed N] [--home]\n"
           "Runs PROG on the simulated machine (or CiA 402 drives over CAN): interpreter ->\n"
           "look-ahead planner -> interpolator -> position loop (SCHED_FIFO when permitted).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill)\n"
@@ -71,6 +72,9 @@ static void usage(FILE *f)
           "  --plot PNG          picture of the run (tools/plot-trace.py, python3-matplotlib):\n"
           "                      XY toolpath, velocity/acceleration, latency histogram\n"
           "  --for SECONDS       stop after this much machine time\n"
+          "  --home              home the machine first, as `cnc-ctl home all` does (the\n"
+          "                      INI's HOME_* keys; the trace's last column shows each\n"
+          "                      axis's phase); without it the machine starts homed\n"
           "  --feed-override PCT 1..200 (default 100)\n"
           "  --clock virtual     simulated clock, as fast as the CPU allows\n"
           "  --tool-table FILE   LinuxCNC tool table (default: rs274's built-in T1-T3)\n"
@@ -124,13 +128,14 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "max-loops", required_argument, 0, 'L' },
         { "inject", required_argument, 0, 'I' },
         { "seed", required_argument, 0, 'R' },
+        { "home", no_argument, 0, 'H' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
     double pct;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:I:R:", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:I:R:H", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': o->config = optarg; break;
         case 't': o->trace = optarg; break;
@@ -140,6 +145,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         case 'b': o->backend = optarg; break;
         case 'I': o->inject = optarg; break;
         case 'R': o->seed = optarg; break;
+        case 'H': o->home = 1; break;
         case 'L':
             if (parse_num(optarg, 1, 2000000000, &pct) || pct != floor(pct))
                 return fprintf(stderr, "cnc-run run: --max-loops wants a positive count\n"), -1;
@@ -227,6 +233,8 @@ static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
     } else if (res->status != RUN_OK && res->diag.line) {
         fprintf(stderr, "%s:%u:%u: error: %s (motion stopped after the last good block)\n",
                 res->diag.file ? res->diag.file : o->prog, res->diag.line, res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
+    } else if (res->home_failed) {
+        fprintf(stderr, "%s: error: %s (the program did not run)\n", o->prog, res->diag.msg);
     } else if (res->status != RUN_OK) {
         fprintf(stderr, "%s: error: %s\n", o->prog, res->diag.msg);
     }
@@ -469,6 +477,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .total_lines = count_lines(src),
         .notes = stderr,
         .interrupt = &run_signal,
+        .home = o->home,
     };
     struct ncp_nck_result *res = malloc(sizeof *res);
     if (!res)

@@ -62,7 +62,7 @@ static const char global_usage[] =
     "commands (cnc-ctl COMMAND --help for each):\n"
     "  status [--json] [--watch]          load PROG           run [--from-line N]\n"
     "  pause   resume   stop   abort      step on|off         mdi 'LINE'\n"
-    "  home AXIS|all                      override feed|rapid|spindle PCT\n"
+    "  home [AXES|all]                    override feed|rapid|spindle PCT\n"
     "  jog AXIS +|- [--speed MM_PER_MIN] [--distance MM]      jog AXIS stop\n"
     "  estop   reset   shutdown           wait STATE [--timeout S]\n"
     "  tool-changed   optional-stop on|off   set-input N 0|1\n"
@@ -342,13 +342,14 @@ static int run_home(struct ctl *c, const struct args *a)
 {
     ncp_command_t cmd;
     init_cmd(&cmd, NCP_COMMAND_T_HOME);
-    char axis = axis_letter(a->words[0]);
-    if (strcmp(a->words[0], "all") == 0)
-        (void)set_text(&cmd, "all");
-    else if (axis)
-        cmd.text[0] = (uint8_t)axis;
-    else
-        return usage_error("home: an axis letter (XYZABCUVW) or all, not '%s'", a->words[0]);
+    const char *w = a->n_words ? a->words[0] : "all";
+    if (strcmp(w, "all") != 0) {
+        size_t k = strlen(w);
+        if (k == 0 || k > 9 || strspn(w, "XYZABCUVWxyzabcuvw") != k)
+            return usage_error("home: axis letters (XYZABCUVW, e.g. Z or XY) or all, not '%s'",
+                               w);
+    }
+    (void)set_text(&cmd, w);
     return ctl_command(c, &cmd);
 }
 
@@ -479,7 +480,8 @@ static const struct command commands[] = {
     {"abort", "", "Abandons the program and motion at once.", 0, 0, 0, run_abort},
     {"step", "on|off", "Single-block mode on or off.", 0, 1, 1, run_step},
     {"mdi", "'LINE'", "Executes one line of G-code.", 0, 1, MAX_WORDS, run_mdi},
-    {"home", "AXIS|all", "Homes one axis, or all of them.", 0, 1, 1, run_home},
+    {"home", "[AXES|all]", "Homes the axes named (XZ), or all of them by HOME_SEQUENCE.", 0, 0, 1,
+     run_home},
     {"override", "feed|rapid|spindle PCT", "Sets an override, in percent.", 0, 2, 2,
      run_override},
     {"jog", "AXIS +|-|stop [--speed MM_PER_MIN] [--distance MM]",

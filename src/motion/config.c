@@ -22,7 +22,9 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->servo_period = 1e-3;
     c->max_linear_vel = 200.0;
     for (int i = 0; i < NCP_AXES; i++) {
-        c->axis[i] = (struct ncp_axis_cfg){ -500.0, 500.0, 200.0, 2000.0, 100000.0, 1.0, 0, 0, 0, 0, 0 };
+        c->axis[i] = (struct ncp_axis_cfg){ .min_limit = -500.0, .max_limit = 500.0,
+                                            .max_vel = 200.0, .max_acc = 2000.0,
+                                            .max_jerk = 100000.0, .ferror = 1.0 };
     }
     c->axis[2].min_limit = -250.0;
     c->axis[2].max_limit = 50.0;
@@ -62,7 +64,7 @@ enum { AK_MIN_LIMIT, AK_MAX_LIMIT, AK_MAX_VELOCITY, AK_MAX_ACCELERATION, AK_MAX_
 static const char *const axis_required[] = { "MIN_LIMIT", "MAX_LIMIT", "MAX_VELOCITY",
                                              "MAX_ACCELERATION", "FERROR" };
 
-#define MAX_SEEN 128 /* more than there are known keys: an unknown one stops the load */
+#define MAX_SEEN 512 /* more than there are known keys: an unknown one stops the load */
 
 struct load_ctx {
     struct ncp_machine_cfg *c;
@@ -200,12 +202,12 @@ static int axis_key(struct ncp_axis_cfg *a, const char *k, const char *v, unsign
         { "MAX_JERK", &a->max_jerk, 0, 1e12, "mm/s^3", AK_MAX_JERK },
         { "FERROR", &a->ferror, 1e-9, 1e6, "mm", AK_FERROR },
         { "COUNTS_PER_MM", &a->counts_per_mm, 1e-3, 1e9, "counts/mm", -1 },
-        { "HOME", &a->home, -1e6, 1e6, "mm", -1 },
-        { "HOME_SEARCH_VEL", &a->home_vel, 0, 1e6, "mm/s (0: half of MAX_VELOCITY)", -1 },
     };
     *bit = 0;
     if (!strcasecmp(k, "NODE_ID"))
         return whole(v, 1, 127, &a->node_id, "CANopen node", why, len);
+    if (!strncasecmp(k, "HOME", 4))
+        return ncp_home_cfg_key(a, k, v, why, len);
     for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
         if (strcasecmp(k, keys[i].name) != 0)
             continue;
@@ -434,7 +436,9 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
     }
     if (!strcasecmp(sec, "SIM")) {
         int r = sim_key(c, k, v, why, len);
-        return r ? r : ncp_io_cfg_key(&c->io, sec, k, v, why, len);
+        if (r == 0 && (r = ncp_home_switch_key(c, k, v, why, len)) == -2)
+            r = ncp_io_cfg_key(&c->io, sec, k, v, why, len);
+        return r;
     }
     if (!strcasecmp(sec, "RT")) {
         int r = rt_key(c, k, v, why, len);
@@ -612,6 +616,24 @@ static int check_cfg(struct load_ctx *lc)
                 return fail_at(lc, lc->axis_line[i],
                                "[AXIS_%c] NODE_ID %d is already the node of [AXIS_%c]",
                                NCP_AXIS_LETTERS[i], c->axis[i].node_id, NCP_AXIS_LETTERS[j]), -1;
+        char why[160];
+        if (ncp_home_cfg_check(c, i, why, sizeof why))
+            return fail_at(lc, lc->axis_line[i], "[AXIS_%c] %s", NCP_AXIS_LETTERS[i], why), -1;
+        /* homing moves the planned axes; a switch sits on a joint */
+        if (ncp_kins_active(c) && c->axis[i].home_search_vel != 0)
+            return fail_at(lc, lc->axis_line[i],
+                           "[AXIS_%c] HOME_SEARCH_VEL: homing on switches is not supported with "
+                           "[KINS] KINEMATICS = %s (the switches sit on joints); home without "
+                           "switches (HOME_SEARCH_VEL = 0)",
+                           NCP_AXIS_LETTERS[i], ncp_kins_name(c->kins.type)), -1;
+    }
+    for (int i = 0; i < NCP_AXES; i++) {
+        if ((c->axis_mask & NCP_AXIS_BIT(i)) || !c->axis[i].have_home_switch)
+            continue;
+        char key[16];
+        snprintf(key, sizeof key, "HOME_SWITCH_%c", NCP_AXIS_LETTERS[i]);
+        return fail_at(lc, key_line(lc, "SIM", key), "[SIM] %s: the machine has no axis %c "
+                       "([TRAJ] COORDINATES)", key, NCP_AXIS_LETTERS[i]), -1;
     }
     if (c->can.heartbeat_timeout_ms <= c->can.heartbeat_period_ms)
         return fail_at(lc, key_line(lc, "CAN", "HEARTBEAT_TIMEOUT_MS"), "[CAN] HEARTBEAT_TIMEOUT_MS %d must be longer than "

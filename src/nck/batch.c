@@ -163,8 +163,36 @@ static void watch_usr1(void)
     sigaction(SIGUSR1, &sa, NULL);
 }
 
+/* --home: the program starts once the loop has homed the machine. */
+struct batch_home {
+    int pending, failed;
+    struct ncp_diag diag;
+};
+
+static void homing_done(struct nck *n, const struct ncp_nck_opts *o, struct batch_home *bh)
+{
+    char report[1024];
+    bh->pending = 0;
+    if (nck_home_report(n, report, sizeof report) != 0) {
+        bh->failed = 1;
+        ncp_diag_set(&bh->diag, NCP_ERR_IO, 0, 0, "%s", report);
+        atomic_store(&n->ctl->stop, 1);
+        atomic_store(&n->job_pending, 0);
+        return;
+    }
+    if (o->notes)
+        fprintf(o->notes, "%s\n", report);
+    memcpy(n->map.pos, n->home.final, sizeof n->map.pos);
+    if (nck_job_start(n)) {
+        bh->failed = 1;
+        ncp_diag_set(&bh->diag, NCP_ERR_IO, 0, 0, "cannot start the interpreter thread");
+        atomic_store(&n->ctl->stop, 1);
+    }
+    atomic_store(&n->job_pending, 0);
+}
+
 /* Reads the loop's cycles until the loop has ended and its ring is empty. */
-static void drain(struct nck *n, const struct ncp_nck_opts *o)
+static void drain(struct nck *n, const struct ncp_nck_opts *o, struct batch_home *bh)
 {
     int64_t last_print = 0;
     if (o->trace) {
@@ -178,6 +206,8 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o)
         int got = nck_read_cycles(n);
         if (!got && !atomic_load(&n->loop.running) && ncp_spsc_count(&n->fbs) == 0)
             break;
+        if (bh->pending && nck_home_finished(n))
+            homing_done(n, o, bh);
         /* a trace that cannot be written (a full disk) stops the run as a
          * stop signal does: a run that was asked to be recorded is not
          * worth going on unrecorded */
@@ -286,8 +316,23 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
     }
 }
 
+/* Where the program starts: --home leaves the homed axes at HOME. */
+static const double *after_home(const struct nck *n, const struct ncp_nck_opts *o,
+                                double at[NCP_AXES])
+{
+    memcpy(at, n->start, sizeof n->start);
+    unsigned mask = o->home ? nck_home_all_mask(o->cfg) : 0;
+    for (int j = 0; j < NCP_AXES; j++)
+        if (mask & NCP_AXIS_BIT(j))
+            at[j] = o->cfg->axis[j].home;
+    return at;
+}
+
 int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
 {
+    struct batch_home bh;
+    double from[NCP_AXES];
+    memset(&bh, 0, sizeof bh);
     memset(res, 0, sizeof res[0]);
     ncp_rt_stats_reset(&res->lat);
     struct nck *n = calloc(1, sizeof *n);
@@ -307,7 +352,7 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
         if (!res->diag.code)
             res->diag.code = NCP_ERR_IO;
         res->status = NCP_NCK_FAULT;
-    } else if ((pre = precheck(o, n->start, &res->diag)) != PC_OK) {
+    } else if ((pre = precheck(o, after_home(n, o, from), &res->diag)) != PC_OK) {
         res->limit_violation = pre == PC_LIMIT;
         res->refused = pre == PC_PROGRAM;
         res->interrupted = pre == PC_INTERRUPTED;
@@ -319,18 +364,29 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
         n->job.kind = NCK_JOB_PROGRAM;
         n->job.interpret = o->interpret;
         n->job.interp_ctx = o->interp_ctx;
-        if (nck_job_start(n) || nck_start_loop(n, &res->diag)) {
+        if (o->home) {
+            bh.pending = 1;
+            atomic_store(&n->job_pending, 1);
+            nck_home_request(n, nck_home_all_mask(o->cfg));
+        }
+        if ((!o->home && nck_job_start(n)) || nck_start_loop(n, &res->diag)) {
             snprintf(res->diag.msg, sizeof res->diag.msg, "cannot set up the runtime");
             res->status = NCP_NCK_FAULT;
         } else {
             if (n->loop.warning[0] && o->progress)
                 fprintf(o->progress, "warning: %s\n", n->loop.warning);
-            drain(n, o);
+            drain(n, o, &bh);
         }
     }
     nck_finish(n);
     if (res->status == NCP_NCK_OK && pre == PC_OK)
         collect(n, res);
+    if (bh.failed && !(o->interrupt && *o->interrupt)) {
+        res->home_failed = 1;
+        res->interrupted = 0;
+        res->diag = bh.diag;
+        res->status = NCP_NCK_FAULT;
+    }
     nck_release(n);
     free(n);
     return res->status;

@@ -359,44 +359,45 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
     return 0;
 }
 
-/* Homing on the simulated machine: its positions are absolute, so an axis
- * homes by moving to its HOME position at HOME_SEARCH_VEL; all axes: Z first
- * (out of the work), then X and Y. */
+/* Homing (homing.c): `all` (or nothing) homes the axes of the HOME_SEQUENCE
+ * list, letters name axes (`XZ`); either way by sequence, the position
+ * loop driving the axes itself. */
 static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
 {
     struct nck *n = &s->n;
+    const struct ncp_machine_cfg *cfg = n->cfg;
     if (s->state != NCP_ST_IDLE)
         return refuse(why, len, "cannot home while %s", ncp_nck_state_name(s->state));
-    int all = !strcasecmp(c->text, "all");
-    int j = all ? -1 : axis_index(c->text);
-    if (!all && (j < 0 || !(n->cfg->axis_mask & NCP_AXIS_BIT(j))))
-        return refuse(why, len, "home takes one of the machine's axis letters or all, not '%s'",
-                      c->text);
-    static const int order[NCP_AXES] = { 2, 0, 1, 3, 4, 5, 6, 7, 8 };
-    struct ncp_seg moves[NCP_AXES];
-    int count = 0, mask = 0;
-    double at[NCP_AXES];
-    memcpy(at, n->map.pos, sizeof at);
-    n->job.step_line = 0;
-    for (int k = 0; k < NCP_AXES; k++) {
-        int ax = order[k];
-        if ((!all && ax != j) || !(n->cfg->axis_mask & NCP_AXIS_BIT(ax)))
-            continue;
-        const struct ncp_axis_cfg *a = &n->cfg->axis[ax];
-        double to[NCP_AXES];
-        memcpy(to, at, sizeof to);
-        to[ax] = a->home;
-        double v = a->home_vel > 0 ? fmin(a->home_vel, a->max_vel) : 0.5 * a->max_vel;
-        nck_line(n, &moves[count], at, to, v, 0);
-        if (moves[count].length > 1e-9)
-            count++;
-        memcpy(at, to, sizeof at);
-        mask |= 1 << ax;
+    unsigned mask = 0;
+    if (!c->text[0] || !strcasecmp(c->text, "all")) {
+        mask = nck_home_all_mask(cfg);
+    } else {
+        for (const char *p = c->text; *p; p++) {
+            char one[2] = { *p, 0 };
+            int j = axis_index(one);
+            if (j < 0 || !(cfg->axis_mask & NCP_AXIS_BIT(j)))
+                return refuse(why, len, "home takes the machine's axis letters or all, not "
+                              "'%s'", c->text);
+            mask |= NCP_AXIS_BIT(j);
+        }
+        /* LinuxCNC's synchronised joints home only as their whole group */
+        for (int j = 0; j < NCP_AXES; j++) {
+            if (!(mask & NCP_AXIS_BIT(j)) || cfg->axis[j].home_sequence >= 0)
+                continue;
+            for (int k = 0; k < NCP_AXES; k++)
+                if ((cfg->axis_mask & NCP_AXIS_BIT(k)) && !(mask & NCP_AXIS_BIT(k)) &&
+                    cfg->axis[k].home_sequence == cfg->axis[j].home_sequence)
+                    return refuse(why, len, "%c and %c home together (HOME_SEQUENCE %d): home "
+                                  "both", NCP_AXIS_LETTERS[j], NCP_AXIS_LETTERS[k],
+                                  cfg->axis[j].home_sequence);
+        }
     }
-    if (start_moves(s, moves, count))
-        return refuse(why, len, "cannot start homing");
-    memcpy(n->map.pos, at, sizeof n->map.pos);
-    s->homing_axes = mask;
+    for (int j = 0; j < NCP_AXES; j++)
+        if (mask & NCP_AXIS_BIT(j))
+            s->homed[j] = 0;
+    n->job.step_line = 0;
+    nck_home_request(n, mask);
+    s->homing_axes = (int)mask;
     set_state(s, NCP_ST_HOMING);
     return 0;
 }
@@ -621,12 +622,6 @@ static void job_ended(struct ncp_nck *s)
     int kind = j->kind;
     j->kind = NCK_JOB_NONE;
     const struct ncp_diag *d = j->map_failed ? &j->map_diag : j->rc != NCP_OK ? &j->diag : NULL;
-    if (kind == NCK_JOB_MOVE && s->state == NCP_ST_HOMING) {
-        for (int a = 0; a < NCP_AXES; a++)
-            if (s->homing_axes & (1 << a))
-                s->homed[a] = 1;
-        nck_post(n, NCP_EV_INFO, NULL, 0, 0, "homed");
-    }
     if (d) {
         const char *file = d->file ? d->file : kind == NCK_JOB_MDI ? "MDI" : s->program;
         snprintf(s->error, sizeof s->error, "%s:%u:%u: %s", file, d->line,
@@ -642,6 +637,37 @@ static void job_ended(struct ncp_nck *s)
         nck_post(n, NCP_EV_INFO, s->program, 0, 0, "program finished");
     }
     /* the whole job in the trace once it is over, not at the next 64 KiB */
+    if (n->setup.trace)
+        nck_trace_flush(&n->sum, n->setup.trace);
+    set_state(s, NCP_ST_IDLE);
+}
+
+/* The loop is done homing: the axes it homed are homed, and the map and
+ * the interpreter start from where it left them (a stop or E-stop during
+ * it has its own drop, which ends in the state it asked for). */
+static void homing_ended(struct ncp_nck *s)
+{
+    struct nck *n = &s->n;
+    char report[1024];
+    int rc = nck_home_report(n, report, sizeof report);
+    for (int a = 0; a < NCP_AXES; a++)
+        if (rc == 0 && (s->homing_axes & (1 << a)))
+            s->homed[a] = 1;
+    s->homing_axes = 0;
+    for (char *line = report, *next; line && *line; line = next) {
+        next = strchr(line, '\n');
+        if (next)
+            *next++ = 0;
+        nck_post(n, rc ? NCP_EV_ERROR : NCP_EV_INFO, NULL, 0, 0, "%s", line);
+    }
+    if (rc)
+        snprintf(s->error, sizeof s->error, "%s", report);
+    else
+        nck_post(n, NCP_EV_INFO, NULL, 0, 0, "homed");
+    if (s->state != NCP_ST_HOMING)
+        return;
+    memcpy(n->map.pos, n->home.final, sizeof n->map.pos);
+    sync_interp(s);
     if (n->setup.trace)
         nck_trace_flush(&n->sum, n->setup.trace);
     set_state(s, NCP_ST_IDLE);
@@ -686,9 +712,11 @@ int ncp_nck_poll(struct ncp_nck *s)
         drop_step(s);
     int st = s->state;
     if ((st == NCP_ST_RUNNING || st == NCP_ST_STEPPING || st == NCP_ST_MDI ||
-         st == NCP_ST_JOGGING || st == NCP_ST_HOMING) &&
+         st == NCP_ST_JOGGING) &&
         atomic_load(&n->job.finished) && nck_motion_done(n))
         job_ended(s);
+    if (s->homing_axes && nck_home_finished(n))
+        homing_ended(s);
     /* the program paused the machine: PAUSED until resume (tool-changed) */
     if (n->have_fb && n->last_fb.waits != s->waits_seen) {
         st = s->state;

@@ -56,9 +56,16 @@ static int drive(struct nck *n, double act[NCP_AXES], int with_faults)
     const struct ncp_kins *k = &n->cfg->kins;
     ncp_kins_inverse(k, n->cur.tool_z, n->cur.pos, n->jcmd);
     ncp_kins_inverse(k, n->next.tool_z, n->next.pos, n->jnext);
+    /* homing's offset between the joints and what the servos count from */
+    double c[NCP_AXES], x[NCP_AXES], a[NCP_AXES];
+    for (int j = 0; j < NCP_AXES; j++) {
+        c[j] = n->jcmd[j] + n->home.off[j];
+        x[j] = n->jnext[j] + n->home.off[j];
+    }
     /* timing faults act on what the servos get: the joints */
-    int rc = with_faults ? nck_servo_cycle(n, n->jcmd, n->jnext, n->jact)
-                         : n->be.ops->cycle(&n->be, n->jcmd, n->jnext, n->jact);
+    int rc = with_faults ? nck_servo_cycle(n, c, x, a) : n->be.ops->cycle(&n->be, c, x, a);
+    for (int j = 0; j < NCP_AXES; j++)
+        n->jact[j] = a[j] - n->home.off[j];
     ncp_kins_forward(k, n->cur.tool_z, n->jact, act);
     return rc;
 }
@@ -205,9 +212,11 @@ static void discard(struct nck *n, const double act[NCP_AXES])
                           memory_order_release);
 }
 
-static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES])
+static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES],
+                       uint64_t home)
 {
     struct nck_fb fb;
+    fb.home = home;
     fb.t = (double)now_ns * 1e-9;
     fb.v = n->cur.v;
     fb.line = n->cur.line;
@@ -254,6 +263,7 @@ static int frozen_cycle(struct nck *n, int64_t now_ns)
         n->be.ops->enable(&n->be, 0);
         n->drives_on = 0;
     }
+    nck_home_cancel(n);
     double act[NCP_AXES];
     n->be.timing = NULL;
     n->next = n->cur;
@@ -265,7 +275,7 @@ static int frozen_cycle(struct nck *n, int64_t now_ns)
         atomic_load_explicit(&n->discard_ack, memory_order_relaxed))
         discard(n, act);
     n->cur.v = 0;
-    push_cycle(n, now_ns, act);
+    push_cycle(n, now_ns, act, 0);
     atomic_store_explicit(&n->at_rest, 1, memory_order_relaxed);
     if (n->setup.virtual_clock)
         idle_nap(n);
@@ -291,15 +301,25 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
     }
     n->scaler.decel = atomic_load_explicit(&n->full_decel, memory_order_relaxed)
                           ? n->decel_full : n->decel_normal;
-    if (take_setpoint(n) == NCP_RT_RETRY)
-        return NCP_RT_RETRY;
+    /* homing drives the axes itself, the planner's stream waits */
+    if (!nck_home_take(n)) {
+        if (atomic_load_explicit(&n->job_pending, memory_order_acquire)) {
+            if (virt)
+                return NCP_RT_RETRY;
+            n->cur = n->next;
+        } else if (take_setpoint(n) == NCP_RT_RETRY) {
+            return NCP_RT_RETRY;
+        }
+    }
+    uint64_t home = nck_home_phases(n);   /* the row shows the phase the period ran in */
     double act[NCP_AXES];
     int be_rc = drive(n, act, 1);
     nck_probe_cycle(n, act);
+    nck_home_sense(n, act);
     track_blocks(n);
-    push_cycle(n, now_ns, act);
-    int rest = n->cur.v == 0 && n->next.v == 0 && (n->scaler.r == 0 || n->end_seen ||
-                                                   ncp_spsc_count(&n->sps) == 0);
+    push_cycle(n, now_ns, act, home);
+    int rest = !nck_home_active(n) && n->cur.v == 0 && n->next.v == 0 &&
+               (n->scaler.r == 0 || n->end_seen || ncp_spsc_count(&n->sps) == 0);
     atomic_store_explicit(&n->at_rest, rest, memory_order_relaxed);
     if (atomic_load_explicit(&n->discard_req, memory_order_acquire) !=
         atomic_load_explicit(&n->discard_ack, memory_order_relaxed))

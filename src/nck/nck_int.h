@@ -154,6 +154,35 @@ struct nck_probe {
     double rest[NCP_AXES];     /* where the axes stopped after a trip */
 };
 
+/* Homing (homing.c): the position loop drives each axis of the request on
+ * its own, away from the planner, through LinuxCNC's phases; the trace's
+ * `home` column shows each axis's phase as one digit. */
+enum nck_home_phase { NCK_HP_NONE, NCK_HP_OFF_SWITCH, NCK_HP_SEARCH, NCK_HP_BACK_OFF,
+                      NCK_HP_LATCH, NCK_HP_LATCHED, NCK_HP_FINAL };
+enum nck_home_result { NCK_HOME_OK, NCK_HOME_NOT_FOUND, NCK_HOME_STOPPED };
+struct nck_home_axis {
+    int phase;             /* enum nck_home_phase */
+    int queued;            /* waits for its HOME_SEQUENCE's turn */
+    int stopping;          /* the phase's event came: braking to a stop */
+    double pos, v;         /* commanded position (machine coordinates), velocity */
+    double from;           /* where the phase began: a search's travel is bounded */
+    double latched;        /* where the switch latched, simulated machine's coordinates */
+};
+struct nck_homing {
+    /* the caller's thread writes mask, then counts req; the loop counts
+     * done once that request is over (result, final and latched then hold) */
+    unsigned mask;
+    _Atomic uint32_t req, done;
+    uint32_t taken;
+    int active;
+    int result, fail_axis;
+    struct nck_home_axis ax[NCP_AXES];
+    /* the simulated machine's position minus the machine position: homing
+     * sets the machine position where the switch latches */
+    double off[NCP_AXES];
+    double final[NCP_AXES];
+};
+
 /* One servo cycle as the position loop saw it. */
 struct nck_fb {
     double t, v;
@@ -170,6 +199,7 @@ struct nck_fb {
     int32_t tool;
     uint32_t wait_line;
     struct ncp_inject_ev inj;   /* the timing faults of the cycle (trace column inject) */
+    uint64_t home;              /* homing phase per axis, 4 bits each (enum nck_home_phase) */
 };
 
 struct nck_summary {
@@ -271,6 +301,9 @@ struct nck {
     uint32_t aux_seq;                /* the last pack numbered (job threads, in turn) */
     struct nck_mach mach;            /* position loop only */
     struct nck_probe probe;          /* position loop; the result for the job (probe.c) */
+    struct nck_homing home;          /* position loop; the request and result (homing.c) */
+    _Atomic int job_pending;         /* batch --home: the program's job starts after homing;
+                                        the loop holds still (virtual clock: time too) */
     /* canonical calls the jobs took, acted on and refused, per kind (job
      * threads, in turn; read after the job) */
     uint64_t calls_in[NCP_C__COUNT], calls_acted[NCP_C__COUNT], calls_refused[NCP_C__COUNT];
@@ -453,6 +486,28 @@ int nck_check_call(const struct ncp_cmd *cmd, const struct ncp_canon *op, struct
 void nck_probe_arm(struct nck *n, int flags);
 void nck_probe_cycle(struct nck *n, const double act[NCP_AXES]);
 int nck_probe_braking(const struct nck *n);
+
+/* homing.c. The loop: nck_home_take instead of the planned setpoint (1 when
+ * homing drives this period), nck_home_sense after the backend's cycle,
+ * nck_home_cancel on an E-stop or fault (loop.c's drive() puts home.off
+ * between the joints and the backend). The caller's thread: nck_home_request
+ * (at rest, nothing queued), nck_home_finished once the loop is done. */
+int nck_home_take(struct nck *n);
+void nck_home_sense(struct nck *n, const double act[NCP_AXES]);
+void nck_home_cancel(struct nck *n);
+int nck_home_active(const struct nck *n);
+uint64_t nck_home_phases(const struct nck *n);
+/* The order of homing: HOME_SEQUENCE's absolute value; without any
+ * HOME_SEQUENCE in the INI, Z first, then all the others together. */
+int nck_home_seq(const struct ncp_machine_cfg *c, int axis);
+/* The axes "home all" homes: all of them, or, once any axis has a
+ * HOME_SEQUENCE, those that have one (LinuxCNC's rule). */
+unsigned nck_home_all_mask(const struct ncp_machine_cfg *c);
+void nck_home_request(struct nck *n, unsigned mask);
+int nck_home_finished(const struct nck *n);
+/* One line per homed axis of the last request (where its switch latched),
+ * or why homing failed; 0, or -1 when it failed. */
+int nck_home_report(const struct nck *n, char *buf, size_t len);
 
 /* pauses.c: the operator is told of a wait the loop began (stats.c) */
 void nck_wait_began(struct nck *n, const struct nck_fb *fb);

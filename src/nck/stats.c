@@ -87,6 +87,20 @@ static int trace_joints(char *buf, size_t len, unsigned mask, const struct nck_f
     return (int)at;
 }
 
+/* The `home` column: one digit per machine axis, in COORDINATES
+ * order, the homing phase it is in (enum nck_home_phase, 0 not homing). */
+static int trace_home(char *buf, size_t len, unsigned mask, uint64_t home)
+{
+    size_t at = 0;
+    if (len < 2 + NCP_AXES)
+        return -1;
+    buf[at++] = ',';
+    for (int j = 0; j < NCP_AXES; j++)
+        if (mask & NCP_AXIS_BIT(j))
+            buf[at++] = (char)('0' + ((home >> (4 * j)) & 0xf));
+    return (int)at;
+}
+
 void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, FILE *trace)
 {
     double e2 = 0;
@@ -144,6 +158,11 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
                              fb->rev);
             m = t > 0 && (size_t)t < sizeof s->tbuf - at - (size_t)m - 1 ? m + t : -1;
         }
+        /* every axis's homing phase */
+        int h = m >= 0 ? trace_home(s->tbuf + at + m, sizeof s->tbuf - at - (size_t)m - 1, mask,
+                                    fb->home)
+                       : -1;
+        m = h >= 0 ? m + h : -1;
         if (m >= 0 && s->joints) {
             int mj = trace_joints(s->tbuf + at + (size_t)m, sizeof s->tbuf - at - (size_t)m - 1,
                                   mask, fb);
@@ -171,7 +190,7 @@ void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints
         if (mask & NCP_AXIS_BIT(j))
             fprintf(trace, ",%c_cmd,%c_act", NCP_AXIS_LETTERS[j] | 0x20,
                     NCP_AXIS_LETTERS[j] | 0x20);
-    fputs(",spindle_turns", trace);
+    fputs(",spindle_turns,home", trace);
     if (joints)
         fputs(",tool_z", trace);
     for (int j = 0; j < NCP_AXES && joints; j++)
