@@ -77,6 +77,12 @@ struct ncp_backend_ops {
      * no torque, CiA 402 "disable operation"). NULL: the backend cannot turn
      * its drives off; the loop then holds them at a frozen setpoint. */
     void (*enable)(struct ncp_backend *b, int on);
+    /* Just before the real-time loop takes over (not real-time): a backend
+     * that kept the machine alive on its own since start() hands over. CAN
+     * drives, once enabled, must see SYNC, RPDOs and the master's heartbeat
+     * all the time (they guard the master), also while the program is
+     * checked before motion. NULL: nothing to hand over. */
+    void (*live)(struct ncp_backend *b);
 };
 
 struct ncp_backend {

@@ -186,6 +186,16 @@ struct ncp_co_master_cfg {
     int sdo_timeout_ms;
     int hb_period_ms;     /* heartbeat producer time written to 0x1017 */
     int hb_timeout_ms;    /* a drive silent this long is lost */
+    /* The drives guard the master (written at start-up when master_node > 0):
+     * its own heartbeat goes out every hb_period_ms as node master_node; a
+     * drive that misses it for hb_consumer_ms (0x1016:01), or RPDO1 for
+     * rpdo_timeout_ms (0x1400:05, 0 = off), reacts as abort_option (0x6007)
+     * and, for a fault, fault_reaction (0x605E) say. */
+    uint8_t master_node;
+    int hb_consumer_ms;
+    int rpdo_timeout_ms;
+    int abort_option;
+    int fault_reaction;
 };
 
 enum ncp_co_fault_kind {
@@ -223,11 +233,15 @@ struct ncp_co_master {
     uint16_t cw[NCP_CO_MAX_NODES];      /* controlword sent in RPDO1 */
     int32_t target[NCP_CO_MAX_NODES];   /* target position sent in RPDO1, counts */
     uint8_t enabled[NCP_CO_MAX_NODES];  /* reached Operation enabled */
+    /* quick stop deceleration (0x6085, counts/s^2) a guarding drive brakes
+     * with on its own: the axis's acceleration limit; 0 = the drive's own */
+    uint32_t quick_stop_dec[NCP_CO_MAX_NODES];
     size_t n;
     struct ncp_co_master_cfg cfg;
     FILE *log;                          /* start-up progress, or NULL */
     int64_t started_ms;                 /* NMT start: heartbeats counted from here */
     long cycle;                         /* SYNCs sent */
+    int64_t next_hb_ms;                 /* the master's next own heartbeat */
     unsigned tx_full;                   /* consecutive periods with a full queue */
     struct ncp_co_fault fault;
     /* blocking cycles call this for every TPDO taken in (tests judge them) */

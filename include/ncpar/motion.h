@@ -74,6 +74,13 @@ struct ncp_can_cfg {
     int heartbeat_period_ms;      /* HEARTBEAT_PERIOD_MS: drives' producer time (0x1017) */
     int heartbeat_timeout_ms;     /* HEARTBEAT_TIMEOUT_MS: later than this = lost */
     int sdo_timeout_ms;           /* SDO_TIMEOUT_MS: start-up SDO answer deadline */
+    int master_node;              /* MASTER_NODE: our heartbeat's node-ID (127); 0: drives
+                                     do not guard the master */
+    int hb_consumer_ms;           /* HEARTBEAT_CONSUMER_MS: drives stop when our heartbeat
+                                     is this late (0x1016) */
+    int rpdo_timeout_ms;          /* RPDO_TIMEOUT_MS: ... or RPDO1 (0x1400:05), 0 off */
+    int abort_option;             /* ABORT_CONNECTION_OPTION: 0x6007 (3: quick stop) */
+    int fault_reaction;           /* FAULT_REACTION_OPTION: 0x605E (2: quick stop ramp) */
 };
 
 

@@ -91,6 +91,10 @@ struct ncp_rt_loop {
     /* called once per period with the cycle's scheduled time (ns since start) */
     int (*cycle)(void *ctx, int64_t now_ns);
     void *ctx;
+    /* optional, once the memory is locked and just before the loop's thread
+     * starts: whatever kept the machine alive until now hands over (locking
+     * the memory may stall every thread of the process for a while) */
+    void (*handover)(void *ctx);
     struct ncp_rt_stats stats;    /* written by the loop thread only */
     _Atomic int stop;             /* request from outside */
     _Atomic int running;

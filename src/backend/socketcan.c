@@ -14,6 +14,8 @@
 #include "ncpar/backend.h"
 #include "ncpar/can.h"
 
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,7 +28,39 @@ struct sc {
     double cpm[NCP_AXES];
     int ax[NCP_AXES];
     int n;
+    /* from start() to the loop: a thread runs the blocking cycle, holding
+     * the drives where they stand */
+    pthread_t idle;
+    int idle_started;
+    atomic_int idle_run;
+    atomic_int idle_failed;
 };
+
+static void *idle_main(void *arg)
+{
+    struct sc *s = arg;
+    struct ncp_diag d;
+    while (atomic_load(&s->idle_run))
+        if (ncp_co_master_cycle(&s->m, &d) != NCP_OK) {
+            atomic_store(&s->idle_failed, 1);
+            break;
+        }
+    return NULL;
+}
+
+static void idle_stop(struct sc *s)
+{
+    if (!s->idle_started)
+        return;
+    atomic_store(&s->idle_run, 0);
+    pthread_join(s->idle, NULL);
+    s->idle_started = 0;
+}
+
+static void sc_live(struct ncp_backend *b)
+{
+    idle_stop(b->impl);
+}
 
 static int sc_start(struct ncp_backend *b, double pos[NCP_AXES])
 {
@@ -43,6 +77,9 @@ static int sc_start(struct ncp_backend *b, double pos[NCP_AXES])
         s->m.cw[k] = NCP_402_CW_ENABLE;
         pos[s->ax[k]] = ncp_counts_to_mm(s->m.node[k].actual, s->cpm[k]);
     }
+    atomic_store(&s->idle_run, 1);
+    atomic_store(&s->idle_failed, 0);
+    s->idle_started = pthread_create(&s->idle, NULL, idle_main, s) == 0;
     return 0;
 }
 
@@ -53,7 +90,9 @@ static int sc_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const dou
     struct sc *s = b->impl;
     struct ncp_co_master *m = &s->m;
     int64_t now = ncp_co_now_ms();
-    int bad = ncp_co_master_poll(m, now, POLL_MAX) || ncp_co_master_check(m, now);
+    /* a fault while the drives were held before the loop (fault recorded) */
+    int bad = atomic_load(&s->idle_failed) || ncp_co_master_poll(m, now, POLL_MAX) ||
+              ncp_co_master_check(m, now);
     for (int k = 0; k < s->n; k++)
         act[s->ax[k]] = ncp_counts_to_mm(m->node[k].actual, s->cpm[k]);
     if (bad)
@@ -67,6 +106,7 @@ static int sc_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const dou
 static void sc_stop(struct ncp_backend *b)
 {
     struct sc *s = b->impl;
+    idle_stop(s);
     ncp_co_master_stop(&s->m);
 }
 
@@ -85,7 +125,7 @@ static void sc_close(struct ncp_backend *b)
 }
 
 static const struct ncp_backend_ops sc_ops = {
-    "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, NULL,
+    "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, NULL, sc_live,
 };
 
 int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
@@ -109,12 +149,21 @@ int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_c
         .sdo_timeout_ms = cfg->can.sdo_timeout_ms,
         .hb_period_ms = cfg->can.heartbeat_period_ms,
         .hb_timeout_ms = cfg->can.heartbeat_timeout_ms,
+        .master_node = (uint8_t)cfg->can.master_node,
+        .hb_consumer_ms = cfg->can.hb_consumer_ms,
+        .rpdo_timeout_ms = cfg->can.rpdo_timeout_ms,
+        .abort_option = cfg->can.abort_option,
+        .fault_reaction = cfg->can.fault_reaction,
     };
     if (ncp_co_master_open(&s->m, cfg->can.interface, nodes, s->n, &mc, d) != NCP_OK) {
         free(s);
         return d->code;
     }
     s->m.log = log;
+    for (int i = 0; i < s->n; i++) {
+        double dec = cfg->axis[s->ax[i]].max_acc * s->cpm[i];
+        s->m.quick_stop_dec[i] = dec >= 1 && dec < 4e9 ? (uint32_t)dec : 0;
+    }
     memset(b, 0, sizeof *b);
     b->ops = &sc_ops;
     b->impl = s;

@@ -32,9 +32,14 @@ static void usage(FILE *f)
           "  --config INI --axis X|Y|Z the servo plant of cnc-run's sim backend for that\n"
           "                            axis ([SIM] gains, COUNTS_PER_MM; period from 0x60C2)\n"
           "                            instead of the slew-limited plant\n"
+          "  --sync-loss-ms MS         no SYNC for MS ms while enabled: EMCY 0x8700 and\n"
+          "                            the stop of 0x6007 (default 100, 0 = never)\n"
           "  --verbose                 log state changes on stderr\n"
           "Answers NMT, SDO (expedited), SYNC and RPDO1/TPDO1 (controlword+target,\n"
-          "statusword+actual); heartbeat period from object 0x1017 (default 100 ms).\n",
+          "statusword+actual); heartbeat period from object 0x1017 (default 100 ms).\n"
+          "Guards the master: its heartbeat (consumer 0x1016:01), SYNC and RPDO1\n"
+          "(deadline 0x1400:05); when one stops while enabled the drive sends EMCY\n"
+          "(0x8130, 0x8700, 0x8250) and stops as 0x6007 and 0x605E say.\n",
           f);
 }
 
@@ -60,10 +65,11 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         {"drop-every", required_argument, 0, 'd'},   {"max-step", required_argument, 0, 'm'},
         {"verbose", no_argument, 0, 'v'},            {"help", no_argument, 0, 'h'},
         {"config", required_argument, 0, 'c'},       {"axis", required_argument, 0, 'x'},
+        {"sync-loss-ms", required_argument, 0, 'L'},
         {0, 0, 0, 0}};
     *o = (struct drive_opts){.node = 0, .fault_after = -1, .emcy_after = -1,
                              .hb_stop_after = -1, .abort_index = -1, .max_step = 1000000,
-                             .axis = -1};
+                             .axis = -1, .sync_loss_ms = 100};
     int c;
     while ((c = getopt_long(argc, argv, "n:v", lo, NULL)) != -1) {
         switch (c) {
@@ -77,6 +83,7 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         case 'd': o->drop_every = num(optarg, "--drop-every", 1, 1L << 30); break;
         case 'm': o->max_step = (int32_t)num(optarg, "--max-step", 1, 1L << 30); break;
         case 'v': o->verbose = 1; break;
+        case 'L': o->sync_loss_ms = num(optarg, "--sync-loss-ms", 0, 600000); break;
         case 'c': o->config = optarg; break;
         case 'x':
             if (!optarg[0] || optarg[1] || !strchr("XYZxyz", optarg[0])) {
@@ -115,18 +122,30 @@ int main(int argc, char **argv)
         return 1;
     }
     uint8_t n = dv.o.node;
-    const uint32_t ids[] = {NCP_COB_NMT, NCP_COB_SYNC, NCP_COB_SDO_RX + n, NCP_COB_RPDO1 + n};
-    if (ncp_can_filter(&dv.bus, ids, sizeof ids / sizeof ids[0], &d) != NCP_OK) {
-        fprintf(stderr, "cnc-drive-sim: %s\n", d.msg);
-        return 1;
-    }
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     drive_boot(&dv);
     long long next_hb = now_ms();
+    uint32_t ids[6], listening[6];
+    size_t n_listening = 0;
     int rc = 0;
     while (!stop) {
+        /* the master's heartbeat joins the filter once 0x1016 names it */
+        size_t n_ids = drive_listen_ids(&dv, ids);
+        if (n_ids != n_listening || memcmp(ids, listening, n_ids * sizeof ids[0])) {
+            if (ncp_can_filter(&dv.bus, ids, n_ids, &d) != NCP_OK) {
+                fprintf(stderr, "cnc-drive-sim: %s\n", d.msg);
+                rc = 1;
+                break;
+            }
+            memcpy(listening, ids, n_ids * sizeof ids[0]);
+            n_listening = n_ids;
+        }
         long long t = now_ms();
+        if (drive_guard_tick(&dv, t) < 0) {
+            rc = 1;
+            break;
+        }
         uint32_t period = od_get(&dv.od, 0x1017, 0);
         if (period > 0 && t >= next_hb) {
             if (drive_send_heartbeat(&dv) < 0)
@@ -134,6 +153,9 @@ int main(int argc, char **argv)
             next_hb = t + period;
         }
         int wait = period > 0 ? (int)(next_hb - t) : 100;
+        int guard = drive_guard_wait_ms(&dv, t);
+        if (guard < wait)
+            wait = guard;
         struct ncp_can_frame f;
         int r = ncp_can_recv(&dv.bus, &f, wait > 100 ? 100 : (wait < 0 ? 0 : wait), &d);
         if (r < 0) {
@@ -141,7 +163,7 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
-        if (r > 0 && drive_on_frame(&dv, &f) < 0) {
+        if (r > 0 && drive_on_frame(&dv, &f, now_ms()) < 0) {
             rc = 1;
             break;
         }

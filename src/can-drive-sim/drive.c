@@ -6,7 +6,7 @@
 
 #include "drive.h"
 
-static int send(struct drive *dv, const struct ncp_can_frame *f)
+int drive_send(struct drive *dv, const struct ncp_can_frame *f)
 {
     struct ncp_diag d;
     if (ncp_can_send(&dv->bus, f, &d) != NCP_OK) {
@@ -16,7 +16,7 @@ static int send(struct drive *dv, const struct ncp_can_frame *f)
     return 0;
 }
 
-static void set_state(struct drive *dv, enum ncp_cia402_state s)
+void drive_set_state(struct drive *dv, enum ncp_cia402_state s)
 {
     if (s != dv->st && dv->o.verbose)
         fprintf(stderr, "cnc-drive-sim node %u: %s -> %s\n", dv->o.node,
@@ -33,12 +33,14 @@ void drive_boot(struct drive *dv)
     dv->target = dv->actual;
     dv->syncs_enabled = 0;
     dv->heartbeat_on = 1;
-    set_state(dv, dv->o.fault_at_start ? NCP_402_FAULT : NCP_402_SWITCH_ON_DISABLED);
+    dv->last_master_hb = dv->last_sync = dv->last_rpdo = -1;
+    dv->lost = 0;
+    drive_set_state(dv, dv->o.fault_at_start ? NCP_402_FAULT : NCP_402_SWITCH_ON_DISABLED);
     if (dv->o.fault_at_start)
         od_set(&dv->od, 0x603F, 0, 0x5530);
     struct ncp_can_frame f;
     ncp_heartbeat_frame(&f, dv->o.node, NCP_NMT_BOOTUP);
-    send(dv, &f);
+    drive_send(dv, &f);
 }
 
 int drive_send_heartbeat(struct drive *dv)
@@ -47,7 +49,7 @@ int drive_send_heartbeat(struct drive *dv)
         return 0;
     struct ncp_can_frame f;
     ncp_heartbeat_frame(&f, dv->o.node, dv->nmt);
-    return send(dv, &f);
+    return drive_send(dv, &f);
 }
 
 static void apply_controlword(struct drive *dv, uint16_t cw)
@@ -60,14 +62,15 @@ static void apply_controlword(struct drive *dv, uint16_t cw)
         od_set(&dv->od, 0x603F, 0, 0);
     if (next == NCP_402_OPERATION_ENABLED && dv->st != next) {
         dv->target = dv->actual; /* no jump on enabling */
+        dv->prev_actual = dv->actual;
         drive_servo_enable(dv);
     }
-    set_state(dv, next);
+    drive_set_state(dv, next);
 }
 
-static int go_fault(struct drive *dv, uint16_t code, int with_emcy)
+int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy)
 {
-    set_state(dv, NCP_402_FAULT);
+    drive_set_state(dv, NCP_402_FAULT);
     od_set(&dv->od, 0x603F, 0, code);
     od_set(&dv->od, 0x1001, 0, 0x21);
     if (!with_emcy)
@@ -75,7 +78,7 @@ static int go_fault(struct drive *dv, uint16_t code, int with_emcy)
     struct ncp_emcy e = {.code = code, .reg = 0x21, .vendor = {0}};
     struct ncp_can_frame f;
     ncp_emcy_frame(&f, dv->o.node, &e);
-    return send(dv, &f);
+    return drive_send(dv, &f);
 }
 
 static int32_t plant_step(int32_t actual, int32_t target, int32_t max_step)
@@ -94,13 +97,14 @@ static int on_sync(struct drive *dv)
         return 0;
     if (dv->st == NCP_402_OPERATION_ENABLED) {
         dv->syncs_enabled++;
+        dv->prev_actual = dv->actual;
         dv->actual = dv->servo ? drive_servo_step(dv)
                                : plant_step(dv->actual, dv->target, dv->o.max_step);
         od_set(&dv->od, 0x6064, 0, (uint32_t)dv->actual);
-        if (dv->syncs_enabled == dv->o.emcy_after && go_fault(dv, 0x8611, 1) < 0)
+        if (dv->syncs_enabled == dv->o.emcy_after && drive_go_fault(dv, 0x8611, 1) < 0)
             return -1;
         if (dv->syncs_enabled == dv->o.fault_after)
-            go_fault(dv, 0x7305, 0);
+            drive_go_fault(dv, 0x7305, 0);
         if (dv->syncs_enabled == dv->o.hb_stop_after)
             dv->heartbeat_on = 0;
     }
@@ -109,7 +113,7 @@ static int on_sync(struct drive *dv)
         return 0;
     struct ncp_can_frame f;
     ncp_tpdo1_frame(&f, dv->o.node, ncp_cia402_statusword(dv->st), dv->actual);
-    return send(dv, &f);
+    return drive_send(dv, &f);
 }
 
 static int on_nmt(struct drive *dv, const struct ncp_can_frame *f)
@@ -185,21 +189,29 @@ static int on_sdo(struct drive *dv, const struct ncp_can_frame *f)
     }
     if (!e)
         ncp_sdo_abort_frame(&r, NCP_COB_SDO_TX + dv->o.node, index, sub, abort);
-    return send(dv, &r);
+    return drive_send(dv, &r);
 }
 
-int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f)
+int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f, long long now_ms)
 {
     uint8_t n = dv->o.node;
+    uint32_t consumer = od_get(&dv->od, 0x1016, 1);
     if (f->id == NCP_COB_NMT)
         return on_nmt(dv, f);
-    if (f->id == NCP_COB_SYNC)
+    if ((consumer >> 16 & 0x7Fu) && f->id == NCP_COB_HEARTBEAT + (consumer >> 16 & 0x7Fu)) {
+        dv->last_master_hb = now_ms;
+        return 0;
+    }
+    if (f->id == NCP_COB_SYNC) {
+        dv->last_sync = now_ms;
         return on_sync(dv);
+    }
     if (f->id == NCP_COB_SDO_RX + n && dv->nmt != NCP_NMT_STOPPED)
         return on_sdo(dv, f);
     if (f->id == NCP_COB_RPDO1 + n && dv->nmt == NCP_NMT_OPERATIONAL) {
         uint16_t cw;
         int32_t target;
+        dv->last_rpdo = now_ms;
         if (ncp_rpdo1_decode(f, &cw, &target) == 0) {
             if (cw != dv->cw)
                 apply_controlword(dv, cw);

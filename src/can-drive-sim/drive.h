@@ -23,6 +23,7 @@ struct drive_opts {
      * ([SIM] gains, COUNTS_PER_MM) instead of the slew limit */
     const char *config;
     int axis;             /* 0..2, -1 = none */
+    long sync_loss_ms;    /* no SYNC this long while enabled: the drive stops; 0 never */
 };
 
 struct drive {
@@ -40,8 +41,19 @@ struct drive {
     struct ncp_machine_cfg cfg;
     struct ncp_sim sim;
     int32_t prev_target;  /* target of the previous SYNC: this period's command */
+    /* Guarding the master (guard.c): when its heartbeat (0x1016), SYNC or
+     * RPDO1 (0x1400:05) was last seen, on the drive's own clock, in ms; -1
+     * before the first. */
+    long long last_master_hb, last_sync, last_rpdo;
+    uint16_t lost;        /* EMCY code of the loss being reacted to, 0 none */
+    int32_t prev_actual;  /* actual at the SYNC before: the speed when the master is lost */
+    double stop_vel;      /* counts per period while ramping down on its own */
+    long long next_step;  /* the ramp's next step, ms */
+    enum ncp_cia402_state after_stop; /* where the ramp ends */
 };
 
+/* 0x60C2: value * 10^index s, the period the master runs SYNC at. */
+double drive_period_s(struct drive *dv);
 /* Loads o.config for the servo plant; -1 with a message on stderr. */
 int drive_servo_load(struct drive *dv);
 /* Entering Operation enabled: the plant starts where the drive stands. */
@@ -50,8 +62,21 @@ void drive_servo_enable(struct drive *dv);
 int32_t drive_servo_step(struct drive *dv);
 
 void drive_boot(struct drive *dv);
-/* Handles one received frame; returns -1 on a bus error. */
-int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f);
+/* Handles one received frame at now_ms (the drive's clock); -1 on a bus error. */
+int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f, long long now_ms);
+/* Shared with guard.c. */
+void drive_set_state(struct drive *dv, enum ncp_cia402_state s);
+int drive_send(struct drive *dv, const struct ncp_can_frame *f);
+int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy);
+
+/* guard.c: the deadlines of the master's heartbeat, SYNC and RPDO1, and the
+ * drive's own reaction (0x6007, 0x605E) when one passes: called whenever the
+ * drive wakes; -1 on a bus error. */
+int drive_guard_tick(struct drive *dv, long long now_ms);
+/* How long the drive may sleep before the next deadline or ramp step, ms. */
+int drive_guard_wait_ms(struct drive *dv, long long now_ms);
+/* The CAN identifiers the drive listens to (its filter): n returned. */
+size_t drive_listen_ids(struct drive *dv, uint32_t ids[6]);
 int drive_send_heartbeat(struct drive *dv);
 
 #endif

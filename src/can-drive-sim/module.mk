@@ -10,3 +10,10 @@ DRIVE_SIM_OBJS = $(patsubst %.c,$(BUILD)/%.o,$(wildcard src/can-drive-sim/*.c) \
 
 $(BUILD)/cnc-drive-sim: $(DRIVE_SIM_OBJS) $(BUILD)/libncpar-can.a
 	$(Q)$(CC) $(ALL_CFLAGS) -o $@ $^ -lm -linih
+
+# The drive's guarding of its master, tested on the host over a socket pair
+# (no CAN needed): the drive's objects without its main.
+$(BUILD)/tests/test_drive_guard: tests/unit/test_drive_guard.c \
+        $(filter-out %/cnc_drive_sim.o,$(DRIVE_SIM_OBJS)) $(BUILD)/libncpar-can.a | $(GEN_STAMP)
+	@mkdir -p $(@D)
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -Isrc/can-drive-sim -o $@ $^ -lcmocka -lm -linih

@@ -14,9 +14,13 @@ void od_init(struct od *od)
     od->n = 0;
     add(od, 0x1000, 0, 4, OD_RO, 0x00020192); /* CiA 402 servo drive */
     add(od, 0x1001, 0, 1, OD_RO, 0);          /* error register */
+    add(od, 0x1006, 0, 4, OD_RW, 0);          /* communication cycle period, us */
+    add(od, 0x1016, 0, 1, OD_RO, 1);          /* heartbeat consumer: one entry */
+    add(od, 0x1016, 1, 4, OD_RW, 0);          /* ... node << 16 | time ms; 0 off */
     add(od, 0x1017, 0, 2, OD_RW, 100);        /* heartbeat producer, ms */
     add(od, 0x1400, 1, 4, OD_RW, 0x200);      /* RPDO1 COB-ID (+ node) */
     add(od, 0x1400, 2, 1, OD_RW, 1);          /* every SYNC */
+    add(od, 0x1400, 5, 2, OD_RW, 0);          /* event timer: RPDO deadline, ms; 0 off */
     add(od, 0x1600, 0, 1, OD_RW, 2);
     add(od, 0x1600, 1, 4, OD_RW, 0x60400010);
     add(od, 0x1600, 2, 4, OD_RW, 0x607A0020);
@@ -28,10 +32,14 @@ void od_init(struct od *od)
     add(od, 0x603F, 0, 2, OD_RO, 0);          /* error code */
     add(od, 0x6040, 0, 2, OD_RW, 0);
     add(od, 0x6041, 0, 2, OD_RO, 0);
+    add(od, 0x6007, 0, 2, OD_RW, 1);          /* abort connection option: fault */
+    add(od, 0x605A, 0, 2, OD_RW, 2);          /* quick stop option: ramp, then disabled */
+    add(od, 0x605E, 0, 2, OD_RW, 2);          /* fault reaction option: quick stop ramp */
     add(od, 0x6060, 0, 1, OD_RW, 0);
     add(od, 0x6061, 0, 1, OD_RO, 0);
     add(od, 0x6064, 0, 4, OD_RO, 0);
     add(od, 0x607A, 0, 4, OD_RW, 0);
+    add(od, 0x6085, 0, 4, OD_RW, 2000000);    /* quick stop deceleration, counts/s^2 */
     add(od, 0x60C2, 1, 1, OD_RW, 1);          /* interpolation period value */
     add(od, 0x60C2, 2, 1, OD_RW, 0xFD);       /* ... index: 10^-3 s */
 }

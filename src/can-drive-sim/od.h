@@ -15,7 +15,7 @@ struct od_entry {
 };
 
 struct od {
-    struct od_entry e[32];
+    struct od_entry e[48];
     int n;
 };
 

@@ -5,8 +5,7 @@
 
 #include "drive.h"
 
-/* 0x60C2: value * 10^index s, the period the master runs SYNC at. */
-static double interp_period(struct drive *dv)
+double drive_period_s(struct drive *dv)
 {
     double t = od_get(&dv->od, 0x60C2, 1);
     unsigned raw = od_get(&dv->od, 0x60C2, 2) & 0xFFu; /* INTEGER8 */
@@ -21,7 +20,7 @@ void drive_servo_enable(struct drive *dv)
         return;
     double start[NCP_AXES] = {0};
     struct ncp_machine_cfg c = dv->cfg;
-    c.servo_period = interp_period(dv);
+    c.servo_period = drive_period_s(dv);
     start[dv->o.axis] = ncp_counts_to_mm(dv->actual, c.axis[dv->o.axis].counts_per_mm);
     ncp_sim_init(&dv->sim, &c, start);
     dv->prev_target = dv->actual;

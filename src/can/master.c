@@ -72,6 +72,15 @@ int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *
         {0x1A00, 0, 2, 1},                      /* TPDO1 = statusword + actual */
         {0x1017, 0, (uint32_t)m->cfg.hb_period_ms, 2}, /* heartbeat producer */
     };
+    /* the drive guards us: consumer of our heartbeat, RPDO deadline, and
+     * what it does on its own when either stops (a killed master) */
+    const struct sdo_step guard[] = {
+        {0x1006, 0, (uint32_t)m->cfg.period_us, 4},
+        {0x1016, 1, (uint32_t)m->cfg.master_node << 16 | (uint32_t)m->cfg.hb_consumer_ms, 4},
+        {0x1400, 5, (uint32_t)m->cfg.rpdo_timeout_ms, 2},
+        {0x6007, 0, (uint32_t)m->cfg.abort_option, 2},
+        {0x605E, 0, (uint32_t)m->cfg.fault_reaction, 2},
+    };
     uint32_t v;
     int to = m->cfg.sdo_timeout_ms;
     if (ncp_sdo_read(&m->bus, node, 0x1000, 0, &v, to, NULL, d) != NCP_OK)
@@ -87,6 +96,14 @@ int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *
         if (ncp_sdo_write(&m->bus, node, s->index, s->sub, s->value, s->size, to, NULL, d))
             return start_fault(m, node, d);
     }
+    for (size_t k = 0; m->cfg.master_node && k < sizeof guard / sizeof guard[0]; k++) {
+        const struct sdo_step *s = &guard[k];
+        if (ncp_sdo_write(&m->bus, node, s->index, s->sub, s->value, s->size, to, NULL, d))
+            return start_fault(m, node, d);
+    }
+    if (m->cfg.master_node && m->quick_stop_dec[i] &&
+        ncp_sdo_write(&m->bus, node, 0x6085, 0, m->quick_stop_dec[i], 4, to, NULL, d))
+        return start_fault(m, node, d);
     if (ncp_sdo_read(&m->bus, node, 0x6061, 0, &v, to, NULL, d) != NCP_OK)
         return start_fault(m, node, d);
     if (v != 8) {
@@ -97,6 +114,12 @@ int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *
     if (m->log)
         fprintf(m->log, "node %u: CiA 402 drive, CSP mode confirmed, PDO 1 mapped, heartbeat %d ms\n",
                 node, m->cfg.hb_period_ms);
+    if (m->log && m->cfg.master_node)
+        fprintf(m->log,
+                "node %u: guards master node %u: heartbeat consumer %d ms, RPDO deadline %d ms, "
+                "abort connection option %d, fault reaction option %d\n",
+                node, m->cfg.master_node, m->cfg.hb_consumer_ms, m->cfg.rpdo_timeout_ms,
+                m->cfg.abort_option, m->cfg.fault_reaction);
     return NCP_OK;
 }
 

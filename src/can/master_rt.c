@@ -113,5 +113,16 @@ int ncp_co_master_send(struct ncp_co_master *m)
     }
     m->tx_full = 0;
     m->cycle++;
+    /* our own heartbeat, which the drives consume (0x1016): when it stops,
+     * they stop on their own */
+    int64_t now = ncp_co_now_ms();
+    if (m->cfg.master_node && now >= m->next_hb_ms) {
+        ncp_heartbeat_frame(&f, m->cfg.master_node, NCP_NMT_OPERATIONAL);
+        if (ncp_can_try_send(&m->bus, &f) < 0) {
+            set_bus_fault(m, f.id, errno);
+            return -1;
+        }
+        m->next_hb_ms = now + m->cfg.hb_period_ms;
+    }
     return 0;
 }

@@ -49,6 +49,12 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->can.heartbeat_period_ms = 50;
     c->can.heartbeat_timeout_ms = 500;
     c->can.sdo_timeout_ms = 200;
+    /* three of our heartbeats may go missing before the drives stop on their own */
+    c->can.master_node = 127;
+    c->can.hb_consumer_ms = 150;
+    c->can.rpdo_timeout_ms = 100;
+    c->can.abort_option = 3;
+    c->can.fault_reaction = 2;
     c->default_linear_vel = 10.0;
     ncp_io_cfg_default(&c->io);
     ncp_inject_cfg_default(&c->inject);
@@ -300,10 +306,20 @@ static int can_key(struct ncp_can_cfg *c, const char *k, const char *v, char *wh
         { "HEARTBEAT_PERIOD_MS", &c->heartbeat_period_ms, 1, 65535 },
         { "HEARTBEAT_TIMEOUT_MS", &c->heartbeat_timeout_ms, 1, 600000 },
         { "SDO_TIMEOUT_MS", &c->sdo_timeout_ms, 1, 600000 },
+        { "HEARTBEAT_CONSUMER_MS", &c->hb_consumer_ms, 1, 65535 },
+        { "RPDO_TIMEOUT_MS", &c->rpdo_timeout_ms, 0, 65535 },
+    };
+    const struct { const char *name; int *dst; int lo, hi; const char *unit; } codes[] = {
+        { "MASTER_NODE", &c->master_node, 0, 127, "a CANopen node-ID (0: off)" },
+        { "ABORT_CONNECTION_OPTION", &c->abort_option, 0, 3, "CiA 402 object 0x6007" },
+        { "FAULT_REACTION_OPTION", &c->fault_reaction, 0, 4, "CiA 402 object 0x605E" },
     };
     for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
         if (!strcasecmp(k, keys[i].name))
             return whole(v, keys[i].lo, keys[i].hi, keys[i].dst, "ms", why, len);
+    for (size_t i = 0; i < sizeof codes / sizeof codes[0]; i++)
+        if (!strcasecmp(k, codes[i].name))
+            return whole(v, codes[i].lo, codes[i].hi, codes[i].dst, codes[i].unit, why, len);
     return 0;
 }
 
@@ -635,6 +651,16 @@ static int check_cfg(struct load_ctx *lc)
         return fail_at(lc, key_line(lc, "SIM", key), "[SIM] %s: the machine has no axis %c "
                        "([TRAJ] COORDINATES)", key, NCP_AXIS_LETTERS[i]), -1;
     }
+    if (c->can.master_node && c->can.hb_consumer_ms <= c->can.heartbeat_period_ms)
+        return fail_at(lc, key_line(lc, "CAN", "HEARTBEAT_CONSUMER_MS"),
+                       "[CAN] HEARTBEAT_CONSUMER_MS %d must be longer than HEARTBEAT_PERIOD_MS "
+                       "%d (our heartbeat's period)",
+                       c->can.hb_consumer_ms, c->can.heartbeat_period_ms), -1;
+    for (int i = 0; c->can.master_node && i < NCP_AXES; i++)
+        if ((c->axis_mask & NCP_AXIS_BIT(i)) && c->axis[i].node_id == c->can.master_node)
+            return fail_at(lc, key_line(lc, "CAN", "MASTER_NODE"),
+                           "[CAN] MASTER_NODE %d is the NODE_ID of [AXIS_%c]",
+                           c->can.master_node, NCP_AXIS_LETTERS[i]), -1;
     if (c->can.heartbeat_timeout_ms <= c->can.heartbeat_period_ms)
         return fail_at(lc, key_line(lc, "CAN", "HEARTBEAT_TIMEOUT_MS"), "[CAN] HEARTBEAT_TIMEOUT_MS %d must be longer than "
                               "HEARTBEAT_PERIOD_MS %d",

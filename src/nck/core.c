@@ -40,6 +40,14 @@ static int start_backend(struct nck *n, struct ncp_diag *d)
     return 0;
 }
 
+/* The backend hands the machine over to the position loop. */
+static void backend_live(void *ctx)
+{
+    struct nck *n = ctx;
+    if (n->be_started && n->be.ops->live)
+        n->be.ops->live(&n->be);
+}
+
 static int init_motion(struct nck *n)
 {
     const struct ncp_machine_cfg *c = n->cfg;
@@ -76,6 +84,7 @@ static int init_motion(struct nck *n)
                                             n->setup.virtual_clock };
     n->loop.cycle = nck_position_cycle;
     n->loop.ctx = n;
+    n->loop.handover = backend_live;
     return 0;
 }
 

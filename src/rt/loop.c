@@ -138,6 +138,8 @@ int ncp_rt_loop_start(struct ncp_rt_loop *l)
         l->memlocked = lock_memory();
         l->dma_fd = hold_dma_latency();
     }
+    if (l->handover)
+        l->handover(l->ctx);
     struct ncp_rt_place at = { l->cfg.cpu, want_fifo ? SCHED_FIFO : SCHED_OTHER,
                                want_fifo ? l->cfg.priority : 0 };
     uint32_t warnings = 0;

@@ -130,7 +130,9 @@ int main(int argc, char **argv)
     if (argc == 2 && !strcmp(argv[1], "--selftest"))
         return selftest();
     static struct ncp_co_master m;
-    struct ncp_co_master_cfg cfg = {4000, -1, HB_PERIOD_MS, -1};
+    /* no guarding: this master stops and starts drives at will */
+    struct ncp_co_master_cfg cfg = {.period_us = 4000, .sdo_timeout_ms = -1,
+                                    .hb_period_ms = HB_PERIOD_MS, .hb_timeout_ms = -1};
     uint8_t nodes[NCP_CO_MAX_NODES];
     size_t n = 0;
     long cycles = 200;

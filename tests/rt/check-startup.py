@@ -13,7 +13,11 @@ a TPDO for nearly every SYNC.
 --period-ms P: the SYNC period the master runs at (0x60C2:01), default 4.
 --servo: the drives run a servo plant (cnc-drive-sim --config), whose
 actual trails the target: TPDO values are not compared with the targets.
-Usage: check-startup.py [--strict|--lenient] [--period-ms P] CAPTURE NODE..."""
+--guard INI: the master is cnc-run with that INI's [CAN] guarding keys: each
+drive is also told to guard it (0x1006, 0x1016:01, 0x1400:05, 0x6007, 0x605E
+after 0x1017) and the master's own heartbeat (MASTER_NODE) runs after NMT start.
+Usage: check-startup.py [--strict|--lenient] [--period-ms P] [--guard INI] CAPTURE NODE..."""
+import configparser
 import sys
 
 OP_ENABLED = 0x27  # statusword & 0x6F in Operation enabled
@@ -47,15 +51,46 @@ def sdo_request(data):
     return (data[0], int.from_bytes(data[1:3], "little"), data[3], value)
 
 
-def check(path, nodes, strict, period_ms):
+def guard_keys(ini):
+    """The [CAN] guarding keys of a cnc-run INI, with cnc-run's defaults."""
+    cp = configparser.ConfigParser(inline_comment_prefixes=None, strict=False)
+    cp.optionxform = str.upper
+    cp.read(ini)
+    can = cp["CAN"] if cp.has_section("CAN") else {}
+    get = lambda k, d: int(can.get(k, d))
+    # each drive brakes at its axis's acceleration limit, in counts/s^2
+    dec = {}
+    for sec in cp.sections():
+        a = cp[sec]
+        if sec.startswith("AXIS_") and "NODE_ID" in a and "COUNTS_PER_MM" in a:
+            dec[int(a["NODE_ID"])] = int(float(a["MAX_ACCELERATION"]) * float(a["COUNTS_PER_MM"]))
+    return {"node": get("MASTER_NODE", 127), "consumer": get("HEARTBEAT_CONSUMER_MS", 150),
+            "rpdo": get("RPDO_TIMEOUT_MS", 100), "abort": get("ABORT_CONNECTION_OPTION", 3),
+            "reaction": get("FAULT_REACTION_OPTION", 2), "dec": dec}
+
+
+def expected_sdos(period_ms, guard, node):
+    seq = [(c, i, s, period_ms if v == "period" else v) for c, i, s, v in SDO_SEQUENCE]
+    if guard and guard["node"]:
+        at = seq.index((0x2B, 0x1017, 0, 50)) + 1
+        seq[at:at] = [(0x23, 0x1006, 0, period_ms * 1000),
+                      (0x23, 0x1016, 1, guard["node"] << 16 | guard["consumer"]),
+                      (0x2B, 0x1400, 5, guard["rpdo"]), (0x2B, 0x6007, 0, guard["abort"]),
+                      (0x2B, 0x605E, 0, guard["reaction"])]
+        if guard["dec"].get(node):
+            seq.insert(at + 5, (0x23, 0x6085, 0, guard["dec"][node]))
+    return seq
+
+
+def check(path, nodes, strict, period_ms, guard=None):
     errors = []
-    expected = [(c, i, s, period_ms if v == "period" else v) for c, i, s, v in SDO_SEQUENCE]
     log = list(frames(path))
     nmt = [i for i, (ident, data) in enumerate(log) if ident == 0 and data == b"\x01\x00"]
     if not nmt:
         return ["no NMT start (000#0100)"]
     start = nmt[0]
     for n in nodes:
+        expected = expected_sdos(period_ms, guard, n)
         reqs = [(i, sdo_request(d)) for i, (ident, d) in enumerate(log[:start])
                 if ident == 0x600 + n]
         got = [r for _, r in reqs]
@@ -84,6 +119,9 @@ def check(path, nodes, strict, period_ms):
     for n in nodes:
         if not any(ident == 0x700 + n and d == b"\x05" for ident, d in log[start:]):
             errors.append(f"node {n}: no operational heartbeat after NMT start")
+    if guard and guard["node"] and not any(ident == 0x700 + guard["node"] and d == b"\x05"
+                                           for ident, d in log[start:]):
+        errors.append(f"no heartbeat of the master (node {guard['node']}) after NMT start")
     return errors
 
 
@@ -140,10 +178,12 @@ def check_tpdo(n, count, k, data, targets):
 
 def main():
     args = sys.argv[1:]
-    strict, period_ms = True, 4
-    while args and args[0] in ("--strict", "--lenient", "--period-ms", "--servo"):
+    strict, period_ms, guard = True, 4, None
+    while args and args[0] in ("--strict", "--lenient", "--period-ms", "--servo", "--guard"):
         opt = args.pop(0)
-        if opt == "--servo":
+        if opt == "--guard":
+            guard = guard_keys(args.pop(0))
+        elif opt == "--servo":
             global COMPARE_VALUES
             COMPARE_VALUES = False
         elif opt == "--period-ms":
@@ -153,7 +193,7 @@ def main():
     path, nodes = args[0], [int(a) for a in args[1:]]
     print(f"startup capture: {'strict' if strict else 'lenient'} check "
           f"({'TPDO at most one SYNC late' if strict else 'TPDOs matched to SYNCs by order, any lag'})")
-    errors = check(path, nodes, strict, period_ms)
+    errors = check(path, nodes, strict, period_ms, guard)
     for e in errors[:12]:
         print("startup capture:", e)
     n = sum(1 for _ in frames(path))

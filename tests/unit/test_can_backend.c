@@ -52,6 +52,9 @@ static void test_ini_can_section(void **state)
     struct ncp_diag d;
     assert_int_equal(load_ini("[CAN]\nINTERFACE = can1\nHEARTBEAT_PERIOD_MS = 20\n"
                               "HEARTBEAT_TIMEOUT_MS = 300\nSDO_TIMEOUT_MS = 150\n"
+                              "MASTER_NODE = 100\nHEARTBEAT_CONSUMER_MS = 70\n"
+                              "RPDO_TIMEOUT_MS = 0\nABORT_CONNECTION_OPTION = 1\n"
+                              "FAULT_REACTION_OPTION = 0\n"
                               "[AXIS_X]\nNODE_ID = 4\nCOUNTS_PER_MM = 1000\n" LIMITS
                               "[AXIS_Y]\n" LIMITS
                               "[AXIS_Z]\nnode_id = 127\nCOUNTS_PER_MM = 2.5\n" LIMITS,
@@ -61,6 +64,11 @@ static void test_ini_can_section(void **state)
     assert_int_equal(c.can.heartbeat_period_ms, 20);
     assert_int_equal(c.can.heartbeat_timeout_ms, 300);
     assert_int_equal(c.can.sdo_timeout_ms, 150);
+    assert_int_equal(c.can.master_node, 100);
+    assert_int_equal(c.can.hb_consumer_ms, 70);
+    assert_int_equal(c.can.rpdo_timeout_ms, 0);
+    assert_int_equal(c.can.abort_option, 1);
+    assert_int_equal(c.can.fault_reaction, 0);
     assert_int_equal(c.axis[0].node_id, 4);
     assert_true(c.axis[0].counts_per_mm == 1000.0);
     assert_int_equal(c.axis[1].node_id, 0);
@@ -72,6 +80,10 @@ static void test_ini_can_section(void **state)
     assert_string_equal(c.can.interface, "");
     assert_int_equal(c.can.heartbeat_timeout_ms, 500);
     assert_int_equal(c.can.sdo_timeout_ms, 200);
+    /* the drives guard a master at node 127 and quick-stop without it */
+    assert_int_equal(c.can.master_node, 127);
+    assert_int_equal(c.can.hb_consumer_ms, 150);
+    assert_int_equal(c.can.abort_option, 3);
 }
 
 static void expect_error(const char *text, const char *want)
@@ -99,6 +111,14 @@ static void test_ini_can_errors(void **state)
                  "[AXIS_Z] NODE_ID 3 is already the node of [AXIS_X]");
     expect_error("[CAN]\nHEARTBEAT_PERIOD_MS = 100\nHEARTBEAT_TIMEOUT_MS = 100\n" AXES,
                  "HEARTBEAT_TIMEOUT_MS 100 must be longer than HEARTBEAT_PERIOD_MS 100");
+    expect_error("[CAN]\nHEARTBEAT_PERIOD_MS = 100\nHEARTBEAT_TIMEOUT_MS = 500\n"
+                 "HEARTBEAT_CONSUMER_MS = 100\n" AXES,
+                 "HEARTBEAT_CONSUMER_MS 100 must be longer than HEARTBEAT_PERIOD_MS 100");
+    expect_error("[AXIS_X]\nNODE_ID = 127\n" LIMITS "[AXIS_Y]\n" LIMITS "[AXIS_Z]\n" LIMITS,
+                 "[CAN] MASTER_NODE 127 is the NODE_ID of [AXIS_X]");
+    expect_error("[CAN]\nABORT_CONNECTION_OPTION = 4\n",
+                 "[CAN] ABORT_CONNECTION_OPTION: bad value '4'");
+    expect_error("[CAN]\nMASTER_NODE = 128\n", "[CAN] MASTER_NODE: bad value '128'");
 }
 
 /* ---- scaling and the configuration check ------------------------------------- */
@@ -172,7 +192,8 @@ static void fake_master(struct ncp_co_master *m)
     memset(m, 0, sizeof *m);
     m->bus.fd = -1;
     snprintf(m->bus.ifname, sizeof m->bus.ifname, "vcan0");
-    m->cfg = (struct ncp_co_master_cfg){1000, 200, 50, 500};
+    m->cfg = (struct ncp_co_master_cfg){.period_us = 1000, .sdo_timeout_ms = 200,
+                                        .hb_period_ms = 50, .hb_timeout_ms = 500};
     m->n = 2;
     for (size_t i = 0; i < m->n; i++) {
         ncp_co_node_init(&m->node[i], (uint8_t)(i + 1));
