@@ -437,8 +437,16 @@ static int arc(struct ncp_canon_map *m, const struct ncp_canon *op, uint32_t lin
     s->axial = he - hs;
     s->r0 = sqrt(dot(rs, rs));
     s->r1 = sqrt(dot(re, re));
+    /* a helix of zero radius (a bore whose tool fills the hole: rs274 sends
+     * such arcs) is its axis: the straight move along it */
+    if (s->r0 < 1e-9 && s->r1 < 1e-9) {
+        double end[NCP_AXES];
+        memcpy(end, s->end, sizeof end);
+        return line_to(m, end, 0, line, s, d);
+    }
     if (s->r0 < 1e-9 || s->r1 < 1e-9)
-        return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0, "arc with zero radius");
+        return -ncp_diag_set(d, NCP_ERR_GEOMETRY, line, 0,
+                             "arc with zero radius at one end (its centre is its start or end)");
     for (int i = 0; i < 3; i++)
         s->u[i] = rs[i] / s->r0;
     cross(s->normal, s->u, s->w);

@@ -61,6 +61,7 @@ static int drive(struct nck *n, double act[NCP_AXES], int with_faults)
     for (int j = 0; j < NCP_AXES; j++) {
         c[j] = n->jcmd[j] + n->home.off[j];
         x[j] = n->jnext[j] + n->home.off[j];
+        a[j] = c[j];  /* a backend reports only the machine's joints */
     }
     /* timing faults act on what the servos get: the joints */
     int rc = with_faults ? nck_servo_cycle(n, c, x, a) : n->be.ops->cycle(&n->be, c, x, a);

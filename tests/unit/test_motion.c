@@ -612,6 +612,28 @@ static void test_canon_units_offsets(void **state)
     assert_int_equal(s.line, 6);
 }
 
+/* A helix of zero radius (rs274 sends one for a bore the tool fills) is
+ * the straight move along its axis; an arc whose centre is only one of its
+ * ends stays refused. */
+static void test_canon_zero_radius_helix(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c = test_cfg();
+    struct ncp_canon_map m;
+    ncp_canon_map_init(&m, &c, NULL, 1.0);
+    struct ncp_seg s;
+    struct ncp_diag d;
+    struct ncp_canon f = op_feed(600);
+    assert_int_equal(ncp_canon_map_op(&m, &f, 1, &s, &d), 0);
+    struct ncp_canon plunge = op_arc(0, 0, 0, 0, 1, -2.5);
+    assert_int_equal(ncp_canon_map_op(&m, &plunge, 2, &s, &d), 1);
+    assert_int_equal(s.kind, NCP_SEG_LINE);
+    assert_true(fabs(s.end[2] + 2.5) < 1e-12 && fabs(s.length - 2.5) < 1e-12);
+    struct ncp_canon spiral = op_arc(5, 0, 0, 0, 1, -2.5);
+    assert_true(ncp_canon_map_op(&m, &spiral, 3, &s, &d) < 0);
+    assert_non_null(strstr(d.msg, "zero radius at one end"));
+}
+
 /* A canon map on the test machine, and what its calls fill. */
 struct map_fixture {
     struct ncp_machine_cfg cfg;
@@ -915,6 +937,7 @@ int main(void)
         cmocka_unit_test(test_canon_tap_and_spline),
         cmocka_unit_test(test_canon_nurbs),
         cmocka_unit_test(test_soft_limit),
+        cmocka_unit_test(test_canon_zero_radius_helix),
         cmocka_unit_test(test_replan_cost_bounded),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
