@@ -202,7 +202,7 @@ int ncp_inject_ini_key(struct ncp_inject_cfg *c, const char *sec, const char *k,
         return snprintf(why, len, "hold, extrapolate, extrapolate2 or timestamped"), -1;
     }
     if (!strcasecmp(k, "SETPOINT_FRAMES")) {
-        if (strcasecmp(v, "shared") && strcasecmp(v, "per-axis"))
+        if (strcasecmp(v, "shared") != 0 && strcasecmp(v, "per-axis") != 0)
             return snprintf(why, len, "shared (one frame for every axis) or per-axis"), -1;
         c->per_axis = !strcasecmp(v, "per-axis");
         return 1;
