@@ -43,6 +43,7 @@ struct ncp_inject_cfg {
     unsigned kinds;                  /* NCP_INJ_* given */
     double miss_ratio, lose_sp_ratio, lose_fb_ratio;   /* per period, 0..1 */
     uint64_t miss_at[NCP_INJECT_AT_MAX];
+    uint32_t miss_at_axes[NCP_INJECT_AT_MAX];   /* miss@CYCLE:AXES (bit per axis), 0 = all */
     int n_miss_at;
     double lat_min_s, lat_max_s;     /* uniform; equal for latency=US */
     double io_s, delay_fb_s;
@@ -52,6 +53,11 @@ struct ncp_inject_cfg {
     uint64_t seed;
     /* [RT] */
     int policy;                      /* enum ncp_miss_policy */
+    int per_axis;                    /* SETPOINT_FRAMES = per-axis: each axis' setpoint
+                                        travels in its own frame, so a miss or a lost
+                                        setpoint is drawn for each axis on its own and
+                                        hits that axis alone (the paper's servo nodes);
+                                        0: one frame carries every axis */
     int max_consecutive;             /* MAX_CONSECUTIVE_MISSES, 0 = no limit */
     double max_ratio;                /* MAX_MISS_RATIO over window cycles, 0 = no limit */
     int window;                      /* MISS_WINDOW (1000) */
@@ -67,7 +73,8 @@ int ncp_inject_parse(struct ncp_inject_cfg *c, const char *list, char *why, size
 int ncp_inject_ini_key(struct ncp_inject_cfg *c, const char *sec, const char *k, const char *v,
                        char *why, size_t len);
 /* Before the run: checks what depends on the servo period (delay-feedback
- * is held for a bounded number of periods). 0, or -1 with why. */
+ * is held for a bounded number of periods) and that miss@CYCLE:AXES has
+ * per-axis frames to act on. 0, or -1 with why. */
 int ncp_inject_check(const struct ncp_inject_cfg *c, double period_s, char *why, size_t len);
 const char *ncp_miss_policy_name(int policy);
 
@@ -80,6 +87,9 @@ struct ncp_inject_ev {
     double io_s;                     /* sample to actuation */
     double delay_fb_s;               /* the feedback is this much older than the sample */
     double jitter_s;                 /* the jitter part of sample_s */
+    uint32_t miss_axes, lose_axes;   /* axes whose setpoint missed / was lost (bit per
+                                        axis); every axis when one frame carries them */
+    int per_axis;                    /* drawn per axis: the trace names the axes */
 };
 
 struct ncp_xoshiro {

@@ -16,6 +16,7 @@ int ncp_cli_apply_inject(const char *who, const char *spec, const char *seed,
         struct ncp_inject_cfg fresh = *c;
         uint64_t keep_seed = fresh.seed;
         int policy = fresh.policy, maxc = fresh.max_consecutive, win = fresh.window;
+        int per_axis = fresh.per_axis;
         double maxr = fresh.max_ratio;
         ncp_inject_cfg_default(&fresh);
         fresh.seed = keep_seed;
@@ -23,6 +24,7 @@ int ncp_cli_apply_inject(const char *who, const char *spec, const char *seed,
         fresh.max_consecutive = maxc;
         fresh.max_ratio = maxr;
         fresh.window = win;
+        fresh.per_axis = per_axis;
         if (ncp_inject_parse(&fresh, spec, why, sizeof why))
             return fprintf(stderr, "%s: --inject: %s\n", who, why), -1;
         *c = fresh;

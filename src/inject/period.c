@@ -28,13 +28,28 @@ void ncp_inject_period(struct ncp_inject *in, uint64_t cycle, struct ncp_inject_
     memset(ev, 0, sizeof *ev);
     if (!c->kinds)
         return;
-    int miss = chance(&in->rng[NCP_INJ_STREAM_MISS], c->miss_ratio);
-    for (int i = 0; i < c->n_miss_at && !miss; i++)
-        miss = c->miss_at[i] == cycle;
+    /* one frame for every axis: one draw per period; a frame per axis: one
+     * draw per axis, each axis' setpoint late or lost on its own */
+    const uint32_t all = (1u << NCP_INJECT_AXES) - 1;
+    int draws = c->per_axis ? NCP_INJECT_AXES : 1;
+    uint32_t miss = 0, lose = 0;
+    for (int j = 0; j < draws; j++) {
+        uint32_t bit = c->per_axis ? 1u << j : all;
+        if (chance(&in->rng[NCP_INJ_STREAM_MISS], c->miss_ratio))
+            miss |= bit;
+        if (chance(&in->rng[NCP_INJ_STREAM_LOSE_SP], c->lose_sp_ratio))
+            lose |= bit;
+    }
+    for (int i = 0; i < c->n_miss_at; i++)
+        if (c->miss_at[i] == cycle)
+            miss |= c->miss_at_axes[i] ? c->miss_at_axes[i] : all;
     if (miss)
         ev->what |= NCP_INJ_MISS;
-    if (chance(&in->rng[NCP_INJ_STREAM_LOSE_SP], c->lose_sp_ratio))
+    if (lose)
         ev->what |= NCP_INJ_LOSE_SP;
+    ev->miss_axes = miss;
+    ev->lose_axes = lose;
+    ev->per_axis = c->per_axis;
     if (chance(&in->rng[NCP_INJ_STREAM_LOSE_FB], c->lose_fb_ratio))
         ev->what |= NCP_INJ_LOSE_FB;
     double u = ncp_xoshiro_uniform(&in->rng[NCP_INJ_STREAM_LATENCY]);
@@ -85,10 +100,22 @@ int ncp_inject_format(const struct ncp_inject_ev *ev, char *buf, size_t len)
             return -1;                                                              \
         at += (size_t)k_;                                                           \
     } while (0)
+    /* a frame per axis: which axes, e.g. miss:Y */
+    char ma[NCP_INJECT_AXES + 2] = "", la[NCP_INJECT_AXES + 2] = "";
+    for (int j = 0, mi = 0, li = 0; ev->per_axis && j < NCP_INJECT_AXES; j++) {
+        if (!mi)
+            ma[mi++] = ':';
+        if (!li)
+            la[li++] = ':';
+        if (ev->miss_axes >> j & 1)
+            ma[mi++] = "XYZABCUVW"[j];
+        if (ev->lose_axes >> j & 1)
+            la[li++] = "XYZABCUVW"[j];
+    }
     if (ev->what & NCP_INJ_MISS)
-        ADD("miss");
+        ADD("miss%s", ma);
     if (ev->what & NCP_INJ_LOSE_SP)
-        ADD("lose-sp");
+        ADD("lose-sp%s", la);
     if (ev->what & NCP_INJ_LOSE_FB)
         ADD("lose-fb");
     if (ev->what & NCP_INJ_LATE)

@@ -50,6 +50,8 @@ static int bad(char *why, size_t len, const char *spec, size_t n, const char *wa
     return -1;
 }
 
+#define AXIS_NAMES "XYZABCUVW"   /* bit i of an axis mask is AXIS_NAMES[i] */
+
 #define US_MAX 1e6   /* one second: more is no timing fault but a stopped loop */
 
 static int one(struct ncp_inject_cfg *c, const char *s, size_t n, char *why, size_t len)
@@ -64,10 +66,23 @@ static int one(struct ncp_inject_cfg *c, const char *s, size_t n, char *why, siz
     double x, y;
 #define IS(name) (kl == strlen(name) && !strncmp(s, name, kl))
     if (at && !eq) {
-        if (!IS("miss") || number(v, vl, 0, 1e15, &x) || x != floor(x))
-            return bad(why, len, s, n, "miss@CYCLE wants a whole cycle number (0 is the first)");
+        /* miss@CYCLE:AXES: that cycle's setpoint misses on those axes only */
+        const char *colon = memchr(v, ':', vl);
+        size_t cl = colon ? (size_t)(colon - v) : vl;
+        uint32_t axes = 0;
+        for (size_t i = cl + 1; colon && i < vl; i++) {
+            const char *l = strchr(AXIS_NAMES, v[i] >= 'a' && v[i] <= 'z' ? v[i] - 32 : v[i]);
+            if (!v[i] || !l)
+                return bad(why, len, s, n, "miss@CYCLE:AXES wants axis letters, e.g. miss@375:Y");
+            axes |= 1u << (l - AXIS_NAMES);
+        }
+        if (!IS("miss") || number(v, cl, 0, 1e15, &x) || x != floor(x) || (colon && !axes))
+            return bad(why, len, s, n,
+                       "miss@CYCLE or miss@CYCLE:AXES wants a whole cycle number (0 is the "
+                       "first) and axis letters");
         if (c->n_miss_at >= NCP_INJECT_AT_MAX)
             return bad(why, len, s, n, "at most 64 miss@CYCLE specs");
+        c->miss_at_axes[c->n_miss_at] = axes;
         c->miss_at[c->n_miss_at++] = (uint64_t)x;
         c->kinds |= NCP_INJ_MISS;
         return 0;
@@ -186,6 +201,12 @@ int ncp_inject_ini_key(struct ncp_inject_cfg *c, const char *sec, const char *k,
             }
         return snprintf(why, len, "hold, extrapolate, extrapolate2 or timestamped"), -1;
     }
+    if (!strcasecmp(k, "SETPOINT_FRAMES")) {
+        if (strcasecmp(v, "shared") != 0 && strcasecmp(v, "per-axis") != 0)
+            return snprintf(why, len, "shared (one frame for every axis) or per-axis"), -1;
+        c->per_axis = !strcasecmp(v, "per-axis");
+        return 1;
+    }
     if (!strcasecmp(k, "MAX_CONSECUTIVE_MISSES")) {
         if (whole_key(v, 0, 1000000, &x))
             return snprintf(why, len, "0 (no limit) to 1000000 periods"), -1;
@@ -214,5 +235,11 @@ int ncp_inject_check(const struct ncp_inject_cfg *c, double period_s, char *why,
                         "delay-feedback=%.0f is longer than %d servo periods (%.0f us)",
                         c->delay_fb_s * 1e6, DELAY_FB_PERIODS - 2,
                         (DELAY_FB_PERIODS - 2) * period_s * 1e6), -1;
+    for (int i = 0; i < c->n_miss_at && !c->per_axis; i++)
+        if (c->miss_at_axes[i])
+            return snprintf(why, len,
+                            "miss@%llu names axes, but one frame carries every axis' setpoint: "
+                            "set [RT] SETPOINT_FRAMES = per-axis",
+                            (unsigned long long)c->miss_at[i]), -1;
     return 0;
 }

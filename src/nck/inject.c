@@ -22,6 +22,8 @@ void nck_inject_setup(struct nck *n)
     n->sum.inject_col = c->kinds != 0;
     ncp_inject_init(&n->inj, c, n->cfg->servo_period);
     ncp_inject_rx_init(&n->rx, c->policy);
+    for (int j = 0; j < NCP_AXES; j++)
+        ncp_inject_rx_init(&n->rx_axis[j], c->policy);
     ncp_inject_guard_init(&n->guard, c);
     memset(&n->inj_rep, 0, sizeof n->inj_rep);
 }
@@ -46,6 +48,15 @@ int nck_servo_cycle(struct nck *n, const double cmd[NCP_AXES], const double next
     uint64_t k = (uint64_t)llround((double)n->now_ns / (double)n->loop.cfg.period_ns);
     struct ncp_inject_ev *ev = &n->inj_ev;
     ncp_inject_period(&n->inj, k, ev);
+    if (n->cfg->inject.per_axis) {
+        /* a frame per drive: only the machine's own axes have one */
+        ev->miss_axes &= n->cfg->axis_mask;
+        ev->lose_axes &= n->cfg->axis_mask;
+        if (!ev->miss_axes)
+            ev->what &= ~(uint32_t)NCP_INJ_MISS;
+        if (!ev->lose_axes)
+            ev->what &= ~(uint32_t)NCP_INJ_LOSE_SP;
+    }
     uint64_t real = n->loop.stats.misses;
     int real_miss = real != n->real_misses_seen;
     n->real_misses_seen = real;
@@ -53,8 +64,17 @@ int nck_servo_cycle(struct nck *n, const double cmd[NCP_AXES], const double next
         n->inj_rep.count[b] += (ev->what >> b) & 1u;
     int arrived = !(ev->what & (NCP_INJ_MISS | NCP_INJ_LOSE_SP));
     double use[NCP_AXES], use_next[NCP_AXES];
-    ncp_inject_rx_take(&n->rx, (int64_t)k, arrived, cmd, next,
-                       ev->sample_s / n->cfg->servo_period, NCP_AXES, use, use_next);
+    double frac = ev->sample_s / n->cfg->servo_period;
+    if (n->cfg->inject.per_axis) {
+        /* each drive keeps its own history of what reached it */
+        uint32_t gone = ev->miss_axes | ev->lose_axes;
+        for (int j = 0; j < NCP_AXES; j++)
+            ncp_inject_rx_take(&n->rx_axis[j], (int64_t)k, !(gone >> j & 1), &cmd[j],
+                               &next[j], frac, 1, &use[j], &use_next[j]);
+    } else {
+        ncp_inject_rx_take(&n->rx, (int64_t)k, arrived, cmd, next, frac, NCP_AXES,
+                           use, use_next);
+    }
     n->be.timing = n->inj_timed ? ev : NULL;
     int rc = n->be.ops->cycle(&n->be, use, use_next, act);
     int missed = !arrived || (ev->what & NCP_INJ_LATE) || real_miss;

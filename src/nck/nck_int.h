@@ -357,6 +357,7 @@ struct nck {
     int inj_on, inj_timed;           /* anything configured; the plant models timing */
     struct ncp_inject inj;
     struct ncp_inject_rx rx;
+    struct ncp_inject_rx rx_axis[NCP_AXES];   /* SETPOINT_FRAMES = per-axis: one per drive */
     struct ncp_inject_guard guard;
     struct ncp_inject_ev inj_ev;
     uint64_t real_misses_seen;
