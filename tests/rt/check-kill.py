@@ -37,7 +37,8 @@ def axes_of(ini):
         if sec.startswith("AXIS_") and "NODE_ID" in a:
             out[int(a["NODE_ID"])] = (float(a["MAX_ACCELERATION"]), float(a["COUNTS_PER_MM"]))
     master = int(cp["CAN"].get("MASTER_NODE", 127)) if cp.has_section("CAN") else 127
-    return out, master
+    period_s = float(cp["EMCMOT"].get("SERVO_PERIOD", 1000000)) * 1e-9
+    return out, master, period_s
 
 
 def main():
@@ -48,7 +49,7 @@ def main():
     ap.add_argument("capture")
     ap.add_argument("nodes", type=int, nargs="+")
     a = ap.parse_args()
-    axes, master = axes_of(a.ini)
+    axes, master, period_s = axes_of(a.ini)
     log = list(frames(a.capture))
     nodes = set(a.nodes)
     from_master = [t for t, i, _ in log if i in (0x000, 0x080, 0x700 + master)
@@ -90,7 +91,8 @@ def main():
                           f"0x{after[-1][1] if after else 0:04X})")
             continue
         t_stop, _, p_stop = after[stopped[0]]
-        speed = abs(before[-1] - before[-2]) / max(1e-6, tp[len(before) - 1][0] - tp[len(before) - 2][0])
+        # one TPDO per SYNC: the capture's own timestamps bunch up under load
+        speed = abs(before[-1] - before[-2]) / period_s
         acc, cpm = axes[n]
         ramp_ms = speed / (acc * cpm) * 1000
         took_ms = (t_stop - t_e) * 1000
