@@ -194,25 +194,37 @@ static void test_heartbeat_loss_quick_stops(void **state)
     assert_int_equal(r->dv.actual, stopped);
 }
 
+/* Moves for a while, then runs periods with only the sources asked for
+ * until the drive's EMCY (at most 300 ms): what it sent then, and after how
+ * many ms without the missing source. */
+static struct sent lose_source(struct rig *r, int with_hb, int with_sync, int with_rpdo,
+                               int *after_ms)
+{
+    int32_t target = 0;
+    run_moving(r, &target);
+    long long lost_at = r->now;
+    struct sent s = {0, 0, 0, 0, 0};
+    while (!s.emcy && r->now < lost_at + 300) {
+        period(r, target, with_hb, with_sync, with_rpdo);
+        s = drain(r);
+    }
+    *after_ms = (int)(r->now - lost_at);
+    return s;
+}
+
 /* SYNC gone (the master's cycle stopped, heartbeat thread alive): EMCY
  * 0x8700 after --sync-loss-ms; 0x6007 = 1 makes it a fault, and 0x605E = 0
  * disables at once (Fault, no ramp). */
 static void test_sync_loss_faults(void **state)
 {
     struct rig *r = *state;
-    int32_t target = 0;
     sdo_write(r, 0x6007, 0, 1);
     sdo_write(r, 0x605E, 0, 0);
     drain(r);
-    run_moving(r, &target);
-    long long last_sync = r->now;
-    struct sent s = {0, 0, 0, 0, 0};
-    while (!s.emcy && r->now < last_sync + 300) {
-        period(r, target, 1, 0, 0);
-        s = drain(r);
-    }
+    int after_ms;
+    struct sent s = lose_source(r, 1, 0, 0, &after_ms);
     assert_int_equal(s.emcy_code, 0x8700);
-    assert_int_equal((int)(r->now - last_sync), 101);
+    assert_int_equal(after_ms, 101);
     assert_int_equal(r->dv.st, NCP_402_FAULT);
     assert_int_equal(od_get(&r->dv.od, 0x603F, 0), 0x8700);
 }
@@ -222,18 +234,12 @@ static void test_sync_loss_faults(void **state)
 static void test_rpdo_loss_disables(void **state)
 {
     struct rig *r = *state;
-    int32_t target = 0;
     sdo_write(r, 0x6007, 0, 2);
     drain(r);
-    run_moving(r, &target);
-    long long last_rpdo = r->now;
-    struct sent s = {0, 0, 0, 0, 0};
-    while (!s.emcy && r->now < last_rpdo + 300) {
-        period(r, target, 1, 1, 0);
-        s = drain(r);
-    }
+    int after_ms;
+    struct sent s = lose_source(r, 1, 1, 0, &after_ms);
     assert_int_equal(s.emcy_code, 0x8250);
-    assert_int_equal((int)(r->now - last_rpdo), 101);
+    assert_int_equal(after_ms, 101);
     assert_int_equal(r->dv.st, NCP_402_SWITCH_ON_DISABLED);
 }
 
