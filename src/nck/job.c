@@ -18,14 +18,21 @@ static void nap_us(long us)
     nanosleep(&ts, NULL);
 }
 
-static int push_wait(struct nck *n, const struct nck_seg_msg *m)
+/* Into one of the rings the loop and the planner read: waits while it is
+ * full, gives up when the job is aborted. */
+static int ring_push(struct nck *n, struct ncp_spsc *ring, const void *item)
 {
-    while (ncp_spsc_push(&n->segs, m) != 0) {
+    while (ncp_spsc_push(ring, item) != 0) {
         if (atomic_load(&n->job.abort))
             return -1;
         nap_us(100);
     }
     return 0;
+}
+
+static int push_wait(struct nck *n, const struct nck_seg_msg *m)
+{
+    return ring_push(n, &n->segs, m);
 }
 
 static int take_seg(struct nck *n, const struct ncp_seg *s);
@@ -37,6 +44,23 @@ static int take_seg(struct nck *n, const struct ncp_seg *s);
  * next segment (push_seg numbers it). */
 static int sync_flush(struct nck *n);
 
+/* The pack, numbered, into the loop's ring; the AUX message that makes the
+ * planner stop for it (m: its other fields) when stop is set. */
+static int send_pack(struct nck *n, int stop, struct nck_seg_msg *m)
+{
+    struct nck_job *j = &n->job;
+    j->aux.seq = ++n->aux_seq;
+    if (ring_push(n, &n->auxq, &j->aux))
+        return -1;
+    j->aux.n = 0;
+    j->aux_stop = 0;
+    if (!stop)
+        return 0;
+    m->kind = NCK_MSG_AUX;
+    m->aux = n->aux_seq;
+    return push_wait(n, m);
+}
+
 static int aux_flush(struct nck *n)
 {
     struct nck_job *j = &n->job;
@@ -44,21 +68,9 @@ static int aux_flush(struct nck *n)
         return -1;
     if (j->aux.n == 0)
         return 0;
-    j->aux.seq = ++n->aux_seq;
-    while (ncp_spsc_push(&n->auxq, &j->aux) != 0) {
-        if (atomic_load(&j->abort))
-            return -1;
-        nap_us(100);
-    }
-    j->aux.n = 0;
-    if (!j->aux_stop)
-        return 0;
-    j->aux_stop = 0;
     struct nck_seg_msg m;
     memset(&m, 0, sizeof m);
-    m.kind = NCK_MSG_AUX;
-    m.aux = n->aux_seq;
-    return push_wait(n, &m);
+    return send_pack(n, j->aux_stop, &m);
 }
 
 static int aux_add(struct nck *n, int kind, int idx, int32_t i, double v, uint32_t line,
@@ -108,11 +120,8 @@ static int sync_flush(struct nck *n)
     struct nck_job *j = &n->job;
     if (j->run.n == 0)
         return 0;
-    while (ncp_spsc_push(&n->syncq, &j->run) != 0) {
-        if (atomic_load(&j->abort))
-            return -1;
-        nap_us(100);
-    }
+    if (ring_push(n, &n->syncq, &j->run))
+        return -1;
     const struct nck_sync_run *r = &j->run;
     double end[NCP_AXES];
     memcpy(end, r->tap ? r->start : r->l[r->n - 1].end, sizeof end);
@@ -125,22 +134,12 @@ static int sync_flush(struct nck *n)
     memset(a, 0, sizeof *a);
     a->kind = NCK_AUX_SYNC;
     a->line = line;
-    j->aux.seq = ++n->aux_seq;
-    while (ncp_spsc_push(&n->auxq, &j->aux) != 0) {
-        if (atomic_load(&j->abort))
-            return -1;
-        nap_us(100);
-    }
-    j->aux.n = 0;
-    j->aux_stop = 0;
     struct nck_seg_msg m;
     memset(&m, 0, sizeof m);
-    m.kind = NCK_MSG_AUX;
-    m.aux = n->aux_seq;
     m.jump = 1;
     memcpy(m.seg.end, end, sizeof m.seg.end);
     n->job.seen_motion = 1;
-    return push_wait(n, &m);
+    return send_pack(n, 1, &m);
 }
 
 /* A synchronised line joins the run being gathered (a rigid tap is a run
