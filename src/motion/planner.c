@@ -303,11 +303,14 @@ static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
         return 0;
     double pos[NCP_AXES], t1[NCP_AXES], t2[NCP_AXES], dmax = 0, v = cur->vmax;
     double beta = kink_share(prev, &cur->s);
+    double share_per_speed = 0;  /* the largest share of an axis's limit per mm/s */
     ncp_seg_eval(prev, prev->length, pos, t1);
     ncp_seg_eval(&cur->s, 0, pos, t2);
     for (int j = 0; j < NCP_AXES; j++) {
         double dj = fabs(t2[j] - t1[j]);
         dmax = fmax(dmax, dj);
+        share_per_speed =
+            fmax(share_per_speed, dj / (p->cfg.axis[j].max_acc * p->cfg.servo_period));
         if (dj > 1e-9)
             v = fmin(v, beta * p->cfg.axis[j].max_acc * p->cfg.servo_period / dj);
         /* S-curve: the velocity step of the corner, within one period, is a
@@ -324,10 +327,7 @@ static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
         return 0;
     *kink = 1;
     if (!plan_scurve(p) && v >= v_cruise) {
-        double need = 0;
-        for (int j = 0; j < NCP_AXES; j++)
-            need = fmax(need, v_cruise * fabs(t2[j] - t1[j]) /
-                                  (p->cfg.axis[j].max_acc * p->cfg.servo_period));
+        double need = v_cruise * share_per_speed;
         if (need <= KINK_SMALL) {
             *beta_small = need;
             return v_cruise;
@@ -395,7 +395,7 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
             f_prev = kink_factor(prev, beta_small);
             if (f_cur < 0.5 || f_prev < 0.5) {  /* not worth it: the usual caps */
                 f_cur = f_prev = 0.5;
-                v = fmin(v, junction(p, &p->last_pushed, ps, INFINITY, &kink, &beta_small));
+                v = fmin(v, fmin(kink_arc_cap(p, &p->last_pushed), kink_arc_cap(p, &ps->s)));
             }
         }
         struct plan_seg cur_half = *ps, prev_half;
