@@ -56,6 +56,19 @@ static int start_fault(struct ncp_co_master *m, uint8_t node, struct ncp_diag *d
 
 struct sdo_step { uint16_t index; uint8_t sub; uint32_t value; unsigned size; };
 
+/* Writes steps[0..n) to node in order; stops at the first that fails. */
+static int write_steps(struct ncp_co_master *m, uint8_t node, const struct sdo_step *steps,
+                       size_t n, struct ncp_diag *d)
+{
+    for (size_t k = 0; k < n; k++) {
+        const struct sdo_step *s = &steps[k];
+        if (ncp_sdo_write(&m->bus, node, s->index, s->sub, s->value, s->size,
+                          m->cfg.sdo_timeout_ms, NULL, d))
+            return -1;
+    }
+    return 0;
+}
+
 int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *d)
 {
     uint8_t node = m->node[i].id, ipv;
@@ -72,15 +85,20 @@ int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *
         {0x1A00, 0, 2, 1},                      /* TPDO1 = statusword + actual */
         {0x1017, 0, (uint32_t)m->cfg.hb_period_ms, 2}, /* heartbeat producer */
     };
-    /* the drive guards us: consumer of our heartbeat, RPDO deadline, and
-     * what it does on its own when either stops (a killed master) */
+    /* the drive guards us: consumer of our heartbeat, RPDO deadline, what
+     * it does on its own when either stops (a killed master), and how hard
+     * it brakes then (last, only when known) */
     const struct sdo_step guard[] = {
         {0x1006, 0, (uint32_t)m->cfg.period_us, 4},
         {0x1016, 1, (uint32_t)m->cfg.master_node << 16 | (uint32_t)m->cfg.hb_consumer_ms, 4},
         {0x1400, 5, (uint32_t)m->cfg.rpdo_timeout_ms, 2},
         {0x6007, 0, (uint32_t)m->cfg.abort_option, 2},
         {0x605E, 0, (uint32_t)m->cfg.fault_reaction, 2},
+        {0x6085, 0, m->quick_stop_dec[i], 4},
     };
+    size_t n_guard = !m->cfg.master_node       ? 0
+                     : m->quick_stop_dec[i] != 0 ? sizeof guard / sizeof guard[0]
+                                               : sizeof guard / sizeof guard[0] - 1;
     uint32_t v;
     int to = m->cfg.sdo_timeout_ms;
     if (ncp_sdo_read(&m->bus, node, 0x1000, 0, &v, to, NULL, d) != NCP_OK)
@@ -91,18 +109,8 @@ int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *
                      v);
         return start_fault(m, node, d);
     }
-    for (size_t k = 0; k < sizeof steps / sizeof steps[0]; k++) {
-        const struct sdo_step *s = &steps[k];
-        if (ncp_sdo_write(&m->bus, node, s->index, s->sub, s->value, s->size, to, NULL, d))
-            return start_fault(m, node, d);
-    }
-    for (size_t k = 0; m->cfg.master_node && k < sizeof guard / sizeof guard[0]; k++) {
-        const struct sdo_step *s = &guard[k];
-        if (ncp_sdo_write(&m->bus, node, s->index, s->sub, s->value, s->size, to, NULL, d))
-            return start_fault(m, node, d);
-    }
-    if (m->cfg.master_node && m->quick_stop_dec[i] &&
-        ncp_sdo_write(&m->bus, node, 0x6085, 0, m->quick_stop_dec[i], 4, to, NULL, d))
+    if (write_steps(m, node, steps, sizeof steps / sizeof steps[0], d) ||
+        write_steps(m, node, guard, n_guard, d))
         return start_fault(m, node, d);
     if (ncp_sdo_read(&m->bus, node, 0x6061, 0, &v, to, NULL, d) != NCP_OK)
         return start_fault(m, node, d);
