@@ -51,20 +51,27 @@ static int nck_motion_column(uint32_t flags)
     return flags & NCP_SP_SYNC ? 3 : flags & NCP_SP_RAPID ? 0 : flags & NCP_SP_ARC ? 2 : 1;
 }
 
-/* The rows' columns for the axes beyond X Y Z the machine has, after all
- * the others, so that readers of the fixed columns keep working. */
-static int trace_more_axes(char *buf, size_t len, unsigned mask, const struct nck_fb *fb)
+/* ",cmd,act" for each axis of mask from axis `from` on. */
+static int trace_pairs(char *buf, size_t len, unsigned mask, int from, const double cmd[NCP_AXES],
+                       const double act[NCP_AXES])
 {
     size_t at = 0;
-    for (int j = 3; j < NCP_AXES; j++) {
+    for (int j = from; j < NCP_AXES; j++) {
         if (!(mask & NCP_AXIS_BIT(j)))
             continue;
-        int k = snprintf(buf + at, len - at, ",%.6f,%.6f", fb->cmd[j], fb->act[j]);
+        int k = snprintf(buf + at, len - at, ",%.6f,%.6f", cmd[j], act[j]);
         if (k < 0 || (size_t)k >= len - at)
             return -1;
         at += (size_t)k;
     }
     return (int)at;
+}
+
+/* The rows' columns for the axes beyond X Y Z the machine has, after all
+ * the others, so that readers of the fixed columns keep working. */
+static int trace_more_axes(char *buf, size_t len, unsigned mask, const struct nck_fb *fb)
+{
+    return trace_pairs(buf, len, mask, 3, fb->cmd, fb->act);
 }
 
 /* The joints, after everything else, under non-trivial kinematics: the
@@ -75,16 +82,8 @@ static int trace_joints(char *buf, size_t len, unsigned mask, const struct nck_f
     int k0 = snprintf(buf, len, ",%.6f", fb->tool_z);
     if (k0 < 0 || (size_t)k0 >= len)
         return -1;
-    size_t at = (size_t)k0;
-    for (int j = 0; j < NCP_AXES; j++) {
-        if (!(mask & NCP_AXIS_BIT(j)))
-            continue;
-        int k = snprintf(buf + at, len - at, ",%.6f,%.6f", fb->jcmd[j], fb->jact[j]);
-        if (k < 0 || (size_t)k >= len - at)
-            return -1;
-        at += (size_t)k;
-    }
-    return (int)at;
+    int k = trace_pairs(buf + k0, len - (size_t)k0, mask, 0, fb->jcmd, fb->jact);
+    return k < 0 ? -1 : k0 + k;
 }
 
 /* The `home` column: one digit per machine axis, in COORDINATES
