@@ -43,6 +43,13 @@ void drive_boot(struct drive *dv)
     drive_send(dv, &f);
 }
 
+int drive_send_tpdo(struct drive *dv)
+{
+    struct ncp_can_frame f;
+    ncp_tpdo1_frame(&f, dv->o.node, ncp_cia402_statusword(dv->st), dv->actual);
+    return drive_send(dv, &f);
+}
+
 int drive_send_heartbeat(struct drive *dv)
 {
     if (!dv->heartbeat_on)
@@ -111,9 +118,7 @@ static int on_sync(struct drive *dv)
     dv->tpdos++;
     if (dv->o.drop_every > 0 && dv->tpdos % dv->o.drop_every == 0)
         return 0;
-    struct ncp_can_frame f;
-    ncp_tpdo1_frame(&f, dv->o.node, ncp_cia402_statusword(dv->st), dv->actual);
-    return drive_send(dv, &f);
+    return drive_send_tpdo(dv);
 }
 
 static int on_nmt(struct drive *dv, const struct ncp_can_frame *f)
@@ -195,10 +200,10 @@ static int on_sdo(struct drive *dv, const struct ncp_can_frame *f)
 int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f, long long now_ms)
 {
     uint8_t n = dv->o.node;
-    uint32_t consumer = od_get(&dv->od, 0x1016, 1);
+    unsigned master = drive_master_node(dv);
     if (f->id == NCP_COB_NMT)
         return on_nmt(dv, f);
-    if ((consumer >> 16 & 0x7Fu) && f->id == NCP_COB_HEARTBEAT + (consumer >> 16 & 0x7Fu)) {
+    if (master && f->id == NCP_COB_HEARTBEAT + master) {
         dv->last_master_hb = now_ms;
         return 0;
     }

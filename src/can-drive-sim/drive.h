@@ -73,10 +73,14 @@ int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy);
  * drive's own reaction (0x6007, 0x605E) when one passes: called whenever the
  * drive wakes; -1 on a bus error. */
 int drive_guard_tick(struct drive *dv, long long now_ms);
+/* The master's node-ID the drive consumes the heartbeat of (0x1016:01), 0 none. */
+unsigned drive_master_node(struct drive *dv);
 /* How long the drive may sleep before the next deadline or ramp step, ms. */
 int drive_guard_wait_ms(struct drive *dv, long long now_ms);
 /* The CAN identifiers the drive listens to (its filter): n returned. */
 size_t drive_listen_ids(struct drive *dv, uint32_t ids[6]);
 int drive_send_heartbeat(struct drive *dv);
+/* TPDO1: statusword and actual position, now. */
+int drive_send_tpdo(struct drive *dv);
 
 #endif

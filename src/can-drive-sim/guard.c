@@ -17,7 +17,7 @@
 #define EMCY_RPDO_TIMEOUT 0x8250u
 #define EMCY_SYNC_LOST 0x8700u
 
-static unsigned master_node(struct drive *dv)
+unsigned drive_master_node(struct drive *dv)
 {
     return od_get(&dv->od, 0x1016, 1) >> 16 & 0x7Fu;
 }
@@ -30,8 +30,8 @@ size_t drive_listen_ids(struct drive *dv, uint32_t ids[6])
     ids[k++] = NCP_COB_SYNC;
     ids[k++] = NCP_COB_SDO_RX + n;
     ids[k++] = NCP_COB_RPDO1 + n;
-    if (master_node(dv))
-        ids[k++] = NCP_COB_HEARTBEAT + master_node(dv);
+    if (drive_master_node(dv))
+        ids[k++] = NCP_COB_HEARTBEAT + drive_master_node(dv);
     return k;
 }
 
@@ -42,7 +42,7 @@ static uint16_t deadline_passed(struct drive *dv, long long now)
 {
     uint32_t consumer_ms = od_get(&dv->od, 0x1016, 1) & 0xFFFFu;
     uint32_t rpdo_ms = od_get(&dv->od, 0x1400, 5);
-    if (master_node(dv) && consumer_ms && dv->last_master_hb >= 0 &&
+    if (drive_master_node(dv) && consumer_ms && dv->last_master_hb >= 0 &&
         now - dv->last_master_hb > (long long)consumer_ms)
         return EMCY_HEARTBEAT;
     if (dv->o.sync_loss_ms > 0 && dv->last_sync >= 0 && now - dv->last_sync > dv->o.sync_loss_ms)
@@ -50,13 +50,6 @@ static uint16_t deadline_passed(struct drive *dv, long long now)
     if (rpdo_ms && dv->last_rpdo >= 0 && now - dv->last_rpdo > (long long)rpdo_ms)
         return EMCY_RPDO_TIMEOUT;
     return 0;
-}
-
-static int send_tpdo(struct drive *dv)
-{
-    struct ncp_can_frame f;
-    ncp_tpdo1_frame(&f, dv->o.node, ncp_cia402_statusword(dv->st), dv->actual);
-    return drive_send(dv, &f);
 }
 
 static int period_ms(struct drive *dv)
@@ -72,7 +65,7 @@ static int start_ramp(struct drive *dv, enum ncp_cia402_state during, enum ncp_c
     dv->after_stop = after;
     dv->next_step = now;
     drive_set_state(dv, during);
-    return send_tpdo(dv);
+    return drive_send_tpdo(dv);
 }
 
 static int react(struct drive *dv, uint16_t code, long long now)
@@ -91,7 +84,7 @@ static int react(struct drive *dv, uint16_t code, long long now)
     case 2:
         dv->target = dv->actual;
         drive_set_state(dv, NCP_402_SWITCH_ON_DISABLED);
-        return send_tpdo(dv);
+        return drive_send_tpdo(dv);
     case 3:
         return start_ramp(dv, NCP_402_QUICK_STOP_ACTIVE, NCP_402_SWITCH_ON_DISABLED, now);
     default:
@@ -100,7 +93,7 @@ static int react(struct drive *dv, uint16_t code, long long now)
         if ((int16_t)od_get(&dv->od, 0x605E, 0) == 0) {  /* disable drive: no ramp */
             dv->target = dv->actual;
             drive_set_state(dv, NCP_402_FAULT);
-            return send_tpdo(dv);
+            return drive_send_tpdo(dv);
         }
         return start_ramp(dv, NCP_402_FAULT_REACTION_ACTIVE, NCP_402_FAULT, now);
     }
@@ -120,7 +113,7 @@ static int ramp_step(struct drive *dv)
     od_set(&dv->od, 0x6064, 0, (uint32_t)dv->actual);
     if (dv->stop_vel == 0)
         drive_set_state(dv, dv->after_stop);
-    return send_tpdo(dv);
+    return drive_send_tpdo(dv);
 }
 
 static int ramping(const struct drive *dv)
