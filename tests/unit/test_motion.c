@@ -612,28 +612,6 @@ static void test_canon_units_offsets(void **state)
     assert_int_equal(s.line, 6);
 }
 
-/* A helix of zero radius (rs274 sends one for a bore the tool fills) is
- * the straight move along its axis; an arc whose centre is only one of its
- * ends stays refused. */
-static void test_canon_zero_radius_helix(void **state)
-{
-    (void)state;
-    struct ncp_machine_cfg c = test_cfg();
-    struct ncp_canon_map m;
-    ncp_canon_map_init(&m, &c, NULL, 1.0);
-    struct ncp_seg s;
-    struct ncp_diag d;
-    struct ncp_canon f = op_feed(600);
-    assert_int_equal(ncp_canon_map_op(&m, &f, 1, &s, &d), 0);
-    struct ncp_canon plunge = op_arc(0, 0, 0, 0, 1, -2.5);
-    assert_int_equal(ncp_canon_map_op(&m, &plunge, 2, &s, &d), 1);
-    assert_int_equal(s.kind, NCP_SEG_LINE);
-    assert_true(fabs(s.end[2] + 2.5) < 1e-12 && fabs(s.length - 2.5) < 1e-12);
-    struct ncp_canon spiral = op_arc(5, 0, 0, 0, 1, -2.5);
-    assert_true(ncp_canon_map_op(&m, &spiral, 3, &s, &d) < 0);
-    assert_non_null(strstr(d.msg, "zero radius at one end"));
-}
-
 /* A canon map on the test machine, and what its calls fill. */
 struct map_fixture {
     struct ncp_machine_cfg cfg;
@@ -850,6 +828,22 @@ static void test_canon_nurbs(void **state)
     assert_int_equal(f.d.line, 5);
     assert_true(map_op(&f, op_nurbs_head(40, NCP_NURBS_MAX_ORDER + 1, 0, 0, 0), 6) < 0);
     assert_non_null(strstr(f.d.msg, "order"));
+}
+
+/* A helix of zero radius (rs274 sends one for a bore the tool fills) is
+ * the straight move along its axis; an arc whose centre is only one of its
+ * ends stays refused. */
+static void test_canon_zero_radius_helix(void **state)
+{
+    (void)state;
+    struct map_fixture f;
+    map_fixture_init(&f, 1.0);
+    assert_int_equal(map_op(&f, op_feed(600), 1), 0);
+    assert_int_equal(map_op(&f, op_arc(0, 0, 0, 0, 1, -2.5), 2), 1);
+    assert_int_equal(f.s.kind, NCP_SEG_LINE);
+    assert_true(fabs(f.s.end[2] + 2.5) < 1e-12 && fabs(f.s.length - 2.5) < 1e-12);
+    assert_true(map_op(&f, op_arc(5, 0, 0, 0, 1, -2.5), 3) < 0);
+    assert_non_null(strstr(f.d.msg, "zero radius at one end"));
 }
 
 static void test_soft_limit(void **state)
