@@ -1,0 +1,182 @@
+#!/usr/bin/env python3
+"""A lower bound on the program time any planner can reach on a feed program
+with per-axis limits and a G64 P tolerance: no planner that keeps every axis
+within its MAX_VELOCITY and MAX_ACCELERATION, the path within P and the feed
+within F can be faster. It answers "how far below LinuxCNC's time is there
+room at all?" for bench/planner-vs-lcnc's programs.
+
+Every estimate is taken on the generous side, so the bound stays a bound:
+- each line runs at most at min(F, min_i vmax_i / |u_i|) and speeds up or
+  slows down at most at min_i amax_i / |u_i| (exact for a straight line);
+- on an arc the speed is at most sqrt(a_n r), and its speed changes at most
+  at a_n, with a_n the norm of the limits of the axes its plane (or its
+  helix) moves (every one of them at its limit at once, more than any
+  direction can get);
+- a corner turning by phi may be passed on the circle that stays within P of
+  it, r = P / (1 / cos(phi / 2) - 1), as long as that circle fits on the
+  whole of both segments, at sqrt(a_n r), a_n over the axes either segment
+  moves; the path is shortened by what such
+  a circle cuts off (on a smaller circle the corner is slower and the cut
+  shorter, so the largest one is the generous choice);
+- the machine starts and ends at rest; in between the fastest profile that
+  these bounds allow (forward and backward passes over the junction speeds,
+  then a trapezoid on each segment).
+
+Motion is read from `cnc-run parse --canon`: STRAIGHT_FEED and ARC_FEED in the
+XY plane (G17) with a helical Z, as bench/gen-planner.py writes them.
+
+usage: planner-bound.py PROGRAM INI [--cnc-run PATH]  -> prints seconds
+"""
+import math
+import re
+import subprocess
+import sys
+
+
+def ini_limits(path):
+    sec, lim = None, {}
+    for line in open(path):
+        line = line.split("#")[0].strip()
+        m = re.match(r"^\[(\w+)\]$", line)
+        if m:
+            sec = m.group(1)
+            continue
+        m = re.match(r"^(\w+)\s*=\s*(\S+)", line)
+        if m and sec and sec.startswith("AXIS_") and m.group(1) in ("MAX_VELOCITY", "MAX_ACCELERATION"):
+            lim.setdefault(sec[5], {})[m.group(1)] = float(m.group(2))
+    try:
+        return ([lim[a]["MAX_VELOCITY"] for a in "XYZ"], [lim[a]["MAX_ACCELERATION"] for a in "XYZ"])
+    except KeyError as e:
+        sys.exit("planner-bound: %s: [AXIS_%s] MAX_VELOCITY / MAX_ACCELERATION missing" % (path, e))
+
+
+def moves(prog, cnc_run):
+    out = subprocess.run([cnc_run, "parse", prog, "--canon", "-"], capture_output=True, text=True)
+    if out.returncode:
+        sys.exit("planner-bound: %s" % out.stderr.strip())
+    pos, feed, tol, segs = [0.0, 0.0, 0.0], None, 0.0, []
+    for line in out.stdout.split("\n"):
+        m = re.match(r"^(\w+)\((.*)\)$", line.strip())
+        if not m:
+            continue
+        name, args = m.group(1), [a.strip() for a in m.group(2).split(",")]
+        if name == "SET_FEED_RATE":
+            feed = float(args[0]) / 60.0
+        elif name == "SET_MOTION_CONTROL_MODE" and len(args) > 1:
+            tol = float(args[1])
+        elif name in ("STRAIGHT_FEED", "STRAIGHT_TRAVERSE"):
+            end = [float(a) for a in args[:3]]
+            if name == "STRAIGHT_FEED" and end != pos:
+                segs.append(("line", list(pos), end, feed))
+            pos = end
+        elif name == "ARC_FEED":
+            x, y, cx, cy, rot, z = (float(a) for a in args[:6])
+            segs.append(("arc", list(pos), [x, y, z], feed, (cx, cy), int(rot)))
+            pos = [x, y, z]
+    return segs, tol
+
+
+def sub(a, b):
+    return [p - q for p, q in zip(a, b)]
+
+
+def norm(a):
+    return math.sqrt(sum(c * c for c in a))
+
+
+def unit(a):
+    n = norm(a)
+    return [c / n for c in a] if n > 0 else [0.0, 0.0, 0.0]
+
+
+def moving_norm(amax, *dirs):
+    """The norm of the limits of the axes any of dirs moves."""
+    return math.sqrt(sum(amax[i] ** 2 for i in range(3) if any(abs(d[i]) > 1e-12 for d in dirs)))
+
+
+def geometry(seg, vmax, amax):
+    """(length, speed cap, acceleration cap, entry tangent, exit tangent, radius or inf)"""
+    if seg[0] == "line":
+        d = sub(seg[2], seg[1])
+        u = unit(d)
+        vcap = min([seg[3]] + [vmax[i] / abs(u[i]) for i in range(3) if abs(u[i]) > 1e-12])
+        acap = min(amax[i] / abs(u[i]) for i in range(3) if abs(u[i]) > 1e-12)
+        return norm(d), vcap, acap, u, u, math.inf
+    (cx, cy), rot = seg[4], seg[5]
+    s, e = seg[1], seg[2]
+    r = math.hypot(s[0] - cx, s[1] - cy)
+    a0 = math.atan2(s[1] - cy, s[0] - cx)
+    a1 = math.atan2(e[1] - cy, e[0] - cx)
+    ccw = rot > 0
+    turns = abs(rot) - 1
+    sweep = (a1 - a0) % (2 * math.pi) if ccw else (a0 - a1) % (2 * math.pi)
+    if sweep < 1e-12:
+        sweep = 2 * math.pi
+    sweep += 2 * math.pi * turns
+    dz = e[2] - s[2]
+    length = math.hypot(r * sweep, dz)
+    sg = 1 if ccw else -1
+
+    def tang(a):
+        return unit([-sg * math.sin(a) * r * sweep, sg * math.cos(a) * r * sweep, dz])
+    an = moving_norm(amax, (1, 1, dz))
+    vcap = min(seg[3], math.sqrt(an * r), *vmax)
+    return length, vcap, an, tang(a0), tang(a1), r
+
+
+def bound(segs, tol, vmax, amax):
+    g = [geometry(s, vmax, amax) for s in segs]
+    n = len(g)
+    length = [x[0] for x in g]
+    vj = [0.0] * (n + 1)          # junction speed caps; 0 at start and end
+    for k in range(1, n):
+        a, b = g[k - 1], g[k]
+        c = max(-1.0, min(1.0, sum(p * q for p, q in zip(a[4], b[3]))))
+        phi = math.acos(c)
+        cap = min(a[1], b[1])
+        if phi > 1e-9:
+            if tol <= 0:
+                cap = 0.0
+            else:
+                r = tol / (1 / math.cos(phi / 2) - 1) if phi < math.pi - 1e-9 else 0.0
+                r = min(r, min(length[k - 1], length[k]) / math.tan(phi / 2) if phi < math.pi else 0.0)
+                an = moving_norm(amax, a[4], b[3])
+                cap = min(cap, math.sqrt(an * r))
+                cut = 2 * r * math.tan(phi / 2) - r * phi
+                length[k - 1] -= cut / 2
+                length[k] -= cut / 2
+        vj[k] = cap
+    # fastest junction speeds reachable forwards and backwards
+    v = list(vj)
+    for k in range(1, n + 1):
+        v[k] = min(v[k], math.sqrt(v[k - 1] ** 2 + 2 * g[k - 1][2] * max(length[k - 1], 0.0)))
+    for k in range(n - 1, -1, -1):
+        v[k] = min(v[k], math.sqrt(v[k + 1] ** 2 + 2 * g[k][2] * max(length[k], 0.0)))
+    t = 0.0
+    for k in range(n):
+        L, vc, a = max(length[k], 0.0), g[k][1], g[k][2]
+        v0, v1 = min(v[k], vc), min(v[k + 1], vc)
+        vp = min(vc, math.sqrt((2 * a * L + v0 * v0 + v1 * v1) / 2))
+        d_acc = (vp * vp - v0 * v0) / (2 * a)
+        d_dec = (vp * vp - v1 * v1) / (2 * a)
+        cruise = max(L - d_acc - d_dec, 0.0)
+        t += (vp - v0) / a + (vp - v1) / a + (cruise / vp if vp > 0 else 0.0)
+    return t
+
+
+def main():
+    args = sys.argv[1:]
+    cnc_run = "build/cnc-run"
+    if "--cnc-run" in args:
+        i = args.index("--cnc-run")
+        cnc_run = args[i + 1]
+        del args[i:i + 2]
+    if len(args) != 2:
+        sys.exit(__doc__.strip().split("\n")[-1])
+    vmax, amax = ini_limits(args[1])
+    segs, tol = moves(args[0], cnc_run)
+    print("%.3f" % bound(segs, tol, vmax, amax))
+
+
+if __name__ == "__main__":
+    main()
