@@ -414,6 +414,51 @@ double ncp_scurve_reach(double v, double len, double a, double j);
 /* Distance and velocity at time t (clamped to the duration). */
 double ncp_trap_eval(const struct ncp_trap *tp, double t, double *v);
 
+/* ---- the interpolator on its own (exec.c) ---------------------------------
+ * One segment as the interpolator runs it, its profile frozen when it starts:
+ * seed 002's ACCDECbuf record of the ADCBI NCK. The planner hands these to its
+ * own interpolator; an LLC at ADCBI's DP4 receives them and runs the same
+ * code, so its samples equal the central run's. */
+struct ncp_accdec {
+    struct ncp_seg s;
+    struct ncp_trap trap;   /* the profile (zero for a dwell) */
+    double dur;             /* s */
+    uint8_t blend;          /* a G64 corner arc, not a programmed segment */
+};
+
+/* Where the interpolator gets its records. next: the record to run after one
+ * that ended at speed v0 (0: from rest); 1 filled, 0 none yet, -1 none and no
+ * more will come. done: the record running has ended. */
+struct ncp_exec_source {
+    int (*next)(void *ctx, double v0, struct ncp_accdec *rec);
+    void (*done)(void *ctx);
+    void *ctx;
+};
+
+struct ncp_exec {
+    double period;          /* planning period, s */
+    int active;             /* cur is running */
+    struct ncp_accdec cur;
+    double t;               /* time into cur */
+    double v_now;           /* path speed at the last sample */
+    double pos[NCP_AXES];
+    uint32_t line, aux;     /* cur's (ncp_seg.line, .aux) */
+    double tool_z;
+};
+
+void ncp_exec_init(struct ncp_exec *e, const double start[NCP_AXES], double period);
+/* One planning period. Returns 1 while moving or waiting (NCP_SP_STARVED: at
+ * rest, no record yet), 0 once the source has said there are no more
+ * (NCP_SP_END). A record that ends at speed with none after it stops on its
+ * end point with NCP_SP_STARVED set: the source fell behind. */
+int ncp_exec_step(struct ncp_exec *e, const struct ncp_exec_source *src,
+                  struct ncp_setpoint *out);
+
+/* Every record the planner starts, as it starts it (the HLC of ADCBI's DP4
+ * sends them on; NULL: none). */
+void ncp_planner_set_tap(struct ncp_planner *p,
+                         void (*tap)(void *ctx, const struct ncp_accdec *rec), void *ctx);
+
 /* ---- the position loop's reading of the setpoint stream (scaler.c) ---------
  * Time scaling (feed override, feed hold, underruns: the path stays, only the
  * time along it changes) and fine interpolation between planning periods. */

@@ -63,8 +63,8 @@ struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
         free(p);
         return NULL;
     }
-    for (int i = 0; i < NCP_AXES; i++)
-        p->pos[i] = start ? start[i] : 0;
+    ncp_exec_init(&p->ex, start, cfg->planning_period > 0 ? cfg->planning_period
+                                                          : cfg->servo_period);
     return p;
 }
 
@@ -90,7 +90,7 @@ size_t ncp_planner_queued(const struct ncp_planner *p)
 
 int ncp_planner_idle(const struct ncp_planner *p)
 {
-    return !p->active;
+    return !p->ex.active;
 }
 
 static void chain_flush(struct ncp_planner *p);
@@ -112,14 +112,16 @@ void ncp_planner_reset(struct ncp_planner *p, const double pos[NCP_AXES])
     p->head = 0;
     p->count = 0;
     p->programmed = 0;
-    p->active = 0;
     p->finished = 0;
     p->have_last = 0;
-    p->t = 0;
-    p->dur = 0;
-    p->v_now = 0;
     p->chain_n = 0;
-    memcpy(p->pos, pos, sizeof p->pos);
+    /* the last block's line, machine functions and tool stay what the held
+     * samples report */
+    struct ncp_exec was = p->ex;
+    ncp_exec_init(&p->ex, pos, was.period);
+    p->ex.line = was.line;
+    p->ex.aux = was.aux;
+    p->ex.tool_z = was.tool_z;
 }
 
 void ncp_planner_get_stats(const struct ncp_planner *p, struct ncp_planner_stats *st)
@@ -341,8 +343,8 @@ static double junction(const struct ncp_planner *p, const struct ncp_seg *prev,
  * segment's frozen profile ends with? Stops as soon as a speed stays put. */
 static int lowering_safe(const struct ncp_planner *p, double v_tail)
 {
-    if (!p->active || p->count < 2)
-        return p->count >= 1 && !(p->active && p->count == 1);
+    if (!p->ex.active || p->count < 2)
+        return p->count >= 1 && !(p->ex.active && p->count == 1);
     size_t k = p->count - 1;
     double v = v_tail;
     for (;;) {
@@ -350,7 +352,7 @@ static int lowering_safe(const struct ncp_planner *p, double v_tail)
         if (v >= ps->v_in)
             return 1;
         if (k == 1)
-            return v >= p->trap.v1;
+            return v >= p->ex.cur.trap.v1;
         k--;
         ps = &p->q[(p->head + k) % p->cap];
         v = fmin(ps->vjunc, ncp_plan_seg_reach(p, ps, v, ps->s.length));
@@ -467,7 +469,7 @@ double ncp_plan_seg_profile_acc(const struct ncp_planner *p, const struct plan_s
  * segments before it were limited by their own caps, not by what follows. */
 static void backward_pass(struct ncp_planner *p)
 {
-    size_t first = p->active ? 1 : 0;
+    size_t first = p->ex.active ? 1 : 0;
     double exit_v = 0;
     for (size_t k = p->count; k-- > first;) {
         struct plan_seg *ps = plan_at(p, k);
@@ -612,7 +614,7 @@ static double blend_vmax_any(const struct ncp_planner *p, const struct ncp_seg *
  * override in force, so the path cut is the same at any override. */
 static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
 {
-    if (!p->count || (p->active && p->count == 1))
+    if (!p->count || (p->ex.active && p->count == 1))
         return 0;
     struct plan_seg *prev = plan_at(p, p->count - 1);
     struct plan_seg arc;

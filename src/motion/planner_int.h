@@ -31,16 +31,11 @@ struct ncp_planner {
     struct plan_seg *q;      /* ring of cap entries */
     size_t head, count;
     size_t programmed;       /* queued segments that are not blend arcs */
-    int active;              /* q[head] is executing with a frozen profile */
     int finished;
-    struct ncp_trap trap;    /* profile of q[head] */
-    double dur;              /* its duration */
-    double t;                /* time into it */
-    double v_now;            /* path speed at the end of the last sample */
-    double pos[NCP_AXES];
-    uint32_t line;
-    uint32_t aux;            /* the executing segment's machine functions (ncp_seg.aux) */
-    double tool_z;           /* and its tool length (ncp_seg.tool_z) */
+    /* the interpolator: ex.active = q[head] is executing with a frozen profile */
+    struct ncp_exec ex;
+    void (*tap)(void *ctx, const struct ncp_accdec *rec);
+    void *tap_ctx;
     int have_last;           /* last_pushed valid: junctions need the previous segment */
     struct ncp_seg last_pushed;
     double last_vmax;        /* its cruise cap */
