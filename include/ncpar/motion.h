@@ -454,10 +454,30 @@ void ncp_exec_init(struct ncp_exec *e, const double start[NCP_AXES], double peri
 int ncp_exec_step(struct ncp_exec *e, const struct ncp_exec_source *src,
                   struct ncp_setpoint *out);
 
-/* Every record the planner starts, as it starts it (the HLC of ADCBI's DP4
- * sends them on; NULL: none). */
+/* The look-ahead's word on one segment as its profile is about to be frozen:
+ * seed 002's LAbuf of the ADCBI NCK. Beside the block, the limits the look-
+ * ahead gave it (cruise cap, path acceleration before and after a corner took
+ * its share, jerk, an arc's acceleration bound, curvature and cap) and the end
+ * speed it allows (the next segment's entry speed; 0 before a stop). */
+struct ncp_la {
+    struct ncp_seg s;
+    double vmax, acc, acc_full, jerk, a_eff, kappa, a_cap;
+    double v_end;
+    uint8_t blend;
+};
+
+/* ADCBI's ACC/DEC stage on its own: the profile of la entered at v0 (the
+ * speed the segment before ended with), as the planner freezes it. */
+void ncp_la_profile(enum ncp_profile profile, const struct ncp_la *la, double v0,
+                    struct ncp_accdec *rec);
+
+/* Every segment the planner starts, as it starts it: its look-ahead record
+ * and the profile frozen from it (the HLC of ADCBI's DP3 or DP4 sends one of
+ * them on; NULL: none). */
 void ncp_planner_set_tap(struct ncp_planner *p,
-                         void (*tap)(void *ctx, const struct ncp_accdec *rec), void *ctx);
+                         void (*tap)(void *ctx, const struct ncp_la *la,
+                                     const struct ncp_accdec *rec),
+                         void *ctx);
 
 /* ---- the position loop's reading of the setpoint stream (scaler.c) ---------
  * Time scaling (feed override, feed hold, underruns: the path stays, only the

@@ -8,30 +8,51 @@
 #include <math.h>
 #include <string.h>
 
+void ncp_la_profile(enum ncp_profile profile, const struct ncp_la *la, double v0,
+                    struct ncp_accdec *rec)
+{
+    struct plan_seg ps;
+    memset(&ps, 0, sizeof ps);
+    ps.s = la->s;
+    ps.vmax = la->vmax;
+    ps.acc = la->acc;
+    ps.acc_full = la->acc_full;
+    ps.jerk = la->jerk;
+    ps.a_eff = la->a_eff;
+    ps.kappa = la->kappa;
+    ps.a_cap = la->a_cap;
+    int scurve = profile == NCP_PROFILE_SCURVE;
+    memset(rec, 0, sizeof *rec);
+    rec->s = la->s;
+    rec->blend = la->blend;
+    if (la->s.kind == NCP_SEG_DWELL) {
+        rec->dur = la->s.dwell;
+        return;
+    }
+    double v1 = fmin(la->v_end, ncp_plan_seg_reach(scurve, &ps, v0, la->s.length));
+    double vmax = fmax(la->vmax, v0);
+    if (scurve && la->jerk > 0 && isfinite(la->jerk))
+        ncp_scurve_plan(&rec->trap, la->s.length, v0, v1, vmax, la->acc, la->jerk);
+    else
+        ncp_trap_plan(&rec->trap, la->s.length, v0, v1, vmax,
+                      ncp_plan_seg_profile_acc(scurve, &ps, v0, v1, vmax));
+    rec->dur = ncp_trap_duration(&rec->trap);
+}
+
 static int head_record(void *ctx, double v0, struct ncp_accdec *rec)
 {
     struct ncp_planner *p = ctx;
     if (p->count == 0)
         return p->finished ? -1 : 0;
-    struct plan_seg *ps = plan_at(p, 0);
-    memset(rec, 0, sizeof *rec);
-    rec->s = ps->s;
-    rec->blend = (uint8_t)ps->blend;
-    if (ps->s.kind == NCP_SEG_DWELL) {
-        rec->dur = ps->s.dwell;
-    } else {
-        double next = p->count > 1 ? plan_at(p, 1)->v_in : 0;
-        double v1 = fmin(next, ncp_plan_seg_reach(p, ps, v0, ps->s.length));
-        double vmax = fmax(ps->vmax, v0);
-        if (plan_scurve(p) && ps->jerk > 0 && isfinite(ps->jerk))
-            ncp_scurve_plan(&rec->trap, ps->s.length, v0, v1, vmax, ps->acc, ps->jerk);
-        else
-            ncp_trap_plan(&rec->trap, ps->s.length, v0, v1, vmax,
-                          ncp_plan_seg_profile_acc(p, ps, v0, v1, vmax));
-        rec->dur = ncp_trap_duration(&rec->trap);
-    }
+    const struct plan_seg *ps = plan_at(p, 0);
+    struct ncp_la la = {
+        .s = ps->s, .vmax = ps->vmax, .acc = ps->acc, .acc_full = ps->acc_full,
+        .jerk = ps->jerk, .a_eff = ps->a_eff, .kappa = ps->kappa, .a_cap = ps->a_cap,
+        .v_end = p->count > 1 ? plan_at(p, 1)->v_in : 0, .blend = (uint8_t)ps->blend,
+    };
+    ncp_la_profile(p->cfg.profile, &la, v0, rec);
     if (p->tap)
-        p->tap(p->tap_ctx, rec);
+        p->tap(p->tap_ctx, &la, rec);
     return 1;
 }
 
@@ -41,7 +62,9 @@ static void head_done(void *ctx)
 }
 
 void ncp_planner_set_tap(struct ncp_planner *p,
-                         void (*tap)(void *ctx, const struct ncp_accdec *rec), void *ctx)
+                         void (*tap)(void *ctx, const struct ncp_la *la,
+                                     const struct ncp_accdec *rec),
+                         void *ctx)
 {
     p->tap = tap;
     p->tap_ctx = ctx;

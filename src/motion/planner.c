@@ -355,7 +355,7 @@ static int lowering_safe(const struct ncp_planner *p, double v_tail)
             return v >= p->ex.cur.trap.v1;
         k--;
         ps = &p->q[(p->head + k) % p->cap];
-        v = fmin(ps->vjunc, ncp_plan_seg_reach(p, ps, v, ps->s.length));
+        v = fmin(ps->vjunc, ncp_plan_seg_reach(plan_scurve(p), ps, v, ps->s.length));
     }
 }
 
@@ -402,12 +402,12 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
         }
         struct plan_seg cur_half = *ps, prev_half;
         cur_half.acc = fmin(ps->acc, f_cur * ps->acc_full);
-        double exit_lb = fmin(v, ncp_plan_seg_reach(p, &cur_half, 0, ps->s.length));
+        double exit_lb = fmin(v, ncp_plan_seg_reach(plan_scurve(p), &cur_half, 0, ps->s.length));
         if (prev) {
             prev_half = *prev;
             prev_half.acc = fmin(prev->acc, f_prev * prev->acc_full);
         }
-        if (!prev || !lowering_safe(p, fmin(prev->vjunc, ncp_plan_seg_reach(p, &prev_half, exit_lb,
+        if (!prev || !lowering_safe(p, fmin(prev->vjunc, ncp_plan_seg_reach(plan_scurve(p), &prev_half, exit_lb,
                                                                             prev->s.length)))) {
             v = 0;
         } else {
@@ -418,16 +418,15 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
     ps->vjunc = v;
 }
 
-double ncp_plan_seg_reach(const struct ncp_planner *p, const struct plan_seg *ps, double v,
-                          double len)
+double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, double len)
 {
-    double lo = plan_reach(p, ps->acc, ps->jerk, v, len);
-    if (ps->kappa <= 0 || plan_scurve(p))
+    double lo = plan_reach_prof(scurve, ps->acc, ps->jerk, v, len);
+    if (ps->kappa <= 0 || scurve)
         return lo;
     /* the move's top speed x is the end reached: x^2 = v^2 + 2 len acc(x),
      * acc falling with x, so the largest such x is found by bisection
      * between the cruise cap's acceleration and the one at v */
-    double hi = plan_reach(p, plan_acc_at(ps, v), ps->jerk, v, len);
+    double hi = plan_reach_prof(scurve, plan_acc_at(ps, v), ps->jerk, v, len);
     for (int i = 0; i < 40 && hi - lo > 1e-9 * hi; i++) {
         double mid = 0.5 * (lo + hi);
         if (mid * mid <= v * v + 2 * len * plan_acc_at(ps, mid))
@@ -445,11 +444,11 @@ static double trap_peak(double a, double len, double v0, double v1, double vmax)
     return fmax(vp, fmax(v0, v1));
 }
 
-double ncp_plan_seg_profile_acc(const struct ncp_planner *p, const struct plan_seg *ps, double v0,
-                                double v1, double vmax)
+double ncp_plan_seg_profile_acc(int scurve, const struct plan_seg *ps, double v0, double v1,
+                                double vmax)
 {
     double len = ps->s.length;
-    if (ps->kappa <= 0 || plan_scurve(p) || len <= 0)
+    if (ps->kappa <= 0 || scurve || len <= 0)
         return ps->acc;
     double lo = ps->acc, hi = plan_acc_at(ps, fmax(v0, v1));
     if (hi <= plan_acc_at(ps, trap_peak(hi, len, v0, v1, vmax)))
@@ -473,7 +472,7 @@ static void backward_pass(struct ncp_planner *p)
     double exit_v = 0;
     for (size_t k = p->count; k-- > first;) {
         struct plan_seg *ps = plan_at(p, k);
-        double v = fmin(ps->vjunc, ncp_plan_seg_reach(p, ps, exit_v, ps->s.length));
+        double v = fmin(ps->vjunc, ncp_plan_seg_reach(plan_scurve(p), ps, exit_v, ps->s.length));
         if (k + 1 < p->count && v == ps->v_in)
             break;
         if (k + 1 < p->count)
@@ -644,7 +643,7 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     arc.blend = 1;
     arc_limits(p, &arc, BLEND_AN_SHARE);
     arc.acc_full = arc.acc;
-    double exit_lb = fmin(arc.vmax, ncp_plan_seg_reach(p, &arc, 0, arc.s.length));
+    double exit_lb = fmin(arc.vmax, ncp_plan_seg_reach(plan_scurve(p), &arc, 0, arc.s.length));
     struct plan_seg cut = *prev;
     cut.s = prev_out;
     if (cut.s.kind == NCP_SEG_ARC) {
@@ -652,7 +651,7 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
         cut.acc_full = cut.acc;
         cut.acc = fmin(prev->acc, cut.acc);
     }
-    double vin = fmin(prev->vjunc, ncp_plan_seg_reach(p, &cut, exit_lb, prev_out.length));
+    double vin = fmin(prev->vjunc, ncp_plan_seg_reach(plan_scurve(p), &cut, exit_lb, prev_out.length));
     if (!lowering_safe(p, vin))
         return 0;
     prev->s = prev_out;

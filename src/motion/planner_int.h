@@ -34,7 +34,7 @@ struct ncp_planner {
     int finished;
     /* the interpolator: ex.active = q[head] is executing with a frozen profile */
     struct ncp_exec ex;
-    void (*tap)(void *ctx, const struct ncp_accdec *rec);
+    void (*tap)(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec);
     void *tap_ctx;
     int have_last;           /* last_pushed valid: junctions need the previous segment */
     struct ncp_seg last_pushed;
@@ -64,13 +64,18 @@ static inline int plan_scurve(const struct ncp_planner *p)
 }
 
 /* Highest speed at one end of ps from which speed v at the other end is
- * reachable over len, under the profile in use. */
+ * reachable over len, under the profile (scurve: jerk-limited). */
+static inline double plan_reach_prof(int scurve, double acc, double jerk, double v, double len)
+{
+    if (scurve && jerk > 0 && isfinite(jerk))
+        return ncp_scurve_reach(v, len, acc, jerk);
+    return sqrt(v * v + 2 * acc * len);
+}
+
 static inline double plan_reach(const struct ncp_planner *p, double acc, double jerk, double v,
                                 double len)
 {
-    if (plan_scurve(p) && jerk > 0 && isfinite(jerk))
-        return ncp_scurve_reach(v, len, acc, jerk);
-    return sqrt(v * v + 2 * acc * len);
+    return plan_reach_prof(plan_scurve(p), acc, jerk, v, len);
 }
 
 /* The path acceleration ps allows at speeds up to v: an arc's centripetal
@@ -88,13 +93,12 @@ static inline double plan_acc_at(const struct plan_seg *ps, double v)
 
 /* planner.c: plan_reach for a queued segment, its acceleration taken at the
  * highest speed of the move (the arc's tangential share grows as it slows). */
-double ncp_plan_seg_reach(const struct ncp_planner *p, const struct plan_seg *ps, double v,
-                          double len);
+double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, double len);
 
 /* planner.c: the largest constant acceleration for ps's profile from v0 to v1
  * whose peak speed (capped at vmax) still allows it. */
-double ncp_plan_seg_profile_acc(const struct ncp_planner *p, const struct plan_seg *ps, double v0,
-                                double v1, double vmax);
+double ncp_plan_seg_profile_acc(int scurve, const struct plan_seg *ps, double v0, double v1,
+                                double vmax);
 
 /* blend.c: the arc joining prev's end to cur's start within prev's G64 P,
  * trimming at most max_trim off either line, and the length trimmed off both.

@@ -1,8 +1,9 @@
-/* The interpolator on its own (ncp_exec, exec.c): fed the records the planner
- * started (its tap: seed 002's ACCDECbuf of the ADCBI NCK), it gives the
- * planner's samples bit for bit, which is what lets an LLC at DP4 run the
- * stages below acc/dec for its axis; and a source that falls behind is told
- * apart from the end of the program. */
+/* The stages below the look-ahead on their own: fed the records the planner
+ * started (its tap: seed 002's ACCDECbuf of the ADCBI NCK), the interpolator
+ * (ncp_exec, exec.c) gives the planner's samples bit for bit, and so does the
+ * ACC/DEC stage (ncp_la_profile) run on the look-ahead's records (LAbuf):
+ * what lets an LLC at DP4 or DP3 run the stages below for its axis. A source
+ * that falls behind is told apart from the end of the program. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -76,17 +77,32 @@ static size_t program(struct ncp_canon *ops)
 struct recs {
     size_t n, cap, next;
     struct ncp_accdec *r;
+    struct ncp_la *la;
+    enum ncp_profile profile;
 };
 
-static void tap(void *ctx, const struct ncp_accdec *rec)
+static void tap(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec)
 {
     struct recs *rs = ctx;
     if (rs->n == rs->cap) {
         rs->cap = rs->cap ? 2 * rs->cap : 256;
         rs->r = realloc(rs->r, rs->cap * sizeof *rs->r);
+        rs->la = realloc(rs->la, rs->cap * sizeof *rs->la);
         assert_non_null(rs->r);
+        assert_non_null(rs->la);
     }
+    rs->la[rs->n] = *la;
     rs->r[rs->n++] = *rec;
+}
+
+/* the LLC at DP3: ACC/DEC on each look-ahead record as it is needed */
+static int from_la(void *ctx, double v0, struct ncp_accdec *rec)
+{
+    struct recs *rs = ctx;
+    if (rs->next == rs->n)
+        return -1;
+    ncp_la_profile(rs->profile, &rs->la[rs->next], v0, rec);
+    return 1;
 }
 
 static int from_array(void *ctx, double v0, struct ncp_accdec *rec)
@@ -126,7 +142,7 @@ static void replay_equals_planner(enum ncp_profile prof, int ratio)
     ncp_canon_map_init(&m, &cfg, zero, 1.0);
     struct ncp_planner *p = ncp_planner_new(&cfg, zero);
     assert_non_null(p);
-    struct recs rs = { 0 };
+    struct recs rs = { .profile = prof };
     ncp_planner_set_tap(p, tap, &rs);
     size_t nsp = 0, cap = 1 << 16, i = 0, segs = 0;
     struct ncp_setpoint *sp = malloc(cap * sizeof *sp);
@@ -159,20 +175,24 @@ static void replay_equals_planner(enum ncp_profile prof, int ratio)
         fail_msg("%zu corner arcs among %zu records", blends, rs.n);
     assert_int_equal(rs.n - blends, segs);
 
-    struct ncp_exec e;
-    ncp_exec_init(&e, zero, cfg.planning_period);
-    const struct ncp_exec_source src = { from_array, array_done, &rs };
-    for (size_t k = 0; k < nsp; k++) {
+    for (int stage = 0; stage < 2; stage++) {   /* ACCDECbuf records, then LAbuf */
+        struct ncp_exec e;
+        ncp_exec_init(&e, zero, cfg.planning_period);
+        const struct ncp_exec_source src = { stage ? from_la : from_array, array_done, &rs };
+        rs.next = 0;
+        for (size_t k = 0; k < nsp; k++) {
+            struct ncp_setpoint out;
+            assert_int_equal(ncp_exec_step(&e, &src, &out), 1);
+            sp_equal(&sp[k], &out, k);
+        }
         struct ncp_setpoint out;
-        assert_int_equal(ncp_exec_step(&e, &src, &out), 1);
-        sp_equal(&sp[k], &out, k);
+        assert_int_equal(ncp_exec_step(&e, &src, &out), 0);
+        assert_true(out.flags & NCP_SP_END);
+        assert_int_equal(rs.next, rs.n);
     }
-    struct ncp_setpoint out;
-    assert_int_equal(ncp_exec_step(&e, &src, &out), 0);
-    assert_true(out.flags & NCP_SP_END);
-    assert_int_equal(rs.next, rs.n);
     free(sp);
     free(rs.r);
+    free(rs.la);
 }
 
 static void test_replay_trapezoid(void **st)
