@@ -263,4 +263,13 @@ struct ncp_nck_serve_opts {
  * meanwhile; -1 with d->msg when LCM cannot be opened. */
 int ncp_nck_serve(struct ncp_nck *n, const struct ncp_nck_serve_opts *o, struct ncp_diag *d);
 
+/* NC channels in one service: ncks[k] is channel nums[k] (the messages'
+ * channel field, 0..NCP_NCK_CHANNELS_MAX-1, each once). The LCM URL, prefix
+ * and status rate are ncks[0]'s INI's (or o's). A command for a channel not
+ * served is refused by its ACK. A shutdown of one channel (a command, or
+ * stop_requested) stops all of them under control, then returns. */
+#define NCP_NCK_CHANNELS_MAX 16
+int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
+                           const struct ncp_nck_serve_opts *o, struct ncp_diag *d);
+
 #endif
