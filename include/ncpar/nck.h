@@ -84,6 +84,9 @@ struct ncp_nck_opts {
     /* home every axis of the home-all list first (as cnc-ctl home all), then
      * run the program from HOME; 0: the machine starts homed where it is */
     int home;
+    /* put before the lines the run itself prints on stderr (a pause's note),
+     * e.g. "ch2: " when several runs share the terminal; NULL: none */
+    const char *label;
 };
 
 enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };

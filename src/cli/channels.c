@@ -26,6 +26,7 @@ enum { CH_OK = 0, CH_USAGE = 1, CH_PROGRAM = 2, CH_FAULT = 3 };
 
 struct channel {
     int num;
+    char label[16];                 /* "chN: " */
     char spec_copy[PATH_MAX * 2];   /* prog and ini point into it */
     const char *prog, *ini;
     struct ncp_machine_cfg cfg;
@@ -83,6 +84,7 @@ static int parse_spec(struct channel *ch, const char *spec)
     if (snprintf(ch->spec_copy, sizeof ch->spec_copy, "%s", end + 1) >= (int)sizeof ch->spec_copy)
         return fprintf(stderr, "cnc-run run: --channel '%s': path too long\n", spec), -1;
     ch->num = (int)num;
+    snprintf(ch->label, sizeof ch->label, "ch%d: ", ch->num);
     ch->prog = ch->spec_copy;
     char *colon = strrchr(ch->spec_copy, ':');
     if (colon) {
@@ -152,7 +154,7 @@ static void start_channel(struct channel *ch, const struct ncp_cli_channel_commo
         .cfg = &ch->cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ch->ic,
         .virtual_clock = c->virtual_clock, .for_s = c->for_s,
         .feed_override = c->feed_override, .trace = ch->trace,
-        .interrupt = c->interrupt,
+        .interrupt = c->interrupt, .label = ch->label,
     };
     if (pthread_create(&ch->thread, NULL, channel_main, ch) == 0) {
         ch->started = 1;

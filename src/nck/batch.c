@@ -346,6 +346,7 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     n->plan_override = o->feed_override > 0 ? o->feed_override : 1.0;
     n->for_s = o->for_s;
     n->ctl = o->ctl;
+    n->label = o->label ? o->label : "";
     enum precheck_end pre = PC_OK;
     struct ncp_nck_setup setup = { .cfg = o->cfg, .virtual_clock = o->virtual_clock,
                                    .trace = o->trace };
