@@ -14,7 +14,6 @@ struct cell_read {
     const char *dir;          /* the INI's folder, "" for the current one */
     int channels, others;     /* sections of each kind seen */
     char first_other[64];
-    int last_num;
     char why[PATH_MAX + 128];
 };
 

@@ -115,15 +115,15 @@ static int parse(int argc, char **argv, struct serve_args *a)
     return 0;
 }
 
-/* One NC channel of the service: its machine, its trace, its NCK. */
+/* One NC channel of the service: its machine and its trace. */
 struct serve_channel {
     int num;
-    const char *config;
+    const char *config;             /* NULL, or config_path or --config */
+    char config_path[PATH_MAX];
     struct ncp_machine_cfg cfg;
     char trace_path[PATH_MAX];
     struct ncp_outfile trace_of;
     FILE *trace;
-    struct ncp_nck *nck;
 };
 
 static int load_channel(struct serve_channel *ch, const struct serve_args *a)
@@ -177,17 +177,24 @@ static int close_trace(struct serve_channel *ch)
 /* The channels from a channels INI, or the one machine INI as channel 0. */
 static struct serve_channel *load_channels(const struct serve_args *a, int *n)
 {
-    static struct ncp_cli_cell cell;
-    int several = a->config ? ncp_cli_cell_load(a->config, &cell) : 0;
-    if (several < 0)
+    struct ncp_cli_cell *cell = calloc(1, sizeof *cell);
+    int several = !cell ? -1 : a->config ? ncp_cli_cell_load(a->config, cell) : 0;
+    *n = several > 0 ? cell->n : 1;
+    struct serve_channel *chs = several < 0 ? NULL : calloc((size_t)*n, sizeof *chs);
+    if (!chs) {
+        if (!cell || several >= 0)
+            fprintf(stderr, "cnc-run serve: out of memory\n");
+        free(cell);
         return NULL;
-    *n = several ? cell.n : 1;
-    struct serve_channel *chs = calloc((size_t)*n, sizeof *chs);
-    if (!chs)
-        return fprintf(stderr, "cnc-run serve: out of memory\n"), NULL;
+    }
     for (int k = 0; k < *n; k++) {
-        chs[k].num = several ? cell.num[k] : 0;
-        chs[k].config = several ? cell.config[k] : a->config;
+        chs[k].num = several ? cell->num[k] : 0;
+        if (several)
+            memcpy(chs[k].config_path, cell->config[k], sizeof chs[k].config_path);
+        chs[k].config = several ? chs[k].config_path : a->config;
+    }
+    free(cell);
+    for (int k = 0; k < *n; k++) {
         chs[k].trace_of.fd = -1;
         if (load_channel(&chs[k], a))
             return free(chs), NULL;
