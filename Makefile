@@ -117,7 +117,7 @@ deps:
 	DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
 	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev linuxcnc-uspace \
 	    liblcm-dev liblcm-bin \
-	    python3 python3-matplotlib valgrind cppcheck clang-tidy
+	    python3 python3-matplotlib valgrind cppcheck clang-tidy file podman
 	tools/rtvm/install-deps
 
 test: all unit test-can-host
@@ -182,3 +182,20 @@ lint: $(GEN_STAMP)
 	    --std=c11 src tests/unit
 	clang-tidy --quiet $(LIB_SRCS) $(CLI_SRCS) $(CTL_SRCS) -- $(CPPFLAGS) -std=c11 -I/usr/include/eigen3
 .PHONY: lint
+
+# ---- container image (deploy/Containerfile) ------------------------------------
+# The build context is staged: the static cnc-run and the shipped INIs and
+# programs, nothing of the source tree's build folders. PODMAN_FLAGS passes
+# e.g. --storage-driver vfs where overlay is not available.
+PODMAN       ?= podman
+PODMAN_FLAGS ?=
+IMAGE        ?= localhost/ncpar:latest
+IMAGE_CTX     = $(BUILD)/image
+image: $(BUILD)/cnc-run
+	@if ! file -L $< | grep -q 'statically linked'; then \
+	    echo "$<: not statically linked (CLI_LDFLAGS=$(CLI_LDFLAGS)): the image has no libc"; exit 1; fi
+	rm -rf $(IMAGE_CTX) && mkdir -p $(IMAGE_CTX)/bin
+	cp $< $(IMAGE_CTX)/bin/cnc-run
+	cp -r rt-config ncprograms $(IMAGE_CTX)/
+	$(PODMAN) $(PODMAN_FLAGS) build --pull=never -f deploy/Containerfile -t $(IMAGE) $(IMAGE_CTX)
+.PHONY: image

@@ -84,6 +84,9 @@ struct ncp_nck_opts {
     /* home every axis of the home-all list first (as cnc-ctl home all), then
      * run the program from HOME; 0: the machine starts homed where it is */
     int home;
+    /* put before the lines the run itself prints on stderr (a pause's note),
+     * e.g. "ch2: " when several runs share the terminal; NULL: none */
+    const char *label;
 };
 
 enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };
@@ -262,5 +265,14 @@ struct ncp_nck_serve_opts {
  * stop_requested, after a controlled stop). 0; 1 when the NCK was in fault
  * meanwhile; -1 with d->msg when LCM cannot be opened. */
 int ncp_nck_serve(struct ncp_nck *n, const struct ncp_nck_serve_opts *o, struct ncp_diag *d);
+
+/* NC channels in one service: ncks[k] is channel nums[k] (the messages'
+ * channel field, 0..NCP_NCK_CHANNELS_MAX-1, each once). The LCM URL, prefix
+ * and status rate are ncks[0]'s INI's (or o's). A command for a channel not
+ * served is refused by its ACK. A shutdown of one channel (a command, or
+ * stop_requested) stops all of them under control, then returns. */
+#define NCP_NCK_CHANNELS_MAX 16
+int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
+                           const struct ncp_nck_serve_opts *o, struct ncp_diag *d);
 
 #endif

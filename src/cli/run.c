@@ -2,6 +2,7 @@
  * loop) on the simulated machine. Option parsing, loading and reporting; the
  * runtime itself is ncp_nck_run (src/rt/). */
 #include "run.h"
+#include "channels.h"
 #include "inject_opts.h"
 #include "machine.h"
 #include "outfile.h"
@@ -36,17 +37,13 @@ struct run_opts {
     uint32_t max_loops;         /* --max-loops, 0 = the interpreter's default */
     const char *inject, *seed;  /* --inject SPECS, --seed N (NULL: the INI's) */
     int home;                   /* --home: home the machine before the program */
+    const char *channel[NCP_CLI_CHANNELS_MAX]; /* --channel N:PROG[:INI], as given */
+    int n_channels;
 };
 
-struct interp_ctx {
-    const struct ncp_source *src;
-    struct ncp_analyzer_cfg acfg;
-    enum ncp_thread_mode mode;
-};
-
-static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
+int ncp_cli_interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
 {
-    struct interp_ctx *ic = ctx;
+    struct ncp_cli_interp *ic = ctx;
     struct ncp_run_stats st;
     memset(&st, 0, sizeof st);
     if (ic->mode == NCP_MODE_SERIAL)
@@ -64,6 +61,7 @@ static void usage(FILE *f)
           "                        [--subroutine-path DIR[:DIR...]] [--max-loops N]\n"
           "                        [--backend sim|socketcan[:IFACE]]\n"
           "                        [--inject SPEC[,SPEC...]] [--seed N] [--home]\n"
+          "       cnc-run run --channel N:PROG[:INI] [--channel M:PROG2[:INI2] ...] [options]\n"
           "Runs PROG on the simulated machine (or CiA 402 drives over CAN): interpreter ->\n"
           "look-ahead planner -> interpolator -> position loop (SCHED_FIFO when permitted).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill)\n"
@@ -97,6 +95,14 @@ static void usage(FILE *f)
           "                      inject column. [RT] MISS_POLICY says what a servo runs on\n"
           "                      when its setpoint is late or lost\n"
           "  --seed N            the faults' random seed (default: the INI's SEED, or 1)\n"
+          "  --channel N:PROG[:INI]  NC channel N (0..15) runs PROG on its own machine INI\n"
+          "                      (default: the built-in mill), planner, position loop and\n"
+          "                      simulated machine, beside the other channels in this\n"
+          "                      process; each channel's summary lines start 'chN: '.\n"
+          "                      --trace names a file per channel: {channel} in it is\n"
+          "                      replaced by N, else .chN goes before the extension.\n"
+          "                      A fault stops its own channel only; the exit status is\n"
+          "                      the worst channel's\n"
           "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault / soft limit\n",
           f);
 }
@@ -129,6 +135,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "inject", required_argument, 0, 'I' },
         { "seed", required_argument, 0, 'R' },
         { "home", no_argument, 0, 'H' },
+        { "channel", required_argument, 0, 'C' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
@@ -146,6 +153,12 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         case 'I': o->inject = optarg; break;
         case 'R': o->seed = optarg; break;
         case 'H': o->home = 1; break;
+        case 'C':
+            if (o->n_channels == NCP_CLI_CHANNELS_MAX)
+                return fprintf(stderr, "cnc-run run: at most %d channels\n",
+                               NCP_CLI_CHANNELS_MAX), -1;
+            o->channel[o->n_channels++] = optarg;
+            break;
         case 'L':
             if (parse_num(optarg, 1, 2000000000, &pct) || pct != floor(pct))
                 return fprintf(stderr, "cnc-run run: --max-loops wants a positive count\n"), -1;
@@ -175,6 +188,11 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         default: return -1;
         }
     }
+    if (o->n_channels && optind != argc)
+        return fprintf(stderr, "cnc-run run: with --channel each program is named in its "
+                               "--channel, not '%s'\n", argv[optind]), -1;
+    if (o->n_channels)
+        return 0;
     if (optind != argc - 1)
         return fprintf(stderr, "cnc-run run: expected exactly one program file\n"), -1;
     o->prog = argv[optind];
@@ -190,53 +208,53 @@ static uint32_t count_lines(const struct ncp_source *src)
     return n;
 }
 
-static int report(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
-                  const struct ncp_nck_result *res)
+int ncp_cli_run_report(const char *prog, const struct ncp_machine_cfg *cfg,
+                       const struct ncp_nck_result *res, FILE *f)
 {
     if (res->limit_violation) {
         /* the machine's limits are a block's, not a word's: column 1 */
-        fprintf(stderr, "%s:%u:%u: error: %s (checked before motion: nothing moved)\n",
-                res->diag.file ? res->diag.file : o->prog, res->diag.line,
+        fprintf(f, "%s:%u:%u: error: %s (checked before motion: nothing moved)\n",
+                res->diag.file ? res->diag.file : prog, res->diag.line,
                 res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
         return RUN_FAULT;
     }
     if (res->refused) {
-        fprintf(stderr, "%s:%u:%u: error: %s (found before motion: nothing moved)\n",
-                res->diag.file ? res->diag.file : o->prog, res->diag.line,
+        fprintf(f, "%s:%u:%u: error: %s (found before motion: nothing moved)\n",
+                res->diag.file ? res->diag.file : prog, res->diag.line,
                 res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
         return RUN_PROGRAM;
     }
     if (res->interrupted && res->lat.cycles == 0) {
-        fprintf(stderr, "%s: stopped while checking the program before motion (nothing moved)\n",
-                o->prog);
+        fprintf(f, "%s: stopped while checking the program before motion (nothing moved)\n",
+                prog);
         return RUN_OK;
     }
     int drive_fault = res->status == RUN_FAULT && res->diag.code == NCP_ERR_IO && !res->fault;
     if (drive_fault && res->lat.cycles == 0) {
-        fprintf(stderr, "%s: error: drive start-up failed: %s (nothing moved)\n", o->prog,
+        fprintf(f, "%s: error: drive start-up failed: %s (nothing moved)\n", prog,
                 res->diag.msg);
         return RUN_FAULT;
     }
-    ncp_nck_print_summary(res, o->prog, stderr);
+    ncp_nck_print_summary(res, prog, f);
     if (drive_fault) {
-        fprintf(stderr, "%s:%u: error: drive fault: %s; controlled stop of all axes\n", o->prog,
+        fprintf(f, "%s:%u: error: drive fault: %s; controlled stop of all axes\n", prog,
                 res->diag.line, res->diag.msg);
     } else if (res->fault) {
-        fprintf(stderr,
+        fprintf(f,
                 "%s:%u: error: following error on %c: %.4f mm exceeds FERROR %.4f mm; servo stopped\n",
-                o->prog, res->fault_line, NCP_AXIS_LETTERS[res->fault_axis], res->fault_err,
+                prog, res->fault_line, NCP_AXIS_LETTERS[res->fault_axis], res->fault_err,
                 cfg->axis[res->fault_axis].ferror);
     } else if (res->inject.trip) {
         char why[300];
         ncp_inject_trip_text(&cfg->inject, &res->inject, cfg->servo_period, why, sizeof why);
-        fprintf(stderr, "%s:%u: error: %s\n", o->prog, res->inject.trip_line, why);
+        fprintf(f, "%s:%u: error: %s\n", prog, res->inject.trip_line, why);
     } else if (res->status != RUN_OK && res->diag.line) {
-        fprintf(stderr, "%s:%u:%u: error: %s (motion stopped after the last good block)\n",
-                res->diag.file ? res->diag.file : o->prog, res->diag.line, res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
+        fprintf(f, "%s:%u:%u: error: %s (motion stopped after the last good block)\n",
+                res->diag.file ? res->diag.file : prog, res->diag.line, res->diag.col ? (unsigned)res->diag.col : 1u, res->diag.msg);
     } else if (res->home_failed) {
-        fprintf(stderr, "%s: error: %s (the program did not run)\n", o->prog, res->diag.msg);
+        fprintf(f, "%s: error: %s (the program did not run)\n", prog, res->diag.msg);
     } else if (res->status != RUN_OK) {
-        fprintf(stderr, "%s: error: %s\n", o->prog, res->diag.msg);
+        fprintf(f, "%s: error: %s\n", prog, res->diag.msg);
     }
     return res->status;
 }
@@ -465,12 +483,12 @@ static void on_signal(int sig)
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
 {
-    struct interp_ctx ic = { src,
+    struct ncp_cli_interp ic = { src,
                              { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path,
                                .max_loop_iterations = o->max_loops, .m66_on_machine = 1 },
                              o->mode };
     struct ncp_nck_opts no = {
-        .cfg = cfg, .interpret = interpret, .interp_ctx = &ic,
+        .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
         .feed_override = o->feed_override, .trace = trace,
         .progress = isatty(2) && !o->virtual_clock ? stderr : NULL,
@@ -485,7 +503,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
     ncp_nck_run(&no, res);
     if (res->warning[0] && !no.progress)
         fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
-    int rc = report(o, cfg, res);
+    int rc = ncp_cli_run_report(o->prog, cfg, res, stderr);
     if (res->trace_errno) {
         fprintf(stderr, "cnc-run run: error writing the trace%s%s: %s (the run stopped there)\n",
                 o->trace ? " " : " for --plot", o->trace ? o->trace : "",
@@ -519,6 +537,20 @@ int ncp_cli_run(int argc, char **argv)
     if (parse_opts(argc, argv, &o))
         return usage(stderr), RUN_USAGE;
     ncp_cli_catch_stop_signals(on_signal);
+    if (o.n_channels) {
+        if (o.plot || o.home)
+            return fprintf(stderr, "cnc-run run: --%s is for one program, not --channel\n",
+                           o.plot ? "plot" : "home"), RUN_USAGE;
+        struct ncp_cli_channel_common cc = {
+            .virtual_clock = o.virtual_clock, .for_s = o.for_s,
+            .feed_override = o.feed_override, .mode = o.mode, .trace = o.trace,
+            .interp = { .tool_table_path = o.tool_table, .subroutine_path = o.sub_path,
+                        .max_loop_iterations = o.max_loops, .m66_on_machine = 1 },
+            .backend = o.backend, .inject = o.inject, .seed = o.seed,
+            .interrupt = &run_signal,
+        };
+        return ncp_cli_run_channels(o.channel, o.n_channels, &cc);
+    }
     struct ncp_machine_cfg cfg;
     if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
         return RUN_USAGE;

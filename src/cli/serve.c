@@ -1,6 +1,8 @@
 /* cnc-run serve: the NCK as a long-running service on LCM. Options, the
  * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
 #include "serve.h"
+#include "cell.h"
+#include "channels.h"
 #include "inject_opts.h"
 #include "outfile.h"
 #include "machine.h"
@@ -11,6 +13,7 @@
 #include <getopt.h>
 #include <signal.h>
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -46,7 +49,12 @@ static void usage(FILE *f)
           "Runs the NCK as a service on the simulated machine: it holds the axes where they\n"
           "are and waits for commands on LCM (cnc-ctl is its command-line client).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill); [LCM] URL,\n"
-          "                      CHANNEL_PREFIX (NCP_) and STATUS_HZ (50) are read from it\n"
+          "                      CHANNEL_PREFIX (NCP_) and STATUS_HZ (50) are read from it.\n"
+          "                      An INI of [CHANNEL_n] sections (n 0..15, CONFIG = machine\n"
+          "                      INI, relative to its folder) serves one NCK per NC channel;\n"
+          "                      LCM messages carry the channel (cnc-ctl --channel N), [LCM]\n"
+          "                      is the lowest channel's, --trace names a file per channel\n"
+          "                      as cnc-run run --channel's; a shutdown stops every channel\n"
           "  --lcm-url URL       LCM URL (default: the INI's, else $LCM_DEFAULT_URL, else\n"
           "                      udpm://239.255.76.67:7667?ttl=0)\n"
           "  --prefix P          channel prefix (channels PCMD, PACK, PSTATUS, PEVENT)\n"
@@ -107,59 +115,151 @@ static int parse(int argc, char **argv, struct serve_args *a)
     return 0;
 }
 
+/* One NC channel of the service: its machine and its trace. */
+struct serve_channel {
+    int num;
+    const char *config;             /* NULL, or config_path or --config */
+    char config_path[PATH_MAX];
+    struct ncp_machine_cfg cfg;
+    char trace_path[PATH_MAX];
+    struct ncp_outfile trace_of;
+    FILE *trace;
+};
+
+static int load_channel(struct serve_channel *ch, const struct serve_args *a)
+{
+    return ncp_cli_load_machine(ch->config, &ch->cfg) ||
+                   ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg)
+               ? -1
+               : 0;
+}
+
+/* the trace is a live record (outfile.h), never over an input */
+static int open_trace(struct serve_channel *ch, const struct serve_args *a, int several)
+{
+    if (!a->trace)
+        return 0;
+    if (!strcmp(a->trace, "-"))
+        return fprintf(stderr, "cnc-run serve: --trace wants a file\n"), -1;
+    if (!several)
+        snprintf(ch->trace_path, sizeof ch->trace_path, "%s", a->trace);
+    else if (ncp_cli_channel_trace_name(a->trace, ch->num, ch->trace_path, sizeof ch->trace_path))
+        return fprintf(stderr, "cnc-run serve: --trace '%s': name too long\n", a->trace), -1;
+    struct ncp_file_id ids[2];
+    int n_ids = ncp_file_id_add(ids, 0, ch->config, "the machine INI");
+    n_ids = ncp_file_id_add(ids, n_ids, a->tool_table, "the tool table");
+    if (ncp_outfile_open(&ch->trace_of, ch->trace_path, ids, n_ids, NCP_OUT_LIVE) != 0)
+        return -1;
+    if (!(ch->trace = fdopen(ch->trace_of.fd, "w"))) {
+        fprintf(stderr, "cnc-run serve: cannot write %s: %s\n", ch->trace_path, strerror(errno));
+        ncp_outfile_discard(&ch->trace_of);
+        return -1;
+    }
+    return 0;
+}
+
+/* Closes the trace; 0, or -1 after saying that writing it failed. */
+static int close_trace(struct serve_channel *ch)
+{
+    if (!ch->trace)
+        return 0;
+    int rc = 0;
+    if (fclose(ch->trace) != 0) {
+        fprintf(stderr, "cnc-run serve: error writing %s: %s\n", ch->trace_path, strerror(errno));
+        rc = -1;
+    }
+    ch->trace = NULL;
+    ch->trace_of.fd = -1;   /* closed with its stream */
+    ncp_outfile_commit(&ch->trace_of);
+    return rc;
+}
+
+/* The channels from a channels INI, or the one machine INI as channel 0. */
+static struct serve_channel *load_channels(const struct serve_args *a, int *n)
+{
+    struct ncp_cli_cell *cell = calloc(1, sizeof *cell);
+    int several = !cell ? -1 : a->config ? ncp_cli_cell_load(a->config, cell) : 0;
+    *n = several > 0 ? cell->n : 1;
+    struct serve_channel *chs = several < 0 ? NULL : calloc((size_t)*n, sizeof *chs);
+    if (!chs) {
+        if (!cell || several >= 0)
+            fprintf(stderr, "cnc-run serve: out of memory\n");
+        free(cell);
+        return NULL;
+    }
+    for (int k = 0; k < *n; k++) {
+        chs[k].num = several ? cell->num[k] : 0;
+        if (several)
+            memcpy(chs[k].config_path, cell->config[k], sizeof chs[k].config_path);
+        chs[k].config = several ? chs[k].config_path : a->config;
+    }
+    free(cell);
+    for (int k = 0; k < *n; k++) {
+        chs[k].trace_of.fd = -1;
+        if (load_channel(&chs[k], a))
+            return free(chs), NULL;
+    }
+    for (int k = 0; k < *n; k++) {
+        if (open_trace(&chs[k], a, several)) {
+            for (int i = 0; i < k; i++)
+                close_trace(&chs[i]);
+            return free(chs), NULL;
+        }
+    }
+    return chs;
+}
+
 int ncp_cli_serve(int argc, char **argv)
 {
     struct serve_args a = { 0 };
     a.mode = NCP_MODE_SERIAL;
     if (parse(argc, argv, &a))
         return usage(stderr), SERVE_USAGE;
-    struct ncp_machine_cfg cfg;
-    if (ncp_cli_load_machine(a.config, &cfg) || ncp_cli_check_tool_table(a.tool_table) ||
-        ncp_cli_apply_inject("cnc-run serve", a.inject, a.seed, &cfg))
+    if (ncp_cli_check_tool_table(a.tool_table))
+        return SERVE_USAGE;
+    int n = 0;
+    struct serve_channel *chs = load_channels(&a, &n);
+    if (!chs)
         return SERVE_USAGE;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     ncp_cli_catch_stop_signals(on_signal);
-    /* the trace is a live record (outfile.h), never over an input */
-    struct ncp_file_id ids[2];
-    int n_ids = ncp_file_id_add(ids, 0, a.config, "the machine INI");
-    n_ids = ncp_file_id_add(ids, n_ids, a.tool_table, "the tool table");
-    struct ncp_outfile trace_of;
-    FILE *trace = NULL;
-    if (a.trace) {
-        if (!strcmp(a.trace, "-"))
-            return fprintf(stderr, "cnc-run serve: --trace wants a file\n"), SERVE_USAGE;
-        if (ncp_outfile_open(&trace_of, a.trace, ids, n_ids, NCP_OUT_LIVE) != 0)
-            return SERVE_USAGE;
-        if (!(trace = fdopen(trace_of.fd, "w"))) {
-            fprintf(stderr, "cnc-run serve: cannot write %s: %s\n", a.trace, strerror(errno));
-            ncp_outfile_discard(&trace_of);
-            return SERVE_USAGE;
+    struct ncp_nck *ncks[NCP_NCK_CHANNELS_MAX];
+    int nums[NCP_NCK_CHANNELS_MAX];
+    int rc = 0, made = 0;
+    for (; made < n; made++) {
+        struct ncp_nck_setup setup = {
+            .cfg = &chs[made].cfg, .virtual_clock = a.virtual_clock, .trace = chs[made].trace,
+            .mode = a.mode,
+            .interp = { .tool_table_path = a.tool_table, .subroutine_path = a.sub_path },
+        };
+        ncks[made] = ncp_nck_new(&setup, &d);
+        nums[made] = chs[made].num;
+        if (!ncks[made]) {
+            if (n > 1)
+                fprintf(stderr, "cnc-run serve: error: channel %d (%s): %s\n", chs[made].num,
+                        chs[made].config, d.msg);
+            else
+                fprintf(stderr, "cnc-run serve: error: %s\n", d.msg);
+            rc = -2;
+            break;
         }
+        if (n > 1)
+            fprintf(stderr, "cnc-run serve: channel %d: %s\n", chs[made].num, chs[made].config);
     }
-    struct ncp_nck_setup setup = {
-        .cfg = &cfg, .virtual_clock = a.virtual_clock, .trace = trace, .mode = a.mode,
-        .interp = { .tool_table_path = a.tool_table, .subroutine_path = a.sub_path },
-    };
-    struct ncp_nck *nck = ncp_nck_new(&setup, &d);
-    if (!nck) {
-        fprintf(stderr, "cnc-run serve: error: %s\n", d.msg);
-        if (trace)
-            fclose(trace);
+    if (rc == 0) {
+        struct ncp_nck_serve_opts so = { .url = a.url, .prefix = a.prefix,
+                                         .stop_requested = stop_requested, .ready = ready };
+        rc = ncp_nck_serve_channels(ncks, nums, n, &so, &d);
+    }
+    for (int k = 0; k < made; k++)
+        ncp_nck_free(ncks[k]);
+    for (int k = 0; k < n; k++)
+        if (close_trace(&chs[k]) != 0 && rc == 0)
+            rc = 1;
+    free(chs);
+    if (rc == -2)
         return SERVE_FAULT;
-    }
-    struct ncp_nck_serve_opts so = { .url = a.url, .prefix = a.prefix,
-                                     .stop_requested = stop_requested, .ready = ready };
-    int rc = ncp_nck_serve(nck, &so, &d);
-    ncp_nck_free(nck);
-    if (trace && fclose(trace) != 0) {
-        fprintf(stderr, "cnc-run serve: error writing %s: %s\n", a.trace, strerror(errno));
-        rc = rc < 0 ? rc : 1;
-    }
-    if (trace) {
-        trace_of.fd = -1;   /* closed with its stream */
-        ncp_outfile_commit(&trace_of);
-    }
     if (rc < 0) {
         fprintf(stderr, "cnc-run serve: error: %s\n", d.msg);
         return SERVE_USAGE;

@@ -145,12 +145,14 @@ static void progress(const struct nck *n, const struct ncp_nck_opts *o)
     fflush(o->progress);
 }
 
-/* [SIM] AUTO_RESUME_S < 0: a pause goes on at SIGUSR1. */
+/* [SIM] AUTO_RESUME_S < 0: a pause goes on at SIGUSR1. A count, not a flag:
+ * every run in the process (one per NC channel) sees each signal once,
+ * where a flag would be taken by whichever run looked first. */
 static volatile sig_atomic_t usr1;
 static void on_usr1(int sig)
 {
     (void)sig;
-    usr1 = 1;
+    usr1++;
 }
 
 static void watch_usr1(void)
@@ -195,6 +197,7 @@ static void homing_done(struct nck *n, const struct ncp_nck_opts *o, struct batc
 static void drain(struct nck *n, const struct ncp_nck_opts *o, struct batch_home *bh)
 {
     int64_t last_print = 0;
+    sig_atomic_t usr1_seen = usr1;
     if (o->trace) {
         errno = 0;
         n->sum.joints = ncp_kins_active(n->cfg);
@@ -214,8 +217,8 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o, struct batch_home
         if (((o->interrupt && *o->interrupt) || n->sum.trace_errno) &&
             !atomic_load(&n->ctl->stop))
             atomic_store(&n->ctl->stop, 1);
-        if (usr1) {
-            usr1 = 0;
+        if (usr1 != usr1_seen) {
+            usr1_seen = usr1;
             atomic_fetch_add(&n->ctl->resume_go, 1);
             atomic_fetch_add(&n->ctl->tool_go, 1);
         }
@@ -343,6 +346,7 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     n->plan_override = o->feed_override > 0 ? o->feed_override : 1.0;
     n->for_s = o->for_s;
     n->ctl = o->ctl;
+    n->label = o->label ? o->label : "";
     enum precheck_end pre = PC_OK;
     struct ncp_nck_setup setup = { .cfg = o->cfg, .virtual_clock = o->virtual_clock,
                                    .trace = o->trace };

@@ -481,8 +481,8 @@ static void log_text(struct nck *n, const struct ncp_cmd *cmd, const struct ncp_
     if (off > NCP_CMD_TEXT_POOL || len > NCP_CMD_TEXT_POOL - off)
         return;
     static const char *const what[] = { "LOGOPEN", "LOGAPPEND", "LOGCLOSE", "LOG" };
-    fprintf(stderr, "line %u: %s: %.*s\n", cmd->line, what[op->kind - NCP_C_LOGOPEN], (int)len,
-            cmd->text + off);
+    fprintf(stderr, "%sline %u: %s: %.*s\n", n->label ? n->label : "", cmd->line,
+            what[op->kind - NCP_C_LOGOPEN], (int)len, cmd->text + off);
 }
 
 /* Run from line: the spindle and coolant the skipped part left on come on

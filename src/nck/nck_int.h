@@ -288,6 +288,7 @@ struct nck {
     const struct ncp_machine_cfg *cfg;
     /* batch (ncp_nck_run): one program, then the loop ends by itself */
     int batch;
+    const char *label;           /* batch: before its own lines on stderr ("ch2: "), or "" */
     double plan_override;        /* feed override the plan is made at (1.0 = 100 %) */
     double for_s;                /* batch: feed hold after this much machine time */
     struct ncp_nck_ctl own_ctl;

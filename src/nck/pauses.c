@@ -44,9 +44,9 @@ void nck_wait_began(struct nck *n, const struct nck_fb *fb)
     }
     double after = n->cfg->io.auto_resume_s;
     if (after < 0)
-        fprintf(stderr, "line %u: paused: %s; continues on SIGUSR1 (kill -USR1 %ld)\n",
-                fb->wait_line, what, (long)getpid());
+        fprintf(stderr, "%sline %u: paused: %s; continues on SIGUSR1 (kill -USR1 %ld)\n",
+                n->label, fb->wait_line, what, (long)getpid());
     else
-        fprintf(stderr, "line %u: paused: %s; continues after %g s ([SIM] AUTO_RESUME_S)\n",
-                fb->wait_line, what, after);
+        fprintf(stderr, "%sline %u: paused: %s; continues after %g s ([SIM] AUTO_RESUME_S)\n",
+                n->label, fb->wait_line, what, after);
 }

@@ -1,6 +1,8 @@
 /* The NCK on LCM: commands in on <prefix>CMD, an ACK for each, STATUS at the
  * status rate and at every state change, EVENTs as they come. One thread (the
- * caller's) does all of it; the NCK's real-time threads never see a message. */
+ * caller's) does all of it; the NCK's real-time threads never see a message.
+ * Several NC channels share the transport: each message carries its
+ * channel, a command goes to the NCK of its channel only. */
 #include "nck_int.h"
 
 #include "ncpar/msg.h"
@@ -22,11 +24,17 @@ struct client {
     ncp_ack_t ack;
 };
 
-struct serve {
+struct serve_channel {
     struct ncp_nck *nck;
+    int num;                         /* the messages' channel field */
+    int32_t jog_client;              /* whose keep-alives hold a continuous jog */
+};
+
+struct serve {
+    struct serve_channel ch[NCP_NCK_CHANNELS_MAX];
+    int n_ch;
     struct ncp_msg *msg;
     struct client clients[SERVE_CLIENTS];
-    int32_t jog_client;              /* whose keep-alives hold a continuous jog */
     uint64_t out_of_order, duplicates;
     int64_t status_seq, event_seq;
     int fault_seen;
@@ -61,16 +69,25 @@ static struct client *client_of(struct serve *sv, int32_t id)
     return oldest;
 }
 
-static void send_status(struct serve *sv)
+static struct serve_channel *channel_of(struct serve *sv, int num)
+{
+    for (int k = 0; k < sv->n_ch; k++)
+        if (sv->ch[k].num == num)
+            return &sv->ch[k];
+    return NULL;
+}
+
+static void send_status(struct serve *sv, const struct serve_channel *ch)
 {
     struct ncp_nck_snapshot st;
-    ncp_nck_get_status(sv->nck, &st);
+    ncp_nck_get_status(ch->nck, &st);
     struct ncp_msg_stats ms;
     ncp_msg_get_stats(sv->msg, &ms);
     ncp_status_t m;
     memset(&m, 0, sizeof m);
     m.utime = utime_now();
     m.seq = ++sv->status_seq;
+    m.channel = (int8_t)ch->num;
     m.state = (int8_t)st.state;
     snprintf((char *)m.program, sizeof m.program, "%s", st.program);
     m.line = (int32_t)st.line;
@@ -105,38 +122,64 @@ static void send_status(struct serve *sv)
         sv->fault_seen = 1;
 }
 
-static void send_events(struct serve *sv)
+static void send_events(struct serve *sv, const struct serve_channel *ch)
 {
     struct ncp_nck_event ev;
-    while (ncp_nck_next_event(sv->nck, &ev)) {
+    while (ncp_nck_next_event(ch->nck, &ev)) {
         ncp_event_t m;
         memset(&m, 0, sizeof m);
         m.utime = utime_now();
         m.seq = ++sv->event_seq;
+        m.channel = (int8_t)ch->num;
         m.kind = (int8_t)ev.kind;
         snprintf((char *)m.file, sizeof m.file, "%s", ev.file);
         m.line = (int32_t)ev.line;
         m.col = (int32_t)ev.col;
         snprintf((char *)m.text, sizeof m.text, "%s", ev.text);
         ncp_msg_send_event(sv->msg, &m);
+        char who[16] = "";
+        if (sv->n_ch > 1)
+            snprintf(who, sizeof who, "ch%d: ", ch->num);
         if (ev.kind >= NCP_EV_ERROR)
-            fprintf(stderr, "cnc-run serve: %s%s%s%s\n", ev.file[0] ? ev.file : "",
+            fprintf(stderr, "cnc-run serve: %s%s%s%s%s\n", who, ev.file[0] ? ev.file : "",
                     ev.file[0] ? ": " : "", ev.kind == NCP_EV_FAULT ? "fault: " : "error: ",
                     ev.text);
     }
 }
 
+/* A command for a channel this service does not have: refused, so that a
+ * client with a wrong --channel hears why instead of waiting. */
+static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *a)
+{
+    memset(a, 0, sizeof *a);
+    a->utime = utime_now();
+    a->client_id = c->client_id;
+    a->seq = c->seq;
+    a->channel = c->channel;
+    a->result = NCP_ACK_T_REJECTED;
+    a->state = -1;
+    char list[64] = "";
+    for (int k = 0, at = 0; k < sv->n_ch && at < (int)sizeof list; k++) {
+        int w = snprintf(list + at, sizeof list - (size_t)at, "%s%d", k ? ", " : "", sv->ch[k].num);
+        at += w > 0 ? w : 0;
+    }
+    snprintf((char *)a->reason, sizeof a->reason, "no NC channel %d here (channels: %s)",
+             c->channel, list);
+    ncp_msg_send_ack(sv->msg, a);
+}
+
 static void on_command(void *ctx, const ncp_command_t *c)
 {
     struct serve *sv = ctx;
+    struct serve_channel *ch = channel_of(sv, c->channel);
     if (c->kind == NCP_CMD_KEEPALIVE) {
         /* only the jogging client's keep-alives hold its jog */
-        if (c->client_id == sv->jog_client) {
+        if (ch && c->client_id == ch->jog_client) {
             struct ncp_nck_cmd k;
             memset(&k, 0, sizeof k);
             k.kind = NCP_CMD_KEEPALIVE;
             char why[8];
-            ncp_nck_command(sv->nck, &k, why, sizeof why);
+            ncp_nck_command(ch->nck, &k, why, sizeof why);
         }
         return;
     }
@@ -149,6 +192,11 @@ static void on_command(void *ctx, const ncp_command_t *c)
     }
     if (cl->seq && c->seq < cl->seq) {
         sv->out_of_order++;
+        return;
+    }
+    if (!ch) {
+        cl->seq = c->seq;
+        refuse_channel(sv, c, &cl->ack);
         return;
     }
     struct ncp_nck_cmd k;
@@ -164,13 +212,13 @@ static void on_command(void *ctx, const ncp_command_t *c)
     ncp_ack_t *a = &cl->ack;
     memset(a, 0, sizeof *a);
     char why[sizeof a->reason];
-    int rc = ncp_nck_command(sv->nck, &k, why, sizeof why);
+    int rc = ncp_nck_command(ch->nck, &k, why, sizeof why);
     if (rc == 0 && c->kind == NCP_CMD_JOG && !(c->value[1] > 0))
-        sv->jog_client = c->client_id;
+        ch->jog_client = c->client_id;
     /* the command may change the state at once: the ACK says the new one */
-    ncp_nck_poll(sv->nck);
+    ncp_nck_poll(ch->nck);
     struct ncp_nck_snapshot st;
-    ncp_nck_get_status(sv->nck, &st);
+    ncp_nck_get_status(ch->nck, &st);
     cl->seq = c->seq;
     a->utime = utime_now();
     a->client_id = c->client_id;
@@ -180,16 +228,42 @@ static void on_command(void *ctx, const ncp_command_t *c)
     a->state = (int8_t)st.state;
     snprintf((char *)a->reason, sizeof a->reason, "%s", rc == 0 ? "" : why);
     ncp_msg_send_ack(sv->msg, a);
-    send_status(sv);
+    send_status(sv, ch);
 }
 
-int ncp_nck_serve(struct ncp_nck *nck, const struct ncp_nck_serve_opts *o, struct ncp_diag *d)
+/* One channel's shutdown (a command, or a stop signal) is the service's:
+ * every channel stops under control, and the service ends when all have. */
+static int all_shut_down(struct serve *sv, int *spread)
 {
+    int all = 1, any = 0;
+    for (int k = 0; k < sv->n_ch; k++) {
+        int down = ncp_nck_shutdown_requested(sv->ch[k].nck);
+        all &= down;
+        any |= down;
+    }
+    if (any && !all && !*spread) {
+        *spread = 1;
+        for (int k = 0; k < sv->n_ch; k++)
+            if (!ncp_nck_shutdown_requested(sv->ch[k].nck))
+                ncp_nck_request_shutdown(sv->ch[k].nck);
+    }
+    return all;
+}
+
+int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
+                           const struct ncp_nck_serve_opts *o, struct ncp_diag *d)
+{
+    if (n < 1 || n > NCP_NCK_CHANNELS_MAX)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "1..%d NC channels, not %d",
+                            NCP_NCK_CHANNELS_MAX, n), -1;
     struct serve *sv = calloc(1, sizeof *sv);
     if (!sv)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory"), -1;
-    sv->nck = nck;
-    const struct ncp_machine_cfg *cfg = nck->n.cfg;
+    for (int k = 0; k < n; k++)
+        sv->ch[k] = (struct serve_channel){ ncks[k], nums[k], 0 };
+    sv->n_ch = n;
+    /* the transport is one for all: the first channel's machine INI says where */
+    const struct ncp_machine_cfg *cfg = ncks[0]->n.cfg;
     const char *url = o->url && *o->url ? o->url : cfg->lcm.url;
     const char *prefix = o->prefix && *o->prefix ? o->prefix : cfg->lcm.prefix;
     if (ncp_msg_open(&sv->msg, url, prefix, d) != 0) {
@@ -200,13 +274,14 @@ int ncp_nck_serve(struct ncp_nck *nck, const struct ncp_nck_serve_opts *o, struc
     double hz = cfg->lcm.status_hz;
     int64_t period = hz > 0 ? (int64_t)llround(1e9 / hz) : INT64_MAX / 4;
     int64_t next_status = hz > 0 ? mono_ns() : INT64_MAX / 2;
-    int stopping = 0;
+    int stopping = 0, spread = 0;
     if (o->ready)
         o->ready(o->ctx, prefix);
-    while (!ncp_nck_shutdown_requested(nck)) {
+    while (!all_shut_down(sv, &spread)) {
         if (!stopping && o->stop_requested && o->stop_requested(o->ctx)) {
             stopping = 1;
-            ncp_nck_request_shutdown(nck);
+            for (int k = 0; k < n; k++)
+                ncp_nck_request_shutdown(sv->ch[k].nck);
         }
         int64_t now = mono_ns();
         int64_t wait_ms = (next_status - now) / 1000000;
@@ -218,21 +293,32 @@ int ncp_nck_serve(struct ncp_nck *nck, const struct ncp_nck_serve_opts *o, struc
             ncp_diag_set(d, NCP_ERR_IO, 0, 0, "LCM socket failed");
             break;
         }
-        int changed = ncp_nck_poll(nck);
-        send_events(sv);
         now = mono_ns();
-        if (changed || now >= next_status) {
-            send_status(sv);
-            if (now >= next_status)
-                next_status += period;
+        int due = now >= next_status;
+        for (int k = 0; k < n; k++) {
+            int changed = ncp_nck_poll(sv->ch[k].nck);
+            send_events(sv, &sv->ch[k]);
+            if (changed || due)
+                send_status(sv, &sv->ch[k]);
+        }
+        if (due) {
+            next_status += period;
             if (next_status < now)   /* fell behind: no burst to catch up */
                 next_status = now + period;
         }
     }
-    send_events(sv);
-    send_status(sv);
+    for (int k = 0; k < n; k++) {
+        send_events(sv, &sv->ch[k]);
+        send_status(sv, &sv->ch[k]);
+    }
     int fault = sv->fault_seen;
     ncp_msg_close(sv->msg);
     free(sv);
     return fault ? 1 : 0;
+}
+
+int ncp_nck_serve(struct ncp_nck *nck, const struct ncp_nck_serve_opts *o, struct ncp_diag *d)
+{
+    int zero = 0;
+    return ncp_nck_serve_channels(&nck, &zero, 1, o, d);
 }

@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <sched.h>
 #include <stdio.h>
 #include <string.h>
@@ -100,6 +101,13 @@ static void *loop_main(void *arg)
     return NULL;
 }
 
+/* The lock is the process's, not the loop's: with several loops in one
+ * process (NC channels) the first to start locks and the last to end
+ * unlocks, so a channel that finishes early never unlocks the pages of one
+ * still running. Set-up and tear-down only, never the loop itself. */
+static pthread_mutex_t lock_users_mu = PTHREAD_MUTEX_INITIALIZER;
+static int lock_users;
+
 /* mlockall(MCL_FUTURE) with a small RLIMIT_MEMLOCK makes later allocations
  * fail, so lock only when the limit allows it. */
 static int lock_memory(void)
@@ -107,7 +115,20 @@ static int lock_memory(void)
     struct rlimit rl;
     if (getrlimit(RLIMIT_MEMLOCK, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY && geteuid() != 0)
         return 0;
-    return mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+    pthread_mutex_lock(&lock_users_mu);
+    int ok = lock_users > 0 || mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+    if (ok)
+        lock_users++;
+    pthread_mutex_unlock(&lock_users_mu);
+    return ok;
+}
+
+static void unlock_memory(void)
+{
+    pthread_mutex_lock(&lock_users_mu);
+    if (lock_users > 0 && --lock_users == 0)
+        munlockall();
+    pthread_mutex_unlock(&lock_users_mu);
 }
 
 /* Keeps the CPUs out of deep idle states while the file stays open. */
@@ -161,7 +182,8 @@ void ncp_rt_loop_join(struct ncp_rt_loop *l)
 {
     pthread_join(l->thread, NULL);
     if (l->memlocked)
-        munlockall();
+        unlock_memory();
+    l->memlocked = 0;
     if (l->dma_fd >= 0)
         close(l->dma_fd);
     l->dma_fd = -1;
