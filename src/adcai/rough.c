@@ -12,6 +12,7 @@
 struct ncp_adcai_rough {
     const struct ncp_machine_cfg *cfg;
     double period;
+    double filter_time;     /* the ACC/DEC's windows together, s */
     struct ncp_seg q[NCP_ADCAI_ROUGH_QUEUE];
     size_t head, count;
     int active;             /* q[head] is being interpolated */
@@ -72,6 +73,12 @@ struct ncp_adcai_rough *ncp_adcai_rough_new(const struct ncp_machine_cfg *cfg, d
         return NULL;
     r->cfg = cfg;
     r->period = period;
+    int n[2];
+    if (ncp_adcai_windows(cfg, period, n) != 0) {
+        free(r);
+        return NULL;
+    }
+    r->filter_time = (n[0] + n[1]) * period;
     ncp_adcai_rough_reset(r, start);
     return r;
 }
@@ -142,10 +149,27 @@ static void pop(struct ncp_adcai_rough *r)
     r->active = 0;
 }
 
+/* How far the ACC/DEC cuts inside the corner from a into b: a moving
+ * average of time Tw turns a velocity step dv into a curve that passes the
+ * corner at |dv| Tw / 8 (exact for one window, an upper bound for two). */
+static double corner_cut(const struct ncp_adcai_rough *r, const struct ncp_seg *a,
+                         const struct ncp_seg *b)
+{
+    double p[NCP_AXES], t1[NCP_AXES], t2[NCP_AXES], dv = 0;
+    ncp_seg_eval(a, a->length, p, t1);
+    ncp_seg_eval(b, 0, p, t2);
+    double va = ncp_adcai_rough_speed(r->cfg, a), vb = ncp_adcai_rough_speed(r->cfg, b);
+    for (int j = 0; j < NCP_AXES; j++)
+        dv += (vb * t2[j] - va * t1[j]) * (vb * t2[j] - va * t1[j]);
+    return sqrt(dv) * r->filter_time / 8;
+}
+
 /* Must the axes come to rest where a ends (next: what follows, NULL when
  * nothing is queued)? The ADCBI planner's stops: G61.1, dwells, the end of
  * the program (finishing with nothing after a), and G61's corners; G61 goes
- * on through a tangent joint, G64 through any. With nothing queued in the
+ * on through a tangent joint. G64 lets the filters round a corner as far as
+ * the ADCBI planner's blend may reach (P, or without P half the shorter
+ * move), and stops where they would cut deeper. With nothing queued in the
  * middle of a program there is no stop: the record runs short and the
  * ACC/DEC smooths the gap, as it smooths a corner. */
 static int stops_after(const struct ncp_adcai_rough *r, const struct ncp_seg *a,
@@ -157,8 +181,10 @@ static int stops_after(const struct ncp_adcai_rough *r, const struct ncp_seg *a,
         return r->finishing;
     if (next->kind == NCP_SEG_DWELL)
         return 1;
-    if (a->term == NCP_TERM_CONTINUOUS)
-        return 0;
+    if (a->term == NCP_TERM_CONTINUOUS) {
+        double tol = a->tolerance > 0 ? a->tolerance : 0.5 * fmin(a->length, next->length);
+        return corner_cut(r, a, next) > tol;
+    }
     double p[NCP_AXES], t1[NCP_AXES], t2[NCP_AXES];
     ncp_seg_eval(a, a->length, p, t1);
     ncp_seg_eval(next, 0, p, t2);

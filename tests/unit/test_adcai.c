@@ -356,7 +356,7 @@ static void test_chain_fine_ipo(void **state)
 
 /* The smallest distance of the output from the corner point, and whether
  * the axes stood still there. */
-static double corner_run(int term, int *stopped)
+static double corner_run(int term, double tolerance, int *stopped)
 {
     struct ncp_machine_cfg c;
     machine(&c, NCP_PROFILE_TRAPEZOID, 1);
@@ -364,6 +364,7 @@ static double corner_run(int term, int *stopped)
     struct ncp_adcai *a = ncp_adcai_new(&c, o);
     const double p0[3] = { 0, 0, 0 }, p1[3] = { 50, 0, 0 }, p2[3] = { 50, 50, 0 };
     struct ncp_seg s1 = line_seg(p0, p1, 40, term), s2 = line_seg(p1, p2, 40, term);
+    s1.tolerance = s2.tolerance = tolerance;
     ncp_adcai_push(a, &s1);
     ncp_adcai_push(a, &s2);
     ncp_adcai_finish(a);
@@ -388,12 +389,13 @@ static double corner_run(int term, int *stopped)
 }
 
 /* G64: the filters round a 90-degree corner, by about |dv| Tw / 8 (Tw the
- * window's time); G61 passes through it exactly, at rest, as G61.1 does. */
+ * window's time), unless that is beyond G64 P; G61 passes through it
+ * exactly, at rest, as G61.1 does. */
 static void test_corner(void **state)
 {
     (void)state;
     int stopped;
-    double g64 = corner_run(NCP_TERM_CONTINUOUS, &stopped);
+    double g64 = corner_run(NCP_TERM_CONTINUOUS, 0, &stopped);
     struct ncp_machine_cfg c;
     machine(&c, NCP_PROFILE_TRAPEZOID, 1);
     int n[2];
@@ -402,9 +404,14 @@ static void test_corner(void **state)
     print_message("  G64 corner cut %.4f mm (|dv| Tw / 8 = %.4f mm)\n", g64, expect);
     assert_false(stopped);
     assert_true(g64 > 0.8 * expect && g64 < 1.2 * expect);
-    assert_true(corner_run(NCP_TERM_EXACT_PATH, &stopped) == 0.0);
+    /* G64 P above the cut rounds it, below it stops at the corner */
+    assert_true(corner_run(NCP_TERM_CONTINUOUS, 1.1 * expect, &stopped) == g64);
+    assert_false(stopped);
+    assert_true(corner_run(NCP_TERM_CONTINUOUS, 0.9 * expect, &stopped) == 0.0);
     assert_true(stopped);
-    assert_true(corner_run(NCP_TERM_STOP, &stopped) == 0.0);
+    assert_true(corner_run(NCP_TERM_EXACT_PATH, 0, &stopped) == 0.0);
+    assert_true(stopped);
+    assert_true(corner_run(NCP_TERM_STOP, 0, &stopped) == 0.0);
     assert_true(stopped);
 }
 
