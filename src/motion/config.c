@@ -711,7 +711,8 @@ static int check_adcai(struct load_ctx *lc)
     if (ncp_adcai_windows(c, period, n) != 0)
         return fail_at(lc, line, "[PLANNER] NCK = adcai: an axis's MAX_VELOCITY over its "
                                  "MAX_ACCELERATION (or MAX_JERK) asks for an acc/dec filter "
-                                 "longer than %d rough periods of %.3f ms",
+                                 "longer than %d rough periods of %.3f ms, or a limit is "
+                                 "below what 1 nm steps make at the servo period",
                        NCP_ADCAI_WINDOW_MAX, period * 1e3), -1;
     return 0;
 }
