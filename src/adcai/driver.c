@@ -18,6 +18,14 @@ struct ncp_adcai {
     int finishing;                  /* no segment follows the queued ones */
     int64_t pos[NCP_AXES];          /* the setpoint, nm */
     struct ncp_adcai_rough_rec tag; /* the newest record's block */
+    /* The chain runs one servo period ahead of the setpoints, so that each
+     * setpoint's velocity is the one at its point (the mean of the periods
+     * either side) and not the one of the period before it: the position
+     * loop's S-curve time scaling reads the stream through a curve on those
+     * velocities, which a half-period lag would make wobble. */
+    int32_t ahead[NCP_AXES];
+    struct ncp_adcai_rough_rec ahead_tag;
+    int have_ahead, ahead_moves;
     struct ncp_planner_stats st;
 };
 
@@ -69,7 +77,7 @@ static int drained(const struct ncp_adcai *a)
 
 int ncp_adcai_idle(const struct ncp_adcai *a)
 {
-    return !ncp_adcai_rough_busy(a->rough) && drained(a);
+    return !ncp_adcai_rough_busy(a->rough) && drained(a) && !(a->have_ahead && a->ahead_moves);
 }
 
 void ncp_adcai_push(struct ncp_adcai *a, const struct ncp_seg *s)
@@ -97,6 +105,7 @@ void ncp_adcai_reset(struct ncp_adcai *a, const double pos[NCP_AXES])
     ncp_adcai_accdec_reset(a->acc);
     ncp_adcai_fine_reset(a->fine);
     a->k = 0;
+    a->have_ahead = 0;
     a->stop_pending = 0;
     a->finishing = 0;
     memset(&a->tag, 0, sizeof a->tag);
@@ -107,30 +116,36 @@ void ncp_adcai_get_stats(const struct ncp_adcai *a, struct ncp_planner_stats *st
     *st = a->st;
 }
 
-/* The setpoint of the position a->pos, moved by inc this servo period. */
-static void setpoint(struct ncp_adcai *a, const int32_t inc[NCP_AXES], struct ncp_setpoint *out)
+/* The setpoint of the position a->pos moved by inc this servo period, with
+ * the velocity between inc and next, the period after it. */
+static void setpoint(struct ncp_adcai *a, const int32_t inc[NCP_AXES], const int32_t next[NCP_AXES],
+                     const struct ncp_adcai_rough_rec *tag, struct ncp_setpoint *out)
 {
-    double xyz = 0, abc = 0, d[NCP_AXES];
+    double xyz = 0, abc = 0, vxyz = 0, vabc = 0, d[NCP_AXES];
     for (int j = 0; j < NCP_AXES; j++) {
         a->pos[j] += inc[j];
         out->pos[j] = (double)a->pos[j] / NCP_ADCAI_UNITS_PER_MM;
-        d[j] = inc[j] / NCP_ADCAI_UNITS_PER_MM;
-        if (j < 3)
-            xyz += d[j] * d[j];
-        else if (j < 6)
-            abc += d[j] * d[j];
+        double step = inc[j] / NCP_ADCAI_UNITS_PER_MM;
+        d[j] = 0.5 * (inc[j] + next[j]) / NCP_ADCAI_UNITS_PER_MM;
+        if (j < 3) {
+            xyz += step * step;
+            vxyz += d[j] * d[j];
+        } else if (j < 6) {
+            abc += step * step;
+            vabc += d[j] * d[j];
+        }
     }
     /* path length as the planner measures it: X Y Z, else A B C */
-    double l = sqrt(xyz > 0 ? xyz : abc);
+    double l = sqrt(xyz > 0 ? xyz : abc), lv = sqrt(vxyz > 0 ? vxyz : vabc);
     for (int j = 0; j < NCP_AXES; j++)
-        out->dir[j] = l > 0 ? d[j] / l : 0;
-    out->v = l / a->cfg.servo_period;
+        out->dir[j] = lv > 0 ? d[j] / lv : 0;
+    out->v = lv / a->cfg.servo_period;
     a->st.path_length += l;
-    out->line = a->tag.line;
-    out->aux = a->tag.aux;
-    out->tool_z = a->tag.tool_z;
-    out->rev_rpm = l > 0 ? a->tag.rev_rpm : 0;
-    out->flags = l > 0 ? a->tag.motion : 0;
+    out->line = tag->line;
+    out->aux = tag->aux;
+    out->tool_z = tag->tool_z;
+    out->rev_rpm = l > 0 ? tag->rev_rpm : 0;
+    out->flags = l > 0 ? tag->motion : 0;
 }
 
 /* The next rough record into the ACC/DEC and the fine interpolator: 1, or 0
@@ -155,12 +170,26 @@ static int next_record(struct ncp_adcai *a)
     return 1;
 }
 
+/* One servo period of the chain: 1 and its increments, or 0 when it is at
+ * rest with nothing to interpolate (nothing changed: it may be asked again). */
+static int produce(struct ncp_adcai *a, int32_t inc[NCP_AXES], struct ncp_adcai_rough_rec *tag)
+{
+    if (a->k == 0 && !next_record(a))
+        return 0;
+    ncp_adcai_fine_step(a->fine, inc);
+    *tag = a->tag;
+    a->k = (a->k + 1) % a->ratio;
+    return 1;
+}
+
 int ncp_adcai_step(struct ncp_adcai *a, struct ncp_setpoint *out)
 {
+    static const int32_t none[NCP_AXES];
     memset(out, 0, sizeof *out);
-    if (a->k == 0 && !next_record(a)) {
-        static const int32_t none[NCP_AXES];
-        setpoint(a, none, out);
+    if (!a->have_ahead)
+        a->have_ahead = produce(a, a->ahead, &a->ahead_tag);
+    if (!a->have_ahead) {
+        setpoint(a, none, none, &a->tag, out);
         if (a->finishing) {   /* the job's end, at rest on its last point */
             out->flags = NCP_SP_END;
             return 0;
@@ -170,8 +199,13 @@ int ncp_adcai_step(struct ncp_adcai *a, struct ncp_setpoint *out)
         return 1;
     }
     int32_t inc[NCP_AXES];
-    ncp_adcai_fine_step(a->fine, inc);
-    setpoint(a, inc, out);
-    a->k = (a->k + 1) % a->ratio;
+    struct ncp_adcai_rough_rec tag = a->ahead_tag;
+    memcpy(inc, a->ahead, sizeof inc);
+    /* a chain at rest now is asked again next time: segments may come meanwhile */
+    a->have_ahead = produce(a, a->ahead, &a->ahead_tag);
+    a->ahead_moves = 0;
+    for (int j = 0; a->have_ahead && j < NCP_AXES; j++)
+        a->ahead_moves |= a->ahead[j] != 0;
+    setpoint(a, inc, a->have_ahead ? a->ahead : none, &tag, out);
     return 1;
 }
