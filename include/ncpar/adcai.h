@@ -69,6 +69,10 @@ int ncp_adcai_rough_step(struct ncp_adcai_rough *r, struct ncp_adcai_rough_rec *
  * its MAX_VELOCITY and an arc's centripetal acceleration stays within its
  * axes' MAX_ACCELERATION. */
 double ncp_adcai_rough_speed(const struct ncp_machine_cfg *cfg, const struct ncp_seg *s);
+/* At rest before the next queued move (the stages below drained): take that
+ * move's start as where the axes are, for a start the stream did not lead
+ * to (after homing, a drop, a reset). 1 when the position changed. */
+int ncp_adcai_rough_align(struct ncp_adcai_rough *r);
 /* Where it is, in nm (the sum of everything it emitted since reset). */
 void ncp_adcai_rough_position(const struct ncp_adcai_rough *r, int64_t pos[NCP_AXES]);
 

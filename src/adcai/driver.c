@@ -157,6 +157,10 @@ static int next_record(struct ncp_adcai *a)
     memset(&rec, 0, sizeof rec);
     if (a->stop_pending && drained(a))
         a->stop_pending = 0;
+    /* at rest the setpoint is where the rough stage is: a move that starts
+     * elsewhere (the machine was homed or moved meanwhile) moves both */
+    if (!a->stop_pending && drained(a) && ncp_adcai_rough_align(a->rough))
+        ncp_adcai_rough_position(a->rough, a->pos);
     int got = !a->stop_pending && ncp_adcai_rough_step(a->rough, &rec);
     if (!got && !a->stop_pending && drained(a))
         return 0;

@@ -9,6 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+struct ncp_adcai_rough;
+static const struct ncp_seg *at(const struct ncp_adcai_rough *r, size_t k);
+
 struct ncp_adcai_rough {
     const struct ncp_machine_cfg *cfg;
     double period;
@@ -130,6 +133,22 @@ void ncp_adcai_rough_reset(struct ncp_adcai_rough *r, const double pos[NCP_AXES]
     for (int j = 0; j < NCP_AXES; j++)
         r->pos[j] = ncp_adcai_quantise(pos[j]);
     memset(&r->tag, 0, sizeof r->tag);
+}
+
+int ncp_adcai_rough_align(struct ncp_adcai_rough *r)
+{
+    const struct ncp_seg *s = at(r, 0);
+    if (r->active || !s)
+        return 0;
+    /* a dwell is at its end point */
+    const double *from = s->kind == NCP_SEG_DWELL ? s->end : s->start;
+    int moved = 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        int64_t q = ncp_adcai_quantise(from[j]);
+        moved |= q != r->pos[j];
+        r->pos[j] = q;
+    }
+    return moved;
 }
 
 void ncp_adcai_rough_position(const struct ncp_adcai_rough *r, int64_t pos[NCP_AXES])

@@ -447,6 +447,36 @@ static void test_dwell(void **state)
     ncp_adcai_free(a);
 }
 
+/* A move that starts where the chain did not lead (the machine was homed
+ * or moved meanwhile) starts there, without a jump; a dwell likewise stays
+ * where it is. */
+static void test_start_elsewhere(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c;
+    machine(&c, NCP_PROFILE_TRAPEZOID, 1);
+    const double o[NCP_AXES] = { 0 };
+    struct ncp_adcai *a = ncp_adcai_new(&c, o);
+    struct ncp_seg d;
+    memset(&d, 0, sizeof d);
+    d.kind = NCP_SEG_DWELL;
+    d.term = NCP_TERM_STOP;
+    d.dwell = 0.01;
+    d.end[0] = 44.5;
+    const double p0[3] = { 44.5, 0, 0 }, p1[3] = { 44.5, 10, 0 };
+    struct ncp_seg s = line_seg(p0, p1, 100, NCP_TERM_STOP);
+    ncp_adcai_push(a, &d);
+    ncp_adcai_push(a, &s);
+    ncp_adcai_finish(a);
+    struct run r = { 0 };
+    run_driver(a, &r);
+    for (size_t k = 1; k < r.n; k++)
+        assert_true(fabs(r.pos[k][0] - 44.5) < 1e-12 && r.pos[k][1] - r.pos[k - 1][1] < 0.2);
+    assert_true(r.pos[r.n - 1][1] == 10.0);
+    free(r.pos);
+    ncp_adcai_free(a);
+}
+
 /* [PLANNER] NCK from an INI: the two values, a bad one named with its line,
  * and a kinematics ADCAI cannot filter. */
 static void test_ini(void **state)
@@ -494,6 +524,7 @@ int main(void)
         cmocka_unit_test(test_chain_fine_ipo),
         cmocka_unit_test(test_corner),
         cmocka_unit_test(test_dwell),
+        cmocka_unit_test(test_start_elsewhere),
         cmocka_unit_test(test_ini),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
