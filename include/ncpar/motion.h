@@ -32,6 +32,11 @@ static inline int ncp_axis_rotary(int i) { return i >= 3 && i < 6; }
 
 enum ncp_profile { NCP_PROFILE_TRAPEZOID, NCP_PROFILE_SCURVE };
 
+/* [PLANNER] NCK (seed 002): ADCBI plans acc/dec on the path with look-ahead
+ * before interpolating (src/motion/planner.c); ADCAI interpolates at the
+ * programmed feed and filters each axis afterwards (ncpar/adcai.h). */
+enum ncp_nck_variant { NCP_NCK_ADCBI, NCP_NCK_ADCAI };
+
 /* The largest feed override cnc-run takes (200 %). Corner blends are planned
  * for it, as LinuxCNC plans them for its MAX_FEED_OVERRIDE. */
 #define NCP_FEED_OVERRIDE_MAX 2.0
@@ -129,6 +134,7 @@ struct ncp_machine_cfg {
     unsigned axis_mask;
     int lookahead;                /* [PLANNER] LOOKAHEAD, segments */
     enum ncp_profile profile;     /* [PLANNER] PROFILE */
+    enum ncp_nck_variant nck;     /* [PLANNER] NCK */
     int setpoint_ring;            /* [PLANNER] SETPOINT_RING, servo cycles buffered (1024) */
     /* [SIM]: PID of the simulated plant plus feed-forward (LinuxCNC pid naming):
      * u = KP e + KI int(e) + KD de/dt + FF1 v_cmd + FF2 a_cmd */

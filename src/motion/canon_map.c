@@ -251,6 +251,13 @@ static int line_to(struct ncp_canon_map *m, const double end_mm[NCP_AXES], int t
     else if ((s->feed = feed_at(m, s->end[0], s->angular)) <= 0)
         return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0, "feed move with zero feed rate");
     s->blend_feed = traverse ? s->feed : blend_feed_at(m, s->end[0], s->angular);
+    /* ADCAI's axes lag the rough path by their filters' delay, which no
+     * spindle angle could follow: a thread would be cut wrong */
+    if (!traverse && m->sync_pitch > 0 && m->cfg->nck == NCP_NCK_ADCAI)
+        return -ncp_diag_set(d, NCP_ERR_SEMANTIC, line, 0,
+                             "spindle-synchronised move (G33/G33.1/G76) under [PLANNER] NCK = "
+                             "adcai: the axes' acc/dec filters cannot follow the spindle; run "
+                             "this program with NCK = adcbi");
     if (!traverse && m->sync_pitch > 0) {
         s->sync = NCP_SYNC_THREAD;
         s->pitch = m->sync_pitch;

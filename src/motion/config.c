@@ -1,6 +1,7 @@
 /* Machine INI (LinuxCNC style) read with libinih. Every key is known: a typo in a
  * machine file must not silently fall back to a default. */
 #include "ncpar/motion.h"
+#include "ncpar/adcai.h"
 #include "ini_num.h"
 #include "kins_cfg.h"
 
@@ -274,6 +275,15 @@ static int planner_key(struct ncp_machine_cfg *c, const char *k, const char *v, 
             c->profile = NCP_PROFILE_SCURVE;
         else
             return snprintf(why, len, "trapezoid or scurve"), -1;
+        return 1;
+    }
+    if (!strcasecmp(k, "NCK")) {
+        if (!strcasecmp(v, "adcbi"))
+            c->nck = NCP_NCK_ADCBI;
+        else if (!strcasecmp(v, "adcai"))
+            c->nck = NCP_NCK_ADCAI;
+        else
+            return snprintf(why, len, "adcbi or adcai"), -1;
         return 1;
     }
     return 0;
@@ -672,12 +682,38 @@ static int check_cfg(struct load_ctx *lc)
     for (int i = 0; i < NCP_AXES; i++)
         if (c->axis_mask & NCP_AXIS_BIT(i))
             a_min = fmin(a_min, c->axis[i].max_acc);
-    double need = c->max_linear_vel / (a_min * c->servo_period) / ratio + 8;
+    /* ADCAI fine-interpolates itself: its stream comes every servo period */
+    int stream_ratio = c->nck == NCP_NCK_ADCAI ? 1 : ratio;
+    double need = c->max_linear_vel / (a_min * c->servo_period) / stream_ratio + 8;
     if ((double)c->setpoint_ring < need)
         return fail_at(lc, key_line(lc, "PLANNER", "SETPOINT_RING"), "[PLANNER] SETPOINT_RING %d is too small to stop along the path "
                               "from MAX_LINEAR_VELOCITY: at least %.0f planning periods "
                               "(up to 1048576)",
                        c->setpoint_ring, ceil(need)), -1;
+    return 0;
+}
+
+/* What ADCAI cannot do is refused with the machine file, before any program. */
+static int check_adcai(struct load_ctx *lc)
+{
+    const struct ncp_machine_cfg *c = lc->c;
+    if (c->nck != NCP_NCK_ADCAI)
+        return 0;
+    unsigned line = key_line(lc, "PLANNER", "NCK");
+    /* its filters smooth each axis on its own: through a non-trivial
+     * kinematics the joints would follow a path nobody checked */
+    if (ncp_kins_active(c))
+        return fail_at(lc, line, "[PLANNER] NCK = adcai needs [KINS] KINEMATICS = trivkins "
+                                 "(it filters each axis on its own); use NCK = adcbi with %s",
+                       ncp_kins_name(c->kins.type)), -1;
+    int n[2];
+    double period = c->servo_period * ncp_machine_cfg_ipo_ratio(c);
+    if (ncp_adcai_windows(c, period, n) != 0)
+        return fail_at(lc, line, "[PLANNER] NCK = adcai: an axis's MAX_VELOCITY over its "
+                                 "MAX_ACCELERATION (or MAX_JERK) asks for an acc/dec filter "
+                                 "longer than %d rough periods of %.3f ms, or a limit is "
+                                 "below what 1 nm steps make at the servo period",
+                       NCP_ADCAI_WINDOW_MAX, period * 1e3), -1;
     return 0;
 }
 
@@ -719,7 +755,8 @@ int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp
         else if (r < 0 || (!lc->failed && ferror(lc->f)))
             fail_at(lc, 0, "cannot read: %s", strerror(errno));
         if (!lc->failed && check_axes(lc) == 0 && check_cfg(lc) == 0)
-            check_kins(lc);
+            if (check_kins(lc) == 0)
+                check_adcai(lc);
         rc = lc->failed ? d->code : NCP_OK;
     }
     if (lc->f)

@@ -255,7 +255,7 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
 {
     const struct nck_summary *s = &n->sum;
     struct ncp_planner_stats ps;
-    ncp_planner_get_stats(n->planner, &ps);
+    nck_plan_stats(n, &ps);
     res->program_time = n->ended ? (double)n->end_ns * 1e-9 : s->t;
     res->path_length = s->path;
     res->segments = ps.segments;

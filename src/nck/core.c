@@ -64,13 +64,12 @@ static int init_motion(struct nck *n)
     n->decel_normal = 0.5 * a_min;
     n->decel_full = a_min;
     ncp_scaler_init(&n->scaler, n->start, n->decel_normal, c->servo_period);
-    int ratio = ncp_machine_cfg_ipo_ratio(c);
+    int ratio = nck_plan_stream_ratio(c);
     if (ratio < 1)
         return -1;
     ncp_scaler_set_ratio(&n->scaler, ratio);
     ncp_scaler_limits(&n->scaler, c);
-    n->planner = ncp_planner_new(c, n->start);
-    if (!n->planner || ncp_spsc_init(&n->segs, sizeof(struct nck_seg_msg), SEG_RING) ||
+    if (nck_plan_new(n) || ncp_spsc_init(&n->segs, sizeof(struct nck_seg_msg), SEG_RING) ||
         ncp_spsc_init(&n->sps, sizeof(struct ncp_setpoint), (size_t)c->setpoint_ring) ||
         ncp_spsc_init(&n->fbs, sizeof(struct nck_fb), FB_RING) ||
         ncp_spsc_init(&n->auxq, sizeof(struct nck_aux_pack), NCK_AUX_RING) ||
@@ -157,8 +156,7 @@ void nck_release(struct nck *n)
     ncp_spsc_destroy(&n->fbs);
     ncp_spsc_destroy(&n->auxq);
     ncp_spsc_destroy(&n->syncq);
-    ncp_planner_free(n->planner);
-    n->planner = NULL;
+    nck_plan_free(n);
     pthread_mutex_destroy(&n->ev_lock);
 }
 

@@ -308,7 +308,10 @@ struct nck {
     /* canonical calls the jobs took, acted on and refused, per kind (job
      * threads, in turn; read after the job) */
     uint64_t calls_in[NCP_C__COUNT], calls_acted[NCP_C__COUNT], calls_refused[NCP_C__COUNT];
+    /* the planner thread's source of setpoints: the ADCBI planner, or under
+     * [PLANNER] NCK = adcai the ADCAI chain (the other is NULL) */
     struct ncp_planner *planner;
+    struct ncp_adcai *adcai;
     struct ncp_canon_map map;
     struct ncp_rt_loop loop;
     pthread_t planner_thread;
@@ -455,6 +458,22 @@ void nck_inject_describe(const struct nck *n, char *buf, size_t len);
 
 /* planner_thread.c */
 void *nck_planner_main(void *arg);
+
+/* plan_src.c: the planner's protocol (ncpar/motion.h) on whichever variant
+ * the NCK runs */
+int nck_plan_new(struct nck *n);
+void nck_plan_free(struct nck *n);
+int nck_plan_full(const struct nck *n);
+size_t nck_plan_queued(const struct nck *n);
+int nck_plan_idle(const struct nck *n);
+void nck_plan_push(struct nck *n, const struct ncp_seg *s);
+void nck_plan_finish(struct nck *n);
+void nck_plan_restart(struct nck *n);
+void nck_plan_reset(struct nck *n, const double pos[NCP_AXES]);
+int nck_plan_step(struct nck *n, struct ncp_setpoint *out);
+void nck_plan_stats(const struct nck *n, struct ncp_planner_stats *st);
+/* Servo periods per setpoint of the stream the position loop reads. */
+int nck_plan_stream_ratio(const struct ncp_machine_cfg *c);
 
 /* job.c */
 int nck_job_start(struct nck *n);

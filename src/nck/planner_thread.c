@@ -28,16 +28,16 @@ static void pull_segments(struct nck *n, int *finishing, uint32_t *stop_aux, int
                           struct nck_seg_msg *jump)
 {
     struct nck_seg_msg m;
-    while (!*finishing && !ncp_planner_full(n->planner) && ncp_spsc_pop(&n->segs, &m) == 0) {
+    while (!*finishing && !nck_plan_full(n) && ncp_spsc_pop(&n->segs, &m) == 0) {
         if (m.kind == NCK_MSG_SEG) {
-            ncp_planner_push(n->planner, &m.seg);
+            nck_plan_push(n, &m.seg);
         } else {
             *finishing = 1;
             *stop_aux = m.aux;
             *aux_stop = m.kind == NCK_MSG_AUX;
             jump->jump = m.jump;
             memcpy(jump->seg.end, m.seg.end, sizeof jump->seg.end);
-            ncp_planner_finish(n->planner);
+            nck_plan_finish(n);
         }
     }
 }
@@ -49,15 +49,15 @@ static void pull_segments(struct nck *n, int *finishing, uint32_t *stop_aux, int
  * the next job's motion by the ring's length). */
 static int may_step(struct nck *n, int finishing, int64_t *wait_since)
 {
-    if (finishing || ncp_planner_full(n->planner)) {
+    if (finishing || nck_plan_full(n)) {
         *wait_since = 0;
         return 1;
     }
-    if (ncp_planner_idle(n->planner) && ncp_planner_queued(n->planner) == 0)
+    if (nck_plan_idle(n) && nck_plan_queued(n) == 0)
         return 0;
     if (n->setup.virtual_clock)
         return 0;
-    if (!ncp_planner_idle(n->planner))
+    if (!nck_plan_idle(n))
         return 1;
     int64_t now = mono_ns();
     if (!*wait_since)
@@ -78,7 +78,7 @@ static void parked(struct nck *n, int *finishing, int *aux_stop)
            atomic_load_explicit(&n->unpark_req, memory_order_acquire) ==
                atomic_load_explicit(&n->unpark_ack, memory_order_relaxed))
         nap_ns(200000);
-    ncp_planner_reset(n->planner, n->rest);
+    nck_plan_reset(n, n->rest);
     *finishing = 0;
     *aux_stop = 0;
     atomic_store_explicit(&n->unpark_ack, atomic_load(&n->unpark_req), memory_order_release);
@@ -92,7 +92,7 @@ void *nck_planner_main(void *arg)
     int64_t wait_since = 0;
     struct nck_seg_msg jump;   /* the stop's jump, if it has one */
     memset(&jump, 0, sizeof jump);
-    long nap = (long)(n->cfg->servo_period * ncp_machine_cfg_ipo_ratio(n->cfg) * 1e9 / 4) + 1000;
+    long nap = (long)(n->cfg->servo_period * nck_plan_stream_ratio(n->cfg) * 1e9 / 4) + 1000;
     while (!atomic_load(&n->quit)) {
         if (atomic_load_explicit(&n->park_req, memory_order_acquire) !=
             atomic_load_explicit(&n->park_ack, memory_order_relaxed)) {
@@ -103,7 +103,7 @@ void *nck_planner_main(void *arg)
         pull_segments(n, &finishing, &stop_aux, &aux_stop, &jump);
         if (ncp_spsc_count(&n->sps) >= ncp_spsc_capacity(&n->sps) ||
             !may_step(n, finishing, &wait_since)) {
-            int idle = ncp_planner_idle(n->planner) && ncp_planner_queued(n->planner) == 0;
+            int idle = nck_plan_idle(n) && nck_plan_queued(n) == 0;
             if (n->setup.virtual_clock && !idle)
                 sched_yield();
             else
@@ -111,7 +111,7 @@ void *nck_planner_main(void *arg)
             continue;
         }
         struct ncp_setpoint sp;
-        int more = ncp_planner_step(n->planner, &sp);
+        int more = nck_plan_step(n, &sp);
         if (!more) {
             /* the stop's sample: the machine functions due there; an AUX
              * stop is no end of the job's motion */
@@ -124,11 +124,11 @@ void *nck_planner_main(void *arg)
         if (!more) {
             if (!aux_stop)
                 atomic_fetch_add_explicit(&n->ends_pushed, 1, memory_order_release);
-            ncp_planner_restart(n->planner);
+            nck_plan_restart(n);
             /* a synchronised run the position loop moves starts here: the
              * next segment is planned from its end */
             if (jump.jump)
-                ncp_planner_reset(n->planner, jump.seg.end);
+                nck_plan_reset(n, jump.seg.end);
             jump.jump = 0;
             finishing = 0;
             aux_stop = 0;

@@ -1,0 +1,2 @@
+# sources of src/adcai, appended by the module
+LIB_SRCS += $(wildcard src/adcai/*.c)
