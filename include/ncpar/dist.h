@@ -80,6 +80,8 @@ enum ncp_dist_rx_verdict ncp_dist_rx_put(struct ncp_dist_rx *r, int32_t seq, int
 /* The setpoint of period t_ns: the one received, else the last one again
  * (counted as held once setpoints have started to come). */
 int32_t ncp_dist_rx_play(struct ncp_dist_rx *r, int64_t t_ns);
+/* The setpoint of period t_ns if it is here (1), without playing it. */
+int ncp_dist_rx_peek(const struct ncp_dist_rx *r, int64_t t_ns, int32_t *nm);
 /* Setpoints held for periods after t_ns. */
 int ncp_dist_rx_level(const struct ncp_dist_rx *r, int64_t t_ns);
 

@@ -79,3 +79,12 @@ int ncp_dist_rx_level(const struct ncp_dist_rx *r, int64_t t_ns)
         n += r->slot[i].t_ns > t_ns;
     return n;
 }
+
+int ncp_dist_rx_peek(const struct ncp_dist_rx *r, int64_t t_ns, int32_t *nm)
+{
+    unsigned k = slot_of(r, t_ns);
+    if (r->slot[k].t_ns != t_ns)
+        return 0;
+    *nm = r->slot[k].nm;
+    return 1;
+}
