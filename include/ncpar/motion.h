@@ -64,9 +64,9 @@ struct ncp_axis_cfg {
     int wrapped;
 };
 
-/* What the position loop drives (backend.h): the simulated machine, or CiA 402
- * drives over SocketCAN. */
-enum ncp_backend_kind { NCP_BACKEND_SIM, NCP_BACKEND_SOCKETCAN };
+/* What the position loop drives (backend.h): the simulated machine, CiA 402
+ * drives over SocketCAN, or cnc-axis LLCs over LCM (the distributed mode). */
+enum ncp_backend_kind { NCP_BACKEND_SIM, NCP_BACKEND_SOCKETCAN, NCP_BACKEND_LCM };
 
 /* [CAN] */
 struct ncp_can_cfg {

@@ -70,7 +70,7 @@ int ncp_msg_fd(const struct ncp_msg *m);
 #define NCP_MSG_CHANNEL_MAX 63
 
 /* A channel to take (exact name): its index, or -1 when there are already
- * 16 or the name is not a channel name. Before the real-time loop. */
+ * 32 or the name is not a channel name. Before the real-time loop. */
 int ncp_msg_subscribe(struct ncp_msg *m, const char *channel);
 /* Frames and sends payload on channel without blocking: 0, or -1 (counted). */
 int ncp_msg_publish(struct ncp_msg *m, const char *channel, const void *payload, size_t len);

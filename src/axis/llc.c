@@ -129,7 +129,8 @@ static double follow(struct llc *l, int64_t slot)
     double target = ncp_dist_nm_to_mm(ncp_dist_rx_play(&l->rx, slot));
     l->run_held = l->rx.held != l->held_seen ? l->run_held + 1 : 0;
     l->held_seen = l->rx.held;
-    double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9;
+    /* a setpoint at MAX_VELOCITY is no jump: 1 nm of rounding allowed */
+    double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9 + 1e-6;
     if (fabs(step) > lim) {
         step = copysign(lim, step);
         l->clamped++;
