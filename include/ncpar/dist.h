@@ -54,6 +54,9 @@ int ncp_dist_decode_fine(const uint8_t *buf, size_t len, struct ncp_dist_fine *f
  * Setpoints are kept by the period they are for (t_ns) and played at a fixed
  * delay behind the HLC; sequence numbers find what went missing. */
 #define NCP_DIST_RX_SLOTS 64
+/* An LLC plays period t at t + (this + 0.5) periods: room for the HLC's
+ * wake-up latency and the wire, and for bridging a lost period. */
+#define NCP_DIST_PLAY_DELAY 3
 
 enum ncp_dist_rx_verdict {
     NCP_DIST_RX_NEW,        /* kept */
@@ -70,15 +73,16 @@ struct ncp_dist_rx {
     int32_t last_nm;        /* what was played last (held through gaps) */
     int primed;
     struct { int64_t t_ns; int32_t nm; } slot[NCP_DIST_RX_SLOTS];
-    uint32_t lost, stale, duplicate, held, early, reordered;
+    uint32_t lost, stale, duplicate, held, bridged, early, reordered;
 };
 
 void ncp_dist_rx_init(struct ncp_dist_rx *r, int64_t period_ns, int32_t start_nm);
 /* A received setpoint for this LLC's axis. */
 enum ncp_dist_rx_verdict ncp_dist_rx_put(struct ncp_dist_rx *r, int32_t seq, int64_t t_ns,
                                          int32_t nm);
-/* The setpoint of period t_ns: the one received, else the last one again
- * (counted as held once setpoints have started to come). */
+/* The setpoint of period t_ns: the one received; else, once setpoints have
+ * started to come, the point on the way to the next one received (bridged),
+ * or with none yet the last one again (held). */
 int32_t ncp_dist_rx_play(struct ncp_dist_rx *r, int64_t t_ns);
 /* The setpoint of period t_ns if it is here (1), without playing it. */
 int ncp_dist_rx_peek(const struct ncp_dist_rx *r, int64_t t_ns, int32_t *nm);

@@ -1,5 +1,5 @@
-/* cnc-axis's parts: the position loop (llc.c), the wait for the HLC before
- * it (wait.c), the trace writer and main (cnc_axis.c). */
+/* cnc-axis's parts: the position loop (llc.c), the trace writer and main
+ * (cnc_axis.c). */
 #ifndef NCP_AXIS_AXIS_H
 #define NCP_AXIS_AXIS_H
 
@@ -25,6 +25,7 @@ struct llc_row {          /* one period of the trace, handed to the main thread 
     int64_t t_ns, slot_ns;
     double cmd, act;
     int state;
+    int gap;              /* 0 its own setpoint, 1 bridged, 2 held */
 };
 
 struct llc {
@@ -43,8 +44,12 @@ struct llc {
     char hlc_axis;        /* LLC_END_HLC_STOP: the axis the HLC named */
     int run_held;         /* setpoints missing in a row */
     uint32_t held_seen;
+    int held_moving;      /* the axis was moving when the setpoints stopped */
     uint32_t clamped;     /* setpoints limited to MAX_VELOCITY */
     int64_t last_hlc_ns, last_hb_ns, last_adv_ns, settle;
+    int64_t lost_at_ns;
+    uint64_t waits;       /* periods before the HLC's first setpoint */
+    double fault_ferr;    /* the following error LLC_END_FERROR saw */   /* when LLC_END_LOST was decided */
     int32_t seq;
     int done_req;
     _Atomic int signal;   /* set by the signal handler */
@@ -61,7 +66,5 @@ void llc_publish_status(struct llc *l, int64_t slot);
 void llc_heartbeat(struct llc *l, int64_t now);
 void llc_advertise(struct llc *l);
 int64_t llc_now(void);
-/* wait.c: until the HLC's first setpoint (1), an end before it (0). */
-int llc_wait_for_hlc(struct llc *l);
 
 #endif

@@ -32,7 +32,9 @@ static void usage(FILE *f)
           "every period. Stops with a ramp within MAX_ACCELERATION when the HLC goes\n"
           "silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS setpoints in a row\n"
           "are missing, on a following error or when the HLC orders it.\n"
-          "  --trace CSV   every period: t_s,slot_s,cmd,act,state\n"
+          "  --trace CSV   every period: t,slot,cmd,act,state,gap (seconds from the HLC's first\n"
+          "                period; slot: the HLC's period played; state: ax_status_t's;\n"
+          "                gap: 0 its own setpoint, 1 bridged to the next, 2 held)\n"
           "exit status: 0 the program is done, 1 usage or configuration, 3 stopped\n",
           f);
 }
@@ -120,22 +122,16 @@ static void drain_trace(struct llc *l, FILE *f)
 {
     struct llc_row r;
     while (l->tracing && ncp_spsc_pop(&l->trace_ring, &r) == 0)
-        fprintf(f, "%.6f,%.6f,%.6f,%.6f,%d\n", (double)(r.t_ns - l->t_first) * 1e-9,
-                (double)(r.slot_ns - l->t_first) * 1e-9, r.cmd, r.act, r.state);
+        fprintf(f, "%.6f,%.6f,%.6f,%.6f,%d,%d\n", (double)(r.t_ns - l->t_first) * 1e-9,
+                (double)(r.slot_ns - l->t_first) * 1e-9, r.cmd, r.act, r.state, r.gap);
 }
 
 static int run_loop(struct llc *l, FILE *trace)
 {
-    /* the first wake-up 1.5 periods after a period of the HLC's grid, at
-     * least 5 ms from now for the thread to start */
-    int64_t T = l->period_ns, t = l->t_first + T / 2;
-    int64_t now = llc_now();
-    if (t < now + 5000000)
-        t += ((now + 5000000 - t) / T + 1) * T;
-    if (l->last_hlc_ns == 0)
-        l->last_hlc_ns = now;
-    l->loop.cfg = (struct ncp_rt_loop_cfg){ T, l->cfg->position.priority, l->cfg->position.cpu,
-                                            0, t };
+    /* its own phase: the period it plays follows from the HLC's grid and
+     * the loop's schedule (llc.c), whatever the offset between them */
+    l->loop.cfg = (struct ncp_rt_loop_cfg){ l->period_ns, l->cfg->position.priority,
+                                            l->cfg->position.cpu, 0, llc_now() };
     l->loop.cycle = llc_cycle;
     l->loop.ctx = l;
     if (l->cfg->position.policy != SCHED_FIFO)
@@ -165,10 +161,10 @@ static int report(const struct llc *l)
     ncp_msg_get_stats(l->msg, &st);
     fprintf(stderr,
             "cnc-axis %c: %llu periods, %u misses; setpoints lost %u, held %u, stale %u, "
-            "duplicate %u, reordered %u, limited to MAX_VELOCITY %u; injected loss %llu, "
+            "duplicate %u, bridged %u, reordered %u, limited to MAX_VELOCITY %u; injected loss %llu, "
             "delayed %llu\n",
             ax, (unsigned long long)l->loop.stats.cycles, (unsigned)l->loop.stats.misses,
-            l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.reordered, l->clamped,
+            l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.bridged, l->rx.reordered, l->clamped,
             (unsigned long long)st.inject_lost, (unsigned long long)st.inject_delayed);
     switch (l->end) {
     case LLC_END_NONE:
@@ -183,12 +179,14 @@ static int report(const struct llc *l)
                 ax, l->cfg->lcm.heartbeat_timeout_ms, l->cmd);
         break;
     case LLC_END_LOST:
-        fprintf(stderr, "cnc-axis %c: error: more than %d setpoints in a row lost; ramped to a "
-                        "standstill at %.4f mm\n", ax, l->cfg->lcm.max_lost_periods, l->cmd);
+        fprintf(stderr, "cnc-axis %c: error: more than %d setpoints in a row lost (the HLC's "
+                        "last heartbeat %lld ms before); ramped to a standstill at %.4f mm\n",
+                ax, l->cfg->lcm.max_lost_periods,
+                (long long)((l->lost_at_ns - l->last_hlc_ns) / 1000000), l->cmd);
         break;
     case LLC_END_FERROR:
         fprintf(stderr, "cnc-axis %c: error: following error %.4f mm exceeds FERROR %.4f mm; "
-                        "ramped to a standstill\n", ax, l->ferr, l->cfg->axis[l->axis].ferror);
+                        "ramped to a standstill\n", ax, l->fault_ferr, l->cfg->axis[l->axis].ferror);
         break;
     case LLC_END_SIGNAL:
         fprintf(stderr, "cnc-axis %c: stopped by a signal; ramped to a standstill at %.4f mm\n",
@@ -223,14 +221,14 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
     if (trace)
-        fputs("t,slot,cmd,act,state\n", trace);
+        fputs("t,slot,cmd,act,state,gap\n", trace);
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
     fprintf(stderr, "cnc-axis %c: waiting for the HLC\n", NCP_AXIS_LETTERS[o.axis]);
-    if (llc_wait_for_hlc(l) == 1 && run_loop(l, trace) != 0)
+    if (run_loop(l, trace) != 0)
         l->end = LLC_END_SIGNAL;
     int rc = report(l);
     if (trace && fclose(trace) != 0)

@@ -1,8 +1,9 @@
 /* The LLC's position loop: once per servo period, on the HLC's period grid.
  *
- * It takes what arrived (non-blocking recv on the one UDP socket, at most 256
- * datagrams), plays the setpoint of the period 1.5 periods back (the HLC sent
- * it a period ago: late datagrams are still on time), steps the simulated
+ * Until the HLC's first setpoint it advertises itself and holds the axis.
+ * Then it takes what arrived (non-blocking recv on the one UDP socket, at most
+ * 256 datagrams), plays the setpoint of the period NCP_DIST_PLAY_DELAY
+ * periods back (late datagrams are still on time), steps the simulated
  * servo of its axis and publishes its status (every period: the HLC counts a
  * period without one as lost). The only system calls are those recv/sendto
  * with MSG_DONTWAIT on a socket set up before the loop, the vDSO's
@@ -127,7 +128,14 @@ static double follow(struct llc *l, int64_t slot)
 {
     const struct ncp_axis_cfg *a = &l->cfg->axis[l->axis];
     double target = ncp_dist_nm_to_mm(ncp_dist_rx_play(&l->rx, slot));
-    l->run_held = l->rx.held != l->held_seen ? l->run_held + 1 : 0;
+    if (l->rx.held != l->held_seen) {
+        /* a stream that stops with the axis at rest (the program's end, the
+         * HLC between jobs) is no loss: heartbeats watch the HLC then */
+        if (l->run_held++ == 0)
+            l->held_moving = l->cmd != l->cmd_prev;
+    } else {
+        l->run_held = 0;
+    }
     l->held_seen = l->rx.held;
     /* a setpoint at MAX_VELOCITY is no jump: 1 nm of rounding allowed */
     double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9 + 1e-6;
@@ -155,31 +163,32 @@ static void check_ends(struct llc *l, int64_t now)
         l->end = LLC_END_SIGNAL;
     else if (now - l->last_hlc_ns > l->hb_timeout_ns)
         l->end = LLC_END_HLC_SILENT;
-    else if (l->run_held > l->cfg->lcm.max_lost_periods)
+    else if (l->run_held > l->cfg->lcm.max_lost_periods && l->held_moving) {
         l->end = LLC_END_LOST;
-    else if (fabs(l->ferr) > l->cfg->axis[l->axis].ferror)
+        l->lost_at_ns = llc_now();
+    }
+    else if (fabs(l->ferr) > l->cfg->axis[l->axis].ferror) {
         l->end = LLC_END_FERROR;
+        l->fault_ferr = l->ferr;
+    }
 }
 
-static void trace(struct llc *l, int64_t now, int64_t slot)
+static void trace(struct llc *l, int64_t now, int64_t slot, int gap)
 {
     if (!l->tracing)
         return;
-    struct llc_row r = { now, slot, l->cmd, l->act, l->state };
+    struct llc_row r = { now, slot, l->cmd, l->act, l->state, gap };
     if (ncp_spsc_push(&l->trace_ring, &r) != 0)
         l->trace_dropped++;
 }
 
-int llc_cycle(void *ctx, int64_t now_ns)
+/* One period of the axis, slot being the HLC's period it plays. */
+static void period(struct llc *l, int64_t now, int64_t slot)
 {
-    struct llc *l = ctx;
-    int64_t now = l->loop.cfg.start_ns + now_ns, T = l->period_ns;
-    /* the period 1.5 back on the HLC's grid: the loop runs half a period
-     * off that grid, so this is exact whatever the wake-up latency */
-    int64_t slot = l->t_first + (now - l->t_first - T - T / 2) / T * T;
-    llc_take(l, llc_now());
+    int64_t T = l->period_ns;
     check_ends(l, now);
     double next_cmd;
+    uint32_t gaps = l->rx.held + l->rx.bridged, bridged = l->rx.bridged;
     if (l->end == LLC_END_NONE && !l->done_req) {
         l->state = NCP_AX_STATUS_T_RUNNING;
         next_cmd = follow(l, slot);
@@ -187,21 +196,91 @@ int llc_cycle(void *ctx, int64_t now_ns)
         l->state = l->end == LLC_END_NONE || l->end == LLC_END_DONE ? NCP_AX_STATUS_T_DONE
                                                                     : NCP_AX_STATUS_T_STOPPING;
         next_cmd = ramp(l);
+        l->rx.played_t = slot;
     }
     l->cmd_prev = l->cmd;
     l->cmd = next_cmd;
     double c[NCP_AXES] = { 0 }, x[NCP_AXES] = { 0 }, a[NCP_AXES];
     c[l->axis] = l->cmd;
     /* feed-forward wants the next period's setpoint: it is usually here
-     * already; else the current velocity goes on */
+     * already (within the velocity limit, as follow() will take it); else
+     * the current velocity goes on */
     int32_t ahead;
-    x[l->axis] = l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead)
-                     ? ncp_dist_nm_to_mm(ahead)
-                     : 2 * l->cmd - l->cmd_prev;
+    double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
+    if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
+        x[l->axis] = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
+    else
+        x[l->axis] = 2 * l->cmd - l->cmd_prev;
     ncp_sim_step(&l->sim, c, x, a);
     l->act = a[l->axis];
     l->ferr = l->cmd - l->act;
-    trace(l, now, slot);
+    int gap = l->rx.held + l->rx.bridged == gaps ? 0 : l->rx.bridged != bridged ? 1 : 2;
+    trace(l, now, slot, gap);
+}
+
+#define ADVERT_PERIOD_NS 200000000LL   /* 5 a second until the HLC streams */
+#define WAIT_STATUS_PERIODS 10
+
+/* Before the HLC's first setpoint: advertise, heartbeat, report the axis at
+ * rest, hold the servo where it stands. 1 while waiting, 0 once the grid is
+ * known, -1 for an end before any motion. */
+static int waiting(struct llc *l, int64_t now)
+{
+    if (l->t_first)
+        return 0;
+    /* the oldest setpoint held names the HLC's period grid */
+    int64_t first = 0;
+    for (int i = 0; i < NCP_DIST_RX_SLOTS; i++)
+        if (l->rx.slot[i].t_ns && (!first || l->rx.slot[i].t_ns < first))
+            first = l->rx.slot[i].t_ns;
+    if (first) {
+        l->t_first = first;
+        if (l->last_hlc_ns == 0)
+            l->last_hlc_ns = now;
+        return 0;
+    }
+    if (now - l->last_adv_ns >= ADVERT_PERIOD_NS) {
+        l->last_adv_ns = now;
+        llc_advertise(l);
+    }
+    if (l->waits++ % WAIT_STATUS_PERIODS == 0)
+        llc_publish_status(l, 0);
+    llc_heartbeat(l, now);
+    if (atomic_load_explicit(&l->signal, memory_order_relaxed))
+        l->end = LLC_END_SIGNAL;
+    else if (l->last_hlc_ns && now - l->last_hlc_ns > l->hb_timeout_ns)
+        l->end = LLC_END_HLC_SILENT;
+    else if (l->done_req)
+        l->end = LLC_END_DONE;
+    if (l->end != LLC_END_NONE)
+        return -1;
+    double c[NCP_AXES] = { 0 }, a[NCP_AXES];
+    c[l->axis] = l->cmd;
+    ncp_sim_step(&l->sim, c, c, a);
+    l->act = a[l->axis];
+    l->ferr = l->cmd - l->act;
+    return 1;
+}
+
+int llc_cycle(void *ctx, int64_t now_ns)
+{
+    struct llc *l = ctx;
+    int64_t now = l->loop.cfg.start_ns + now_ns, T = l->period_ns;
+    llc_take(l, llc_now());
+    int w = waiting(l, now);
+    if (w)
+        return w < 0 ? NCP_RT_STOP : NCP_RT_CONTINUE;
+    /* the HLC's period NCP_DIST_PLAY_DELAY + 0..1 back: from the loop's
+     * scheduled time, not the clock, so a late wake-up never changes it */
+    int64_t slot = now - l->t_first - NCP_DIST_PLAY_DELAY * T - T / 2;
+    slot = l->t_first + (slot < 0 ? -((-slot + T - 1) / T) : slot / T) * T;
+    /* periods the loop slept through (a deadline miss) still passed for the
+     * simulated plant: it runs them now, a few at most */
+    int64_t from = l->rx.played_t ? l->rx.played_t + T : slot;
+    if (slot - from > 8 * T)
+        from = slot - 8 * T;
+    for (int64_t s = from; s <= slot; s += T)
+        period(l, now, s);
     llc_publish_status(l, slot);
     llc_heartbeat(l, now);
     if (l->state != NCP_AX_STATUS_T_RUNNING && l->cmd == l->cmd_prev) {

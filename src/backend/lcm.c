@@ -46,7 +46,7 @@ struct lcm_be {
     struct ncp_msg *msg;
     int n;
     struct peer p[NCP_AXES];
-    int64_t T, t0, hb_period, hb_timeout, last_hb;
+    int64_t T, t0, last_t, hb_period, hb_timeout, last_hb;
     int32_t seq, fine_seq;   /* heartbeats', setpoints' (the LLCs count gaps in these) */
     int cycles;
     int64_t hist_t[HIST];
@@ -226,8 +226,9 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
     char why[120];
     if (p->statuses == before) {
         p->lost++;
-        /* the first periods: statuses of the grid's start are not due yet */
-        if (s->cycles > 3 && ++p->run_lost > s->cfg->lcm.max_lost_periods) {
+        /* counted from the LLC's first period played (it starts its loop
+         * on the first setpoints; until then its heartbeat says it lives) */
+        if (p->st.t_ns > 0 && ++p->run_lost > s->cfg->lcm.max_lost_periods) {
             snprintf(why, sizeof why, "no status for %d periods ([LCM] MAX_LOST_PERIODS %d)",
                      p->run_lost, s->cfg->lcm.max_lost_periods);
             fail(s, p, why);
@@ -254,9 +255,16 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
     int64_t now = mono();
     if (s->cycles == 0)
         s->t0 = now;
-    /* this period on the grid the LLCs play by (the loop's absolute schedule
-     * keeps now within a small latency of it) */
-    int64_t t = s->t0 + (now - s->t0 + s->T / 2) / s->T * s->T;
+    /* this period on the grid the LLCs play by: the loop's absolute schedule
+     * wakes it up to a latency after the period's start (a later wake-up
+     * skips periods), so rounding down, with a tenth of a period for the
+     * clock read, names its period */
+    int64_t t = s->t0 + (now - s->t0 + s->T / 10) / s->T * s->T;
+    /* a wake-up a little late must not name the next period twice: the
+     * grid only jumps for periods the loop skipped */
+    if (s->cycles > 0 && t <= s->last_t + s->T)
+        t = s->last_t + s->T;
+    s->last_t = t;
     struct ncp_dist_fine f = { s->fine_seq++, NCP_DIST_HLC_ID, t, (int8_t)s->n, { 0 } };
     int bad = 0;
     for (int i = 0; i < s->n; i++)

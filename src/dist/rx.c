@@ -6,8 +6,9 @@
  *    (a later arrival of one of them takes it back as reordered);
  *  - its period already held, or seq equal to one held: duplicate;
  *  - its period already played: stale.
- * A period with no setpoint plays the last one again (held): the axis stands
- * for a period rather than guess. */
+ * A period with no setpoint of its own is bridged on the straight line to the
+ * next one received, when one is here already; with nothing after it the
+ * last one is played again (held): the axis stands rather than guess. */
 #include "ncpar/dist.h"
 
 #include <string.h>
@@ -35,11 +36,6 @@ enum ncp_dist_rx_verdict ncp_dist_rx_put(struct ncp_dist_rx *r, int32_t seq, int
         r->early++;
         return NCP_DIST_RX_EARLY;
     }
-    unsigned k = slot_of(r, t_ns);
-    if (r->slot[k].t_ns == t_ns) {
-        r->duplicate++;
-        return NCP_DIST_RX_DUPLICATE;
-    }
     if (!r->have_seq) {
         r->have_seq = 1;
         r->top_seq = seq;
@@ -54,6 +50,13 @@ enum ncp_dist_rx_verdict ncp_dist_rx_put(struct ncp_dist_rx *r, int32_t seq, int
         r->lost--;
         r->reordered++;
     }
+    /* a second setpoint for a period already held (a copy under a new
+     * number, or the sender's clock slipped): the first one stands */
+    unsigned k = slot_of(r, t_ns);
+    if (r->slot[k].t_ns == t_ns) {
+        r->duplicate++;
+        return NCP_DIST_RX_DUPLICATE;
+    }
     r->slot[k].t_ns = t_ns;
     r->slot[k].nm = nm;
     return NCP_DIST_RX_NEW;
@@ -66,7 +69,21 @@ int32_t ncp_dist_rx_play(struct ncp_dist_rx *r, int64_t t_ns)
         r->last_nm = r->slot[k].nm;
         r->primed = 1;
     } else if (r->primed) {
-        r->held++;
+        /* a later one here already: the missing period lies on the straight
+         * line to it (exact on a line, a chord on an arc), no stop and no
+         * double step afterwards */
+        int found = 0;
+        for (int j = 2; j < NCP_DIST_RX_SLOTS && !found; j++) {
+            unsigned kj = slot_of(r, t_ns + (j - 1) * r->period_ns);
+            if (r->slot[kj].t_ns == t_ns + (j - 1) * r->period_ns) {
+                r->last_nm += (int32_t)(((int64_t)r->slot[kj].nm - r->last_nm) / j);
+                found = 1;
+            }
+        }
+        if (found)
+            r->bridged++;
+        else
+            r->held++;
     }
     r->played_t = t_ns;
     return r->last_nm;

@@ -78,13 +78,17 @@ static void rx_gap_held_and_counted(void **state)
     ncp_dist_rx_put(&r, 4, 4 * T, 400);   /* 2 and 3 lost */
     assert_int_equal(r.lost, 2);
     assert_int_equal(ncp_dist_rx_play(&r, 1 * T), 100);
-    assert_int_equal(ncp_dist_rx_play(&r, 2 * T), 100);   /* held */
+    /* 2 is bridged on the way to 4 */
+    assert_int_equal(ncp_dist_rx_play(&r, 2 * T), 200);
+    assert_int_equal(r.bridged, 1);
     /* 3 comes late but in time: not lost after all */
     assert_int_equal(ncp_dist_rx_put(&r, 3, 3 * T, 300), NCP_DIST_RX_NEW);
     assert_int_equal(r.lost, 1);
     assert_int_equal(r.reordered, 1);
     assert_int_equal(ncp_dist_rx_play(&r, 3 * T), 300);
     assert_int_equal(ncp_dist_rx_play(&r, 4 * T), 400);
+    /* nothing after 4: 5 holds */
+    assert_int_equal(ncp_dist_rx_play(&r, 5 * T), 400);
     assert_int_equal(r.held, 1);
     /* 2 now: its period is past */
     assert_int_equal(ncp_dist_rx_put(&r, 2, 2 * T, 200), NCP_DIST_RX_STALE);
