@@ -39,14 +39,14 @@ int ncp_dist_decode_fine(const uint8_t *buf, size_t len, struct ncp_dist_fine *f
 {
     if (len < FIXED || (int64_t)be(buf, 8) != fine_hash)
         return -1;
-    int n = (int8_t)buf[22];
-    if (n < 0 || n > NCP_AXES || len != FIXED + 4u * (size_t)n)
+    int n = buf[22];   /* an int8: above 127 it is negative, refused as too many */
+    if (n > NCP_AXES || len != FIXED + 4u * (size_t)n)
         return -1;
     f->seq = (int32_t)(uint32_t)be(buf + 8, 4);
     f->sender = (int16_t)(uint16_t)be(buf + 12, 2);
     f->t_ns = (int64_t)be(buf + 14, 8);
     f->n = (int8_t)n;
     for (int i = 0; i < n; i++)
-        f->pos_nm[i] = (int32_t)(uint32_t)be(buf + FIXED + 4 * i, 4);
+        f->pos_nm[i] = (int32_t)(uint32_t)be(buf + FIXED + (size_t)4 * (size_t)i, 4);
     return 0;
 }

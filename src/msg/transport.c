@@ -374,9 +374,8 @@ int ncp_msg_take(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t **pa
  * seed on every machine. */
 void ncp_msg_dice_seed(struct ncp_msg_dice *d, uint64_t seed)
 {
-    d->s = seed * 0x9E3779B97F4A7C15ull + 0x2545F4914F6CDD1Dull;
-    if (d->s == 0)
-        d->s = 1;
+    /* xorshift's state must not be 0 */
+    d->s = (seed * 0x9E3779B97F4A7C15ull + 0x2545F4914F6CDD1Dull) | 1u;
 }
 
 int ncp_msg_dice_drop(struct ncp_msg_dice *d, double fraction)
