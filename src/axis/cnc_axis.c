@@ -170,8 +170,12 @@ static int report(const struct llc *l)
     case LLC_END_NONE:
     case LLC_END_DONE: return EXIT_OK;
     case LLC_END_HLC_STOP:
-        fprintf(stderr, "cnc-axis %c: error: the HLC ordered a stop (axis %c lost); ramped to "
-                        "a standstill at %.4f mm\n", ax, l->hlc_axis ? l->hlc_axis : '?', l->cmd);
+        if (l->hlc_axis)
+            fprintf(stderr, "cnc-axis %c: error: the HLC ordered a stop (axis %c lost); ramped "
+                            "to a standstill at %.4f mm\n", ax, l->hlc_axis, l->cmd);
+        else
+            fprintf(stderr, "cnc-axis %c: error: the HLC ordered a stop (its start-up failed, "
+                            "see its output); ramped to a standstill at %.4f mm\n", ax, l->cmd);
         break;
     case LLC_END_HLC_SILENT:
         fprintf(stderr, "cnc-axis %c: error: the HLC went silent (no heartbeat for %d ms); "
