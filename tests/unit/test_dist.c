@@ -11,7 +11,7 @@
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
 
-#define T 1000000 /* 1 ms */
+#define T 1000000LL /* 1 ms */
 
 static void fine_round_trip(void **state)
 {
