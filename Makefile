@@ -180,7 +180,7 @@ lint: $(GEN_STAMP)
 	cppcheck --quiet --error-exitcode=1 --enable=warning,style,performance,portability \
 	    --inline-suppr --suppress=missingIncludeSystem -Iinclude -I$(GEN_DIR) -D_GNU_SOURCE \
 	    --std=c11 src tests/unit
-	clang-tidy --quiet $(LIB_SRCS) $(CLI_SRCS) $(CTL_SRCS) -- $(CPPFLAGS) -std=c11 -I/usr/include/eigen3
+	clang-tidy --quiet $(LIB_SRCS) $(CLI_SRCS) $(CTL_SRCS) $(AXIS_SRCS) -- $(CPPFLAGS) -std=c11 -I/usr/include/eigen3
 .PHONY: lint
 
 # ---- container image (deploy/Containerfile) ------------------------------------

@@ -100,6 +100,10 @@ int ncp_backend_open(struct ncp_backend *b, const struct ncp_machine_cfg *cfg, F
                      struct ncp_diag *d);
 int ncp_backend_open_sim(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d);
+/* cnc-axis LLCs over LCM ([LCM] URL, DP, heartbeat and injection keys; the
+ * distributed mode, ncpar/dist.h). Only DP 5 so far: others are refused. */
+int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
+                         struct ncp_diag *d);
 int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                                FILE *log, struct ncp_diag *d);
 

@@ -69,9 +69,9 @@ struct ncp_axis_cfg {
     int wrapped;
 };
 
-/* What the position loop drives (backend.h): the simulated machine, or CiA 402
- * drives over SocketCAN. */
-enum ncp_backend_kind { NCP_BACKEND_SIM, NCP_BACKEND_SOCKETCAN };
+/* What the position loop drives (backend.h): the simulated machine, CiA 402
+ * drives over SocketCAN, or cnc-axis LLCs over LCM (the distributed mode). */
+enum ncp_backend_kind { NCP_BACKEND_SIM, NCP_BACKEND_SOCKETCAN, NCP_BACKEND_LCM };
 
 /* [CAN] */
 struct ncp_can_cfg {
@@ -155,6 +155,17 @@ struct ncp_machine_cfg {
         char prefix[32];          /* CHANNEL_PREFIX, default NCP_ */
         double status_hz;         /* STATUS_HZ, default 50; 0: only at state changes
                                      and after each command */
+        /* the distributed mode (cnc-run run --backend lcm, cnc-axis; seed 002) */
+        int dp;                   /* DP: distribution point 1..5 (5) */
+        int max_lost_periods;     /* MAX_LOST_PERIODS: statuses (HLC) or setpoints
+                                     (LLC) missing in a row before a controlled stop (20) */
+        int heartbeat_period_ms;  /* HEARTBEAT_PERIOD_MS (20) */
+        int heartbeat_timeout_ms; /* HEARTBEAT_TIMEOUT_MS: a peer silent this long is lost (200) */
+        int axis_wait_ms;         /* AXIS_WAIT_MS: how long the HLC waits for the axes'
+                                     advertisements (5000) */
+        double inject_loss;       /* INJECT_LOSS: fraction of received messages dropped (0) */
+        int inject_delay_us;      /* INJECT_DELAY_US: every received message held back (0) */
+        int inject_seed;          /* INJECT_SEED (1) */
     } lcm;
     struct ncp_io_cfg io;
     /* [INJECT] and [RT]'s miss keys: timing faults, setpoint policy, miss limits */

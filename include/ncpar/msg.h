@@ -31,6 +31,12 @@ struct ncp_msg_stats {
     uint64_t garbage;     /* on <prefix>CMD, or unreadable at all: bad magic,
                              truncated, wrong fingerprint, bad fields */
     uint64_t sent, send_errors;
+    /* ncp_msg_take's channels (the distributed mode) */
+    uint64_t taken, taken_bytes;       /* datagrams on a subscribed channel, with headers */
+    uint64_t sent_bytes, sent_payload_bytes; /* by ncp_msg_publish: datagrams, payloads */
+    uint64_t inject_lost;              /* dropped by INJECT_LOSS */
+    uint64_t inject_delayed;           /* held back by INJECT_DELAY_US */
+    uint64_t inject_undelayed;         /* too large or no room to hold back: passed on */
 };
 
 /* url NULL or "": $LCM_DEFAULT_URL, else NCP_MSG_DEFAULT_URL. Only udpm://
@@ -55,6 +61,41 @@ void ncp_msg_get_stats(const struct ncp_msg *m, struct ncp_msg_stats *st);
 /* The socket, for a caller that waits on it beside others (POLLIN: call
  * ncp_msg_poll with timeout 0). */
 int ncp_msg_fd(const struct ncp_msg *m);
+
+/* ---- any channel (the distributed mode, seed 002) ------------------------
+ * Several channels on one socket; encoded payloads in and out. What comes in
+ * may be lost or delayed on purpose ([LCM] INJECT_*): on the receiving side,
+ * so each receiver has its own losses and counts them. Nothing here blocks:
+ * the position loops of cnc-axis and of the lcm backend call it directly. */
+#define NCP_MSG_CHANNEL_MAX 63
+
+/* A channel to take (exact name): its index, or -1 when there are already
+ * 32 or the name is not a channel name. Before the real-time loop. */
+int ncp_msg_subscribe(struct ncp_msg *m, const char *channel);
+/* Frames and sends payload on channel without blocking: 0, or -1 (counted). */
+int ncp_msg_publish(struct ncp_msg *m, const char *channel, const void *payload, size_t len);
+/* The next datagram on a subscribed channel (after injected loss and delay):
+ * 1 with *sub and the payload set (valid until the next call), 0 when none
+ * is waiting (at most 256 are read per call), -1 on a socket error. now_ns:
+ * CLOCK_MONOTONIC, for the injected delay. */
+int ncp_msg_take(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t **payload,
+                 size_t *len);
+
+/* Seeded dice for the injected loss: the same seed loses the same messages. */
+struct ncp_msg_dice {
+    uint64_t s;
+};
+void ncp_msg_dice_seed(struct ncp_msg_dice *d, uint64_t seed);
+/* 1 with probability fraction. */
+int ncp_msg_dice_drop(struct ncp_msg_dice *d, double fraction);
+
+struct ncp_msg_inject {
+    double loss;        /* fraction of incoming messages dropped, 0..1 */
+    int64_t delay_ns;   /* every incoming message held back this long */
+    uint64_t seed;
+};
+/* Before the real-time loop (allocates the delay queue): 0, or -1. */
+int ncp_msg_set_inject(struct ncp_msg *m, const struct ncp_msg_inject *in);
 
 /* Pure helpers (tested without a network). */
 /* What a udpm:// URL says (LCM's syntax and defaults: udpm://239.255.76.67:7667,

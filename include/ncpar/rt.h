@@ -84,6 +84,10 @@ struct ncp_rt_loop_cfg {
     int priority;          /* 1..99 SCHED_FIFO, 0 SCHED_OTHER */
     int cpu;               /* < 0: any */
     int virtual_clock;     /* simulated time, as fast as the CPU allows */
+    /* real clock: CLOCK_MONOTONIC of the schedule's origin (the first cycle
+     * runs one period after it), so that processes can share one period
+     * grid; 0: now */
+    int64_t start_ns;
 };
 
 struct ncp_rt_loop {

@@ -10,6 +10,7 @@ int ncp_backend_open(struct ncp_backend *b, const struct ncp_machine_cfg *cfg, F
     switch (cfg->backend) {
     case NCP_BACKEND_SIM: return ncp_backend_open_sim(b, cfg, d);
     case NCP_BACKEND_SOCKETCAN: return ncp_backend_open_socketcan(b, cfg, log, d);
+    case NCP_BACKEND_LCM: return ncp_backend_open_lcm(b, cfg, d);
     }
     return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0, "unknown backend %d", (int)cfg->backend);
 }

@@ -11,6 +11,7 @@
 #include "ncpar/backend.h"
 #include "ncpar/feeder.h"
 #include "ncpar/motion.h"
+#include "ncpar/msg.h"
 #include "ncpar/pipeline.h"
 #include "ncpar/nck.h"
 
@@ -34,6 +35,8 @@ struct run_opts {
     int virtual_clock;
     enum ncp_thread_mode mode;
     const char *backend;        /* --backend as given, NULL = sim */
+    int dp;                     /* --dp, 0 = the INI's [LCM] DP */
+    const char *lcm_url;        /* --lcm-url, NULL = the INI's [LCM] URL */
     uint32_t max_loops;         /* --max-loops, 0 = the interpreter's default */
     const char *inject, *seed;  /* --inject SPECS, --seed N (NULL: the INI's) */
     int home;                   /* --home: home the machine before the program */
@@ -59,7 +62,7 @@ static void usage(FILE *f)
           "                        [--feed-override PCT] [--clock real|virtual]\n"
           "                        [--mode serial|det|att] [--tool-table FILE]\n"
           "                        [--subroutine-path DIR[:DIR...]] [--max-loops N]\n"
-          "                        [--backend sim|socketcan[:IFACE]]\n"
+          "                        [--backend sim|socketcan[:IFACE]|lcm] [--dp N] [--lcm-url URL]\n"
           "                        [--inject SPEC[,SPEC...]] [--seed N] [--home]\n"
           "       cnc-run run --channel N:PROG[:INI] [--channel M:PROG2[:INI2] ...] [options]\n"
           "Runs PROG on the simulated machine (or CiA 402 drives over CAN): interpreter ->\n"
@@ -88,6 +91,13 @@ static void usage(FILE *f)
           "                      Operation enabled, SDO failure) stops all axes: exit 3.\n"
           "                      The trace's actual positions are then the drives' TPDOs,\n"
           "                      one servo period old\n"
+          "  --backend lcm       the distributed NCK: one `cnc-axis` per axis of the INI\n"
+          "                      over LCM (README \"Distributed mode\"); real clock only.\n"
+          "                      An axis lost (no status for [LCM] MAX_LOST_PERIODS, no\n"
+          "                      heartbeat) stops the others: exit 3\n"
+          "  --dp N              distribution point 1..5 (default: the INI's [LCM] DP, 5);\n"
+          "                      implemented: 5 (fine setpoints every servo period)\n"
+          "  --lcm-url URL       udpm://GROUP:PORT?ttl=N (default: [LCM] URL, $LCM_DEFAULT_URL)\n"
           "  --inject SPECS      timing faults in the position loop (over the INI's [INJECT]\n"
           "                      SPEC): miss=RATIO, miss@CYCLE, latency=US, latency=MIN-MAX,\n"
           "                      io-latency=US, jitter=US[:normal], lose-setpoint=RATIO,\n"
@@ -131,6 +141,8 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "tool-table", required_argument, 0, 'T' },
         { "subroutine-path", required_argument, 0, 'S' },
         { "backend", required_argument, 0, 'b' },
+        { "dp", required_argument, 0, 'D' },
+        { "lcm-url", required_argument, 0, 'U' },
         { "max-loops", required_argument, 0, 'L' },
         { "inject", required_argument, 0, 'I' },
         { "seed", required_argument, 0, 'R' },
@@ -142,7 +154,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     double pct;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:I:R:H", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:I:R:HD:U:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': o->config = optarg; break;
         case 't': o->trace = optarg; break;
@@ -150,6 +162,14 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         case 'T': o->tool_table = optarg; break;
         case 'S': o->sub_path = optarg; break;
         case 'b': o->backend = optarg; break;
+        case 'D':
+            if (parse_num(optarg, 1, 5, &pct) || pct != floor(pct) || strchr(optarg, '.') ||
+                strpbrk(optarg, "eE"))
+                return fprintf(stderr, "cnc-run run: --dp is a distribution point 1..5, not "
+                                       "'%s'\n", optarg), -1;
+            o->dp = (int)pct;
+            break;
+        case 'U': o->lcm_url = optarg; break;
         case 'I': o->inject = optarg; break;
         case 'R': o->seed = optarg; break;
         case 'H': o->home = 1; break;
@@ -259,16 +279,46 @@ int ncp_cli_run_report(const char *prog, const struct ncp_machine_cfg *cfg,
     return res->status;
 }
 
+/* --backend lcm: the distributed NCK at the INI's or --dp's point. Points
+ * not implemented yet are refused here, before anything is opened. */
+static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
+{
+    cfg->backend = NCP_BACKEND_LCM;
+    if (o->dp)
+        cfg->lcm.dp = o->dp;
+    if (o->lcm_url) {
+        struct ncp_msg_url u;
+        struct ncp_diag d;
+        memset(&d, 0, sizeof d);
+        if (strlen(o->lcm_url) >= sizeof cfg->lcm.url || ncp_msg_parse_url(o->lcm_url, &u, &d))
+            return fprintf(stderr, "cnc-run run: --lcm-url: %s\n",
+                           d.msg[0] ? d.msg : "too long"), -1;
+        snprintf(cfg->lcm.url, sizeof cfg->lcm.url, "%s", o->lcm_url);
+    }
+    if (o->virtual_clock)
+        return fprintf(stderr, "cnc-run run: --backend lcm runs with its axes in real time: it "
+                               "needs --clock real\n"), -1;
+    if (cfg->lcm.dp != 5)
+        return fprintf(stderr, "cnc-run run: --backend lcm: DP %d is not implemented yet (DP 5, "
+                               "fine setpoints every servo period, is)\n", cfg->lcm.dp), -1;
+    return 0;
+}
+
 /* --backend sim | socketcan | socketcan:IFACE, over what the INI said. */
 static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 {
     const char *b = o->backend;
+    int lcm = b && !strcmp(b, "lcm");
+    if (!lcm && (o->dp || o->lcm_url))
+        return fprintf(stderr, "cnc-run run: --dp and --lcm-url go with --backend lcm\n"), -1;
+    if (lcm)
+        return apply_lcm(o, cfg);
     if (!b || !strcmp(b, "sim")) {
         cfg->backend = NCP_BACKEND_SIM;
         return 0;
     }
     if (strncmp(b, "socketcan", 9) != 0 || (b[9] != 0 && b[9] != ':'))
-        return fprintf(stderr, "cnc-run run: --backend is sim or socketcan[:IFACE], not '%s'\n",
+        return fprintf(stderr, "cnc-run run: --backend is sim, socketcan[:IFACE] or lcm, not '%s'\n",
                        b), -1;
     cfg->backend = NCP_BACKEND_SOCKETCAN;
     if (b[9] == ':') {

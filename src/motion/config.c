@@ -61,6 +61,12 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     ncp_inject_cfg_default(&c->inject);
     snprintf(c->lcm.prefix, sizeof c->lcm.prefix, "NCP_");
     c->lcm.status_hz = 50.0;
+    c->lcm.dp = 5;
+    c->lcm.max_lost_periods = 20;
+    c->lcm.heartbeat_period_ms = 20;
+    c->lcm.heartbeat_timeout_ms = 200;
+    c->lcm.axis_wait_ms = 5000;
+    c->lcm.inject_seed = 1;
     ncp_machine_joints_from_axes(c);
 }
 
@@ -353,6 +359,23 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v, char *wh
     }
     if (!strcasecmp(k, "STATUS_HZ"))
         return real(v, 0, 1000, &l->status_hz, "Hz (0: only at changes)", why, len);
+    if (!strcasecmp(k, "INJECT_LOSS"))
+        return real(v, 0, 1, &l->inject_loss, "(a fraction)", why, len);
+    static const struct { const char *name; int lo, hi; const char *unit; } ints[] = {
+        { "DP", 1, 5, "(a distribution point)" },
+        { "MAX_LOST_PERIODS", 1, 100000, "periods" },
+        { "HEARTBEAT_PERIOD_MS", 1, 10000, "ms" },
+        { "HEARTBEAT_TIMEOUT_MS", 2, 60000, "ms" },
+        { "AXIS_WAIT_MS", 1, 600000, "ms" },
+        { "INJECT_DELAY_US", 0, 1000000, "us" },
+        { "INJECT_SEED", 0, 2147483647, "" },
+    };
+    int *dst[] = { &l->dp, &l->max_lost_periods, &l->heartbeat_period_ms,
+                   &l->heartbeat_timeout_ms, &l->axis_wait_ms, &l->inject_delay_us,
+                   &l->inject_seed };
+    for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++)
+        if (!strcasecmp(k, ints[i].name))
+            return whole(v, ints[i].lo, ints[i].hi, dst[i], ints[i].unit, why, len);
     return 0;
 }
 
@@ -661,6 +684,10 @@ static int check_cfg(struct load_ctx *lc)
         return fail_at(lc, key_line(lc, "SIM", key), "[SIM] %s: the machine has no axis %c "
                        "([TRAJ] COORDINATES)", key, NCP_AXIS_LETTERS[i]), -1;
     }
+    if (c->lcm.heartbeat_timeout_ms <= c->lcm.heartbeat_period_ms)
+        return fail_at(lc, key_line(lc, "LCM", "HEARTBEAT_TIMEOUT_MS"),
+                       "[LCM] HEARTBEAT_TIMEOUT_MS %d must be longer than HEARTBEAT_PERIOD_MS %d",
+                       c->lcm.heartbeat_timeout_ms, c->lcm.heartbeat_period_ms), -1;
     if (c->can.master_node && c->can.hb_consumer_ms <= c->can.heartbeat_period_ms)
         return fail_at(lc, key_line(lc, "CAN", "HEARTBEAT_CONSUMER_MS"),
                        "[CAN] HEARTBEAT_CONSUMER_MS %d must be longer than HEARTBEAT_PERIOD_MS "

@@ -27,9 +27,27 @@
 #define CHANNEL_SIZE (NCP_MSG_PREFIX_MAX + 8)
 #define UDP_DATAGRAM_MAX 65536
 #define SEND_BUF_SIZE 4096 /* header + the largest type (status_t) */
+#define SUBS_MAX 32
+/* Held back by INJECT_DELAY_US: our own messages are far smaller than this;
+ * a larger one is passed on undelayed (and counted) rather than cut. */
+#define DELAY_SLOTS 256
+#define DELAY_BYTES 768
+
+struct delayed {
+    int64_t due_ns;
+    int sub;
+    uint16_t len;
+    uint8_t data[DELAY_BYTES];
+};
 
 struct ncp_msg {
     int fd;
+    int n_subs;
+    char subs[SUBS_MAX][NCP_MSG_CHANNEL_MAX + 1];
+    struct ncp_msg_inject inj;
+    struct ncp_msg_dice dice;
+    unsigned dq_head, dq_count;   /* FIFO: one delay for all, so due times ascend */
+    struct delayed *dq;
     struct sockaddr_in group;
     uint32_t seqno; /* LC02 sequence number of the next datagram sent */
     char ch_cmd[CHANNEL_SIZE], ch_ack[CHANNEL_SIZE], ch_status[CHANNEL_SIZE],
@@ -133,6 +151,7 @@ void ncp_msg_close(struct ncp_msg *m)
         return;
     if (m->fd >= 0)
         close(m->fd);
+    free(m->dq);
     free(m);
 }
 
@@ -240,4 +259,130 @@ int ncp_msg_send_event(struct ncp_msg *m, const ncp_event_t *e)
     int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, m->ch_event);
     int n = h < 0 ? -1 : ncp_event_t_encode(m->sbuf, h, (int)sizeof m->sbuf - h, e);
     return send_frame(m, h, n);
+}
+
+/* ---- any channel: the distributed mode's subscriptions ------------------- */
+
+int ncp_msg_subscribe(struct ncp_msg *m, const char *channel)
+{
+    size_t n = strlen(channel);
+    if (m->n_subs >= SUBS_MAX || n == 0 || n > NCP_MSG_CHANNEL_MAX)
+        return -1;
+    memcpy(m->subs[m->n_subs], channel, n + 1);
+    return m->n_subs++;
+}
+
+int ncp_msg_set_inject(struct ncp_msg *m, const struct ncp_msg_inject *in)
+{
+    if (in->delay_ns > 0 && m->dq == NULL) {
+        m->dq = calloc(DELAY_SLOTS, sizeof *m->dq);
+        if (m->dq == NULL)
+            return -1;
+    }
+    m->inj = *in;
+    ncp_msg_dice_seed(&m->dice, in->seed);
+    return 0;
+}
+
+int ncp_msg_publish(struct ncp_msg *m, const char *channel, const void *payload, size_t len)
+{
+    int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, channel);
+    if (h < 0 || len > sizeof m->sbuf - (size_t)h) {
+        m->stats.send_errors++;
+        return -1;
+    }
+    memcpy(m->sbuf + h, payload, len);
+    int rc = send_frame(m, h, (int)len);
+    if (rc == 0) {
+        m->stats.sent_bytes += (uint64_t)h + len;
+        m->stats.sent_payload_bytes += len;
+    }
+    return rc;
+}
+
+static int sub_index(const struct ncp_msg *m, const char *channel)
+{
+    for (int i = 0; i < m->n_subs; i++)
+        if (strcmp(m->subs[i], channel) == 0)
+            return i;
+    return -1;
+}
+
+/* The oldest held-back datagram when it is due: 1 with *sub, *p, *len set. */
+static int take_due(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t **p, size_t *len)
+{
+    if (m->dq_count == 0 || m->dq[m->dq_head].due_ns > now_ns)
+        return 0;
+    struct delayed *e = &m->dq[m->dq_head];
+    m->dq_head = (m->dq_head + 1) % DELAY_SLOTS;
+    m->dq_count--;
+    *sub = e->sub;
+    *p = e->data;
+    *len = e->len;
+    return 1;
+}
+
+int ncp_msg_take(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t **payload,
+                 size_t *len)
+{
+    if (take_due(m, now_ns, sub, payload, len))
+        return 1;
+    for (int i = 0; i < POLL_DATAGRAMS_MAX; i++) {
+        ssize_t n = recv(m->fd, m->rbuf, sizeof m->rbuf, MSG_DONTWAIT);
+        if (n < 0)
+            return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? 0 : -1;
+        m->stats.received++;
+        const char *channel;
+        const uint8_t *p;
+        size_t plen;
+        if (ncp_msg_parse_datagram(m->rbuf, (size_t)n, &channel, &p, &plen) != 0) {
+            m->stats.garbage += !ncp_msg_is_fragment(m->rbuf, (size_t)n);
+            continue;
+        }
+        int s = sub_index(m, channel);
+        if (s < 0)
+            continue;   /* other LCM traffic on the group */
+        m->stats.taken++;
+        m->stats.taken_bytes += (uint64_t)n;
+        if (m->inj.loss > 0 && ncp_msg_dice_drop(&m->dice, m->inj.loss)) {
+            m->stats.inject_lost++;
+            continue;
+        }
+        if (m->inj.delay_ns > 0 && m->dq != NULL) {
+            if (plen > DELAY_BYTES || m->dq_count == DELAY_SLOTS) {
+                m->stats.inject_undelayed++;
+            } else {
+                struct delayed *e = &m->dq[(m->dq_head + m->dq_count) % DELAY_SLOTS];
+                e->due_ns = now_ns + m->inj.delay_ns;
+                e->sub = s;
+                e->len = (uint16_t)plen;
+                memcpy(e->data, p, plen);
+                m->dq_count++;
+                m->stats.inject_delayed++;
+                continue;
+            }
+        }
+        *sub = s;
+        *payload = p;
+        *len = plen;
+        return 1;
+    }
+    return 0;
+}
+
+/* xorshift64*: a few instructions per message, the same losses for the same
+ * seed on every machine. */
+void ncp_msg_dice_seed(struct ncp_msg_dice *d, uint64_t seed)
+{
+    /* xorshift's state must not be 0 */
+    d->s = (seed * 0x9E3779B97F4A7C15ull + 0x2545F4914F6CDD1Dull) | 1u;
+}
+
+int ncp_msg_dice_drop(struct ncp_msg_dice *d, double fraction)
+{
+    d->s ^= d->s >> 12;
+    d->s ^= d->s << 25;
+    d->s ^= d->s >> 27;
+    uint64_t r = d->s * 0x2545F4914F6CDD1Dull;
+    return (double)(r >> 11) * (1.0 / 9007199254740992.0) < fraction;
 }

@@ -80,7 +80,7 @@ static int init_motion(struct nck *n)
     atomic_store(&n->ctl->din, c->io.din);
     n->loop.cfg = (struct ncp_rt_loop_cfg){ (int64_t)llround(c->servo_period * 1e9),
                                             c->position.priority, c->position.cpu,
-                                            n->setup.virtual_clock };
+                                            n->setup.virtual_clock, 0 };
     n->loop.cycle = nck_position_cycle;
     n->loop.ctx = n;
     n->loop.handover = backend_live;

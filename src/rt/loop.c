@@ -66,7 +66,7 @@ static void run_virtual(struct ncp_rt_loop *l)
 static void run_real(struct ncp_rt_loop *l)
 {
     const int64_t period = l->cfg.period_ns;
-    const int64_t base = mono_ns();
+    const int64_t base = l->cfg.start_ns > 0 ? l->cfg.start_ns : mono_ns();
     int64_t next = base;
     while (!atomic_load_explicit(&l->stop, memory_order_relaxed)) {
         next += period;

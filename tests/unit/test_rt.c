@@ -92,7 +92,7 @@ static void run_loop(int virt, int cycles, struct ncp_rt_loop *l, struct count_c
     memset(l, 0, sizeof *l);
     memset(c, 0, sizeof *c);
     c->limit = cycles;
-    l->cfg = (struct ncp_rt_loop_cfg){ 1000000, 90, -1, virt };
+    l->cfg = (struct ncp_rt_loop_cfg){ 1000000, 90, -1, virt, 0 };
     l->cycle = count_cycle;
     l->ctx = c;
     assert_int_equal(ncp_rt_loop_start(l), 0);

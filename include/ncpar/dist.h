@@ -1,0 +1,92 @@
+/* The distributed NCK (seed 002): what the HLC (cnc-run run --backend lcm)
+ * and its LLCs (cnc-axis) share: channel names, the setpoint message without
+ * allocation, and the LLC's receive buffer with its loss accounting.
+ *
+ * Distribution points, ADCBI (today's planner): DP1 the part program, DP2
+ * INTbuf, DP3 LAbuf, DP4 ACCDECbuf (block-level: bursts), DP5 fineIPObuf
+ * (period-level: a record every servo period). ADCAI: DP2 roughIPObuf, DP3
+ * ACCDECbuf, DP4 fineIPObuf. Implemented: ADCBI DP5.
+ *
+ * Positions travel as int32 nanometres: exact and the same for every LLC,
+ * +-2.1 m of travel. */
+#ifndef NCPAR_DIST_H
+#define NCPAR_DIST_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ncpar/motion.h"
+#include "ncp_ax_advert_t.h"
+#include "ncp_ax_status_t.h"
+#include "ncp_fine_ipo_t.h"
+#include "ncp_heartbeat_t.h"
+
+#define NCP_DIST_HLC_ID 100   /* sender id of the HLC; an LLC's is its axis index + 1 */
+
+/* Channel names: NCP_HLC_<WHAT> and NCP_AX_<L>_<WHAT>. */
+#define NCP_DIST_CH_FINE "NCP_HLC_FINE"
+#define NCP_DIST_CH_HLC_HEARTBEAT "NCP_HLC_HEARTBEAT"
+enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTBEAT };
+/* "NCP_AX_<L>_ADVERT" etc. into buf (32 bytes are enough). */
+void ncp_dist_ax_channel(char *buf, size_t size, int axis, enum ncp_dist_ax_ch what);
+
+/* nm <-> mm; out of the int32 range: -1. */
+int ncp_dist_mm_to_nm(double mm, int32_t *nm);
+static inline double ncp_dist_nm_to_mm(int32_t nm) { return (double)nm * 1e-6; }
+
+/* ---- fine_ipo_t without the generated decoder's malloc ------------------- */
+struct ncp_dist_fine {
+    int32_t seq;
+    int16_t sender;
+    int64_t t_ns;
+    int8_t n;
+    int32_t pos_nm[NCP_AXES];
+};
+/* Before any real-time use: the type's fingerprint is computed once here. */
+void ncp_dist_init(void);
+/* Encoded length, or -1 when it does not fit. */
+int ncp_dist_encode_fine(uint8_t *buf, size_t size, const struct ncp_dist_fine *f);
+/* 0, or -1 for anything that is not exactly one fine_ipo_t of at most
+ * NCP_AXES axes. */
+int ncp_dist_decode_fine(const uint8_t *buf, size_t len, struct ncp_dist_fine *f);
+
+/* ---- the LLC's setpoint buffer ------------------------------------------
+ * Setpoints are kept by the period they are for (t_ns) and played at a fixed
+ * delay behind the HLC; sequence numbers find what went missing. */
+#define NCP_DIST_RX_SLOTS 64
+/* An LLC plays period t at t + (this + 0.5) periods: room for the HLC's
+ * wake-up latency and the wire, and for bridging a lost period. */
+#define NCP_DIST_PLAY_DELAY 3
+
+enum ncp_dist_rx_verdict {
+    NCP_DIST_RX_NEW,        /* kept */
+    NCP_DIST_RX_DUPLICATE,  /* its period is already held: ignored */
+    NCP_DIST_RX_STALE,      /* for a period already played (or too old): ignored */
+    NCP_DIST_RX_EARLY       /* too far ahead for the buffer: ignored */
+};
+
+struct ncp_dist_rx {
+    int64_t period_ns;
+    int have_seq;
+    int32_t top_seq;        /* highest sequence number seen */
+    int64_t played_t;       /* the period played last (0: none yet) */
+    int32_t last_nm;        /* what was played last (held through gaps) */
+    int primed;
+    struct { int64_t t_ns; int32_t nm; } slot[NCP_DIST_RX_SLOTS];
+    uint32_t lost, stale, duplicate, held, bridged, early, reordered;
+};
+
+void ncp_dist_rx_init(struct ncp_dist_rx *r, int64_t period_ns, int32_t start_nm);
+/* A received setpoint for this LLC's axis. */
+enum ncp_dist_rx_verdict ncp_dist_rx_put(struct ncp_dist_rx *r, int32_t seq, int64_t t_ns,
+                                         int32_t nm);
+/* The setpoint of period t_ns: the one received; else, once setpoints have
+ * started to come, the point on the way to the next one received (bridged),
+ * or with none yet the last one again (held). */
+int32_t ncp_dist_rx_play(struct ncp_dist_rx *r, int64_t t_ns);
+/* The setpoint of period t_ns if it is here (1), without playing it. */
+int ncp_dist_rx_peek(const struct ncp_dist_rx *r, int64_t t_ns, int32_t *nm);
+/* Setpoints held for periods after t_ns. */
+int ncp_dist_rx_level(const struct ncp_dist_rx *r, int64_t t_ns);
+
+#endif

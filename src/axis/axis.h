@@ -1,0 +1,70 @@
+/* cnc-axis's parts: the position loop (llc.c), the trace writer and main
+ * (cnc_axis.c). */
+#ifndef NCP_AXIS_AXIS_H
+#define NCP_AXIS_AXIS_H
+
+#include <stdatomic.h>
+#include <stdio.h>
+
+#include "ncpar/backend.h"
+#include "ncpar/dist.h"
+#include "ncpar/msg.h"
+#include "ncpar/rt.h"
+
+enum llc_end {
+    LLC_END_NONE,
+    LLC_END_DONE,       /* the HLC said the program is done */
+    LLC_END_HLC_STOP,   /* the HLC ordered a stop (another axis was lost) */
+    LLC_END_HLC_SILENT, /* no heartbeat from the HLC for HEARTBEAT_TIMEOUT_MS */
+    LLC_END_LOST,       /* MAX_LOST_PERIODS setpoints in a row missing */
+    LLC_END_FERROR,     /* following error past FERROR */
+    LLC_END_SIGNAL      /* SIGINT / SIGTERM */
+};
+
+struct llc_row {          /* one period of the trace, handed to the main thread */
+    int64_t t_ns, slot_ns;
+    double cmd, act;
+    int state;
+    int gap;              /* 0 its own setpoint, 1 bridged, 2 held */
+};
+
+struct llc {
+    const struct ncp_machine_cfg *cfg;
+    int axis;             /* index in NCP_AXIS_LETTERS */
+    int slot;             /* its place in the HLC's setpoint (the machine's axes in order) */
+    struct ncp_msg *msg;
+    char ch_status[32], ch_heartbeat[32], ch_advert[32];
+    int64_t period_ns, t_first;   /* the HLC's first setpoint period */
+    int64_t hb_period_ns, hb_timeout_ns;
+    struct ncp_dist_rx rx;
+    struct ncp_sim sim;
+    double cmd, cmd_prev, act, ferr;
+    int state;            /* ncp_ax_status_t's constants */
+    enum llc_end end;
+    char hlc_axis;        /* LLC_END_HLC_STOP: the axis the HLC named */
+    int run_held;         /* setpoints missing in a row */
+    uint32_t held_seen;
+    int held_moving;      /* the axis was moving when the setpoints stopped */
+    uint32_t clamped;     /* setpoints limited to MAX_VELOCITY */
+    int64_t last_hlc_ns, last_hb_ns, last_adv_ns, settle;
+    int64_t lost_at_ns;
+    uint64_t waits;       /* periods before the HLC's first setpoint */
+    double fault_ferr;    /* the following error LLC_END_FERROR saw */   /* when LLC_END_LOST was decided */
+    int32_t seq;
+    int done_req;
+    _Atomic int signal;   /* set by the signal handler */
+    struct ncp_spsc trace_ring;
+    int tracing;
+    uint32_t trace_dropped;
+    struct ncp_rt_loop loop;
+};
+
+/* llc.c */
+int llc_cycle(void *ctx, int64_t now_ns);
+void llc_take(struct llc *l, int64_t now);
+void llc_publish_status(struct llc *l, int64_t slot);
+void llc_heartbeat(struct llc *l, int64_t now);
+void llc_advertise(struct llc *l);
+int64_t llc_now(void);
+
+#endif

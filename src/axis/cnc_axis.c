@@ -1,0 +1,242 @@
+/* cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]: one low-level
+ * axis controller of the distributed NCK (seed 002). It advertises its axis,
+ * waits for the HLC (cnc-run run --backend lcm), then runs the axis's
+ * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5)
+ * until the HLC says the program is done (exit 0) or something makes it stop
+ * (exit 3, after a ramp to standstill). */
+#include "axis.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_FAULT = 3 };
+
+static struct llc *the_llc;
+
+static void on_signal(int sig)
+{
+    atomic_store(&the_llc->signal, sig);
+}
+
+static void usage(FILE *f)
+{
+    fputs("usage: cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]\n"
+          "One axis of the distributed NCK: advertises axis L of the machine INI over LCM,\n"
+          "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
+          "servo at the HLC's setpoints (every servo period, DP 5) and reports its status\n"
+          "every period. Stops with a ramp within MAX_ACCELERATION when the HLC goes\n"
+          "silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS setpoints in a row\n"
+          "are missing, on a following error or when the HLC orders it.\n"
+          "  --trace CSV   every period: t,slot,cmd,act,state,gap (seconds from the HLC's first\n"
+          "                period; slot: the HLC's period played; state: ax_status_t's;\n"
+          "                gap: 0 its own setpoint, 1 bridged to the next, 2 held)\n"
+          "exit status: 0 the program is done, 1 usage or configuration, 3 stopped\n",
+          f);
+}
+
+struct opts {
+    const char *config, *url, *trace;
+    int axis;
+};
+
+static int parse(int argc, char **argv, struct opts *o)
+{
+    static const struct option lo[] = {
+        { "axis", required_argument, 0, 'a' },   { "config", required_argument, 0, 'c' },
+        { "lcm-url", required_argument, 0, 'u' }, { "trace", required_argument, 0, 't' },
+        { "help", no_argument, 0, 'h' },          { 0, 0, 0, 0 },
+    };
+    int c;
+    o->axis = -1;
+    while ((c = getopt_long(argc, argv, "a:c:u:t:h", lo, NULL)) != -1) {
+        switch (c) {
+        case 'a': {
+            const char *p = optarg[0] && !optarg[1] ? strchr(NCP_AXIS_LETTERS, optarg[0] & ~0x20)
+                                                    : NULL;
+            if (!p || !*p)
+                return fprintf(stderr, "cnc-axis: --axis is one letter of %s, not '%s'\n",
+                               NCP_AXIS_LETTERS, optarg), -1;
+            o->axis = (int)(p - NCP_AXIS_LETTERS);
+            break;
+        }
+        case 'c': o->config = optarg; break;
+        case 'u': o->url = optarg; break;
+        case 't': o->trace = optarg; break;
+        case 'h': usage(stdout); exit(0);
+        default: return -1;
+        }
+    }
+    if (optind != argc)
+        return fprintf(stderr, "cnc-axis: unexpected argument '%s'\n", argv[optind]), -1;
+    if (o->axis < 0 || !o->config)
+        return fprintf(stderr, "cnc-axis: --axis and --config are required\n"), -1;
+    return 0;
+}
+
+static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_cfg *cfg)
+{
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    l->cfg = cfg;
+    l->axis = o->axis;
+    if (!(cfg->axis_mask & NCP_AXIS_BIT(o->axis)))
+        return fprintf(stderr, "%s: error: the machine has no axis %c ([TRAJ] COORDINATES)\n",
+                       o->config, NCP_AXIS_LETTERS[o->axis]), -1;
+    for (int j = 0; j < o->axis; j++)
+        l->slot += (cfg->axis_mask >> j) & 1u;
+    l->period_ns = llround(cfg->servo_period * 1e9);
+    l->hb_period_ns = cfg->lcm.heartbeat_period_ms * 1000000LL;
+    l->hb_timeout_ns = cfg->lcm.heartbeat_timeout_ms * 1000000LL;
+    ncp_dist_init();
+    ncp_dist_ax_channel(l->ch_status, sizeof l->ch_status, o->axis, NCP_DIST_AX_STATUS);
+    ncp_dist_ax_channel(l->ch_heartbeat, sizeof l->ch_heartbeat, o->axis, NCP_DIST_AX_HEARTBEAT);
+    ncp_dist_ax_channel(l->ch_advert, sizeof l->ch_advert, o->axis, NCP_DIST_AX_ADVERT);
+    const char *url = o->url ? o->url : cfg->lcm.url;
+    if (ncp_msg_open(&l->msg, url, NULL, &d) != NCP_OK)
+        return fprintf(stderr, "cnc-axis: error: %s\n", d.msg), -1;
+    /* the order llc_take expects */
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_FINE);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_HLC_HEARTBEAT);
+    /* each axis its own losses: the seed plus its index */
+    struct ncp_msg_inject in = { cfg->lcm.inject_loss, cfg->lcm.inject_delay_us * 1000LL,
+                                 (uint64_t)cfg->lcm.inject_seed + 1u + (uint64_t)o->axis };
+    if (ncp_msg_set_inject(l->msg, &in) != 0)
+        return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
+    static const double origin[NCP_AXES];
+    ncp_sim_init(&l->sim, cfg, origin);
+    ncp_dist_rx_init(&l->rx, l->period_ns, 0);
+    if (o->trace) {
+        l->tracing = 1;
+        if (ncp_spsc_init(&l->trace_ring, sizeof(struct llc_row), 1 << 14) != 0)
+            return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
+    }
+    return 0;
+}
+
+static void drain_trace(struct llc *l, FILE *f)
+{
+    struct llc_row r;
+    while (l->tracing && ncp_spsc_pop(&l->trace_ring, &r) == 0)
+        fprintf(f, "%.6f,%.6f,%.6f,%.6f,%d,%d\n", (double)(r.t_ns - l->t_first) * 1e-9,
+                (double)(r.slot_ns - l->t_first) * 1e-9, r.cmd, r.act, r.state, r.gap);
+}
+
+static int run_loop(struct llc *l, FILE *trace)
+{
+    /* its own phase: the period it plays follows from the HLC's grid and
+     * the loop's schedule (llc.c), whatever the offset between them */
+    l->loop.cfg = (struct ncp_rt_loop_cfg){ l->period_ns, l->cfg->position.priority,
+                                            l->cfg->position.cpu, 0, llc_now() };
+    l->loop.cycle = llc_cycle;
+    l->loop.ctx = l;
+    if (l->cfg->position.policy != SCHED_FIFO)
+        l->loop.cfg.priority = 0;
+    int rc = ncp_rt_loop_start(&l->loop);
+    if (rc != 0)
+        return fprintf(stderr, "cnc-axis: cannot start the position loop: %s\n", strerror(rc)),
+               -1;
+    if (l->loop.warning[0])
+        fprintf(stderr, "cnc-axis %c: warning: %s\n", NCP_AXIS_LETTERS[l->axis], l->loop.warning);
+    while (atomic_load(&l->loop.running)) {
+        struct timespec ts = { 0, 5000000 };
+        nanosleep(&ts, NULL);
+        if (trace)
+            drain_trace(l, trace);
+    }
+    ncp_rt_loop_join(&l->loop);
+    if (trace)
+        drain_trace(l, trace);
+    return 0;
+}
+
+static int report(const struct llc *l)
+{
+    char ax = NCP_AXIS_LETTERS[l->axis];
+    struct ncp_msg_stats st;
+    ncp_msg_get_stats(l->msg, &st);
+    fprintf(stderr,
+            "cnc-axis %c: %llu periods, %u misses; setpoints lost %u, held %u, stale %u, "
+            "duplicate %u, bridged %u, reordered %u, limited to MAX_VELOCITY %u; injected loss %llu, "
+            "delayed %llu\n",
+            ax, (unsigned long long)l->loop.stats.cycles, (unsigned)l->loop.stats.misses,
+            l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.bridged, l->rx.reordered, l->clamped,
+            (unsigned long long)st.inject_lost, (unsigned long long)st.inject_delayed);
+    switch (l->end) {
+    case LLC_END_NONE:
+    case LLC_END_DONE: return EXIT_OK;
+    case LLC_END_HLC_STOP:
+        if (l->hlc_axis)
+            fprintf(stderr, "cnc-axis %c: error: the HLC ordered a stop (axis %c lost); ramped "
+                            "to a standstill at %.4f mm\n", ax, l->hlc_axis, l->cmd);
+        else
+            fprintf(stderr, "cnc-axis %c: error: the HLC ordered a stop (its start-up failed, "
+                            "see its output); ramped to a standstill at %.4f mm\n", ax, l->cmd);
+        break;
+    case LLC_END_HLC_SILENT:
+        fprintf(stderr, "cnc-axis %c: error: the HLC went silent (no heartbeat for %d ms); "
+                        "ramped to a standstill at %.4f mm\n",
+                ax, l->cfg->lcm.heartbeat_timeout_ms, l->cmd);
+        break;
+    case LLC_END_LOST:
+        fprintf(stderr, "cnc-axis %c: error: more than %d setpoints in a row lost (the HLC's "
+                        "last heartbeat %lld ms before); ramped to a standstill at %.4f mm\n",
+                ax, l->cfg->lcm.max_lost_periods,
+                (long long)((l->lost_at_ns - l->last_hlc_ns) / 1000000), l->cmd);
+        break;
+    case LLC_END_FERROR:
+        fprintf(stderr, "cnc-axis %c: error: following error %.4f mm exceeds FERROR %.4f mm; "
+                        "ramped to a standstill\n", ax, l->fault_ferr, l->cfg->axis[l->axis].ferror);
+        break;
+    case LLC_END_SIGNAL:
+        fprintf(stderr, "cnc-axis %c: stopped by a signal; ramped to a standstill at %.4f mm\n",
+                ax, l->cmd);
+        return 128 + atomic_load(&l->signal);
+    }
+    return EXIT_FAULT;
+}
+
+int main(int argc, char **argv)
+{
+    struct opts o = { 0 };
+    if (parse(argc, argv, &o) != 0)
+        return usage(stderr), EXIT_USAGE;
+    static struct ncp_machine_cfg cfg;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    ncp_machine_cfg_default(&cfg);
+    if (ncp_machine_cfg_load(&cfg, o.config, &d) != NCP_OK) {
+        fprintf(stderr, "%s:%u: error: %s\n", o.config, d.line, d.msg);
+        return EXIT_USAGE;
+    }
+    struct llc *l = calloc(1, sizeof *l);
+    if (!l)
+        return EXIT_FAULT;
+    the_llc = l;
+    FILE *trace = NULL;
+    if (setup(l, &o, &cfg) != 0)
+        return EXIT_USAGE;
+    if (o.trace && !(trace = fopen(o.trace, "w"))) {
+        fprintf(stderr, "cnc-axis: cannot write %s: %s\n", o.trace, strerror(errno));
+        return EXIT_USAGE;
+    }
+    if (trace)
+        fputs("t,slot,cmd,act,state,gap\n", trace);
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    fprintf(stderr, "cnc-axis %c: waiting for the HLC\n", NCP_AXIS_LETTERS[o.axis]);
+    if (run_loop(l, trace) != 0)
+        l->end = LLC_END_SIGNAL;
+    int rc = report(l);
+    if (trace && fclose(trace) != 0)
+        fprintf(stderr, "cnc-axis: error writing %s\n", o.trace);
+    ncp_msg_close(l->msg);
+    return rc;
+}

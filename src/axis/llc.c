@@ -1,0 +1,297 @@
+/* The LLC's position loop: once per servo period, on the HLC's period grid.
+ *
+ * Until the HLC's first setpoint it advertises itself and holds the axis.
+ * Then it takes what arrived (non-blocking recv on the one UDP socket, at most
+ * 256 datagrams), plays the setpoint of the period NCP_DIST_PLAY_DELAY
+ * periods back (late datagrams are still on time), steps the simulated
+ * servo of its axis and publishes its status (every period: the HLC counts a
+ * period without one as lost). The only system calls are those recv/sendto
+ * with MSG_DONTWAIT on a socket set up before the loop, the vDSO's
+ * clock_gettime and the loop's clock_nanosleep: UDP sends to the loopback or a
+ * LAN interface do not block, and a full socket buffer is a counted send
+ * error, not a wait. A separate network thread would add a hand-off and a
+ * period of latency for nothing here.
+ *
+ * Safety: a setpoint never moves the axis faster than its MAX_VELOCITY (a
+ * step after a gap is limited and counted), and every stop is a ramp at
+ * MAX_ACCELERATION from the velocity the axis has, never a jump. */
+#include "axis.h"
+
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+int64_t llc_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+static void on_fine(struct llc *l, const uint8_t *p, size_t len)
+{
+    struct ncp_dist_fine f;
+    if (ncp_dist_decode_fine(p, len, &f) != 0 || f.n <= l->slot)
+        return;
+    (void)ncp_dist_rx_put(&l->rx, f.seq, f.t_ns, f.pos_nm[l->slot]);
+}
+
+static void on_hlc_heartbeat(struct llc *l, const uint8_t *p, size_t len, int64_t now)
+{
+    ncp_heartbeat_t h;
+    memset(&h, 0, sizeof h);
+    if (ncp_heartbeat_t_decode(p, 0, (int)len, &h) != (int)len || h.sender != NCP_DIST_HLC_ID)
+        return;
+    l->last_hlc_ns = now;
+    if (h.command == NCP_HEARTBEAT_T_COMMAND_DONE)
+        l->done_req = 1;
+    else if (h.command == NCP_HEARTBEAT_T_COMMAND_STOP && l->end == LLC_END_NONE) {
+        l->end = LLC_END_HLC_STOP;
+        l->hlc_axis = (char)h.axis;
+    }
+}
+
+/* Subscriptions, in the order wait.c makes them. */
+enum { SUB_FINE, SUB_HLC_HEARTBEAT };
+
+void llc_take(struct llc *l, int64_t now)
+{
+    int sub;
+    const uint8_t *p;
+    size_t len;
+    while (ncp_msg_take(l->msg, now, &sub, &p, &len) == 1) {
+        if (sub == SUB_FINE)
+            on_fine(l, p, len);
+        else if (sub == SUB_HLC_HEARTBEAT)
+            on_hlc_heartbeat(l, p, len, now);
+    }
+}
+
+static int32_t nm(double mm)
+{
+    int32_t v = 0;
+    (void)ncp_dist_mm_to_nm(mm, &v);
+    return v;
+}
+
+void llc_publish_status(struct llc *l, int64_t slot)
+{
+    ncp_ax_status_t s;
+    memset(&s, 0, sizeof s);
+    s.seq = l->seq++;
+    s.sender = (int16_t)(l->axis + 1);
+    s.t_ns = slot;
+    s.cmd_nm = nm(l->cmd);
+    s.act_nm = nm(l->act);
+    s.ferr_nm = nm(l->ferr);
+    s.state = (int8_t)l->state;
+    s.buffer_level = (int16_t)ncp_dist_rx_level(&l->rx, slot);
+    s.lost = (int32_t)l->rx.lost;
+    s.stale = (int32_t)l->rx.stale;
+    s.duplicate = (int32_t)l->rx.duplicate;
+    s.held = (int32_t)l->rx.held;
+    uint8_t buf[256];
+    int n = ncp_ax_status_t_encode(buf, 0, sizeof buf, &s);
+    if (n > 0)
+        (void)ncp_msg_publish(l->msg, l->ch_status, buf, (size_t)n);
+}
+
+void llc_heartbeat(struct llc *l, int64_t now)
+{
+    if (now - l->last_hb_ns < l->hb_period_ns)
+        return;
+    l->last_hb_ns = now;
+    ncp_heartbeat_t h = { l->seq++, (int16_t)(l->axis + 1), now, 0, 0, 0 };
+    uint8_t buf[64];
+    int n = ncp_heartbeat_t_encode(buf, 0, sizeof buf, &h);
+    if (n > 0)
+        (void)ncp_msg_publish(l->msg, l->ch_heartbeat, buf, (size_t)n);
+}
+
+void llc_advertise(struct llc *l)
+{
+    const struct ncp_axis_cfg *a = &l->cfg->axis[l->axis];
+    ncp_ax_advert_t m = { l->seq++,        (int16_t)(l->axis + 1),
+                          (uint8_t)NCP_AXIS_LETTERS[l->axis],
+                          a->min_limit,    a->max_limit,
+                          a->max_vel,      a->max_acc,
+                          a->max_jerk,     l->period_ns,
+                          1 << 5,          NCP_AX_ADVERT_T_STAGE_FINE };
+    uint8_t buf[128];
+    int n = ncp_ax_advert_t_encode(buf, 0, sizeof buf, &m);
+    if (n > 0)
+        (void)ncp_msg_publish(l->msg, l->ch_advert, buf, (size_t)n);
+}
+
+/* Running: the received setpoint, at most MAX_VELOCITY away from the last. */
+static double follow(struct llc *l, int64_t slot)
+{
+    const struct ncp_axis_cfg *a = &l->cfg->axis[l->axis];
+    double target = ncp_dist_nm_to_mm(ncp_dist_rx_play(&l->rx, slot));
+    if (l->rx.held != l->held_seen) {
+        /* a stream that stops with the axis at rest (the program's end, the
+         * HLC between jobs) is no loss: heartbeats watch the HLC then */
+        if (l->run_held++ == 0)
+            l->held_moving = l->cmd != l->cmd_prev;
+    } else {
+        l->run_held = 0;
+    }
+    l->held_seen = l->rx.held;
+    /* a setpoint at MAX_VELOCITY is no jump: 1 nm of rounding allowed */
+    double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9 + 1e-6;
+    if (fabs(step) > lim) {
+        step = copysign(lim, step);
+        l->clamped++;
+    }
+    return l->cmd + step;
+}
+
+/* Stopping: the velocity reduced by MAX_ACCELERATION each period. */
+static double ramp(struct llc *l)
+{
+    double T = (double)l->period_ns * 1e-9, v = (l->cmd - l->cmd_prev) / T;
+    double dv = l->cfg->axis[l->axis].max_acc * T;
+    v = fabs(v) <= dv ? 0.0 : v - copysign(dv, v);
+    return l->cmd + v * T;
+}
+
+static void check_ends(struct llc *l, int64_t now)
+{
+    if (l->end != LLC_END_NONE)
+        return;
+    if (atomic_load_explicit(&l->signal, memory_order_relaxed))
+        l->end = LLC_END_SIGNAL;
+    else if (now - l->last_hlc_ns > l->hb_timeout_ns)
+        l->end = LLC_END_HLC_SILENT;
+    else if (l->run_held > l->cfg->lcm.max_lost_periods && l->held_moving) {
+        l->end = LLC_END_LOST;
+        l->lost_at_ns = llc_now();
+    }
+    else if (fabs(l->ferr) > l->cfg->axis[l->axis].ferror) {
+        l->end = LLC_END_FERROR;
+        l->fault_ferr = l->ferr;
+    }
+}
+
+static void trace(struct llc *l, int64_t now, int64_t slot, int gap)
+{
+    if (!l->tracing)
+        return;
+    struct llc_row r = { now, slot, l->cmd, l->act, l->state, gap };
+    if (ncp_spsc_push(&l->trace_ring, &r) != 0)
+        l->trace_dropped++;
+}
+
+/* One period of the axis, slot being the HLC's period it plays. */
+static void period(struct llc *l, int64_t now, int64_t slot)
+{
+    int64_t T = l->period_ns;
+    check_ends(l, now);
+    double next_cmd;
+    uint32_t gaps = l->rx.held + l->rx.bridged, bridged = l->rx.bridged;
+    if (l->end == LLC_END_NONE && !l->done_req) {
+        l->state = NCP_AX_STATUS_T_RUNNING;
+        next_cmd = follow(l, slot);
+    } else {
+        l->state = l->end == LLC_END_NONE || l->end == LLC_END_DONE ? NCP_AX_STATUS_T_DONE
+                                                                    : NCP_AX_STATUS_T_STOPPING;
+        next_cmd = ramp(l);
+        l->rx.played_t = slot;
+    }
+    l->cmd_prev = l->cmd;
+    l->cmd = next_cmd;
+    double c[NCP_AXES] = { 0 }, x[NCP_AXES] = { 0 }, a[NCP_AXES];
+    c[l->axis] = l->cmd;
+    /* feed-forward wants the next period's setpoint: it is usually here
+     * already (within the velocity limit, as follow() will take it); else
+     * the current velocity goes on */
+    int32_t ahead;
+    double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
+    if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
+        x[l->axis] = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
+    else
+        x[l->axis] = 2 * l->cmd - l->cmd_prev;
+    ncp_sim_step(&l->sim, c, x, a);
+    l->act = a[l->axis];
+    l->ferr = l->cmd - l->act;
+    int gap = l->rx.held + l->rx.bridged == gaps ? 0 : l->rx.bridged != bridged ? 1 : 2;
+    trace(l, now, slot, gap);
+}
+
+#define ADVERT_PERIOD_NS 200000000LL   /* 5 a second until the HLC streams */
+#define WAIT_STATUS_PERIODS 10
+
+/* Before the HLC's first setpoint: advertise, heartbeat, report the axis at
+ * rest, hold the servo where it stands. 1 while waiting, 0 once the grid is
+ * known, -1 for an end before any motion. */
+static int waiting(struct llc *l, int64_t now)
+{
+    if (l->t_first)
+        return 0;
+    /* the oldest setpoint held names the HLC's period grid */
+    int64_t first = 0;
+    for (int i = 0; i < NCP_DIST_RX_SLOTS; i++)
+        if (l->rx.slot[i].t_ns && (!first || l->rx.slot[i].t_ns < first))
+            first = l->rx.slot[i].t_ns;
+    if (first) {
+        l->t_first = first;
+        if (l->last_hlc_ns == 0)
+            l->last_hlc_ns = now;
+        return 0;
+    }
+    if (now - l->last_adv_ns >= ADVERT_PERIOD_NS) {
+        l->last_adv_ns = now;
+        llc_advertise(l);
+    }
+    if (l->waits++ % WAIT_STATUS_PERIODS == 0)
+        llc_publish_status(l, 0);
+    llc_heartbeat(l, now);
+    if (atomic_load_explicit(&l->signal, memory_order_relaxed))
+        l->end = LLC_END_SIGNAL;
+    else if (l->last_hlc_ns && now - l->last_hlc_ns > l->hb_timeout_ns)
+        l->end = LLC_END_HLC_SILENT;
+    else if (l->done_req)
+        l->end = LLC_END_DONE;
+    if (l->end != LLC_END_NONE)
+        return -1;
+    double c[NCP_AXES] = { 0 }, a[NCP_AXES];
+    c[l->axis] = l->cmd;
+    ncp_sim_step(&l->sim, c, c, a);
+    l->act = a[l->axis];
+    l->ferr = l->cmd - l->act;
+    return 1;
+}
+
+int llc_cycle(void *ctx, int64_t now_ns)
+{
+    struct llc *l = ctx;
+    int64_t now = l->loop.cfg.start_ns + now_ns, T = l->period_ns;
+    llc_take(l, llc_now());
+    int w = waiting(l, now);
+    if (w)
+        return w < 0 ? NCP_RT_STOP : NCP_RT_CONTINUE;
+    /* the HLC's period NCP_DIST_PLAY_DELAY + 0..1 back: from the loop's
+     * scheduled time, not the clock, so a late wake-up never changes it */
+    int64_t slot = now - l->t_first - NCP_DIST_PLAY_DELAY * T - T / 2;
+    slot = l->t_first + (slot < 0 ? -((-slot + T - 1) / T) : slot / T) * T;
+    /* periods the loop slept through (a deadline miss) still passed for the
+     * simulated plant: it runs them now, a few at most */
+    int64_t from = l->rx.played_t ? l->rx.played_t + T : slot;
+    if (slot - from > 8 * T)
+        from = slot - 8 * T;
+    for (int64_t s = from; s <= slot; s += T)
+        period(l, now, s);
+    llc_publish_status(l, slot);
+    llc_heartbeat(l, now);
+    if (l->state != NCP_AX_STATUS_T_RUNNING && l->cmd == l->cmd_prev) {
+        /* at a standstill: a few periods for the servo to settle, then out */
+        if (l->done_req && l->end == LLC_END_NONE)
+            l->end = LLC_END_DONE;
+        if (++l->settle >= 50) {
+            l->state = l->end == LLC_END_DONE ? NCP_AX_STATUS_T_DONE : NCP_AX_STATUS_T_STOPPED;
+            llc_publish_status(l, slot);
+            return NCP_RT_STOP;
+        }
+    }
+    return NCP_RT_CONTINUE;
+}

@@ -1,0 +1,417 @@
+/* The distributed NCK's high-level end (seed 002): the position loop's
+ * setpoints go to one cnc-axis LLC per axis over LCM, and the actual positions
+ * come back in their statuses. Implemented: ADCBI DP5 (fineIPObuf, a message
+ * every servo period carrying every axis).
+ *
+ * start() (blocking): waits for every axis's advertisement and first status,
+ * checks its limits and period against the INI, and from then on a thread
+ * heartbeats until the loop takes over (live()).
+ * cycle() (the real-time path): one setpoint message out, the statuses and
+ * heartbeats in, all with MSG_DONTWAIT on the socket opened before (see
+ * src/axis/llc.c for why no network thread): no allocation, no lock.
+ * stop(): the heartbeat says done (or stop, after a fault) until every LLC
+ * still alive reports a standstill.
+ *
+ * The LLC reports the actual position of a period 1.5-2.5 periods back. The
+ * loop gets that position carried forward by what the HLC commanded since,
+ * so cmd - act is the LLC's own following error, not the transport's delay. */
+#include "ncpar/backend.h"
+#include "ncpar/dist.h"
+#include "ncpar/msg.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define HIST 64   /* setpoints remembered, periods: more than any status lags */
+#define STOP_WAIT_NS 3000000000LL
+
+struct peer {
+    int axis;
+    int sub_advert, sub_status, sub_hb;
+    int advertised, have_status;
+    ncp_ax_status_t st;          /* the last status */
+    int64_t last_status_ns, last_hb_ns;
+    int32_t last_seq;
+    int run_lost;                /* periods in a row without a status */
+    uint64_t statuses, lost, late;
+};
+
+struct lcm_be {
+    const struct ncp_machine_cfg *cfg;
+    struct ncp_msg *msg;
+    int n;
+    struct peer p[NCP_AXES];
+    int64_t T, t0, last_t, hb_period, hb_timeout, last_hb;
+    int32_t seq, fine_seq;   /* heartbeats', setpoints' (the LLCs count gaps in these) */
+    int cycles;
+    int64_t hist_t[HIST];
+    double hist_cmd[HIST][NCP_AXES];
+    char fault[200];
+    int faulted;
+    char fault_axis;
+    pthread_t idle;
+    atomic_int idle_run;
+    int idle_started;
+    uint64_t sent_fine;
+    int fine_bytes;
+};
+
+static int64_t mono(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+static void heartbeat(struct lcm_be *s, int command, char axis)
+{
+    ncp_heartbeat_t h = { s->seq++, NCP_DIST_HLC_ID, mono(), (int8_t)s->cfg->lcm.dp,
+                          (int8_t)command, (uint8_t)axis };
+    uint8_t buf[64];
+    int n = ncp_heartbeat_t_encode(buf, 0, sizeof buf, &h);
+    if (n > 0)
+        (void)ncp_msg_publish(s->msg, NCP_DIST_CH_HLC_HEARTBEAT, buf, (size_t)n);
+}
+
+static void on_status(struct peer *p, const uint8_t *b, size_t len, int64_t now)
+{
+    ncp_ax_status_t st;
+    memset(&st, 0, sizeof st);
+    if (ncp_ax_status_t_decode(b, 0, (int)len, &st) != (int)len || st.sender != p->axis + 1)
+        return;
+    if (p->have_status && st.seq - p->last_seq <= 0) {
+        p->late++;   /* a duplicate or an older one: the newer stands */
+        return;
+    }
+    p->st = st;
+    p->last_seq = st.seq;
+    p->have_status = 1;
+    p->last_status_ns = now;
+    p->last_hb_ns = now;   /* a status is as good a sign of life */
+    p->statuses++;
+}
+
+/* Everything waiting on the socket (bounded by the transport). */
+static void take(struct lcm_be *s, int64_t now)
+{
+    int sub;
+    const uint8_t *b;
+    size_t len;
+    while (ncp_msg_take(s->msg, now, &sub, &b, &len) == 1) {
+        for (int i = 0; i < s->n; i++) {
+            struct peer *p = &s->p[i];
+            if (sub == p->sub_status) {
+                on_status(p, b, len, now);
+            } else if (sub == p->sub_hb) {
+                p->last_hb_ns = now;
+            } else if (sub == p->sub_advert) {
+                ncp_ax_advert_t a;
+                memset(&a, 0, sizeof a);
+                if (ncp_ax_advert_t_decode(b, 0, (int)len, &a) != (int)len ||
+                    a.axis != (uint8_t)NCP_AXIS_LETTERS[p->axis])
+                    continue;
+                const struct ncp_axis_cfg *c = &s->cfg->axis[p->axis];
+                if (!p->advertised && !s->faulted &&
+                    (a.period_ns != s->T || a.max_vel < c->max_vel || a.max_acc < c->max_acc ||
+                     a.min_limit > c->min_limit || a.max_limit < c->max_limit ||
+                     !(a.dp_mask & (1 << s->cfg->lcm.dp)))) {
+                    snprintf(s->fault, sizeof s->fault,
+                             "axis %c's LLC does not fit the INI: period %lld ns, travel "
+                             "%.3f..%.3f mm, MAX_VELOCITY %.3f, MAX_ACCELERATION %.3f, DPs 0x%x "
+                             "(the INI: %lld ns, %.3f..%.3f, %.3f, %.3f, DP %d)",
+                             a.axis, (long long)a.period_ns, a.min_limit, a.max_limit, a.max_vel,
+                             a.max_acc, (unsigned)a.dp_mask, (long long)s->T, c->min_limit,
+                             c->max_limit, c->max_vel, c->max_acc, s->cfg->lcm.dp);
+                    s->faulted = 1;
+                }
+                p->advertised = 1;
+                p->last_hb_ns = now;
+            }
+        }
+    }
+}
+
+static void *idle_main(void *arg)
+{
+    struct lcm_be *s = arg;
+    while (atomic_load(&s->idle_run)) {
+        int64_t now = mono();
+        take(s, now);
+        if (now - s->last_hb >= s->hb_period) {
+            s->last_hb = now;
+            heartbeat(s, NCP_HEARTBEAT_T_COMMAND_RUN, 0);
+        }
+        struct timespec ts = { 0, 1000000 };
+        nanosleep(&ts, NULL);
+    }
+    return NULL;
+}
+
+static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
+{
+    struct lcm_be *s = b->impl;
+    int64_t start = mono(), deadline = start + s->cfg->lcm.axis_wait_ms * 1000000LL;
+    for (;;) {
+        int64_t now = mono();
+        take(s, now);
+        if (s->faulted)
+            return -1;
+        if (now - s->last_hb >= s->hb_period) {
+            s->last_hb = now;
+            heartbeat(s, NCP_HEARTBEAT_T_COMMAND_RUN, 0);
+        }
+        int ready = 0;
+        for (int i = 0; i < s->n; i++)
+            ready += s->p[i].advertised && s->p[i].have_status;
+        if (ready == s->n)
+            break;
+        if (now > deadline) {
+            char missing[40] = "";
+            for (int i = 0, k = 0; i < s->n; i++)
+                if (!(s->p[i].advertised && s->p[i].have_status)) {
+                    missing[k++] = NCP_AXIS_LETTERS[s->p[i].axis];
+                    missing[k++] = ' ';
+                    missing[k] = 0;
+                }
+            missing[strlen(missing) - 1] = 0;
+            snprintf(s->fault, sizeof s->fault,
+                     "no LLC answered for axis %s within %d ms ([LCM] AXIS_WAIT_MS): start "
+                     "`cnc-axis --axis L --config INI` for each, on the same LCM URL",
+                     missing, s->cfg->lcm.axis_wait_ms);
+            s->faulted = 1;
+            return -1;
+        }
+        struct timespec ts = { 0, 1000000 };
+        nanosleep(&ts, NULL);
+    }
+    for (int j = 0; j < NCP_AXES; j++)
+        pos[j] = 0;
+    for (int i = 0; i < s->n; i++)
+        pos[s->p[i].axis] = ncp_dist_nm_to_mm(s->p[i].st.act_nm);
+    atomic_store(&s->idle_run, 1);
+    s->idle_started = pthread_create(&s->idle, NULL, idle_main, s) == 0;
+    return 0;
+}
+
+static void idle_stop(struct lcm_be *s)
+{
+    if (!s->idle_started)
+        return;
+    atomic_store(&s->idle_run, 0);
+    pthread_join(s->idle, NULL);
+    s->idle_started = 0;
+}
+
+static void lcm_live(struct ncp_backend *b)
+{
+    idle_stop(b->impl);
+}
+
+static void fail(struct lcm_be *s, const struct peer *p, const char *why)
+{
+    if (s->faulted)
+        return;
+    s->faulted = 1;
+    s->fault_axis = NCP_AXIS_LETTERS[p->axis];
+    snprintf(s->fault, sizeof s->fault, "axis %c's LLC: %s", s->fault_axis, why);
+}
+
+static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_t now)
+{
+    char why[120];
+    if (p->statuses == before) {
+        p->lost++;
+        /* counted from the LLC's first period played (it starts its loop
+         * on the first setpoints; until then its heartbeat says it lives) */
+        if (p->st.t_ns > 0 && ++p->run_lost > s->cfg->lcm.max_lost_periods) {
+            snprintf(why, sizeof why, "no status for %d periods ([LCM] MAX_LOST_PERIODS %d)",
+                     p->run_lost, s->cfg->lcm.max_lost_periods);
+            fail(s, p, why);
+        }
+    } else {
+        p->run_lost = 0;
+    }
+    if (now - p->last_hb_ns > s->hb_timeout) {
+        snprintf(why, sizeof why, "heartbeat lost (silent for %lld ms)",
+                 (long long)((now - p->last_hb_ns) / 1000000));
+        fail(s, p, why);
+    } else if (p->st.state == NCP_AX_STATUS_T_STOPPING || p->st.state == NCP_AX_STATUS_T_STOPPED ||
+               p->st.state == NCP_AX_STATUS_T_FAULT) {
+        fail(s, p, "stopped on its own (lost setpoints, following error or a signal: see its "
+                   "output)");
+    }
+}
+
+static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const double next[NCP_AXES],
+                     double act[NCP_AXES])
+{
+    (void)next;
+    struct lcm_be *s = b->impl;
+    int64_t now = mono();
+    if (s->cycles == 0)
+        s->t0 = now;
+    /* this period on the grid the LLCs play by: the loop's absolute schedule
+     * wakes it up to a latency after the period's start (a later wake-up
+     * skips periods), so rounding down, with a tenth of a period for the
+     * clock read, names its period */
+    int64_t t = s->t0 + (now - s->t0 + s->T / 10) / s->T * s->T;
+    /* a wake-up a little late must not name the next period twice: the
+     * grid only jumps for periods the loop skipped */
+    if (s->cycles > 0 && t <= s->last_t + s->T)
+        t = s->last_t + s->T;
+    s->last_t = t;
+    struct ncp_dist_fine f = { s->fine_seq++, NCP_DIST_HLC_ID, t, (int8_t)s->n, { 0 } };
+    int bad = 0;
+    for (int i = 0; i < s->n; i++)
+        bad |= ncp_dist_mm_to_nm(cmd[s->p[i].axis], &f.pos_nm[i]);
+    unsigned h = (unsigned)((uint64_t)(t / s->T) % HIST);
+    s->hist_t[h] = t;
+    memcpy(s->hist_cmd[h], cmd, sizeof s->hist_cmd[h]);
+    uint8_t buf[128];
+    int n = bad ? -1 : ncp_dist_encode_fine(buf, sizeof buf, &f);
+    if (n > 0 && ncp_msg_publish(s->msg, NCP_DIST_CH_FINE, buf, (size_t)n) == 0) {
+        s->sent_fine++;
+        s->fine_bytes = n;
+    }
+    if (now - s->last_hb >= s->hb_period) {
+        s->last_hb = now;
+        heartbeat(s, NCP_HEARTBEAT_T_COMMAND_RUN, 0);
+    }
+    uint64_t before[NCP_AXES];
+    for (int i = 0; i < s->n; i++)
+        before[i] = s->p[i].statuses;
+    take(s, now);
+    s->cycles++;
+    for (int j = 0; j < NCP_AXES; j++)
+        act[j] = cmd[j];
+    for (int i = 0; i < s->n; i++) {
+        struct peer *p = &s->p[i];
+        check_peer(s, p, before[i], now);
+        int j = p->axis;
+        double a = ncp_dist_nm_to_mm(p->st.act_nm);
+        unsigned k = (unsigned)((uint64_t)(p->st.t_ns / s->T) % HIST);
+        /* its period's setpoint is remembered (it always is, unless the
+         * status is older than HIST periods): carried forward from there */
+        if (p->have_status && p->st.t_ns > 0 && s->hist_t[k] == p->st.t_ns)
+            act[j] = a + cmd[j] - s->hist_cmd[k][j];
+        else
+            act[j] = cmd[j] - ncp_dist_nm_to_mm(p->st.ferr_nm);
+    }
+    return s->faulted ? -1 : 0;
+}
+
+static void lcm_stop(struct ncp_backend *b)
+{
+    struct lcm_be *s = b->impl;
+    idle_stop(s);
+    int command = s->faulted ? NCP_HEARTBEAT_T_COMMAND_STOP : NCP_HEARTBEAT_T_COMMAND_DONE;
+    int64_t end = mono() + STOP_WAIT_NS;
+    for (;;) {
+        int64_t now = mono();
+        heartbeat(s, command, s->fault_axis);
+        take(s, now);
+        int busy = 0;
+        for (int i = 0; i < s->n; i++) {
+            const struct peer *p = &s->p[i];
+            int alive = now - p->last_hb_ns <= s->hb_timeout;
+            busy += alive && p->st.state != NCP_AX_STATUS_T_DONE &&
+                    p->st.state != NCP_AX_STATUS_T_STOPPED;
+        }
+        if (!busy || now > end)
+            break;
+        struct timespec ts = { 0, (long)s->hb_period };
+        nanosleep(&ts, NULL);
+    }
+    struct ncp_msg_stats st;
+    ncp_msg_get_stats(s->msg, &st);
+    fprintf(stderr, "lcm: DP %d: %llu setpoint messages of %d bytes (all %d axes; %d with the "
+                    "LCM header), %.0f per second\n",
+            s->cfg->lcm.dp, (unsigned long long)s->sent_fine, s->fine_bytes, s->n,
+            s->fine_bytes + 8 + (int)sizeof NCP_DIST_CH_FINE, 1e9 / (double)s->T);
+    for (int i = 0; i < s->n; i++) {
+        const struct peer *p = &s->p[i];
+        fprintf(stderr, "lcm: axis %c: %llu statuses, %llu periods without one, %llu late; "
+                        "its setpoints: lost %d, held %d, stale %d, duplicate %d\n",
+                NCP_AXIS_LETTERS[p->axis], (unsigned long long)p->statuses,
+                (unsigned long long)p->lost, (unsigned long long)p->late, p->st.lost,
+                p->st.held, p->st.stale, p->st.duplicate);
+    }
+    fprintf(stderr, "lcm: transport: sent %llu (%llu send errors), taken %llu, injected loss "
+                    "%llu, delayed %llu\n",
+            (unsigned long long)st.sent, (unsigned long long)st.send_errors,
+            (unsigned long long)st.taken, (unsigned long long)st.inject_lost,
+            (unsigned long long)st.inject_delayed);
+}
+
+static void lcm_describe(const struct ncp_backend *b, char *buf, size_t len)
+{
+    const struct lcm_be *s = b->impl;
+    snprintf(buf, len, "%s", s->fault);
+}
+
+static void lcm_close(struct ncp_backend *b)
+{
+    struct lcm_be *s = b->impl;
+    if (!s)
+        return;
+    idle_stop(s);
+    ncp_msg_close(s->msg);
+    free(s);
+    b->impl = NULL;
+}
+
+static const struct ncp_backend_ops lcm_ops = {
+    "lcm", lcm_start, lcm_cycle, lcm_stop, lcm_describe, lcm_close, NULL, lcm_live,
+};
+
+int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
+                         struct ncp_diag *d)
+{
+    if (cfg->lcm.dp != 5)
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
+                            "DP %d is not implemented yet: the lcm backend streams at DP 5 "
+                            "(ADCBI fineIPObuf) only", cfg->lcm.dp);
+    struct lcm_be *s = calloc(1, sizeof *s);
+    if (!s)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
+    s->cfg = cfg;
+    s->T = llround(cfg->servo_period * 1e9);
+    s->hb_period = cfg->lcm.heartbeat_period_ms * 1000000LL;
+    s->hb_timeout = cfg->lcm.heartbeat_timeout_ms * 1000000LL;
+    ncp_dist_init();
+    int rc = ncp_msg_open(&s->msg, cfg->lcm.url, NULL, d);
+    if (rc != NCP_OK) {
+        free(s);
+        return rc;
+    }
+    for (int j = 0; j < NCP_AXES; j++) {
+        if (!(cfg->axis_mask & NCP_AXIS_BIT(j)))
+            continue;
+        struct peer *p = &s->p[s->n++];
+        char ch[32];
+        p->axis = j;
+        ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_ADVERT);
+        p->sub_advert = ncp_msg_subscribe(s->msg, ch);
+        ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_STATUS);
+        p->sub_status = ncp_msg_subscribe(s->msg, ch);
+        ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_HEARTBEAT);
+        p->sub_hb = ncp_msg_subscribe(s->msg, ch);
+    }
+    struct ncp_msg_inject in = { cfg->lcm.inject_loss, cfg->lcm.inject_delay_us * 1000LL,
+                                 (uint64_t)cfg->lcm.inject_seed };
+    if (ncp_msg_set_inject(s->msg, &in) != 0) {
+        ncp_msg_close(s->msg);
+        free(s);
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
+    }
+    memset(b, 0, sizeof *b);
+    b->ops = &lcm_ops;
+    b->impl = s;
+    b->real_clock_only = 1;
+    return NCP_OK;
+}

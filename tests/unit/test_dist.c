@@ -1,0 +1,150 @@
+/* src/dist and the transport's injection switch: the setpoint codec against
+ * lcm-gen's own decoder, the LLC buffer's gap / duplicate / stale accounting,
+ * and the dice that lose messages (same seed, same losses). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <string.h>
+
+#include "ncpar/dist.h"
+#include "ncpar/msg.h"
+
+#define T 1000000LL /* 1 ms */
+
+static void fine_round_trip(void **state)
+{
+    (void)state;
+    ncp_dist_init();
+    struct ncp_dist_fine f = { 42, NCP_DIST_HLC_ID, 123456789000LL, 3, { -5, 2147483647, -2147483647 - 1 } };
+    uint8_t buf[256];
+    int n = ncp_dist_encode_fine(buf, sizeof buf, &f);
+    /* the payload of seed 002's fineIPObuf is 4N; ours adds fingerprint, seq, sender, period, n */
+    assert_int_equal(n, 8 + 4 + 2 + 8 + 1 + 4 * 3);
+    ncp_fine_ipo_t g;
+    memset(&g, 0, sizeof g);
+    assert_int_equal(ncp_fine_ipo_t_decode(buf, 0, n, &g), n);
+    assert_int_equal(g.seq, 42);
+    assert_int_equal(g.n, 3);
+    assert_int_equal(g.pos_nm[1], 2147483647);
+    ncp_fine_ipo_t_decode_cleanup(&g);
+    struct ncp_dist_fine h;
+    assert_int_equal(ncp_dist_decode_fine(buf, (size_t)n, &h), 0);
+    assert_memory_equal(&h.pos_nm, &f.pos_nm, 3 * sizeof(int32_t));
+    assert_true(h.t_ns == f.t_ns && h.sender == f.sender && h.seq == 42);
+    /* truncated, padded, wrong fingerprint, too many axes */
+    assert_int_equal(ncp_dist_decode_fine(buf, (size_t)n - 1, &h), -1);
+    assert_int_equal(ncp_dist_decode_fine(buf, (size_t)n + 1, &h), -1);
+    buf[0] ^= 1;
+    assert_int_equal(ncp_dist_decode_fine(buf, (size_t)n, &h), -1);
+    buf[0] ^= 1;
+    buf[22] = 10;
+    assert_int_equal(ncp_dist_decode_fine(buf, 23 + 40, &h), -1);
+}
+
+static void nm_range(void **state)
+{
+    (void)state;
+    int32_t nm = 0;
+    assert_int_equal(ncp_dist_mm_to_nm(1.0000004, &nm), 0);
+    assert_int_equal(nm, 1000000);
+    assert_int_equal(ncp_dist_mm_to_nm(-0.0000016, &nm), 0);
+    assert_int_equal(nm, -2);
+    assert_int_equal(ncp_dist_mm_to_nm(2200.0, &nm), -1);
+}
+
+static void rx_in_order(void **state)
+{
+    (void)state;
+    struct ncp_dist_rx r;
+    ncp_dist_rx_init(&r, T, 7);
+    assert_int_equal(ncp_dist_rx_play(&r, 1 * T), 7);   /* nothing yet: the start */
+    assert_int_equal(r.held, 0);
+    for (int k = 2; k < 10; k++)
+        assert_int_equal(ncp_dist_rx_put(&r, k, (int64_t)k * T, k * 100), NCP_DIST_RX_NEW);
+    assert_int_equal(ncp_dist_rx_level(&r, 1 * T), 8);
+    for (int k = 2; k < 10; k++)
+        assert_int_equal(ncp_dist_rx_play(&r, (int64_t)k * T), k * 100);
+    assert_int_equal(r.lost + r.stale + r.duplicate + r.held, 0);
+}
+
+static void rx_gap_held_and_counted(void **state)
+{
+    (void)state;
+    struct ncp_dist_rx r;
+    ncp_dist_rx_init(&r, T, 0);
+    ncp_dist_rx_put(&r, 1, 1 * T, 100);
+    ncp_dist_rx_put(&r, 4, 4 * T, 400);   /* 2 and 3 lost */
+    assert_int_equal(r.lost, 2);
+    assert_int_equal(ncp_dist_rx_play(&r, 1 * T), 100);
+    /* 2 is bridged on the way to 4 */
+    assert_int_equal(ncp_dist_rx_play(&r, 2 * T), 200);
+    assert_int_equal(r.bridged, 1);
+    /* 3 comes late but in time: not lost after all */
+    assert_int_equal(ncp_dist_rx_put(&r, 3, 3 * T, 300), NCP_DIST_RX_NEW);
+    assert_int_equal(r.lost, 1);
+    assert_int_equal(r.reordered, 1);
+    assert_int_equal(ncp_dist_rx_play(&r, 3 * T), 300);
+    assert_int_equal(ncp_dist_rx_play(&r, 4 * T), 400);
+    /* nothing after 4: 5 holds */
+    assert_int_equal(ncp_dist_rx_play(&r, 5 * T), 400);
+    assert_int_equal(r.held, 1);
+    /* 2 now: its period is past */
+    assert_int_equal(ncp_dist_rx_put(&r, 2, 2 * T, 200), NCP_DIST_RX_STALE);
+    assert_int_equal(r.stale, 1);
+}
+
+static void rx_duplicates_and_stale_ignored(void **state)
+{
+    (void)state;
+    struct ncp_dist_rx r;
+    ncp_dist_rx_init(&r, T, 0);
+    assert_int_equal(ncp_dist_rx_put(&r, 10, 10 * T, 1), NCP_DIST_RX_NEW);
+    assert_int_equal(ncp_dist_rx_put(&r, 10, 10 * T, 999), NCP_DIST_RX_DUPLICATE);
+    assert_int_equal(ncp_dist_rx_put(&r, 11, 10 * T, 999), NCP_DIST_RX_DUPLICATE);
+    assert_int_equal(ncp_dist_rx_play(&r, 10 * T), 1);
+    assert_int_equal(ncp_dist_rx_put(&r, 10, 10 * T, 999), NCP_DIST_RX_STALE);
+    assert_int_equal(ncp_dist_rx_put(&r, 3, 3 * T, 999), NCP_DIST_RX_STALE);
+    assert_int_equal(ncp_dist_rx_put(&r, 500, 500 * T, 999), NCP_DIST_RX_EARLY);
+    assert_int_equal(ncp_dist_rx_play(&r, 11 * T), 1);
+    assert_int_equal(r.duplicate, 2);
+    assert_int_equal(r.stale, 2);
+    assert_int_equal(r.lost, 0);
+}
+
+static void dice_same_seed_same_losses(void **state)
+{
+    (void)state;
+    struct ncp_msg_dice a, b, c;
+    ncp_msg_dice_seed(&a, 7);
+    ncp_msg_dice_seed(&b, 7);
+    ncp_msg_dice_seed(&c, 8);
+    int lost = 0, differ = 0;
+    for (int i = 0; i < 100000; i++) {
+        int x = ncp_msg_dice_drop(&a, 0.05), y = ncp_msg_dice_drop(&b, 0.05);
+        assert_int_equal(x, y);
+        differ += x != ncp_msg_dice_drop(&c, 0.05);
+        lost += x;
+    }
+    assert_in_range(lost, 4700, 5300);
+    assert_true(differ > 1000);
+    ncp_msg_dice_seed(&a, 1);
+    for (int i = 0; i < 1000; i++) {
+        assert_false(ncp_msg_dice_drop(&a, 0.0));
+        assert_true(ncp_msg_dice_drop(&a, 1.0));
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(fine_round_trip),
+        cmocka_unit_test(nm_range),
+        cmocka_unit_test(rx_in_order),
+        cmocka_unit_test(rx_gap_held_and_counted),
+        cmocka_unit_test(rx_duplicates_and_stale_ignored),
+        cmocka_unit_test(dice_same_seed_same_losses),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
