@@ -30,6 +30,7 @@ struct serve {
     uint64_t out_of_order, duplicates;
     int64_t status_seq, event_seq;
     int fault_seen;
+    const struct ncp_nck_serve_hook *hook;   /* another front end, or NULL */
 };
 
 static int64_t mono_ns(void)
@@ -101,6 +102,8 @@ static void send_status(struct serve *sv)
     m.deadline_misses = (int64_t)st.deadline_misses;
     m.latency_max_us = st.latency_max_us;
     ncp_msg_send_status(sv->msg, &m);
+    if (sv->hook && sv->hook->status)
+        sv->hook->status(sv->hook->ctx, &m);
     if (st.state == NCP_ST_FAULT)
         sv->fault_seen = 1;
 }
@@ -119,11 +122,20 @@ static void send_events(struct serve *sv)
         m.col = (int32_t)ev.col;
         snprintf((char *)m.text, sizeof m.text, "%s", ev.text);
         ncp_msg_send_event(sv->msg, &m);
+        if (sv->hook && sv->hook->event)
+            sv->hook->event(sv->hook->ctx, &m);
         if (ev.kind >= NCP_EV_ERROR)
             fprintf(stderr, "cnc-run serve: %s%s%s%s\n", ev.file[0] ? ev.file : "",
                     ev.file[0] ? ": " : "", ev.kind == NCP_EV_FAULT ? "fault: " : "error: ",
                     ev.text);
     }
+}
+
+static void send_ack(struct serve *sv, const ncp_ack_t *a)
+{
+    ncp_msg_send_ack(sv->msg, a);
+    if (sv->hook && sv->hook->ack)
+        sv->hook->ack(sv->hook->ctx, a);
 }
 
 static void on_command(void *ctx, const ncp_command_t *c)
@@ -144,7 +156,7 @@ static void on_command(void *ctx, const ncp_command_t *c)
     cl->last_ns = mono_ns();
     if (cl->seq && c->seq == cl->seq) {
         sv->duplicates++;
-        ncp_msg_send_ack(sv->msg, &cl->ack);
+        send_ack(sv, &cl->ack);
         return;
     }
     if (cl->seq && c->seq < cl->seq) {
@@ -179,7 +191,7 @@ static void on_command(void *ctx, const ncp_command_t *c)
     a->result = rc == 0 ? NCP_ACK_T_ACCEPTED : NCP_ACK_T_REJECTED;
     a->state = (int8_t)st.state;
     snprintf((char *)a->reason, sizeof a->reason, "%s", rc == 0 ? "" : why);
-    ncp_msg_send_ack(sv->msg, a);
+    send_ack(sv, a);
     send_status(sv);
 }
 
@@ -189,6 +201,7 @@ int ncp_nck_serve(struct ncp_nck *nck, const struct ncp_nck_serve_opts *o, struc
     if (!sv)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory"), -1;
     sv->nck = nck;
+    sv->hook = o->hook;
     const struct ncp_machine_cfg *cfg = nck->n.cfg;
     const char *url = o->url && *o->url ? o->url : cfg->lcm.url;
     const char *prefix = o->prefix && *o->prefix ? o->prefix : cfg->lcm.prefix;
@@ -218,6 +231,10 @@ int ncp_nck_serve(struct ncp_nck *nck, const struct ncp_nck_serve_opts *o, struc
             ncp_diag_set(d, NCP_ERR_IO, 0, 0, "LCM socket failed");
             break;
         }
+        /* the other front end's commands take the same path as LCM's */
+        ncp_command_t hc;
+        while (sv->hook && sv->hook->next_command && sv->hook->next_command(sv->hook->ctx, &hc))
+            on_command(sv, &hc);
         int changed = ncp_nck_poll(nck);
         send_events(sv);
         now = mono_ns();
