@@ -5,7 +5,8 @@
 WEB_SRCS := $(wildcard web/*.html web/*.css web/*.js)
 WEB_OUT  := $(WEB_SRCS:web/%=$(BUILD)/web/%)
 NPM_DIR  := $(BUILD)/npm
-THREE_JS := $(NPM_DIR)/node_modules/three/build/three.module.js
+THREE_DIR := $(NPM_DIR)/node_modules/three
+THREE_JS := $(THREE_DIR)/build/three.module.js
 
 all: $(WEB_OUT) $(BUILD)/web/vendor/.stamp
 
@@ -13,11 +14,13 @@ $(BUILD)/web/%: web/%
 	@mkdir -p $(@D)
 	$(Q)cp $< $@
 
-# three.module.js when present; the stamp notes whether it was
+# three.js and its orbit controls when installed, else neither (the stamp
+# is remade when they appear or change)
 $(BUILD)/web/vendor/.stamp: $(wildcard $(THREE_JS)) web/web.mk
 	@mkdir -p $(@D)
-	$(Q)if [ -f $(THREE_JS) ]; then cp $(THREE_JS) $(@D)/three.module.js; \
-	    else rm -f $(@D)/three.module.js; fi
+	$(Q)if [ -f $(THREE_JS) ]; then cp $(THREE_JS) $(@D)/three.module.js && \
+	    cp $(THREE_DIR)/examples/jsm/controls/OrbitControls.js $(@D)/; \
+	    else rm -f $(@D)/three.module.js $(@D)/OrbitControls.js; fi
 	$(Q)touch $@
 
 # npm packages of the panel and its browser test (web/package.json, locked),

@@ -68,6 +68,8 @@ static void usage(FILE *f)
           "SIGINT/SIGTERM: a controlled stop along the path, then shutdown.\n"
           "exit status: 0 ok, 1 usage or set-up, 3 a fault happened while serving\n",
           f);
+    if (!ncp_http_available())
+        fputs("(--http is missing: this cnc-run was built without libwebsockets)\n", f);
 }
 
 struct serve_args {
