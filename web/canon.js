@@ -1,19 +1,22 @@
 // The interpreter's canonical commands (`cnc-run parse --canon`, the text the
 // NCK runs) as line segments for the preview: feeds and arcs, rapids apart.
 // Coordinates are the program's work coordinates in mm (inch programs scaled).
-// Only the linear axes are drawn; rotary words are ignored.
+// Only the linear axes are drawn; rotary words are ignored. tlo says the tool
+// length offset the program uses with each tool, so that the machine's
+// position can be put on the drawing.
 
 const ARC_SEG_DEG = 5;   // one chord per 5 degrees: smooth at any zoom the panel offers
 
 function nums(line) {
   const open = line.indexOf('('), close = line.lastIndexOf(')');
-  return line.slice(open + 1, close).split(',').map((t) => parseFloat(t));
+  return line.slice(open + 1, close).split(/[ ,]+/).map((t) => parseFloat(t));
 }
 
 export function parseCanon(text) {
   const feed = [], rapid = [];
   let pos = null;            // unknown until the first move
-  let plane = 'XY', scale = 1;
+  let plane = 'XY', scale = 1, tool = 0;
+  const tlo = {};
   const min = [Infinity, Infinity, Infinity], max = [-Infinity, -Infinity, -Infinity];
   const errors = [];
   const push = (arr, a, b) => {
@@ -24,7 +27,11 @@ export function parseCanon(text) {
     if (line.includes(': error:')) { errors.push(line); continue; }
     const name = line.slice(0, line.indexOf('('));
     if (name === 'USE_LENGTH_UNITS') scale = line.includes('INCHES') ? 25.4 : line.includes('CM') ? 10 : 1;
-    else if (name === 'SELECT_PLANE') plane = line.includes('_YZ') ? 'YZ' : line.includes('_XZ') ? 'XZ' : 'XY';
+    else if (name === 'CHANGE_TOOL') tool = nums(line)[0];
+    else if (name === 'USE_TOOL_LENGTH_OFFSET') {
+      const v = nums(line).slice(0, 3).map((x) => x * scale);
+      if (v.some((x) => x !== 0) || !tlo[tool]) tlo[tool] = v;   // not the reset at the end
+    } else if (name === 'SELECT_PLANE') plane = line.includes('_YZ') ? 'YZ' : line.includes('_XZ') ? 'XZ' : 'XY';
     else if (name === 'STRAIGHT_TRAVERSE' || name === 'STRAIGHT_FEED' || name === 'STRAIGHT_PROBE') {
       const v = nums(line).slice(0, 3).map((x) => x * scale);
       if (pos) push(name === 'STRAIGHT_TRAVERSE' ? rapid : feed, pos, v);
@@ -33,7 +40,7 @@ export function parseCanon(text) {
       pos = arc(nums(line).map((x, i) => (i === 4 ? x : x * scale)), plane, pos, (a, b) => push(feed, a, b));
     }
   }
-  return { feed, rapid, min, max, errors };
+  return { feed, rapid, min, max, errors, tlo };
 }
 
 // rs274's ARC_FEED(first_end, second_end, first_axis, second_axis, rotation,

@@ -149,7 +149,7 @@ function onStatus(m) {
   }
   if (s.line !== ui.currentLine) highlight(s.line);
   preview.setTool(axes.map((a) => s.pos_act[a] - (off[a] || 0)), axes,
-                  ['running', 'stepping', 'paused', 'mdi', 'jogging', 'homing', 'stopping'].includes(s.state));
+                  ['running', 'stepping', 'paused', 'mdi', 'jogging', 'homing', 'stopping'].includes(s.state), s.tool);
   if (prev && prev.error !== s.error && s.error) log('error', s.error);
 }
 

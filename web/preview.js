@@ -17,8 +17,11 @@ export function createPreview(box, canvas2d) {
       state.trail = [];
       if (state.impl) state.impl.setPath(state.path);
     },
-    setTool(p, axes, moving) {
-      const xyz = [0, 1, 2].map((i) => (axes[i] ? p[i] : 0));
+    // p: work position (machine minus G5x) per axis; the tool's length
+    // offset as the program gives it, so that the tip meets the path
+    setTool(p, axes, moving, toolNo) {
+      const tlo = (state.path && state.path.tlo[toolNo]) || [0, 0, 0];
+      const xyz = [0, 1, 2].map((i) => (axes[i] ? p[i] - tlo[i] : 0));
       const last = state.trail[state.trail.length - 1];
       if (moving && (!last || Math.hypot(xyz[0] - last[0], xyz[1] - last[1], xyz[2] - last[2]) > 0.02)) {
         if (state.trail.length < TRAIL_MAX) state.trail.push(xyz);
