@@ -72,6 +72,7 @@ function threeView(THREE, OrbitControls, box, canvas2d, state) {
   scene.add(trail);
   let trailDrawn = 0;
 
+  let dirty = true, viewMoved = false, last = 0;
   function resize() {
     const w = box.clientWidth, h = box.clientHeight;
     renderer.setSize(w, h, false);
@@ -79,6 +80,7 @@ function threeView(THREE, OrbitControls, box, canvas2d, state) {
     renderer.domElement.style.height = '100%';
     camera.aspect = w / Math.max(1, h);
     camera.updateProjectionMatrix();
+    viewMoved = true;   // a resized canvas is blank until drawn again
   }
   new ResizeObserver(resize).observe(box);
   resize();
@@ -93,7 +95,6 @@ function threeView(THREE, OrbitControls, box, canvas2d, state) {
 
   // At most 20 frames a second for the moving tool: software WebGL on a small
   // panel PC would otherwise take the CPU the status and the DRO need.
-  let dirty = true, viewMoved = false, last = 0;
   function draw(now) {
     controls.update();
     if (viewMoved || (dirty && now - last >= 50)) {

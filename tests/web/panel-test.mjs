@@ -93,8 +93,9 @@ async function shot(page, name) {
 // The jog step radio: clicked, and checked before the jog that depends on it.
 async function setStep(page, v) {
   const sel = `input[name=jogstep][value="${v}"]`;
-  await page.click(sel);
-  await page.waitForFunction((s) => document.querySelector(s).checked, { timeout: 2000 }, sel);
+  // a DOM click: the 13 px radio is easily missed by a pointer on a starved page
+  await page.$eval(sel, (e) => e.click());
+  await page.waitForFunction((s) => document.querySelector(s).checked, { timeout: 5000 }, sel);
 }
 
 async function click(page, sel) {
