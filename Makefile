@@ -62,7 +62,7 @@ $(LIB): $(LIB_OBJS)
 	$(Q)rm -f $@ && $(AR) rcs $@ $^
 
 $(BUILD)/cnc-run: $(CLI_OBJS) $(LIB)
-	$(Q)$(CXX) $(ALL_CXXFLAGS) $(CLI_LDFLAGS) -o $@ $(CLI_OBJS) $(LIB) $(LDLIBS)
+	$(Q)$(CXX) $(ALL_CXXFLAGS) $(CLI_LDFLAGS) -o $@ $(CLI_OBJS) $(LIB) $(HTTP_LDLIBS) $(LDLIBS)
 
 # lcm-gen names each file after package and type (ncp_command_t.{c,h}), as
 # the .lcm files are named. It skips files newer than their .lcm, so the
@@ -117,8 +117,12 @@ deps:
 	DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
 	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev linuxcnc-uspace \
 	    liblcm-dev liblcm-bin \
-	    python3 python3-matplotlib valgrind cppcheck clang-tidy file podman
+	    python3 python3-matplotlib valgrind cppcheck clang-tidy file podman \
+	    libwebsockets-dev chromium
+	command -v npm >/dev/null || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	    --no-install-recommends nodejs npm
 	tools/rtvm/install-deps
+	$(MAKE) web-deps
 
 test: all unit test-can-host
 	$(Q)tests/run-tests $(BUILD)
@@ -128,6 +132,7 @@ clean:
 
 include tools/rtvm/rtvm.mk
 include bench/bench.mk
+include web/web.mk
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 

@@ -25,6 +25,7 @@
 #include "ncpar/analyzer.h"
 #include "ncpar/diag.h"
 #include "ncpar/motion.h"
+#include "ncpar/msg.h"
 #include "ncpar/pipeline.h"
 #include "ncpar/rt.h"
 
@@ -255,7 +256,20 @@ void ncp_nck_request_shutdown(struct ncp_nck *n);
 
 /* ---- on LCM (service.c; messages in lcm/, transport in src/msg/) ------------------- */
 
+/* A front end beside LCM (the browser panel, src/http/), called on the serving
+ * thread. Its commands go the LCM commands' way (resend and order checks per
+ * client_id and seq, the NCK, an ACK); it sees every ACK, STATUS and EVENT
+ * sent on LCM. The callbacks must not block: they run between polls of the NCK. */
+struct ncp_nck_serve_hook {
+    int (*next_command)(void *ctx, ncp_command_t *c);     /* 1: c is the next one */
+    void (*ack)(void *ctx, const ncp_ack_t *a);
+    void (*status)(void *ctx, const ncp_status_t *s);
+    void (*event)(void *ctx, const ncp_event_t *e);
+    void *ctx;
+};
+
 struct ncp_nck_serve_opts {
+    const struct ncp_nck_serve_hook *hook;  /* NULL: LCM only */
     const char *url, *prefix;        /* NULL or "": the INI's [LCM] URL / CHANNEL_PREFIX */
     int (*stop_requested)(void *ctx);/* polled: SIGINT/SIGTERM arrived */
     void (*ready)(void *ctx, const char *prefix); /* listening (may be NULL) */

@@ -8,9 +8,12 @@
 #include "machine.h"
 #include "signals.h"
 
+#include "ncpar/http.h"
 #include "ncpar/nck.h"
 
 #include <getopt.h>
+#include <libgen.h>
+#include <unistd.h>
 #include <signal.h>
 #include <errno.h>
 #include <limits.h>
@@ -46,6 +49,7 @@ static void usage(FILE *f)
           "                     [--clock real|virtual] [--trace CSV] [--mode serial|det|att]\n"
           "                     [--tool-table FILE] [--subroutine-path DIR[:DIR...]]\n"
           "                     [--inject SPEC[,SPEC...]] [--seed N]\n"
+          "                     [--http [ADDR:]PORT [--http-readonly] [--web DIR]]\n"
           "Runs the NCK as a service on the simulated machine: it holds the axes where they\n"
           "are and waits for commands on LCM (cnc-ctl is its command-line client).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill); [LCM] URL,\n"
@@ -63,14 +67,22 @@ static void usage(FILE *f)
           "  --trace CSV         per-cycle trace of the whole service life\n"
           "  --inject SPECS      timing faults in the position loop, as cnc-run run's;\n"
           "  --seed N            their seed\n"
+          "  --http [ADDR:]PORT  the operator's panel in a browser at http://ADDR:PORT/\n"
+          "                      (ADDR: numeric, default 127.0.0.1; [::1] for IPv6); the\n"
+          "                      URL printed at start carries the token commands need\n"
+          "  --http-readonly     the panel shows the status but takes no commands\n"
+          "  --web DIR           the panel's files (default: web/ beside cnc-run)\n"
           "SIGINT/SIGTERM: a controlled stop along the path, then shutdown.\n"
           "exit status: 0 ok, 1 usage or set-up, 3 a fault happened while serving\n",
           f);
+    if (!ncp_http_available())
+        fputs("(--http is missing: this cnc-run was built without libwebsockets)\n", f);
 }
 
 struct serve_args {
     const char *config, *url, *prefix, *trace, *tool_table, *sub_path, *inject, *seed;
-    int virtual_clock;
+    const char *http, *web;
+    int virtual_clock, http_readonly;
     enum ncp_thread_mode mode;
 };
 
@@ -83,7 +95,8 @@ static int parse(int argc, char **argv, struct serve_args *a)
         { "tool-table", required_argument, 0, 'T' },
         { "subroutine-path", required_argument, 0, 'S' }, { "help", no_argument, 0, 'h' },
         { "inject", required_argument, 0, 'I' }, { "seed", required_argument, 0, 'R' },
-        { 0, 0, 0, 0 },
+        { "http", required_argument, 0, 'H' }, { "http-readonly", no_argument, 0, 'O' },
+        { "web", required_argument, 0, 'W' }, { 0, 0, 0, 0 },
     };
     int c;
     optind = 1;
@@ -97,6 +110,9 @@ static int parse(int argc, char **argv, struct serve_args *a)
         case 'S': a->sub_path = optarg; break;
         case 'I': a->inject = optarg; break;
         case 'R': a->seed = optarg; break;
+        case 'H': a->http = optarg; break;
+        case 'O': a->http_readonly = 1; break;
+        case 'W': a->web = optarg; break;
         case 'k':
             if (strcmp(optarg, "real") != 0 && strcmp(optarg, "virtual") != 0)
                 return fprintf(stderr, "cnc-run serve: --clock is real or virtual\n"), -1;
@@ -112,6 +128,42 @@ static int parse(int argc, char **argv, struct serve_args *a)
     }
     if (optind != argc)
         return fprintf(stderr, "cnc-run serve: unexpected argument '%s'\n", argv[optind]), -1;
+    if ((a->http_readonly || a->web) && !a->http)
+        return fprintf(stderr, "cnc-run serve: --http-readonly and --web need --http\n"), -1;
+    return 0;
+}
+
+/* The panel's server, started before the NCK so that a port in use or a
+ * build without it is a usage error before any axis is powered. */
+static int start_http(const struct serve_args *a, struct ncp_http **out)
+{
+    static char exe[PATH_MAX], web[PATH_MAX];
+    struct ncp_http_opts ho = { .readonly = a->http_readonly };
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0)
+        return fprintf(stderr, "cnc-run serve: --http: cannot find cnc-run itself\n"), -1;
+    exe[n] = 0;
+    if (a->web) {
+        snprintf(web, sizeof web, "%s", a->web);
+    } else {
+        char dir[PATH_MAX];
+        snprintf(dir, sizeof dir, "%s", exe);
+        snprintf(web, sizeof web, "%s/web", dirname(dir));
+    }
+    char index[PATH_MAX + 16];
+    snprintf(index, sizeof index, "%s/index.html", web);
+    if (ncp_http_available() && access(index, R_OK) != 0)
+        return fprintf(stderr, "cnc-run serve: --http: no panel in %s (run make)\n", web), -1;
+    ho.web_root = web;
+    ho.self_exe = exe;
+    if (ncp_http_parse_listen(a->http, &ho, &d) || !(*out = ncp_http_start(&ho, &d)))
+        return fprintf(stderr, "cnc-run serve: %s\n", d.msg), -1;
+    const char *v6 = strchr(ho.addr, ':');
+    fprintf(stderr, "cnc-run serve: panel at http://%s%s%s:%d/?token=%s%s\n", v6 ? "[" : "",
+            ho.addr, v6 ? "]" : "", ho.port, ncp_http_token(*out),
+            a->http_readonly ? " (read-only)" : "");
     return 0;
 }
 
@@ -223,6 +275,13 @@ int ncp_cli_serve(int argc, char **argv)
         return SERVE_USAGE;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
+    struct ncp_http *http = NULL;
+    if (a.http && start_http(&a, &http)) {
+        for (int k = 0; k < n; k++)
+            close_trace(&chs[k]);
+        free(chs);
+        return SERVE_USAGE;
+    }
     ncp_cli_catch_stop_signals(on_signal);
     struct ncp_nck *ncks[NCP_NCK_CHANNELS_MAX];
     int nums[NCP_NCK_CHANNELS_MAX];
@@ -248,12 +307,26 @@ int ncp_cli_serve(int argc, char **argv)
             fprintf(stderr, "cnc-run serve: channel %d: %s\n", chs[made].num, chs[made].config);
     }
     if (rc == 0) {
-        struct ncp_nck_serve_opts so = { .url = a.url, .prefix = a.prefix,
+        struct ncp_nck_serve_opts so = { .hook = http ? ncp_http_hook(http) : NULL,
+                                         .url = a.url, .prefix = a.prefix,
                                          .stop_requested = stop_requested, .ready = ready };
         rc = ncp_nck_serve_channels(ncks, nums, n, &so, &d);
     }
     for (int k = 0; k < made; k++)
         ncp_nck_free(ncks[k]);
+    if (http) {
+        struct ncp_http_stats hs;
+        ncp_http_get_stats(http, &hs);
+        ncp_http_stop(http);
+        fprintf(stderr, "cnc-run serve: panel: %llu connections, %llu commands; refused: "
+                "%llu malformed, %llu unknown, %llu oversized, %llu flood, %llu without "
+                "token, %llu read-only, %llu busy\n",
+                (unsigned long long)hs.connections, (unsigned long long)hs.commands,
+                (unsigned long long)hs.bad_json, (unsigned long long)hs.unknown,
+                (unsigned long long)hs.oversized, (unsigned long long)hs.flood,
+                (unsigned long long)hs.no_token, (unsigned long long)hs.readonly,
+                (unsigned long long)hs.busy);
+    }
     for (int k = 0; k < n; k++)
         if (close_trace(&chs[k]) != 0 && rc == 0)
             rc = 1;

@@ -38,6 +38,7 @@ struct serve {
     uint64_t out_of_order, duplicates;
     int64_t status_seq, event_seq;
     int fault_seen;
+    const struct ncp_nck_serve_hook *hook;   /* another front end, or NULL */
 };
 
 static int64_t mono_ns(void)
@@ -118,6 +119,8 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.deadline_misses = (int64_t)st.deadline_misses;
     m.latency_max_us = st.latency_max_us;
     ncp_msg_send_status(sv->msg, &m);
+    if (sv->hook && sv->hook->status)
+        sv->hook->status(sv->hook->ctx, &m);
     if (st.state == NCP_ST_FAULT)
         sv->fault_seen = 1;
 }
@@ -137,6 +140,8 @@ static void send_events(struct serve *sv, const struct serve_channel *ch)
         m.col = (int32_t)ev.col;
         snprintf((char *)m.text, sizeof m.text, "%s", ev.text);
         ncp_msg_send_event(sv->msg, &m);
+        if (sv->hook && sv->hook->event)
+            sv->hook->event(sv->hook->ctx, &m);
         char who[16] = "";
         if (sv->n_ch > 1)
             snprintf(who, sizeof who, "ch%d: ", ch->num);
@@ -145,6 +150,13 @@ static void send_events(struct serve *sv, const struct serve_channel *ch)
                     ev.file[0] ? ": " : "", ev.kind == NCP_EV_FAULT ? "fault: " : "error: ",
                     ev.text);
     }
+}
+
+static void send_ack(struct serve *sv, const ncp_ack_t *a)
+{
+    ncp_msg_send_ack(sv->msg, a);
+    if (sv->hook && sv->hook->ack)
+        sv->hook->ack(sv->hook->ctx, a);
 }
 
 /* A command for a channel this service does not have: refused, so that a
@@ -165,7 +177,7 @@ static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *
     }
     snprintf((char *)a->reason, sizeof a->reason, "no NC channel %d here (channels: %s)",
              c->channel, list);
-    ncp_msg_send_ack(sv->msg, a);
+    send_ack(sv, a);
 }
 
 static void on_command(void *ctx, const ncp_command_t *c)
@@ -187,7 +199,7 @@ static void on_command(void *ctx, const ncp_command_t *c)
     cl->last_ns = mono_ns();
     if (cl->seq && c->seq == cl->seq) {
         sv->duplicates++;
-        ncp_msg_send_ack(sv->msg, &cl->ack);
+        send_ack(sv, &cl->ack);
         return;
     }
     if (cl->seq && c->seq < cl->seq) {
@@ -227,7 +239,7 @@ static void on_command(void *ctx, const ncp_command_t *c)
     a->result = rc == 0 ? NCP_ACK_T_ACCEPTED : NCP_ACK_T_REJECTED;
     a->state = (int8_t)st.state;
     snprintf((char *)a->reason, sizeof a->reason, "%s", rc == 0 ? "" : why);
-    ncp_msg_send_ack(sv->msg, a);
+    send_ack(sv, a);
     send_status(sv, ch);
 }
 
@@ -262,6 +274,7 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
     for (int k = 0; k < n; k++)
         sv->ch[k] = (struct serve_channel){ ncks[k], nums[k], 0 };
     sv->n_ch = n;
+    sv->hook = o->hook;
     /* the transport is one for all: the first channel's machine INI says where */
     const struct ncp_machine_cfg *cfg = ncks[0]->n.cfg;
     const char *url = o->url && *o->url ? o->url : cfg->lcm.url;
@@ -293,6 +306,10 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
             ncp_diag_set(d, NCP_ERR_IO, 0, 0, "LCM socket failed");
             break;
         }
+        /* the other front end's commands take the same path as LCM's */
+        ncp_command_t hc;
+        while (sv->hook && sv->hook->next_command && sv->hook->next_command(sv->hook->ctx, &hc))
+            on_command(sv, &hc);
         now = mono_ns();
         int due = now >= next_status;
         for (int k = 0; k < n; k++) {

@@ -1,0 +1,139 @@
+/* src/http's pure parts: the browser's JSON messages into LCM commands (and
+ * everything that must be refused), JSON string output, --http's argument. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ncpar/http.h"
+
+static enum ncp_http_req parse(const char *json, ncp_command_t *c, int *unknown, char *why)
+{
+    return ncp_http_parse_request(json, strlen(json), 0x57000001, c, unknown, why, 128);
+}
+
+static void commands_map_onto_the_lcm_type(void **state)
+{
+    (void)state;
+    ncp_command_t c;
+    int unknown;
+    char why[128];
+    assert_int_equal(parse("{\"cmd\": \"jog\", \"axis\": \"X\", \"dir\": -1, \"speed\": 300, "
+                           "\"dist\": 0.1, \"seq\": 9}", &c, &unknown, why),
+                     NCP_HTTP_REQ_COMMAND);
+    assert_int_equal(c.kind, NCP_COMMAND_T_JOG);
+    assert_string_equal((char *)c.text, "X");
+    assert_int_equal(c.ivalue[0], -1);
+    assert_true(c.value[0] == 300.0 && c.value[1] == 0.1);
+    assert_int_equal(c.seq, 9);
+    assert_int_equal(c.client_id, 0x57000001);
+
+    assert_int_equal(parse("{\"cmd\":\"mdi\",\"text\":\"G0 X10 (\\u00e9\\\"q\\\")\",\"seq\":1}",
+                           &c, &unknown, why), NCP_HTTP_REQ_COMMAND);
+    assert_string_equal((char *)c.text, "G0 X10 (\xc3\xa9\"q\")");
+
+    assert_int_equal(parse("{\"cmd\":\"override\",\"which\":\"spindle\",\"value\":80,\"seq\":2}",
+                           &c, &unknown, why), NCP_HTTP_REQ_COMMAND);
+    assert_int_equal(c.kind, NCP_COMMAND_T_OVERRIDE);
+    assert_int_equal(c.ivalue[0], 2);
+    assert_true(c.value[0] == 80.0);
+
+    assert_int_equal(parse("{\"cmd\":\"home\",\"seq\":3}", &c, &unknown, why),
+                     NCP_HTTP_REQ_COMMAND);
+    assert_string_equal((char *)c.text, "all");
+    assert_int_equal(parse("{\"cmd\":\"step\",\"on\":true,\"seq\":4}", &c, &unknown, why),
+                     NCP_HTTP_REQ_COMMAND);
+    assert_int_equal(c.ivalue[0], 1);
+    /* a keep-alive has no ack, so no seq */
+    assert_int_equal(parse("{\"cmd\":\"keepalive\"}", &c, &unknown, why), NCP_HTTP_REQ_COMMAND);
+    assert_int_equal(parse(" {\"cmd\":\"preview\"} ", &c, &unknown, why), NCP_HTTP_REQ_PREVIEW);
+    assert_int_equal(parse("{\"cmd\":\"list\"}", &c, &unknown, why), NCP_HTTP_REQ_LIST);
+}
+
+static void bad_messages_are_refused(void **state)
+{
+    (void)state;
+    static const char *const bad[] = {
+        "", "{", "}", "[]", "null", "{\"cmd\":\"run\",\"seq\":1", "{\"cmd\":\"run\",\"seq\":1}x",
+        "{\"cmd\":\"run\",\"seq\":1,}", "{'cmd':'run'}", "{\"cmd\":\"run\"}",
+        "{\"cmd\":\"run\",\"seq\":0}", "{\"cmd\":\"run\",\"seq\":1.5}",
+        "{\"cmd\":\"run\",\"seq\":1e12}", "{\"cmd\":\"run\",\"seq\":\"1\"}",
+        "{\"cmd\":\"run\",\"seq\":1,\"seq\":2}", "{\"cmd\":\"run\",\"seq\":1,\"x\":{}}",
+        "{\"cmd\":\"run\",\"seq\":1,\"line\":[1]}", "{\"cmd\":\"run\",\"seq\":1,\"speed\":5}",
+        "{\"cmd\":\"mdi\",\"text\":\"G0\\u0000\",\"seq\":1}", "{\"cmd\":\"mdi\",\"text\":5,\"seq\":1}",
+        "{\"cmd\":\"jog\",\"axis\":\"X\",\"speed\":1e999,\"seq\":1}",
+        "{\"cmd\":\"jog\",\"axis\":\"X\",\"speed\":NaN,\"seq\":1}",
+        "{\"cmd\":\"override\",\"which\":\"coolant\",\"value\":5,\"seq\":1}",
+        "{\"cmd\":\"mdi\",\"text\":\"\\ud800\",\"seq\":1}", "{\"cmd\":\"mdi\",\"text\":\"a\nb\",\"seq\":1}",
+        "{\"cmd\":\"shutdown\",\"seq\":1}", "{\"cmd\":\"nonsense\",\"seq\":1}", "{\"cmd\":7}",
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        ncp_command_t c;
+        int unknown;
+        char why[128] = "";
+        if (parse(bad[i], &c, &unknown, why) != NCP_HTTP_REQ_BAD)
+            fail_msg("taken: %s", bad[i]);
+        assert_true(why[0] != 0);
+    }
+    ncp_command_t c;
+    int unknown;
+    char why[128];
+    parse("{\"cmd\":\"shutdown\",\"seq\":1}", &c, &unknown, why);
+    assert_int_equal(unknown, 1);
+    parse("{\"cmd\":\"run\",\"seq\":1,}", &c, &unknown, why);
+    assert_int_equal(unknown, 0);
+    /* a text longer than the command's field */
+    char big[700];
+    int n = snprintf(big, sizeof big, "{\"cmd\":\"mdi\",\"seq\":1,\"text\":\"");
+    memset(big + n, 'G', 600);
+    snprintf(big + n + 600, sizeof big - (size_t)n - 600, "\"}");
+    assert_int_equal(parse(big, &c, &unknown, why), NCP_HTTP_REQ_BAD);
+}
+
+static void json_strings_are_escaped(void **state)
+{
+    (void)state;
+    char buf[64];
+    size_t len = 0;
+    assert_int_equal(ncp_http_json_string(buf, sizeof buf, &len, "a\"b\\c\nd\x01", 8), 0);
+    assert_string_equal(buf, "\"a\\\"b\\\\c\\nd\\u0001\"");
+    len = 0;
+    assert_int_equal(ncp_http_json_string(buf, 8, &len, "0123456789", 10), -1);
+    assert_true(len < 8);
+}
+
+static void listen_spec(void **state)
+{
+    (void)state;
+    struct ncp_http_opts o;
+    struct ncp_diag d;
+    memset(&o, 0, sizeof o);
+    assert_int_equal(ncp_http_parse_listen("8080", &o, &d), 0);
+    assert_string_equal(o.addr, "127.0.0.1");
+    assert_int_equal(o.port, 8080);
+    assert_int_equal(ncp_http_parse_listen("0.0.0.0:80", &o, &d), 0);
+    assert_string_equal(o.addr, "0.0.0.0");
+    assert_int_equal(ncp_http_parse_listen("[::1]:9000", &o, &d), 0);
+    assert_string_equal(o.addr, "::1");
+    assert_int_equal(o.port, 9000);
+    static const char *const bad[] = { "", "0", "65536", "x", "localhost:80", ":80",
+                                       "1.2.3.4:", "1.2.3.4:80x", "[::1]", "300.1.1.1:80" };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+        if (ncp_http_parse_listen(bad[i], &o, &d) == 0)
+            fail_msg("taken: '%s'", bad[i]);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(commands_map_onto_the_lcm_type),
+        cmocka_unit_test(bad_messages_are_refused),
+        cmocka_unit_test(json_strings_are_escaped),
+        cmocka_unit_test(listen_spec),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,299 @@
+// The operator's panel: one WebSocket to the NCK (status, events, acks in;
+// commands out), the DRO, program view, controls and the log. Everything the
+// NCK decides (states, refusals) comes back from it: the panel never guesses.
+import { createPreview } from './preview.js';
+
+const $ = (id) => document.getElementById(id);
+const params = new URLSearchParams(location.search);
+const token = params.get('token') || '';
+
+const ui = {
+  ws: null, seq: 0, status: null, authed: false, readonly: false,
+  program: '', programLines: [], currentLine: 0, selectedLine: 0,
+  mdiHistory: [], mdiIndex: -1, jogTimer: null, jogAxis: null,
+  lag: [],           // [seq, NCK utime (us), receive time (us)] for the test and the title
+};
+window.ncpPanel = ui;  // for tests and the curious: read-only use
+
+const preview = createPreview($('preview'), $('preview-2d'));
+
+// ---- log ------------------------------------------------------------------------------
+function log(kind, text) {
+  const el = document.createElement('div');
+  el.className = kind;
+  const t = new Date().toTimeString().slice(0, 8);
+  el.textContent = `${t} ${kind.padEnd(7)} ${text}`;
+  const box = $('log');
+  box.appendChild(el);
+  while (box.childNodes.length > 500) box.removeChild(box.firstChild);
+  box.scrollTop = box.scrollHeight;
+}
+
+// ---- connection ---------------------------------------------------------------------------
+function setOnline(up) {
+  document.body.classList.toggle('offline', !up);
+  $('conn').textContent = up ? (ui.authed ? (ui.readonly ? 'read-only' : 'connected') : 'watching (no token)') : 'disconnected';
+  $('conn').classList.toggle('up', up);
+  const canCommand = up && ui.authed && !ui.readonly;
+  for (const el of document.querySelectorAll('button, input, select')) el.disabled = !canCommand;
+  if (!up) stopJog();
+}
+
+function connect() {
+  const proto = location.protocol === 'https:' ? 'wss:' : 'ws:';
+  const url = `${proto}//${location.host}/ws${token ? '?token=' + encodeURIComponent(token) : ''}`;
+  const ws = new WebSocket(url, 'ncp-panel');
+  ui.ws = ws;
+  ws.onmessage = (m) => onMessage(m.data);
+  ws.onclose = () => {
+    if (ui.ws === ws) {
+      if (!document.body.classList.contains('offline')) log('fault', 'connection to the NCK lost');
+      setOnline(false);
+      setTimeout(connect, 1000);
+    }
+  };
+  // a stalled link shows as lost too: the status comes at least every 20 ms
+  ws.onerror = () => {};
+}
+setInterval(() => {
+  if (ui.ws && ui.ws.readyState === WebSocket.OPEN && ui.lastRecv && performance.now() - ui.lastRecv > 2000) {
+    log('fault', 'no status for 2 s: reconnecting');
+    ui.ws.close();
+  }
+}, 500);
+
+function send(obj) {
+  if (!ui.ws || ui.ws.readyState !== WebSocket.OPEN) return 0;
+  if (obj.cmd !== 'keepalive' && !['list', 'program', 'preview'].includes(obj.cmd)) obj.seq = ++ui.seq;
+  ui.ws.send(JSON.stringify(obj));
+  return obj.seq || 0;
+}
+
+function onMessage(text) {
+  ui.lastRecv = performance.now();
+  let m;
+  try { m = JSON.parse(text); } catch { return; }
+  switch (m.type) {
+    case 'hello':
+      ui.authed = m.authed; ui.readonly = m.readonly;
+      setOnline(true);
+      log('info', m.authed ? (m.readonly ? 'connected, read-only' : 'connected') : 'connected without a valid token: watching only');
+      if (m.authed) send({ cmd: 'list' });
+      break;
+    case 'status': onStatus(m); break;
+    case 'ack':
+      if (m.result !== 'accepted') log('rejected', `#${m.seq}: ${m.reason}`);
+      break;
+    case 'refused': log('refused', (m.seq ? `#${m.seq}: ` : '') + m.reason); break;
+    case 'event': {
+      const where = m.file ? `${m.file}${m.line ? ':' + m.line : ''}${m.col ? ':' + m.col : ''}: ` : '';
+      log(m.kind, where + m.text);
+      break;
+    }
+    case 'list': fillFiles(m.files); break;
+    case 'program': showProgram(m.path, m.text); break;
+    case 'preview': preview.setCanon(m.canon); break;
+  }
+}
+
+// ---- status -> DRO, program line, preview ---------------------------------------------
+const fmt = (v, d = 3) => (v === null || v === undefined ? '—' : Number(v).toFixed(d));
+
+function onStatus(m) {
+  const recvUs = (performance.timeOrigin + performance.now()) * 1000;
+  ui.lag.push([m.status.seq, m.utime, recvUs]);
+  if (ui.lag.length > 5000) ui.lag.splice(0, 1000);
+  const s = m.status;
+  const prev = ui.status;
+  ui.status = s;
+  ui.http = m.http;
+  $('state').textContent = s.state || '?';
+  $('state').className = 'state ' + (s.state || '');
+  $('prog-name').textContent = s.program || '';
+  const body = $('dro').tBodies[0];
+  const axes = Object.keys(s.pos_cmd);
+  if (body.rows.length !== axes.length) {
+    body.innerHTML = '';
+    for (const a of axes) {
+      const r = body.insertRow();
+      r.innerHTML = `<td class="axis">${a.toUpperCase()}</td><td class="work"></td><td></td><td></td><td></td>`;
+    }
+    buildJog(axes);
+  }
+  const off = (s.g5x && s.g5x.offset) || {};
+  axes.forEach((a, i) => {
+    const c = body.rows[i].cells;
+    c[0].classList.toggle('unhomed', !s.homed[a]);
+    c[0].title = s.homed[a] ? 'homed' : 'not homed';
+    c[1].textContent = fmt(s.pos_act[a] - (off[a] || 0));
+    c[2].textContent = fmt(s.pos_cmd[a]);
+    c[3].textContent = fmt(s.pos_act[a]);
+    c[4].textContent = fmt(s.pos_cmd[a] - s.pos_act[a], 4);
+  });
+  $('line').textContent = s.line || '—';
+  $('vel').textContent = `${fmt(s.vel, 0)} mm/min`;
+  $('spindle').textContent = `${fmt(s.spindle.speed, 0)} rpm ${s.spindle.dir > 0 ? 'CW' : s.spindle.dir < 0 ? 'CCW' : 'stopped'}`;
+  $('tool').textContent = `T${s.tool}`;
+  $('g5x').textContent = (s.g5x && s.g5x.name) || '—';
+  $('coolant').textContent = [s.coolant.mist && 'mist', s.coolant.flood && 'flood'].filter(Boolean).join(', ') || 'off';
+  $('stepmode').textContent = s.step ? 'on' : 'off';
+  if (document.activeElement !== $('step')) $('step').checked = !!s.step;
+  for (const w of ['feed', 'rapid', 'spindle']) {
+    const el = $('ov-' + w);
+    if (document.activeElement !== el && !el.dragging) el.value = s[w + '_override'];
+    $('ov-' + w + '-v').textContent = `${Math.round(s[w + '_override'])} %`;
+  }
+  if (!prev || prev.program !== s.program) {
+    if (s.program && ui.authed) { send({ cmd: 'program' }); send({ cmd: 'preview' }); }
+    else if (!s.program) { showProgram('', ''); preview.setCanon(''); }
+  }
+  if (s.line !== ui.currentLine) highlight(s.line);
+  preview.setTool(axes.map((a) => s.pos_act[a] - (off[a] || 0)), axes,
+                  ['running', 'stepping', 'paused', 'mdi', 'jogging', 'homing', 'stopping'].includes(s.state), s.tool);
+  if (prev && prev.error !== s.error && s.error) log('error', s.error);
+}
+
+// ---- program ------------------------------------------------------------------------------
+function showProgram(path, text) {
+  const box = $('program');
+  box.innerHTML = '';
+  ui.programLines = [];
+  const frag = document.createDocumentFragment();
+  text.split('\n').forEach((line, i) => {
+    const el = document.createElement('div');
+    el.textContent = line || ' ';
+    el.dataset.line = i + 1;
+    frag.appendChild(el);
+    ui.programLines.push(el);
+  });
+  box.appendChild(frag);
+  ui.currentLine = 0;
+  if (ui.status) highlight(ui.status.line);
+}
+
+function highlight(line) {
+  const old = ui.programLines[ui.currentLine - 1];
+  if (old) old.classList.remove('current');
+  ui.currentLine = line;
+  const el = ui.programLines[line - 1];
+  if (el) {
+    el.classList.add('current');
+    const box = $('program');
+    const top = el.offsetTop - box.offsetTop;
+    if (top < box.scrollTop || top > box.scrollTop + box.clientHeight - 20)
+      box.scrollTop = top - box.clientHeight / 3;
+  }
+}
+
+$('program').addEventListener('click', (e) => {
+  const el = e.target.closest('div[data-line]');
+  if (!el) return;
+  const old = ui.programLines[ui.selectedLine - 1];
+  if (old) old.classList.remove('selected');
+  ui.selectedLine = Number(el.dataset.line);
+  el.classList.add('selected');
+  $('sel-line').textContent = ui.selectedLine;
+});
+
+function fillFiles(files) {
+  const sel = $('files');
+  const keep = sel.value;
+  sel.innerHTML = '';
+  for (const f of files) {
+    const o = document.createElement('option');
+    o.value = o.textContent = f;
+    sel.appendChild(o);
+  }
+  if (files.includes(keep)) sel.value = keep;
+  else if (files.includes('demo.ngc')) sel.value = 'demo.ngc';
+}
+
+// ---- controls ----------------------------------------------------------------------------
+for (const el of document.querySelectorAll('[data-cmd]'))
+  el.addEventListener('click', () => send({ cmd: el.dataset.cmd }));
+$('load').addEventListener('click', () => { if ($('files').value) send({ cmd: 'load', path: $('files').value }); });
+$('run').addEventListener('click', () => send({ cmd: 'run' }));
+$('run-from').addEventListener('click', () => { if (ui.selectedLine) send({ cmd: 'run', line: ui.selectedLine }); });
+$('step').addEventListener('change', () => send({ cmd: 'step', on: $('step').checked ? 1 : 0 }));
+
+for (const w of ['feed', 'rapid', 'spindle']) {
+  const el = $('ov-' + w);
+  el.addEventListener('pointerdown', () => { el.dragging = true; });
+  el.addEventListener('pointerup', () => { el.dragging = false; });
+  el.addEventListener('input', () => { $('ov-' + w + '-v').textContent = `${el.value} %`; });
+  el.addEventListener('change', () => send({ cmd: 'override', which: w, value: Number(el.value) }));
+}
+
+$('mdi-form').addEventListener('submit', (e) => {
+  e.preventDefault();
+  const text = $('mdi').value.trim();
+  if (!text) return;
+  send({ cmd: 'mdi', text });
+  ui.mdiHistory = [text, ...ui.mdiHistory.filter((t) => t !== text)].slice(0, 50);
+  ui.mdiIndex = -1;
+  $('mdi').value = '';
+  const ol = $('mdi-history');
+  ol.innerHTML = '';
+  for (const t of ui.mdiHistory) {
+    const li = document.createElement('li');
+    li.textContent = t;
+    li.addEventListener('click', () => { $('mdi').value = t; $('mdi').focus(); });
+    ol.appendChild(li);
+  }
+});
+$('mdi').addEventListener('keydown', (e) => {
+  if (e.key !== 'ArrowUp' && e.key !== 'ArrowDown') return;
+  e.preventDefault();
+  ui.mdiIndex = Math.max(-1, Math.min(ui.mdiHistory.length - 1, ui.mdiIndex + (e.key === 'ArrowUp' ? 1 : -1)));
+  $('mdi').value = ui.mdiIndex < 0 ? '' : ui.mdiHistory[ui.mdiIndex];
+});
+
+// ---- jogging: steps, or continuous while held with a keep-alive ------------------------------
+const jogStep = () => Number(document.querySelector('input[name=jogstep]:checked').value);
+
+function startJog(axis, dir) {
+  const step = jogStep();
+  if (step > 0) { send({ cmd: 'jog', axis, dir, dist: step }); return; }
+  if (ui.jogAxis) return;
+  ui.jogAxis = axis;
+  send({ cmd: 'jog', axis, dir });
+  ui.jogTimer = setInterval(() => send({ cmd: 'keepalive' }), 100);
+}
+
+function stopJog() {
+  if (!ui.jogAxis) return;
+  clearInterval(ui.jogTimer);
+  send({ cmd: 'jog_stop', axis: ui.jogAxis });
+  ui.jogAxis = null;
+}
+
+function buildJog(axes) {
+  const box = $('jog-buttons');
+  box.innerHTML = '';
+  for (const a of axes) {
+    for (const dir of [-1, 1]) {
+      const b = document.createElement('button');
+      b.textContent = `${a.toUpperCase()}${dir > 0 ? '+' : '−'}`;
+      b.id = `jog-${a}${dir > 0 ? 'p' : 'm'}`;
+      b.addEventListener('pointerdown', () => startJog(a.toUpperCase(), dir));
+      b.addEventListener('pointerup', stopJog);
+      b.addEventListener('pointerleave', stopJog);
+      box.appendChild(b);
+    }
+  }
+  setOnline(!document.body.classList.contains('offline'));
+}
+
+const jogKeys = { ArrowLeft: ['X', -1], ArrowRight: ['X', 1], ArrowDown: ['Y', -1], ArrowUp: ['Y', 1], PageDown: ['Z', -1], PageUp: ['Z', 1] };
+document.addEventListener('keydown', (e) => {
+  const k = jogKeys[e.key];
+  if (!k || e.repeat || e.target.tagName === 'INPUT' || e.target.tagName === 'SELECT') return;
+  if (!ui.authed || ui.readonly || document.body.classList.contains('offline')) return;
+  e.preventDefault();
+  startJog(k[0], k[1]);
+});
+document.addEventListener('keyup', (e) => { if (jogKeys[e.key]) stopJog(); });
+window.addEventListener('blur', stopJog);
+
+setOnline(false);
+connect();
