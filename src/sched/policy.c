@@ -6,6 +6,11 @@ static int clamp(int p, int floor, int ceiling)
     return p < floor ? floor : p > ceiling ? ceiling : p;
 }
 
+int ncp_sched_ceiling(int loop_priority)
+{
+    return loop_priority - 1;
+}
+
 void ncp_sched_static(int n, int floor, int ceiling, int *prio)
 {
     for (int i = 0; i < n; i++)

@@ -9,11 +9,6 @@
 #include <time.h>
 #include <unistd.h>
 
-int ncp_sched_ceiling(int loop_priority)
-{
-    return loop_priority - 1;
-}
-
 void ncp_sched_enter(struct ncp_sched_task *t)
 {
     atomic_store_explicit(&t->tid, (int)gettid(), memory_order_release);
