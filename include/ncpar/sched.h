@@ -4,13 +4,16 @@
  *
  * static:   SCHED_FIFO by dependency distance from the position loop, fixed
  *           for the run: the planner one below the loop, the job one below that.
- * dataflow: a scheduler thread (SCHED_OTHER: it never runs on the position
- *           loop's path) re-ranks the tasks every PERIOD_MS from their rings'
- *           fill: the task with the most input waiting and the least output
+ * dataflow: a scheduler thread re-ranks the tasks every PERIOD_MS from their
+ *           rings' fill: the task with the most input waiting and the least output
  *           ready goes to the top of the band, a task that cannot run (input
  *           empty or output full) to its bottom.
  * Both keep every task within [floor, ceiling], and the ceiling is below the
- * lowest position loop of the process, so the position loops stay on top. */
+ * lowest position loop of the process, so the position loops stay on top.
+ * The data-flow thread itself runs SCHED_FIFO just above its band (and
+ * below the loops): a SCHED_OTHER scheduler would starve exactly when its
+ * re-ranking matters, with FIFO tasks keeping every CPU busy. It wakes for a
+ * few microseconds each period and never runs on the position loop's path. */
 #ifndef NCPAR_SCHED_H
 #define NCPAR_SCHED_H
 
@@ -73,7 +76,8 @@ struct ncp_sched_task {
 
 struct ncp_sched {
     struct ncp_sched_cfg cfg;
-    int ceiling;
+    int ceiling;                /* the band's top */
+    int thread_priority;        /* the data-flow thread's (0: SCHED_OTHER) */
     int n;
     struct ncp_sched_task task[NCP_SCHED_TASKS];
     _Atomic int stop;

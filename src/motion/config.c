@@ -708,7 +708,8 @@ static int check_sched(struct load_ctx *lc)
     if (c->position.policy != SCHED_FIFO || ceiling - 1 < c->sched.floor)
         return fail_at(lc, key_line(lc, "SCHED", "STRATEGY"),
                        "[SCHED] STRATEGY = %s needs [RT] POSITION_PRIORITY at least %d "
-                       "(PRIORITY_MIN %d + 2): the tasks' band lies below the position loop",
+                       "(PRIORITY_MIN %d + 2): the tasks' band and the scheduler lie below "
+                       "the position loop",
                        ncp_sched_strategy_name(c->sched.strategy), c->sched.floor + 2,
                        c->sched.floor), -1;
     return 0;

@@ -45,6 +45,11 @@ void nck_sched_setup(struct nck *n)
                    ? n->setup.loop_priority_min
                    : c->position.priority;
     n->sched.ceiling = ncp_sched_ceiling(loop);
+    if (c->sched.strategy == NCP_SCHED_DATAFLOW) {
+        /* the scheduler thread just below the loops, its band below it */
+        n->sched.thread_priority = n->sched.ceiling;
+        n->sched.ceiling--;
+    }
     n->sched.n = 2;
     n->sched.task[TASK_JOB] = (struct ncp_sched_task){ .name = "job", .out_fill = segs_fill,
                                                        .out_cap = ncp_spsc_capacity(&n->segs),
@@ -109,8 +114,9 @@ void nck_sched_summary(const struct nck *n, char *buf, size_t len)
     const struct ncp_sched_task *p = &n->sched.task[TASK_PLANNER], *j = &n->sched.task[TASK_JOB];
     snprintf(buf, len,
              "dataflow every %d ms: position loop %d, planner %d..%d (%llu changes), "
-             "job %d..%d (%llu changes), band %d..%d",
+             "job %d..%d (%llu changes), band %d..%d, scheduler %d",
              c->sched.period_ms, c->position.priority, p->prio_min, p->prio_max,
              (unsigned long long)p->changes, j->prio_min, j->prio_max,
-             (unsigned long long)j->changes, c->sched.floor, n->sched.ceiling);
+             (unsigned long long)j->changes, c->sched.floor, n->sched.ceiling,
+             n->sched.thread_priority);
 }

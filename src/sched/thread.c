@@ -3,6 +3,7 @@
  * thread id, which they publish while they run, so a task that comes and
  * goes (a job thread per program) needs no handshake. */
 #include "ncpar/sched.h"
+#include "ncpar/rt.h"
 
 #include <errno.h>
 #include <sched.h>
@@ -86,7 +87,9 @@ int ncp_sched_start(struct ncp_sched *s)
     s->refused = 0;
     if (s->cfg.strategy != NCP_SCHED_DATAFLOW || s->started)
         return 0;
-    int rc = pthread_create(&s->thread, NULL, sched_main, s);
+    struct ncp_rt_place at = { -1, s->thread_priority > 0 ? SCHED_FIFO : SCHED_OTHER,
+                               s->thread_priority };
+    int rc = ncp_rt_start(&s->thread, &at, sched_main, s, NULL);
     s->started = rc == 0;
     return rc;
 }
