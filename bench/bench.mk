@@ -1,7 +1,8 @@
 # `make bench`: the benchmark suite of bench/ (not part of `make test`). It
 # reproduces seed 001's Table 3, compares with LinuxCNC's rs274 and measures the
 # position loop's latency beside cyclictest, runs seed 003's circle under timing
-# faults (bench/seed003), then rewrites its sections of
+# faults (bench/seed003) and seed 000's task chain under both scheduling
+# strategies (bench/seed000), then rewrites its sections of
 # bench/RESULTS.md and the PNGs in bench/. RUNS, RUNS_BIG, LAT_SECONDS, ... scale it down (bench/run-bench).
 .PHONY: bench
 # Every program in bench/: `make` (all, what CI builds) builds them too, so that a
