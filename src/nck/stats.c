@@ -145,7 +145,7 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
     s->v = fb->v;
     if (!trace)
         return;
-    if (sizeof s->tbuf - s->tlen < 512)
+    if (sizeof s->tbuf - s->tlen < 1024)   /* room for the widest row */
         nck_trace_flush(s, trace);
     /* the machine functions after the axes: readers of the first ten
      * columns keep working */
