@@ -11,6 +11,7 @@
 #include "ncpar/inject.h"
 #include "ncpar/kins.h"
 #include "ncpar/rt.h"
+#include "ncpar/sched.h"
 
 /* The machine's axes, in LinuxCNC's order X Y Z A B C U V W. A machine has
  * the ones its [TRAJ] COORDINATES names (ncp_machine_cfg.axis_mask); the
@@ -140,6 +141,7 @@ struct ncp_machine_cfg {
      * u = KP e + KI int(e) + KD de/dt + FF1 v_cmd + FF2 a_cmd */
     double kp, ki, kd, ff1, ff2;
     struct ncp_rt_place position, planner, interp; /* [RT] */
+    struct ncp_sched_cfg sched;   /* [SCHED]: the soft-RT tasks' priorities, trace columns */
     /* [TRAJ] PLANNING_PERIOD (ns in the INI): the rough interpolator's period,
      * an integer multiple of servo_period; the position loop fine-interpolates
      * between its points. 0 = servo_period (no fine interpolation). */

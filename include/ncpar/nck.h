@@ -88,6 +88,8 @@ struct ncp_nck_opts {
     /* put before the lines the run itself prints on stderr (a pause's note),
      * e.g. "ch2: " when several runs share the terminal; NULL: none */
     const char *label;
+    int trace_rings;         /* as ncp_nck_setup's */
+    int loop_priority_min;
 };
 
 enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };
@@ -123,6 +125,9 @@ struct ncp_nck_result {
      * stopped the run (inject.trip: exit 3) */
     struct ncp_inject_report inject;
     char inject_summary[256];
+    /* [SCHED]: the strategy and the priorities the tasks ran at, read back
+     * from the threads ("" without a strategy) */
+    char sched_summary[256];
 };
 
 /* Runs the whole chain. Returns res->status. */
@@ -193,6 +198,9 @@ struct ncp_nck_setup {
                                         keep-alive (0: 0.5 s) */
     double virtual_pace;             /* virtual clock: machine seconds per real second
                                         while moving (0: as fast as the CPU allows) */
+    int trace_rings;                 /* ring and task columns in the trace (or [SCHED]'s) */
+    int loop_priority_min;           /* the process's lowest position loop priority, where
+                                        several NCKs run (0: this NCK's own) */
 };
 
 struct ncp_nck;

@@ -147,7 +147,8 @@ static void *channel_main(void *arg)
     return NULL;
 }
 
-static void start_channel(struct channel *ch, const struct ncp_cli_channel_common *c)
+static void start_channel(struct channel *ch, const struct ncp_cli_channel_common *c,
+                          int loop_priority_min)
 {
     ch->ic = (struct ncp_cli_interp){ &ch->src, c->interp, c->mode };
     ch->no = (struct ncp_nck_opts){
@@ -155,6 +156,7 @@ static void start_channel(struct channel *ch, const struct ncp_cli_channel_commo
         .virtual_clock = c->virtual_clock, .for_s = c->for_s,
         .feed_override = c->feed_override, .trace = ch->trace,
         .interrupt = c->interrupt, .label = ch->label,
+        .trace_rings = c->trace_rings, .loop_priority_min = loop_priority_min,
     };
     if (pthread_create(&ch->thread, NULL, channel_main, ch) == 0) {
         ch->started = 1;
@@ -276,8 +278,15 @@ int ncp_cli_run_channels(const char *const *specs, int n, const struct ncp_cli_c
         at += k > 0 ? k : 0;
     }
     ncp_cli_catch_input_faults(names, 0);
+    /* [SCHED]'s band lies below the lowest position loop of all channels:
+     * no channel's soft-RT task rises above another channel's loop */
+    int loop_min = 0;
     for (int i = 0; i < n; i++)
-        start_channel(&chs[i], c);
+        if (chs[i].cfg.position.priority > 0 &&
+            (!loop_min || chs[i].cfg.position.priority < loop_min))
+            loop_min = chs[i].cfg.position.priority;
+    for (int i = 0; i < n; i++)
+        start_channel(&chs[i], c, loop_min);
     int worst = CH_OK;
     for (int i = 0; i < n; i++) {
         int r = finish_channel(&chs[i], c);

@@ -20,6 +20,7 @@ struct ncp_cli_channel_common {
     struct ncp_analyzer_cfg interp;
     const char *backend, *inject, *seed;
     volatile sig_atomic_t *interrupt; /* a stop signal: every channel stops */
+    int trace_rings;             /* --trace-rings */
 };
 
 /* specs[i] is "N:PROG" or "N:PROG:INI". Runs every channel to its end, each

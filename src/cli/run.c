@@ -40,6 +40,7 @@ struct run_opts {
     uint32_t max_loops;         /* --max-loops, 0 = the interpreter's default */
     const char *inject, *seed;  /* --inject SPECS, --seed N (NULL: the INI's) */
     int home;                   /* --home: home the machine before the program */
+    int trace_rings;            /* --trace-rings: ring and task columns in the trace */
     const char *channel[NCP_CLI_CHANNELS_MAX]; /* --channel N:PROG[:INI], as given */
     int n_channels;
 };
@@ -70,6 +71,10 @@ static void usage(FILE *f)
           "  --config INI        machine INI (default: built-in 3-axis mill)\n"
           "  --trace CSV         per-cycle trace: t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n"
           "                      (motion: 0 rapid, 1 feed, 2 arc)\n"
+          "  --trace-rings       add the task chain to the trace: seg_fill,seg_cap,sp_fill,\n"
+          "                      sp_cap (segment and setpoint rings), job_cycle_us,\n"
+          "                      plan_resp_us, plan_cycle_us, loop_cycle_us (as [SCHED]\n"
+          "                      TRACE_RINGS = 1)\n"
           "  --plot PNG          picture of the run (tools/plot-trace.py, python3-matplotlib):\n"
           "                      XY toolpath, velocity/acceleration, latency histogram\n"
           "  --for SECONDS       stop after this much machine time\n"
@@ -147,6 +152,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "inject", required_argument, 0, 'I' },
         { "seed", required_argument, 0, 'R' },
         { "home", no_argument, 0, 'H' },
+        { "trace-rings", no_argument, 0, 'G' },
         { "channel", required_argument, 0, 'C' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
@@ -173,6 +179,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         case 'I': o->inject = optarg; break;
         case 'R': o->seed = optarg; break;
         case 'H': o->home = 1; break;
+        case 'G': o->trace_rings = 1; break;
         case 'C':
             if (o->n_channels == NCP_CLI_CHANNELS_MAX)
                 return fprintf(stderr, "cnc-run run: at most %d channels\n",
@@ -546,6 +553,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .notes = stderr,
         .interrupt = &run_signal,
         .home = o->home,
+        .trace_rings = o->trace_rings,
     };
     struct ncp_nck_result *res = malloc(sizeof *res);
     if (!res)
@@ -597,7 +605,7 @@ int ncp_cli_run(int argc, char **argv)
             .interp = { .tool_table_path = o.tool_table, .subroutine_path = o.sub_path,
                         .max_loop_iterations = o.max_loops, .m66_on_machine = 1 },
             .backend = o.backend, .inject = o.inject, .seed = o.seed,
-            .interrupt = &run_signal,
+            .interrupt = &run_signal, .trace_rings = o.trace_rings,
         };
         return ncp_cli_run_channels(o.channel, o.n_channels, &cc);
     }

@@ -286,11 +286,18 @@ int ncp_cli_serve(int argc, char **argv)
     struct ncp_nck *ncks[NCP_NCK_CHANNELS_MAX];
     int nums[NCP_NCK_CHANNELS_MAX];
     int rc = 0, made = 0;
+    /* [SCHED]'s band lies below the lowest position loop of all channels */
+    int loop_min = 0;
+    for (int i = 0; i < n; i++)
+        if (chs[i].cfg.position.priority > 0 &&
+            (!loop_min || chs[i].cfg.position.priority < loop_min))
+            loop_min = chs[i].cfg.position.priority;
     for (; made < n; made++) {
         struct ncp_nck_setup setup = {
             .cfg = &chs[made].cfg, .virtual_clock = a.virtual_clock, .trace = chs[made].trace,
             .mode = a.mode,
             .interp = { .tool_table_path = a.tool_table, .subroutine_path = a.sub_path },
+            .loop_priority_min = loop_min,
         };
         ncks[made] = ncp_nck_new(&setup, &d);
         nums[made] = chs[made].num;

@@ -59,6 +59,7 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->default_linear_vel = 10.0;
     ncp_io_cfg_default(&c->io);
     ncp_inject_cfg_default(&c->inject);
+    ncp_sched_cfg_default(&c->sched);
     snprintf(c->lcm.prefix, sizeof c->lcm.prefix, "NCP_");
     c->lcm.status_hz = 50.0;
     c->lcm.dp = 5;
@@ -439,7 +440,7 @@ static int known_section(const char *sec)
 {
     static const char *const names[] = { "EMCMOT", "TRAJ",   "LCM",   "PLANNER",
                                          "SIM",    "RT",     "CAN",   "SPINDLE_0",
-                                         "EMCIO",  "INJECT" };
+                                         "EMCIO",  "INJECT", "SCHED" };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcasecmp(sec, names[i]))
             return 1;
@@ -495,6 +496,8 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
     }
     if (!strcasecmp(sec, "INJECT"))
         return ncp_inject_ini_key(&c->inject, sec, k, v, why, len);
+    if (!strcasecmp(sec, "SCHED"))
+        return ncp_sched_ini_key(&c->sched, k, v, why, len);
     if (!strcasecmp(sec, "CAN"))
         return can_key(&c->can, k, v, why, len);
     int r = ncp_kins_cfg_key(&lc->kl, c, sec, k, v, lc->line, why, len);
@@ -720,6 +723,25 @@ static int check_cfg(struct load_ctx *lc)
     return 0;
 }
 
+/* A strategy ranks the soft-RT tasks in a band of SCHED_FIFO priorities
+ * below the position loop: it needs the loop on SCHED_FIFO, high enough to
+ * leave the band room for the chain's tasks. */
+static int check_sched(struct load_ctx *lc)
+{
+    const struct ncp_machine_cfg *c = lc->c;
+    if (c->sched.strategy == NCP_SCHED_NONE)
+        return 0;
+    int ceiling = ncp_sched_ceiling(c->position.priority);
+    if (c->position.policy != SCHED_FIFO || ceiling - 1 < c->sched.floor)
+        return fail_at(lc, key_line(lc, "SCHED", "STRATEGY"),
+                       "[SCHED] STRATEGY = %s needs [RT] POSITION_PRIORITY at least %d "
+                       "(PRIORITY_MIN %d + 2): the tasks' band and the scheduler lie below "
+                       "the position loop",
+                       ncp_sched_strategy_name(c->sched.strategy), c->sched.floor + 2,
+                       c->sched.floor), -1;
+    return 0;
+}
+
 /* What ADCAI cannot do is refused with the machine file, before any program. */
 static int check_adcai(struct load_ctx *lc)
 {
@@ -782,8 +804,8 @@ int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp
         else if (r < 0 || (!lc->failed && ferror(lc->f)))
             fail_at(lc, 0, "cannot read: %s", strerror(errno));
         if (!lc->failed && check_axes(lc) == 0 && check_cfg(lc) == 0)
-            if (check_kins(lc) == 0)
-                check_adcai(lc);
+            if (check_kins(lc) == 0 && check_adcai(lc) == 0)
+                check_sched(lc);
         rc = lc->failed ? d->code : NCP_OK;
     }
     if (lc->f)

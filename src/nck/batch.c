@@ -201,7 +201,7 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o, struct batch_home
     if (o->trace) {
         errno = 0;
         n->sum.joints = ncp_kins_active(n->cfg);
-        nck_trace_header(o->trace, n->cfg, n->sum.joints);
+        nck_trace_header(o->trace, n->cfg, n->sum.joints, n->sum.rings);
         if (ferror(o->trace))
             n->sum.trace_errno = errno ? errno : EIO;
     }
@@ -280,6 +280,7 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
     res->interrupted = atomic_load(&n->ctl->stop) && !n->ended;
     res->trace_errno = n->sum.trace_errno;
     res->spindle_rpm_max = s->rpm_max;
+    nck_sched_summary(n, res->sched_summary, sizeof res->sched_summary);
     res->pauses = n->pauses;
     for (int k = 0; k < NCP_C__COUNT; k++) {
         res->calls_in += n->calls_in[k];
@@ -349,7 +350,8 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     n->label = o->label ? o->label : "";
     enum precheck_end pre = PC_OK;
     struct ncp_nck_setup setup = { .cfg = o->cfg, .virtual_clock = o->virtual_clock,
-                                   .trace = o->trace };
+                                   .trace = o->trace, .trace_rings = o->trace_rings,
+                                   .loop_priority_min = o->loop_priority_min };
     /* the soft limits are checked from where the machine is, before it moves:
      * the backend reports that as it starts */
     if (nck_start(n, &setup, 1, &res->diag)) {

@@ -765,7 +765,8 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->acfg.instance = s->interp;
     n->sum.joints = ncp_kins_active(setup->cfg);
     if (setup->trace)
-        nck_trace_header(setup->trace, setup->cfg, n->sum.joints);
+        nck_trace_header(setup->trace, setup->cfg, n->sum.joints,
+                         setup->trace_rings || setup->cfg->sched.trace_rings);
     if (!s->interp || nck_start(n, setup, 0, d) || nck_start_loop(n, d)) {
         ncp_nck_free(s);
         return NULL;

@@ -106,12 +106,20 @@ int nck_start(struct nck *n, const struct ncp_nck_setup *s, int batch, struct nc
         return -1;
     }
     nck_inject_setup(n);
-    const struct ncp_machine_cfg *c = n->cfg;
-    if (ncp_rt_start(&n->planner_thread, &c->planner, nck_planner_main, n, NULL)) {
+    n->trace_rings = s->trace_rings || n->cfg->sched.trace_rings;
+    n->sum.rings = n->trace_rings;
+    n->sum.seg_cap = (uint32_t)ncp_spsc_capacity(&n->segs);
+    n->sum.sp_cap = (uint32_t)ncp_spsc_capacity(&n->sps);
+    nck_sched_setup(n);
+    if (ncp_rt_start(&n->planner_thread, &n->planner_place, nck_planner_main, n, NULL)) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the planner thread");
         return -1;
     }
     n->planner_started = 1;
+    if (nck_sched_start(n)) {
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the scheduler thread");
+        return -1;
+    }
     return 0;
 }
 
@@ -129,6 +137,7 @@ int nck_start_loop(struct nck *n, struct ncp_diag *d)
  * loop, then the backend's controlled stop. */
 void nck_finish(struct nck *n)
 {
+    ncp_sched_stop(&n->sched);
     atomic_store(&n->job.abort, 1);
     nck_job_join(n);
     atomic_store(&n->quit, 1);

@@ -30,9 +30,18 @@ static int ring_push(struct nck *n, struct ncp_spsc *ring, const void *item)
     return 0;
 }
 
+/* With TRACE_RINGS the job's cycle is the time from one segment to the next. */
 static int push_wait(struct nck *n, const struct nck_seg_msg *m)
 {
-    return ring_push(n, &n->segs, m);
+    int rc = ring_push(n, &n->segs, m);
+    if (n->trace_rings) {
+        static _Thread_local int64_t last;
+        int64_t now = nck_mono_ns();
+        if (last)
+            atomic_store_explicit(&n->job_cycle_ns, now - last, memory_order_relaxed);
+        last = now;
+    }
+    return rc;
 }
 
 static int take_seg(struct nck *n, const struct ncp_seg *s);
@@ -693,9 +702,11 @@ static void *interp_main(void *arg)
     struct nck *n = arg;
     struct nck_job *j = &n->job;
     struct ncp_output out = { .ctx = n, .emit = emit_job, .sync = machine_sync };
+    nck_sched_enter(n, 0);
     memset(&j->diag, 0, sizeof j->diag);
     j->rc = j->interpret(j->interp_ctx, &out, &j->diag);
     push_mark(n, NCK_MSG_END);
+    nck_sched_leave(n, 0);
     atomic_store(&j->finished, 1);
     return NULL;
 }
@@ -704,10 +715,12 @@ static void *moves_main(void *arg)
 {
     struct nck *n = arg;
     struct nck_job *j = &n->job;
+    nck_sched_enter(n, 0);
     for (int k = 0; k < j->n_moves; k++)
         if (j->moves[k].length > 1e-9 && push_seg(n, &j->moves[k]))
             break;
     push_mark(n, NCK_MSG_END);
+    nck_sched_leave(n, 0);
     atomic_store(&j->finished, 1);
     return NULL;
 }
@@ -741,7 +754,7 @@ int nck_job_start(struct nck *n)
     /* the stretch the job's first END or SYNC closes */
     atomic_fetch_add_explicit(&n->marks_sent, 1, memory_order_release);
     void *(*fn)(void *) = j->kind == NCK_JOB_MOVE ? moves_main : interp_main;
-    const struct ncp_rt_place *pl = &n->cfg->interp;
+    const struct ncp_rt_place *pl = &n->job_place;
     if (ncp_rt_start(&j->thread, pl, fn, n, NULL)) {
         atomic_fetch_sub(&n->marks_sent, 1);
         j->kind = NCK_JOB_NONE;

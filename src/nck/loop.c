@@ -213,6 +213,22 @@ static void discard(struct nck *n, const double act[NCP_AXES])
                           memory_order_release);
 }
 
+/* TRACE_RINGS: the rings' fill as this cycle sees it and the tasks' last
+ * times; the loop's own cycle is the actual time since its last wake-up
+ * (clock_gettime is the vDSO's, no system call; the virtual clock's time is
+ * the schedule itself). */
+static void ring_columns(struct nck *n, int64_t now_ns, struct nck_fb *fb)
+{
+    fb->seg_fill = (uint32_t)ncp_spsc_count(&n->segs);
+    fb->sp_fill = (uint32_t)ncp_spsc_count(&n->sps);
+    fb->plan_resp_ns = atomic_load_explicit(&n->plan_resp_ns, memory_order_relaxed);
+    fb->plan_cycle_ns = atomic_load_explicit(&n->plan_cycle_ns, memory_order_relaxed);
+    fb->job_cycle_ns = atomic_load_explicit(&n->job_cycle_ns, memory_order_relaxed);
+    int64_t t = n->setup.virtual_clock ? now_ns : nck_mono_ns();
+    fb->loop_cycle_ns = n->loop_last_ns ? t - n->loop_last_ns : 0;
+    n->loop_last_ns = t;
+}
+
 static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES],
                        uint64_t home)
 {
@@ -239,6 +255,8 @@ static void push_cycle(struct nck *n, int64_t now_ns, const double act[NCP_AXES]
     fb.waits = m->waits;
     fb.tool = m->tool;
     fb.wait_line = m->wait_line;
+    if (n->trace_rings)
+        ring_columns(n, now_ns, &fb);
     if (ncp_spsc_push(&n->fbs, &fb) != 0)
         n->fb_dropped++;
 }

@@ -200,6 +200,9 @@ struct nck_fb {
     uint32_t wait_line;
     struct ncp_inject_ev inj;   /* the timing faults of the cycle (trace column inject) */
     uint64_t home;              /* homing phase per axis, 4 bits each (enum nck_home_phase) */
+    /* TRACE_RINGS: the rings' fill and the tasks' last times (ns) */
+    uint32_t seg_fill, sp_fill;
+    int64_t plan_resp_ns, plan_cycle_ns, job_cycle_ns, loop_cycle_ns;
 };
 
 struct nck_summary {
@@ -221,6 +224,8 @@ struct nck_summary {
     int trace_errno;         /* the first failed write's errno, 0 = none */
     int inject_col;          /* the trace has the inject column */
     int joints;              /* the trace has joint columns (non-trivial kinematics) */
+    int rings;               /* the trace has the ring and task columns (TRACE_RINGS) */
+    uint32_t seg_cap, sp_cap;
 };
 
 /* NCK_LF_TIMING: a miss limit tripped; NCK_LF_JOINT: a joint commanded
@@ -316,6 +321,14 @@ struct nck {
     struct ncp_rt_loop loop;
     pthread_t planner_thread;
     int planner_started, loop_started;
+    /* [SCHED]: task 0 the job thread, task 1 the planner (sched.c) */
+    struct ncp_sched sched;
+    struct ncp_rt_place job_place, planner_place;
+    _Atomic int prio_seen[2];    /* each task's priority, read back by itself */
+    int trace_rings;
+    /* ring and task timing for the trace (TRACE_RINGS): written by their task */
+    _Atomic int64_t plan_resp_ns, plan_cycle_ns, job_cycle_ns;
+    int64_t loop_last_ns;        /* position loop only */
     _Atomic int quit;            /* planner thread: leave */
     double start[NCP_AXES];      /* where the backend reported the axes at start */
 
@@ -545,7 +558,14 @@ void nck_account(struct nck_summary *s, unsigned axis_mask, const struct nck_fb 
 int nck_read_cycles(struct nck *n);
 /* The trace's first row: the fixed columns, then cmd and act of each of
  * the machine's axes beyond X Y Z (axis_mask). */
-void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints);
+void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints, int rings);
+/* sched.c: [SCHED] for this NCK (task 0 the job thread, 1 the planner) */
+void nck_sched_setup(struct nck *n);
+int64_t nck_mono_ns(void);
+int nck_sched_start(struct nck *n);
+void nck_sched_enter(struct nck *n, int task);
+void nck_sched_leave(struct nck *n, int task);
+void nck_sched_summary(const struct nck *n, char *buf, size_t len);
 /* Writes the rows gathered so far. 0, or -1 when the write failed. */
 int nck_trace_flush(struct nck_summary *s, FILE *trace);
 

@@ -93,6 +93,8 @@ void *nck_planner_main(void *arg)
     struct nck_seg_msg jump;   /* the stop's jump, if it has one */
     memset(&jump, 0, sizeof jump);
     long nap = (long)(n->cfg->servo_period * nck_plan_stream_ratio(n->cfg) * 1e9 / 4) + 1000;
+    int64_t last_step = 0;
+    nck_sched_enter(n, 1);
     while (!atomic_load(&n->quit)) {
         if (atomic_load_explicit(&n->park_req, memory_order_acquire) !=
             atomic_load_explicit(&n->park_ack, memory_order_relaxed)) {
@@ -111,6 +113,7 @@ void *nck_planner_main(void *arg)
             continue;
         }
         struct ncp_setpoint sp;
+        int64_t t0 = n->trace_rings ? mono_ns() : 0;
         int more = nck_plan_step(n, &sp);
         if (!more) {
             /* the stop's sample: the machine functions due there; an AUX
@@ -121,6 +124,14 @@ void *nck_planner_main(void *arg)
                 sp.flags &= ~(uint32_t)NCP_SP_END;
         }
         ncp_spsc_push(&n->sps, &sp);
+        if (n->trace_rings) {
+            /* response: one step's work; cycle: from one setpoint to the next */
+            int64_t t1 = mono_ns();
+            atomic_store_explicit(&n->plan_resp_ns, t1 - t0, memory_order_relaxed);
+            if (last_step)
+                atomic_store_explicit(&n->plan_cycle_ns, t1 - last_step, memory_order_relaxed);
+            last_step = t1;
+        }
         if (!more) {
             if (!aux_stop)
                 atomic_fetch_add_explicit(&n->ends_pushed, 1, memory_order_release);
@@ -134,5 +145,6 @@ void *nck_planner_main(void *arg)
             aux_stop = 0;
         }
     }
+    nck_sched_leave(n, 1);
     return NULL;
 }

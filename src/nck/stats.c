@@ -100,6 +100,16 @@ static int trace_home(char *buf, size_t len, unsigned mask, uint64_t home)
     return (int)at;
 }
 
+static int ring_columns(char *buf, size_t len, const struct nck_summary *s,
+                        const struct nck_fb *fb)
+{
+    int k = snprintf(buf, len, ",%u,%u,%u,%u,%.1f,%.1f,%.1f,%.1f", fb->seg_fill, s->seg_cap,
+                     fb->sp_fill, s->sp_cap, (double)fb->job_cycle_ns * 1e-3,
+                     (double)fb->plan_resp_ns * 1e-3, (double)fb->plan_cycle_ns * 1e-3,
+                     (double)fb->loop_cycle_ns * 1e-3);
+    return k > 0 && (size_t)k < len ? k : -1;
+}
+
 void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, FILE *trace)
 {
     double e2 = 0;
@@ -135,7 +145,7 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
     s->v = fb->v;
     if (!trace)
         return;
-    if (sizeof s->tbuf - s->tlen < 512)
+    if (sizeof s->tbuf - s->tlen < 1024)   /* room for the widest row */
         nck_trace_flush(s, trace);
     /* the machine functions after the axes: readers of the first ten
      * columns keep working */
@@ -167,11 +177,15 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
                                   mask, fb);
             m = mj < 0 ? -1 : m + mj;
         }
-        /* the inject column comes last */
+        /* the inject column, then the ring columns come last */
         if (m >= 0 && s->inject_col) {
             at += (size_t)m;
             s->tbuf[at++] = ',';
             m = ncp_inject_format(&fb->inj, s->tbuf + at, sizeof s->tbuf - at - 1);
+        }
+        if (m >= 0 && s->rings) {
+            at += (size_t)m;
+            m = ring_columns(s->tbuf + at, sizeof s->tbuf - at - 1, s, fb);
         }
         if (m >= 0) {
             s->tbuf[at + (size_t)m] = '\n';
@@ -180,7 +194,7 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
     }
 }
 
-void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints)
+void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints, int rings)
 {
     unsigned mask = cfg->axis_mask;
     fputs("t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion,spindle_rpm,spindle_deg,mist,"
@@ -199,6 +213,11 @@ void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints
     /* what was injected in the period: "-", or e.g. "miss+jit=12.500" */
     if (cfg->inject.kinds)
         fputs(",inject", trace);
+    /* the soft-RT chain: segment ring (job -> planner), setpoint ring
+     * (planner -> position loop), each task's last cycle, in us */
+    if (rings)
+        fputs(",seg_fill,seg_cap,sp_fill,sp_cap,job_cycle_us,plan_resp_us,plan_cycle_us,"
+              "loop_cycle_us", trace);
     fputc('\n', trace);
     fflush(trace);
 }
@@ -297,6 +316,8 @@ void ncp_nck_print_summary(const struct ncp_nck_result *r, const char *prog, FIL
             (unsigned long long)r->starved);
     if (r->inject_summary[0])
         fprintf(f, "  %s\n", r->inject_summary);
+    if (r->sched_summary[0])
+        fprintf(f, "  sched: %s\n", r->sched_summary);
     if (r->trace_dropped)
         fprintf(f, "  trace: %llu cycles dropped (the writer fell behind)\n",
                 (unsigned long long)r->trace_dropped);

@@ -1,0 +1,2 @@
+# sources of src/sched, appended by the module
+LIB_SRCS += $(wildcard src/sched/*.c)
