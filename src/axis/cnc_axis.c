@@ -1,7 +1,8 @@
 /* cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]: one low-level
  * axis controller of the distributed NCK (seed 002). It advertises its axis,
  * waits for the HLC (cnc-run run --backend lcm), then runs the axis's
- * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5)
+ * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5), or
+ * interpolating the records the HLC's planner starts (ADCBI DP4),
  * until the HLC says the program is done (exit 0) or something makes it stop
  * (exit 3, after a ramp to standstill). */
 #include "axis.h"
@@ -28,7 +29,8 @@ static void usage(FILE *f)
     fputs("usage: cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]\n"
           "One axis of the distributed NCK: advertises axis L of the machine INI over LCM,\n"
           "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
-          "servo at the HLC's setpoints (every servo period, DP 5) and reports its status\n"
+          "servo at the HLC's setpoints (every servo period, DP 5) or interpolating the\n"
+          "records of its planner (ADCBI DP 4), and reports its status\n"
           "every period. Stops with a ramp within MAX_ACCELERATION when the HLC goes\n"
           "silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS setpoints in a row\n"
           "are missing, on a following error or when the HLC orders it.\n"

@@ -246,7 +246,9 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
     struct ncp_setpoint sp;
     l->missing = 0;
     (void)ncp_exec_step(&l->ex, &src, &sp);
-    int moving = memcmp(sp.pos, l->ex_prev, sizeof l->ex_prev) != 0;
+    int moving = 0;
+    for (int j = 0; j < NCP_AXES; j++)
+        moving |= sp.pos[j] != l->ex_prev[j];
     int hold = moving && l->ex_rest && (!due || slot < due);
     if (!moving && l->ex_rest && due && slot >= due && !ncp_dist_recs_peek(&l->recs, &first)) {
         /* the HLC moved off here: the record it moved on is needed now */

@@ -303,7 +303,9 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
     memcpy(s->hist_cmd[h], cmd, sizeof s->hist_cmd[h]);
     if (s->tx) {
         /* the LLCs' interpolators leave each standstill when this does */
-        int moving = s->cycles > 0 && memcmp(cmd, s->prev_cmd, sizeof s->prev_cmd) != 0;
+        int moving = 0;
+        for (int j = 0; j < NCP_AXES && s->cycles > 0; j++)
+            moving |= cmd[j] != s->prev_cmd[j];
         int start = moving && s->rest;
         s->rest = !moving;
         memcpy(s->prev_cmd, cmd, sizeof s->prev_cmd);
