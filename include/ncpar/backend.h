@@ -92,6 +92,9 @@ struct ncp_backend {
     /* Injected timing of the coming cycle (set by the position loop, NULL =
      * none): the simulated plant models it; real drives have their own. */
     const struct ncp_inject_ev *timing;
+    /* An HLC at a block-level point sends on what the ADCBI planner starts:
+     * the NCK hands it to the planner's tap (planner thread; NULL: none). */
+    void (*plan_tap)(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec);
 };
 
 /* Opens what cfg->backend names (not started yet). log gets start-up

@@ -5,7 +5,7 @@
  * Distribution points, ADCBI (today's planner): DP1 the part program, DP2
  * INTbuf, DP3 LAbuf, DP4 ACCDECbuf (block-level: bursts), DP5 fineIPObuf
  * (period-level: a record every servo period). ADCAI: DP2 roughIPObuf, DP3
- * ACCDECbuf, DP4 fineIPObuf. Implemented: ADCBI DP5.
+ * ACCDECbuf, DP4 fineIPObuf. Implemented: ADCBI DP5 and DP4.
  *
  * Positions travel as int32 nanometres: exact and the same for every LLC,
  * +-2.1 m of travel. */
@@ -16,17 +16,22 @@
 #include <stdint.h>
 
 #include "ncpar/motion.h"
+#include "ncp_accdec_burst_t.h"
 #include "ncp_ax_advert_t.h"
 #include "ncp_ax_status_t.h"
 #include "ncp_fine_ipo_t.h"
 #include "ncp_heartbeat_t.h"
+#include "ncp_rec_mark_t.h"
 
 #define NCP_DIST_HLC_ID 100   /* sender id of the HLC; an LLC's is its axis index + 1 */
 
 /* Channel names: NCP_HLC_<WHAT> and NCP_AX_<L>_<WHAT>. */
 #define NCP_DIST_CH_FINE "NCP_HLC_FINE"
 #define NCP_DIST_CH_HLC_HEARTBEAT "NCP_HLC_HEARTBEAT"
-enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTBEAT };
+#define NCP_DIST_CH_ACCDEC "NCP_HLC_ACCDEC"
+#define NCP_DIST_CH_SYNC "NCP_HLC_SYNC"
+enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTBEAT,
+                      NCP_DIST_AX_RESEND };
 /* "NCP_AX_<L>_ADVERT" etc. into buf (32 bytes are enough). */
 void ncp_dist_ax_channel(char *buf, size_t size, int axis, enum ncp_dist_ax_ch what);
 
@@ -88,5 +93,38 @@ int32_t ncp_dist_rx_play(struct ncp_dist_rx *r, int64_t t_ns);
 int ncp_dist_rx_peek(const struct ncp_dist_rx *r, int64_t t_ns, int32_t *nm);
 /* Setpoints held for periods after t_ns. */
 int ncp_dist_rx_level(const struct ncp_dist_rx *r, int64_t t_ns);
+
+/* ---- block-level points: ACCDECbuf records (ADCBI DP4) -------------------
+ * The HLC numbers every record it taps from its planner from 0 and sends them
+ * in bursts of up to NCP_DIST_BURST; an LLC keeps them by number in a ring
+ * until its interpolator has run them. */
+#define NCP_DIST_BURST 10
+/* Records an LLC holds: the HLC's planner starts a segment (and taps its
+ * record) at most [PLANNER] SETPOINT_RING periods (1024) before the position
+ * loop plays its first sample, so at most that many segments are ever ahead
+ * of an LLC; the HLC holds back bursts an LLC has no room for. */
+#define NCP_DIST_RECS 2048
+
+void ncp_dist_rec_encode(const struct ncp_accdec *a, ncp_accdec_rec_t *r);
+void ncp_dist_rec_decode(const ncp_accdec_rec_t *r, struct ncp_accdec *a);
+
+struct ncp_dist_recs {
+    int32_t num[NCP_DIST_RECS];   /* the record held in each place (-1: none) */
+    ncp_accdec_rec_t *rec;        /* NCP_DIST_RECS of them, allocated once */
+    int32_t next;                 /* the next record the interpolator takes */
+    int32_t have;                 /* all records below this are here or taken */
+    int32_t top;                  /* one past the highest number received */
+    uint32_t stale, duplicate, early, gaps;
+};
+/* 0, or -1 out of memory. */
+int ncp_dist_recs_init(struct ncp_dist_recs *q);
+void ncp_dist_recs_free(struct ncp_dist_recs *q);
+/* A received record (kept, or counted stale, duplicate or too early). */
+void ncp_dist_recs_put(struct ncp_dist_recs *q, int32_t num, const ncp_accdec_rec_t *r);
+/* The next record if it is here (1), else 0. */
+int ncp_dist_recs_peek(const struct ncp_dist_recs *q, struct ncp_accdec *a);
+/* The interpolator is done with the next record. */
+void ncp_dist_recs_pop(struct ncp_dist_recs *q);
+static inline int ncp_dist_recs_level(const struct ncp_dist_recs *q) { return q->have - q->next; }
 
 #endif

@@ -18,6 +18,7 @@ enum llc_end {
     LLC_END_HLC_SILENT, /* no heartbeat from the HLC for HEARTBEAT_TIMEOUT_MS */
     LLC_END_LOST,       /* MAX_LOST_PERIODS setpoints in a row missing */
     LLC_END_FERROR,     /* following error past FERROR */
+    LLC_END_MISSING,    /* DP4: the next record was not here when needed */
     LLC_END_SIGNAL      /* SIGINT / SIGTERM */
 };
 
@@ -33,7 +34,7 @@ struct llc {
     int axis;             /* index in NCP_AXIS_LETTERS */
     int slot;             /* its place in the HLC's setpoint (the machine's axes in order) */
     struct ncp_msg *msg;
-    char ch_status[32], ch_heartbeat[32], ch_advert[32];
+    char ch_status[32], ch_heartbeat[32], ch_advert[32], ch_resend[32];
     int64_t period_ns, t_first;   /* the HLC's first setpoint period */
     int64_t hb_period_ns, hb_timeout_ns;
     struct ncp_dist_rx rx;
@@ -57,6 +58,27 @@ struct llc {
     int tracing;
     uint32_t trace_dropped;
     struct ncp_rt_loop loop;
+    /* DP4 (ACCDECbuf): the records, the interpolator running them from the
+     * HLC's first moving period (t_start) on, and the HLC's word on how many
+     * it sent (a lost last burst shows there) */
+    int dp4;
+    int64_t t_start;
+    struct ncp_dist_recs recs;
+    struct ncp_exec ex;
+    int32_t hlc_records, mark_seq;
+    /* when the HLC's path left its k-th standstill, and how many of them
+     * this interpolator has left */
+#define LLC_STARTS 64
+    int64_t start_t[LLC_STARTS];
+    int32_t start_k[LLC_STARTS];
+    int32_t starts_done;
+    int ex_on, ex_rest;
+    double ex_prev[NCP_AXES];
+    int missing;
+    int32_t missing_rec;
+    int64_t last_resend_ns;
+    uint32_t resends;
+    ncp_accdec_burst_t burst;   /* decoded here, not on the loop's stack */
 };
 
 /* llc.c */

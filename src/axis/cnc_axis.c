@@ -1,7 +1,8 @@
 /* cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]: one low-level
  * axis controller of the distributed NCK (seed 002). It advertises its axis,
  * waits for the HLC (cnc-run run --backend lcm), then runs the axis's
- * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5)
+ * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5), or
+ * interpolating the records the HLC's planner starts (ADCBI DP4),
  * until the HLC says the program is done (exit 0) or something makes it stop
  * (exit 3, after a ramp to standstill). */
 #include "axis.h"
@@ -28,7 +29,8 @@ static void usage(FILE *f)
     fputs("usage: cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]\n"
           "One axis of the distributed NCK: advertises axis L of the machine INI over LCM,\n"
           "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
-          "servo at the HLC's setpoints (every servo period, DP 5) and reports its status\n"
+          "servo at the HLC's setpoints (every servo period, DP 5) or interpolating the\n"
+          "records of its planner (ADCBI DP 4), and reports its status\n"
           "every period. Stops with a ramp within MAX_ACCELERATION when the HLC goes\n"
           "silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS setpoints in a row\n"
           "are missing, on a following error or when the HLC orders it.\n"
@@ -96,12 +98,15 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     ncp_dist_ax_channel(l->ch_status, sizeof l->ch_status, o->axis, NCP_DIST_AX_STATUS);
     ncp_dist_ax_channel(l->ch_heartbeat, sizeof l->ch_heartbeat, o->axis, NCP_DIST_AX_HEARTBEAT);
     ncp_dist_ax_channel(l->ch_advert, sizeof l->ch_advert, o->axis, NCP_DIST_AX_ADVERT);
+    ncp_dist_ax_channel(l->ch_resend, sizeof l->ch_resend, o->axis, NCP_DIST_AX_RESEND);
     const char *url = o->url ? o->url : cfg->lcm.url;
     if (ncp_msg_open(&l->msg, url, NULL, &d) != NCP_OK)
         return fprintf(stderr, "cnc-axis: error: %s\n", d.msg), -1;
     /* the order llc_take expects */
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_FINE);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_HLC_HEARTBEAT);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_ACCDEC);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_SYNC);
     /* each axis its own losses: the seed plus its index */
     struct ncp_msg_inject in = { cfg->lcm.inject_loss, cfg->lcm.inject_delay_us * 1000LL,
                                  (uint64_t)cfg->lcm.inject_seed + 1u + (uint64_t)o->axis };
@@ -110,6 +115,8 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     static const double origin[NCP_AXES];
     ncp_sim_init(&l->sim, cfg, origin);
     ncp_dist_rx_init(&l->rx, l->period_ns, 0);
+    if (ncp_dist_recs_init(&l->recs) != 0)
+        return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
     if (o->trace) {
         l->tracing = 1;
         if (ncp_spsc_init(&l->trace_ring, sizeof(struct llc_row), 1 << 14) != 0)
@@ -166,7 +173,17 @@ static int report(const struct llc *l)
             ax, (unsigned long long)l->loop.stats.cycles, (unsigned)l->loop.stats.misses,
             l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.bridged, l->rx.reordered, l->clamped,
             (unsigned long long)st.inject_lost, (unsigned long long)st.inject_delayed);
+    if (l->dp4)
+        fprintf(stderr, "cnc-axis %c: DP 4: records taken %d, gaps %u, resend requests %u, "
+                        "stale %u, duplicate %u, too early %u\n",
+                ax, (int)l->recs.next, l->recs.gaps, l->resends, l->recs.stale,
+                l->recs.duplicate, l->recs.early);
     switch (l->end) {
+    case LLC_END_MISSING:
+        fprintf(stderr, "cnc-axis %c: error: record %d was not here when the interpolator "
+                        "needed it; ramped to a standstill at %.4f mm\n",
+                ax, (int)l->missing_rec, l->cmd);
+        break;
     case LLC_END_NONE:
     case LLC_END_DONE: return EXIT_OK;
     case LLC_END_HLC_STOP:

@@ -12,6 +12,13 @@
  * error, not a wait. A separate network thread would add a hand-off and a
  * period of latency for nothing here.
  *
+ * At DP4 the HLC sends ACCDECbuf records instead (bursts, numbered) and
+ * the period its motion began; the LLC runs the interpolator (ncp_exec) on
+ * them, one step per period from that one on, so its samples are the central
+ * run's. A record lost on the way is asked for again (NCP_AX_<L>_RESEND)
+ * as soon as a later one, or the HLC's count, shows the gap; one still
+ * missing when the interpolator needs it stops the axis (ramp) and says so.
+ *
  * Safety: a setpoint never moves the axis faster than its MAX_VELOCITY (a
  * step after a gap is limited and counted), and every stop is a ramp at
  * MAX_ACCELERATION from the velocity the axis has, never a jump. */
@@ -51,8 +58,35 @@ static void on_hlc_heartbeat(struct llc *l, const uint8_t *p, size_t len, int64_
     }
 }
 
-/* Subscriptions, in the order wait.c makes them. */
-enum { SUB_FINE, SUB_HLC_HEARTBEAT };
+static void on_accdec(struct llc *l, const uint8_t *p, size_t len)
+{
+    ncp_accdec_burst_t *b = &l->burst;
+    if (ncp_accdec_burst_t_decode(p, 0, (int)len, b) != (int)len ||
+        b->sender != NCP_DIST_HLC_ID || b->count < 0 || b->count > NCP_DIST_BURST)
+        return;
+    for (int i = 0; i < b->count; i++)
+        ncp_dist_recs_put(&l->recs, b->first + i, &b->recs[i]);
+}
+
+static void on_sync(struct llc *l, const uint8_t *p, size_t len)
+{
+    ncp_rec_mark_t k;
+    memset(&k, 0, sizeof k);
+    if (ncp_rec_mark_t_decode(p, 0, (int)len, &k) != (int)len || k.sender != NCP_DIST_HLC_ID)
+        return;
+    l->dp4 = 1;
+    if (k.records > l->hlc_records)
+        l->hlc_records = k.records;
+    if (k.t_ns > 0 && k.start >= 0) {
+        if (!l->t_start)
+            l->t_start = k.t_ns;
+        l->start_t[(unsigned)k.start % LLC_STARTS] = k.t_ns;
+        l->start_k[(unsigned)k.start % LLC_STARTS] = k.start;
+    }
+}
+
+/* Subscriptions, in the order cnc_axis.c makes them. */
+enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC };
 
 void llc_take(struct llc *l, int64_t now)
 {
@@ -64,6 +98,10 @@ void llc_take(struct llc *l, int64_t now)
             on_fine(l, p, len);
         else if (sub == SUB_HLC_HEARTBEAT)
             on_hlc_heartbeat(l, p, len, now);
+        else if (sub == SUB_ACCDEC)
+            on_accdec(l, p, len);
+        else if (sub == SUB_SYNC)
+            on_sync(l, p, len);
     }
 }
 
@@ -85,11 +123,22 @@ void llc_publish_status(struct llc *l, int64_t slot)
     s.act_nm = nm(l->act);
     s.ferr_nm = nm(l->ferr);
     s.state = (int8_t)l->state;
-    s.buffer_level = (int16_t)ncp_dist_rx_level(&l->rx, slot);
-    s.lost = (int32_t)l->rx.lost;
-    s.stale = (int32_t)l->rx.stale;
-    s.duplicate = (int32_t)l->rx.duplicate;
-    s.held = (int32_t)l->rx.held;
+    if (l->dp4) {
+        s.buffer_level = (int16_t)ncp_dist_recs_level(&l->recs);
+        s.lost = (int32_t)l->recs.gaps;
+        s.stale = (int32_t)l->recs.stale;
+        s.duplicate = (int32_t)l->recs.duplicate;
+        s.rec_next = l->recs.next;
+        if (l->end == LLC_END_MISSING)
+            snprintf((char *)s.fault, sizeof s.fault, "record %d missing when needed",
+                     (int)l->missing_rec);
+    } else {
+        s.buffer_level = (int16_t)ncp_dist_rx_level(&l->rx, slot);
+        s.lost = (int32_t)l->rx.lost;
+        s.stale = (int32_t)l->rx.stale;
+        s.duplicate = (int32_t)l->rx.duplicate;
+        s.held = (int32_t)l->rx.held;
+    }
     uint8_t buf[256];
     int n = ncp_ax_status_t_encode(buf, 0, sizeof buf, &s);
     if (n > 0)
@@ -116,7 +165,7 @@ void llc_advertise(struct llc *l)
                           a->min_limit,    a->max_limit,
                           a->max_vel,      a->max_acc,
                           a->max_jerk,     l->period_ns,
-                          1 << 5,          NCP_AX_ADVERT_T_STAGE_FINE };
+                          1 << 5 | 1 << 4, NCP_AX_ADVERT_T_STAGE_FINE };
     uint8_t buf[128];
     int n = ncp_ax_advert_t_encode(buf, 0, sizeof buf, &m);
     if (n > 0)
@@ -144,6 +193,126 @@ static double follow(struct llc *l, int64_t slot)
         l->clamped++;
     }
     return l->cmd + step;
+}
+
+/* DP4's record source for the interpolator. A record it needs at speed
+ * that is not here is missing (at a standstill: see interpolate()). */
+static int rec_next(void *ctx, double v0, struct ncp_accdec *rec)
+{
+    struct llc *l = ctx;
+    if (ncp_dist_recs_peek(&l->recs, rec))
+        return 1;
+    if (v0 > 0) {
+        l->missing = 1;
+        l->missing_rec = l->recs.next;
+    }
+    return 0;
+}
+
+/* The HLC's period its path left its k-th standstill, 0 not known (yet). */
+static int64_t start_at(const struct llc *l, int32_t k)
+{
+    unsigned i = (unsigned)k % LLC_STARTS;
+    return l->start_k[i] == k ? l->start_t[i] : 0;
+}
+
+static void rec_done(void *ctx)
+{
+    ncp_dist_recs_pop(&((struct llc *)ctx)->recs);
+}
+
+static double ramp(struct llc *l);
+
+/* The interpolator's sample for slot (1), or a standstill held (0): the
+ * interpolator leaves a standstill at the period the HLC's path did (a step
+ * taken too early is taken back), a dwell's time passing meanwhile as it
+ * does at the HLC. commit 0: the step is only looked at (feed-forward). */
+static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
+{
+    struct ncp_accdec first;
+    if (!l->ex_on) {
+        /* every axis from where the first record starts: a standstill is
+         * then the same on every LLC and the HLC */
+        if (!ncp_dist_recs_peek(&l->recs, &first))
+            first.s.start[l->axis] = l->cmd;
+        ncp_exec_init(&l->ex, first.s.start, (double)l->period_ns * 1e-9);
+        memcpy(l->ex_prev, first.s.start, sizeof l->ex_prev);
+        l->ex_on = l->ex_rest = 1;
+    }
+    int64_t due = start_at(l, l->starts_done);
+    struct ncp_exec before = l->ex;
+    int32_t next = l->recs.next;
+    const struct ncp_exec_source src = { rec_next, rec_done, l };
+    struct ncp_setpoint sp;
+    l->missing = 0;
+    (void)ncp_exec_step(&l->ex, &src, &sp);
+    int moving = 0;
+    for (int j = 0; j < NCP_AXES; j++)
+        moving |= sp.pos[j] != l->ex_prev[j];
+    int hold = moving && l->ex_rest && (!due || slot < due);
+    if (!moving && l->ex_rest && due && slot >= due && !ncp_dist_recs_peek(&l->recs, &first)) {
+        /* the HLC moved off here: the record it moved on is needed now */
+        l->missing = 1;
+        l->missing_rec = l->recs.next;
+    }
+    if (hold || !commit) {
+        l->ex = before;
+        l->recs.next = next;
+        if (hold)
+            l->missing = 0;
+        *pos = hold ? l->ex_prev[l->axis] : sp.pos[l->axis];
+        return !hold;
+    }
+    if (moving && l->ex_rest)
+        l->starts_done++;
+    l->ex_rest = !moving;
+    memcpy(l->ex_prev, sp.pos, sizeof l->ex_prev);
+    *pos = sp.pos[l->axis];
+    return 1;
+}
+
+static double interpolate(struct llc *l, int64_t slot)
+{
+    if (slot < l->t_start)
+        return l->cmd;
+    double pos;
+    (void)exec_try(l, slot, 1, &pos);
+    if (l->missing) {
+        l->end = LLC_END_MISSING;
+        l->state = NCP_AX_STATUS_T_STOPPING;
+        return ramp(l);
+    }
+    return pos;
+}
+
+/* Feed-forward's next setpoint at DP4: the interpolator's next step, looked
+ * at and taken back (a missing record: the current velocity goes on). */
+static double interpolate_ahead(struct llc *l, int64_t slot)
+{
+    double pos;
+    if (slot < l->t_start)
+        return l->cmd;
+    (void)exec_try(l, slot, 0, &pos);
+    if (l->missing) {
+        l->missing = 0;
+        return 2 * l->cmd - l->cmd_prev;
+    }
+    return pos;
+}
+
+/* Asks the HLC again for what a later record or its count shows missing,
+ * every few periods while it stays missing. */
+static void resend_request(struct llc *l, int64_t now)
+{
+    int32_t want = l->recs.top > l->hlc_records ? l->recs.top : l->hlc_records;
+    if (l->recs.have >= want || now - l->last_resend_ns < 3 * l->period_ns)
+        return;
+    l->last_resend_ns = now;
+    ncp_rec_mark_t k = { l->mark_seq++, (int16_t)(l->axis + 1), now, l->recs.have, -1 };
+    uint8_t buf[64];
+    int n = ncp_rec_mark_t_encode(buf, 0, sizeof buf, &k);
+    if (n > 0 && ncp_msg_publish(l->msg, l->ch_resend, buf, (size_t)n) == 0)
+        l->resends++;
 }
 
 /* Stopping: the velocity reduced by MAX_ACCELERATION each period. */
@@ -191,7 +360,9 @@ static void period(struct llc *l, int64_t now, int64_t slot)
     uint32_t gaps = l->rx.held + l->rx.bridged, bridged = l->rx.bridged;
     if (l->end == LLC_END_NONE && !l->done_req) {
         l->state = NCP_AX_STATUS_T_RUNNING;
-        next_cmd = follow(l, slot);
+        next_cmd = l->dp4 ? interpolate(l, slot) : follow(l, slot);
+        if (l->dp4)
+            l->rx.played_t = slot;   /* where a late loop catches up from */
     } else {
         l->state = l->end == LLC_END_NONE || l->end == LLC_END_DONE ? NCP_AX_STATUS_T_DONE
                                                                     : NCP_AX_STATUS_T_STOPPING;
@@ -207,7 +378,9 @@ static void period(struct llc *l, int64_t now, int64_t slot)
      * the current velocity goes on */
     int32_t ahead;
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
-    if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
+    if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
+        x[l->axis] = interpolate_ahead(l, slot + T);
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
         x[l->axis] = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
     else
         x[l->axis] = 2 * l->cmd - l->cmd_prev;
@@ -228,6 +401,12 @@ static int waiting(struct llc *l, int64_t now)
 {
     if (l->t_first)
         return 0;
+    if (l->t_start) {
+        l->t_first = l->t_start;
+        if (l->last_hlc_ns == 0)
+            l->last_hlc_ns = now;
+        return 0;
+    }
     /* the oldest setpoint held names the HLC's period grid */
     int64_t first = 0;
     for (int i = 0; i < NCP_DIST_RX_SLOTS; i++)
@@ -267,6 +446,8 @@ int llc_cycle(void *ctx, int64_t now_ns)
     struct llc *l = ctx;
     int64_t now = l->loop.cfg.start_ns + now_ns, T = l->period_ns;
     llc_take(l, llc_now());
+    if (l->dp4)
+        resend_request(l, now);
     int w = waiting(l, now);
     if (w)
         return w < 0 ? NCP_RT_STOP : NCP_RT_CONTINUE;

@@ -1,7 +1,8 @@
 /* The distributed NCK's high-level end (seed 002): the position loop's
  * setpoints go to one cnc-axis LLC per axis over LCM, and the actual positions
  * come back in their statuses. Implemented: ADCBI DP5 (fineIPObuf, a message
- * every servo period carrying every axis).
+ * every servo period carrying every axis) and DP4 (ACCDECbuf: the records the
+ * planner starts, in bursts, lcm_tx.c; the LLCs interpolate them).
  *
  * start() (blocking): waits for every axis's advertisement and first status,
  * checks its limits and period against the INI, and from then on a thread
@@ -15,6 +16,7 @@
  * The LLC reports the actual position of a period 1.5-2.5 periods back. The
  * loop gets that position carried forward by what the HLC commanded since,
  * so cmd - act is the LLC's own following error, not the transport's delay. */
+#include "lcm_tx.h"
 #include "ncpar/backend.h"
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
@@ -32,7 +34,7 @@
 
 struct peer {
     int axis;
-    int sub_advert, sub_status, sub_hb;
+    int sub_advert, sub_status, sub_hb, sub_resend;
     int advertised, have_status;
     ncp_ax_status_t st;          /* the last status */
     int64_t last_status_ns, last_hb_ns;
@@ -59,6 +61,9 @@ struct lcm_be {
     int idle_started;
     uint64_t sent_fine;
     int fine_bytes;
+    struct lcm_tx *tx;       /* DP4 */
+    int rest;                /* the path stood still last period */
+    double prev_cmd[NCP_AXES];
 };
 
 static int64_t mono(void)
@@ -109,6 +114,8 @@ static void take(struct lcm_be *s, int64_t now)
                 on_status(p, b, len, now);
             } else if (sub == p->sub_hb) {
                 p->last_hb_ns = now;
+            } else if (sub == p->sub_resend && s->tx) {
+                lcm_tx_resend(s->tx, s->msg, b, len);
             } else if (sub == p->sub_advert) {
                 ncp_ax_advert_t a;
                 memset(&a, 0, sizeof a);
@@ -242,9 +249,35 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
         fail(s, p, why);
     } else if (p->st.state == NCP_AX_STATUS_T_STOPPING || p->st.state == NCP_AX_STATUS_T_STOPPED ||
                p->st.state == NCP_AX_STATUS_T_FAULT) {
-        fail(s, p, "stopped on its own (lost setpoints, following error or a signal: see its "
-                   "output)");
+        if (p->st.fault[0]) {
+            snprintf(why, sizeof why, "stopped on its own: %.*s", (int)sizeof p->st.fault,
+                     (const char *)p->st.fault);
+            fail(s, p, why);
+        } else {
+            fail(s, p, "stopped on its own (lost setpoints, following error or a signal: see "
+                       "its output)");
+        }
     }
+}
+
+static void send_fine(struct lcm_be *s, int64_t t, const double cmd[NCP_AXES])
+{
+    struct ncp_dist_fine f = { s->fine_seq++, NCP_DIST_HLC_ID, t, (int8_t)s->n, { 0 } };
+    int bad = 0;
+    for (int i = 0; i < s->n; i++)
+        bad |= ncp_dist_mm_to_nm(cmd[s->p[i].axis], &f.pos_nm[i]);
+    uint8_t buf[128];
+    int n = bad ? -1 : ncp_dist_encode_fine(buf, sizeof buf, &f);
+    if (n > 0 && ncp_msg_publish(s->msg, NCP_DIST_CH_FINE, buf, (size_t)n) == 0) {
+        s->sent_fine++;
+        s->fine_bytes = n;
+    }
+}
+
+static void tap(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec)
+{
+    (void)la;
+    lcm_tx_push(((struct lcm_be *)impl)->tx, rec);
 }
 
 static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const double next[NCP_AXES],
@@ -265,18 +298,23 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
     if (s->cycles > 0 && t <= s->last_t + s->T)
         t = s->last_t + s->T;
     s->last_t = t;
-    struct ncp_dist_fine f = { s->fine_seq++, NCP_DIST_HLC_ID, t, (int8_t)s->n, { 0 } };
-    int bad = 0;
-    for (int i = 0; i < s->n; i++)
-        bad |= ncp_dist_mm_to_nm(cmd[s->p[i].axis], &f.pos_nm[i]);
     unsigned h = (unsigned)((uint64_t)(t / s->T) % HIST);
     s->hist_t[h] = t;
     memcpy(s->hist_cmd[h], cmd, sizeof s->hist_cmd[h]);
-    uint8_t buf[128];
-    int n = bad ? -1 : ncp_dist_encode_fine(buf, sizeof buf, &f);
-    if (n > 0 && ncp_msg_publish(s->msg, NCP_DIST_CH_FINE, buf, (size_t)n) == 0) {
-        s->sent_fine++;
-        s->fine_bytes = n;
+    if (s->tx) {
+        /* the LLCs' interpolators leave each standstill when this does */
+        int moving = 0;
+        for (int j = 0; j < NCP_AXES && s->cycles > 0; j++)
+            moving |= cmd[j] != s->prev_cmd[j];
+        int start = moving && s->rest;
+        s->rest = !moving;
+        memcpy(s->prev_cmd, cmd, sizeof s->prev_cmd);
+        int32_t taken = INT32_MAX;
+        for (int i = 0; i < s->n; i++)
+            taken = s->p[i].st.rec_next < taken ? s->p[i].st.rec_next : taken;
+        lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken);
+    } else {
+        send_fine(s, t, cmd);
     }
     if (now - s->last_hb >= s->hb_period) {
         s->last_hb = now;
@@ -329,10 +367,17 @@ static void lcm_stop(struct ncp_backend *b)
     }
     struct ncp_msg_stats st;
     ncp_msg_get_stats(s->msg, &st);
-    fprintf(stderr, "lcm: DP %d: %llu setpoint messages of %d bytes (all %d axes; %d with the "
-                    "LCM header), %.0f per second\n",
-            s->cfg->lcm.dp, (unsigned long long)s->sent_fine, s->fine_bytes, s->n,
-            s->fine_bytes + 8 + (int)sizeof NCP_DIST_CH_FINE, 1e9 / (double)s->T);
+    if (s->tx)
+        fprintf(stderr, "lcm: DP 4: %d records in %llu bursts of %d bytes (%d with the LCM "
+                        "header), %llu resent on request, %llu lost to a full tap ring\n",
+                s->tx->sent, (unsigned long long)s->tx->bursts, s->tx->burst_bytes,
+                s->tx->burst_bytes + 8 + (int)sizeof NCP_DIST_CH_ACCDEC,
+                (unsigned long long)s->tx->resent, (unsigned long long)s->tx->overflow);
+    else
+        fprintf(stderr, "lcm: DP %d: %llu setpoint messages of %d bytes (all %d axes; %d with "
+                        "the LCM header), %.0f per second\n",
+                s->cfg->lcm.dp, (unsigned long long)s->sent_fine, s->fine_bytes, s->n,
+                s->fine_bytes + 8 + (int)sizeof NCP_DIST_CH_FINE, 1e9 / (double)s->T);
     for (int i = 0; i < s->n; i++) {
         const struct peer *p = &s->p[i];
         fprintf(stderr, "lcm: axis %c: %llu statuses, %llu periods without one, %llu late; "
@@ -354,6 +399,15 @@ static void lcm_describe(const struct ncp_backend *b, char *buf, size_t len)
     snprintf(buf, len, "%s", s->fault);
 }
 
+static void free_tx(struct lcm_be *s)
+{
+    if (s->tx) {
+        lcm_tx_free(s->tx);
+        free(s->tx);
+        s->tx = NULL;
+    }
+}
+
 static void lcm_close(struct ncp_backend *b)
 {
     struct lcm_be *s = b->impl;
@@ -361,6 +415,7 @@ static void lcm_close(struct ncp_backend *b)
         return;
     idle_stop(s);
     ncp_msg_close(s->msg);
+    free_tx(s);
     free(s);
     b->impl = NULL;
 }
@@ -372,20 +427,33 @@ static const struct ncp_backend_ops lcm_ops = {
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d)
 {
-    if (cfg->lcm.dp != 5)
+    if (cfg->lcm.dp != 5 && !(cfg->lcm.dp == 4 && cfg->nck == NCP_NCK_ADCBI))
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "DP %d is not implemented yet: the lcm backend streams at DP 5 "
-                            "(ADCBI fineIPObuf) only", cfg->lcm.dp);
+                            "(fineIPObuf) and ADCBI's DP 4 (ACCDECbuf)", cfg->lcm.dp);
+    if (cfg->lcm.dp == 4 && ncp_machine_cfg_ipo_ratio(cfg) != 1)
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
+                            "DP 4 needs [TRAJ] PLANNING_PERIOD equal to SERVO_PERIOD: the LLCs "
+                            "do not fine-interpolate yet");
     struct lcm_be *s = calloc(1, sizeof *s);
     if (!s)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
     s->cfg = cfg;
+    if (cfg->lcm.dp == 4) {
+        s->tx = malloc(sizeof *s->tx);
+        if (!s->tx || lcm_tx_init(s->tx) != 0) {
+            free(s->tx);
+            free(s);
+            return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
+        }
+    }
     s->T = llround(cfg->servo_period * 1e9);
     s->hb_period = cfg->lcm.heartbeat_period_ms * 1000000LL;
     s->hb_timeout = cfg->lcm.heartbeat_timeout_ms * 1000000LL;
     ncp_dist_init();
     int rc = ncp_msg_open(&s->msg, cfg->lcm.url, NULL, d);
     if (rc != NCP_OK) {
+        free_tx(s);
         free(s);
         return rc;
     }
@@ -401,11 +469,14 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
         p->sub_status = ncp_msg_subscribe(s->msg, ch);
         ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_HEARTBEAT);
         p->sub_hb = ncp_msg_subscribe(s->msg, ch);
+        ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_RESEND);
+        p->sub_resend = ncp_msg_subscribe(s->msg, ch);
     }
     struct ncp_msg_inject in = { cfg->lcm.inject_loss, cfg->lcm.inject_delay_us * 1000LL,
                                  (uint64_t)cfg->lcm.inject_seed };
     if (ncp_msg_set_inject(s->msg, &in) != 0) {
         ncp_msg_close(s->msg);
+        free_tx(s);
         free(s);
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
     }
@@ -413,5 +484,7 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     b->ops = &lcm_ops;
     b->impl = s;
     b->real_clock_only = 1;
+    if (s->tx)
+        b->plan_tap = tap;
     return NCP_OK;
 }

@@ -305,9 +305,11 @@ static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
     if (o->virtual_clock)
         return fprintf(stderr, "cnc-run run: --backend lcm runs with its axes in real time: it "
                                "needs --clock real\n"), -1;
-    if (cfg->lcm.dp != 5)
-        return fprintf(stderr, "cnc-run run: --backend lcm: DP %d is not implemented yet (DP 5, "
-                               "fine setpoints every servo period, is)\n", cfg->lcm.dp), -1;
+    if (cfg->lcm.dp != 5 && !(cfg->lcm.dp == 4 && cfg->nck == NCP_NCK_ADCBI))
+        return fprintf(stderr, "cnc-run run: --backend lcm: DP %d is not implemented yet for "
+                               "[PLANNER] NCK = %s (DP 5, fine setpoints every servo period, "
+                               "is, and ADCBI's DP 4, ACCDECbuf records)\n",
+                       cfg->lcm.dp, cfg->nck == NCP_NCK_ADCAI ? "adcai" : "adcbi"), -1;
     return 0;
 }
 

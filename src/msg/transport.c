@@ -26,7 +26,7 @@
 
 #define CHANNEL_SIZE (NCP_MSG_PREFIX_MAX + 8)
 #define UDP_DATAGRAM_MAX 65536
-#define SEND_BUF_SIZE 4096 /* header + the largest type (status_t) */
+#define SEND_BUF_SIZE 8192 /* header + the largest type (accdec_burst_t) */
 #define SUBS_MAX 32
 /* Held back by INJECT_DELAY_US: our own messages are far smaller than this;
  * a larger one is passed on undelayed (and counted) rather than cut. */

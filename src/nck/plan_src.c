@@ -9,6 +9,8 @@ int nck_plan_new(struct nck *n)
         n->adcai = ncp_adcai_new(n->cfg, n->start);
     else
         n->planner = ncp_planner_new(n->cfg, n->start);
+    if (n->planner && n->be.plan_tap)
+        ncp_planner_set_tap(n->planner, n->be.plan_tap, n->be.impl);
     return n->adcai || n->planner ? 0 : -1;
 }
 

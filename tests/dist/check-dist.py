@@ -76,6 +76,8 @@ def main():
     ap.add_argument("--contour-pct", type=float, default=5.0)
     ap.add_argument("--contour-floor", type=float, default=0.0005)
     ap.add_argument("--no-compare", action="store_true")
+    ap.add_argument("--cut", type=float, default=None,
+                    help="compare the LLCs' periods before this many seconds of motion only")
     ap.add_argument("--no-contour", action="store_true",
                     help="path and steps only (runs with losses: the servo sees the gaps)")
     a = ap.parse_args()
@@ -110,7 +112,8 @@ def main():
     cact = [[float(r[k + "_act"]) for k in "xyz"] for r in central]
     # the LLCs' periods, merged: every axis's row for the same HLC period
     by = [{round(float(r["slot"]), 6): r for r in llc[k]} for k in "XYZ"]
-    slots = sorted(set(by[0]) & set(by[1]) & set(by[2]))
+    slots = sorted(s for s in set(by[0]) & set(by[1]) & set(by[2])
+                   if a.cut is None or s < a.cut)
     dcmd = [[float(by[i][s]["cmd"]) for i in range(3)] for s in slots]
     dact = [[float(by[i][s]["act"]) for i in range(3)] for s in slots]
     # a period bridged or held (a loss, or the HLC's loop late by more than

@@ -136,6 +136,60 @@ static void dice_same_seed_same_losses(void **state)
     }
 }
 
+/* ACCDECbuf records: through the LCM type and back bit for bit, and the
+ * LLC's ring tells gaps, duplicates and stale copies apart. */
+static void recs_round_trip_and_ring(void **state)
+{
+    (void)state;
+    struct ncp_accdec a, b;
+    memset(&a, 0, sizeof a);
+    a.s.kind = NCP_SEG_ARC;
+    a.s.line = 42;
+    a.s.start[0] = 0.1;
+    a.s.end[8] = 1.0 / 3.0;
+    a.s.axial = -2.0 / 7.0;
+    a.s.r1 = 5e-17;
+    a.trap.j = 1e9 / 3.0;
+    a.dur = 0.123456789012345678;
+    a.blend = 1;
+    ncp_accdec_burst_t m, back;
+    memset(&m, 0, sizeof m);
+    m.count = 1;
+    ncp_dist_rec_encode(&a, &m.recs[0]);
+    uint8_t buf[8192];
+    int n = ncp_accdec_burst_t_encode(buf, 0, sizeof buf, &m);
+    assert_true(n > 0);
+    assert_int_equal(ncp_accdec_burst_t_decode(buf, 0, n, &back), n);
+    ncp_dist_rec_decode(&back.recs[0], &b);
+    assert_memory_equal(&a.s, &b.s, sizeof a.s);
+    assert_memory_equal(&a.trap, &b.trap, sizeof a.trap);
+    assert_memory_equal(&a.dur, &b.dur, sizeof a.dur);
+    assert_int_equal(b.blend, 1);
+
+    struct ncp_dist_recs q;
+    assert_int_equal(ncp_dist_recs_init(&q), 0);
+    ncp_dist_recs_put(&q, 0, &m.recs[0]);
+    ncp_dist_recs_put(&q, 2, &m.recs[0]);   /* 1 lost */
+    assert_int_equal(q.have, 1);
+    assert_int_equal(q.top, 3);
+    assert_int_equal(q.gaps, 1);
+    ncp_dist_recs_put(&q, 2, &m.recs[0]);
+    assert_int_equal(q.duplicate, 1);
+    ncp_dist_recs_put(&q, 1, &m.recs[0]);   /* the resend */
+    assert_int_equal(q.have, 3);
+    assert_int_equal(ncp_dist_recs_level(&q), 3);
+    assert_int_equal(ncp_dist_recs_peek(&q, &b), 1);
+    ncp_dist_recs_pop(&q);
+    ncp_dist_recs_put(&q, 0, &m.recs[0]);
+    assert_int_equal(q.stale, 1);
+    ncp_dist_recs_put(&q, 1 + NCP_DIST_RECS, &m.recs[0]);
+    assert_int_equal(q.early, 1);
+    ncp_dist_recs_pop(&q);
+    ncp_dist_recs_pop(&q);
+    assert_int_equal(ncp_dist_recs_peek(&q, &b), 0);
+    ncp_dist_recs_free(&q);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -145,6 +199,7 @@ int main(void)
         cmocka_unit_test(rx_gap_held_and_counted),
         cmocka_unit_test(rx_duplicates_and_stale_ignored),
         cmocka_unit_test(dice_same_seed_same_losses),
+        cmocka_unit_test(recs_round_trip_and_ring),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

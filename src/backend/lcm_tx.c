@@ -1,0 +1,120 @@
+/* ACCDECbuf records to the LLCs (ADCBI DP4).
+ *
+ * The planner taps a record when it starts a segment. Its samples reach the
+ * position loop through the setpoint ring, so once the ring is full (the
+ * planner runs ahead of the loop whenever it can) a record is tapped up to
+ * [PLANNER] SETPOINT_RING periods before its first sample plays; at the
+ * program's start the ring is still filling and the first records go out
+ * at once. Bursts of NCP_DIST_BURST then, or whatever waited HOLD periods:
+ * the LLCs play LAG periods behind the HLC, so either way a record is there
+ * before its first sample is needed, unless the planner ran dry mid-program
+ * (then the LLC stops and says which record it missed). */
+#include "lcm_tx.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define TAP_RING 4096
+#define HOLD 50          /* periods an unsent record may wait for a full burst */
+#define BURSTS_MAX 2     /* per period: bounds the position loop's time here */
+#define SYNC_BURST 6     /* syncs sent in a row at the start: one lost is no delay */
+
+int lcm_tx_init(struct lcm_tx *x)
+{
+    memset(x, 0, sizeof *x);
+    x->hist = calloc(LCM_TX_HIST, sizeof *x->hist);
+    if (!x->hist || ncp_spsc_init(&x->tapped, sizeof(struct ncp_accdec), TAP_RING) != 0) {
+        free(x->hist);
+        x->hist = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+void lcm_tx_free(struct lcm_tx *x)
+{
+    free(x->hist);
+    x->hist = NULL;
+    ncp_spsc_destroy(&x->tapped);
+}
+
+void lcm_tx_push(struct lcm_tx *x, const struct ncp_accdec *rec)
+{
+    if (ncp_spsc_push(&x->tapped, rec) != 0)
+        x->overflow++;
+}
+
+static void send_burst(struct lcm_tx *x, struct ncp_msg *m, int32_t first, int count)
+{
+    ncp_accdec_burst_t *b = &x->burst;
+    memset(b, 0, sizeof *b);
+    b->seq = x->burst_seq++;
+    b->sender = NCP_DIST_HLC_ID;
+    b->first = first;
+    b->count = (int8_t)count;
+    for (int i = 0; i < count; i++)
+        b->recs[i] = x->hist[(unsigned)(first + i) % LCM_TX_HIST];
+    int n = ncp_accdec_burst_t_encode(x->buf, 0, sizeof x->buf, b);
+    if (n > 0 && ncp_msg_publish(m, NCP_DIST_CH_ACCDEC, x->buf, (size_t)n) == 0) {
+        x->bursts++;
+        x->burst_bytes = n;
+    }
+}
+
+static void sync(struct lcm_tx *x, struct ncp_msg *m)
+{
+    ncp_rec_mark_t k = { x->mark_seq++, NCP_DIST_HLC_ID, x->t_start, x->sent, x->starts - 1 };
+    uint8_t buf[64];
+    int n = ncp_rec_mark_t_encode(buf, 0, sizeof buf, &k);
+    if (n > 0)
+        (void)ncp_msg_publish(m, NCP_DIST_CH_SYNC, buf, (size_t)n);
+}
+
+void lcm_tx_cycle(struct lcm_tx *x, struct ncp_msg *m, int64_t t, int64_t period, int moving,
+                  int32_t taken)
+{
+    struct ncp_accdec a;
+    /* no further than the history can serve resends from */
+    while (x->next - taken < LCM_TX_HIST - NCP_DIST_BURST && ncp_spsc_pop(&x->tapped, &a) == 0)
+        ncp_dist_rec_encode(&a, &x->hist[(unsigned)x->next++ % LCM_TX_HIST]);
+    if (x->sent < x->next)
+        x->oldest_wait++;
+    for (int k = 0; k < BURSTS_MAX && x->sent < x->next; k++) {
+        int count = x->next - x->sent;
+        if (count > NCP_DIST_BURST)
+            count = NCP_DIST_BURST;
+        /* flow control: no LLC is sent more than it has room for */
+        if (x->sent + count - taken > NCP_DIST_RECS)
+            break;
+        if (count < NCP_DIST_BURST && x->t_start && x->oldest_wait < HOLD)
+            break;
+        send_burst(x, m, x->sent, count);
+        x->sent += count;
+        x->oldest_wait = 0;
+    }
+    if (moving) {
+        x->t_start = t;
+        x->starts++;
+        x->sync_left = SYNC_BURST;
+    }
+    if (x->sync_left > 0 || t - x->last_sync >= 20 * period) {
+        if (x->sync_left > 0)
+            x->sync_left--;
+        x->last_sync = t;
+        sync(x, m);
+    }
+}
+
+void lcm_tx_resend(struct lcm_tx *x, struct ncp_msg *m, const uint8_t *b, size_t len)
+{
+    ncp_rec_mark_t k;
+    memset(&k, 0, sizeof k);
+    if (ncp_rec_mark_t_decode(b, 0, (int)len, &k) != (int)len)
+        return;
+    int32_t from = k.records;
+    if (from < 0 || from >= x->sent || x->next - from > LCM_TX_HIST)
+        return;
+    int count = x->sent - from < NCP_DIST_BURST ? x->sent - from : NCP_DIST_BURST;
+    send_burst(x, m, from, count);
+    x->resent++;
+}
