@@ -42,6 +42,10 @@ async function freePort() {
 }
 
 // One `cnc-run serve --http` with its log; resolves to {proc, url, token}.
+// every server started, so that a test that gives up never leaves one running
+const servers = new Set();
+process.on('exit', () => { for (const p of servers) if (p.exitCode === null) p.kill('SIGKILL'); });
+
 async function startServer(tag, extra = []) {
   const port = await freePort();
   const group = `239.255.${(process.pid >> 8) & 255}.${process.pid & 255}`;
@@ -51,6 +55,7 @@ async function startServer(tag, extra = []) {
     ['serve', '--http', `127.0.0.1:${port}`, '--lcm-url', `udpm://${group}:${port}?ttl=0`,
      '--prefix', `WEBT${process.pid}${tag}_`, ...extra],
     { cwd: path.join(ROOT, 'ncprograms'), stdio: ['ignore', out, out] });
+  servers.add(proc);
   const deadline = Date.now() + 8000;
   for (;;) {
     const text = fs.readFileSync(log, 'utf8');
