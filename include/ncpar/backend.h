@@ -60,7 +60,8 @@ struct ncp_backend;
 struct ncp_backend_ops {
     const char *name;
     /* Before the real-time loop (may block, allocate, talk SDO): brings the
-     * machine up and reports where its axes are. 0, or -1 with fault(). */
+     * machine up and reports where its axes are: the joints it drives are
+     * written, the others keep the caller's value (0). 0, or -1 with fault(). */
     int (*start)(struct ncp_backend *b, double pos[NCP_AXES]);
     /* Real-time, once per servo period: cmd is this period's setpoint, next
      * the one after (feed-forward, or what a CSP drive gets now and runs at

@@ -420,13 +420,13 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
 
 double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, double len)
 {
-    double lo = plan_reach_prof(scurve, ps->acc, ps->jerk, v, len);
+    double lo = plan_reach(scurve, ps->acc, ps->jerk, v, len);
     if (ps->kappa <= 0 || scurve)
         return lo;
     /* the move's top speed x is the end reached: x^2 = v^2 + 2 len acc(x),
      * acc falling with x, so the largest such x is found by bisection
      * between the cruise cap's acceleration and the one at v */
-    double hi = plan_reach_prof(scurve, plan_acc_at(ps, v), ps->jerk, v, len);
+    double hi = plan_reach(scurve, plan_acc_at(ps, v), ps->jerk, v, len);
     for (int i = 0; i < 40 && hi - lo > 1e-9 * hi; i++) {
         double mid = 0.5 * (lo + hi);
         if (mid * mid <= v * v + 2 * len * plan_acc_at(ps, mid))

@@ -65,17 +65,11 @@ static inline int plan_scurve(const struct ncp_planner *p)
 
 /* Highest speed at one end of ps from which speed v at the other end is
  * reachable over len, under the profile (scurve: jerk-limited). */
-static inline double plan_reach_prof(int scurve, double acc, double jerk, double v, double len)
+static inline double plan_reach(int scurve, double acc, double jerk, double v, double len)
 {
     if (scurve && jerk > 0 && isfinite(jerk))
         return ncp_scurve_reach(v, len, acc, jerk);
     return sqrt(v * v + 2 * acc * len);
-}
-
-static inline double plan_reach(const struct ncp_planner *p, double acc, double jerk, double v,
-                                double len)
-{
-    return plan_reach_prof(plan_scurve(p), acc, jerk, v, len);
 }
 
 /* The path acceleration ps allows at speeds up to v: an arc's centripetal

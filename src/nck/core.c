@@ -25,8 +25,10 @@ static int start_backend(struct nck *n, struct ncp_diag *d)
         return -1;
     }
     /* the backend reports its joints; the machine starts from the tool tip
-     * they put in the work (no tool length yet) */
-    double joints[NCP_AXES];
+     * they put in the work (no tool length yet). A joint no drive reports
+     * (CAN drives for X Y Z only) starts at 0, not at what the stack held:
+     * the first move would turn that joint too and lose its corner's blend. */
+    double joints[NCP_AXES] = { 0 };
     if (n->be.ops->start(&n->be, joints) != 0) {
         char why[NCP_DIAG_MSG_MAX];
         n->be.ops->describe_fault(&n->be, why, sizeof why);

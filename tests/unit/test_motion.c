@@ -13,41 +13,9 @@
 #include <unistd.h>
 
 #include "ncpar/motion.h"
+#include "canon_ops.h"
 
 /* ---- helpers ------------------------------------------------------------- */
-
-static struct ncp_canon op6(int kind, double x, double y, double z)
-{
-    struct ncp_canon c;
-    memset(&c, 0, sizeof c);
-    c.kind = (uint16_t)kind; /* the first three numbers of any kind, by position */
-    c.raw.d[0] = x;
-    c.raw.d[1] = y;
-    c.raw.d[2] = z;
-    return c;
-}
-
-static struct ncp_canon op_feed(double f)
-{
-    return op6(NCP_C_SET_FEED_RATE, f, 0, 0);
-}
-
-static struct ncp_canon op_mode(int mode)
-{
-    struct ncp_canon c = op6(NCP_C_SET_MOTION_CONTROL_MODE, 0, 0, 0);
-    c.motion_control.mode = mode;
-    return c;
-}
-
-/* ARC_FEED in the XY plane */
-static struct ncp_canon op_arc(double x, double y, double cx, double cy, int rot, double z)
-{
-    struct ncp_canon c = op6(NCP_C_ARC_FEED, x, y, cx);
-    c.arc_feed.second_axis = cy;
-    c.arc_feed.axis_end = z;
-    c.arc_feed.rotation = rot;
-    return c;
-}
 
 struct trace {
     size_t n, cap;
@@ -280,7 +248,7 @@ static void test_g61_exact_stop_ends(void **state)
     struct ncp_machine_cfg c = test_cfg();
     struct ncp_canon ops[16];
     size_t n = 0;
-    ops[n++] = op_mode(0);
+    ops[n++] = op_mode(0, 0);
     ops[n++] = op_feed(3000);
     for (size_t i = 0; i < sizeof square / sizeof square[0]; i++)
         ops[n++] = op6(NCP_C_STRAIGHT_FEED, square[i][0], square[i][1], 0);
@@ -306,7 +274,7 @@ static void test_g64_corners_within_limits(void **state)
     struct ncp_machine_cfg c = test_cfg();
     struct ncp_canon ops[64];
     size_t n = 0;
-    ops[n++] = op_mode(2);
+    ops[n++] = op_mode(2, 0);
     ops[n++] = op_feed(9000);
     for (size_t i = 0; i < sizeof square / sizeof square[0]; i++)
         ops[n++] = op6(NCP_C_STRAIGHT_FEED, square[i][0], square[i][1], -1.0 * (double)i);
@@ -344,7 +312,7 @@ static void test_g64_p_tolerance(void **state)
     const double tol = 0.05;
     struct ncp_canon ops[16];
     size_t n = 0;
-    ops[n] = op_mode(2);
+    ops[n] = op_mode(2, 0);
     ops[n++].motion_control.tolerance = tol;
     ops[n++] = op_feed(9000);
     for (size_t i = 1; i < np; i++)
@@ -417,7 +385,7 @@ static void test_g64_path_independent_of_override(void **state)
     struct ncp_canon ops[64];
     size_t n = 0;
     for (int pass = 0; pass < 2; pass++) {
-        ops[n] = op_mode(2);
+        ops[n] = op_mode(2, 0);
         ops[n++].motion_control.tolerance = pass ? 0.05 : 0;
         ops[n++] = op_feed(pass ? 1000 : 6000);
         ops[n++] = op6(NCP_C_STRAIGHT_FEED, 0, 0, pass ? -1.0 : 0);
@@ -445,7 +413,7 @@ static void test_g64_blend_only_as_needed(void **state)
     struct ncp_machine_cfg c = test_cfg();
     struct ncp_canon ops[8];
     size_t n = 0;
-    ops[n++] = op_mode(2);
+    ops[n++] = op_mode(2, 0);
     ops[n++] = op_feed(120);
     ops[n++] = op6(NCP_C_STRAIGHT_FEED, 4, 0, 0);
     ops[n++] = op6(NCP_C_STRAIGHT_FEED, 4, 4, 0);
@@ -478,7 +446,7 @@ static void run_naivecam(double q, struct ncp_planner_stats *st, double *worst_p
     static double pts[N + 1][3];
     size_t n = 0, np = 0;
     const double p_tol = 0.01;
-    ops[n] = op_mode(2);
+    ops[n] = op_mode(2, 0);
     ops[n++].motion_control.tolerance = p_tol;
     ops[n].kind = NCP_C_SET_NAIVECAM_TOLERANCE;
     ops[n++].naivecam.tolerance = q;

@@ -15,47 +15,13 @@
 #include <string.h>
 
 #include "ncpar/motion.h"
-
-static struct ncp_canon op6(int kind, double x, double y, double z)
-{
-    struct ncp_canon c;
-    memset(&c, 0, sizeof c);
-    c.kind = (uint16_t)kind;
-    c.raw.d[0] = x;
-    c.raw.d[1] = y;
-    c.raw.d[2] = z;
-    return c;
-}
-
-static struct ncp_canon op_mode(int mode, double tol)
-{
-    struct ncp_canon c = op6(NCP_C_SET_MOTION_CONTROL_MODE, 0, 0, 0);
-    c.motion_control.mode = mode;
-    c.motion_control.tolerance = tol;
-    return c;
-}
-
-static struct ncp_canon op_arc(double x, double y, double cx, double cy, int rot, double z)
-{
-    struct ncp_canon c = op6(NCP_C_ARC_FEED, x, y, cx);
-    c.arc_feed.second_axis = cy;
-    c.arc_feed.axis_end = z;
-    c.arc_feed.rotation = rot;
-    return c;
-}
-
-static struct ncp_canon op_dwell(double s)
-{
-    struct ncp_canon c = op6(NCP_C_DWELL, 0, 0, 0);
-    c.dwell.seconds = s;
-    return c;
-}
+#include "canon_ops.h"
 
 /* corners blended within P, an arc, a helix, a dwell, an exact stop, a rapid */
 static size_t program(struct ncp_canon *ops)
 {
     size_t n = 0;
-    ops[n++] = op6(NCP_C_SET_FEED_RATE, 3000, 0, 0);
+    ops[n++] = op_feed(3000);
     ops[n++] = op_mode(2, 0.01);
     ops[n++] = op6(NCP_C_STRAIGHT_FEED, 10, 0, 0);
     ops[n++] = op6(NCP_C_STRAIGHT_FEED, 10, 8, 0);
