@@ -14,8 +14,9 @@
  * still alive reports a standstill.
  *
  * The LLC reports the actual position of a period 1.5-2.5 periods back. The
- * loop gets that position carried forward by what the HLC commanded since,
- * so cmd - act is the LLC's own following error, not the transport's delay. */
+ * loop gets that position carried forward by what the HLC commanded since
+ * (DP5), or its command less the LLC's own following error (block-level DPs),
+ * so cmd - act is the LLC's following error, not the transport's delay. */
 #include "lcm_tx.h"
 #include "ncpar/backend.h"
 #include "ncpar/dist.h"
@@ -334,8 +335,11 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         double a = ncp_dist_nm_to_mm(p->st.act_nm);
         unsigned k = (unsigned)((uint64_t)(p->st.t_ns / s->T) % HIST);
         /* its period's setpoint is remembered (it always is, unless the
-         * status is older than HIST periods): carried forward from there */
-        if (p->have_status && p->st.t_ns > 0 && s->hist_t[k] == p->st.t_ns)
+         * status is older than HIST periods): carried forward from there.
+         * Block-level DPs: the LLC interpolates on its own clock, so after
+         * periods this loop skipped its command is ahead of this one's and
+         * only its own following error says how well it follows */
+        if (!s->tx && p->have_status && p->st.t_ns > 0 && s->hist_t[k] == p->st.t_ns)
             act[j] = a + cmd[j] - s->hist_cmd[k][j];
         else
             act[j] = cmd[j] - ncp_dist_nm_to_mm(p->st.ferr_nm);
