@@ -65,6 +65,43 @@ int ncp_cpus_usable(void);
 /* Load an INI thread map; fills d (file:line) on error. */
 int ncp_thread_map_load(struct ncp_thread_map *m, const char *path, struct ncp_diag *d);
 
+/* The pipeline's threads as tasks of seed 000's chain, for a scheduler that
+ * ranks them (the NCK's [SCHED]): each thread is announced on itself as it
+ * starts a run and again as it ends it, with what it is and a handle to read
+ * its rings' fill without locks while it runs. */
+enum ncp_pipe_kind {
+    NCP_PIPE_FEEDER,     /* the feeder (or, without lexers, the text's prefaulter) */
+    NCP_PIPE_LEXER,
+    NCP_PIPE_ANALYZER,
+    NCP_PIPE_EXECUTOR,
+    NCP_PIPE_OUTPUT      /* hands the commands on in order (emit): the chain's next task */
+};
+#define NCP_PIPE_KINDS 5
+
+struct ncp_pipe;
+struct ncp_pipe_thread {
+    enum ncp_pipe_kind kind;
+    int index;                   /* among the threads of its kind */
+    const struct ncp_pipe *pipe;
+};
+
+/* Elements waiting in the thread's input rings and ready in its output rings
+ * (summed over the rings of its kind), with their capacities; a capacity of 0
+ * means no ring on that side (the feeder's input, the output's output). Only
+ * between the started and ended calls. */
+struct ncp_pipe_fill {
+    size_t in_fill, in_cap, out_fill, out_cap;
+};
+void ncp_pipe_thread_fill(const struct ncp_pipe_thread *t, struct ncp_pipe_fill *f);
+const char *ncp_pipe_kind_name(enum ncp_pipe_kind k);
+
+struct ncp_pipe_hooks {
+    void *ctx;
+    void (*started)(void *ctx, const struct ncp_pipe_thread *t);
+    /* the thread is done with the run's rings: after this returns they may go */
+    void (*ended)(void *ctx, const struct ncp_pipe_thread *t);
+};
+
 /* Receives completed slots in cmd_id order on the output thread. Return non-zero
  * to stop the run (e.g. write error). */
 struct ncp_output {
@@ -83,6 +120,9 @@ struct ncp_output {
      * on (the pipeline publishes what its stages hold back first), so it
      * may wait until emit has taken them. NULL: rs274 -g's stand-ins. */
     ncp_machine_sync_fn sync;
+    /* Optional: told of every pipeline thread of the run (the serial
+     * reference has none) */
+    const struct ncp_pipe_hooks *threads;
 };
 
 /* Per-stage counters, each written by its own thread only (read after join). */

@@ -1,6 +1,6 @@
-/* Priorities of the NCK's soft-real-time tasks (seed 000): the job thread
- * (interpreter) and the planner (look-ahead, acc/dec, rough interpolation),
- * each fed by a ring, all below the position loop.
+/* Priorities of the NCK's soft-real-time tasks (seed 000): the interpreter
+ * pipeline's threads, the job thread and the planner (look-ahead, acc/dec,
+ * rough interpolation), each fed by a ring, all below the position loop.
  *
  * static:   SCHED_FIFO by dependency distance from the position loop, fixed
  *           for the run: the planner one below the loop, the job one below that.
@@ -56,17 +56,27 @@ void ncp_sched_static(int n, int floor, int ceiling, int *prio);
  * the task nearer the position loop. */
 void ncp_sched_dataflow(const struct ncp_sched_fill *f, int n, int floor, int ceiling,
                         int *prio);
+/* The same for tasks in any order: rank[i] is task i's place in the chain
+ * (higher: nearer the position loop), which breaks ties before the index. */
+void ncp_sched_dataflow_ranked(const struct ncp_sched_fill *f, const int *rank, int n,
+                               int floor, int ceiling, int *prio);
 
 /* ---- the scheduler thread ----------------------------------------------------- */
 
-#define NCP_SCHED_TASKS 8
+/* the NCK's job and planner, and every thread an interpreter pipeline may run */
+#define NCP_SCHED_TASKS 40
 
 struct ncp_sched_task {
     const char *name;
-    _Atomic int tid;            /* the task's Linux thread id while it runs, else 0 */
+    _Atomic int tid;            /* the task's Linux thread id while it runs, else 0:
+                                 * only running tasks are ranked */
+    int rank;                   /* place in the chain, higher nearer the position loop */
     /* its rings' fill and capacity, read without locks */
     size_t (*in_fill)(void *ctx), (*out_fill)(void *ctx);
     size_t in_cap, out_cap;
+    /* or, where the rings come and go with the task, all four at once
+     * (only called while tid is set) */
+    void (*gauge)(void *ctx, struct ncp_sched_fill *f);
     void *ctx;
     /* written by the scheduler thread only */
     int prio, prio_min, prio_max;
@@ -81,6 +91,7 @@ struct ncp_sched {
     int n;
     struct ncp_sched_task task[NCP_SCHED_TASKS];
     _Atomic int stop;
+    _Atomic unsigned round_seq; /* odd while a data-flow round reads the tasks */
     int started, refused;
     pthread_t thread;
 };
@@ -92,6 +103,9 @@ int ncp_sched_ceiling(int loop_priority);
  * creation instead. */
 void ncp_sched_enter(struct ncp_sched_task *t);
 void ncp_sched_leave(struct ncp_sched_task *t);
+/* Leave, then wait until no round can still be reading the task's rings (a
+ * task whose rings are freed once it ends). */
+void ncp_sched_leave_sync(struct ncp_sched *s, struct ncp_sched_task *t);
 /* Starts the data-flow thread (no-op for the other strategies). 0 or errno. */
 int ncp_sched_start(struct ncp_sched *s);
 void ncp_sched_stop(struct ncp_sched *s);

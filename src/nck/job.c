@@ -701,7 +701,8 @@ static void *interp_main(void *arg)
 {
     struct nck *n = arg;
     struct nck_job *j = &n->job;
-    struct ncp_output out = { .ctx = n, .emit = emit_job, .sync = machine_sync };
+    struct ncp_output out = { .ctx = n, .emit = emit_job, .sync = machine_sync,
+                              .threads = nck_sched_pipe_hooks(n) };
     nck_sched_enter(n, 0);
     memset(&j->diag, 0, sizeof j->diag);
     j->rc = j->interpret(j->interp_ctx, &out, &j->diag);

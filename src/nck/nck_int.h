@@ -324,7 +324,10 @@ struct nck {
     /* [SCHED]: task 0 the job thread, task 1 the planner (sched.c) */
     struct ncp_sched sched;
     struct ncp_rt_place job_place, planner_place;
-    _Atomic int prio_seen[2];    /* each task's priority, read back by itself */
+    _Atomic int prio_seen[NCP_SCHED_TASKS]; /* each task's priority, read back by itself */
+    /* the interpreter pipeline's threads as tasks (src/nck/sched.c) */
+    struct ncp_pipe_thread pipe_thread[NCP_SCHED_TASKS];
+    struct ncp_pipe_hooks pipe_hooks;
     int trace_rings;
     /* ring and task timing for the trace (TRACE_RINGS): written by their task */
     _Atomic int64_t plan_resp_ns, plan_cycle_ns, job_cycle_ns;
@@ -566,6 +569,9 @@ int nck_sched_start(struct nck *n);
 void nck_sched_enter(struct nck *n, int task);
 void nck_sched_leave(struct nck *n, int task);
 void nck_sched_summary(const struct nck *n, char *buf, size_t len);
+/* For the job's interpreter output: its pipeline threads join the strategy
+ * (NULL where none applies). */
+const struct ncp_pipe_hooks *nck_sched_pipe_hooks(struct nck *n);
 /* Writes the rows gathered so far. 0, or -1 when the write failed. */
 int nck_trace_flush(struct nck_summary *s, FILE *trace);
 

@@ -34,6 +34,7 @@ struct ncp_chunk {
 /* Own cache line each: counters are bumped per item by their thread. */
 struct ncp_pipe_worker {
     alignas(64) struct ncp_pipe *p;
+    void *(*fn)(void *);         /* its stage's code */
     int index;
     uint64_t items;              /* written by this worker's thread only */
     double cpu_ms;               /* its thread's CPU time, set as it ends */
@@ -118,8 +119,11 @@ struct ncp_pipe_stage {
 };
 
 /* The run's stage threads in the paper's start order (feeder, lexers,
- * analyzer, executors, output); returns how many. */
+ * analyzer, executors, output); returns how many. Sets each worker's fn. */
 int ncp_pipe_stages(struct ncp_pipe *p, struct ncp_pipe_stage out[NCP_PIPE_MAX_THREADS]);
+/* A stage thread's run: w->fn(w) between the output's thread hooks. */
+void ncp_pipe_run_stage(struct ncp_pipe_worker *w);
+void *ncp_pipe_stage_main(void *w);
 
 /* The threads of one run and how their start went. */
 struct ncp_starter {

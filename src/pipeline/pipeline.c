@@ -166,15 +166,22 @@ struct ncp_pipe *ncp_pipe_new(const struct ncp_thread_map *map)
     return p;
 }
 
+/* The counters start again; a worker keeps its stage's code (a pool's
+ * threads run it again in the next run). */
+static void worker_reset(struct ncp_pipe *p, struct ncp_pipe_worker *w, int index)
+{
+    *w = (struct ncp_pipe_worker){ .p = p, .fn = w->fn, .index = index };
+}
+
 static void workers_reset(struct ncp_pipe *p)
 {
     for (int i = 0; i < NCP_MAX_LEXERS; i++)
-        p->lexer[i] = (struct ncp_pipe_worker){ p, i, 0, 0.0 };
+        worker_reset(p, &p->lexer[i], i);
     for (int j = 0; j < NCP_MAX_EXECUTORS; j++)
-        p->executor[j] = (struct ncp_pipe_worker){ p, j, 0, 0.0 };
-    p->feeder = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
-    p->analyzer = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
-    p->output = (struct ncp_pipe_worker){ p, 0, 0, 0.0 };
+        worker_reset(p, &p->executor[j], j);
+    worker_reset(p, &p->feeder, 0);
+    worker_reset(p, &p->analyzer, 0);
+    worker_reset(p, &p->output, 0);
 }
 
 void ncp_pipe_reset(struct ncp_pipe *p)
@@ -263,6 +270,8 @@ int ncp_pipe_stages(struct ncp_pipe *p, struct ncp_pipe_stage out[NCP_PIPE_MAX_T
                                             &p->executor[j], 0 };
     if (!p->inline_out)
         out[k++] = (struct ncp_pipe_stage){ &map->output, ncp_pipe_output, &p->output, 0 };
+    for (int i = 0; i < k; i++)
+        out[i].w->fn = out[i].fn;
     return k;
 }
 
@@ -274,7 +283,7 @@ static void start_all(struct ncp_starter *s)
     for (int k = 0; k < n; k++) {
         if (k == 1 && s->p->n > 0 && !s->failed)
             ncp_pipe_wait_gate(s->p, s->p->map->start_timeout_us);
-        ncp_pipe_start_thread(s, st[k].spec, st[k].fn, st[k].w);
+        ncp_pipe_start_thread(s, st[k].spec, ncp_pipe_stage_main, st[k].w);
     }
 }
 

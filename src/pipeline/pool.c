@@ -13,7 +13,6 @@
 
 struct pool_member {
     struct ncp_pipeline_pool *pool;
-    void *(*stage)(void *);
     struct ncp_pipe_worker *w;
     int waits_gate;               /* lexers keep the paper's start rule */
 };
@@ -43,7 +42,7 @@ static void *member_main(void *arg)
         if (m->waits_gate)
             ncp_pipe_wait_gate(pool->p, pool->map.start_timeout_us);
         double cpu0 = ncp_pipe_thread_cpu_ms();
-        m->stage(m->w); /* ends with the thread's absolute CPU time in w->cpu_ms */
+        ncp_pipe_run_stage(m->w); /* ends with the thread's absolute CPU time in w->cpu_ms */
         m->w->cpu_ms -= cpu0;
         if (atomic_fetch_add(&pool->done, 1) + 1 == (uint32_t)pool->s.started)
             ncp_futex_wake_all(&pool->done);
@@ -87,7 +86,7 @@ struct ncp_pipeline_pool *ncp_pipeline_pool_new(const struct ncp_thread_map *map
     int n = ncp_pipe_stages(p, st);
     for (int k = 0; k < n && !pool->s.failed; k++) {
         struct pool_member *m = &pool->member[pool->s.started];
-        *m = (struct pool_member){ pool, st[k].fn, st[k].w, st[k].is_lexer };
+        *m = (struct pool_member){ pool, st[k].w, st[k].is_lexer };
         ncp_pipe_start_thread(&pool->s, st[k].spec, member_main, m);
     }
     pool->s.setup_ms = 0; /* the runs never pay it */

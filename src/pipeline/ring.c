@@ -460,6 +460,15 @@ uint32_t ncp_ring_stage_known(const struct ncp_ring *r, unsigned s)
     return st->seen - st->next;
 }
 
+uint32_t ncp_ring_between(const struct ncp_ring *r, unsigned s)
+{
+    uint32_t to = atomic_load_explicit(&r->stage[s + 1].pos, memory_order_relaxed);
+    uint32_t from = atomic_load_explicit(&r->stage[s].pos, memory_order_relaxed);
+    uint32_t n = from - to;
+    /* the two loads are not one snapshot: never more than the ring holds */
+    return n > r->mask + 1 ? r->mask + 1 : n;
+}
+
 uint64_t ncp_ring_waits(const struct ncp_ring *r, unsigned s)
 {
     return r->stage[s].waits;

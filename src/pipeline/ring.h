@@ -61,6 +61,10 @@ struct ncp_ring {
     struct ncp_mem mem;                  /* where the slots are */
 };
 
+/* Elements stage s has published that stage s + 1 has not (s + 1 below
+ * n_stages), from the published positions with relaxed loads: a gauge for
+ * another thread, up to a batch behind. */
+uint32_t ncp_ring_between(const struct ncp_ring *r, unsigned s);
 /* Round up to a power of two within [1, NCP_RING_MAX_CAPACITY]. */
 uint32_t ncp_ring_capacity(uint32_t want);
 

@@ -35,8 +35,22 @@ static int runnable(const struct ncp_sched_fill *f)
 void ncp_sched_dataflow(const struct ncp_sched_fill *f, int n, int floor, int ceiling,
                         int *prio)
 {
+    ncp_sched_dataflow_ranked(f, NULL, n, floor, ceiling, prio);
+}
+
+/* j is nearer the position loop than i */
+static int downstream(const int *rank, int j, int i)
+{
+    if (rank && rank[j] != rank[i])
+        return rank[j] > rank[i];
+    return j > i;
+}
+
+void ncp_sched_dataflow_ranked(const struct ncp_sched_fill *f, const int *rank, int n,
+                               int floor, int ceiling, int *prio)
+{
     /* rank among the runnable: a task outranks another with less pressure,
-     * or the same pressure further upstream */
+     * or the same pressure further upstream (nearer the position loop) */
     for (int i = 0; i < n; i++) {
         if (!runnable(&f[i])) {
             prio[i] = floor;
@@ -48,7 +62,7 @@ void ncp_sched_dataflow(const struct ncp_sched_fill *f, int n, int floor, int ce
             if (j == i || !runnable(&f[j]))
                 continue;
             double pj = pressure(&f[j]);
-            if (pj > pi || (pj == pi && j > i))
+            if (pj > pi || (pj == pi && downstream(rank, j, i)))
                 above++;
         }
         prio[i] = clamp(ceiling - above, floor, ceiling);

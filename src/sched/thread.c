@@ -38,27 +38,52 @@ static int apply(struct ncp_sched_task *t, int prio)
     return 1;
 }
 
-int ncp_sched_round(struct ncp_sched *s)
+void ncp_sched_leave_sync(struct ncp_sched *s, struct ncp_sched_task *t)
+{
+    ncp_sched_leave(t);
+    /* a round that began before the leave may still read the rings; one that
+     * begins after it sees tid 0 and skips them */
+    unsigned seq = atomic_load(&s->round_seq);
+    while ((seq & 1u) && atomic_load(&s->round_seq) == seq)
+        sched_yield();
+}
+
+static int ranked_round(struct ncp_sched *s)
 {
     struct ncp_sched_fill f[NCP_SCHED_TASKS] = { { 0, 0, 0, 0 } };
-    int prio[NCP_SCHED_TASKS] = { 0 };
+    int prio[NCP_SCHED_TASKS] = { 0 }, rank[NCP_SCHED_TASKS] = { 0 }, at[NCP_SCHED_TASKS], k = 0;
     for (int i = 0; i < s->n; i++) {
         struct ncp_sched_task *t = &s->task[i];
-        f[i] = (struct ncp_sched_fill){ t->in_fill ? t->in_fill(t->ctx) : 0, t->in_cap,
-                                        t->out_fill ? t->out_fill(t->ctx) : 0, t->out_cap };
-    }
-    ncp_sched_dataflow(f, s->n, s->cfg.floor, s->ceiling, prio);
-    int changed = 0;
-    for (int i = 0; i < s->n; i++) {
-        struct ncp_sched_task *t = &s->task[i];
-        if (t->applied_tid && t->applied_tid == atomic_load(&t->tid) && t->prio == prio[i])
+        if (!atomic_load_explicit(&t->tid, memory_order_acquire))
             continue;
-        int r = apply(t, prio[i]);
+        if (t->gauge)
+            t->gauge(t->ctx, &f[k]);
+        else
+            f[k] = (struct ncp_sched_fill){ t->in_fill ? t->in_fill(t->ctx) : 0, t->in_cap,
+                                            t->out_fill ? t->out_fill(t->ctx) : 0, t->out_cap };
+        rank[k] = t->rank;
+        at[k++] = i;
+    }
+    ncp_sched_dataflow_ranked(f, rank, k, s->cfg.floor, s->ceiling, prio);
+    int changed = 0;
+    for (int m = 0; m < k; m++) {
+        struct ncp_sched_task *t = &s->task[at[m]];
+        if (t->applied_tid && t->applied_tid == atomic_load(&t->tid) && t->prio == prio[m])
+            continue;
+        int r = apply(t, prio[m]);
         if (r < 0)
             return -1;
         changed += r;
     }
     return changed;
+}
+
+int ncp_sched_round(struct ncp_sched *s)
+{
+    atomic_fetch_add(&s->round_seq, 1);
+    int r = ranked_round(s);
+    atomic_fetch_add(&s->round_seq, 1);
+    return r;
 }
 
 static void *sched_main(void *arg)

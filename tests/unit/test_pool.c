@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -146,11 +147,83 @@ static void test_serial_pool_is_serial(void **state)
     ncp_pipeline_pool_free(NULL);
 }
 
+/* ---- the thread hooks a scheduler ranks the pipeline's threads by ---- */
+
+static _Atomic int hook_started[NCP_PIPE_KINDS], hook_ended[NCP_PIPE_KINDS], hook_bad;
+
+static void check_fill(const struct ncp_pipe_thread *t)
+{
+    struct ncp_pipe_fill f;
+    ncp_pipe_thread_fill(t, &f);
+    /* a source has no input ring, a sink no output ring, the rest both */
+    int want_in = t->kind != NCP_PIPE_FEEDER, want_out = t->kind != NCP_PIPE_OUTPUT;
+    if (f.in_fill > f.in_cap || f.out_fill > f.out_cap || (f.in_cap > 0) != want_in ||
+        (f.out_cap > 0) != want_out)
+        atomic_fetch_add(&hook_bad, 1);
+}
+
+static void on_started(void *ctx, const struct ncp_pipe_thread *t)
+{
+    (void)ctx;
+    check_fill(t);
+    atomic_fetch_add(&hook_started[t->kind], 1);
+}
+
+static void on_ended(void *ctx, const struct ncp_pipe_thread *t)
+{
+    (void)ctx;
+    check_fill(t);
+    atomic_fetch_add(&hook_ended[t->kind], 1);
+}
+
+static void test_thread_hooks(void **state)
+{
+    (void)state;
+    static const struct ncp_pipe_hooks hooks = { NULL, on_started, on_ended };
+    size_t cap = 5000 * 32 + 64, len = 0;
+    char *big = malloc(cap);
+    assert_non_null(big);
+    for (int i = 0; i < 5000; i++)
+        len += (size_t)snprintf(big + len, cap - len, "G1 X%d Y%d F600\n", i % 97, i % 89);
+    snprintf(big + len, cap - len, "M2\n");
+    struct ncp_thread_map map;
+    ncp_thread_map_default(&map, NCP_MODE_DET, 2, 1);
+    struct ncp_pipeline_pool *pool = ncp_pipeline_pool_new(&map, &(struct ncp_diag){ 0 });
+    assert_non_null(pool);
+    for (int run = 0; run < 3; run++) {
+        for (int k = 0; k < NCP_PIPE_KINDS; k++)
+            atomic_store(&hook_started[k], 0), atomic_store(&hook_ended[k], 0);
+        struct ncp_source src;
+        struct ncp_diag d;
+        assert_int_equal(ncp_source_from_memory(&src, big, strlen(big), "t.ngc", &d), 0);
+        struct ncp_analyzer_cfg cfg = { .max_loop_iterations = 1000 };
+        struct text_out text = { NULL, 0, 0, -1, 0 };
+        struct ncp_output out = { .ctx = &text, .emit = collect, .threads = &hooks };
+        struct ncp_run_stats st;
+        /* run 0 starts its own threads, the others reuse the pool's */
+        int rc = run == 0 ? ncp_pipeline_run(&src, &map, &cfg, &out, &st, &d)
+                          : ncp_pipeline_pool_run(pool, &src, &cfg, &out, &st, &d);
+        assert_int_equal(rc, NCP_OK);
+        ncp_source_close(&src);
+        free(text.buf);
+        static const int want[NCP_PIPE_KINDS] = { 1, 2, 1, 1, 1 };
+        for (int k = 0; k < NCP_PIPE_KINDS; k++) {
+            assert_int_equal(atomic_load(&hook_started[k]), want[k]);
+            assert_int_equal(atomic_load(&hook_ended[k]), want[k]);
+        }
+    }
+    assert_int_equal(atomic_load(&hook_bad), 0);
+    assert_string_equal(ncp_pipe_kind_name(NCP_PIPE_EXECUTOR), "executor");
+    ncp_pipeline_pool_free(pool);
+    free(big);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_runs_equal_serial),
         cmocka_unit_test(test_serial_pool_is_serial),
+        cmocka_unit_test(test_thread_hooks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -95,6 +95,22 @@ static void test_ini_keys(void **state)
     assert_int_equal(ncp_sched_ini_key(&c, "COLOUR", "2", why, sizeof why), 0);
 }
 
+static void test_dataflow_ranked_ties(void **state)
+{
+    (void)state;
+    /* equal pressure: the task nearer the position loop (higher rank) wins,
+     * whatever its place in the array; without ranks, the later index */
+    struct ncp_sched_fill f[3] = { { 8, 16, 8, 16 }, { 8, 16, 8, 16 }, { 8, 16, 8, 16 } };
+    int rank[3] = { 6, 0, 3 }, p[3];
+    ncp_sched_dataflow_ranked(f, rank, 3, 10, 89, p);
+    assert_int_equal(p[0], 89);
+    assert_int_equal(p[2], 88);
+    assert_int_equal(p[1], 87);
+    ncp_sched_dataflow(f, 3, 10, 89, p);
+    assert_int_equal(p[2], 89);
+    assert_int_equal(p[0], 87);
+}
+
 /* ---- one round on real threads ---------------------------------------------- */
 
 static size_t fill_in, fill_out;
@@ -164,6 +180,7 @@ int main(void)
         cmocka_unit_test(test_static_by_distance),
         cmocka_unit_test(test_dataflow_raises_the_starved),
         cmocka_unit_test(test_dataflow_bounded),
+        cmocka_unit_test(test_dataflow_ranked_ties),
         cmocka_unit_test(test_ini_keys),
         cmocka_unit_test(test_round_applies_within_bounds),
     };
