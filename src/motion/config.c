@@ -268,6 +268,18 @@ static int rt_key(struct ncp_machine_cfg *c, const char *k, const char *v, char 
     return 0;
 }
 
+/* A key that takes one of two words (any case): *second says which; else
+ * why names both. */
+static int either(const char *v, const char *first, const char *other, int *second, char *why,
+                  size_t len)
+{
+    *second = !strcasecmp(v, other);
+    if (*second || !strcasecmp(v, first))
+        return 0;
+    snprintf(why, len, "%s or %s", first, other);
+    return -1;
+}
+
 static int planner_key(struct ncp_machine_cfg *c, const char *k, const char *v, char *why,
                        size_t len)
 {
@@ -275,22 +287,17 @@ static int planner_key(struct ncp_machine_cfg *c, const char *k, const char *v, 
         return whole(v, 2, 100000, &c->lookahead, "segments", why, len);
     if (!strcasecmp(k, "SETPOINT_RING"))
         return whole(v, 4, 1 << 20, &c->setpoint_ring, "planning periods", why, len);
+    int second;
     if (!strcasecmp(k, "PROFILE")) {
-        if (!strcasecmp(v, "trapezoid"))
-            c->profile = NCP_PROFILE_TRAPEZOID;
-        else if (!strcasecmp(v, "scurve"))
-            c->profile = NCP_PROFILE_SCURVE;
-        else
-            return snprintf(why, len, "trapezoid or scurve"), -1;
+        if (either(v, "trapezoid", "scurve", &second, why, len) < 0)
+            return -1;
+        c->profile = second ? NCP_PROFILE_SCURVE : NCP_PROFILE_TRAPEZOID;
         return 1;
     }
     if (!strcasecmp(k, "NCK")) {
-        if (!strcasecmp(v, "adcbi"))
-            c->nck = NCP_NCK_ADCBI;
-        else if (!strcasecmp(v, "adcai"))
-            c->nck = NCP_NCK_ADCAI;
-        else
-            return snprintf(why, len, "adcbi or adcai"), -1;
+        if (either(v, "adcbi", "adcai", &second, why, len) < 0)
+            return -1;
+        c->nck = second ? NCP_NCK_ADCAI : NCP_NCK_ADCBI;
         return 1;
     }
     return 0;
