@@ -128,7 +128,7 @@ static void begin(struct ncp_http *h, struct lws *wsi, struct upload *u)
     }
 }
 
-static void body(struct ncp_http *h, struct upload *u, const char *in, size_t len)
+static void take_body(struct ncp_http *h, struct upload *u, const char *in, size_t len)
 {
     if (u->status)
         return;
@@ -164,7 +164,6 @@ static void finish(struct ncp_http *h, struct upload *u)
 {
     if (u->status)
         return;
-    char why[200];
     if (u->got == 0) {
         refuse(h, u, HTTP_STATUS_BAD_REQUEST, NCP_HTTP_STAT_UPLOAD_BAD, "the file is empty");
         return;
@@ -176,6 +175,7 @@ static void finish(struct ncp_http *h, struct upload *u)
     int err = errno;
     unlink(u->tmp);   /* after link(), the program keeps its own name */
     if (rc) {
+        char why[200];
         if (err == EEXIST)
             snprintf(why, sizeof why, "%s exists: upload it again with overwrite to replace it",
                      u->name);
@@ -209,7 +209,7 @@ int ncp_http_on_upload(struct lws *wsi, enum lws_callback_reasons reason, void *
         }
         return 0;
     case LWS_CALLBACK_HTTP_BODY:
-        body(h, u, in, len);
+        take_body(h, u, in, len);
         return 0;
     case LWS_CALLBACK_HTTP_BODY_COMPLETION:
         finish(h, u);

@@ -361,7 +361,7 @@ static void test_active_codes(void **state)
     s.g64_p = 0;
     s.gcodes[9] = 592;   /* G59.2 */
     s.gcodes[0] = 0;     /* G0 */
-    n = ncp_msg_active_codes_text(&s, buf, sizeof buf);
+    assert_true(ncp_msg_active_codes_text(&s, buf, sizeof buf) > 0);
     assert_non_null(strstr(buf, "G0 G17"));
     assert_non_null(strstr(buf, "G59.2 G64 G97"));
     char js[8192];
