@@ -137,6 +137,9 @@ function onStatus(m) {
   $('g5x').textContent = (s.g5x && s.g5x.name) || '—';
   $('coolant').textContent = [s.coolant.mist && 'mist', s.coolant.flood && 'flood'].filter(Boolean).join(', ') || 'off';
   $('stepmode').textContent = s.step ? 'on' : 'off';
+  const g = (s.gcodes || []).map((c) => (c === 'G64' && s.g64 && (s.g64.p > 0 || s.g64.q > 0)) ? `G64 P${s.g64.p} Q${s.g64.q}` : c);
+  $('gcodes').textContent = g.join(' ') || '—';
+  $('mcodes').textContent = (s.mcodes || []).join(' ') || '—';
   if (document.activeElement !== $('step')) $('step').checked = !!s.step;
   for (const w of ['feed', 'rapid', 'spindle']) {
     const el = $('ov-' + w);
@@ -204,7 +207,8 @@ function fillFiles(files) {
     o.value = o.textContent = f;
     sel.appendChild(o);
   }
-  if (files.includes(keep)) sel.value = keep;
+  if (ui.pendingSelect && files.includes(ui.pendingSelect)) { sel.value = ui.pendingSelect; ui.pendingSelect = null; }
+  else if (files.includes(keep)) sel.value = keep;
   else if (files.includes('demo.ngc')) sel.value = 'demo.ngc';
 }
 
@@ -213,6 +217,29 @@ for (const el of document.querySelectorAll('[data-cmd]'))
   el.addEventListener('click', () => send({ cmd: el.dataset.cmd }));
 $('load').addEventListener('click', () => { if ($('files').value) send({ cmd: 'load', path: $('files').value }); });
 $('run').addEventListener('click', () => send({ cmd: 'run' }));
+
+// ---- upload: POST the file into the NCK's folder, then load it like any other --------------
+$('upload').addEventListener('click', () => $('upload-file').click());
+$('upload-file').addEventListener('change', async () => {
+  const input = $('upload-file');
+  const file = input.files[0];
+  input.value = '';
+  if (!file) return;
+  const q = new URLSearchParams({ token, name: file.name, overwrite: $('upload-overwrite').checked ? '1' : '0' });
+  let answer;
+  try {
+    const r = await fetch(`/upload?${q}`, { method: 'POST', body: file });
+    answer = await r.json();
+  } catch (e) {
+    answer = { ok: false, reason: `upload failed: ${e.message}` };
+  }
+  ui.lastUpload = answer;
+  if (!answer.ok) { log('refused', `upload of ${file.name}: ${answer.reason}`); return; }
+  log('info', `uploaded ${answer.name}`);
+  ui.pendingSelect = answer.name;
+  send({ cmd: 'list' });
+  send({ cmd: 'load', path: answer.name });
+});
 $('run-from').addEventListener('click', () => { if (ui.selectedLine) send({ cmd: 'run', line: ui.selectedLine }); });
 $('step').addEventListener('change', () => send({ cmd: 'step', on: $('step').checked ? 1 : 0 }));
 

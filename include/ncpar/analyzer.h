@@ -101,6 +101,10 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
  * program coordinates and units: see ncp_canon_map_to_program). */
 void ncp_analyzer_set_position(struct ncp_analyzer *a, const double pos[3]);
 
+/* The modal codes in force (what every slot is stamped with when handed on);
+ * for a resident analyzer between runs, the state the next run starts in. */
+void ncp_analyzer_active_codes(const struct ncp_analyzer *a, struct ncp_active_codes *out);
+
 /* The machine a run's busters wait for (the pipeline sets it for a run whose
  * output has one; NULL: none, rs274 -g's stand-ins). */
 void ncp_analyzer_set_sync(struct ncp_analyzer *a, ncp_machine_sync_fn fn, void *ctx);

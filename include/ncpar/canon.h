@@ -240,6 +240,23 @@ enum ncp_cmd_flags {
 #define NCP_CMD_FILE(c) ((unsigned)(c)->flags >> NCP_CMD_FILE_SHIFT)
 _Static_assert(NCP_DIAG_FILE_TAGS < (1u << (16 - NCP_CMD_FILE_SHIFT)), "a tag fits the flags");
 
+/* The modal codes in force after a slot's block, as rs274's active G and M
+ * codes (code*10, G64 = 640, G61.1 = 611; -1 = none in that group), for a
+ * controller's display. The interpreter stamps every slot it hands on, so a
+ * block that makes no call (G91 alone) shows in the next slot, at the latest
+ * in the run's closing one. */
+enum ncp_active_g {
+    NCP_AG_MOTION, NCP_AG_PLANE, NCP_AG_DIST, NCP_AG_ARCDIST, NCP_AG_FEEDMODE,
+    NCP_AG_UNITS, NCP_AG_COMP, NCP_AG_TLO, NCP_AG_RETRACT, NCP_AG_COORD, NCP_AG_CONTROL,
+    NCP_AG_SPINDLE, NCP_AG_LATHE, NCP_AG__N
+};
+enum ncp_active_m { NCP_AM_SPINDLE, NCP_AM_MIST, NCP_AM_FLOOD, NCP_AM_OVERRIDE, NCP_AM__N };
+struct ncp_active_codes {
+    int16_t g[NCP_AG__N];
+    int16_t m[NCP_AM__N];       /* M7 and M8 each in its slot; both off: M9 in MIST's */
+    double g64_p, g64_q;        /* G64's tolerances (program units) */
+};
+
 /* Slots cross cores in the pipeline's rings: what every slot writes (the
  * header and its first op) is contiguous from the start; the error, which
  * only a failing block writes, and the pools follow. */
@@ -252,6 +269,7 @@ struct ncp_cmd {
     uint32_t out_len;           /* filled by the executor */
     struct ncp_canon ops[NCP_CMD_MAX_OPS];
     struct ncp_diag diag;       /* the error: valid only when flags has NCP_CMD_F_ERROR */
+    struct ncp_active_codes active; /* stamped when the slot is handed on */
     char text[NCP_CMD_TEXT_POOL];
     char out[NCP_CMD_OUT_MAX];  /* filled by the executor */
 };

@@ -8,7 +8,12 @@
  * A token drawn at start (printed with the panel's address) must be in the
  * socket's URL (?token=...) for any command; without it the socket shows the
  * status only. Bad input is refused, counted (ncp_http_stats) and never
- * reaches the NCK. */
+ * reaches the NCK.
+ *
+ * A program is uploaded into the NCK's program folder (its working
+ * directory) by POST /upload?token=...&name=NAME[&overwrite=1] with the file
+ * as the body; the answer is JSON {"ok": true, "name": ...} or {"ok": false,
+ * "reason": ...}. Loading it is then an ordinary load command. */
 #ifndef NCPAR_HTTP_H
 #define NCPAR_HTTP_H
 
@@ -21,6 +26,8 @@
 
 #define NCP_HTTP_TOKEN_LEN 32       /* hex digits */
 #define NCP_HTTP_MSG_MAX 4096       /* largest message taken in */
+#define NCP_HTTP_UPLOAD_MAX (4u << 20) /* largest program uploaded (what the panel shows) */
+#define NCP_HTTP_UPLOAD_NAME_MAX 100
 
 struct ncp_http_opts {
     char addr[64];                  /* numeric IPv4/IPv6 address to listen on */
@@ -35,6 +42,8 @@ struct ncp_http_stats {
     uint64_t connections, commands;      /* commands handed to the NCK */
     uint64_t bad_json, unknown, oversized, flood, no_token, readonly, busy;
     uint64_t dropped;                    /* answers lost to a socket that does not read */
+    uint64_t uploads, upload_bad;        /* programs stored; refused for their name, size
+                                            or content (no token, read-only: counted above) */
     uint64_t status_sent, status_skipped; /* skipped: a slow client got a newer one */
 };
 
@@ -68,6 +77,10 @@ enum ncp_http_req {
 enum ncp_http_req ncp_http_parse_request(const char *json, size_t len, int32_t client_id,
                                          ncp_command_t *cmd, int *unknown, char *why,
                                          size_t why_len);
+/* Whether name may be an uploaded program's (a plain file name of letters,
+ * digits and . _ - +, not starting with . or -, ending in .ngc, .nc or .tap):
+ * 1, or 0 with why. */
+int ncp_http_upload_name_ok(const char *name, char *why, size_t why_len);
 /* s as a JSON string (quoted, escaped) appended to buf at *len; -1 if it
  * does not fit (buf then holds a truncated prefix). */
 int ncp_http_json_string(char *buf, size_t size, size_t *len, const char *s, size_t n);

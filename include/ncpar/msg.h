@@ -125,7 +125,14 @@ int ncp_msg_decode_command(const uint8_t *payload, size_t len, ncp_command_t *cm
 const char *ncp_msg_state_name(int state);
 int ncp_msg_state_parse(const char *name);
 /* A status as one JSON object (no newline), the keys of `cnc-ctl status
- * --json`. Returns its length, or -1 when size is too small (4096 is enough). */
+ * --json`. Returns its length, or -1 when size is too small (8192 is enough). */
 int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size);
+/* A modal code (code*10, as in the status's gcodes and mcodes: 911 -> "G91.1")
+ * into buf: its length, or -1 for none (< 0) or no room. */
+int ncp_msg_code_name(char letter, int code10, char *buf, size_t size);
+/* The status's modal codes in force, G then M, space-separated, G64 with its
+ * P and Q when set ("G1 G17 ... G64 P0.01 Q0 ... M5 M9 M48"): length, or -1
+ * when buf is too small. */
+int ncp_msg_active_codes_text(const ncp_status_t *s, char *buf, size_t size);
 
 #endif

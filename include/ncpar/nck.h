@@ -238,6 +238,9 @@ struct ncp_nck_snapshot {
     int tool;
     int g5x_index;                   /* 1 = G54 ... 9 = G59.3 */
     double g5x_offset[NCP_NCK_AXES_MAX];
+    /* the interpreter's modal codes (it runs ahead of the machine: these are
+     * the codes of the line last interpreted, as on LinuxCNC's display) */
+    struct ncp_active_codes active;
     int step_mode;
     char error[256];                 /* the last error, "" = none */
     uint64_t rejected, cycles, deadline_misses;

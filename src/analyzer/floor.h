@@ -44,6 +44,7 @@ struct ncp_cmd *ncp_an_slot(struct ncp_analyzer *a, size_t text_need);
 static inline void ncp_an_publish(struct ncp_analyzer *a)
 {
     if (a->cmd) {
+        ncp_analyzer_active_codes(a, &a->cmd->active);
         a->sink->publish(a->sink->ctx, a->cmd);
         a->cmd = NULL;
     }

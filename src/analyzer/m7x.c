@@ -35,32 +35,59 @@ struct ncp_m7x_frame {
     struct ncp_m7x_state s;
 };
 
+void ncp_analyzer_active_codes(const struct ncp_analyzer *a, struct ncp_active_codes *o)
+{
+    const struct ncp_modal *m = &a->st.m;
+    int tlo = 0;
+    for (int ax = 0; ax < NCP_NAX; ax++)
+        tlo |= a->st.tlo[ax] != 0.0;
+    o->g[NCP_AG_MOTION] = (int16_t)m->motion;
+    o->g[NCP_AG_PLANE] = m->plane == 0 ? 170 : m->plane == 1 ? 190 : 180;
+    o->g[NCP_AG_DIST] = m->incremental ? 910 : 900;
+    o->g[NCP_AG_ARCDIST] = m->arc_incremental ? 911 : 901;
+    o->g[NCP_AG_FEEDMODE] = m->feed_mode == 1 ? 930 : m->feed_mode == 0 ? 940 : 950;
+    o->g[NCP_AG_UNITS] = m->inches ? 200 : 210;
+    o->g[NCP_AG_COMP] = m->comp_side == 1 ? 410 : m->comp_side == 2 ? 420 : 400;
+    o->g[NCP_AG_TLO] = tlo ? 430 : 490;
+    o->g[NCP_AG_RETRACT] = m->retract_r ? 990 : 980;
+    o->g[NCP_AG_COORD] = (int16_t)(m->origin < 7 ? 530 + 10 * m->origin : 584 + m->origin);
+    o->g[NCP_AG_CONTROL] = m->control == 2 ? 640 : m->control == 1 ? 610 : 611;
+    o->g[NCP_AG_SPINDLE] = m->css ? 960 : 970;
+    o->g[NCP_AG_LATHE] = m->lathe_diameter ? 70 : 80;
+    o->m[NCP_AM_SPINDLE] = m->spindle_dir == 0 ? 5 : m->spindle_dir == 1 ? 3 : 4;
+    o->m[NCP_AM_MIST] = m->mist ? 7 : m->flood ? -1 : 9;
+    o->m[NCP_AM_FLOOD] = m->flood ? 8 : -1;
+    o->m[NCP_AM_OVERRIDE] = m->feed_override ? 48 : 49; /* 2.9 looks at the feed override only */
+    o->g64_p = m->g64_p;
+    o->g64_q = m->g64_q;
+}
+
+/* rs274's restore reads the same codes as the display, in its own slots. */
 static void ncp_m7x_snapshot(const struct ncp_analyzer *a, struct ncp_m7x_state *o)
 {
     const struct ncp_modal *m = &a->st.m;
+    struct ncp_active_codes ac;
+    ncp_analyzer_active_codes(a, &ac);
     for (int i = 0; i < G_SLOTS; i++)
         o->g[i] = -1;
     for (int i = 0; i < M_SLOTS; i++)
         o->m[i] = -1;
-    o->g[G_PLANE] = m->plane == 0 ? 170 : m->plane == 1 ? 190 : 180;
-    o->g[G_COMP] = m->comp_side == 1 ? 410 : m->comp_side == 2 ? 420 : 400;
-    o->g[G_UNITS] = m->inches ? 200 : 210;
-    o->g[G_DIST] = m->incremental ? 910 : 900;
-    o->g[G_FEEDMODE] = m->feed_mode == 1 ? 930 : m->feed_mode == 0 ? 940 : 950;
-    o->g[G_COORD] = m->origin < 7 ? 530 + 10 * m->origin : 584 + m->origin;
-    int tlo = 0;
-    for (int ax = 0; ax < NCP_NAX; ax++)
-        tlo |= a->st.tlo[ax] != 0.0;
-    o->g[G_TLO] = tlo ? 430 : 490;
-    o->g[G_RETRACT] = m->retract_r ? 990 : 980;
-    o->g[G_CONTROL] = m->control == 2 ? 640 : m->control == 1 ? 610 : 611;
-    o->g[G_SPINDLE] = m->css ? 960 : 970;
-    o->g[G_IJK] = m->arc_incremental ? 911 : 901;
-    o->g[G_LATHE] = m->lathe_diameter ? 70 : 80;
-    o->m[M_SPINDLE] = m->spindle_dir == 0 ? 5 : m->spindle_dir == 1 ? 3 : 4;
-    o->m[M_MIST] = m->mist ? 7 : m->flood ? -1 : 9;
-    o->m[M_FLOOD] = m->flood ? 8 : -1;
-    o->m[M_OVERRIDE] = m->feed_override ? 48 : 49; /* 2.9 looks at the feed override only */
+    o->g[G_PLANE] = ac.g[NCP_AG_PLANE];
+    o->g[G_COMP] = ac.g[NCP_AG_COMP];
+    o->g[G_UNITS] = ac.g[NCP_AG_UNITS];
+    o->g[G_DIST] = ac.g[NCP_AG_DIST];
+    o->g[G_FEEDMODE] = ac.g[NCP_AG_FEEDMODE];
+    o->g[G_COORD] = ac.g[NCP_AG_COORD];
+    o->g[G_TLO] = ac.g[NCP_AG_TLO];
+    o->g[G_RETRACT] = ac.g[NCP_AG_RETRACT];
+    o->g[G_CONTROL] = ac.g[NCP_AG_CONTROL];
+    o->g[G_SPINDLE] = ac.g[NCP_AG_SPINDLE];
+    o->g[G_IJK] = ac.g[NCP_AG_ARCDIST];
+    o->g[G_LATHE] = ac.g[NCP_AG_LATHE];
+    o->m[M_SPINDLE] = ac.m[NCP_AM_SPINDLE];
+    o->m[M_MIST] = ac.m[NCP_AM_MIST];
+    o->m[M_FLOOD] = ac.m[NCP_AM_FLOOD];
+    o->m[M_OVERRIDE] = ac.m[NCP_AM_OVERRIDE];
     o->m[M_ADAPTIVE] = m->adaptive ? 52 : -1;
     o->m[M_HOLD] = m->feed_hold ? 53 : -1;
     o->feed = a->st.feed;

@@ -325,14 +325,15 @@ int ncp_cli_serve(int argc, char **argv)
         struct ncp_http_stats hs;
         ncp_http_get_stats(http, &hs);
         ncp_http_stop(http);
-        fprintf(stderr, "cnc-run serve: panel: %llu connections, %llu commands; refused: "
-                "%llu malformed, %llu unknown, %llu oversized, %llu flood, %llu without "
-                "token, %llu read-only, %llu busy\n",
+        fprintf(stderr, "cnc-run serve: panel: %llu connections, %llu commands, %llu uploads; "
+                "refused: %llu malformed, %llu unknown, %llu oversized, %llu flood, %llu "
+                "without token, %llu read-only, %llu busy, %llu bad uploads\n",
                 (unsigned long long)hs.connections, (unsigned long long)hs.commands,
+                (unsigned long long)hs.uploads,
                 (unsigned long long)hs.bad_json, (unsigned long long)hs.unknown,
                 (unsigned long long)hs.oversized, (unsigned long long)hs.flood,
                 (unsigned long long)hs.no_token, (unsigned long long)hs.readonly,
-                (unsigned long long)hs.busy);
+                (unsigned long long)hs.busy, (unsigned long long)hs.upload_bad);
     }
     for (int k = 0; k < n; k++)
         if (close_trace(&chs[k]) != 0 && rc == 0)

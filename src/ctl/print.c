@@ -52,6 +52,8 @@ void ctl_print_status(const ncp_status_t *s)
            s->mist ? "mist" : "", s->mist && s->flood ? "+" : "",
            s->flood ? "flood" : (s->mist ? "" : "off"), (int)s->tool,
            s->g5x_index >= 1 && s->g5x_index <= 9 ? g5x[s->g5x_index - 1] : "G5x?");
+    if (ncp_msg_active_codes_text(s, buf, sizeof buf) > 0)
+        printf("modal     %s\n", buf);
     text(s->error, sizeof s->error, buf, sizeof buf);
     if (buf[0])
         printf("error     %s\n", buf);

@@ -52,8 +52,8 @@ struct ncp_http {
     char token[NCP_HTTP_TOKEN_LEN + 1];
     struct ncp_nck_serve_hook hook;
     struct lws_context *ctx;
-    struct lws_http_mount mount;
-    struct lws_protocols protocols[3];
+    struct lws_http_mount mount, upload_mount;
+    struct lws_protocols protocols[4];
     pthread_t thread;
     atomic_int stop;
     int32_t next_client;
@@ -89,6 +89,16 @@ static void count(struct ncp_http *h, uint64_t *field)
     pthread_mutex_lock(&h->mu);
     (*field)++;
     pthread_mutex_unlock(&h->mu);
+}
+
+void ncp_http_count(struct ncp_http *h, enum ncp_http_stat which)
+{
+    struct ncp_http_stats *st = &h->stats;
+    uint64_t *field = which == NCP_HTTP_STAT_NO_TOKEN ? &st->no_token
+                    : which == NCP_HTTP_STAT_READONLY ? &st->readonly
+                    : which == NCP_HTTP_STAT_OVERSIZED ? &st->oversized
+                    : which == NCP_HTTP_STAT_UPLOADS ? &st->uploads : &st->upload_bad;
+    count(h, field);
 }
 
 /* ---- the serving thread's side (the hook) ------------------------------------------ */
@@ -199,12 +209,14 @@ static void render_status(struct ncp_http *h)
     n += snprintf(p + n, size - (size_t)n,
                   ", \"http\": {\"connections\": %llu, \"commands\": %llu, \"bad_json\": %llu, "
                   "\"unknown\": %llu, \"oversized\": %llu, \"flood\": %llu, \"no_token\": "
-                  "%llu, \"readonly\": %llu, \"busy\": %llu, \"dropped\": %llu}}",
+                  "%llu, \"readonly\": %llu, \"busy\": %llu, \"dropped\": %llu, "
+                  "\"uploads\": %llu, \"upload_bad\": %llu}}",
                   (unsigned long long)st.connections, (unsigned long long)st.commands,
                   (unsigned long long)st.bad_json, (unsigned long long)st.unknown,
                   (unsigned long long)st.oversized, (unsigned long long)st.flood,
                   (unsigned long long)st.no_token, (unsigned long long)st.readonly,
-                  (unsigned long long)st.busy, (unsigned long long)st.dropped);
+                  (unsigned long long)st.busy, (unsigned long long)st.dropped,
+                  (unsigned long long)st.uploads, (unsigned long long)st.upload_bad);
     h->status_len = (size_t)n < size ? (size_t)n : 0;
 }
 
@@ -383,7 +395,7 @@ static void on_message(struct ncp_http *h, struct conn *c)
     }
 }
 
-static int token_ok(const struct ncp_http *h, struct lws *wsi)
+int ncp_http_token_ok(const struct ncp_http *h, struct lws *wsi)
 {
     char buf[128];
     const char *t = lws_get_urlarg_by_name(wsi, "token=", buf, (int)sizeof buf);
@@ -421,7 +433,7 @@ static int on_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, 
     case LWS_CALLBACK_ESTABLISHED:
         /* the session's memory is new here; the URL's query still readable */
         memset(c, 0, sizeof *c);
-        c->authed = token_ok(h, wsi);
+        c->authed = ncp_http_token_ok(h, wsi);
         c->wsi = wsi;
         c->client_id = NCP_HTTP_CLIENT_TAG | (h->next_client++ & ~NCP_HTTP_CLIENT_MASK);
         c->bucket = RATE_BURST;
@@ -517,6 +529,12 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
     h->protocols[0] = (struct lws_protocols){ "http", lws_callback_http_dummy, 0, 0, 0, NULL, 0 };
     h->protocols[1] = (struct lws_protocols){ "ncp-panel", on_ws, sizeof(struct conn),
                                               NCP_HTTP_MSG_MAX, 0, NULL, 0 };
+    h->protocols[2] = (struct lws_protocols){ "ncp-upload", ncp_http_on_upload,
+                                              ncp_http_upload_session_size(), 0, 0, NULL, 0 };
+    h->upload_mount = (struct lws_http_mount){ .mountpoint = "/upload", .origin = "ncp-upload",
+                                               .origin_protocol = LWSMPRO_CALLBACK,
+                                               .mountpoint_len = 7 };
+    h->mount.mount_next = &h->upload_mount;
     lws_set_log_level(LLL_ERR, NULL);
     struct lws_context_creation_info info;
     memset(&info, 0, sizeof info);

@@ -91,6 +91,20 @@ static const char *g5x_name(int index)
     return index >= 1 && index <= 9 ? names[index - 1] : NULL;
 }
 
+/* ["G1", "G17", ...]: the codes in force (scale: to code*10). */
+static void put_codes(struct out *o, char letter, const int16_t *codes, int n, int scale)
+{
+    put(o, "[");
+    for (int i = 0, first = 1; i < n; i++) {
+        char name[16];
+        if (ncp_msg_code_name(letter, codes[i] * scale, name, sizeof name) < 0)
+            continue;
+        put(o, "%s\"%s\"", first ? "" : ", ", name);
+        first = 0;
+    }
+    put(o, "]");
+}
+
 int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
 {
     struct out o = {.buf = buf, .size = size};
@@ -126,6 +140,14 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
     put(&o, g5x ? "\"%s\"" : "null", g5x ? g5x : "");
     put(&o, ", \"offset\": ");
     put_axes(&o, s, s->g5x_offset, NULL);
+    put(&o, "}, \"gcodes\": ");
+    put_codes(&o, 'G', s->gcodes, 13, 1);
+    put(&o, ", \"mcodes\": ");
+    put_codes(&o, 'M', s->mcodes, 4, 10);
+    put(&o, ", \"g64\": {\"p\": ");
+    put_num(&o, "%.6g", s->g64_p);
+    put(&o, ", \"q\": ");
+    put_num(&o, "%.6g", s->g64_q);
     put(&o, "}, \"step\": %s, \"error\": ", s->step_mode ? "true" : "false");
     put_text(&o, s->error, sizeof s->error);
     put(&o,

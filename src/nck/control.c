@@ -763,6 +763,8 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->acfg.instance = NULL;
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
+    if (s->interp)   /* no run yet: the codes the first one starts in */
+        ncp_analyzer_active_codes(s->interp, &n->io.active);
     n->sum.joints = ncp_kins_active(setup->cfg);
     if (setup->trace)
         nck_trace_header(setup->trace, setup->cfg, n->sum.joints,
@@ -841,6 +843,7 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     st->flood = fb->flood;
     st->tool = fb->tool;
     st->g5x_index = n->io.g5x_index ? n->io.g5x_index : 1;
+    st->active = n->io.active;
     for (int k = 0; k < 6 && k < NCP_NCK_AXES_MAX; k++)
         st->g5x_offset[k] = n->io.g5x[k];
     pthread_mutex_unlock(lock);

@@ -685,6 +685,7 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
     if (n->post_prints) {   /* a serving NCK's status shows it */
         pthread_mutex_lock(&n->ev_lock);
         n->io.interp_line = cmd->line;
+        n->io.active = cmd->active;
         pthread_mutex_unlock(&n->ev_lock);
     }
     int moved = j->seen_motion;

@@ -286,6 +286,7 @@ struct nck_io {
     int dir, mist, flood, tool, g5x_index;
     double g5x[6];
     uint32_t interp_line;
+    struct ncp_active_codes active;  /* as of interp_line's slot */
 };
 
 struct nck {

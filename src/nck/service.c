@@ -110,6 +110,12 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.flood = (int8_t)st.flood;
     m.tool = st.tool;
     m.g5x_index = (int8_t)st.g5x_index;
+    _Static_assert(sizeof m.gcodes / sizeof m.gcodes[0] == NCP_AG__N &&
+                   sizeof m.mcodes / sizeof m.mcodes[0] == NCP_AM__N, "status holds every group");
+    memcpy(m.gcodes, st.active.g, sizeof m.gcodes);
+    memcpy(m.mcodes, st.active.m, sizeof m.mcodes);
+    m.g64_p = st.active.g64_p;
+    m.g64_q = st.active.g64_q;
     m.step_mode = (int8_t)st.step_mode;
     snprintf((char *)m.error, sizeof m.error, "%s", st.error);
     m.commands = (int64_t)ms.commands;

@@ -127,6 +127,31 @@ static void listen_spec(void **state)
             fail_msg("taken: '%s'", bad[i]);
 }
 
+/* Uploaded programs' names: plain names in the program folder, never a path. */
+static void upload_names(void **state)
+{
+    (void)state;
+    char why[160];
+    static const char *const good[] = { "part1.ngc", "A-b_c+2.NC", "x.tap", "1.ngc" };
+    for (size_t i = 0; i < sizeof good / sizeof good[0]; i++)
+        assert_int_equal(ncp_http_upload_name_ok(good[i], why, sizeof why), 1);
+    static const char *const bad[] = { "", "../x.ngc", "dir/x.ngc", "..\\x.ngc", ".hidden.ngc",
+                                       "-rf.ngc", "a b.ngc", "x.txt", ".ngc", "x.ngc/",
+                                       "caf\xc3\xa9.ngc", "x\n.ngc", "ngc" };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        why[0] = 0;
+        assert_int_equal(ncp_http_upload_name_ok(bad[i], why, sizeof why), 0);
+        assert_true(why[0] != 0);
+    }
+    char longname[NCP_HTTP_UPLOAD_NAME_MAX + 8];
+    memset(longname, 'a', sizeof longname);
+    memcpy(longname + NCP_HTTP_UPLOAD_NAME_MAX - 4, ".ngc", 5);
+    assert_int_equal(ncp_http_upload_name_ok(longname, why, sizeof why), 1);
+    memset(longname, 'a', sizeof longname);
+    memcpy(longname + NCP_HTTP_UPLOAD_NAME_MAX - 3, ".ngc", 5);
+    assert_int_equal(ncp_http_upload_name_ok(longname, why, sizeof why), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -134,6 +159,7 @@ int main(void)
         cmocka_unit_test(bad_messages_are_refused),
         cmocka_unit_test(json_strings_are_escaped),
         cmocka_unit_test(listen_spec),
+        cmocka_unit_test(upload_names),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

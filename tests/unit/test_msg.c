@@ -340,6 +340,40 @@ static void test_status_json(void **state)
     assert_int_equal(ncp_msg_status_json(&s, buf, 40), -1);
 }
 
+/* The modal codes in force, spelt as written: code*10 with a decimal, G64's
+ * P and Q in the text only when set, -1 slots left out. */
+static void test_active_codes(void **state)
+{
+    (void)state;
+    ncp_status_t s;
+    memset(&s, 0, sizeof s);
+    static const int16_t g[13] = { 10, 170, 910, 901, 940, 200, 400, 490, 980, 590, 640, 970, 80 };
+    static const int16_t m[4] = { 3, -1, 8, 48 };
+    memcpy(s.gcodes, g, sizeof g);
+    memcpy(s.mcodes, m, sizeof m);
+    s.g64_p = 0.05;
+    char buf[256];
+    int n = ncp_msg_active_codes_text(&s, buf, sizeof buf);
+    assert_true(n > 0 && (size_t)n == strlen(buf));
+    assert_string_equal(buf, "G1 G17 G91 G90.1 G94 G20 G40 G49 G98 G59 G64 P0.05 Q0 G97 G8 "
+                             "M3 M8 M48");
+    assert_int_equal(ncp_msg_active_codes_text(&s, buf, 20), -1);
+    s.g64_p = 0;
+    s.gcodes[9] = 592;   /* G59.2 */
+    s.gcodes[0] = 0;     /* G0 */
+    assert_true(ncp_msg_active_codes_text(&s, buf, sizeof buf) > 0);
+    assert_non_null(strstr(buf, "G0 G17"));
+    assert_non_null(strstr(buf, "G59.2 G64 G97"));
+    char js[8192];
+    assert_true(ncp_msg_status_json(&s, js, sizeof js) > 0);
+    assert_non_null(strstr(js, "\"gcodes\": [\"G0\", \"G17\", \"G91\", \"G90.1\""));
+    assert_non_null(strstr(js, "\"mcodes\": [\"M3\", \"M8\", \"M48\"], \"g64\": {\"p\": 0, \"q\": 0}"));
+    char one[8];
+    assert_int_equal(ncp_msg_code_name('G', -1, one, sizeof one), -1);
+    assert_int_equal(ncp_msg_code_name('G', 611, one, sizeof one), 5);
+    assert_string_equal(one, "G61.1");
+}
+
 /* ---- loopback through the transport ---------------------------------------- */
 
 struct got {
@@ -462,6 +496,7 @@ int main(void)
         cmocka_unit_test(test_command_good),  cmocka_unit_test(test_command_garbage),
         cmocka_unit_test(test_round_trips),   cmocka_unit_test(test_url),
         cmocka_unit_test(test_state_names),   cmocka_unit_test(test_status_json),
+        cmocka_unit_test(test_active_codes),
         cmocka_unit_test(test_open_errors),   cmocka_unit_test(test_loopback),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
