@@ -44,7 +44,10 @@ struct ncp_cmd *ncp_an_slot(struct ncp_analyzer *a, size_t text_need);
 static inline void ncp_an_publish(struct ncp_analyzer *a)
 {
     if (a->cmd) {
-        ncp_analyzer_active_codes(a, &a->cmd->active);
+        /* only a machine (a run with busters to wait for) shows the codes:
+         * a translation to text would pay about 8 % for them */
+        if (a->sai.sync)
+            ncp_analyzer_active_codes(a, &a->cmd->active);
         a->sink->publish(a->sink->ctx, a->cmd);
         a->cmd = NULL;
     }
