@@ -5,7 +5,8 @@
  * Distribution points, ADCBI (today's planner): DP1 the part program, DP2
  * INTbuf, DP3 LAbuf, DP4 ACCDECbuf (block-level: bursts), DP5 fineIPObuf
  * (period-level: a record every servo period). ADCAI: DP2 roughIPObuf, DP3
- * ACCDECbuf, DP4 fineIPObuf. Implemented: ADCBI DP5 and DP4.
+ * ACCDECbuf, DP4 fineIPObuf; it has no DP5. Implemented: ADCBI DP5 and DP4,
+ * ADCAI DP4.
  *
  * Positions travel as int32 nanometres: exact and the same for every LLC,
  * +-2.1 m of travel. */
@@ -34,6 +35,11 @@ enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTB
                       NCP_DIST_AX_RESEND };
 /* "NCP_AX_<L>_ADVERT" etc. into buf (32 bytes are enough). */
 void ncp_dist_ax_channel(char *buf, size_t size, int axis, enum ncp_dist_ax_ch what);
+
+/* The ADCAI points the lcm backend streams at. DP4 (fineIPObuf) is the same
+ * message as ADCBI's DP5: every servo period's setpoints, so the LLCs need
+ * not know which variant made them. */
+static inline int ncp_dist_adcai_dp(int dp) { return dp == 4; }
 
 /* nm <-> mm; out of the int32 range: -1. */
 int ncp_dist_mm_to_nm(double mm, int32_t *nm);

@@ -374,9 +374,10 @@ static void lcm_stop(struct ncp_backend *b)
                 s->tx->burst_bytes + 8 + (int)sizeof NCP_DIST_CH_ACCDEC,
                 (unsigned long long)s->tx->resent, (unsigned long long)s->tx->overflow);
     else
-        fprintf(stderr, "lcm: DP %d: %llu setpoint messages of %d bytes (all %d axes; %d with "
-                        "the LCM header), %.0f per second\n",
-                s->cfg->lcm.dp, (unsigned long long)s->sent_fine, s->fine_bytes, s->n,
+        fprintf(stderr, "lcm: DP %d (%s): %llu setpoint messages of %d bytes (all %d axes; %d "
+                        "with the LCM header), %.0f per second\n",
+                s->cfg->lcm.dp, s->cfg->nck == NCP_NCK_ADCAI ? "ADCAI" : "ADCBI",
+                (unsigned long long)s->sent_fine, s->fine_bytes, s->n,
                 s->fine_bytes + 8 + (int)sizeof NCP_DIST_CH_FINE, 1e9 / (double)s->T);
     for (int i = 0; i < s->n; i++) {
         const struct peer *p = &s->p[i];
@@ -427,11 +428,15 @@ static const struct ncp_backend_ops lcm_ops = {
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d)
 {
-    if (cfg->lcm.dp != 5 && !(cfg->lcm.dp == 4 && cfg->nck == NCP_NCK_ADCBI))
+    int adcai = cfg->nck == NCP_NCK_ADCAI;
+    /* ADCAI's fineIPObuf is its DP 4: the same setpoint stream as ADCBI's DP 5 */
+    int fine = adcai ? cfg->lcm.dp == 4 : cfg->lcm.dp == 5;
+    if (adcai ? !ncp_dist_adcai_dp(cfg->lcm.dp) : cfg->lcm.dp != 5 && cfg->lcm.dp != 4)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "DP %d is not implemented yet: the lcm backend streams at DP 5 "
-                            "(fineIPObuf) and ADCBI's DP 4 (ACCDECbuf)", cfg->lcm.dp);
-    if (cfg->lcm.dp == 4 && ncp_machine_cfg_ipo_ratio(cfg) != 1)
+                            "DP %d is not implemented yet for NCK = %s: the lcm backend streams "
+                            "at ADCBI's DP 5 (fineIPObuf) and DP 4 (ACCDECbuf) and ADCAI's "
+                            "DP 4 (fineIPObuf)", cfg->lcm.dp, adcai ? "adcai" : "adcbi");
+    if (!fine && ncp_machine_cfg_ipo_ratio(cfg) != 1)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "DP 4 needs [TRAJ] PLANNING_PERIOD equal to SERVO_PERIOD: the LLCs "
                             "do not fine-interpolate yet");
@@ -439,7 +444,7 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     if (!s)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
     s->cfg = cfg;
-    if (cfg->lcm.dp == 4) {
+    if (!fine) {
         s->tx = malloc(sizeof *s->tx);
         if (!s->tx || lcm_tx_init(s->tx) != 0) {
             free(s->tx);
