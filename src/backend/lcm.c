@@ -2,7 +2,8 @@
  * setpoints go to one cnc-axis LLC per axis over LCM, and the actual positions
  * come back in their statuses. Implemented: ADCBI DP5 (fineIPObuf, a message
  * every servo period carrying every axis) and DP4 (ACCDECbuf: the records the
- * planner starts, in bursts, lcm_tx.c; the LLCs interpolate them).
+ * planner starts, in bursts, lcm_tx.c; the LLCs interpolate them), and
+ * ADCAI's DP4 (its fineIPObuf: the same stream as ADCBI's DP5).
  *
  * start() (blocking): waits for every axis's advertisement and first status,
  * checks its limits and period against the INI, and from then on a thread
