@@ -83,8 +83,9 @@ static void replay_case(enum ncp_profile prof, int ratio, int dp)
         int64_t pos = ncp_adcai_quantise(o[j]);
         for (size_t i = 0; i < taps.n; i++) {
             const struct ncp_adcai_tap *t = &taps.t[i];
-            int32_t in[NCP_AXES] = { 0 }, out[NCP_AXES];
+            int32_t out[NCP_AXES];
             if (t->start) {
+                int32_t in[NCP_AXES] = { 0 };
                 int32_t sum = dp == 2 ? t->rough[j] : t->accdec[j];
                 in[j] = (int32_t)((uint32_t)sum - (uint32_t)in_sum);
                 in_sum = sum;
