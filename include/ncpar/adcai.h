@@ -133,4 +133,19 @@ void ncp_adcai_reset(struct ncp_adcai *a, const double pos[NCP_AXES]);
 int ncp_adcai_step(struct ncp_adcai *a, struct ncp_setpoint *out);
 void ncp_adcai_get_stats(const struct ncp_adcai *a, struct ncp_planner_stats *st);
 
+/* What the distributed mode's HLC sends at DP2 and DP3, one per setpoint the
+ * driver emits (planner thread), in the stream's order. Sums are of the
+ * increments since the reset (a jump of the start at rest is not in them):
+ * an LLC feeding their differences to the same stages gets the same
+ * increments, and a lost record costs no drift. */
+struct ncp_adcai_tap {
+    uint8_t start;                /* this setpoint is a rough period's first */
+    uint8_t stop;                 /* its rough record's path-control flag */
+    int32_t rough[NCP_AXES];      /* rough increments summed, through that record */
+    int32_t accdec[NCP_AXES];     /* ACC/DEC output summed, through that record */
+    int64_t pos[NCP_AXES];        /* the setpoint, nm (the HLC finds it by this) */
+};
+void ncp_adcai_set_tap(struct ncp_adcai *a, void (*fn)(void *ctx, const struct ncp_adcai_tap *t),
+                       void *ctx);
+
 #endif

@@ -56,6 +56,7 @@ void ncp_sim_step_timed(struct ncp_sim *s, struct ncp_sim_timed *tm,
 /* ---- the interface the position loop drives ------------------------------ */
 
 struct ncp_backend;
+struct ncp_adcai_tap;
 
 struct ncp_backend_ops {
     const char *name;
@@ -96,6 +97,9 @@ struct ncp_backend {
     /* An HLC at a block-level point sends on what the ADCBI planner starts:
      * the NCK hands it to the planner's tap (planner thread; NULL: none). */
     void (*plan_tap)(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec);
+    /* An HLC at ADCAI's DP2 or DP3 sends what the ADCAI chain taps there
+     * (planner thread; ncpar/adcai.h; NULL: none). */
+    void (*adcai_tap)(void *impl, const struct ncp_adcai_tap *t);
 };
 
 /* Opens what cfg->backend names (not started yet). log gets start-up

@@ -5,7 +5,8 @@
  * Distribution points, ADCBI (today's planner): DP1 the part program, DP2
  * INTbuf, DP3 LAbuf, DP4 ACCDECbuf (block-level: bursts), DP5 fineIPObuf
  * (period-level: a record every servo period). ADCAI: DP2 roughIPObuf, DP3
- * ACCDECbuf, DP4 fineIPObuf. Implemented: ADCBI DP5 and DP4.
+ * ACCDECbuf, DP4 fineIPObuf; it has no DP5. Implemented: ADCBI DP5 and DP4,
+ * ADCAI DP2-DP4.
  *
  * Positions travel as int32 nanometres: exact and the same for every LLC,
  * +-2.1 m of travel. */
@@ -22,6 +23,8 @@
 #include "ncp_fine_ipo_t.h"
 #include "ncp_heartbeat_t.h"
 #include "ncp_rec_mark_t.h"
+#include "ncp_rough_ipo_t.h"
+#include "ncp_accdec_ai_t.h"
 
 #define NCP_DIST_HLC_ID 100   /* sender id of the HLC; an LLC's is its axis index + 1 */
 
@@ -34,6 +37,11 @@ enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTB
                       NCP_DIST_AX_RESEND };
 /* "NCP_AX_<L>_ADVERT" etc. into buf (32 bytes are enough). */
 void ncp_dist_ax_channel(char *buf, size_t size, int axis, enum ncp_dist_ax_ch what);
+
+/* The ADCAI points the lcm backend streams at. DP4 (fineIPObuf) is the same
+ * message as ADCBI's DP5: every servo period's setpoints, so the LLCs need
+ * not know which variant made them. */
+static inline int ncp_dist_adcai_dp(int dp) { return dp >= 2 && dp <= 4; }
 
 /* nm <-> mm; out of the int32 range: -1. */
 int ncp_dist_mm_to_nm(double mm, int32_t *nm);
@@ -126,5 +134,27 @@ int ncp_dist_recs_peek(const struct ncp_dist_recs *q, struct ncp_accdec *a);
 /* The interpolator is done with the next record. */
 void ncp_dist_recs_pop(struct ncp_dist_recs *q);
 static inline int ncp_dist_recs_level(const struct ncp_dist_recs *q) { return q->have - q->next; }
+
+/* ---- ADCAI's period-level points DP2 and DP3 (ai.c) -------------------
+ * One message per rough period with every axis's increments summed through
+ * that period's record: rough_ipo_t (DP2, with the path-control flag) or
+ * accdec_ai_t (DP3). Decoded by hand, as fine_ipo_t, for the LLC's loop. */
+#define NCP_DIST_CH_ROUGH "NCP_HLC_ROUGH"
+#define NCP_DIST_CH_ACCDEC_AI "NCP_HLC_ACCDEC_AI"
+
+struct ncp_dist_ai {
+    int32_t seq;
+    int16_t sender;
+    int64_t t_ns;
+    int8_t flag;                 /* DP2 only */
+    int8_t n;
+    int32_t sum_nm[NCP_AXES];
+};
+/* Before any real-time use: the types' fingerprints. */
+void ncp_dist_ai_init(void);
+/* dp 2 or 3: encoded length, or -1 when it does not fit. */
+int ncp_dist_encode_ai(uint8_t *buf, size_t size, int dp, const struct ncp_dist_ai *r);
+/* 0, or -1 for anything that is not exactly one such message. */
+int ncp_dist_decode_ai(const uint8_t *buf, size_t len, int dp, struct ncp_dist_ai *r);
 
 #endif

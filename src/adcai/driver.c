@@ -27,6 +27,11 @@ struct ncp_adcai {
     struct ncp_adcai_rough_rec ahead_tag;
     int have_ahead, ahead_moves;
     struct ncp_planner_stats st;
+    /* the distributed mode's tap: the sums so far, and the ahead sample's */
+    void (*tap)(void *ctx, const struct ncp_adcai_tap *t);
+    void *tap_ctx;
+    struct ncp_adcai_tap sums, ahead_rec;
+    int loaded;                     /* produce() loaded a record for its sample */
 };
 
 struct ncp_adcai *ncp_adcai_new(const struct ncp_machine_cfg *cfg, const double start[NCP_AXES])
@@ -109,6 +114,14 @@ void ncp_adcai_reset(struct ncp_adcai *a, const double pos[NCP_AXES])
     a->stop_pending = 0;
     a->finishing = 0;
     memset(&a->tag, 0, sizeof a->tag);
+    memset(&a->sums, 0, sizeof a->sums);
+}
+
+void ncp_adcai_set_tap(struct ncp_adcai *a, void (*fn)(void *ctx, const struct ncp_adcai_tap *t),
+                       void *ctx)
+{
+    a->tap = fn;
+    a->tap_ctx = ctx;
 }
 
 void ncp_adcai_get_stats(const struct ncp_adcai *a, struct ncp_planner_stats *st)
@@ -171,6 +184,13 @@ static int next_record(struct ncp_adcai *a)
     int32_t acc[NCP_AXES];
     ncp_adcai_accdec_step(a->acc, rec.inc, acc);
     ncp_adcai_fine_load(a->fine, acc);
+    for (int j = 0; j < NCP_AXES; j++) {
+        /* wraps after 2.1 m of travel summed: the LLCs take differences */
+        a->sums.rough[j] = (int32_t)((uint32_t)a->sums.rough[j] + (uint32_t)rec.inc[j]);
+        a->sums.accdec[j] = (int32_t)((uint32_t)a->sums.accdec[j] + (uint32_t)acc[j]);
+    }
+    a->sums.stop = got && rec.stop;
+    a->loaded = 1;
     return 1;
 }
 
@@ -178,6 +198,7 @@ static int next_record(struct ncp_adcai *a)
  * rest with nothing to interpolate (nothing changed: it may be asked again). */
 static int produce(struct ncp_adcai *a, int32_t inc[NCP_AXES], struct ncp_adcai_rough_rec *tag)
 {
+    a->loaded = 0;
     if (a->k == 0 && !next_record(a))
         return 0;
     ncp_adcai_fine_step(a->fine, inc);
@@ -186,14 +207,36 @@ static int produce(struct ncp_adcai *a, int32_t inc[NCP_AXES], struct ncp_adcai_
     return 1;
 }
 
+/* The sample just produced into a->ahead: whether it starts a record. */
+static void note_ahead(struct ncp_adcai *a)
+{
+    a->ahead_rec = a->sums;
+    a->ahead_rec.start = (uint8_t)a->loaded;
+}
+
+/* The setpoint out goes to the tap with the record its sample started. */
+static void tap(struct ncp_adcai *a, const struct ncp_adcai_tap *rec)
+{
+    if (!a->tap)
+        return;
+    struct ncp_adcai_tap t = *rec;
+    memcpy(t.pos, a->pos, sizeof t.pos);
+    a->tap(a->tap_ctx, &t);
+}
+
 int ncp_adcai_step(struct ncp_adcai *a, struct ncp_setpoint *out)
 {
     static const int32_t none[NCP_AXES];
     memset(out, 0, sizeof *out);
-    if (!a->have_ahead)
+    if (!a->have_ahead) {
         a->have_ahead = produce(a, a->ahead, &a->ahead_tag);
+        note_ahead(a);
+    }
     if (!a->have_ahead) {
         setpoint(a, none, none, &a->tag, out);
+        struct ncp_adcai_tap rest = a->sums;
+        rest.start = 0;
+        tap(a, &rest);
         if (a->finishing) {   /* the job's end, at rest on its last point */
             out->flags = NCP_SP_END;
             return 0;
@@ -204,12 +247,15 @@ int ncp_adcai_step(struct ncp_adcai *a, struct ncp_setpoint *out)
     }
     int32_t inc[NCP_AXES];
     struct ncp_adcai_rough_rec tag = a->ahead_tag;
+    struct ncp_adcai_tap rec = a->ahead_rec;
     memcpy(inc, a->ahead, sizeof inc);
     /* a chain at rest now is asked again next time: segments may come meanwhile */
     a->have_ahead = produce(a, a->ahead, &a->ahead_tag);
+    note_ahead(a);
     a->ahead_moves = 0;
     for (int j = 0; a->have_ahead && j < NCP_AXES; j++)
         a->ahead_moves |= a->ahead[j] != 0;
     setpoint(a, inc, a->have_ahead ? a->ahead : none, &tag, out);
+    tap(a, &rec);
     return 1;
 }

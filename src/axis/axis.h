@@ -22,6 +22,8 @@ enum llc_end {
     LLC_END_SIGNAL      /* SIGINT / SIGTERM */
 };
 
+struct llc_ai;
+
 struct llc_row {          /* one period of the trace, handed to the main thread */
     int64_t t_ns, slot_ns;
     double cmd, act;
@@ -79,7 +81,15 @@ struct llc {
     int64_t last_resend_ns;
     uint32_t resends;
     ncp_accdec_burst_t burst;   /* decoded here, not on the loop's stack */
+    struct llc_ai *ai;          /* ADCAI's DP2 and DP3: this axis's stages (llc_adcai.c) */
 };
+
+/* llc_adcai.c: NULL when out of memory or the INI's limits give no filter */
+struct llc_ai *llc_ai_new(const struct ncp_machine_cfg *cfg);
+void llc_ai_free(struct llc_ai *a);
+/* A DP2 (rough_ipo_t) or DP3 (accdec_ai_t) message: into the setpoint buffer. */
+void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len);
+void llc_ai_report(const struct llc *l);
 
 /* llc.c */
 int llc_cycle(void *ctx, int64_t now_ns);

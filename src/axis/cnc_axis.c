@@ -107,6 +107,8 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_HLC_HEARTBEAT);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_ACCDEC);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_SYNC);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_ROUGH);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_ACCDEC_AI);
     /* each axis its own losses: the seed plus its index */
     struct ncp_msg_inject in = { cfg->lcm.inject_loss, cfg->lcm.inject_delay_us * 1000LL,
                                  (uint64_t)cfg->lcm.inject_seed + 1u + (uint64_t)o->axis };
@@ -117,6 +119,10 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     ncp_dist_rx_init(&l->rx, l->period_ns, 0);
     if (ncp_dist_recs_init(&l->recs) != 0)
         return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
+    /* ADCAI's stages, for DP2 and DP3 (the same windows as the HLC's: the
+     * same INI); without them those points are not advertised */
+    if (cfg->nck == NCP_NCK_ADCAI)
+        l->ai = llc_ai_new(cfg);
     if (o->trace) {
         l->tracing = 1;
         if (ncp_spsc_init(&l->trace_ring, sizeof(struct llc_row), 1 << 14) != 0)
@@ -178,6 +184,7 @@ static int report(const struct llc *l)
                         "stale %u, duplicate %u, too early %u\n",
                 ax, (int)l->recs.next, l->recs.gaps, l->resends, l->recs.stale,
                 l->recs.duplicate, l->recs.early);
+    llc_ai_report(l);
     switch (l->end) {
     case LLC_END_MISSING:
         fprintf(stderr, "cnc-axis %c: error: record %d was not here when the interpolator "
@@ -255,5 +262,6 @@ int main(int argc, char **argv)
     if (trace && fclose(trace) != 0)
         fprintf(stderr, "cnc-axis: error writing %s\n", o.trace);
     ncp_msg_close(l->msg);
+    llc_ai_free(l->ai);
     return rc;
 }

@@ -86,7 +86,7 @@ static void on_sync(struct llc *l, const uint8_t *p, size_t len)
 }
 
 /* Subscriptions, in the order cnc_axis.c makes them. */
-enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC };
+enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC, SUB_ROUGH, SUB_ACCDEC_AI };
 
 void llc_take(struct llc *l, int64_t now)
 {
@@ -102,6 +102,8 @@ void llc_take(struct llc *l, int64_t now)
             on_accdec(l, p, len);
         else if (sub == SUB_SYNC)
             on_sync(l, p, len);
+        else if (sub == SUB_ROUGH || sub == SUB_ACCDEC_AI)
+            llc_ai_take(l, sub == SUB_ROUGH ? 2 : 3, p, len);
     }
 }
 
@@ -165,7 +167,9 @@ void llc_advertise(struct llc *l)
                           a->min_limit,    a->max_limit,
                           a->max_vel,      a->max_acc,
                           a->max_jerk,     l->period_ns,
-                          1 << 5 | 1 << 4, NCP_AX_ADVERT_T_STAGE_FINE };
+                          (int8_t)(1 << 5 | 1 << 4 | (l->ai ? 1 << 3 | 1 << 2 : 0)),
+                          (int8_t)(NCP_AX_ADVERT_T_STAGE_FINE |
+                                   (l->ai ? NCP_AX_ADVERT_T_STAGE_ACCDEC : 0)) };
     uint8_t buf[128];
     int n = ncp_ax_advert_t_encode(buf, 0, sizeof buf, &m);
     if (n > 0)

@@ -2,7 +2,9 @@
  * setpoints go to one cnc-axis LLC per axis over LCM, and the actual positions
  * come back in their statuses. Implemented: ADCBI DP5 (fineIPObuf, a message
  * every servo period carrying every axis) and DP4 (ACCDECbuf: the records the
- * planner starts, in bursts, lcm_tx.c; the LLCs interpolate them).
+ * planner starts, in bursts, lcm_tx.c; the LLCs interpolate them), and
+ * ADCAI's DP4 (its fineIPObuf: the same stream as ADCBI's DP5), DP3 and DP2
+ * (a record every rough period, lcm_ai.c; the LLCs run the stages below).
  *
  * start() (blocking): waits for every axis's advertisement and first status,
  * checks its limits and period against the INI, and from then on a thread
@@ -15,8 +17,10 @@
  *
  * The LLC reports the actual position of a period 1.5-2.5 periods back. The
  * loop gets that position carried forward by what the HLC commanded since
- * (DP5), or its command less the LLC's own following error (block-level DPs),
- * so cmd - act is the LLC's following error, not the transport's delay. */
+ * (period-level DPs), or its command less the LLC's own following error
+ * (ADCBI's block-level DPs), so cmd - act is the LLC's following error, not
+ * the transport's delay. */
+#include "lcm_ai.h"
 #include "lcm_tx.h"
 #include "ncpar/backend.h"
 #include "ncpar/dist.h"
@@ -63,6 +67,7 @@ struct lcm_be {
     uint64_t sent_fine;
     int fine_bytes;
     struct lcm_tx *tx;       /* DP4 */
+    struct lcm_ai *ai;       /* ADCAI's DP2, DP3 */
     int rest;                /* the path stood still last period */
     double prev_cmd[NCP_AXES];
 };
@@ -314,6 +319,8 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         for (int i = 0; i < s->n; i++)
             taken = s->p[i].st.rec_next < taken ? s->p[i].st.rec_next : taken;
         lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken);
+    } else if (s->ai) {
+        lcm_ai_cycle(s->ai, s->msg, t, cmd);
     } else {
         send_fine(s, t, cmd);
     }
@@ -371,16 +378,19 @@ static void lcm_stop(struct ncp_backend *b)
     }
     struct ncp_msg_stats st;
     ncp_msg_get_stats(s->msg, &st);
-    if (s->tx)
+    if (s->ai)
+        lcm_ai_report(s->ai);
+    else if (s->tx)
         fprintf(stderr, "lcm: DP 4: %d records in %llu bursts of %d bytes (%d with the LCM "
                         "header), %llu resent on request, %llu lost to a full tap ring\n",
                 s->tx->sent, (unsigned long long)s->tx->bursts, s->tx->burst_bytes,
                 s->tx->burst_bytes + 8 + (int)sizeof NCP_DIST_CH_ACCDEC,
                 (unsigned long long)s->tx->resent, (unsigned long long)s->tx->overflow);
     else
-        fprintf(stderr, "lcm: DP %d: %llu setpoint messages of %d bytes (all %d axes; %d with "
-                        "the LCM header), %.0f per second\n",
-                s->cfg->lcm.dp, (unsigned long long)s->sent_fine, s->fine_bytes, s->n,
+        fprintf(stderr, "lcm: DP %d (%s): %llu setpoint messages of %d bytes (all %d axes; %d "
+                        "with the LCM header), %.0f per second\n",
+                s->cfg->lcm.dp, s->cfg->nck == NCP_NCK_ADCAI ? "ADCAI" : "ADCBI",
+                (unsigned long long)s->sent_fine, s->fine_bytes, s->n,
                 s->fine_bytes + 8 + (int)sizeof NCP_DIST_CH_FINE, 1e9 / (double)s->T);
     for (int i = 0; i < s->n; i++) {
         const struct peer *p = &s->p[i];
@@ -410,6 +420,16 @@ static void free_tx(struct lcm_be *s)
         free(s->tx);
         s->tx = NULL;
     }
+    if (s->ai) {
+        lcm_ai_free(s->ai);
+        free(s->ai);
+        s->ai = NULL;
+    }
+}
+
+static void ai_tap(void *impl, const struct ncp_adcai_tap *t)
+{
+    lcm_ai_push(((struct lcm_be *)impl)->ai, t);
 }
 
 static void lcm_close(struct ncp_backend *b)
@@ -431,11 +451,15 @@ static const struct ncp_backend_ops lcm_ops = {
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d)
 {
-    if (cfg->lcm.dp != 5 && !(cfg->lcm.dp == 4 && cfg->nck == NCP_NCK_ADCBI))
+    int adcai = cfg->nck == NCP_NCK_ADCAI;
+    /* ADCAI's fineIPObuf is its DP 4: the same setpoint stream as ADCBI's DP 5 */
+    int fine = adcai ? cfg->lcm.dp == 4 : cfg->lcm.dp == 5;
+    if (adcai ? !ncp_dist_adcai_dp(cfg->lcm.dp) : cfg->lcm.dp != 5 && cfg->lcm.dp != 4)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "DP %d is not implemented yet: the lcm backend streams at DP 5 "
-                            "(fineIPObuf) and ADCBI's DP 4 (ACCDECbuf)", cfg->lcm.dp);
-    if (cfg->lcm.dp == 4 && ncp_machine_cfg_ipo_ratio(cfg) != 1)
+                            "DP %d is not implemented yet for NCK = %s: the lcm backend streams "
+                            "at ADCBI's DP 5 (fineIPObuf) and DP 4 (ACCDECbuf) and ADCAI's "
+                            "DP 4 (fineIPObuf)", cfg->lcm.dp, adcai ? "adcai" : "adcbi");
+    if (!fine && !adcai && ncp_machine_cfg_ipo_ratio(cfg) != 1)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "DP 4 needs [TRAJ] PLANNING_PERIOD equal to SERVO_PERIOD: the LLCs "
                             "do not fine-interpolate yet");
@@ -443,7 +467,14 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     if (!s)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
     s->cfg = cfg;
-    if (cfg->lcm.dp == 4) {
+    if (!fine && adcai) {
+        s->ai = malloc(sizeof *s->ai);
+        if (!s->ai || lcm_ai_init(s->ai, cfg->lcm.dp, cfg) != 0) {
+            free(s->ai);
+            free(s);
+            return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
+        }
+    } else if (!fine) {
         s->tx = malloc(sizeof *s->tx);
         if (!s->tx || lcm_tx_init(s->tx) != 0) {
             free(s->tx);
@@ -490,5 +521,7 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     b->real_clock_only = 1;
     if (s->tx)
         b->plan_tap = tap;
+    if (s->ai)
+        b->adcai_tap = ai_tap;
     return NCP_OK;
 }

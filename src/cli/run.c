@@ -9,6 +9,7 @@
 #include "signals.h"
 
 #include "ncpar/backend.h"
+#include "ncpar/dist.h"
 #include "ncpar/feeder.h"
 #include "ncpar/motion.h"
 #include "ncpar/msg.h"
@@ -305,10 +306,15 @@ static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
     if (o->virtual_clock)
         return fprintf(stderr, "cnc-run run: --backend lcm runs with its axes in real time: it "
                                "needs --clock real\n"), -1;
-    if (cfg->lcm.dp != 5 && !(cfg->lcm.dp == 4 && cfg->nck == NCP_NCK_ADCBI))
+    if (cfg->nck == NCP_NCK_ADCAI && cfg->lcm.dp == 5)
+        return fprintf(stderr, "cnc-run run: --backend lcm: [PLANNER] NCK = adcai has no DP 5: "
+                               "its fine setpoints (fineIPObuf) are DP 4; choose --dp 2, 3 or "
+                               "4 (the INI's [LCM] DP defaults to 5)\n"), -1;
+    if (cfg->nck == NCP_NCK_ADCAI ? !ncp_dist_adcai_dp(cfg->lcm.dp)
+                                  : cfg->lcm.dp != 5 && cfg->lcm.dp != 4)
         return fprintf(stderr, "cnc-run run: --backend lcm: DP %d is not implemented yet for "
                                "[PLANNER] NCK = %s (DP 5, fine setpoints every servo period, "
-                               "is, and ADCBI's DP 4, ACCDECbuf records)\n",
+                               "is, and ADCBI's DP 4, ACCDECbuf records; ADCAI: DP 2-4)\n",
                        cfg->lcm.dp, cfg->nck == NCP_NCK_ADCAI ? "adcai" : "adcbi"), -1;
     return 0;
 }

@@ -11,6 +11,8 @@ int nck_plan_new(struct nck *n)
         n->planner = ncp_planner_new(n->cfg, n->start);
     if (n->planner && n->be.plan_tap)
         ncp_planner_set_tap(n->planner, n->be.plan_tap, n->be.impl);
+    if (n->adcai && n->be.adcai_tap)
+        ncp_adcai_set_tap(n->adcai, n->be.adcai_tap, n->be.impl);
     return n->adcai || n->planner ? 0 : -1;
 }
 
