@@ -79,7 +79,29 @@ struct llc {
     int64_t last_resend_ns;
     uint32_t resends;
     ncp_accdec_burst_t burst;   /* decoded here, not on the loop's stack */
+    /* The block-level point (4, 3 or 2; 0 not known yet): at DP3 recs holds
+     * LAbuf records (profiled as the interpolator takes them), at DP2 the
+     * planner's calls, which this LLC's own planner replays into own, the
+     * ring the interpolator then runs (dp_block.c). */
+    int dp;
+    struct ncp_planner *plan;
+    struct ncp_dist_recs own;
+    int32_t own_n, plan_steps, mark_records, mark_steps;
+    ncp_la_burst_t la_burst;
+    ncp_int_burst_t int_burst;
 };
+
+/* dp_block.c: ADCBI DP3 and DP2 at the LLC */
+int llc_blocks_init(struct llc *l);
+void llc_on_la(struct llc *l, const uint8_t *p, size_t len);
+void llc_on_int(struct llc *l, const uint8_t *p, size_t len);
+void llc_on_steps(struct llc *l, const uint8_t *p, size_t len);
+/* DP2: this LLC's planner as far as the HLC's calls and steps allow. */
+void llc_plan_advance(struct llc *l);
+/* The ring the interpolator takes its records from, and its next record
+ * after one that ended at speed v0 (1), or none here (0). */
+struct ncp_dist_recs *llc_exec_ring(struct llc *l);
+int llc_exec_head(struct llc *l, double v0, struct ncp_accdec *a);
 
 /* llc.c */
 int llc_cycle(void *ctx, int64_t now_ns);

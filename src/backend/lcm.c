@@ -1,8 +1,11 @@
 /* The distributed NCK's high-level end (seed 002): the position loop's
  * setpoints go to one cnc-axis LLC per axis over LCM, and the actual positions
  * come back in their statuses. Implemented: ADCBI DP5 (fineIPObuf, a message
- * every servo period carrying every axis) and DP4 (ACCDECbuf: the records the
- * planner starts, in bursts, lcm_tx.c; the LLCs interpolate them).
+ * every servo period carrying every axis) and the block-level DP4 (ACCDECbuf:
+ * the records the planner starts, in bursts, lcm_tx.c; the LLCs interpolate
+ * them), DP3 (LAbuf: the look-ahead's records; the LLCs profile and
+ * interpolate them) and DP2 (INTbuf: the planner's blocks and calls,
+ * lcm_dp2.c; each LLC plans them itself).
  *
  * start() (blocking): waits for every axis's advertisement and first status,
  * checks its limits and period against the INI, and from then on a thread
@@ -61,7 +64,8 @@ struct lcm_be {
     int idle_started;
     uint64_t sent_fine;
     int fine_bytes;
-    struct lcm_tx *tx;       /* DP4 */
+    struct lcm_tx *tx;       /* block-level points */
+    struct lcm_dp2 dp2;
     int rest;                /* the path stood still last period */
     double prev_cmd[NCP_AXES];
 };
@@ -276,8 +280,15 @@ static void send_fine(struct lcm_be *s, int64_t t, const double cmd[NCP_AXES])
 
 static void tap(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec)
 {
-    (void)la;
-    lcm_tx_push(((struct lcm_be *)impl)->tx, rec);
+    struct lcm_tx *x = ((struct lcm_be *)impl)->tx;
+    lcm_tx_push(x, x->kind == &lcm_kind_la ? (const void *)la : (const void *)rec);
+}
+
+static void journal(void *impl, enum ncp_plan_call c, const struct ncp_seg *seg,
+                    const double *pos)
+{
+    struct lcm_be *s = impl;
+    lcm_dp2_journal(s->tx, &s->dp2, c, seg, pos);
 }
 
 static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const double next[NCP_AXES],
@@ -312,7 +323,10 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         int32_t taken = INT32_MAX;
         for (int i = 0; i < s->n; i++)
             taken = s->p[i].st.rec_next < taken ? s->p[i].st.rec_next : taken;
+        int32_t steps = atomic_load_explicit(&s->dp2.steps, memory_order_acquire);
         lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken);
+        if (s->tx->kind == &lcm_kind_int)
+            lcm_dp2_mark(s->tx, &s->dp2, s->msg, steps, t, s->T);
     } else {
         send_fine(s, t, cmd);
     }
@@ -368,10 +382,11 @@ static void lcm_stop(struct ncp_backend *b)
     struct ncp_msg_stats st;
     ncp_msg_get_stats(s->msg, &st);
     if (s->tx)
-        fprintf(stderr, "lcm: DP 4: %d records in %llu bursts of %d bytes (%d with the LCM "
+        fprintf(stderr, "lcm: DP %d: %d records in %llu bursts of %d bytes (%d with the LCM "
                         "header), %llu resent on request, %llu lost to a full tap ring\n",
-                s->tx->sent, (unsigned long long)s->tx->bursts, s->tx->burst_bytes,
-                s->tx->burst_bytes + 8 + (int)sizeof NCP_DIST_CH_ACCDEC,
+                s->tx->kind->dp, s->tx->sent, (unsigned long long)s->tx->bursts,
+                s->tx->burst_bytes,
+                s->tx->burst_bytes + 8 + (int)strlen(s->tx->kind->channel) + 1,
                 (unsigned long long)s->tx->resent, (unsigned long long)s->tx->overflow);
     else
         fprintf(stderr, "lcm: DP %d: %llu setpoint messages of %d bytes (all %d axes; %d with "
@@ -427,21 +442,26 @@ static const struct ncp_backend_ops lcm_ops = {
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d)
 {
-    if (cfg->lcm.dp != 5 && !(cfg->lcm.dp == 4 && cfg->nck == NCP_NCK_ADCBI))
+    int blocks = cfg->nck == NCP_NCK_ADCBI && cfg->lcm.dp >= 2 && cfg->lcm.dp <= 4;
+    if (cfg->lcm.dp != 5 && !blocks)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "DP %d is not implemented yet: the lcm backend streams at DP 5 "
-                            "(fineIPObuf) and ADCBI's DP 4 (ACCDECbuf)", cfg->lcm.dp);
-    if (cfg->lcm.dp == 4 && ncp_machine_cfg_ipo_ratio(cfg) != 1)
+                            "(fineIPObuf) and ADCBI's DP 2-4 (INTbuf, LAbuf, ACCDECbuf)",
+                            cfg->lcm.dp);
+    if (blocks && ncp_machine_cfg_ipo_ratio(cfg) != 1)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "DP 4 needs [TRAJ] PLANNING_PERIOD equal to SERVO_PERIOD: the LLCs "
-                            "do not fine-interpolate yet");
+                            "DP %d needs [TRAJ] PLANNING_PERIOD equal to SERVO_PERIOD: the LLCs "
+                            "do not fine-interpolate yet", cfg->lcm.dp);
     struct lcm_be *s = calloc(1, sizeof *s);
     if (!s)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
     s->cfg = cfg;
-    if (cfg->lcm.dp == 4) {
+    if (blocks) {
+        const struct lcm_tx_kind *k = cfg->lcm.dp == 2   ? &lcm_kind_int
+                                      : cfg->lcm.dp == 3 ? &lcm_kind_la
+                                                         : &lcm_kind_accdec;
         s->tx = malloc(sizeof *s->tx);
-        if (!s->tx || lcm_tx_init(s->tx) != 0) {
+        if (!s->tx || lcm_tx_init(s->tx, k) != 0) {
             free(s->tx);
             free(s);
             return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
@@ -484,7 +504,9 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     b->ops = &lcm_ops;
     b->impl = s;
     b->real_clock_only = 1;
-    if (s->tx)
+    if (s->tx && s->tx->kind == &lcm_kind_int)
+        b->plan_journal = journal;
+    else if (s->tx)
         b->plan_tap = tap;
     return NCP_OK;
 }

@@ -101,7 +101,8 @@ static void usage(FILE *f)
           "                      An axis lost (no status for [LCM] MAX_LOST_PERIODS, no\n"
           "                      heartbeat) stops the others: exit 3\n"
           "  --dp N              distribution point 1..5 (default: the INI's [LCM] DP, 5);\n"
-          "                      implemented: 5 (fine setpoints every servo period)\n"
+          "                      implemented: 5 (fine setpoints every servo period);\n"
+          "                      ADCBI 4, 3, 2 (ACCDECbuf, LAbuf, INTbuf records)\n"
           "  --lcm-url URL       udpm://GROUP:PORT?ttl=N (default: [LCM] URL, $LCM_DEFAULT_URL)\n"
           "  --inject SPECS      timing faults in the position loop (over the INI's [INJECT]\n"
           "                      SPEC): miss=RATIO, miss@CYCLE, latency=US, latency=MIN-MAX,\n"
@@ -305,10 +306,10 @@ static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
     if (o->virtual_clock)
         return fprintf(stderr, "cnc-run run: --backend lcm runs with its axes in real time: it "
                                "needs --clock real\n"), -1;
-    if (cfg->lcm.dp != 5 && !(cfg->lcm.dp == 4 && cfg->nck == NCP_NCK_ADCBI))
+    if (cfg->lcm.dp != 5 && !(cfg->lcm.dp >= 2 && cfg->lcm.dp <= 4 && cfg->nck == NCP_NCK_ADCBI))
         return fprintf(stderr, "cnc-run run: --backend lcm: DP %d is not implemented yet for "
                                "[PLANNER] NCK = %s (DP 5, fine setpoints every servo period, "
-                               "is, and ADCBI's DP 4, ACCDECbuf records)\n",
+                               "is, and ADCBI's DP 2-4: INTbuf, LAbuf, ACCDECbuf records)\n",
                        cfg->lcm.dp, cfg->nck == NCP_NCK_ADCAI ? "adcai" : "adcbi"), -1;
     return 0;
 }
