@@ -89,7 +89,8 @@ static void apply(struct llc *l, const struct ncp_dist_op *o)
     case NCP_INT_REC_T_PUSH: ncp_planner_push(l->plan, &o->s); break;
     case NCP_INT_REC_T_FINISH: ncp_planner_finish(l->plan); break;
     case NCP_INT_REC_T_RESTART: ncp_planner_restart(l->plan); break;
-    default: ncp_planner_reset(l->plan, o->s.end); break;
+    case NCP_INT_REC_T_RESET: ncp_planner_reset(l->plan, o->s.end); break;
+    default: break;   /* a newer HLC's call this LLC does not know */
     }
 }
 

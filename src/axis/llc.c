@@ -53,7 +53,7 @@ static void on_hlc_heartbeat(struct llc *l, const uint8_t *p, size_t len, int64_
         return;
     l->last_hlc_ns = now;
     if (!l->dp && h.dp >= 2 && h.dp <= 4)
-        l->dp = h.dp;
+        l->dp = (unsigned char)h.dp;
     if (h.command == NCP_HEARTBEAT_T_COMMAND_DONE)
         l->done_req = 1;
     else if (h.command == NCP_HEARTBEAT_T_COMMAND_STOP && l->end == LLC_END_NONE) {

@@ -95,6 +95,6 @@ void ncp_dist_op_decode(const ncp_int_rec_t *r, struct ncp_dist_op *o)
 {
     memset(o, 0, sizeof *o);
     ncp_dist_seg_decode(&r->s, &o->s);
-    o->op = r->op;
+    o->op = (unsigned char)r->op;
     o->step = r->step;
 }
