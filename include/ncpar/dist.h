@@ -24,6 +24,7 @@
 #include "ncp_int_burst_t.h"
 #include "ncp_la_burst_t.h"
 #include "ncp_plan_mark_t.h"
+#include "ncp_program_t.h"
 #include "ncp_rec_mark_t.h"
 
 #define NCP_DIST_HLC_ID 100   /* sender id of the HLC; an LLC's is its axis index + 1 */
@@ -36,6 +37,7 @@
 #define NCP_DIST_CH_LA "NCP_HLC_LA"         /* ADCBI DP3 */
 #define NCP_DIST_CH_INT "NCP_HLC_INT"       /* ADCBI DP2 */
 #define NCP_DIST_CH_STEPS "NCP_HLC_STEPS"   /* ADCBI DP2 */
+#define NCP_DIST_CH_PROGRAM "NCP_HLC_PROGRAM" /* ADCBI DP1 */
 enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTBEAT,
                       NCP_DIST_AX_RESEND };
 /* "NCP_AX_<L>_ADVERT" etc. into buf (32 bytes are enough). */

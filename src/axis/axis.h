@@ -19,7 +19,8 @@ enum llc_end {
     LLC_END_LOST,       /* MAX_LOST_PERIODS setpoints in a row missing */
     LLC_END_FERROR,     /* following error past FERROR */
     LLC_END_MISSING,    /* DP4: the next record was not here when needed */
-    LLC_END_SIGNAL      /* SIGINT / SIGTERM */
+    LLC_END_SIGNAL,     /* SIGINT / SIGTERM */
+    LLC_END_PROGRAM     /* DP1: its own NCK could not run the program (fault says why) */
 };
 
 struct llc_row {          /* one period of the trace, handed to the main thread */
@@ -89,6 +90,8 @@ struct llc {
     int32_t own_n, plan_steps, mark_records, mark_steps;
     ncp_la_burst_t la_burst;
     ncp_int_burst_t int_burst;
+    struct llc_dp1 *dp1;          /* DP1: its own NCK (dp1.c) */
+    char fault[200];              /* LLC_END_PROGRAM: why */
 };
 
 /* dp_block.c: ADCBI DP3 and DP2 at the LLC */
@@ -102,6 +105,13 @@ void llc_plan_advance(struct llc *l);
  * after one that ended at speed v0 (1), or none here (0). */
 struct ncp_dist_recs *llc_exec_ring(struct llc *l);
 int llc_exec_head(struct llc *l, double v0, struct ncp_accdec *a);
+
+/* dp1.c: ADCBI DP1 at the LLC */
+struct llc_dp1;
+int llc_dp1_init(struct llc *l);
+void llc_dp1_free(struct llc *l);
+void llc_on_program(struct llc *l, const uint8_t *p, size_t len);
+void llc_dp1_cycle(struct llc *l);
 
 /* llc.c */
 int llc_cycle(void *ctx, int64_t now_ns);

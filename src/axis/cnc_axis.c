@@ -112,6 +112,7 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_LA);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_INT);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_STEPS);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_PROGRAM);
     /* each axis its own losses: the seed plus its index */
     struct ncp_msg_inject in = { cfg->lcm.inject_loss, cfg->lcm.inject_delay_us * 1000LL,
                                  (uint64_t)cfg->lcm.inject_seed + 1u + (uint64_t)o->axis };
@@ -120,7 +121,7 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     static const double origin[NCP_AXES];
     ncp_sim_init(&l->sim, cfg, origin);
     ncp_dist_rx_init(&l->rx, l->period_ns, 0);
-    if (ncp_dist_recs_init(&l->recs) != 0 || llc_blocks_init(l) != 0)
+    if (ncp_dist_recs_init(&l->recs) != 0 || llc_blocks_init(l) != 0 || llc_dp1_init(l) != 0)
         return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
     if (o->trace) {
         l->tracing = 1;
@@ -184,6 +185,9 @@ static int report(const struct llc *l)
                 ax, l->dp ? l->dp : 4, (int)l->recs.next, l->recs.gaps, l->resends, l->recs.stale,
                 l->recs.duplicate, l->recs.early);
     switch (l->end) {
+    case LLC_END_PROGRAM:
+        fprintf(stderr, "cnc-axis %c: error: DP 1: %s; held at %.4f mm\n", ax, l->fault, l->cmd);
+        break;
     case LLC_END_MISSING:
         fprintf(stderr, "cnc-axis %c: error: record %d was not here when the interpolator "
                         "needed it; ramped to a standstill at %.4f mm\n",
@@ -256,6 +260,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "cnc-axis %c: waiting for the HLC\n", NCP_AXIS_LETTERS[o.axis]);
     if (run_loop(l, trace) != 0)
         l->end = LLC_END_SIGNAL;
+    llc_dp1_free(l);
     int rc = report(l);
     if (trace && fclose(trace) != 0)
         fprintf(stderr, "cnc-axis: error writing %s\n", o.trace);

@@ -117,7 +117,7 @@ void llc_plan_advance(struct llc *l)
 
 struct ncp_dist_recs *llc_exec_ring(struct llc *l)
 {
-    return l->dp == 2 ? &l->own : &l->recs;
+    return l->dp == 2 || l->dp == 1 ? &l->own : &l->recs;
 }
 
 int llc_exec_head(struct llc *l, double v0, struct ncp_accdec *a)

@@ -52,7 +52,7 @@ static void on_hlc_heartbeat(struct llc *l, const uint8_t *p, size_t len, int64_
     if (ncp_heartbeat_t_decode(p, 0, (int)len, &h) != (int)len || h.sender != NCP_DIST_HLC_ID)
         return;
     l->last_hlc_ns = now;
-    if (!l->dp && h.dp >= 2 && h.dp <= 4)
+    if (!l->dp && h.dp >= 1 && h.dp <= 4)
         l->dp = (unsigned char)h.dp;
     if (h.command == NCP_HEARTBEAT_T_COMMAND_DONE)
         l->done_req = 1;
@@ -93,7 +93,8 @@ static void on_sync(struct llc *l, const uint8_t *p, size_t len)
 }
 
 /* Subscriptions, in the order cnc_axis.c makes them. */
-enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC, SUB_LA, SUB_INT, SUB_STEPS };
+enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC, SUB_LA, SUB_INT, SUB_STEPS,
+       SUB_PROGRAM };
 
 void llc_take(struct llc *l, int64_t now)
 {
@@ -115,6 +116,8 @@ void llc_take(struct llc *l, int64_t now)
             llc_on_int(l, p, len);
         else if (sub == SUB_STEPS)
             llc_on_steps(l, p, len);
+        else if (sub == SUB_PROGRAM)
+            llc_on_program(l, p, len);
     }
 }
 
@@ -136,8 +139,11 @@ void llc_publish_status(struct llc *l, int64_t slot)
     s.act_nm = nm(l->act);
     s.ferr_nm = nm(l->ferr);
     s.state = (int8_t)l->state;
-    if (l->dp4) {
-        s.buffer_level = (int16_t)ncp_dist_recs_level(&l->recs);
+    if (l->end == LLC_END_PROGRAM)
+        snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault);
+    /* DP1: its own NCK's records, the HLC waits for the first */
+    if (l->dp4 || l->dp == 1) {
+        s.buffer_level = (int16_t)ncp_dist_recs_level(llc_exec_ring(l));
         s.lost = (int32_t)l->recs.gaps;
         s.stale = (int32_t)l->recs.stale;
         s.duplicate = (int32_t)l->recs.duplicate;
@@ -178,7 +184,8 @@ void llc_advertise(struct llc *l)
                           a->min_limit,    a->max_limit,
                           a->max_vel,      a->max_acc,
                           a->max_jerk,     l->period_ns,
-                          1 << 5 | 1 << 4 | 1 << 3 | 1 << 2, NCP_AX_ADVERT_T_STAGE_FINE };
+                          1 << 5 | 1 << 4 | 1 << 3 | 1 << 2 | 1 << 1,
+                          NCP_AX_ADVERT_T_STAGE_FINE };
     uint8_t buf[128];
     int n = ncp_ax_advert_t_encode(buf, 0, sizeof buf, &m);
     if (n > 0)
@@ -446,6 +453,10 @@ static int waiting(struct llc *l, int64_t now)
         l->end = LLC_END_HLC_SILENT;
     else if (l->done_req)
         l->end = LLC_END_DONE;
+    if (l->end == LLC_END_PROGRAM) {
+        l->state = NCP_AX_STATUS_T_FAULT;   /* the HLC names the axis and why */
+        llc_publish_status(l, 0);
+    }
     if (l->end != LLC_END_NONE)
         return -1;
     double c[NCP_AXES] = { 0 }, a[NCP_AXES];
@@ -465,6 +476,8 @@ int llc_cycle(void *ctx, int64_t now_ns)
         resend_request(l, now);
     if (l->dp == 2)
         llc_plan_advance(l);
+    else if (l->dp == 1)
+        llc_dp1_cycle(l);
     int w = waiting(l, now);
     if (w)
         return w < 0 ? NCP_RT_STOP : NCP_RT_CONTINUE;

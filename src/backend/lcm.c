@@ -5,7 +5,8 @@
  * the records the planner starts, in bursts, lcm_tx.c; the LLCs interpolate
  * them), DP3 (LAbuf: the look-ahead's records; the LLCs profile and
  * interpolate them) and DP2 (INTbuf: the planner's blocks and calls,
- * lcm_dp2.c; each LLC plans them itself).
+ * lcm_dp2.c; each LLC plans them itself) and DP1 (the program: each LLC runs
+ * its own NCK on it, lcm_dp1.c).
  *
  * start() (blocking): waits for every axis's advertisement and first status,
  * checks its limits and period against the INI, and from then on a thread
@@ -66,6 +67,7 @@ struct lcm_be {
     int fine_bytes;
     struct lcm_tx *tx;       /* block-level points */
     struct lcm_dp2 dp2;
+    struct lcm_dp1 *dp1;     /* DP1: the program the LLCs run */
     int rest;                /* the path stood still last period */
     double prev_cmd[NCP_AXES];
 };
@@ -163,6 +165,42 @@ static void *idle_main(void *arg)
     return NULL;
 }
 
+/* DP1: the LLCs' NCKs start on the program message; this one waits (up to
+ * AXIS_WAIT_MS) until each has its first record, as its own planner would
+ * have before moving. */
+static int dp1_wait(struct lcm_be *s, int64_t deadline)
+{
+    int64_t last = 0;
+    for (;;) {
+        int64_t now = mono();
+        if (now - last >= 100000000LL) {   /* again for one that lost it */
+            last = now;
+            lcm_dp1_send(s->dp1, s->msg);
+        }
+        take(s, now);
+        int ready = 0;
+        for (int i = 0; i < s->n; i++) {
+            const struct peer *p = &s->p[i];
+            if (p->st.state == NCP_AX_STATUS_T_FAULT) {
+                snprintf(s->fault, sizeof s->fault, "axis %c's LLC: DP 1: %.*s",
+                         NCP_AXIS_LETTERS[p->axis], (int)sizeof p->st.fault,
+                         (const char *)p->st.fault);
+                s->faulted = 1;
+                return -1;
+            }
+            ready += p->st.buffer_level > 0;
+        }
+        if (ready == s->n || now > deadline)
+            return 0;
+        if (now - s->last_hb >= s->hb_period) {
+            s->last_hb = now;
+            heartbeat(s, NCP_HEARTBEAT_T_COMMAND_RUN, 0);
+        }
+        struct timespec ts = { 0, 1000000 };
+        nanosleep(&ts, NULL);
+    }
+}
+
 static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
 {
     struct lcm_be *s = b->impl;
@@ -204,6 +242,8 @@ static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
         pos[j] = 0;
     for (int i = 0; i < s->n; i++)
         pos[s->p[i].axis] = ncp_dist_nm_to_mm(s->p[i].st.act_nm);
+    if (s->dp1 && dp1_wait(s, mono() + s->cfg->lcm.axis_wait_ms * 1000000LL) != 0)
+        return -1;
     atomic_store(&s->idle_run, 1);
     s->idle_started = pthread_create(&s->idle, NULL, idle_main, s) == 0;
     return 0;
@@ -327,6 +367,8 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken);
         if (s->tx->kind == &lcm_kind_int)
             lcm_dp2_mark(s->tx, &s->dp2, s->msg, steps, t, s->T);
+        if (s->dp1 && s->cycles % 20 == 0)   /* an LLC that lost the first one */
+            lcm_dp1_send(s->dp1, s->msg);
     } else {
         send_fine(s, t, cmd);
     }
@@ -381,7 +423,12 @@ static void lcm_stop(struct ncp_backend *b)
     }
     struct ncp_msg_stats st;
     ncp_msg_get_stats(s->msg, &st);
-    if (s->tx)
+    if (s->dp1)
+        fprintf(stderr, "lcm: DP 1: the program (%lld bytes, by path) in messages of %d bytes "
+                        "(%d with the LCM header), %d sent\n",
+                (long long)s->dp1->msg.size, s->dp1->bytes,
+                s->dp1->bytes + 8 + (int)sizeof NCP_DIST_CH_PROGRAM, (int)s->dp1->seq);
+    else if (s->tx)
         fprintf(stderr, "lcm: DP %d: %d records in %llu bursts of %d bytes (%d with the LCM "
                         "header), %llu resent on request, %llu lost to a full tap ring\n",
                 s->tx->kind->dp, s->tx->sent, (unsigned long long)s->tx->bursts,
@@ -416,6 +463,8 @@ static void lcm_describe(const struct ncp_backend *b, char *buf, size_t len)
 
 static void free_tx(struct lcm_be *s)
 {
+    free(s->dp1);
+    s->dp1 = NULL;
     if (s->tx) {
         lcm_tx_free(s->tx);
         free(s->tx);
@@ -442,11 +491,12 @@ static const struct ncp_backend_ops lcm_ops = {
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d)
 {
-    int blocks = cfg->nck == NCP_NCK_ADCBI && cfg->lcm.dp >= 2 && cfg->lcm.dp <= 4;
+    int blocks = cfg->nck == NCP_NCK_ADCBI && cfg->lcm.dp >= 1 && cfg->lcm.dp <= 4;
     if (cfg->lcm.dp != 5 && !blocks)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "DP %d is not implemented yet: the lcm backend streams at DP 5 "
-                            "(fineIPObuf) and ADCBI's DP 2-4 (INTbuf, LAbuf, ACCDECbuf)",
+                            "(fineIPObuf) and ADCBI's DP 1-4 (program, INTbuf, LAbuf, "
+                            "ACCDECbuf)",
                             cfg->lcm.dp);
     if (blocks && ncp_machine_cfg_ipo_ratio(cfg) != 1)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
@@ -465,6 +515,16 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
             free(s->tx);
             free(s);
             return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
+        }
+    }
+    if (cfg->lcm.dp == 1) {
+        s->dp1 = malloc(sizeof *s->dp1);
+        if (!s->dp1 || lcm_dp1_init(s->dp1, &cfg->lcm) != 0) {
+            int rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "DP 1: cannot read the program %s",
+                                  cfg->lcm.program);
+            free_tx(s);
+            free(s);
+            return rc;
         }
     }
     s->T = llround(cfg->servo_period * 1e9);
@@ -506,7 +566,7 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     b->real_clock_only = 1;
     if (s->tx && s->tx->kind == &lcm_kind_int)
         b->plan_journal = journal;
-    else if (s->tx)
+    else if (s->tx && !s->dp1)
         b->plan_tap = tap;
     return NCP_OK;
 }

@@ -59,6 +59,18 @@ void lcm_tx_cycle(struct lcm_tx *x, struct ncp_msg *m, int64_t t, int64_t period
 /* An LLC's resend request (rec_mark_t) for records from its number on. */
 void lcm_tx_resend(struct lcm_tx *x, struct ncp_msg *m, const uint8_t *b, size_t len);
 
+/* ---- ADCBI DP1 (lcm_dp1.c): the program to run ------------------------ */
+struct lcm_dp1 {
+    ncp_program_t msg;
+    int32_t seq;
+    int bytes;                     /* the message's encoded size */
+};
+/* FNV-1a of what is left of f, and its length. */
+uint64_t lcm_dp1_hash(FILE *f, int64_t *size);
+/* Reads c->program for its size and hash: 0, or -1 (errno says why). */
+int lcm_dp1_init(struct lcm_dp1 *p, const struct ncp_lcm_cfg *c);
+void lcm_dp1_send(struct lcm_dp1 *p, struct ncp_msg *m);
+
 /* ---- ADCBI DP2 (lcm_dp2.c): the planner's calls as INTbuf records ------- */
 struct lcm_dp2 {
     int32_t steps_own;             /* planner thread: steps its planner took */

@@ -11,6 +11,8 @@ int nck_plan_new(struct nck *n)
         n->planner = ncp_planner_new(n->cfg, n->start);
     if (n->planner && n->be.plan_tap)
         ncp_planner_set_tap(n->planner, n->be.plan_tap, n->be.impl);
+    else if (n->planner && n->setup.plan_tap)
+        ncp_planner_set_tap(n->planner, n->setup.plan_tap, n->setup.plan_tap_ctx);
     if (n->planner && n->be.plan_journal)
         n->be.plan_journal(n->be.impl, NCP_PLAN_RESET, NULL, n->start);
     return n->adcai || n->planner ? 0 : -1;
