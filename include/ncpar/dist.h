@@ -5,7 +5,7 @@
  * Distribution points, ADCBI (today's planner): DP1 the part program, DP2
  * INTbuf, DP3 LAbuf, DP4 ACCDECbuf (block-level: bursts), DP5 fineIPObuf
  * (period-level: a record every servo period). ADCAI: DP2 roughIPObuf, DP3
- * ACCDECbuf, DP4 fineIPObuf. Implemented: ADCBI DP5, DP4, DP3 and DP2.
+ * ACCDECbuf, DP4 fineIPObuf. Implemented: ADCBI DP5, DP4, DP3, DP2 and DP1.
  *
  * Positions travel as int32 nanometres: exact and the same for every LLC,
  * +-2.1 m of travel. */
@@ -129,6 +129,10 @@ void ncp_dist_la_encode(const struct ncp_la *la, ncp_la_rec_t *r);
 void ncp_dist_la_decode(const ncp_la_rec_t *r, struct ncp_la *la);
 void ncp_dist_op_encode(const struct ncp_dist_op *o, ncp_int_rec_t *r);
 void ncp_dist_op_decode(const ncp_int_rec_t *r, struct ncp_dist_op *o);
+
+/* DP1: a program file's FNV-1a hash and size (-1: cannot be read), so an LLC
+ * knows it reads the HLC's program. */
+uint64_t ncp_dist_file_hash(const char *path, int64_t *size);
 
 /* What one place of an LLC's ring holds: the record of its point. */
 union ncp_dist_rec {

@@ -3,7 +3,8 @@
  * waits for the HLC (cnc-run run --backend lcm), then runs the axis's
  * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5), or
  * interpolating the records the HLC's planner starts (ADCBI DP4; DP3 after
- * profiling its look-ahead records; DP2 planning the HLC's blocks itself),
+ * profiling its look-ahead records; DP2 planning the HLC's blocks itself;
+ * DP1 running its own NCK on the HLC's program),
  * until the HLC says the program is done (exit 0) or something makes it stop
  * (exit 3, after a ramp to standstill). */
 #include "axis.h"
@@ -32,7 +33,7 @@ static void usage(FILE *f)
           "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
           "servo at the HLC's setpoints (every servo period, DP 5) or interpolating the\n"
           "records of its planner (ADCBI DP 4; DP 3 its look-ahead records, DP 2 its\n"
-          "blocks, planned here), and reports its status\n"
+          "blocks, planned here; DP 1 the program, run here), and reports its status\n"
           "every period. Stops with a ramp within MAX_ACCELERATION when the HLC goes\n"
           "silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS setpoints in a row\n"
           "are missing, on a following error or when the HLC orders it.\n"

@@ -35,23 +35,6 @@ struct llc_dp1 {
     char label[32];
 };
 
-static uint64_t fnv(const char *path, int64_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    uint64_t h = 14695981039346656037ULL;
-    *size = -1;
-    if (!f)
-        return 0;
-    int c;
-    *size = 0;
-    while ((c = getc(f)) != EOF) {
-        h = (h ^ (uint64_t)(unsigned char)c) * 1099511628211ULL;
-        ++*size;
-    }
-    fclose(f);
-    return h;
-}
-
 static void tap(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec)
 {
     (void)la;
@@ -141,7 +124,7 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
     /* one look at the file, on the loop: a program is read once, and the
      * HLC waits for the records anyway */
     int64_t size;
-    uint64_t h = fnv(p->path, &size);
+    uint64_t h = ncp_dist_file_hash(p->path, &size);
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     if (size != m.size || h != (uint64_t)m.hash) {

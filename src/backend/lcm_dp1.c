@@ -1,6 +1,5 @@
 /* ADCBI DP1 at the HLC: no blocks and no records go out, only the program
- * to run (by path, on one host, with its size and hash: lcm_dp1.h's
- * message) and, through lcm_tx with nothing to send, the periods the path
+ * to run (by path, on one host, with its size and hash: program_t) and, through lcm_tx with nothing to send, the periods the path
  * leaves each standstill. Each LLC runs the NCK on the program itself and
  * follows those marks (src/axis/dp1.c). The HLC runs its own NCK as well:
  * it decides when motion starts (spindle at speed, a pause) and keeps the
@@ -10,32 +9,15 @@
 #include <stdio.h>
 #include <string.h>
 
-uint64_t lcm_dp1_hash(FILE *f, int64_t *size)
-{
-    uint64_t h = 14695981039346656037ULL;   /* FNV-1a, 64 bit */
-    int c;
-    *size = 0;
-    while ((c = getc(f)) != EOF) {
-        h = (h ^ (uint64_t)(unsigned char)c) * 1099511628211ULL;
-        ++*size;
-    }
-    return h;
-}
-
 int lcm_dp1_init(struct lcm_dp1 *p, const struct ncp_lcm_cfg *c)
 {
     memset(p, 0, sizeof *p);
-    FILE *f = fopen(c->program, "rb");
-    if (!f)
-        return -1;
-    p->msg.hash = (int64_t)lcm_dp1_hash(f, &p->msg.size);
-    int bad = ferror(f);
-    fclose(f);
+    p->msg.hash = (int64_t)ncp_dist_file_hash(c->program, &p->msg.size);
     p->msg.sender = NCP_DIST_HLC_ID;
     snprintf((char *)p->msg.path, sizeof p->msg.path, "%s", c->program);
     snprintf((char *)p->msg.tool_table, sizeof p->msg.tool_table, "%s", c->tool_table);
     snprintf((char *)p->msg.sub_path, sizeof p->msg.sub_path, "%s", c->sub_path);
-    return bad ? -1 : 0;
+    return p->msg.size < 0 ? -1 : 0;
 }
 
 void lcm_dp1_send(struct lcm_dp1 *p, struct ncp_msg *m)

@@ -65,8 +65,6 @@ struct lcm_dp1 {
     int32_t seq;
     int bytes;                     /* the message's encoded size */
 };
-/* FNV-1a of what is left of f, and its length. */
-uint64_t lcm_dp1_hash(FILE *f, int64_t *size);
 /* Reads c->program for its size and hash: 0, or -1 (errno says why). */
 int lcm_dp1_init(struct lcm_dp1 *p, const struct ncp_lcm_cfg *c);
 void lcm_dp1_send(struct lcm_dp1 *p, struct ncp_msg *m);
