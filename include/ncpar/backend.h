@@ -87,6 +87,10 @@ struct ncp_backend_ops {
     void (*live)(struct ncp_backend *b);
 };
 
+/* The ADCBI planner's calls, as plan_journal sees them. */
+enum ncp_plan_call { NCP_PLAN_PUSH, NCP_PLAN_FINISH, NCP_PLAN_RESTART, NCP_PLAN_RESET,
+                     NCP_PLAN_STEP };
+
 struct ncp_backend {
     const struct ncp_backend_ops *ops;
     void *impl;
@@ -100,6 +104,11 @@ struct ncp_backend {
     /* An HLC at ADCAI's DP2 or DP3 sends what the ADCAI chain taps there
      * (planner thread; ncpar/adcai.h; NULL: none). */
     void (*adcai_tap)(void *impl, const struct ncp_adcai_tap *t);
+    /* An HLC at ADCBI's DP2 sends on what the planner is given: every call
+     * on the ADCBI planner, in order (planner thread; NULL: none). s is the
+     * block (PUSH) or NULL; pos the position (RESET, and the start) or NULL. */
+    void (*plan_journal)(void *impl, enum ncp_plan_call call, const struct ncp_seg *s,
+                         const double *pos);
 };
 
 /* Opens what cfg->backend names (not started yet). log gets start-up

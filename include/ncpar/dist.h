@@ -5,8 +5,8 @@
  * Distribution points, ADCBI (today's planner): DP1 the part program, DP2
  * INTbuf, DP3 LAbuf, DP4 ACCDECbuf (block-level: bursts), DP5 fineIPObuf
  * (period-level: a record every servo period). ADCAI: DP2 roughIPObuf, DP3
- * ACCDECbuf, DP4 fineIPObuf; it has no DP5. Implemented: ADCBI DP5 and DP4,
- * ADCAI DP2-DP4.
+ * ACCDECbuf, DP4 fineIPObuf; it has no DP5. Implemented: ADCBI DP5, DP4, DP3,
+ * DP2 and DP1; ADCAI DP2-DP4.
  *
  * Positions travel as int32 nanometres: exact and the same for every LLC,
  * +-2.1 m of travel. */
@@ -22,6 +22,10 @@
 #include "ncp_ax_status_t.h"
 #include "ncp_fine_ipo_t.h"
 #include "ncp_heartbeat_t.h"
+#include "ncp_int_burst_t.h"
+#include "ncp_la_burst_t.h"
+#include "ncp_plan_mark_t.h"
+#include "ncp_program_t.h"
 #include "ncp_rec_mark_t.h"
 #include "ncp_rough_ipo_t.h"
 #include "ncp_accdec_ai_t.h"
@@ -33,6 +37,10 @@
 #define NCP_DIST_CH_HLC_HEARTBEAT "NCP_HLC_HEARTBEAT"
 #define NCP_DIST_CH_ACCDEC "NCP_HLC_ACCDEC"
 #define NCP_DIST_CH_SYNC "NCP_HLC_SYNC"
+#define NCP_DIST_CH_LA "NCP_HLC_LA"         /* ADCBI DP3 */
+#define NCP_DIST_CH_INT "NCP_HLC_INT"       /* ADCBI DP2 */
+#define NCP_DIST_CH_STEPS "NCP_HLC_STEPS"   /* ADCBI DP2 */
+#define NCP_DIST_CH_PROGRAM "NCP_HLC_PROGRAM" /* ADCBI DP1 */
 enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTBEAT,
                       NCP_DIST_AX_RESEND };
 /* "NCP_AX_<L>_ADVERT" etc. into buf (32 bytes are enough). */
@@ -116,9 +124,34 @@ int ncp_dist_rx_level(const struct ncp_dist_rx *r, int64_t t_ns);
 void ncp_dist_rec_encode(const struct ncp_accdec *a, ncp_accdec_rec_t *r);
 void ncp_dist_rec_decode(const ncp_accdec_rec_t *r, struct ncp_accdec *a);
 
+/* ---- ADCBI DP3 (LAbuf) and DP2 (INTbuf) records (blocks.c) -------------- */
+/* DP2: a call the HLC's planner got, after `step` of its steps. */
+struct ncp_dist_op {
+    int op;                 /* NCP_INT_REC_T_PUSH .. RESET */
+    int32_t step;
+    struct ncp_seg s;       /* PUSH: the block; RESET: the position in s.end */
+};
+void ncp_dist_seg_encode(const struct ncp_seg *s, ncp_seg_rec_t *r);
+void ncp_dist_seg_decode(const ncp_seg_rec_t *r, struct ncp_seg *s);
+void ncp_dist_la_encode(const struct ncp_la *la, ncp_la_rec_t *r);
+void ncp_dist_la_decode(const ncp_la_rec_t *r, struct ncp_la *la);
+void ncp_dist_op_encode(const struct ncp_dist_op *o, ncp_int_rec_t *r);
+void ncp_dist_op_decode(const ncp_int_rec_t *r, struct ncp_dist_op *o);
+
+/* DP1: a program file's FNV-1a hash and size (-1: cannot be read), so an LLC
+ * knows it reads the HLC's program. */
+uint64_t ncp_dist_file_hash(const char *path, int64_t *size);
+
+/* What one place of an LLC's ring holds: the record of its point. */
+union ncp_dist_rec {
+    struct ncp_accdec a;    /* DP4 (and DP2's own planner's records) */
+    struct ncp_la la;       /* DP3 */
+    struct ncp_dist_op op;  /* DP2 */
+};
+
 struct ncp_dist_recs {
     int32_t num[NCP_DIST_RECS];   /* the record held in each place (-1: none) */
-    ncp_accdec_rec_t *rec;        /* NCP_DIST_RECS of them, allocated once */
+    union ncp_dist_rec *rec;      /* NCP_DIST_RECS of them, allocated once */
     int32_t next;                 /* the next record the interpolator takes */
     int32_t have;                 /* all records below this are here or taken */
     int32_t top;                  /* one past the highest number received */
@@ -128,9 +161,9 @@ struct ncp_dist_recs {
 int ncp_dist_recs_init(struct ncp_dist_recs *q);
 void ncp_dist_recs_free(struct ncp_dist_recs *q);
 /* A received record (kept, or counted stale, duplicate or too early). */
-void ncp_dist_recs_put(struct ncp_dist_recs *q, int32_t num, const ncp_accdec_rec_t *r);
+void ncp_dist_recs_put(struct ncp_dist_recs *q, int32_t num, const union ncp_dist_rec *r);
 /* The next record if it is here (1), else 0. */
-int ncp_dist_recs_peek(const struct ncp_dist_recs *q, struct ncp_accdec *a);
+int ncp_dist_recs_peek(const struct ncp_dist_recs *q, union ncp_dist_rec *r);
 /* The interpolator is done with the next record. */
 void ncp_dist_recs_pop(struct ncp_dist_recs *q);
 static inline int ncp_dist_recs_level(const struct ncp_dist_recs *q) { return q->have - q->next; }

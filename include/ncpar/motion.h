@@ -159,6 +159,9 @@ struct ncp_machine_cfg {
                                      and after each command */
         /* the distributed mode (cnc-run run --backend lcm, cnc-axis; seed 002) */
         int dp;                   /* DP: distribution point 1..5 (5) */
+        /* DP 1: the program and what it needs, absolute (not from the INI:
+         * cnc-run run's PROG, --tool-table, --sub-path) */
+        char program[256], tool_table[256], sub_path[256];
         int max_lost_periods;     /* MAX_LOST_PERIODS: statuses (HLC) or setpoints
                                      (LLC) missing in a row before a controlled stop (20) */
         int heartbeat_period_ms;  /* HEARTBEAT_PERIOD_MS (20) */

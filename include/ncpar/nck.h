@@ -90,6 +90,10 @@ struct ncp_nck_opts {
     const char *label;
     int trace_rings;         /* as ncp_nck_setup's */
     int loop_priority_min;
+    /* every segment the ADCBI planner starts (ncp_planner_set_tap; planner
+     * thread), or NULL: an LLC at DP 1 runs its own NCK for these */
+    void (*plan_tap)(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec);
+    void *plan_tap_ctx;
 };
 
 enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };
@@ -201,6 +205,9 @@ struct ncp_nck_setup {
     int trace_rings;                 /* ring and task columns in the trace (or [SCHED]'s) */
     int loop_priority_min;           /* the process's lowest position loop priority, where
                                         several NCKs run (0: this NCK's own) */
+    /* as ncp_nck_opts' */
+    void (*plan_tap)(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec);
+    void *plan_tap_ctx;
 };
 
 struct ncp_nck;

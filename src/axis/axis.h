@@ -19,7 +19,8 @@ enum llc_end {
     LLC_END_LOST,       /* MAX_LOST_PERIODS setpoints in a row missing */
     LLC_END_FERROR,     /* following error past FERROR */
     LLC_END_MISSING,    /* DP4: the next record was not here when needed */
-    LLC_END_SIGNAL      /* SIGINT / SIGTERM */
+    LLC_END_SIGNAL,     /* SIGINT / SIGTERM */
+    LLC_END_PROGRAM     /* DP1: its own NCK could not run the program (fault says why) */
 };
 
 struct llc_ai;
@@ -82,6 +83,18 @@ struct llc {
     uint32_t resends;
     ncp_accdec_burst_t burst;   /* decoded here, not on the loop's stack */
     struct llc_ai *ai;          /* ADCAI's DP2 and DP3: this axis's stages (llc_adcai.c) */
+    /* The block-level point (4, 3 or 2; 0 not known yet): at DP3 recs holds
+     * LAbuf records (profiled as the interpolator takes them), at DP2 the
+     * planner's calls, which this LLC's own planner replays into own, the
+     * ring the interpolator then runs (dp_block.c). */
+    int dp;
+    struct ncp_planner *plan;
+    struct ncp_dist_recs own;
+    int32_t own_n, plan_steps, mark_records, mark_steps;
+    ncp_la_burst_t la_burst;
+    ncp_int_burst_t int_burst;
+    struct llc_dp1 *dp1;          /* DP1: its own NCK (dp1.c) */
+    char fault[200];              /* LLC_END_PROGRAM: why */
 };
 
 /* llc_adcai.c: NULL when out of memory or the INI's limits give no filter */
@@ -90,6 +103,25 @@ void llc_ai_free(struct llc_ai *a);
 /* A DP2 (rough_ipo_t) or DP3 (accdec_ai_t) message: into the setpoint buffer. */
 void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len);
 void llc_ai_report(const struct llc *l);
+
+/* dp_block.c: ADCBI DP3 and DP2 at the LLC */
+int llc_blocks_init(struct llc *l);
+void llc_on_la(struct llc *l, const uint8_t *p, size_t len);
+void llc_on_int(struct llc *l, const uint8_t *p, size_t len);
+void llc_on_steps(struct llc *l, const uint8_t *p, size_t len);
+/* DP2: this LLC's planner as far as the HLC's calls and steps allow. */
+void llc_plan_advance(struct llc *l);
+/* The ring the interpolator takes its records from, and its next record
+ * after one that ended at speed v0 (1), or none here (0). */
+struct ncp_dist_recs *llc_exec_ring(struct llc *l);
+int llc_exec_head(struct llc *l, double v0, struct ncp_accdec *a);
+
+/* dp1.c: ADCBI DP1 at the LLC */
+struct llc_dp1;
+int llc_dp1_init(struct llc *l);
+void llc_dp1_free(struct llc *l);
+void llc_on_program(struct llc *l, const uint8_t *p, size_t len);
+void llc_dp1_cycle(struct llc *l);
 
 /* llc.c */
 int llc_cycle(void *ctx, int64_t now_ns);

@@ -2,7 +2,9 @@
  * axis controller of the distributed NCK (seed 002). It advertises its axis,
  * waits for the HLC (cnc-run run --backend lcm), then runs the axis's
  * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5), or
- * interpolating the records the HLC's planner starts (ADCBI DP4),
+ * interpolating the records the HLC's planner starts (ADCBI DP4; DP3 after
+ * profiling its look-ahead records; DP2 planning the HLC's blocks itself;
+ * DP1 running its own NCK on the HLC's program),
  * until the HLC says the program is done (exit 0) or something makes it stop
  * (exit 3, after a ramp to standstill). */
 #include "axis.h"
@@ -30,7 +32,8 @@ static void usage(FILE *f)
           "One axis of the distributed NCK: advertises axis L of the machine INI over LCM,\n"
           "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
           "servo at the HLC's setpoints (every servo period, DP 5) or interpolating the\n"
-          "records of its planner (ADCBI DP 4), and reports its status\n"
+          "records of its planner (ADCBI DP 4; DP 3 its look-ahead records, DP 2 its\n"
+          "blocks, planned here; DP 1 the program, run here), and reports its status\n"
           "every period. Stops with a ramp within MAX_ACCELERATION when the HLC goes\n"
           "silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS setpoints in a row\n"
           "are missing, on a following error or when the HLC orders it.\n"
@@ -109,6 +112,10 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_SYNC);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_ROUGH);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_ACCDEC_AI);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_LA);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_INT);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_STEPS);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_PROGRAM);
     /* each axis its own losses: the seed plus its index */
     struct ncp_msg_inject in = { cfg->lcm.inject_loss, cfg->lcm.inject_delay_us * 1000LL,
                                  (uint64_t)cfg->lcm.inject_seed + 1u + (uint64_t)o->axis };
@@ -117,7 +124,7 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     static const double origin[NCP_AXES];
     ncp_sim_init(&l->sim, cfg, origin);
     ncp_dist_rx_init(&l->rx, l->period_ns, 0);
-    if (ncp_dist_recs_init(&l->recs) != 0)
+    if (ncp_dist_recs_init(&l->recs) != 0 || llc_blocks_init(l) != 0 || llc_dp1_init(l) != 0)
         return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
     /* ADCAI's stages, for DP2 and DP3 (the same windows as the HLC's: the
      * same INI); without them those points are not advertised */
@@ -180,12 +187,15 @@ static int report(const struct llc *l)
             l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.bridged, l->rx.reordered, l->clamped,
             (unsigned long long)st.inject_lost, (unsigned long long)st.inject_delayed);
     if (l->dp4)
-        fprintf(stderr, "cnc-axis %c: DP 4: records taken %d, gaps %u, resend requests %u, "
+        fprintf(stderr, "cnc-axis %c: DP %d: records taken %d, gaps %u, resend requests %u, "
                         "stale %u, duplicate %u, too early %u\n",
-                ax, (int)l->recs.next, l->recs.gaps, l->resends, l->recs.stale,
+                ax, l->dp ? l->dp : 4, (int)l->recs.next, l->recs.gaps, l->resends, l->recs.stale,
                 l->recs.duplicate, l->recs.early);
     llc_ai_report(l);
     switch (l->end) {
+    case LLC_END_PROGRAM:
+        fprintf(stderr, "cnc-axis %c: error: DP 1: %s; held at %.4f mm\n", ax, l->fault, l->cmd);
+        break;
     case LLC_END_MISSING:
         fprintf(stderr, "cnc-axis %c: error: record %d was not here when the interpolator "
                         "needed it; ramped to a standstill at %.4f mm\n",
@@ -258,6 +268,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "cnc-axis %c: waiting for the HLC\n", NCP_AXIS_LETTERS[o.axis]);
     if (run_loop(l, trace) != 0)
         l->end = LLC_END_SIGNAL;
+    llc_dp1_free(l);
     int rc = report(l);
     if (trace && fclose(trace) != 0)
         fprintf(stderr, "cnc-axis: error writing %s\n", o.trace);

@@ -12,7 +12,9 @@
  * error, not a wait. A separate network thread would add a hand-off and a
  * period of latency for nothing here.
  *
- * At DP4 the HLC sends ACCDECbuf records instead (bursts, numbered) and
+ * At DP4 the HLC sends ACCDECbuf records instead (bursts, numbered; DP3
+ * and DP2 their LAbuf and INTbuf records, dp_block.c makes ACCDECbuf ones
+ * of them) and
  * the period its motion began; the LLC runs the interpolator (ncp_exec) on
  * them, one step per period from that one on, so its samples are the central
  * run's. A record lost on the way is asked for again (NCP_AX_<L>_RESEND)
@@ -50,6 +52,8 @@ static void on_hlc_heartbeat(struct llc *l, const uint8_t *p, size_t len, int64_
     if (ncp_heartbeat_t_decode(p, 0, (int)len, &h) != (int)len || h.sender != NCP_DIST_HLC_ID)
         return;
     l->last_hlc_ns = now;
+    if (!l->dp && h.dp >= 1 && h.dp <= 4)
+        l->dp = (unsigned char)h.dp;
     if (h.command == NCP_HEARTBEAT_T_COMMAND_DONE)
         l->done_req = 1;
     else if (h.command == NCP_HEARTBEAT_T_COMMAND_STOP && l->end == LLC_END_NONE) {
@@ -64,8 +68,11 @@ static void on_accdec(struct llc *l, const uint8_t *p, size_t len)
     if (ncp_accdec_burst_t_decode(p, 0, (int)len, b) != (int)len ||
         b->sender != NCP_DIST_HLC_ID || b->count < 0 || b->count > NCP_DIST_BURST)
         return;
-    for (int i = 0; i < b->count; i++)
-        ncp_dist_recs_put(&l->recs, b->first + i, &b->recs[i]);
+    union ncp_dist_rec u;
+    for (int i = 0; i < b->count; i++) {
+        ncp_dist_rec_decode(&b->recs[i], &u.a);
+        ncp_dist_recs_put(&l->recs, b->first + i, &u);
+    }
 }
 
 static void on_sync(struct llc *l, const uint8_t *p, size_t len)
@@ -86,7 +93,8 @@ static void on_sync(struct llc *l, const uint8_t *p, size_t len)
 }
 
 /* Subscriptions, in the order cnc_axis.c makes them. */
-enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC, SUB_ROUGH, SUB_ACCDEC_AI };
+enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC, SUB_ROUGH, SUB_ACCDEC_AI, SUB_LA,
+       SUB_INT, SUB_STEPS, SUB_PROGRAM };
 
 void llc_take(struct llc *l, int64_t now)
 {
@@ -104,6 +112,14 @@ void llc_take(struct llc *l, int64_t now)
             on_sync(l, p, len);
         else if (sub == SUB_ROUGH || sub == SUB_ACCDEC_AI)
             llc_ai_take(l, sub == SUB_ROUGH ? 2 : 3, p, len);
+        else if (sub == SUB_LA)
+            llc_on_la(l, p, len);
+        else if (sub == SUB_INT)
+            llc_on_int(l, p, len);
+        else if (sub == SUB_STEPS)
+            llc_on_steps(l, p, len);
+        else if (sub == SUB_PROGRAM)
+            llc_on_program(l, p, len);
     }
 }
 
@@ -125,8 +141,11 @@ void llc_publish_status(struct llc *l, int64_t slot)
     s.act_nm = nm(l->act);
     s.ferr_nm = nm(l->ferr);
     s.state = (int8_t)l->state;
-    if (l->dp4) {
-        s.buffer_level = (int16_t)ncp_dist_recs_level(&l->recs);
+    if (l->end == LLC_END_PROGRAM)
+        snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault);
+    /* DP1: its own NCK's records, the HLC waits for the first */
+    if (l->dp4 || l->dp == 1) {
+        s.buffer_level = (int16_t)ncp_dist_recs_level(llc_exec_ring(l));
         s.lost = (int32_t)l->recs.gaps;
         s.stale = (int32_t)l->recs.stale;
         s.duplicate = (int32_t)l->recs.duplicate;
@@ -167,7 +186,7 @@ void llc_advertise(struct llc *l)
                           a->min_limit,    a->max_limit,
                           a->max_vel,      a->max_acc,
                           a->max_jerk,     l->period_ns,
-                          (int8_t)(1 << 5 | 1 << 4 | (l->ai ? 1 << 3 | 1 << 2 : 0)),
+                          (int8_t)(1 << 5 | 1 << 4 | 1 << 3 | 1 << 2 | 1 << 1),
                           (int8_t)(NCP_AX_ADVERT_T_STAGE_FINE |
                                    (l->ai ? NCP_AX_ADVERT_T_STAGE_ACCDEC : 0)) };
     uint8_t buf[128];
@@ -199,16 +218,17 @@ static double follow(struct llc *l, int64_t slot)
     return l->cmd + step;
 }
 
-/* DP4's record source for the interpolator. A record it needs at speed
- * that is not here is missing (at a standstill: see interpolate()). */
+/* The block-level points' record source for the interpolator. A record it
+ * needs at speed that is not here is missing (at a standstill: see
+ * interpolate()). */
 static int rec_next(void *ctx, double v0, struct ncp_accdec *rec)
 {
     struct llc *l = ctx;
-    if (ncp_dist_recs_peek(&l->recs, rec))
+    if (llc_exec_head(l, v0, rec))
         return 1;
     if (v0 > 0) {
         l->missing = 1;
-        l->missing_rec = l->recs.next;
+        l->missing_rec = llc_exec_ring(l)->next;
     }
     return 0;
 }
@@ -222,7 +242,7 @@ static int64_t start_at(const struct llc *l, int32_t k)
 
 static void rec_done(void *ctx)
 {
-    ncp_dist_recs_pop(&((struct llc *)ctx)->recs);
+    ncp_dist_recs_pop(llc_exec_ring(ctx));
 }
 
 static double ramp(struct llc *l);
@@ -237,7 +257,7 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
     if (!l->ex_on) {
         /* every axis from where the first record starts: a standstill is
          * then the same on every LLC and the HLC */
-        if (!ncp_dist_recs_peek(&l->recs, &first))
+        if (!llc_exec_head(l, 0, &first))
             first.s.start[l->axis] = l->cmd;
         ncp_exec_init(&l->ex, first.s.start, (double)l->period_ns * 1e-9);
         memcpy(l->ex_prev, first.s.start, sizeof l->ex_prev);
@@ -245,7 +265,8 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
     }
     int64_t due = start_at(l, l->starts_done);
     struct ncp_exec before = l->ex;
-    int32_t next = l->recs.next;
+    struct ncp_dist_recs *q = llc_exec_ring(l);
+    int32_t next = q->next;
     const struct ncp_exec_source src = { rec_next, rec_done, l };
     struct ncp_setpoint sp;
     l->missing = 0;
@@ -254,14 +275,14 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
     for (int j = 0; j < NCP_AXES; j++)
         moving |= sp.pos[j] != l->ex_prev[j];
     int hold = moving && l->ex_rest && (!due || slot < due);
-    if (!moving && l->ex_rest && due && slot >= due && !ncp_dist_recs_peek(&l->recs, &first)) {
+    if (!moving && l->ex_rest && due && slot >= due && !llc_exec_head(l, 0, &first)) {
         /* the HLC moved off here: the record it moved on is needed now */
         l->missing = 1;
-        l->missing_rec = l->recs.next;
+        l->missing_rec = q->next;
     }
     if (hold || !commit) {
         l->ex = before;
-        l->recs.next = next;
+        q->next = next;
         if (hold)
             l->missing = 0;
         *pos = hold ? l->ex_prev[l->axis] : sp.pos[l->axis];
@@ -435,6 +456,10 @@ static int waiting(struct llc *l, int64_t now)
         l->end = LLC_END_HLC_SILENT;
     else if (l->done_req)
         l->end = LLC_END_DONE;
+    if (l->end == LLC_END_PROGRAM) {
+        l->state = NCP_AX_STATUS_T_FAULT;   /* the HLC names the axis and why */
+        llc_publish_status(l, 0);
+    }
     if (l->end != LLC_END_NONE)
         return -1;
     double c[NCP_AXES] = { 0 }, a[NCP_AXES];
@@ -452,6 +477,10 @@ int llc_cycle(void *ctx, int64_t now_ns)
     llc_take(l, llc_now());
     if (l->dp4)
         resend_request(l, now);
+    if (l->dp == 2)
+        llc_plan_advance(l);
+    else if (l->dp == 1)
+        llc_dp1_cycle(l);
     int w = waiting(l, now);
     if (w)
         return w < 0 ? NCP_RT_STOP : NCP_RT_CONTINUE;

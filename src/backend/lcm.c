@@ -1,10 +1,14 @@
 /* The distributed NCK's high-level end (seed 002): the position loop's
  * setpoints go to one cnc-axis LLC per axis over LCM, and the actual positions
  * come back in their statuses. Implemented: ADCBI DP5 (fineIPObuf, a message
- * every servo period carrying every axis) and DP4 (ACCDECbuf: the records the
- * planner starts, in bursts, lcm_tx.c; the LLCs interpolate them), and
- * ADCAI's DP4 (its fineIPObuf: the same stream as ADCBI's DP5), DP3 and DP2
- * (a record every rough period, lcm_ai.c; the LLCs run the stages below).
+ * every servo period carrying every axis), the block-level DP4 (ACCDECbuf:
+ * the records the planner starts, in bursts, lcm_tx.c; the LLCs interpolate
+ * them), DP3 (LAbuf: the look-ahead's records; the LLCs profile and
+ * interpolate them), DP2 (INTbuf: the planner's blocks and calls,
+ * lcm_dp2.c; each LLC plans them itself) and DP1 (the program: each LLC runs
+ * its own NCK on it, lcm_dp1.c); and ADCAI's DP4 (its fineIPObuf: the same
+ * stream as ADCBI's DP5), DP3 and DP2 (a record every rough period,
+ * lcm_ai.c; the LLCs run the stages below).
  *
  * start() (blocking): waits for every axis's advertisement and first status,
  * checks its limits and period against the INI, and from then on a thread
@@ -66,7 +70,9 @@ struct lcm_be {
     int idle_started;
     uint64_t sent_fine;
     int fine_bytes;
-    struct lcm_tx *tx;       /* DP4 */
+    struct lcm_tx *tx;       /* ADCBI's block-level points */
+    struct lcm_dp2 dp2;
+    struct lcm_dp1 *dp1;     /* DP1: the program the LLCs run */
     struct lcm_ai *ai;       /* ADCAI's DP2, DP3 */
     int rest;                /* the path stood still last period */
     double prev_cmd[NCP_AXES];
@@ -165,6 +171,42 @@ static void *idle_main(void *arg)
     return NULL;
 }
 
+/* DP1: the LLCs' NCKs start on the program message; this one waits (up to
+ * AXIS_WAIT_MS) until each has its first record, as its own planner would
+ * have before moving. */
+static int dp1_wait(struct lcm_be *s, int64_t deadline)
+{
+    int64_t last = 0;
+    for (;;) {
+        int64_t now = mono();
+        if (now - last >= 100000000LL) {   /* again for one that lost it */
+            last = now;
+            lcm_dp1_send(s->dp1, s->msg);
+        }
+        take(s, now);
+        int ready = 0;
+        for (int i = 0; i < s->n; i++) {
+            const struct peer *p = &s->p[i];
+            if (p->st.state == NCP_AX_STATUS_T_FAULT) {
+                snprintf(s->fault, sizeof s->fault, "axis %c's LLC: DP 1: %.*s",
+                         NCP_AXIS_LETTERS[p->axis], (int)sizeof p->st.fault,
+                         (const char *)p->st.fault);
+                s->faulted = 1;
+                return -1;
+            }
+            ready += p->st.buffer_level > 0;
+        }
+        if (ready == s->n || now > deadline)
+            return 0;
+        if (now - s->last_hb >= s->hb_period) {
+            s->last_hb = now;
+            heartbeat(s, NCP_HEARTBEAT_T_COMMAND_RUN, 0);
+        }
+        struct timespec ts = { 0, 1000000 };
+        nanosleep(&ts, NULL);
+    }
+}
+
 static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
 {
     struct lcm_be *s = b->impl;
@@ -206,6 +248,8 @@ static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
         pos[j] = 0;
     for (int i = 0; i < s->n; i++)
         pos[s->p[i].axis] = ncp_dist_nm_to_mm(s->p[i].st.act_nm);
+    if (s->dp1 && dp1_wait(s, mono() + s->cfg->lcm.axis_wait_ms * 1000000LL) != 0)
+        return -1;
     atomic_store(&s->idle_run, 1);
     s->idle_started = pthread_create(&s->idle, NULL, idle_main, s) == 0;
     return 0;
@@ -282,8 +326,15 @@ static void send_fine(struct lcm_be *s, int64_t t, const double cmd[NCP_AXES])
 
 static void tap(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec)
 {
-    (void)la;
-    lcm_tx_push(((struct lcm_be *)impl)->tx, rec);
+    struct lcm_tx *x = ((struct lcm_be *)impl)->tx;
+    lcm_tx_push(x, x->kind == &lcm_kind_la ? (const void *)la : (const void *)rec);
+}
+
+static void journal(void *impl, enum ncp_plan_call c, const struct ncp_seg *seg,
+                    const double *pos)
+{
+    struct lcm_be *s = impl;
+    lcm_dp2_journal(s->tx, &s->dp2, c, seg, pos);
 }
 
 static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const double next[NCP_AXES],
@@ -318,7 +369,12 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         int32_t taken = INT32_MAX;
         for (int i = 0; i < s->n; i++)
             taken = s->p[i].st.rec_next < taken ? s->p[i].st.rec_next : taken;
+        int32_t steps = atomic_load_explicit(&s->dp2.steps, memory_order_acquire);
         lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken);
+        if (s->tx->kind == &lcm_kind_int)
+            lcm_dp2_mark(s->tx, &s->dp2, s->msg, steps, t, s->T);
+        if (s->dp1 && s->cycles % 20 == 0)   /* an LLC that lost the first one */
+            lcm_dp1_send(s->dp1, s->msg);
     } else if (s->ai) {
         lcm_ai_cycle(s->ai, s->msg, t, cmd);
     } else {
@@ -380,11 +436,17 @@ static void lcm_stop(struct ncp_backend *b)
     ncp_msg_get_stats(s->msg, &st);
     if (s->ai)
         lcm_ai_report(s->ai);
+    else if (s->dp1)
+        fprintf(stderr, "lcm: DP 1: the program (%lld bytes, by path) in messages of %d bytes "
+                        "(%d with the LCM header), %d sent\n",
+                (long long)s->dp1->msg.size, s->dp1->bytes,
+                s->dp1->bytes + 8 + (int)sizeof NCP_DIST_CH_PROGRAM, (int)s->dp1->seq);
     else if (s->tx)
-        fprintf(stderr, "lcm: DP 4: %d records in %llu bursts of %d bytes (%d with the LCM "
+        fprintf(stderr, "lcm: DP %d: %d records in %llu bursts of %d bytes (%d with the LCM "
                         "header), %llu resent on request, %llu lost to a full tap ring\n",
-                s->tx->sent, (unsigned long long)s->tx->bursts, s->tx->burst_bytes,
-                s->tx->burst_bytes + 8 + (int)sizeof NCP_DIST_CH_ACCDEC,
+                s->tx->kind->dp, s->tx->sent, (unsigned long long)s->tx->bursts,
+                s->tx->burst_bytes,
+                s->tx->burst_bytes + 8 + (int)strlen(s->tx->kind->channel) + 1,
                 (unsigned long long)s->tx->resent, (unsigned long long)s->tx->overflow);
     else
         fprintf(stderr, "lcm: DP %d (%s): %llu setpoint messages of %d bytes (all %d axes; %d "
@@ -415,6 +477,8 @@ static void lcm_describe(const struct ncp_backend *b, char *buf, size_t len)
 
 static void free_tx(struct lcm_be *s)
 {
+    free(s->dp1);
+    s->dp1 = NULL;
     if (s->tx) {
         lcm_tx_free(s->tx);
         free(s->tx);
@@ -454,15 +518,16 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     int adcai = cfg->nck == NCP_NCK_ADCAI;
     /* ADCAI's fineIPObuf is its DP 4: the same setpoint stream as ADCBI's DP 5 */
     int fine = adcai ? cfg->lcm.dp == 4 : cfg->lcm.dp == 5;
-    if (adcai ? !ncp_dist_adcai_dp(cfg->lcm.dp) : cfg->lcm.dp != 5 && cfg->lcm.dp != 4)
+    int blocks = !adcai && cfg->lcm.dp >= 1 && cfg->lcm.dp <= 4;
+    if (adcai ? !ncp_dist_adcai_dp(cfg->lcm.dp) : !fine && !blocks)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "DP %d is not implemented yet for NCK = %s: the lcm backend streams "
-                            "at ADCBI's DP 5 (fineIPObuf) and DP 4 (ACCDECbuf) and ADCAI's "
-                            "DP 4 (fineIPObuf)", cfg->lcm.dp, adcai ? "adcai" : "adcbi");
-    if (!fine && !adcai && ncp_machine_cfg_ipo_ratio(cfg) != 1)
+                            "at ADCBI's DP 1-5 and ADCAI's DP 2-4", cfg->lcm.dp,
+                            adcai ? "adcai" : "adcbi");
+    if (blocks && ncp_machine_cfg_ipo_ratio(cfg) != 1)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "DP 4 needs [TRAJ] PLANNING_PERIOD equal to SERVO_PERIOD: the LLCs "
-                            "do not fine-interpolate yet");
+                            "DP %d needs [TRAJ] PLANNING_PERIOD equal to SERVO_PERIOD: the LLCs "
+                            "do not fine-interpolate yet", cfg->lcm.dp);
     struct lcm_be *s = calloc(1, sizeof *s);
     if (!s)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
@@ -474,12 +539,25 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
             free(s);
             return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
         }
-    } else if (!fine) {
+    } else if (blocks) {
+        const struct lcm_tx_kind *k = cfg->lcm.dp == 2   ? &lcm_kind_int
+                                      : cfg->lcm.dp == 3 ? &lcm_kind_la
+                                                         : &lcm_kind_accdec;
         s->tx = malloc(sizeof *s->tx);
-        if (!s->tx || lcm_tx_init(s->tx) != 0) {
+        if (!s->tx || lcm_tx_init(s->tx, k) != 0) {
             free(s->tx);
             free(s);
             return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
+        }
+    }
+    if (cfg->lcm.dp == 1) {
+        s->dp1 = malloc(sizeof *s->dp1);
+        if (!s->dp1 || lcm_dp1_init(s->dp1, &cfg->lcm) != 0) {
+            int rc = ncp_diag_set(d, NCP_ERR_IO, 0, 0, "DP 1: cannot read the program %s",
+                                  cfg->lcm.program);
+            free_tx(s);
+            free(s);
+            return rc;
         }
     }
     s->T = llround(cfg->servo_period * 1e9);
@@ -519,7 +597,9 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     b->ops = &lcm_ops;
     b->impl = s;
     b->real_clock_only = 1;
-    if (s->tx)
+    if (s->tx && s->tx->kind == &lcm_kind_int)
+        b->plan_journal = journal;
+    else if (s->tx && !s->dp1)
         b->plan_tap = tap;
     if (s->ai)
         b->adcai_tap = ai_tap;

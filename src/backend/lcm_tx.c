@@ -1,6 +1,8 @@
-/* ACCDECbuf records to the LLCs (ADCBI DP4).
+/* Block-level records to the LLCs (ADCBI DP4 ACCDECbuf, DP3 LAbuf, DP2
+ * INTbuf: the kind says which).
  *
- * The planner taps a record when it starts a segment. Its samples reach the
+ * The planner taps a record when it starts a segment (DP2: when it gets a
+ * block, ahead of that). Its samples reach the
  * position loop through the setpoint ring, so once the ring is full (the
  * planner runs ahead of the loop whenever it can) a record is tapped up to
  * [PLANNER] SETPOINT_RING periods before its first sample plays; at the
@@ -19,13 +21,16 @@
 #define BURSTS_MAX 2     /* per period: bounds the position loop's time here */
 #define SYNC_BURST 6     /* syncs sent in a row at the start: one lost is no delay */
 
-int lcm_tx_init(struct lcm_tx *x)
+int lcm_tx_init(struct lcm_tx *x, const struct lcm_tx_kind *kind)
 {
     memset(x, 0, sizeof *x);
-    x->hist = calloc(LCM_TX_HIST, sizeof *x->hist);
-    if (!x->hist || ncp_spsc_init(&x->tapped, sizeof(struct ncp_accdec), TAP_RING) != 0) {
-        free(x->hist);
-        x->hist = NULL;
+    x->kind = kind;
+    x->hist = calloc(LCM_TX_HIST, kind->size);
+    x->row = calloc(NCP_DIST_BURST, kind->size);
+    x->burst = calloc(1, kind->burst_size);
+    if (!x->hist || !x->row || !x->burst ||
+        ncp_spsc_init(&x->tapped, kind->size, TAP_RING) != 0) {
+        lcm_tx_free(x);
         return -1;
     }
     return 0;
@@ -34,28 +39,37 @@ int lcm_tx_init(struct lcm_tx *x)
 void lcm_tx_free(struct lcm_tx *x)
 {
     free(x->hist);
-    x->hist = NULL;
+    free(x->row);
+    free(x->burst);
+    x->hist = x->row = NULL;
+    x->burst = NULL;
     ncp_spsc_destroy(&x->tapped);
 }
 
-void lcm_tx_push(struct lcm_tx *x, const struct ncp_accdec *rec)
+void lcm_tx_push(struct lcm_tx *x, const void *rec)
 {
     if (ncp_spsc_push(&x->tapped, rec) != 0)
         x->overflow++;
 }
 
+static unsigned char *slot(const struct lcm_tx *x, int32_t n)
+{
+    return x->hist + (size_t)((unsigned)n % LCM_TX_HIST) * x->kind->size;
+}
+
+const void *lcm_tx_rec(const struct lcm_tx *x, int32_t n)
+{
+    return slot(x, n);
+}
+
 static void send_burst(struct lcm_tx *x, struct ncp_msg *m, int32_t first, int count)
 {
-    ncp_accdec_burst_t *b = &x->burst;
-    memset(b, 0, sizeof *b);
-    b->seq = x->burst_seq++;
-    b->sender = NCP_DIST_HLC_ID;
-    b->first = first;
-    b->count = (int8_t)count;
+    size_t z = x->kind->size;
     for (int i = 0; i < count; i++)
-        b->recs[i] = x->hist[(unsigned)(first + i) % LCM_TX_HIST];
-    int n = ncp_accdec_burst_t_encode(x->buf, 0, sizeof x->buf, b);
-    if (n > 0 && ncp_msg_publish(m, NCP_DIST_CH_ACCDEC, x->buf, (size_t)n) == 0) {
+        memcpy(x->row + (size_t)i * z, lcm_tx_rec(x, first + i), z);
+    int n = x->kind->encode(x->buf, sizeof x->buf, x->burst, x->burst_seq++, first, count,
+                            x->row);
+    if (n > 0 && ncp_msg_publish(m, x->kind->channel, x->buf, (size_t)n) == 0) {
         x->bursts++;
         x->burst_bytes = n;
     }
@@ -73,10 +87,10 @@ static void sync(struct lcm_tx *x, struct ncp_msg *m)
 void lcm_tx_cycle(struct lcm_tx *x, struct ncp_msg *m, int64_t t, int64_t period, int moving,
                   int32_t taken)
 {
-    struct ncp_accdec a;
     /* no further than the history can serve resends from */
-    while (x->next - taken < LCM_TX_HIST - NCP_DIST_BURST && ncp_spsc_pop(&x->tapped, &a) == 0)
-        ncp_dist_rec_encode(&a, &x->hist[(unsigned)x->next++ % LCM_TX_HIST]);
+    while (x->next - taken < LCM_TX_HIST - NCP_DIST_BURST &&
+           ncp_spsc_pop(&x->tapped, slot(x, x->next)) == 0)
+        x->next++;
     if (x->sent < x->next)
         x->oldest_wait++;
     for (int k = 0; k < BURSTS_MAX && x->sent < x->next; k++) {

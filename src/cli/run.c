@@ -20,6 +20,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <getopt.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -102,7 +103,9 @@ static void usage(FILE *f)
           "                      An axis lost (no status for [LCM] MAX_LOST_PERIODS, no\n"
           "                      heartbeat) stops the others: exit 3\n"
           "  --dp N              distribution point 1..5 (default: the INI's [LCM] DP, 5);\n"
-          "                      implemented: 5 (fine setpoints every servo period)\n"
+          "                      implemented: 5 (fine setpoints every servo period);\n"
+          "                      ADCBI 4, 3, 2 (ACCDECbuf, LAbuf, INTbuf records) and 1\n"
+          "                      (each LLC runs the program itself, from its path)\n"
           "  --lcm-url URL       udpm://GROUP:PORT?ttl=N (default: [LCM] URL, $LCM_DEFAULT_URL)\n"
           "  --inject SPECS      timing faults in the position loop (over the INI's [INJECT]\n"
           "                      SPEC): miss=RATIO, miss@CYCLE, latency=US, latency=MIN-MAX,\n"
@@ -287,6 +290,34 @@ int ncp_cli_run_report(const char *prog, const struct ncp_machine_cfg *cfg,
     return res->status;
 }
 
+/* DP 1: the LLCs read the program (and its tool table) themselves, on this
+ * host, by absolute path; they plan at 100 % feed. */
+static int apply_dp1(const struct run_opts *o, struct ncp_machine_cfg *cfg)
+{
+    char abs[PATH_MAX];
+    if (o->feed_override != 1.0)
+        return fprintf(stderr, "cnc-run run: --backend lcm --dp 1: the LLCs plan the program "
+                               "at 100 %% feed: no --feed-override\n"), -1;
+    if (!strcmp(o->prog, "-"))
+        return fprintf(stderr, "cnc-run run: --backend lcm --dp 1: the LLCs read the program "
+                               "from its file: not from standard input\n"), -1;
+    const char *in[2] = { o->prog, o->tool_table };
+    char *out[2] = { cfg->lcm.program, cfg->lcm.tool_table };
+    for (int i = 0; i < 2; i++) {
+        out[i][0] = 0;
+        if (!in[i])
+            continue;
+        if (!realpath(in[i], abs) || strlen(abs) >= sizeof cfg->lcm.program)
+            return fprintf(stderr, "cnc-run run: --backend lcm --dp 1: %s: %s\n", in[i],
+                           strerror(errno ? errno : ENAMETOOLONG)), -1;
+        snprintf(out[i], sizeof cfg->lcm.program, "%s", abs);
+    }
+    if (o->sub_path && strlen(o->sub_path) >= sizeof cfg->lcm.sub_path)
+        return fprintf(stderr, "cnc-run run: --backend lcm --dp 1: --sub-path too long\n"), -1;
+    snprintf(cfg->lcm.sub_path, sizeof cfg->lcm.sub_path, "%s", o->sub_path ? o->sub_path : "");
+    return 0;
+}
+
 /* --backend lcm: the distributed NCK at the INI's or --dp's point. Points
  * not implemented yet are refused here, before anything is opened. */
 static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
@@ -310,11 +341,12 @@ static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
         return fprintf(stderr, "cnc-run run: --backend lcm: [PLANNER] NCK = adcai has no DP 5: "
                                "its fine setpoints (fineIPObuf) are DP 4; choose --dp 2, 3 or "
                                "4 (the INI's [LCM] DP defaults to 5)\n"), -1;
+    if (cfg->lcm.dp == 1 && cfg->nck == NCP_NCK_ADCBI)
+        return apply_dp1(o, cfg);
     if (cfg->nck == NCP_NCK_ADCAI ? !ncp_dist_adcai_dp(cfg->lcm.dp)
-                                  : cfg->lcm.dp != 5 && cfg->lcm.dp != 4)
+                                  : cfg->lcm.dp < 1 || cfg->lcm.dp > 5)
         return fprintf(stderr, "cnc-run run: --backend lcm: DP %d is not implemented yet for "
-                               "[PLANNER] NCK = %s (DP 5, fine setpoints every servo period, "
-                               "is, and ADCBI's DP 4, ACCDECbuf records; ADCAI: DP 2-4)\n",
+                               "[PLANNER] NCK = %s (ADCBI: DP 1-5; ADCAI: DP 2-4)\n",
                        cfg->lcm.dp, cfg->nck == NCP_NCK_ADCAI ? "adcai" : "adcbi"), -1;
     return 0;
 }

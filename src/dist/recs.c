@@ -1,4 +1,5 @@
-/* ACCDECbuf records on the wire and in an LLC's ring. The record keeps the
+/* ACCDECbuf records on the wire, and an LLC's ring of block-level records
+ * (any point's: they are kept decoded). The record keeps the
  * doubles as the planner froze them: an LLC at DP4 must compute exactly the
  * central run's samples, and any rounding here would show as a path
  * deviation there. */
@@ -98,7 +99,7 @@ void ncp_dist_recs_free(struct ncp_dist_recs *q)
     q->rec = NULL;
 }
 
-void ncp_dist_recs_put(struct ncp_dist_recs *q, int32_t num, const ncp_accdec_rec_t *r)
+void ncp_dist_recs_put(struct ncp_dist_recs *q, int32_t num, const union ncp_dist_rec *r)
 {
     if (num < q->next) {
         q->stale++;
@@ -123,12 +124,12 @@ void ncp_dist_recs_put(struct ncp_dist_recs *q, int32_t num, const ncp_accdec_re
         q->have++;
 }
 
-int ncp_dist_recs_peek(const struct ncp_dist_recs *q, struct ncp_accdec *a)
+int ncp_dist_recs_peek(const struct ncp_dist_recs *q, union ncp_dist_rec *r)
 {
     unsigned k = (unsigned)q->next % NCP_DIST_RECS;
     if (q->num[k] != q->next)
         return 0;
-    ncp_dist_rec_decode(&q->rec[k], a);
+    *r = q->rec[k];
     return 1;
 }
 

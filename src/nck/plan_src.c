@@ -11,8 +11,12 @@ int nck_plan_new(struct nck *n)
         n->planner = ncp_planner_new(n->cfg, n->start);
     if (n->planner && n->be.plan_tap)
         ncp_planner_set_tap(n->planner, n->be.plan_tap, n->be.impl);
+    else if (n->planner && n->setup.plan_tap)
+        ncp_planner_set_tap(n->planner, n->setup.plan_tap, n->setup.plan_tap_ctx);
     if (n->adcai && n->be.adcai_tap)
         ncp_adcai_set_tap(n->adcai, n->be.adcai_tap, n->be.impl);
+    if (n->planner && n->be.plan_journal)
+        n->be.plan_journal(n->be.impl, NCP_PLAN_RESET, NULL, n->start);
     return n->adcai || n->planner ? 0 : -1;
 }
 
@@ -39,8 +43,17 @@ int nck_plan_idle(const struct nck *n)
     return n->adcai ? ncp_adcai_idle(n->adcai) : ncp_planner_idle(n->planner);
 }
 
+/* An HLC at ADCBI's DP2 hands every call on the planner on. */
+static void journal(const struct nck *n, enum ncp_plan_call c, const struct ncp_seg *s,
+                    const double *pos)
+{
+    if (n->planner && n->be.plan_journal)
+        n->be.plan_journal(n->be.impl, c, s, pos);
+}
+
 void nck_plan_push(struct nck *n, const struct ncp_seg *s)
 {
+    journal(n, NCP_PLAN_PUSH, s, NULL);
     if (n->adcai)
         ncp_adcai_push(n->adcai, s);
     else
@@ -49,6 +62,7 @@ void nck_plan_push(struct nck *n, const struct ncp_seg *s)
 
 void nck_plan_finish(struct nck *n)
 {
+    journal(n, NCP_PLAN_FINISH, NULL, NULL);
     if (n->adcai)
         ncp_adcai_finish(n->adcai);
     else
@@ -57,6 +71,7 @@ void nck_plan_finish(struct nck *n)
 
 void nck_plan_restart(struct nck *n)
 {
+    journal(n, NCP_PLAN_RESTART, NULL, NULL);
     if (n->adcai)
         ncp_adcai_restart(n->adcai);
     else
@@ -65,6 +80,7 @@ void nck_plan_restart(struct nck *n)
 
 void nck_plan_reset(struct nck *n, const double pos[NCP_AXES])
 {
+    journal(n, NCP_PLAN_RESET, NULL, pos);
     if (n->adcai)
         ncp_adcai_reset(n->adcai, pos);
     else
@@ -73,6 +89,7 @@ void nck_plan_reset(struct nck *n, const double pos[NCP_AXES])
 
 int nck_plan_step(struct nck *n, struct ncp_setpoint *out)
 {
+    journal(n, NCP_PLAN_STEP, NULL, NULL);
     return n->adcai ? ncp_adcai_step(n->adcai, out) : ncp_planner_step(n->planner, out);
 }
 

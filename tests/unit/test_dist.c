@@ -166,28 +166,78 @@ static void recs_round_trip_and_ring(void **state)
     assert_memory_equal(&a.dur, &b.dur, sizeof a.dur);
     assert_int_equal(b.blend, 1);
 
+    union ncp_dist_rec u, got;
+    u.a = a;
     struct ncp_dist_recs q;
     assert_int_equal(ncp_dist_recs_init(&q), 0);
-    ncp_dist_recs_put(&q, 0, &m.recs[0]);
-    ncp_dist_recs_put(&q, 2, &m.recs[0]);   /* 1 lost */
+    ncp_dist_recs_put(&q, 0, &u);
+    ncp_dist_recs_put(&q, 2, &u);   /* 1 lost */
     assert_int_equal(q.have, 1);
     assert_int_equal(q.top, 3);
     assert_int_equal(q.gaps, 1);
-    ncp_dist_recs_put(&q, 2, &m.recs[0]);
+    ncp_dist_recs_put(&q, 2, &u);
     assert_int_equal(q.duplicate, 1);
-    ncp_dist_recs_put(&q, 1, &m.recs[0]);   /* the resend */
+    ncp_dist_recs_put(&q, 1, &u);   /* the resend */
     assert_int_equal(q.have, 3);
     assert_int_equal(ncp_dist_recs_level(&q), 3);
-    assert_int_equal(ncp_dist_recs_peek(&q, &b), 1);
+    assert_int_equal(ncp_dist_recs_peek(&q, &got), 1);
+    assert_memory_equal(&got.a, &a, sizeof a);
     ncp_dist_recs_pop(&q);
-    ncp_dist_recs_put(&q, 0, &m.recs[0]);
+    ncp_dist_recs_put(&q, 0, &u);
     assert_int_equal(q.stale, 1);
-    ncp_dist_recs_put(&q, 1 + NCP_DIST_RECS, &m.recs[0]);
+    ncp_dist_recs_put(&q, 1 + NCP_DIST_RECS, &u);
     assert_int_equal(q.early, 1);
     ncp_dist_recs_pop(&q);
     ncp_dist_recs_pop(&q);
-    assert_int_equal(ncp_dist_recs_peek(&q, &b), 0);
+    assert_int_equal(ncp_dist_recs_peek(&q, &got), 0);
     ncp_dist_recs_free(&q);
+}
+
+/* DP3's and DP2's records: every double (and the op, its step) comes back
+ * bit for bit through a burst. */
+static void la_and_int_round_trip(void **state)
+{
+    (void)state;
+    struct ncp_la la, la2;
+    memset(&la, 0, sizeof la);
+    la.s.kind = NCP_SEG_ARC;
+    la.s.line = 7;
+    la.s.end[8] = 1.0 / 3.0;
+    la.s.u[2] = -1.0 / 7.0;
+    la.s.dwell = 0.25;
+    la.vmax = 100.0 / 3.0;
+    la.kappa = 1e-300;
+    la.v_end = 2.0 / 9.0;
+    la.blend = 1;
+    ncp_la_burst_t m, back;
+    memset(&m, 0, sizeof m);
+    m.count = 1;
+    ncp_dist_la_encode(&la, &m.recs[0]);
+    uint8_t buf[8192];
+    int n = ncp_la_burst_t_encode(buf, 0, sizeof buf, &m);
+    assert_true(n > 0);
+    assert_int_equal(ncp_la_burst_t_decode(buf, 0, n, &back), n);
+    ncp_dist_la_decode(&back.recs[0], &la2);
+    assert_memory_equal(&la.s, &la2.s, sizeof la.s);
+    assert_true(la2.vmax == la.vmax && la2.kappa == la.kappa && la2.v_end == la.v_end);
+    assert_int_equal(la2.blend, 1);
+
+    struct ncp_dist_op o, o2;
+    memset(&o, 0, sizeof o);
+    o.op = NCP_INT_REC_T_RESET;
+    o.step = 123456;
+    o.s = la.s;
+    ncp_int_burst_t mi, backi;
+    memset(&mi, 0, sizeof mi);
+    mi.count = 1;
+    ncp_dist_op_encode(&o, &mi.recs[0]);
+    n = ncp_int_burst_t_encode(buf, 0, sizeof buf, &mi);
+    assert_true(n > 0);
+    assert_int_equal(ncp_int_burst_t_decode(buf, 0, n, &backi), n);
+    ncp_dist_op_decode(&backi.recs[0], &o2);
+    assert_int_equal(o2.op, NCP_INT_REC_T_RESET);
+    assert_int_equal(o2.step, 123456);
+    assert_memory_equal(&o.s, &o2.s, sizeof o.s);
 }
 
 int main(void)
@@ -200,6 +250,7 @@ int main(void)
         cmocka_unit_test(rx_duplicates_and_stale_ignored),
         cmocka_unit_test(dice_same_seed_same_losses),
         cmocka_unit_test(recs_round_trip_and_ring),
+        cmocka_unit_test(la_and_int_round_trip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,180 @@
+/* ADCBI DP1 at the LLC: the HLC names the program (one host: its path, size
+ * and hash); this LLC runs the NCK on it itself, in a thread of its own,
+ * on the virtual clock and the simulated machine, only for the records its
+ * planner starts (the tap). Those go, through a ring, into `own`, which the
+ * interpolator runs on the HLC's period grid as at DP2, leaving each
+ * standstill when the HLC's path did. The virtual clock steps the planner
+ * only with its window full (or the program's end in it), so every LLC's
+ * plan is the same, and that of a central run, however the threads are
+ * scheduled. A full ring holds the planner thread back: the inner NCK
+ * runs ahead of the position loop by at most the ring and `own`. */
+#include "axis.h"
+
+#include <sched.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "ncpar/nck.h"
+#include "ncpar/pipeline.h"
+
+#define TAP_RING 1024
+
+struct llc_dp1 {
+    struct llc *l;
+    struct ncp_machine_cfg cfg;      /* the INI's, on the simulated machine */
+    char path[256], tool_table[256], sub_path[256];
+    struct ncp_source src;
+    struct ncp_analyzer_cfg acfg;
+    struct ncp_spsc ring;            /* inner planner thread -> position loop */
+    pthread_t th;
+    int started;
+    _Atomic int done, quit;          /* done: 1 ok, -1 its run failed (why says) */
+    char why[200];
+    char label[32];
+};
+
+static void tap(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec)
+{
+    (void)la;
+    struct llc_dp1 *p = ctx;
+    while (ncp_spsc_push(&p->ring, rec) != 0 && !atomic_load(&p->quit)) {
+        struct timespec ts = { 0, 200000 };
+        nanosleep(&ts, NULL);
+    }
+}
+
+static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
+{
+    struct llc_dp1 *p = ctx;
+    struct ncp_run_stats st;
+    memset(&st, 0, sizeof st);
+    return ncp_serial_run(&p->src, &p->acfg, out, &st, d);
+}
+
+static void *inner_main(void *arg)
+{
+    struct llc_dp1 *p = arg;
+    /* the leftovers of the CPU: its threads (which inherit this) must never
+     * take a period from the position loops of this host */
+    (void)setpriority(PRIO_PROCESS, (id_t)gettid(), 19);
+    struct ncp_nck_opts no = {
+        .cfg = &p->cfg, .interpret = interpret, .interp_ctx = p, .virtual_clock = 1,
+        .feed_override = 1.0, .label = p->label, .plan_tap = tap, .plan_tap_ctx = p,
+    };
+    struct ncp_nck_result *res = calloc(1, sizeof *res);
+    int ok = res && ncp_nck_run(&no, res) == NCP_NCK_OK;
+    if (!ok)
+        snprintf(p->why, sizeof p->why, "%s:%u: %s", p->path, res ? res->diag.line : 0,
+                 res && res->diag.msg[0] ? res->diag.msg : "its NCK stopped");
+    free(res);
+    atomic_store(&p->done, ok ? 1 : -1);
+    return NULL;
+}
+
+int llc_dp1_init(struct llc *l)
+{
+    struct llc_dp1 *p = calloc(1, sizeof *p);
+    if (!p || ncp_spsc_init(&p->ring, sizeof(struct ncp_accdec), TAP_RING) != 0) {
+        free(p);
+        return -1;
+    }
+    p->l = l;
+    l->dp1 = p;
+    return 0;
+}
+
+void llc_dp1_free(struct llc *l)
+{
+    struct llc_dp1 *p = l->dp1;
+    if (!p)
+        return;
+    if (p->started) {
+        atomic_store(&p->quit, 1);
+        /* its virtual run ends on its own; the tap no longer waits */
+        struct ncp_accdec a;
+        while (!atomic_load(&p->done)) {
+            while (ncp_spsc_pop(&p->ring, &a) == 0)
+                ;
+            struct timespec ts = { 0, 1000000 };
+            nanosleep(&ts, NULL);
+        }
+        pthread_join(p->th, NULL);
+        ncp_source_close(&p->src);
+    }
+    ncp_spsc_destroy(&p->ring);
+    free(p);
+    l->dp1 = NULL;
+}
+
+/* Position loop: the program message. The first one starts the NCK. */
+void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
+{
+    struct llc_dp1 *p = l->dp1;
+    ncp_program_t m;
+    memset(&m, 0, sizeof m);
+    if (ncp_program_t_decode(b, 0, (int)len, &m) != (int)len || m.sender != NCP_DIST_HLC_ID ||
+        p->started || l->end != LLC_END_NONE)
+        return;
+    l->dp = 1;
+    memcpy(p->path, m.path, sizeof p->path - 1);
+    memcpy(p->tool_table, m.tool_table, sizeof p->tool_table - 1);
+    memcpy(p->sub_path, m.sub_path, sizeof p->sub_path - 1);
+    /* one look at the file, on the loop: a program is read once, and the
+     * HLC waits for the records anyway */
+    int64_t size;
+    uint64_t h = ncp_dist_file_hash(p->path, &size);
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (size != m.size || h != (uint64_t)m.hash) {
+        snprintf(p->why, sizeof p->why, "%s: %s", p->path,
+                 size < 0 ? "cannot read it" : "not the HLC's program (size or hash differ)");
+    } else if (ncp_source_open(&p->src, p->path, &d) != NCP_OK) {
+        snprintf(p->why, sizeof p->why, "%s: %s", p->path, d.msg);
+    } else {
+        p->cfg = *l->cfg;
+        p->cfg.backend = NCP_BACKEND_SIM;
+        p->cfg.position.policy = p->cfg.planner.policy = p->cfg.interp.policy = SCHED_OTHER;
+        p->cfg.position.priority = p->cfg.planner.priority = p->cfg.interp.priority = 0;
+        p->cfg.position.cpu = p->cfg.planner.cpu = p->cfg.interp.cpu = -1;
+        snprintf(p->label, sizeof p->label, "cnc-axis %c's NCK: ", NCP_AXIS_LETTERS[l->axis]);
+        p->acfg.tool_table_path = p->tool_table[0] ? p->tool_table : NULL;
+        p->acfg.subroutine_path = p->sub_path[0] ? p->sub_path : NULL;
+        p->acfg.m66_on_machine = 1;
+        /* not the position loop's SCHED_FIFO, which a thread inherits */
+        pthread_attr_t at;
+        struct sched_param sp = { 0 };
+        pthread_attr_init(&at);
+        pthread_attr_setinheritsched(&at, PTHREAD_EXPLICIT_SCHED);
+        pthread_attr_setschedpolicy(&at, SCHED_OTHER);
+        pthread_attr_setschedparam(&at, &sp);
+        p->started = pthread_create(&p->th, &at, inner_main, p) == 0;
+        pthread_attr_destroy(&at);
+        if (!p->started) {
+            ncp_source_close(&p->src);
+            snprintf(p->why, sizeof p->why, "cannot start its NCK thread");
+        }
+    }
+    if (!p->started) {
+        l->end = LLC_END_PROGRAM;
+        snprintf(l->fault, sizeof l->fault, "%s", p->why);
+    }
+}
+
+/* Position loop, every period: the records its NCK started, into `own`;
+ * its NCK's failure stops the axis. */
+void llc_dp1_cycle(struct llc *l)
+{
+    struct llc_dp1 *p = l->dp1;
+    struct ncp_accdec a;
+    union ncp_dist_rec u;
+    while (ncp_dist_recs_level(&l->own) < NCP_DIST_RECS - 1 && ncp_spsc_pop(&p->ring, &a) == 0) {
+        u.a = a;
+        ncp_dist_recs_put(&l->own, l->own_n++, &u);
+    }
+    if (atomic_load(&p->done) < 0 && l->end == LLC_END_NONE) {
+        l->end = LLC_END_PROGRAM;
+        snprintf(l->fault, sizeof l->fault, "%s", p->why);
+    }
+}

@@ -1,0 +1,120 @@
+/* The records of ADCBI's DP3 (LAbuf) and DP2 (INTbuf) on the wire. As with
+ * DP4's, every double travels as it is: an LLC that profiles (DP3) or plans
+ * (DP2) a block again must get exactly the central run's samples. */
+#include "ncpar/dist.h"
+
+#include <stdio.h>
+#include <string.h>
+
+uint64_t ncp_dist_file_hash(const char *path, int64_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    uint64_t h = 14695981039346656037ULL;
+    *size = -1;
+    if (!f)
+        return 0;
+    int c;
+    *size = 0;
+    while ((c = getc(f)) != EOF) {
+        h = (h ^ (uint64_t)(unsigned char)c) * 1099511628211ULL;
+        ++*size;
+    }
+    if (ferror(f))
+        *size = -1;
+    fclose(f);
+    return h;
+}
+
+void ncp_dist_seg_encode(const struct ncp_seg *s, ncp_seg_rec_t *r)
+{
+    memset(r, 0, sizeof *r);
+    r->kind = (int8_t)s->kind;
+    r->term = (int8_t)s->term;
+    r->traverse = (int8_t)s->traverse;
+    r->angular = (int8_t)s->angular;
+    r->sync = (int8_t)s->sync;
+    r->line = (int32_t)s->line;
+    r->aux = (int32_t)s->aux;
+    memcpy(r->start, s->start, sizeof r->start);
+    memcpy(r->end, s->end, sizeof r->end);
+    const double seg[10] = { s->length, s->feed,   s->blend_feed, s->tolerance, s->merge_tol,
+                             s->dwell,  s->tool_z, s->pitch,      s->rev_rpm,   s->r0 };
+    memcpy(r->seg, seg, sizeof seg);
+    memcpy(r->geom, s->center, sizeof s->center);
+    memcpy(r->geom + 3, s->normal, sizeof s->normal);
+    memcpy(r->geom + 6, s->u, sizeof s->u);
+    memcpy(r->geom + 9, s->w, sizeof s->w);
+    r->geom[12] = s->r1;
+    r->geom[13] = s->angle;
+    r->geom[14] = s->axial;
+}
+
+void ncp_dist_seg_decode(const ncp_seg_rec_t *r, struct ncp_seg *s)
+{
+    memset(s, 0, sizeof *s);
+    s->kind = (uint8_t)r->kind;
+    s->term = (uint8_t)r->term;
+    s->traverse = (uint8_t)r->traverse;
+    s->angular = (uint8_t)r->angular;
+    s->sync = (uint8_t)r->sync;
+    s->line = (uint32_t)r->line;
+    s->aux = (uint32_t)r->aux;
+    memcpy(s->start, r->start, sizeof s->start);
+    memcpy(s->end, r->end, sizeof s->end);
+    s->length = r->seg[0];
+    s->feed = r->seg[1];
+    s->blend_feed = r->seg[2];
+    s->tolerance = r->seg[3];
+    s->merge_tol = r->seg[4];
+    s->dwell = r->seg[5];
+    s->tool_z = r->seg[6];
+    s->pitch = r->seg[7];
+    s->rev_rpm = r->seg[8];
+    s->r0 = r->seg[9];
+    memcpy(s->center, r->geom, sizeof s->center);
+    memcpy(s->normal, r->geom + 3, sizeof s->normal);
+    memcpy(s->u, r->geom + 6, sizeof s->u);
+    memcpy(s->w, r->geom + 9, sizeof s->w);
+    s->r1 = r->geom[12];
+    s->angle = r->geom[13];
+    s->axial = r->geom[14];
+}
+
+void ncp_dist_la_encode(const struct ncp_la *la, ncp_la_rec_t *r)
+{
+    ncp_dist_seg_encode(&la->s, &r->s);
+    const double v[8] = { la->vmax,  la->acc,   la->acc_full, la->jerk,
+                          la->a_eff, la->kappa, la->a_cap,    la->v_end };
+    memcpy(r->la, v, sizeof v);
+    r->blend = (int8_t)la->blend;
+}
+
+void ncp_dist_la_decode(const ncp_la_rec_t *r, struct ncp_la *la)
+{
+    memset(la, 0, sizeof *la);
+    ncp_dist_seg_decode(&r->s, &la->s);
+    la->vmax = r->la[0];
+    la->acc = r->la[1];
+    la->acc_full = r->la[2];
+    la->jerk = r->la[3];
+    la->a_eff = r->la[4];
+    la->kappa = r->la[5];
+    la->a_cap = r->la[6];
+    la->v_end = r->la[7];
+    la->blend = (uint8_t)r->blend;
+}
+
+void ncp_dist_op_encode(const struct ncp_dist_op *o, ncp_int_rec_t *r)
+{
+    ncp_dist_seg_encode(&o->s, &r->s);
+    r->op = (int8_t)o->op;
+    r->step = o->step;
+}
+
+void ncp_dist_op_decode(const ncp_int_rec_t *r, struct ncp_dist_op *o)
+{
+    memset(o, 0, sizeof *o);
+    ncp_dist_seg_decode(&r->s, &o->s);
+    o->op = (unsigned char)r->op;
+    o->step = r->step;
+}
