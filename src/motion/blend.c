@@ -1,12 +1,16 @@
 /* G64 corner blending: two lines meeting at a corner are joined by a circular
  * arc tangent to both, so the path keeps its tangent and the corner is taken at
  * speed. The arc stays within the tolerance P of the corner and uses at most
- * half of either line, so neighbouring blends never overlap; the planner
+ * the rest of the line before it and half of the line after it, so
+ * neighbouring blends never overlap; the planner
  * (try_blend) makes it no larger than the speed it is for needs. */
 #include "planner_int.h"
 
 #include <math.h>
 #include <string.h>
+
+/* What a blend leaves of the line before it, mm. */
+#define BLEND_LINE_LEFT 1e-3
 
 static double dot3(const double a[3], const double b[3])
 {
@@ -43,7 +47,10 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
     if (c > 1 - 1e-12 || c < -0.999)
         return 0;
     double phi = acos(c), th = tan(0.5 * phi);
-    double d = fmin(max_trim, 0.5 * fmin(prev->length, cur->length));
+    /* prev's start is settled by the corner before: what is left of it may
+     * all go to this corner (a micrometre stays, so its direction stays
+     * exact); cur keeps half for the corner after */
+    double d = fmin(max_trim, fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length));
     if (prev->tolerance > 0) {
         double r_tol = prev->tolerance / (1.0 / cos(0.5 * phi) - 1.0);
         d = fmin(d, r_tol * th);

@@ -359,6 +359,28 @@ static int lowering_safe(const struct ncp_planner *p, double v_tail)
     }
 }
 
+/* Time to leave a corner at v0 and cover len at acceleration acc, capped at
+ * vmax: one side of a kink, its other end left out (the same either way). */
+static double side_time(double len, double acc, double v0, double vmax)
+{
+    if (len <= 0)
+        return 0;
+    if (v0 >= vmax || acc <= 0)
+        return vmax > 0 ? len / vmax : INFINITY;
+    double d_acc = (vmax * vmax - v0 * v0) / (2 * acc);
+    if (d_acc >= len)
+        return (sqrt(v0 * v0 + 2 * acc * len) - v0) / acc;
+    return (vmax - v0) / acc + (len - d_acc) / vmax;
+}
+
+/* Both sides of a kink taken at v with the share f of their acceleration. */
+static double kink_sides_time(const struct plan_seg *prev, const struct plan_seg *cur, double v,
+                              double f)
+{
+    return side_time(prev->s.length, fmin(prev->acc, f * prev->acc_full), v, prev->vmax) +
+           side_time(cur->s.length, fmin(cur->acc, f * cur->acc_full), v, cur->vmax);
+}
+
 static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
 {
     if (ps->s.kind == NCP_SEG_DWELL) {
@@ -399,6 +421,17 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
                 f_cur = f_prev = 0.5;
                 v = fmin(v, fmin(kink_arc_cap(p, &p->last_pushed), kink_arc_cap(p, &ps->s)));
             }
+        }
+        /* a kink taken so slowly that stopping there loses less than the
+         * halved acceleration of both sides (a near reversal): stop, and
+         * the lines keep all of theirs (an arc's share is not only its
+         * tangent's: left as it is) */
+        if (prev && f_cur == 0.5 && f_prev == 0.5 && prev->s.kind == NCP_SEG_LINE &&
+            ps->s.kind == NCP_SEG_LINE && kink_sides_time(prev, ps, 0, 1) <= kink_sides_time(prev, ps, v, 0.5))
+            v = 0;
+        if (v <= 0) {
+            ps->vjunc = 0;
+            return;
         }
         struct plan_seg cur_half = *ps, prev_half;
         cur_half.acc = fmin(ps->acc, f_cur * ps->acc_full);

@@ -1,0 +1,140 @@
+/* Corners in the planner, from whole virtual-clock runs on LinuxCNC-like
+ * limits (100 mm/s, 1000 mm/s^2 per axis, 1 ms): a chain of short chords gives
+ * each blend the rest of the chord before it, not half of what the blend
+ * before left; a near reversal (no blend possible) stops with the full
+ * acceleration of both lines instead of creeping through the kink at half of
+ * it. Every run also keeps every axis within its limits and the path within P. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "trace_rows.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ncpar/feeder.h"
+#include "ncpar/motion.h"
+#include "ncpar/nck.h"
+#include "gcode_src.h"
+
+/* the trace's 6 decimals: a second difference is off by up to 4 half-units / T^2 */
+#define PRINT_Q 0.5e-6
+#define AMAX 1000.0
+#define VMAX 100.0
+
+static void lcnc_like_cfg(struct ncp_machine_cfg *c)
+{
+    ncp_machine_cfg_default(c);
+    for (int j = 0; j < 3; j++) {
+        c->axis[j].max_vel = VMAX;
+        c->axis[j].max_acc = AMAX;
+    }
+}
+
+static double worst_acc(const struct row *r, size_t n, double T)
+{
+    double w = 0;
+    for (size_t k = 2; k < n; k++)
+        for (int j = 0; j < 3; j++) {
+            double a = fabs(r[k].cmd[j] - 2 * r[k - 1].cmd[j] + r[k - 2].cmd[j]) / (T * T);
+            w = fmax(w, (a - 4 * PRINT_Q / (T * T)) / AMAX);
+        }
+    return w;
+}
+
+/* Distance from p to the polyline pts[0..m-1] in X Y. */
+static double dist_polyline(const double p[3], const double (*pts)[2], int m)
+{
+    double best = INFINITY;
+    for (int i = 0; i + 1 < m; i++) {
+        double ax = pts[i][0], ay = pts[i][1], dx = pts[i + 1][0] - ax, dy = pts[i + 1][1] - ay;
+        double t = fmin(1, fmax(0, ((p[0] - ax) * dx + (p[1] - ay) * dy) / (dx * dx + dy * dy)));
+        best = fmin(best, hypot(p[0] - ax - t * dx, p[1] - ay - t * dy));
+    }
+    return best;
+}
+
+#define CHORDS 120
+
+/* 0.1 mm chords around a circle of radius 2 mm, turning 2.9 degrees each,
+ * P0.01: the blends are bounded by the chords, not by P. With half of each
+ * chord's remainder (a quarter of the chord) the blends have a radius of
+ * about 1 mm, good for 31 mm/s; with all of it (half the chord) about 2 mm,
+ * 44 mm/s. The middle of the chain must run above 40 mm/s. */
+static void test_chord_chain_blends_use_whole_chords(void **state)
+{
+    (void)state;
+    static double pts[CHORDS + 2][2];  /* the origin, then the circle */
+    char *prog = malloc(64 * (CHORDS + 4));
+    assert_non_null(prog);
+    int len = sprintf(prog, "G21 G90 G17 G64 P0.01 Q0\nG1 X2 Y0 F3000\n");
+    const double R = 2.0, step = 0.1 / R;
+    for (int i = 0; i <= CHORDS; i++) {
+        pts[i + 1][0] = R * cos(i * step);
+        pts[i + 1][1] = R * sin(i * step);
+        if (i > 0)
+            len += sprintf(prog + len, "G1 X%.6f Y%.6f\n", pts[i + 1][0], pts[i + 1][1]);
+    }
+    sprintf(prog + len, "M2\n");
+    struct ncp_machine_cfg cfg;
+    lcnc_like_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(prog, &cfg, &n, &res);
+    free(prog);
+    const double T = cfg.servo_period;
+    double dev = 0, v_mid = INFINITY;
+    for (size_t k = 0; k < n; k++) {
+        dev = fmax(dev, dist_polyline(r[k].cmd, (const double(*)[2])pts, CHORDS + 2));
+        /* lines 3 + 40 .. 3 + 80: well away from the start and the end */
+        if (r[k].line >= 43 && r[k].line <= 83)
+            v_mid = fmin(v_mid, r[k].v);
+    }
+    double w = worst_acc(r, n, T);
+    if (v_mid < 40 || dev > 0.01 + 1e-6 || w > 1 + 1e-9)
+        fail_msg("slowest %.2f mm/s mid-chain (want >= 40), deviation %.5f mm (P 0.01), axis "
+                 "acceleration %.4f of the limit",
+                 v_mid, dev, w);
+    free(r);
+}
+
+/* X5, then back to X0 Y0.05: turning 179.4 degrees, too sharp for a blend.
+ * The kink's own speed (half of an axis's acceleration over a period, spread
+ * over a velocity step of 2) is 0.25 mm/s, for which both lines would give up
+ * half their acceleration; stopping costs far less. The approach must brake
+ * at the axis's full limit. */
+static void test_near_reversal_stops_at_full_acceleration(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    lcnc_like_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text("G21 G90 G17 G64 P0.01 Q0\nG1 X0 Y0 F3000\nG1 X5\nG1 X0 Y0.05\nM2\n",
+                             &cfg, &n, &res);
+    const double T = cfg.servo_period;
+    double a_brake = 0;
+    for (size_t k = 2; k < n; k++)
+        if (r[k].line == 3 && r[k - 2].line == 3)
+            a_brake = fmax(a_brake, -(r[k].cmd[0] - 2 * r[k - 1].cmd[0] + r[k - 2].cmd[0]) / (T * T));
+    double w = worst_acc(r, n, T);
+    if (a_brake < 0.95 * AMAX || w > 1 + 1e-9)
+        fail_msg("braking at %.1f mm/s^2 into the reversal (want >= %.0f), axis acceleration "
+                 "%.4f of the limit",
+                 a_brake, 0.95 * AMAX, w);
+    free(r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_chord_chain_blends_use_whole_chords),
+        cmocka_unit_test(test_near_reversal_stops_at_full_acceleration),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
