@@ -2,6 +2,7 @@
  * DP4's, every double travels as it is: an LLC that profiles (DP3) or plans
  * (DP2) a block again must get exactly the central run's samples. */
 #include "ncpar/dist.h"
+#include "seg_fields.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -28,56 +29,13 @@ uint64_t ncp_dist_file_hash(const char *path, int64_t *size)
 void ncp_dist_seg_encode(const struct ncp_seg *s, ncp_seg_rec_t *r)
 {
     memset(r, 0, sizeof *r);
-    r->kind = (int8_t)s->kind;
-    r->term = (int8_t)s->term;
-    r->traverse = (int8_t)s->traverse;
-    r->angular = (int8_t)s->angular;
-    r->sync = (int8_t)s->sync;
-    r->line = (int32_t)s->line;
-    r->aux = (int32_t)s->aux;
-    memcpy(r->start, s->start, sizeof r->start);
-    memcpy(r->end, s->end, sizeof r->end);
-    const double seg[10] = { s->length, s->feed,   s->blend_feed, s->tolerance, s->merge_tol,
-                             s->dwell,  s->tool_z, s->pitch,      s->rev_rpm,   s->r0 };
-    memcpy(r->seg, seg, sizeof seg);
-    memcpy(r->geom, s->center, sizeof s->center);
-    memcpy(r->geom + 3, s->normal, sizeof s->normal);
-    memcpy(r->geom + 6, s->u, sizeof s->u);
-    memcpy(r->geom + 9, s->w, sizeof s->w);
-    r->geom[12] = s->r1;
-    r->geom[13] = s->angle;
-    r->geom[14] = s->axial;
+    NCP_DIST_SEG_ENCODE(s, r);
 }
 
 void ncp_dist_seg_decode(const ncp_seg_rec_t *r, struct ncp_seg *s)
 {
     memset(s, 0, sizeof *s);
-    s->kind = (uint8_t)r->kind;
-    s->term = (uint8_t)r->term;
-    s->traverse = (uint8_t)r->traverse;
-    s->angular = (uint8_t)r->angular;
-    s->sync = (uint8_t)r->sync;
-    s->line = (uint32_t)r->line;
-    s->aux = (uint32_t)r->aux;
-    memcpy(s->start, r->start, sizeof s->start);
-    memcpy(s->end, r->end, sizeof s->end);
-    s->length = r->seg[0];
-    s->feed = r->seg[1];
-    s->blend_feed = r->seg[2];
-    s->tolerance = r->seg[3];
-    s->merge_tol = r->seg[4];
-    s->dwell = r->seg[5];
-    s->tool_z = r->seg[6];
-    s->pitch = r->seg[7];
-    s->rev_rpm = r->seg[8];
-    s->r0 = r->seg[9];
-    memcpy(s->center, r->geom, sizeof s->center);
-    memcpy(s->normal, r->geom + 3, sizeof s->normal);
-    memcpy(s->u, r->geom + 6, sizeof s->u);
-    memcpy(s->w, r->geom + 9, sizeof s->w);
-    s->r1 = r->geom[12];
-    s->angle = r->geom[13];
-    s->axial = r->geom[14];
+    NCP_DIST_SEG_DECODE(r, s);
 }
 
 void ncp_dist_la_encode(const struct ncp_la *la, ncp_la_rec_t *r)
