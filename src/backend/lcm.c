@@ -21,9 +21,9 @@
  *
  * The LLC reports the actual position of a period 1.5-2.5 periods back. The
  * loop gets that position carried forward by what the HLC commanded since
- * (period-level DPs), or its command less the LLC's own following error
- * (ADCBI's block-level DPs), so cmd - act is the LLC's following error, not
- * the transport's delay. */
+ * (fine setpoints), or its command less the LLC's own following error (where
+ * the LLC computes its command), so cmd - act is the LLC's following error,
+ * not the transport's delay. */
 #include "lcm_ai.h"
 #include "lcm_tx.h"
 #include "ncpar/backend.h"
@@ -399,10 +399,11 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         unsigned k = (unsigned)((uint64_t)(p->st.t_ns / s->T) % HIST);
         /* its period's setpoint is remembered (it always is, unless the
          * status is older than HIST periods): carried forward from there.
-         * Block-level DPs: the LLC interpolates on its own clock, so after
-         * periods this loop skipped its command is ahead of this one's and
+         * Where the LLC computes its own command (ADCBI's block-level DPs,
+         * ADCAI's DP2 and DP3) it runs on its own clock, up to a rough period
+         * or the periods this loop skipped apart from this one's command:
          * only its own following error says how well it follows */
-        if (!s->tx && p->have_status && p->st.t_ns > 0 && s->hist_t[k] == p->st.t_ns)
+        if (!s->tx && !s->ai && p->have_status && p->st.t_ns > 0 && s->hist_t[k] == p->st.t_ns)
             act[j] = a + cmd[j] - s->hist_cmd[k][j];
         else
             act[j] = cmd[j] - ncp_dist_nm_to_mm(p->st.ferr_nm);
