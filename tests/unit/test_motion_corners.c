@@ -22,30 +22,7 @@
 #include "ncpar/nck.h"
 #include "gcode_src.h"
 
-/* the trace's 6 decimals: a second difference is off by up to 4 half-units / T^2 */
-#define PRINT_Q 0.5e-6
-#define AMAX 1000.0
-#define VMAX 100.0
-
-static void lcnc_like_cfg(struct ncp_machine_cfg *c)
-{
-    ncp_machine_cfg_default(c);
-    for (int j = 0; j < 3; j++) {
-        c->axis[j].max_vel = VMAX;
-        c->axis[j].max_acc = AMAX;
-    }
-}
-
-static double worst_acc(const struct row *r, size_t n, double T)
-{
-    double w = 0;
-    for (size_t k = 2; k < n; k++)
-        for (int j = 0; j < 3; j++) {
-            double a = fabs(r[k].cmd[j] - 2 * r[k - 1].cmd[j] + r[k - 2].cmd[j]) / (T * T);
-            w = fmax(w, (a - 4 * PRINT_Q / (T * T)) / AMAX);
-        }
-    return w;
-}
+#include "lcnc_limits.h"
 
 /* Distance from p to the polyline pts[0..m-1] in X Y. */
 static double dist_polyline(const double p[3], const double (*pts)[2], int m)
