@@ -14,6 +14,7 @@
 
 #include "ncpar/adcai.h"
 #include "ncpar/dist.h"
+#include "seg_line.h"
 
 #define MAXTAP 200000
 
@@ -27,20 +28,6 @@ static void on_tap(void *ctx, const struct ncp_adcai_tap *t)
     struct taps *c = ctx;
     if (c->n < MAXTAP)
         c->t[c->n++] = *t;
-}
-
-static struct ncp_seg line_seg(const double a[3], const double b[3], double feed, int term)
-{
-    struct ncp_seg s;
-    memset(&s, 0, sizeof s);
-    s.kind = NCP_SEG_LINE;
-    s.term = (uint8_t)term;
-    s.line = 1;
-    memcpy(s.start, a, 3 * sizeof(double));
-    memcpy(s.end, b, 3 * sizeof(double));
-    ncp_seg_set_length(&s);
-    s.feed = feed;
-    return s;
 }
 
 /* Lines at several feeds, continuous and with exact stops, on a machine of
