@@ -145,7 +145,8 @@ void llc_publish_status(struct llc *l, int64_t slot)
         snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault);
     /* DP1: its own NCK's records, the HLC waits for the first */
     if (l->dp4 || l->dp == 1) {
-        s.buffer_level = (int16_t)ncp_dist_recs_level(llc_exec_ring(l));
+        s.buffer_level = (int16_t)(l->dp == 1 ? llc_dp1_level(l)
+                                              : ncp_dist_recs_level(llc_exec_ring(l)));
         s.lost = (int32_t)l->recs.gaps;
         s.stale = (int32_t)l->recs.stale;
         s.duplicate = (int32_t)l->recs.duplicate;
@@ -233,8 +234,7 @@ static int rec_next(void *ctx, double v0, struct ncp_accdec *rec)
     return 0;
 }
 
-/* The HLC's period its path left its k-th standstill, 0 not known (yet). */
-static int64_t start_at(const struct llc *l, int32_t k)
+int64_t llc_start_at(const struct llc *l, int32_t k)
 {
     unsigned i = (unsigned)k % LLC_STARTS;
     return l->start_k[i] == k ? l->start_t[i] : 0;
@@ -263,7 +263,7 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
         memcpy(l->ex_prev, first.s.start, sizeof l->ex_prev);
         l->ex_on = l->ex_rest = 1;
     }
-    int64_t due = start_at(l, l->starts_done);
+    int64_t due = llc_start_at(l, l->starts_done);
     struct ncp_exec before = l->ex;
     struct ncp_dist_recs *q = llc_exec_ring(l);
     int32_t next = q->next;
@@ -349,6 +349,17 @@ static double ramp(struct llc *l)
     return l->cmd + v * T;
 }
 
+/* ADCAI's DP1: its NCK's samples through this axis's stages; a sample
+ * missing in motion stops the axis (ramp). */
+static double play_ai(struct llc *l, int64_t slot)
+{
+    double c = llc_dp1_ai_play(l, slot);
+    if (l->end == LLC_END_NONE)
+        return c;
+    l->state = NCP_AX_STATUS_T_STOPPING;
+    return ramp(l);
+}
+
 static void check_ends(struct llc *l, int64_t now)
 {
     if (l->end != LLC_END_NONE)
@@ -385,8 +396,8 @@ static void period(struct llc *l, int64_t now, int64_t slot)
     uint32_t gaps = l->rx.held + l->rx.bridged, bridged = l->rx.bridged;
     if (l->end == LLC_END_NONE && !l->done_req) {
         l->state = NCP_AX_STATUS_T_RUNNING;
-        next_cmd = l->dp4 ? interpolate(l, slot) : follow(l, slot);
-        if (l->dp4)
+        next_cmd = l->dp1ai ? play_ai(l, slot) : l->dp4 ? interpolate(l, slot) : follow(l, slot);
+        if (l->dp4 || l->dp1ai)
             l->rx.played_t = slot;   /* where a late loop catches up from */
     } else {
         l->state = l->end == LLC_END_NONE || l->end == LLC_END_DONE ? NCP_AX_STATUS_T_DONE
@@ -403,7 +414,9 @@ static void period(struct llc *l, int64_t now, int64_t slot)
      * the current velocity goes on */
     int32_t ahead;
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
-    if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
+    if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp1ai)
+        x[l->axis] = llc_dp1_ai_ahead(l, slot + T);
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
         x[l->axis] = interpolate_ahead(l, slot + T);
     else if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
         x[l->axis] = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
