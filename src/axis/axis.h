@@ -23,6 +23,10 @@ enum llc_end {
     LLC_END_PROGRAM     /* DP1: its own NCK could not run the program (fault says why) */
 };
 
+/* Periods an LLC at DP1 plays behind the HLC: more than the 6 standstill
+ * marks the HLC sends in a row as its path leaves a standstill (lcm_tx.c). */
+#define LLC_DP1_PLAY_DELAY 8
+
 struct llc_ai;
 struct llc_dp1_ai;
 struct ncp_adcai_tap;
@@ -98,6 +102,7 @@ struct llc {
     struct llc_dp1 *dp1;          /* DP1: its own NCK (dp1.c) */
     struct llc_dp1_ai *dp1ai;     /* ADCAI's DP1: its NCK's samples (dp1_ai.c) */
     char fault[200];              /* LLC_END_PROGRAM: why */
+    char fault_short[64];         /* the same in what its status carries ("": fault) */
 };
 
 /* llc_adcai.c: NULL when out of memory or the INI's limits give no filter */

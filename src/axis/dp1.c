@@ -35,6 +35,7 @@ struct llc_dp1 {
     int started;
     _Atomic int done, quit;          /* done: 1 ok, -1 its run failed (why says) */
     char why[200];
+    char why_short[64];              /* as much as the status carries to the HLC */
     char label[32];
 };
 
@@ -76,6 +77,7 @@ static void why_failed(struct llc_dp1 *p, const struct ncp_nck_result *res)
         snprintf(what, sizeof what, "%s", res->diag.msg[0] ? res->diag.msg : "its NCK stopped");
     }
     snprintf(p->why, sizeof p->why, "%s:%u: %s", p->path, line, what);
+    snprintf(p->why_short, sizeof p->why_short, "its NCK, line %u: %s", line, what);
 }
 
 static void *inner_main(void *arg)
@@ -158,8 +160,10 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     if (size != m.size || h != (uint64_t)m.hash) {
-        snprintf(p->why, sizeof p->why, "%s: %s", p->path,
-                 size < 0 ? "cannot read it" : "not the HLC's program (size or hash differ)");
+        snprintf(p->why_short, sizeof p->why_short, "%s",
+                 size < 0 ? "cannot read the program"
+                          : "not the HLC's program (size or hash differ)");
+        snprintf(p->why, sizeof p->why, "%s: %s", p->path, p->why_short);
     } else if (l->cfg->nck == NCP_NCK_ADCAI &&
                (!l->ai || !(l->dp1ai = llc_dp1_ai_new(l, &p->quit)))) {
         snprintf(p->why, sizeof p->why, "cannot set up ADCAI's stages for its axis");
@@ -192,6 +196,7 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
     if (!p->started) {
         l->end = LLC_END_PROGRAM;
         snprintf(l->fault, sizeof l->fault, "%s", p->why);
+        snprintf(l->fault_short, sizeof l->fault_short, "%s", p->why_short);
     }
 }
 
@@ -211,6 +216,7 @@ void llc_dp1_cycle(struct llc *l)
     if (atomic_load(&p->done) < 0 && l->end == LLC_END_NONE) {
         l->end = LLC_END_PROGRAM;
         snprintf(l->fault, sizeof l->fault, "%s", p->why);
+        snprintf(l->fault_short, sizeof l->fault_short, "%s", p->why_short);
     }
 }
 

@@ -142,7 +142,8 @@ void llc_publish_status(struct llc *l, int64_t slot)
     s.ferr_nm = nm(l->ferr);
     s.state = (int8_t)l->state;
     if (l->end == LLC_END_PROGRAM)
-        snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault);
+        snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault_short[0] ? l->fault_short
+                                                                          : l->fault);
     /* DP1: its own NCK's records, the HLC waits for the first */
     if (l->dp4 || l->dp == 1) {
         s.buffer_level = (int16_t)(l->dp == 1 ? llc_dp1_level(l)
@@ -498,14 +499,24 @@ int llc_cycle(void *ctx, int64_t now_ns)
     if (w)
         return w < 0 ? NCP_RT_STOP : NCP_RT_CONTINUE;
     /* the HLC's period NCP_DIST_PLAY_DELAY + 0..1 back: from the loop's
-     * scheduled time, not the clock, so a late wake-up never changes it */
-    int64_t slot = now - l->t_first - NCP_DIST_PLAY_DELAY * T - T / 2;
+     * scheduled time, not the clock, so a late wake-up never changes it.
+     * At DP1 only the standstill marks travel, and a start whose marks all
+     * came too late would shift this axis's whole motion run: there the
+     * LLC plays further back, so that every one of the marks the HLC sends
+     * in a row at a start is still in time */
+    int64_t delay = l->dp == 1 ? LLC_DP1_PLAY_DELAY : NCP_DIST_PLAY_DELAY;
+    int64_t slot = now - l->t_first - delay * T - T / 2;
     slot = l->t_first + (slot < 0 ? -((-slot + T - 1) / T) : slot / T) * T;
     /* periods the loop slept through (a deadline miss) still passed for the
-     * simulated plant: it runs them now, a few at most */
+     * simulated plant: it runs them now, a few at most. Where this LLC
+     * computes its command itself (block-level points, ADCAI's DP1) a
+     * period left out would put its axis a period behind the others until
+     * the next standstill: there it catches up further (a host that stalls
+     * a loop for 10 ms skipped one of them at 8) */
     int64_t from = l->rx.played_t ? l->rx.played_t + T : slot;
-    if (slot - from > 8 * T)
-        from = slot - 8 * T;
+    int64_t most = l->dp4 || l->dp1ai ? 64 : 8;
+    if (slot - from > most * T)
+        from = slot - most * T;
     for (int64_t s = from; s <= slot; s += T)
         period(l, now, s);
     llc_publish_status(l, slot);
