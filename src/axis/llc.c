@@ -20,6 +20,8 @@
  * run's. A record lost on the way is asked for again (NCP_AX_<L>_RESEND)
  * as soon as a later one, or the HLC's count, shows the gap; one still
  * missing when the interpolator needs it stops the axis (ramp) and says so.
+ * At DP1 the records are its own NCK's (dp1.c); with ADCAI its samples go
+ * through this axis's stages instead (dp1_ai.c), on the same marks.
  *
  * Safety: a setpoint never moves the axis faster than its MAX_VELOCITY (a
  * step after a gap is limited and counted), and every stop is a ramp at
