@@ -1,7 +1,8 @@
 /* The distributed ADCAI's record path without the network: what the chain
- * taps (the sums a DP2 or DP3 HLC sends) fed through one axis's own stages,
- * as a cnc-axis does, gives every setpoint of the central chain exactly; and
- * the DP2 / DP3 messages' codec against lcm-gen's. */
+ * taps (the sums a DP2 or DP3 HLC sends, or a DP1 LLC's own NCK hands over)
+ * fed through one axis's own stages, as a cnc-axis does, gives every
+ * setpoint of the central chain exactly, and each tap says whether any axis
+ * moves in it; and the DP2 / DP3 messages' codec against lcm-gen's. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -59,6 +60,22 @@ static void replay_case(enum ncp_profile prof, int ratio, int dp)
     while (ncp_adcai_step(a, &sp) && ++guard < MAXTAP)
         ;
     assert_true(taps.n > 1000);
+    /* a standstill is a sample no axis moves in: DP1's LLCs split the
+     * samples into motion runs there, as the HLC splits its path */
+    int64_t prev[NCP_AXES] = { 0 };
+    for (int j = 0; j < 3; j++)
+        prev[j] = ncp_adcai_quantise(o[j]);
+    size_t rests = 0;
+    for (size_t i = 0; i < taps.n; i++) {
+        int moved = 0;
+        for (int j = 0; j < NCP_AXES; j++)
+            moved |= taps.t[i].pos[j] != prev[j];
+        if (moved != taps.t[i].moved)
+            fail_msg("setpoint %zu: moved %d, its positions say %d", i, taps.t[i].moved, moved);
+        rests += !moved;
+        memcpy(prev, taps.t[i].pos, sizeof prev);
+    }
+    assert_true(rests > 0);
     int n[2];
     assert_int_equal(ncp_adcai_windows(&c, c.servo_period * ratio, n), 0);
     for (int j = 0; j < 3; j++) {
