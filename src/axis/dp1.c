@@ -13,6 +13,7 @@
 #include "axis.h"
 
 #include <sched.h>
+#include <signal.h>
 #include <string.h>
 #include <sys/resource.h>
 #include <time.h>
@@ -34,6 +35,7 @@ struct llc_dp1 {
     pthread_t th;
     int started;
     _Atomic int done, quit;          /* done: 1 ok, -1 its run failed (why says) */
+    volatile sig_atomic_t stop;      /* its NCK brakes and ends: this LLC is leaving */
     char why[200];
     char why_short[64];              /* as much as the status carries to the HLC */
     char label[32];
@@ -98,6 +100,7 @@ static void *inner_main(void *arg)
         .cfg = &p->cfg, .interpret = interpret, .interp_ctx = p, .virtual_clock = 1,
         .feed_override = 1.0, .label = p->label, .plan_tap = tap, .plan_tap_ctx = p,
         .adcai_tap = ai ? llc_dp1_ai_tap : NULL, .adcai_tap_ctx = ai,
+        .interrupt = &p->stop,
     };
     struct ncp_nck_result *res = calloc(1, sizeof *res);
     int ok = res && ncp_nck_run(&no, res) == NCP_NCK_OK;
@@ -127,7 +130,10 @@ void llc_dp1_free(struct llc *l)
         return;
     if (p->started) {
         atomic_store(&p->quit, 1);
-        /* its virtual run ends on its own; the tap no longer waits */
+        /* its run brakes and ends as a stop signal would end it, rather
+         * than going on to the program's end unwatched (seconds, for a
+         * program of a million blocks); the tap no longer waits */
+        p->stop = 1;
         struct ncp_accdec a;
         while (!atomic_load(&p->done)) {
             while (ncp_spsc_pop(&p->ring, &a) == 0)
