@@ -246,6 +246,61 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps, double 
     }
 }
 
+/* A corner parabola (NCP_SEG_PARAB) at parameter speed v and acceleration
+ * a_t: axis j moves at v g_j, g_j between the two lines' u1_j and u2_j, and
+ * accelerates at v^2 k_j + a_t g_j, k_j = |u2_j - u1_j| / length (the
+ * curve's constant second derivative). The cruise cap leaves v^2 k_j at
+ * most share of the axis's limit and the tangent gets the rest at that cap.
+ * S-curve: the acceleration steps from 0 to v^2 k_j where the curve meets a
+ * line, within one period, so that step gets half of the jerk limit; the
+ * tangential jerk j_t g_j and the turn of the tangential acceleration
+ * (at most 3 v a_t k_j) a quarter each. */
+static void parab_limits(const struct ncp_planner *p, struct plan_seg *ps, double share)
+{
+    const struct ncp_seg *s = &ps->s;
+    double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY, jerk = INFINITY;
+    double g[NCP_AXES], k[NCP_AXES];
+    for (int j = 0; j < NCP_AXES; j++) {
+        double c = j < 3 ? s->center[j] : 0.5 * (s->start[j] + s->end[j]);
+        double u1 = 2 * (c - s->start[j]) / s->length, u2 = 2 * (s->end[j] - c) / s->length;
+        g[j] = fmax(fabs(u1), fabs(u2));
+        k[j] = fabs(u2 - u1) / s->length;
+        const struct ncp_axis_cfg *a = &p->cfg.axis[j];
+        if (g[j] > 1e-12)
+            vmax = fmin(vmax, a->max_vel / g[j]);
+        if (k[j] > 1e-12)
+            vmax = fmin(vmax, sqrt(share * a->max_acc / k[j]));
+        if (k[j] > 1e-12 && plan_scurve(p) && a->max_jerk > 0)
+            vmax = fmin(vmax, sqrt(0.5 * a->max_jerk * p->cfg.servo_period / k[j]));
+    }
+    for (int j = 0; j < NCP_AXES; j++) {
+        const struct ncp_axis_cfg *a = &p->cfg.axis[j];
+        if (g[j] > 1e-12)
+            acc = fmin(acc, fmax(0, a->max_acc - vmax * vmax * k[j]) / g[j]);
+        if (!plan_scurve(p) || a->max_jerk <= 0)
+            continue;
+        if (g[j] > 1e-12)
+            jerk = fmin(jerk, 0.25 * a->max_jerk / g[j]);
+        if (k[j] > 1e-12 && vmax > 0)
+            acc = fmin(acc, a->max_jerk / (12 * vmax * k[j]));
+    }
+    ps->vmax = vmax;
+    ps->acc = acc;
+    ps->jerk = jerk;
+    /* below the cruise cap v^2 k_j takes less: axis j leaves the tangent
+     * a_j / g_j - v^2 k_j / g_j, so min(a_j / g_j) - v^2 max(k_j / g_j)
+     * is below every axis's (plan_acc_at); the S-curve keeps the cap's */
+    double a_eff = INFINITY, kappa = 0;
+    for (int j = 0; j < NCP_AXES; j++)
+        if (g[j] > 1e-12) {
+            a_eff = fmin(a_eff, p->cfg.axis[j].max_acc / g[j]);
+            kappa = fmax(kappa, k[j] / g[j]);
+        }
+    ps->a_eff = a_eff;
+    ps->kappa = plan_scurve(p) ? 0 : kappa;
+    ps->a_cap = INFINITY;
+}
+
 /* Programmed arcs keep LinuxCNC's split (half the vector for a_t even at full
  * speed); a blend arc is so short that its speed hardly changes on it, so the
  * speed through the corner gets nearly all of it. */
@@ -388,6 +443,8 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
         ps->acc = 1;
     } else if (ps->s.kind == NCP_SEG_ARC) {
         arc_limits(p, ps, ps->blend ? BLEND_AN_SHARE : ARC_AN_SHARE);
+    } else if (ps->s.kind == NCP_SEG_PARAB) {
+        parab_limits(p, ps, BLEND_AN_SHARE);
     } else {
         line_limits(p, ps);
     }
@@ -559,14 +616,23 @@ static double blend_vmax(const struct ncp_planner *p, const struct ncp_seg *s)
     return ps.vmax;
 }
 
-/* How fast a blend arc lets the corner be taken, feed aside. */
+/* A blend's caps (an arc's or a parabola's). */
+static void blend_limits(const struct ncp_planner *p, struct plan_seg *ps)
+{
+    if (ps->s.kind == NCP_SEG_PARAB)
+        parab_limits(p, ps, BLEND_AN_SHARE);
+    else
+        arc_limits(p, ps, BLEND_AN_SHARE);
+}
+
+/* How fast a blend lets the corner be taken, feed aside. */
 static double arc_speed(const struct ncp_planner *p, const struct ncp_seg *arc)
 {
     struct plan_seg ps;
     memset(&ps, 0, sizeof ps);
     ps.s = *arc;
     ps.s.feed = INFINITY;
-    arc_limits(p, &ps, BLEND_AN_SHARE);
+    blend_limits(p, &ps);
     return ps.vmax;
 }
 
@@ -674,7 +740,7 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     }
     prev_out.tolerance = prev->s.tolerance;
     arc.blend = 1;
-    arc_limits(p, &arc, BLEND_AN_SHARE);
+    blend_limits(p, &arc);
     arc.acc_full = arc.acc;
     double exit_lb = fmin(arc.vmax, ncp_plan_seg_reach(plan_scurve(p), &arc, 0, arc.s.length));
     struct plan_seg cut = *prev;

@@ -74,14 +74,18 @@ static inline double plan_reach(int scurve, double acc, double jerk, double v, d
 
 /* The path acceleration ps allows at speeds up to v: an arc's centripetal
  * acceleration v^2 kappa takes less of its bound a_eff below the cruise cap,
- * so the tangent gets the rest, scaled as a corner scaled acc. Never below
- * acc, the value at the cruise cap. */
+ * so the tangent gets the rest, scaled as a corner scaled acc. On a corner
+ * parabola a_eff - v^2 kappa is a bound below every axis's share
+ * (parab_limits in planner.c). Never below acc, the value at the cruise cap. */
 static inline double plan_acc_at(const struct plan_seg *ps, double v)
 {
     if (ps->kappa <= 0 || ps->acc_full <= 0)
         return ps->acc;
-    double an = v * v * ps->kappa;
-    double at = ps->a_eff > an ? sqrt(ps->a_eff * ps->a_eff - an * an) : 0;
+    double an = v * v * ps->kappa, at;
+    if (ps->s.kind == NCP_SEG_PARAB)  /* per axis, so the shares add up */
+        at = ps->a_eff - an;
+    else
+        at = ps->a_eff > an ? sqrt(ps->a_eff * ps->a_eff - an * an) : 0;
     return ps->acc / ps->acc_full * fmax(ps->acc_full, fmin(ps->a_cap, at));
 }
 
@@ -94,7 +98,7 @@ double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, doubl
 double ncp_plan_seg_profile_acc(int scurve, const struct plan_seg *ps, double v0, double v1,
                                 double vmax);
 
-/* blend.c: the arc joining prev's end to cur's start within prev's G64 P,
+/* blend.c: the parabola joining prev's end to cur's start within prev's G64 P,
  * trimming at most max_trim off either line, and the length trimmed off both.
  * Returns 0 when the corner is not blended. */
 int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,
