@@ -287,17 +287,23 @@ static void parab_limits(const struct ncp_planner *p, struct plan_seg *ps, doubl
     ps->vmax = vmax;
     ps->acc = acc;
     ps->jerk = jerk;
-    /* below the cruise cap v^2 k_j takes less: axis j leaves the tangent
-     * a_j / g_j - v^2 k_j / g_j, so min(a_j / g_j) - v^2 max(k_j / g_j)
-     * is below every axis's (plan_acc_at); the S-curve keeps the cap's */
-    double a_eff = INFINITY, kappa = 0;
+    /* Below the cruise cap the turn takes less and the tangent may have
+     * more, as on an arc (plan_acc_at): with a_n = v^2 |u2 - u1| / length
+     * and h_j = |u2_j - u1_j| / |u2 - u1|, axis j feels a_t g_j + a_n h_j,
+     * at most sqrt(a_t^2 + a_n^2) sqrt(g_j^2 + h_j^2) (Cauchy-Schwarz), so
+     * the vector stays within the least a_j / sqrt(g_j^2 + h_j^2). The
+     * S-curve keeps the cap's. */
+    double du = 0, a_eff = INFINITY;
     for (int j = 0; j < NCP_AXES; j++)
-        if (g[j] > 1e-12) {
-            a_eff = fmin(a_eff, p->cfg.axis[j].max_acc / g[j]);
-            kappa = fmax(kappa, k[j] / g[j]);
-        }
+        du += k[j] * k[j];
+    du = sqrt(du);  /* |u2 - u1| / length */
+    for (int j = 0; j < NCP_AXES && du > 0; j++) {
+        double h = k[j] / du, b = sqrt(g[j] * g[j] + h * h);
+        if (b > 1e-12)
+            a_eff = fmin(a_eff, p->cfg.axis[j].max_acc / b);
+    }
     ps->a_eff = a_eff;
-    ps->kappa = plan_scurve(p) ? 0 : kappa;
+    ps->kappa = plan_scurve(p) || !isfinite(a_eff) ? 0 : du;
     ps->a_cap = INFINITY;
 }
 

@@ -73,19 +73,15 @@ static inline double plan_reach(int scurve, double acc, double jerk, double v, d
 }
 
 /* The path acceleration ps allows at speeds up to v: an arc's centripetal
- * acceleration v^2 kappa takes less of its bound a_eff below the cruise cap,
- * so the tangent gets the rest, scaled as a corner scaled acc. On a corner
- * parabola a_eff - v^2 kappa is a bound below every axis's share
- * (parab_limits in planner.c). Never below acc, the value at the cruise cap. */
+ * acceleration v^2 kappa (a corner parabola's turn, parab_limits) takes less
+ * of its bound a_eff below the cruise cap, so the tangent gets the rest,
+ * scaled as a corner scaled acc. Never below acc, the value at the cruise cap. */
 static inline double plan_acc_at(const struct plan_seg *ps, double v)
 {
     if (ps->kappa <= 0 || ps->acc_full <= 0)
         return ps->acc;
-    double an = v * v * ps->kappa, at;
-    if (ps->s.kind == NCP_SEG_PARAB)  /* per axis, so the shares add up */
-        at = ps->a_eff - an;
-    else
-        at = ps->a_eff > an ? sqrt(ps->a_eff * ps->a_eff - an * an) : 0;
+    double an = v * v * ps->kappa;
+    double at = ps->a_eff > an ? sqrt(ps->a_eff * ps->a_eff - an * an) : 0;
     return ps->acc / ps->acc_full * fmax(ps->acc_full, fmin(ps->a_cap, at));
 }
 
