@@ -312,6 +312,12 @@ static void parab_limits(const struct ncp_planner *p, struct plan_seg *ps, doubl
  * speed through the corner gets nearly all of it. */
 #define ARC_AN_SHARE 0.866
 #define BLEND_AN_SHARE 0.95
+/* A corner parabola's turn loads each axis at a constant rate, exactly, so it
+ * may take nearly all of the limit at the cruise cap: below the cap the
+ * vector bound (parab_limits) leaves the tangent most of it again, and at
+ * the cap the blend's speed need hardly change (bench: 0.99 rather than
+ * 0.95 makes sharp 0.5 % faster and no program slower). */
+#define PARAB_TURN_SHARE 0.99
 
 /* A corner (kink) turns the velocity vector within one servo period. A servo
  * sample's second difference is a weighted mean of the continuous acceleration
@@ -450,7 +456,7 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
     } else if (ps->s.kind == NCP_SEG_ARC) {
         arc_limits(p, ps, ps->blend ? BLEND_AN_SHARE : ARC_AN_SHARE);
     } else if (ps->s.kind == NCP_SEG_PARAB) {
-        parab_limits(p, ps, BLEND_AN_SHARE);
+        parab_limits(p, ps, PARAB_TURN_SHARE);
     } else {
         line_limits(p, ps);
     }
@@ -626,7 +632,7 @@ static double blend_vmax(const struct ncp_planner *p, const struct ncp_seg *s)
 static void blend_limits(const struct ncp_planner *p, struct plan_seg *ps)
 {
     if (ps->s.kind == NCP_SEG_PARAB)
-        parab_limits(p, ps, BLEND_AN_SHARE);
+        parab_limits(p, ps, PARAB_TURN_SHARE);
     else
         arc_limits(p, ps, BLEND_AN_SHARE);
 }
