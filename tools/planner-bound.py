@@ -12,12 +12,26 @@ Every estimate is taken on the generous side, so the bound stays a bound:
   at a_n, with a_n the norm of the limits of the axes its plane (or its
   helix) moves (every one of them at its limit at once, more than any
   direction can get);
-- a corner turning by phi may be passed on the circle that stays within P of
-  it, r = P / (1 / cos(phi / 2) - 1), as long as that circle fits on the
-  whole of both segments, at sqrt(a_n r), a_n over the axes either segment
-  moves; the path is shortened by what such
-  a circle cuts off (on a smaller circle the corner is slower and the cut
-  shorter, so the largest one is the generous choice);
+- a corner from tangent u1 to u2 is passed at v with v^2 |u2 - u1|^2 <=
+  8 A_w P, where w = (u2 - u1) / |u2 - u1| and A_w = sum_i amax_i |w_i| is
+  the most acceleration the axes together can give along w. Derivation: a
+  turn whose velocity goes from v u1 to v u2 at a constant acceleration
+  (the fastest kind of turn: no axis ever waits for another) takes
+  T = v |u2 - u1| / A at an acceleration A along w and passes the corner
+  at v T |u2 - u1| / 8 (halfway, where the chord from its start to its end
+  is closest); within P that is v^2 <= 8 A P / |u2 - u1|^2, and no
+  direction gets more than A_w from axes each at its limit. Turns whose
+  acceleration varies are not proved slower; A_w (every axis at its limit
+  together, which a constant direction w rarely allows) is the margin
+  taken for them. Our parabolic blend (per axis
+  v^2 <= 8 P amax_i / (|u2 - u1| |u2_i - u1_i|)) stays below. The corner
+  costs no time and shortens the path by 2 d (1 - cos(phi / 2)),
+  d = 4 P / |u2 - u1| (the parabola's reach along each line, within both
+  whole segments): the chord from where it leaves one line to where it
+  meets the other, shorter than the curve. The circle within P
+  (r = P / (1 / cos(phi / 2) - 1), at sqrt(a_n r), a_n the norm of the
+  moving axes' limits, cutting 2 r tan(phi / 2) - r phi) is taken where
+  it is the faster or the larger cut;
 - the machine starts and ends at rest; in between the fastest profile that
   these bounds allow (forward and backward passes over the junction speeds,
   then a trapezoid on each segment).
@@ -141,8 +155,14 @@ def bound(segs, tol, vmax, amax):
                 r = tol / (1 / math.cos(phi / 2) - 1) if phi < math.pi - 1e-9 else 0.0
                 r = min(r, min(length[k - 1], length[k]) / math.tan(phi / 2) if phi < math.pi else 0.0)
                 an = moving_norm(amax, a[4], b[3])
-                cap = min(cap, math.sqrt(an * r))
+                circle = math.sqrt(an * r)
                 cut = 2 * r * math.tan(phi / 2) - r * phi
+                du = sub(b[3], a[4])
+                dn = norm(du)
+                aw = sum(amax[i] * abs(du[i]) / dn for i in range(3))
+                d = min(4 * tol / dn, length[k - 1], length[k])
+                cap = min(cap, max(circle, math.sqrt(8 * aw * tol) / dn))
+                cut = max(cut, 2 * d * (1 - math.cos(phi / 2)))
                 length[k - 1] -= cut / 2
                 length[k] -= cut / 2
         vj[k] = cap

@@ -204,7 +204,10 @@ int ncp_machine_cfg_ipo_ratio(const struct ncp_machine_cfg *c);
 
 /* ---- segments -------------------------------------------------------------- */
 
-enum ncp_seg_kind { NCP_SEG_LINE, NCP_SEG_ARC, NCP_SEG_DWELL };
+/* NCP_SEG_PARAB: a G64 corner between two lines (src/motion/blend.c), the
+ * quadratic curve from start through the pull of the corner (center) to end,
+ * at a constant acceleration vector when run at a constant speed. */
+enum ncp_seg_kind { NCP_SEG_LINE, NCP_SEG_ARC, NCP_SEG_DWELL, NCP_SEG_PARAB };
 
 enum ncp_seg_term { NCP_TERM_STOP, NCP_TERM_EXACT_PATH, NCP_TERM_CONTINUOUS };
 
@@ -246,7 +249,11 @@ struct ncp_seg {
      * scales the path speed by the actual speed over it (0: not per turn) */
     double rev_rpm;
     /* arcs and helices: p(l) = c + r(l)(cos(A l) u + sin(A l) w) + n h l, l in [0,1],
-     * in X Y Z; the other axes move linearly in l from start to end */
+     * in X Y Z; the other axes move linearly in l from start to end.
+     * NCP_SEG_PARAB: center is the programmed corner C and, with l = dist /
+     * length, p(l) = (1-l)^2 start + 2 l (1-l) C + l^2 end: its tangent runs
+     * from the line before's direction to the line after's, both unit in
+     * X Y Z when C sits length / 2 from start and from end. */
     double center[3], normal[3], u[3], w[3];
     double r0, r1, angle, axial;
 };
@@ -258,7 +265,9 @@ void ncp_seg_set_length(struct ncp_seg *s);
 int ncp_seg_moves_other(const struct ncp_seg *s);
 /* Position at path distance s (0..length) and the tangent there (may be NULL):
  * per axis its change per unit of path length, so the X Y Z part is a unit
- * vector when the path runs along X Y Z. */
+ * vector when the path runs along X Y Z. On NCP_SEG_PARAB "length" is the
+ * curve's parameter: the tangent is shorter than a unit inside it (the tool
+ * moves slower than the parameter, so the feed holds). */
 void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                   double tangent[NCP_AXES]);
 

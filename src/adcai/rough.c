@@ -33,6 +33,11 @@ static void axis_rates(const struct ncp_seg *s, double rate[NCP_AXES])
     double len = s->length > 0 ? s->length : 1;
     for (int j = 0; j < NCP_AXES; j++)
         rate[j] = fabs(s->end[j] - s->start[j]) / len;
+    if (s->kind == NCP_SEG_PARAB) {  /* its tangent runs from one line's to the other's */
+        for (int j = 0; j < 3; j++)
+            rate[j] = 2 * fmax(fabs(s->center[j] - s->start[j]), fabs(s->end[j] - s->center[j])) / len;
+        return;
+    }
     if (s->kind != NCP_SEG_ARC)
         return;
     double r = fmax(s->r0, s->r1), turn = fabs(s->angle) * r + fabs(s->r1 - s->r0);
@@ -59,6 +64,12 @@ double ncp_adcai_rough_speed(const struct ncp_machine_cfg *cfg, const struct ncp
     double r = fmin(s->r0, s->r1);
     if (s->kind == NCP_SEG_ARC && r > 0 && isfinite(a_plane))
         v = fmin(v, sqrt(a_plane * r));
+    /* a corner parabola: v^2 times its constant second derivative per axis */
+    for (int j = 0; j < 3 && s->kind == NCP_SEG_PARAB && s->length > 0; j++) {
+        double k = 2 * fabs(s->start[j] - 2 * s->center[j] + s->end[j]) / (s->length * s->length);
+        if ((cfg->axis_mask & NCP_AXIS_BIT(j)) && k > 1e-12)
+            v = fmin(v, sqrt(cfg->axis[j].max_acc / k));
+    }
     /* a speed of 0 would never end the block: the map refuses zero feeds,
      * this only keeps a broken segment from hanging the machine */
     if (!(v > 1e-6))

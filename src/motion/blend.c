@@ -1,9 +1,16 @@
-/* G64 corner blending: two lines meeting at a corner are joined by a circular
- * arc tangent to both, so the path keeps its tangent and the corner is taken at
- * speed. The arc stays within the tolerance P of the corner and uses at most
- * the rest of the line before it and half of the line after it, so
- * neighbouring blends never overlap; the planner
- * (try_blend) makes it no larger than the speed it is for needs. */
+/* G64 corner blending: two lines meeting at a corner are joined by a curve
+ * tangent to both, so the path keeps its tangent and the corner is taken at
+ * speed. Between lines the curve is a parabola (NCP_SEG_PARAB): run at a
+ * constant speed its velocity turns linearly from the one line's to the
+ * other's, so each axis brakes or speeds up at a constant rate and the axes
+ * of both lines work at once, where on a circle the centripetal acceleration
+ * falls on one axis after the other: within the same P the parabola is
+ * faster (v^2 <= 8 P a / (|u2 - u1| |u2_j - u1_j|) per axis j against the
+ * circle's a r, r = P cos(phi/2) / (1 - cos(phi/2)), always below). Between
+ * an arc and a line the blend is a circular arc. Either stays within the
+ * tolerance P of the corner and uses at most the rest of the line before it
+ * and half of the line after it, so neighbouring blends never overlap; the
+ * planner (try_blend) makes it no larger than the speed it is for needs. */
 #include "planner_int.h"
 
 #include <math.h>
@@ -31,66 +38,52 @@ static void direction(const struct ncp_seg *s, double u[3])
 }
 
 int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,
-                     struct ncp_seg *arc, double *trim)
+                     struct ncp_seg *blend, double *trim)
 {
-    /* the blend arc is drawn in X Y Z: a corner where another axis moves
-     * is a kink instead */
+    /* the blend is drawn in X Y Z: a corner where another axis moves is a
+     * kink instead */
     if (prev->kind != NCP_SEG_LINE || cur->kind != NCP_SEG_LINE ||
         prev->term != NCP_TERM_CONTINUOUS || prev->length <= 0 || cur->length <= 0 ||
         ncp_seg_moves_other(prev) || ncp_seg_moves_other(cur))
         return 0;
-    double u1[3], u2[3], n[3];
+    double u1[3], u2[3];
     direction(prev, u1);
     direction(cur, u2);
-    double c = dot3(u1, u2);
+    double c = dot3(u1, u2), du = 0;
     /* collinear needs no blend; a near reversal would need a vanishing radius */
     if (c > 1 - 1e-12 || c < -0.999)
         return 0;
-    double phi = acos(c), th = tan(0.5 * phi);
+    for (int i = 0; i < 3; i++)
+        du += (u2[i] - u1[i]) * (u2[i] - u1[i]);
+    du = sqrt(du);
     /* prev's start is settled by the corner before: what is left of it may
      * all go to this corner (a micrometre stays, so its direction stays
      * exact); cur keeps half for the corner after */
     double d = fmin(max_trim, fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length));
-    if (prev->tolerance > 0) {
-        double r_tol = prev->tolerance / (1.0 / cos(0.5 * phi) - 1.0);
-        d = fmin(d, r_tol * th);
-    }
+    /* the curve passes the corner closest halfway, d |u2 - u1| / 4 from it */
+    if (prev->tolerance > 0)
+        d = fmin(d, 4 * prev->tolerance / du);
     if (d < 1e-6)
         return 0;
-    double r = d / th;
-    cross3(u1, u2, n);
-    double nl = sqrt(dot3(n, n));
-    memset(arc, 0, sizeof *arc);
-    arc->kind = NCP_SEG_ARC;
-    arc->term = NCP_TERM_CONTINUOUS;
-    arc->traverse = (uint8_t)(prev->traverse && cur->traverse);
-    arc->line = cur->line;  /* the corner is where the next block's motion begins */
-    arc->tool_z = prev->tool_z;
-    arc->aux = prev->aux;   /* what comes with the next block waits for its own segment */
-    arc->rev_rpm = prev->rev_rpm;
-    arc->feed = fmin(prev->feed, cur->feed);
-    arc->blend_feed = fmin(prev->blend_feed > 0 ? prev->blend_feed : prev->feed,
-                           cur->blend_feed > 0 ? cur->blend_feed : cur->feed);
-    double bis[3], bl = 0;
-    for (int i = 0; i < 3; i++) {
-        bis[i] = u2[i] - u1[i];
-        bl += bis[i] * bis[i];
-    }
-    bl = sqrt(bl);
+    memset(blend, 0, sizeof *blend);
+    blend->kind = NCP_SEG_PARAB;
+    blend->term = NCP_TERM_CONTINUOUS;
+    blend->traverse = (uint8_t)(prev->traverse && cur->traverse);
+    blend->line = cur->line;  /* the corner is where the next block's motion begins */
+    blend->tool_z = prev->tool_z;
+    blend->aux = prev->aux;   /* what comes with the next block waits for its own segment */
+    blend->rev_rpm = prev->rev_rpm;
+    blend->feed = fmin(prev->feed, cur->feed);
+    blend->blend_feed = fmin(prev->blend_feed > 0 ? prev->blend_feed : prev->feed,
+                             cur->blend_feed > 0 ? cur->blend_feed : cur->feed);
     for (int i = 3; i < NCP_AXES; i++)
-        arc->start[i] = arc->end[i] = prev->end[i];
+        blend->start[i] = blend->end[i] = prev->end[i];
     for (int i = 0; i < 3; i++) {
-        arc->start[i] = prev->end[i] - u1[i] * d;
-        arc->end[i] = prev->end[i] + u2[i] * d;
-        arc->normal[i] = n[i] / nl;
-        arc->center[i] = prev->end[i] + bis[i] / bl * (r / cos(0.5 * phi));
+        blend->start[i] = prev->end[i] - u1[i] * d;
+        blend->end[i] = prev->end[i] + u2[i] * d;
+        blend->center[i] = prev->end[i];
     }
-    for (int i = 0; i < 3; i++)
-        arc->u[i] = (arc->start[i] - arc->center[i]) / r;
-    cross3(arc->normal, arc->u, arc->w);
-    arc->r0 = arc->r1 = r;
-    arc->angle = phi;
-    arc->length = r * phi;
+    blend->length = 2 * d;
     *trim = d;
     return 1;
 }

@@ -73,9 +73,9 @@ static inline double plan_reach(int scurve, double acc, double jerk, double v, d
 }
 
 /* The path acceleration ps allows at speeds up to v: an arc's centripetal
- * acceleration v^2 kappa takes less of its bound a_eff below the cruise cap,
- * so the tangent gets the rest, scaled as a corner scaled acc. Never below
- * acc, the value at the cruise cap. */
+ * acceleration v^2 kappa (a corner parabola's turn, parab_limits) takes less
+ * of its bound a_eff below the cruise cap, so the tangent gets the rest,
+ * scaled as a corner scaled acc. Never below acc, the value at the cruise cap. */
 static inline double plan_acc_at(const struct plan_seg *ps, double v)
 {
     if (ps->kappa <= 0 || ps->acc_full <= 0)
@@ -94,7 +94,7 @@ double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, doubl
 double ncp_plan_seg_profile_acc(int scurve, const struct plan_seg *ps, double v0, double v1,
                                 double vmax);
 
-/* blend.c: the arc joining prev's end to cur's start within prev's G64 P,
+/* blend.c: the parabola joining prev's end to cur's start within prev's G64 P,
  * trimming at most max_trim off either line, and the length trimmed off both.
  * Returns 0 when the corner is not blended. */
 int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,

@@ -78,6 +78,22 @@ static void eval_arc(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
     }
 }
 
+/* The corner curve: a quadratic through start, the corner and end. Its
+ * second derivative is constant, so at a constant parameter speed every
+ * axis accelerates constantly, the axes of both lines at once. */
+static void eval_parab(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
+                       double tan[NCP_AXES])
+{
+    double l = s->length > 0 ? fmin(dist / s->length, 1.0) : 1.0, m = 1 - l;
+    for (int i = 0; i < NCP_AXES; i++) {
+        double c = i < 3 ? s->center[i] : 0.5 * (s->start[i] + s->end[i]);
+        pos[i] = l >= 1.0 ? s->end[i] : m * m * s->start[i] + 2 * l * m * c + l * l * s->end[i];
+        if (tan)
+            tan[i] = s->length > 0 ? 2 * (m * (c - s->start[i]) + l * (s->end[i] - c)) / s->length
+                                   : 0;
+    }
+}
+
 void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                   double tangent[NCP_AXES])
 {
@@ -89,6 +105,9 @@ void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
         break;
     case NCP_SEG_LINE:
         eval_line(s, dist, pos, tangent);
+        break;
+    case NCP_SEG_PARAB:
+        eval_parab(s, dist, pos, tangent);
         break;
     default:
         for (int i = 0; i < NCP_AXES; i++) {

@@ -3,7 +3,8 @@
  * each blend the rest of the chord before it, not half of what the blend
  * before left; a near reversal (no blend possible) stops with the full
  * acceleration of both lines instead of creeping through the kink at half of
- * it. Every run also keeps every axis within its limits and the path within P. */
+ * it; a corner between lines is taken faster than on the circle within P.
+ * Every run also keeps every axis within its limits and the path within P. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -107,11 +108,70 @@ static void test_near_reversal_stops_at_full_acceleration(void **state)
     free(r);
 }
 
+/* Turning phi degrees at X5 Y0 from a line along +X, P0.01: the blend is
+ * bounded by P, not by the lines. A circle within P (its servo chords take
+ * 0.3 um of P) runs at sqrt(0.95 a r), r = P cos(phi/2) / (1 - cos(phi/2)):
+ * 4.7 mm/s at 90 degrees. The parabola takes the corner with both axes
+ * accelerating at once: the tool must run on it faster than 1.1 times that
+ * (it slows down to v cos(phi/2) halfway, so the fastest step on the blend
+ * is the one compared); every sample stays within P of the programmed path
+ * and every axis within its limits. */
+static void corner_faster_than_circle(double phi_deg)
+{
+    const double phi = phi_deg * M_PI / 180, u2[2] = { cos(phi), sin(phi) };
+    char prog[160];
+    snprintf(prog, sizeof prog, "G21 G90 G17 G64 P0.01 Q0\nG1 X0 Y0 F3000\nG1 X5\nG1 X%.9f Y%.9f\nM2\n",
+             5 + 5 * u2[0], 5 * u2[1]);
+    struct ncp_machine_cfg cfg;
+    lcnc_like_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(prog, &cfg, &n, &res);
+    const double T = cfg.servo_period, P = 0.01 - 0.3 * AMAX * T * T;
+    double half = fabs(phi) / 2;
+    double r_circle = P * cos(half) / (1 - cos(half)), v_circle = sqrt(0.95 * AMAX * r_circle);
+    double v_blend = 0, dev = 0, v_max = 0;
+    int was_on = 1;
+    for (size_t k = 1; k < n; k++) {
+        double dx = r[k].cmd[0] - 5, dy = r[k].cmd[1];
+        double off1 = dx <= 0 ? fabs(dy) : hypot(dx, dy);
+        double along = dx * u2[0] + dy * u2[1];
+        double off2 = along >= 0 ? fabs(dx * u2[1] - dy * u2[0]) : hypot(dx, dy);
+        /* off both lines by more than the trace's rounding: on the blend */
+        int on = off1 < 2e-6 || off2 < 2e-6;
+        if (!on && !was_on)
+            v_blend = fmax(v_blend, hypot(r[k].cmd[0] - r[k - 1].cmd[0],
+                                          r[k].cmd[1] - r[k - 1].cmd[1]) / T);
+        was_on = on;
+        dev = fmax(dev, fmin(off1, off2));
+        for (int j = 0; j < 3; j++)
+            v_max = fmax(v_max, fabs(r[k].cmd[j] - r[k - 1].cmd[j]) / T);
+    }
+    double w = worst_acc(r, n, T);
+    if (v_blend < 1.1 * v_circle || dev > 0.01 + 1e-6 || w > 1 + 1e-9 || v_max > VMAX + 0.01)
+        fail_msg("%.0f deg: on the blend at up to %.2f mm/s (a circle within P: %.2f, want 1.1 "
+                 "times that), %.5f mm off the path (P 0.01), axis acceleration %.4f of the "
+                 "limit, axis speed %.2f mm/s",
+                 phi_deg, v_blend, v_circle, dev, w, v_max);
+    print_message("%.0f deg: %.2f mm/s on the blend, %.2f on a circle\n", phi_deg, v_blend, v_circle);
+    free(r);
+}
+
+static void test_corner_faster_than_circle_within_p(void **state)
+{
+    (void)state;
+    corner_faster_than_circle(90);
+    corner_faster_than_circle(60);
+    corner_faster_than_circle(135);
+    corner_faster_than_circle(-120);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_chord_chain_blends_use_whole_chords),
         cmocka_unit_test(test_near_reversal_stops_at_full_acceleration),
+        cmocka_unit_test(test_corner_faster_than_circle_within_p),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
