@@ -6,7 +6,7 @@
 
 void ncp_dist_ax_channel(char *buf, size_t size, int axis, enum ncp_dist_ax_ch what)
 {
-    static const char *const tail[] = { "ADVERT", "STATUS", "HEARTBEAT", "RESEND" };
+    static const char *const tail[] = { "ADVERT", "STATUS", "HEARTBEAT", "RESEND", "CLOCK" };
     snprintf(buf, size, "NCP_AX_%c_%s", NCP_AXIS_LETTERS[axis], tail[what]);
 }
 
