@@ -172,7 +172,9 @@ void llc_heartbeat(struct llc *l, int64_t now)
     if (now - l->last_hb_ns < l->hb_period_ns)
         return;
     l->last_hb_ns = now;
-    ncp_heartbeat_t h = { l->seq++, (int16_t)(l->axis + 1), llc_clock_local(&l->clk, now), 0, 0,
+    /* done once the HLC's is heard: the HLC repeats its own until then */
+    ncp_heartbeat_t h = { l->seq++, (int16_t)(l->axis + 1), llc_clock_local(&l->clk, now), 0,
+                          l->done_req ? NCP_HEARTBEAT_T_COMMAND_DONE : NCP_HEARTBEAT_T_COMMAND_RUN,
                           0 };
     uint8_t buf[64];
     int n = ncp_heartbeat_t_encode(buf, 0, sizeof buf, &h);

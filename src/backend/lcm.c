@@ -50,6 +50,7 @@ struct peer {
     int axis;
     int sub_advert, sub_status, sub_hb, sub_resend;
     int advertised, have_status;
+    int done_heard;              /* its heartbeat says it heard the HLC's done */
     ncp_ax_status_t st;          /* the last status */
     int64_t last_status_ns, last_hb_ns;
     int32_t last_seq;
@@ -82,6 +83,8 @@ struct lcm_be {
     int rest;                /* the path stood still last period */
     double prev_cmd[NCP_AXES];
     struct lcm_clock clk;    /* answers the LLCs' clock probes; the HLC's clock */
+    uint64_t ends_sent;      /* heartbeats saying done (or stop) at the end */
+    int64_t last_cycle_ns, end_gap_ns;   /* the loop's last period; from it to the end said */
 };
 
 /* Every time the HLC sends is on this clock ([LCM] CLOCK), its grid too. */
@@ -130,6 +133,11 @@ static void take(struct lcm_be *s, int64_t now)
             if (sub == p->sub_status) {
                 on_status(p, b, len, now);
             } else if (sub == p->sub_hb) {
+                ncp_heartbeat_t h;
+                memset(&h, 0, sizeof h);
+                if (ncp_heartbeat_t_decode(b, 0, (int)len, &h) == (int)len &&
+                    h.sender == p->axis + 1 && h.command == NCP_HEARTBEAT_T_COMMAND_DONE)
+                    p->done_heard = 1;
                 p->last_hb_ns = now;
             } else if (sub == p->sub_resend && s->tx) {
                 lcm_tx_resend(s->tx, s->msg, b, len);
@@ -404,6 +412,7 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         before[i] = s->p[i].statuses;
     take(s, now);
     s->cycles++;
+    s->last_cycle_ns = now;
     for (int j = 0; j < NCP_AXES; j++)
         act[j] = cmd[j];
     for (int i = 0; i < s->n; i++) {
@@ -432,20 +441,28 @@ static void lcm_stop(struct ncp_backend *b)
     idle_stop(s);
     int command = s->faulted ? NCP_HEARTBEAT_T_COMMAND_STOP : NCP_HEARTBEAT_T_COMMAND_DONE;
     int64_t end = hlc_now(s) + STOP_WAIT_NS;
+    /* Said every servo period, not every heartbeat period, until each LLC
+     * still alive has answered (its status says done or stopped, or its
+     * heartbeat says it heard done): an LLC whose setpoints ended in motion
+     * holds them for only MAX_LOST_PERIODS periods, so one lost "done"
+     * must cost a period, not a heartbeat period. */
     for (;;) {
         int64_t now = hlc_now(s);
         heartbeat(s, command, s->fault_axis);
+        if (s->ends_sent++ == 0 && s->last_cycle_ns)
+            s->end_gap_ns = now - s->last_cycle_ns;
         take(s, now);
         int busy = 0;
         for (int i = 0; i < s->n; i++) {
             const struct peer *p = &s->p[i];
             int alive = now - p->last_hb_ns <= s->hb_timeout;
             busy += alive && p->st.state != NCP_AX_STATUS_T_DONE &&
-                    p->st.state != NCP_AX_STATUS_T_STOPPED;
+                    p->st.state != NCP_AX_STATUS_T_STOPPED &&
+                    !(command == NCP_HEARTBEAT_T_COMMAND_DONE && p->done_heard);
         }
         if (!busy || now > end)
             break;
-        struct timespec ts = { 0, (long)s->hb_period };
+        struct timespec ts = { 0, (long)s->T };
         nanosleep(&ts, NULL);
     }
     struct ncp_msg_stats st;
@@ -485,6 +502,10 @@ static void lcm_stop(struct ncp_backend *b)
                     NCP_AXIS_LETTERS[p->axis], mode[m], (double)p->st.clock_offset_ns * 1e-6,
                     (double)p->st.clock_rtt_ns * 1e-3, (double)p->st.clock_jitter_ns * 1e-3);
     }
+    fprintf(stderr, "lcm: the end (%s) said %llu times, the first %.1f ms after the loop's "
+                    "last period\n",
+            command == NCP_HEARTBEAT_T_COMMAND_DONE ? "done" : "stop",
+            (unsigned long long)s->ends_sent, (double)s->end_gap_ns * 1e-6);
     fprintf(stderr, "lcm: transport: sent %llu (%llu send errors), taken %llu, injected loss "
                     "%llu, delayed %llu\n",
             (unsigned long long)st.sent, (unsigned long long)st.send_errors,
