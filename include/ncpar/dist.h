@@ -16,6 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "ncpar/diag.h"
 #include "ncpar/motion.h"
 #include "ncp_accdec_burst_t.h"
 #include "ncp_ax_advert_t.h"
@@ -47,6 +48,11 @@ enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTB
                       NCP_DIST_AX_RESEND, NCP_DIST_AX_CLOCK };
 /* "NCP_AX_<L>_ADVERT" etc. into buf (32 bytes are enough). */
 void ncp_dist_ax_channel(char *buf, size_t size, int axis, enum ncp_dist_ax_ch what);
+/* The clock probes travel on the LCM URL's group and the port after its
+ * (url NULL or "": as ncp_msg_open resolves it): the threads that stamp
+ * them then wake for them alone, not for every setpoint and status. 128
+ * bytes are enough; NCP_OK, or why not in d. */
+int ncp_dist_clock_url(const char *url, char *buf, size_t size, struct ncp_diag *d);
 
 /* The ADCAI points the lcm backend streams at. DP4 (fineIPObuf) is the same
  * message as ADCBI's DP5: every servo period's setpoints, so the LLCs need

@@ -116,7 +116,10 @@ int llc_clock_start(struct llc *l, const char *url, struct ncp_diag *d)
     }
     ncp_dist_clock_init(&c->win);
     ncp_dist_ax_channel(c->channel, sizeof c->channel, l->axis, NCP_DIST_AX_CLOCK);
-    int rc = ncp_msg_open(&c->msg, url, NULL, d);
+    char curl[128];
+    int rc = ncp_dist_clock_url(url, curl, sizeof curl, d);
+    if (rc == NCP_OK)
+        rc = ncp_msg_open(&c->msg, curl, NULL, d);
     if (rc != NCP_OK)
         return rc;
     ncp_msg_subscribe(c->msg, NCP_DIST_CH_CLOCK);
@@ -146,8 +149,8 @@ void llc_clock_stop(struct llc *l)
 
 int llc_clock_known(const struct llc *l)
 {
-    return atomic_load_explicit(&l->clk.probes, memory_order_relaxed) >=
-           NCP_DIST_CLOCK_WINDOW / 2;
+    /* a full window: a grid set up on fewer may start a round trip off */
+    return atomic_load_explicit(&l->clk.probes, memory_order_relaxed) >= NCP_DIST_CLOCK_WINDOW;
 }
 
 int llc_clock_cycle(struct llc *l, int grid_known)
@@ -157,8 +160,11 @@ int llc_clock_cycle(struct llc *l, int grid_known)
         return 0;
     int64_t est = atomic_load_explicit(&c->est_offset, memory_order_relaxed);
     if (c->mode != NCP_LCM_CLOCK_PROBE) {
+        /* apart for certain: even where the best probe's round trip was all
+         * one way (a loaded host at start-up), not only by the estimate */
         c->applied = 0;
-        return llabs(est) > c->tolerance_ns ? -1 : 0;
+        int64_t rtt = atomic_load_explicit(&c->est_rtt, memory_order_relaxed);
+        return llabs(est) - rtt / 2 > c->tolerance_ns ? -1 : 0;
     }
     if (!grid_known)
         c->applied = est;

@@ -61,7 +61,10 @@ int lcm_clock_start(struct lcm_clock *c, const struct ncp_machine_cfg *cfg, stru
         clock_gettime(CLOCK_REALTIME, &r);
         c->off_ns = (int64_t)r.tv_sec * 1000000000LL + r.tv_nsec - mono();
     }
-    int rc = ncp_msg_open(&c->msg, cfg->lcm.url, NULL, d);
+    char url[128];
+    int rc = ncp_dist_clock_url(cfg->lcm.url, url, sizeof url, d);
+    if (rc == NCP_OK)
+        rc = ncp_msg_open(&c->msg, url, NULL, d);
     if (rc != NCP_OK)
         return rc;
     for (int j = 0; j < NCP_AXES; j++) {
