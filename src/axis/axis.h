@@ -44,6 +44,7 @@ struct llc_clock {
     struct ncp_dist_clock win;
     _Atomic int64_t est_offset, est_rtt, est_jitter;
     atomic_int probes;            /* in the estimate's window: 0 none yet */
+    atomic_int ready;             /* the estimate stands (see clock.c) */
     atomic_ullong sent, answers;
     int64_t applied;              /* the HLC's clock minus this one, as the grid runs */
     int64_t slewed;               /* all the slewing, ns */
@@ -159,7 +160,7 @@ void llc_clock_stop(struct llc *l);
 /* This LLC's clock (mono_ns: CLOCK_MONOTONIC), and the HLC's as it maps. */
 int64_t llc_clock_local(const struct llc_clock *c, int64_t mono_ns);
 int64_t llc_hlc_time(const struct llc *l, int64_t mono_ns);
-/* Enough probes answered for an estimate. */
+/* The estimate stands: a full window of probes, short round trips or many. */
 int llc_clock_known(const struct llc *l);
 /* Once a period, from the loop: follows the estimate (CLOCK = probe; stepped
  * until grid_known, then slewed) or checks it: 0, or -1 when the clocks are

@@ -20,7 +20,12 @@
 #include <string.h>
 #include <time.h>
 
-#define PROBE_FAST_NS 5000000LL    /* until the window is full */
+#define PROBE_FAST_NS 5000000LL    /* until the estimate stands */
+/* The estimate stands with a full window whose best round trip is this
+ * short, or after this many answers whatever it is: a host busy starting
+ * its loops delays whole windows of answers by milliseconds. */
+#define GOOD_RTT_NS 500000LL
+#define SETTLE_ANSWERS 60
 #define PROBE_SLOW_NS 50000000LL   /* then: drift is slow, probes cost bandwidth */
 /* Under CLOCK = probe the grid follows the estimate within this much and
  * slews at most this much a period: 1 us per 1 ms period is 1000 ppm, far
@@ -72,11 +77,13 @@ static void answered(struct llc *l, const uint8_t *p, size_t len, int64_t t4)
     struct ncp_dist_clock_est e;
     if (ncp_dist_clock_estimate(&c->win, &e) != 0)
         return;
-    atomic_fetch_add(&c->answers, 1);
+    unsigned long long n = atomic_fetch_add(&c->answers, 1) + 1;
     atomic_store(&c->est_rtt, e.rtt_ns);
     atomic_store(&c->est_jitter, e.jitter_ns);
     atomic_store(&c->est_offset, e.offset_ns);
     atomic_store(&c->probes, e.probes);
+    if (e.probes == NCP_DIST_CLOCK_WINDOW && (e.rtt_ns <= GOOD_RTT_NS || n >= SETTLE_ANSWERS))
+        atomic_store(&c->ready, 1);
 }
 
 static void *clock_main(void *arg)
@@ -85,8 +92,7 @@ static void *clock_main(void *arg)
     struct llc_clock *c = &l->clk;
     struct pollfd pfd = { .fd = ncp_msg_fd(c->msg), .events = POLLIN };
     while (atomic_load(&c->run)) {
-        int64_t due = mono() + (atomic_load(&c->probes) < NCP_DIST_CLOCK_WINDOW ? PROBE_FAST_NS
-                                                                                : PROBE_SLOW_NS);
+        int64_t due = mono() + (atomic_load(&c->ready) ? PROBE_SLOW_NS : PROBE_FAST_NS);
         probe(l);
         for (int64_t left; (left = due - mono()) > 0 && atomic_load(&c->run);) {
             if (poll(&pfd, 1, (int)(left / 1000000 + 1)) <= 0)
@@ -149,8 +155,7 @@ void llc_clock_stop(struct llc *l)
 
 int llc_clock_known(const struct llc *l)
 {
-    /* a full window: a grid set up on fewer may start a round trip off */
-    return atomic_load_explicit(&l->clk.probes, memory_order_relaxed) >= NCP_DIST_CLOCK_WINDOW;
+    return atomic_load_explicit(&l->clk.ready, memory_order_relaxed);
 }
 
 int llc_clock_cycle(struct llc *l, int grid_known)

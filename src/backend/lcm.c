@@ -497,8 +497,8 @@ static void lcm_stop(struct ncp_backend *b)
         static const char *const mode[] = { "monotonic", "probe", "ptp" };
         int m = p->st.clock_mode >= 0 && p->st.clock_mode <= 2 ? p->st.clock_mode : 0;
         if (p->st.clock_rtt_ns > 0)
-            fprintf(stderr, "lcm: axis %c: clock %s: this clock ahead of its by %+.3f ms "
-                            "(round trip %.1f us, jitter %.1f us)\n",
+            fprintf(stderr, "lcm: axis %c: clock %s: the HLC's clock ahead of the LLC's by "
+                            "%+.3f ms (round trip %.1f us, jitter %.1f us)\n",
                     NCP_AXIS_LETTERS[p->axis], mode[m], (double)p->st.clock_offset_ns * 1e-6,
                     (double)p->st.clock_rtt_ns * 1e-3, (double)p->st.clock_jitter_ns * 1e-3);
     }
