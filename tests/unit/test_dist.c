@@ -296,6 +296,22 @@ static void clock_slew_is_bounded(void **state)
                 -4000000000000000000LL + 1000);
 }
 
+static void clock_url_next_port(void **state)
+{
+    (void)state;
+    char buf[128];
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    assert_int_equal(ncp_dist_clock_url("udpm://239.255.76.67:7667?ttl=1&recv_buf_size=65536",
+                                        buf, sizeof buf, &d), NCP_OK);
+    assert_string_equal(buf, "udpm://239.255.76.67:7668?ttl=1");
+    assert_int_equal(ncp_dist_clock_url("udpm://239.1.2.3", buf, sizeof buf, &d), NCP_OK);
+    assert_string_equal(buf, "udpm://239.1.2.3:7668?ttl=0");
+    assert_int_not_equal(ncp_dist_clock_url("udpm://239.1.2.3:65535", buf, sizeof buf, &d),
+                         NCP_OK);
+    assert_non_null(strstr(d.msg, "next port"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -309,6 +325,7 @@ int main(void)
         cmocka_unit_test(la_and_int_round_trip),
         cmocka_unit_test(clock_shortest_round_trip_wins),
         cmocka_unit_test(clock_slew_is_bounded),
+        cmocka_unit_test(clock_url_next_port),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
