@@ -141,6 +141,8 @@ void ncp_adcai_get_stats(const struct ncp_adcai *a, struct ncp_planner_stats *st
 struct ncp_adcai_tap {
     uint8_t start;                /* this setpoint is a rough period's first */
     uint8_t stop;                 /* its rough record's path-control flag */
+    uint8_t moved;                /* some axis moves this servo period (a standstill
+                                     is a setpoint no axis moves in) */
     int32_t rough[NCP_AXES];      /* rough increments summed, through that record */
     int32_t accdec[NCP_AXES];     /* ACC/DEC output summed, through that record */
     int64_t pos[NCP_AXES];        /* the setpoint, nm (the HLC finds it by this) */

@@ -4,9 +4,9 @@
  *
  * Distribution points, ADCBI (today's planner): DP1 the part program, DP2
  * INTbuf, DP3 LAbuf, DP4 ACCDECbuf (block-level: bursts), DP5 fineIPObuf
- * (period-level: a record every servo period). ADCAI: DP2 roughIPObuf, DP3
- * ACCDECbuf, DP4 fineIPObuf; it has no DP5. Implemented: ADCBI DP5, DP4, DP3,
- * DP2 and DP1; ADCAI DP2-DP4.
+ * (period-level: a record every servo period). ADCAI: DP1 the part program,
+ * DP2 roughIPObuf, DP3 ACCDECbuf, DP4 fineIPObuf; it has no DP5. Implemented:
+ * ADCBI DP5, DP4, DP3, DP2 and DP1; ADCAI DP1-DP4.
  *
  * Positions travel as int32 nanometres: exact and the same for every LLC,
  * +-2.1 m of travel. */
@@ -56,8 +56,8 @@ int ncp_dist_clock_url(const char *url, char *buf, size_t size, struct ncp_diag 
 
 /* The ADCAI points the lcm backend streams at. DP4 (fineIPObuf) is the same
  * message as ADCBI's DP5: every servo period's setpoints, so the LLCs need
- * not know which variant made them. */
-static inline int ncp_dist_adcai_dp(int dp) { return dp >= 2 && dp <= 4; }
+ * not know which variant made them; DP1 sends the program as ADCBI's does. */
+static inline int ncp_dist_adcai_dp(int dp) { return dp >= 1 && dp <= 4; }
 
 /* nm <-> mm; out of the int32 range: -1. */
 int ncp_dist_mm_to_nm(double mm, int32_t *nm);

@@ -33,6 +33,7 @@
 
 struct ncp_output;
 struct ncp_machine_cfg;
+struct ncp_adcai_tap;
 
 /* Live controls of a running NCK, safe to use from any thread. */
 struct ncp_nck_ctl {
@@ -94,6 +95,10 @@ struct ncp_nck_opts {
      * thread), or NULL: an LLC at DP 1 runs its own NCK for these */
     void (*plan_tap)(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec);
     void *plan_tap_ctx;
+    /* every setpoint the ADCAI chain emits (ncp_adcai_set_tap; planner
+     * thread), or NULL: an LLC at ADCAI's DP 1 takes the rough records here */
+    void (*adcai_tap)(void *ctx, const struct ncp_adcai_tap *t);
+    void *adcai_tap_ctx;
 };
 
 enum ncp_nck_status { NCP_NCK_OK = 0, NCP_NCK_PROGRAM_ERROR = 2, NCP_NCK_FAULT = 3 };
@@ -208,6 +213,8 @@ struct ncp_nck_setup {
     /* as ncp_nck_opts' */
     void (*plan_tap)(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec);
     void *plan_tap_ctx;
+    void (*adcai_tap)(void *ctx, const struct ncp_adcai_tap *t);
+    void *adcai_tap_ctx;
 };
 
 struct ncp_nck;

@@ -215,12 +215,15 @@ static void note_ahead(struct ncp_adcai *a)
 }
 
 /* The setpoint out goes to the tap with the record its sample started. */
-static void tap(struct ncp_adcai *a, const struct ncp_adcai_tap *rec)
+static void tap(struct ncp_adcai *a, const struct ncp_adcai_tap *rec, const int32_t inc[NCP_AXES])
 {
     if (!a->tap)
         return;
     struct ncp_adcai_tap t = *rec;
     memcpy(t.pos, a->pos, sizeof t.pos);
+    t.moved = 0;
+    for (int j = 0; j < NCP_AXES; j++)
+        t.moved |= inc[j] != 0;
     a->tap(a->tap_ctx, &t);
 }
 
@@ -236,7 +239,7 @@ int ncp_adcai_step(struct ncp_adcai *a, struct ncp_setpoint *out)
         setpoint(a, none, none, &a->tag, out);
         struct ncp_adcai_tap rest = a->sums;
         rest.start = 0;
-        tap(a, &rest);
+        tap(a, &rest, none);
         if (a->finishing) {   /* the job's end, at rest on its last point */
             out->flags = NCP_SP_END;
             return 0;
@@ -256,6 +259,6 @@ int ncp_adcai_step(struct ncp_adcai *a, struct ncp_setpoint *out)
     for (int j = 0; a->have_ahead && j < NCP_AXES; j++)
         a->ahead_moves |= a->ahead[j] != 0;
     setpoint(a, inc, a->have_ahead ? a->ahead : none, &tag, out);
-    tap(a, &rec);
+    tap(a, &rec, inc);
     return 1;
 }

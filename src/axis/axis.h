@@ -51,7 +51,13 @@ struct llc_clock {
     int slewing;
 };
 
+/* Periods an LLC at DP1 plays behind the HLC: more than the 6 standstill
+ * marks the HLC sends in a row as its path leaves a standstill (lcm_tx.c). */
+#define LLC_DP1_PLAY_DELAY 8
+
 struct llc_ai;
+struct llc_dp1_ai;
+struct ncp_adcai_tap;
 
 struct llc_row {          /* one period of the trace, handed to the main thread */
     int64_t t_ns, slot_ns;
@@ -122,7 +128,9 @@ struct llc {
     ncp_la_burst_t la_burst;
     ncp_int_burst_t int_burst;
     struct llc_dp1 *dp1;          /* DP1: its own NCK (dp1.c) */
+    struct llc_dp1_ai *dp1ai;     /* ADCAI's DP1: its NCK's samples (dp1_ai.c) */
     char fault[200];              /* LLC_END_PROGRAM: why */
+    char fault_short[64];         /* the same in what its status carries ("": fault) */
     struct llc_clock clk;
     int64_t hlc_now;              /* this period's time on the HLC's clock */
     int fault_reports;            /* LLC_END_CLOCK before motion: statuses saying so */
@@ -134,6 +142,12 @@ void llc_ai_free(struct llc_ai *a);
 /* A DP2 (rough_ipo_t) or DP3 (accdec_ai_t) message: into the setpoint buffer. */
 void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len);
 void llc_ai_report(const struct llc *l);
+/* The stages one by one (DP1): begin at mm (returned in nm) at point dp, one
+ * rough record's sum in, one servo period's setpoint out (nm). */
+int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm);
+void llc_ai_load(struct llc_ai *a, int axis, int32_t sum);
+int64_t llc_ai_step(struct llc_ai *a, int axis);
+int llc_ai_ratio(const struct llc_ai *a);
 
 /* dp_block.c: ADCBI DP3 and DP2 at the LLC */
 int llc_blocks_init(struct llc *l);
@@ -147,12 +161,26 @@ void llc_plan_advance(struct llc *l);
 struct ncp_dist_recs *llc_exec_ring(struct llc *l);
 int llc_exec_head(struct llc *l, double v0, struct ncp_accdec *a);
 
-/* dp1.c: ADCBI DP1 at the LLC */
+/* dp1.c: DP1 at the LLC (its own NCK on the HLC's program) */
 struct llc_dp1;
 int llc_dp1_init(struct llc *l);
 void llc_dp1_free(struct llc *l);
 void llc_on_program(struct llc *l, const uint8_t *p, size_t len);
 void llc_dp1_cycle(struct llc *l);
+/* What its status reports as buffered: the HLC starts when every LLC has some. */
+int llc_dp1_level(const struct llc *l);
+
+/* dp1_ai.c: ADCAI's DP1, its NCK's samples through this axis's stages */
+struct llc_dp1_ai *llc_dp1_ai_new(const struct llc *l, const _Atomic int *quit);
+void llc_dp1_ai_free(struct llc_dp1_ai *x);
+void llc_dp1_ai_drain(struct llc_dp1_ai *x);
+void llc_dp1_ai_tap(void *ctx, const struct ncp_adcai_tap *t);
+void llc_dp1_ai_cycle(struct llc *l);
+int llc_dp1_ai_level(const struct llc *l, int inner_done);
+/* The command of slot (mm); sets l->end when its NCK fell behind in motion. */
+double llc_dp1_ai_play(struct llc *l, int64_t slot);
+double llc_dp1_ai_ahead(struct llc *l, int64_t slot);
+void llc_dp1_ai_report(const struct llc *l);
 
 /* clock.c: the common time base */
 int llc_clock_start(struct llc *l, const char *url, struct ncp_diag *d);
@@ -171,6 +199,8 @@ void llc_clock_report(const struct llc *l);
 
 /* llc.c */
 int llc_cycle(void *ctx, int64_t now_ns);
+/* The HLC's period its path left its k-th standstill, 0 not known (yet). */
+int64_t llc_start_at(const struct llc *l, int32_t k);
 void llc_take(struct llc *l, int64_t now);
 void llc_publish_status(struct llc *l, int64_t slot);
 void llc_heartbeat(struct llc *l, int64_t now);

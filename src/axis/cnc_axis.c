@@ -4,7 +4,9 @@
  * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5), or
  * interpolating the records the HLC's planner starts (ADCBI DP4; DP3 after
  * profiling its look-ahead records; DP2 planning the HLC's blocks itself;
- * DP1 running its own NCK on the HLC's program),
+ * DP1 running its own NCK on the HLC's program; ADCAI's DP2 and DP3 through
+ * its axis's stages below the point, its DP1 from its own ADCAI NCK's rough
+ * records),
  * until the HLC says the program is done (exit 0) or something makes it stop
  * (exit 3, after a ramp to standstill). */
 #include "axis.h"
@@ -34,10 +36,12 @@ static void usage(FILE *f)
           "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
           "servo at the HLC's setpoints (every servo period, DP 5) or interpolating the\n"
           "records of its planner (ADCBI DP 4; DP 3 its look-ahead records, DP 2 its\n"
-          "blocks, planned here; DP 1 the program, run here), and reports its status\n"
-          "every period. Stops with a ramp within MAX_ACCELERATION when the HLC goes\n"
-          "silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS setpoints in a row\n"
-          "are missing, on a following error or when the HLC orders it.\n"
+          "blocks, planned here; DP 1 the program, run here with the NCK of the INI's\n"
+          "[PLANNER] NCK; with NCK = adcai, DP 2-3 through this axis's ADCAI stages),\n"
+          "and reports its status every period. Stops with a ramp within MAX_ACCELERATION\n"
+          "when the HLC goes silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS\n"
+          "setpoints in a row are missing, on a following error, when its own NCK fails\n"
+          "(DP 1) or when the HLC orders it.\n"
           "  --trace CSV   every period: t,slot,cmd,act,state,gap (seconds from the HLC's first\n"
           "                period; slot: the HLC's period played; state: ax_status_t's;\n"
           "                gap: 0 its own setpoint, 1 bridged to the next, 2 held)\n"
@@ -158,7 +162,7 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     ncp_dist_rx_init(&l->rx, l->period_ns, 0);
     if (ncp_dist_recs_init(&l->recs) != 0 || llc_blocks_init(l) != 0 || llc_dp1_init(l) != 0)
         return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
-    /* ADCAI's stages, for DP2 and DP3 (the same windows as the HLC's: the
+    /* ADCAI's stages, for DP1-DP3 (the same windows as the HLC's: the
      * same INI); without them those points are not advertised */
     if (cfg->nck == NCP_NCK_ADCAI)
         l->ai = llc_ai_new(cfg);
@@ -218,12 +222,13 @@ static int report(const struct llc *l)
             ax, (unsigned long long)l->loop.stats.cycles, (unsigned)l->loop.stats.misses,
             l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.bridged, l->rx.reordered, l->clamped,
             (unsigned long long)st.inject_lost, (unsigned long long)st.inject_delayed);
-    if (l->dp4)
+    if (l->dp4 && !l->dp1ai)
         fprintf(stderr, "cnc-axis %c: DP %d: records taken %d, gaps %u, resend requests %u, "
                         "stale %u, duplicate %u, too early %u\n",
                 ax, l->dp ? l->dp : 4, (int)l->recs.next, l->recs.gaps, l->resends, l->recs.stale,
                 l->recs.duplicate, l->recs.early);
     llc_ai_report(l);
+    llc_dp1_ai_report(l);
     llc_clock_report(l);
     switch (l->end) {
     case LLC_END_CLOCK:
@@ -308,8 +313,8 @@ int main(int argc, char **argv)
     if (run_loop(l, trace) != 0)
         l->end = LLC_END_SIGNAL;
     llc_clock_stop(l);
-    llc_dp1_free(l);
     int rc = report(l);
+    llc_dp1_free(l);
     if (trace && fclose(trace) != 0)
         fprintf(stderr, "cnc-axis: error writing %s\n", o.trace);
     ncp_msg_close(l->msg);

@@ -1,21 +1,25 @@
-/* ADCBI DP1 at the LLC: the HLC names the program (one host: its path, size
+/* DP1 at the LLC: the HLC names the program (one host: its path, size
  * and hash); this LLC runs the NCK on it itself, in a thread of its own,
- * on the virtual clock and the simulated machine, only for the records its
- * planner starts (the tap). Those go, through a ring, into `own`, which the
+ * on the virtual clock and the simulated machine, only for what its
+ * planner emits (the tap). ADCBI: the records its planner starts. Those go, through a ring, into `own`, which the
  * interpolator runs on the HLC's period grid as at DP2, leaving each
  * standstill when the HLC's path did. The virtual clock steps the planner
  * only with its window full (or the program's end in it), so every LLC's
  * plan is the same, and that of a central run, however the threads are
  * scheduled. A full ring holds the planner thread back: the inner NCK
- * runs ahead of the position loop by at most the ring and `own`. */
+ * runs ahead of the position loop by at most the ring and `own`.
+ * ADCAI (the INI's NCK): its chain's samples with their rough records,
+ * which this axis's own stages take (dp1_ai.c). */
 #include "axis.h"
 
 #include <sched.h>
+#include <signal.h>
 #include <string.h>
 #include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "ncpar/inject.h"
 #include "ncpar/nck.h"
 #include "ncpar/pipeline.h"
 
@@ -31,7 +35,9 @@ struct llc_dp1 {
     pthread_t th;
     int started;
     _Atomic int done, quit;          /* done: 1 ok, -1 its run failed (why says) */
+    volatile sig_atomic_t stop;      /* its NCK brakes and ends: this LLC is leaving */
     char why[200];
+    char why_short[64];              /* as much as the status carries to the HLC */
     char label[32];
 };
 
@@ -53,21 +59,53 @@ static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d
     return ncp_serial_run(&p->src, &p->acfg, out, &st, d);
 }
 
+/* Why its run failed, for the HLC to report: where in the program and what. */
+static void why_failed(struct llc_dp1 *p, const struct ncp_nck_result *res)
+{
+    char what[160];
+    unsigned line = 0;
+    if (!res) {
+        snprintf(what, sizeof what, "out of memory");
+    } else if (res->fault) {
+        line = res->fault_line;
+        snprintf(what, sizeof what, "its NCK's following error on %c: %.4f mm",
+                 NCP_AXIS_LETTERS[res->fault_axis], res->fault_err);
+    } else if (res->inject.trip) {
+        line = res->inject.trip_line;
+        ncp_inject_trip_text(&p->cfg.inject, &res->inject, p->cfg.servo_period, what,
+                             sizeof what);
+    } else {
+        line = res->diag.line;
+        snprintf(what, sizeof what, "%s", res->diag.msg[0] ? res->diag.msg : "its NCK stopped");
+    }
+    snprintf(p->why, sizeof p->why, "%s:%u: %s", p->path, line, what);
+    /* cut at a word, not inside a number the HLC would then show */
+    int n = snprintf(p->why_short, sizeof p->why_short, "its NCK, line %u: %s", line, what);
+    if (n >= (int)sizeof p->why_short) {
+        char *cut = p->why_short + sizeof p->why_short - 4;
+        while (cut > p->why_short && *cut != ' ')
+            cut--;
+        memcpy(cut, "...", 4);
+    }
+}
+
 static void *inner_main(void *arg)
 {
     struct llc_dp1 *p = arg;
     /* the leftovers of the CPU: its threads (which inherit this) must never
      * take a period from the position loops of this host */
     (void)setpriority(PRIO_PROCESS, (id_t)gettid(), 19);
+    struct llc_dp1_ai *ai = p->l->dp1ai;
     struct ncp_nck_opts no = {
         .cfg = &p->cfg, .interpret = interpret, .interp_ctx = p, .virtual_clock = 1,
         .feed_override = 1.0, .label = p->label, .plan_tap = tap, .plan_tap_ctx = p,
+        .adcai_tap = ai ? llc_dp1_ai_tap : NULL, .adcai_tap_ctx = ai,
+        .interrupt = &p->stop,
     };
     struct ncp_nck_result *res = calloc(1, sizeof *res);
     int ok = res && ncp_nck_run(&no, res) == NCP_NCK_OK;
     if (!ok)
-        snprintf(p->why, sizeof p->why, "%s:%u: %s", p->path, res ? res->diag.line : 0,
-                 res && res->diag.msg[0] ? res->diag.msg : "its NCK stopped");
+        why_failed(p, res);
     free(res);
     atomic_store(&p->done, ok ? 1 : -1);
     return NULL;
@@ -92,11 +130,16 @@ void llc_dp1_free(struct llc *l)
         return;
     if (p->started) {
         atomic_store(&p->quit, 1);
-        /* its virtual run ends on its own; the tap no longer waits */
+        /* its run brakes and ends as a stop signal would end it, rather
+         * than going on to the program's end unwatched (seconds, for a
+         * program of a million blocks); the tap no longer waits */
+        p->stop = 1;
         struct ncp_accdec a;
         while (!atomic_load(&p->done)) {
             while (ncp_spsc_pop(&p->ring, &a) == 0)
                 ;
+            if (l->dp1ai)
+                llc_dp1_ai_drain(l->dp1ai);
             struct timespec ts = { 0, 1000000 };
             nanosleep(&ts, NULL);
         }
@@ -106,6 +149,8 @@ void llc_dp1_free(struct llc *l)
     ncp_spsc_destroy(&p->ring);
     free(p);
     l->dp1 = NULL;
+    llc_dp1_ai_free(l->dp1ai);
+    l->dp1ai = NULL;
 }
 
 /* Position loop: the program message. The first one starts the NCK. */
@@ -128,8 +173,13 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     if (size != m.size || h != (uint64_t)m.hash) {
-        snprintf(p->why, sizeof p->why, "%s: %s", p->path,
-                 size < 0 ? "cannot read it" : "not the HLC's program (size or hash differ)");
+        snprintf(p->why_short, sizeof p->why_short, "%s",
+                 size < 0 ? "cannot read the program"
+                          : "not the HLC's program (size or hash differ)");
+        snprintf(p->why, sizeof p->why, "%s: %s", p->path, p->why_short);
+    } else if (l->cfg->nck == NCP_NCK_ADCAI &&
+               (!l->ai || !(l->dp1ai = llc_dp1_ai_new(l, &p->quit)))) {
+        snprintf(p->why, sizeof p->why, "cannot set up ADCAI's stages for its axis");
     } else if (ncp_source_open(&p->src, p->path, &d) != NCP_OK) {
         snprintf(p->why, sizeof p->why, "%s: %s", p->path, d.msg);
     } else {
@@ -159,6 +209,7 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
     if (!p->started) {
         l->end = LLC_END_PROGRAM;
         snprintf(l->fault, sizeof l->fault, "%s", p->why);
+        snprintf(l->fault_short, sizeof l->fault_short, "%s", p->why_short);
     }
 }
 
@@ -169,6 +220,8 @@ void llc_dp1_cycle(struct llc *l)
     struct llc_dp1 *p = l->dp1;
     struct ncp_accdec a;
     union ncp_dist_rec u;
+    if (l->dp1ai)
+        llc_dp1_ai_cycle(l);
     while (ncp_dist_recs_level(&l->own) < NCP_DIST_RECS - 1 && ncp_spsc_pop(&p->ring, &a) == 0) {
         u.a = a;
         ncp_dist_recs_put(&l->own, l->own_n++, &u);
@@ -176,5 +229,13 @@ void llc_dp1_cycle(struct llc *l)
     if (atomic_load(&p->done) < 0 && l->end == LLC_END_NONE) {
         l->end = LLC_END_PROGRAM;
         snprintf(l->fault, sizeof l->fault, "%s", p->why);
+        snprintf(l->fault_short, sizeof l->fault_short, "%s", p->why_short);
     }
+}
+
+int llc_dp1_level(const struct llc *l)
+{
+    if (l->dp1ai)
+        return llc_dp1_ai_level(l, atomic_load(&l->dp1->done) > 0);
+    return ncp_dist_recs_level(&l->own);
 }

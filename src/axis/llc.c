@@ -20,6 +20,8 @@
  * run's. A record lost on the way is asked for again (NCP_AX_<L>_RESEND)
  * as soon as a later one, or the HLC's count, shows the gap; one still
  * missing when the interpolator needs it stops the axis (ramp) and says so.
+ * At DP1 the records are its own NCK's (dp1.c); with ADCAI its samples go
+ * through this axis's stages instead (dp1_ai.c), on the same marks.
  *
  * Safety: a setpoint never moves the axis faster than its MAX_VELOCITY (a
  * step after a gap is limited and counted), and every stop is a ramp at
@@ -141,12 +143,16 @@ void llc_publish_status(struct llc *l, int64_t slot)
     s.act_nm = nm(l->act);
     s.ferr_nm = nm(l->ferr);
     s.state = (int8_t)l->state;
-    if (l->end == LLC_END_PROGRAM || l->end == LLC_END_CLOCK)
+    if (l->end == LLC_END_PROGRAM)
+        snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault_short[0] ? l->fault_short
+                                                                          : l->fault);
+    else if (l->end == LLC_END_CLOCK)
         snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault);
     llc_clock_status(l, &s);
     /* DP1: its own NCK's records, the HLC waits for the first */
     if (l->dp4 || l->dp == 1) {
-        s.buffer_level = (int16_t)ncp_dist_recs_level(llc_exec_ring(l));
+        s.buffer_level = (int16_t)(l->dp == 1 ? llc_dp1_level(l)
+                                              : ncp_dist_recs_level(llc_exec_ring(l)));
         s.lost = (int32_t)l->recs.gaps;
         s.stale = (int32_t)l->recs.stale;
         s.duplicate = (int32_t)l->recs.duplicate;
@@ -237,8 +243,7 @@ static int rec_next(void *ctx, double v0, struct ncp_accdec *rec)
     return 0;
 }
 
-/* The HLC's period its path left its k-th standstill, 0 not known (yet). */
-static int64_t start_at(const struct llc *l, int32_t k)
+int64_t llc_start_at(const struct llc *l, int32_t k)
 {
     unsigned i = (unsigned)k % LLC_STARTS;
     return l->start_k[i] == k ? l->start_t[i] : 0;
@@ -267,7 +272,7 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
         memcpy(l->ex_prev, first.s.start, sizeof l->ex_prev);
         l->ex_on = l->ex_rest = 1;
     }
-    int64_t due = start_at(l, l->starts_done);
+    int64_t due = llc_start_at(l, l->starts_done);
     struct ncp_exec before = l->ex;
     struct ncp_dist_recs *q = llc_exec_ring(l);
     int32_t next = q->next;
@@ -353,6 +358,17 @@ static double ramp(struct llc *l)
     return l->cmd + v * T;
 }
 
+/* ADCAI's DP1: its NCK's samples through this axis's stages; a sample
+ * missing in motion stops the axis (ramp). */
+static double play_ai(struct llc *l, int64_t slot)
+{
+    double c = llc_dp1_ai_play(l, slot);
+    if (l->end == LLC_END_NONE)
+        return c;
+    l->state = NCP_AX_STATUS_T_STOPPING;
+    return ramp(l);
+}
+
 static void check_ends(struct llc *l, int64_t now)
 {
     if (l->end != LLC_END_NONE)
@@ -390,8 +406,8 @@ static void period(struct llc *l, int64_t now, int64_t slot)
     uint32_t gaps = l->rx.held + l->rx.bridged, bridged = l->rx.bridged;
     if (l->end == LLC_END_NONE && !l->done_req) {
         l->state = NCP_AX_STATUS_T_RUNNING;
-        next_cmd = l->dp4 ? interpolate(l, slot) : follow(l, slot);
-        if (l->dp4)
+        next_cmd = l->dp1ai ? play_ai(l, slot) : l->dp4 ? interpolate(l, slot) : follow(l, slot);
+        if (l->dp4 || l->dp1ai)
             l->rx.played_t = slot;   /* where a late loop catches up from */
     } else {
         l->state = l->end == LLC_END_NONE || l->end == LLC_END_DONE ? NCP_AX_STATUS_T_DONE
@@ -408,7 +424,9 @@ static void period(struct llc *l, int64_t now, int64_t slot)
      * the current velocity goes on */
     int32_t ahead;
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
-    if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
+    if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp1ai)
+        x[l->axis] = llc_dp1_ai_ahead(l, slot + T);
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
         x[l->axis] = interpolate_ahead(l, slot + T);
     else if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
         x[l->axis] = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
@@ -518,15 +536,24 @@ int llc_cycle(void *ctx, int64_t now_ns)
         clock_fault(l);
     /* the HLC's period NCP_DIST_PLAY_DELAY + 0..1 back: from the loop's
      * scheduled time on the HLC's clock, not the clock read now, so a late
-     * wake-up never changes it */
+     * wake-up never changes it. At DP1 only the standstill marks travel,
+     * and a start whose marks all came too late would shift this axis's
+     * whole motion run: there the LLC plays further back, so that every one
+     * of the marks the HLC sends in a row at a start is still in time */
+    int64_t delay = l->dp == 1 ? LLC_DP1_PLAY_DELAY : NCP_DIST_PLAY_DELAY;
     l->hlc_now = llc_hlc_time(l, now);
-    int64_t slot = l->hlc_now - l->t_first - NCP_DIST_PLAY_DELAY * T - T / 2;
+    int64_t slot = l->hlc_now - l->t_first - delay * T - T / 2;
     slot = l->t_first + (slot < 0 ? -((-slot + T - 1) / T) : slot / T) * T;
     /* periods the loop slept through (a deadline miss) still passed for the
-     * simulated plant: it runs them now, a few at most */
+     * simulated plant: it runs them now, a few at most. Where this LLC
+     * computes its command itself (block-level points, ADCAI's DP1) a
+     * period left out would put its axis a period behind the others until
+     * the next standstill: there it catches up further (a host that stalls
+     * a loop for 10 ms skipped one of them at 8) */
     int64_t from = l->rx.played_t ? l->rx.played_t + T : slot;
-    if (slot - from > 8 * T)
-        from = slot - 8 * T;
+    int64_t most = l->dp4 || l->dp1ai ? 64 : 8;
+    if (slot - from > most * T)
+        from = slot - most * T;
     for (int64_t s = from; s <= slot; s += T)
         period(l, now, s);
     llc_publish_status(l, slot);

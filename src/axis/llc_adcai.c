@@ -21,7 +21,7 @@
 #include <string.h>
 
 struct llc_ai {
-    int dp;                         /* 2 or 3 once a record came, else 0 */
+    int dp;                         /* 1, 2 or 3 once begun, else 0 */
     int ratio;
     struct ncp_adcai_accdec *acc;   /* DP2 */
     struct ncp_adcai_fine *fine;
@@ -68,18 +68,49 @@ static void put(struct llc *l, int64_t t)
     l->ai->last_t = t;
 }
 
+int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm)
+{
+    a->started = 1;
+    a->dp = dp;
+    int32_t nm = 0;
+    (void)ncp_dist_mm_to_nm(mm, &nm);
+    a->out_nm = nm;
+    return nm;
+}
+
+void llc_ai_load(struct llc_ai *a, int axis, int32_t sum)
+{
+    int32_t in[NCP_AXES] = { 0 }, out[NCP_AXES];
+    in[axis] = (int32_t)((uint32_t)sum - (uint32_t)a->in_sum);
+    a->in_sum = sum;
+    /* below DP3 the filters are this LLC's too */
+    if (a->dp != 3) {
+        ncp_adcai_accdec_step(a->acc, in, out);
+        in[axis] = out[axis];
+    }
+    ncp_adcai_fine_load(a->fine, in);
+    a->records++;
+}
+
+int64_t llc_ai_step(struct llc_ai *a, int axis)
+{
+    int32_t out[NCP_AXES];
+    ncp_adcai_fine_step(a->fine, out);
+    a->out_nm += out[axis];
+    return a->out_nm;
+}
+
+int llc_ai_ratio(const struct llc_ai *a)
+{
+    return a->ratio;
+}
+
 /* One record through the stages: ratio setpoints from period t on. */
 static void stages(struct llc *l, int64_t t, int32_t sum)
 {
     struct llc_ai *a = l->ai;
     int64_t T = l->period_ns;
-    int32_t in[NCP_AXES] = { 0 }, out[NCP_AXES];
-    in[l->axis] = (int32_t)((uint32_t)sum - (uint32_t)a->in_sum);
-    a->in_sum = sum;
-    if (a->dp == 2) {
-        ncp_adcai_accdec_step(a->acc, in, out);
-        in[l->axis] = out[l->axis];
-    }
+    llc_ai_load(a, l->axis, sum);
     /* the periods the HLC's stream stood still before this record: at rest
      * where it is (the buffer would bridge towards the record, a creep) */
     if (a->last_t) {
@@ -89,13 +120,10 @@ static void stages(struct llc *l, int64_t t, int32_t sum)
         for (int64_t s = from; s < t; s += T)
             put(l, s);
     }
-    ncp_adcai_fine_load(a->fine, in);
     for (int k = 0; k < a->ratio; k++) {
-        ncp_adcai_fine_step(a->fine, out);
-        a->out_nm += out[l->axis];
+        (void)llc_ai_step(a, l->axis);
         put(l, t + k * T);
     }
-    a->records++;
 }
 
 void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len)
@@ -105,14 +133,9 @@ void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len)
     if (!a || ncp_dist_decode_ai(p, len, dp, &r) != 0 || r.sender != NCP_DIST_HLC_ID ||
         r.n <= l->slot || r.t_ns <= 0 || (a->dp && a->dp != dp))
         return;
-    if (!a->started) {
-        /* the HLC's sums start at 0 where it found the axis: here */
-        a->started = 1;
-        a->dp = dp;
-        int32_t nm = 0;
-        (void)ncp_dist_mm_to_nm(l->cmd, &nm);
-        a->out_nm = nm;
-    }
+    /* the HLC's sums start at 0 where it found the axis: here */
+    if (!a->started)
+        llc_ai_begin(a, dp, l->cmd);
     int32_t gap = r.seq - a->next_seq;
     if (gap < 0) {
         a->stale++;   /* a duplicate, or one already bridged */
@@ -134,7 +157,7 @@ void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len)
 void llc_ai_report(const struct llc *l)
 {
     const struct llc_ai *a = l->ai;
-    if (a && a->dp)
+    if (a && a->dp >= 2)
         fprintf(stderr, "cnc-axis %c: DP %d: records %u, lost and bridged %u, stale %u\n",
                 NCP_AXIS_LETTERS[l->axis], a->dp, a->records, a->lost, a->stale);
 }

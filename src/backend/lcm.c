@@ -8,7 +8,8 @@
  * lcm_dp2.c; each LLC plans them itself) and DP1 (the program: each LLC runs
  * its own NCK on it, lcm_dp1.c); and ADCAI's DP4 (its fineIPObuf: the same
  * stream as ADCBI's DP5), DP3 and DP2 (a record every rough period,
- * lcm_ai.c; the LLCs run the stages below).
+ * lcm_ai.c; the LLCs run the stages below) and DP1 (as ADCBI's: each LLC
+ * runs an ADCAI NCK on the program and its axis's stages on its records).
  *
  * start() (blocking): waits for every axis's advertisement and first status,
  * checks its limits and period against the INI, and from then on a thread
@@ -148,7 +149,16 @@ static void take(struct lcm_be *s, int64_t now)
                     a.axis != (uint8_t)NCP_AXIS_LETTERS[p->axis])
                     continue;
                 const struct ncp_axis_cfg *c = &s->cfg->axis[p->axis];
-                if (!p->advertised && !s->faulted &&
+                int ai_llc = (a.stage_mask & NCP_AX_ADVERT_T_STAGE_ACCDEC) != 0;
+                if (!p->advertised && !s->faulted && s->dp1 &&
+                    ai_llc != (s->cfg->nck == NCP_NCK_ADCAI)) {
+                    snprintf(s->fault, sizeof s->fault,
+                             "axis %c's LLC runs NCK = %s and this HLC %s: at DP 1 each LLC "
+                             "runs the NCK its INI's [PLANNER] NCK names on the program, so "
+                             "both INIs must name the same", a.axis, ai_llc ? "adcai" : "adcbi",
+                             ai_llc ? "adcbi" : "adcai");
+                    s->faulted = 1;
+                } else if (!p->advertised && !s->faulted &&
                     (a.period_ns != s->T || a.max_vel < c->max_vel || a.max_acc < c->max_acc ||
                      a.min_limit > c->min_limit || a.max_limit < c->max_limit ||
                      !(a.dp_mask & (1 << s->cfg->lcm.dp)))) {
@@ -470,9 +480,10 @@ static void lcm_stop(struct ncp_backend *b)
     if (s->ai)
         lcm_ai_report(s->ai);
     else if (s->dp1)
-        fprintf(stderr, "lcm: DP 1: the program (%lld bytes, by path) in messages of %d bytes "
-                        "(%d with the LCM header), %d sent\n",
-                (long long)s->dp1->msg.size, s->dp1->bytes,
+        fprintf(stderr, "lcm: DP 1 (%s): the program (%lld bytes, by path) in messages of %d "
+                        "bytes (%d with the LCM header), %d sent\n",
+                s->cfg->nck == NCP_NCK_ADCAI ? "ADCAI" : "ADCBI", (long long)s->dp1->msg.size,
+                s->dp1->bytes,
                 s->dp1->bytes + 8 + (int)sizeof NCP_DIST_CH_PROGRAM, (int)s->dp1->seq);
     else if (s->tx)
         fprintf(stderr, "lcm: DP %d: %d records in %llu bursts of %d bytes (%d with the LCM "
@@ -563,13 +574,16 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     int adcai = cfg->nck == NCP_NCK_ADCAI;
     /* ADCAI's fineIPObuf is its DP 4: the same setpoint stream as ADCBI's DP 5 */
     int fine = adcai ? cfg->lcm.dp == 4 : cfg->lcm.dp == 5;
-    int blocks = !adcai && cfg->lcm.dp >= 1 && cfg->lcm.dp <= 4;
+    /* DP 1 of either variant sends no records, only its standstill marks
+     * through the block-level sender */
+    int blocks = cfg->lcm.dp == 1 || (!adcai && cfg->lcm.dp >= 2 && cfg->lcm.dp <= 4);
     if (adcai ? !ncp_dist_adcai_dp(cfg->lcm.dp) : !fine && !blocks)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "DP %d is not implemented yet for NCK = %s: the lcm backend streams "
-                            "at ADCBI's DP 1-5 and ADCAI's DP 2-4", cfg->lcm.dp,
+                            "at ADCBI's DP 1-5 and ADCAI's DP 1-4", cfg->lcm.dp,
                             adcai ? "adcai" : "adcbi");
-    if (blocks && ncp_machine_cfg_ipo_ratio(cfg) != 1)
+    /* ADCAI's LLCs fine-interpolate at every point but its DP 4 */
+    if (blocks && !adcai && ncp_machine_cfg_ipo_ratio(cfg) != 1)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
                             "DP %d needs [TRAJ] PLANNING_PERIOD equal to SERVO_PERIOD: the LLCs "
                             "do not fine-interpolate yet", cfg->lcm.dp);
@@ -577,7 +591,7 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     if (!s)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
     s->cfg = cfg;
-    if (!fine && adcai) {
+    if (!fine && adcai && !blocks) {
         s->ai = malloc(sizeof *s->ai);
         if (!s->ai || lcm_ai_init(s->ai, cfg->lcm.dp, cfg) != 0) {
             free(s->ai);

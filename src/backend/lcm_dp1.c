@@ -1,7 +1,8 @@
-/* ADCBI DP1 at the HLC: no blocks and no records go out, only the program
- * to run (by path, on one host, with its size and hash: program_t) and, through lcm_tx with nothing to send, the periods the path
- * leaves each standstill. Each LLC runs the NCK on the program itself and
- * follows those marks (src/axis/dp1.c). The HLC runs its own NCK as well:
+/* DP1 at the HLC, either variant: no blocks and no records go out, only the
+ * program to run (by path, on one host, with its size and hash: program_t)
+ * and, through lcm_tx with nothing to send, the periods the path leaves
+ * each standstill. Each LLC runs the NCK of its INI's variant on the
+ * program itself and follows those marks (src/axis/dp1.c, dp1_ai.c). The HLC runs its own NCK as well:
  * it decides when motion starts (spindle at speed, a pause) and keeps the
  * trace and summary of a central run. */
 #include "lcm_tx.h"

@@ -339,14 +339,14 @@ static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
                                "needs --clock real\n"), -1;
     if (cfg->nck == NCP_NCK_ADCAI && cfg->lcm.dp == 5)
         return fprintf(stderr, "cnc-run run: --backend lcm: [PLANNER] NCK = adcai has no DP 5: "
-                               "its fine setpoints (fineIPObuf) are DP 4; choose --dp 2, 3 or "
-                               "4 (the INI's [LCM] DP defaults to 5)\n"), -1;
-    if (cfg->lcm.dp == 1 && cfg->nck == NCP_NCK_ADCBI)
+                               "its fine setpoints (fineIPObuf) are DP 4; choose --dp 1, 2, 3 "
+                               "or 4 (the INI's [LCM] DP defaults to 5)\n"), -1;
+    if (cfg->lcm.dp == 1)
         return apply_dp1(o, cfg);
     if (cfg->nck == NCP_NCK_ADCAI ? !ncp_dist_adcai_dp(cfg->lcm.dp)
                                   : cfg->lcm.dp < 1 || cfg->lcm.dp > 5)
         return fprintf(stderr, "cnc-run run: --backend lcm: DP %d is not implemented yet for "
-                               "[PLANNER] NCK = %s (ADCBI: DP 1-5; ADCAI: DP 2-4)\n",
+                               "[PLANNER] NCK = %s (ADCBI: DP 1-5; ADCAI: DP 1-4)\n",
                        cfg->lcm.dp, cfg->nck == NCP_NCK_ADCAI ? "adcai" : "adcbi"), -1;
     return 0;
 }

@@ -352,7 +352,8 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     struct ncp_nck_setup setup = { .cfg = o->cfg, .virtual_clock = o->virtual_clock,
                                    .trace = o->trace, .trace_rings = o->trace_rings,
                                    .loop_priority_min = o->loop_priority_min,
-                                   .plan_tap = o->plan_tap, .plan_tap_ctx = o->plan_tap_ctx };
+                                   .plan_tap = o->plan_tap, .plan_tap_ctx = o->plan_tap_ctx,
+                                   .adcai_tap = o->adcai_tap, .adcai_tap_ctx = o->adcai_tap_ctx };
     /* the soft limits are checked from where the machine is, before it moves:
      * the backend reports that as it starts */
     if (nck_start(n, &setup, 1, &res->diag)) {

@@ -15,6 +15,8 @@ int nck_plan_new(struct nck *n)
         ncp_planner_set_tap(n->planner, n->setup.plan_tap, n->setup.plan_tap_ctx);
     if (n->adcai && n->be.adcai_tap)
         ncp_adcai_set_tap(n->adcai, n->be.adcai_tap, n->be.impl);
+    else if (n->adcai && n->setup.adcai_tap)
+        ncp_adcai_set_tap(n->adcai, n->setup.adcai_tap, n->setup.adcai_tap_ctx);
     if (n->planner && n->be.plan_journal)
         n->be.plan_journal(n->be.impl, NCP_PLAN_RESET, NULL, n->start);
     return n->adcai || n->planner ? 0 : -1;

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "ncpar/adcai.h"
+#include "seg_line.h"
 
 /* Quantising positions to 1 nm lets a k-th difference be off by 2^(k-1) nm. */
 #define NM 1e-6
@@ -26,22 +27,6 @@ static void machine(struct ncp_machine_cfg *c, enum ncp_profile prof, int ratio)
     c->axis[2].max_acc = 1000;
     c->axis[2].max_jerk = 50000;
     c->planning_period = ratio * c->servo_period;
-}
-
-static struct ncp_seg line_seg(const double a[3], const double b[3], double feed, int term)
-{
-    struct ncp_seg s;
-    memset(&s, 0, sizeof s);
-    s.kind = NCP_SEG_LINE;
-    s.term = (uint8_t)term;
-    s.line = 1;
-    for (int j = 0; j < 3; j++) {
-        s.start[j] = a[j];
-        s.end[j] = b[j];
-    }
-    ncp_seg_set_length(&s);
-    s.feed = feed;
-    return s;
 }
 
 /* A circle's arc in XY about (cx, cy) of radius r from angle a0 through da. */

@@ -1,7 +1,8 @@
 /* The distributed ADCAI's record path without the network: what the chain
- * taps (the sums a DP2 or DP3 HLC sends) fed through one axis's own stages,
- * as a cnc-axis does, gives every setpoint of the central chain exactly; and
- * the DP2 / DP3 messages' codec against lcm-gen's. */
+ * taps (the sums a DP2 or DP3 HLC sends, or a DP1 LLC's own NCK hands over)
+ * fed through one axis's own stages, as a cnc-axis does, gives every
+ * setpoint of the central chain exactly, and each tap says whether any axis
+ * moves in it; and the DP2 / DP3 messages' codec against lcm-gen's. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +15,7 @@
 
 #include "ncpar/adcai.h"
 #include "ncpar/dist.h"
+#include "seg_line.h"
 
 #define MAXTAP 200000
 
@@ -27,20 +29,6 @@ static void on_tap(void *ctx, const struct ncp_adcai_tap *t)
     struct taps *c = ctx;
     if (c->n < MAXTAP)
         c->t[c->n++] = *t;
-}
-
-static struct ncp_seg line_seg(const double a[3], const double b[3], double feed, int term)
-{
-    struct ncp_seg s;
-    memset(&s, 0, sizeof s);
-    s.kind = NCP_SEG_LINE;
-    s.term = (uint8_t)term;
-    s.line = 1;
-    memcpy(s.start, a, 3 * sizeof(double));
-    memcpy(s.end, b, 3 * sizeof(double));
-    ncp_seg_set_length(&s);
-    s.feed = feed;
-    return s;
 }
 
 /* Lines at several feeds, continuous and with exact stops, on a machine of
@@ -72,6 +60,22 @@ static void replay_case(enum ncp_profile prof, int ratio, int dp)
     while (ncp_adcai_step(a, &sp) && ++guard < MAXTAP)
         ;
     assert_true(taps.n > 1000);
+    /* a standstill is a sample no axis moves in: DP1's LLCs split the
+     * samples into motion runs there, as the HLC splits its path */
+    int64_t prev[NCP_AXES] = { 0 };
+    for (int j = 0; j < 3; j++)
+        prev[j] = ncp_adcai_quantise(o[j]);
+    size_t rests = 0;
+    for (size_t i = 0; i < taps.n; i++) {
+        int moved = 0;
+        for (int j = 0; j < NCP_AXES; j++)
+            moved |= taps.t[i].pos[j] != prev[j];
+        if (moved != taps.t[i].moved)
+            fail_msg("setpoint %zu: moved %d, its positions say %d", i, taps.t[i].moved, moved);
+        rests += !moved;
+        memcpy(prev, taps.t[i].pos, sizeof prev);
+    }
+    assert_true(rests > 0);
     int n[2];
     assert_int_equal(ncp_adcai_windows(&c, c.servo_period * ratio, n), 0);
     for (int j = 0; j < 3; j++) {
