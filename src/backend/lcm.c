@@ -211,6 +211,7 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
         for (int i = 0; i < s->n; i++) {
             const struct peer *p = &s->p[i];
             if (p->st.state == NCP_AX_STATUS_T_FAULT) {
+                s->fault_axis = NCP_AXIS_LETTERS[p->axis];
                 snprintf(s->fault, sizeof s->fault, "axis %c's LLC: DP 1: %.*s",
                          NCP_AXIS_LETTERS[p->axis], (int)sizeof p->st.fault,
                          (const char *)p->st.fault);
@@ -247,10 +248,11 @@ static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
         for (int i = 0; i < s->n; i++) {
             const struct peer *p = &s->p[i];
             if (p->have_status && p->st.state == NCP_AX_STATUS_T_FAULT && p->st.fault[0]) {
-                /* one that cannot start says why (its clock, ...) */
-                snprintf(s->fault, sizeof s->fault, "axis %c's LLC: %.*s",
-                         NCP_AXIS_LETTERS[p->axis], (int)sizeof p->st.fault,
-                         (const char *)p->st.fault);
+                /* one that cannot start says why (its clock, ...); the
+                 * others hear which axis stopped them */
+                s->fault_axis = NCP_AXIS_LETTERS[p->axis];
+                snprintf(s->fault, sizeof s->fault, "axis %c's LLC: %.*s", s->fault_axis,
+                         (int)sizeof p->st.fault, (const char *)p->st.fault);
                 s->faulted = 1;
                 return -1;
             }
