@@ -16,6 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "ncpar/diag.h"
 #include "ncpar/motion.h"
 #include "ncp_accdec_burst_t.h"
 #include "ncp_ax_advert_t.h"
@@ -29,6 +30,7 @@
 #include "ncp_rec_mark_t.h"
 #include "ncp_rough_ipo_t.h"
 #include "ncp_accdec_ai_t.h"
+#include "ncp_clock_probe_t.h"
 
 #define NCP_DIST_HLC_ID 100   /* sender id of the HLC; an LLC's is its axis index + 1 */
 
@@ -41,10 +43,16 @@
 #define NCP_DIST_CH_INT "NCP_HLC_INT"       /* ADCBI DP2 */
 #define NCP_DIST_CH_STEPS "NCP_HLC_STEPS"   /* ADCBI DP2 */
 #define NCP_DIST_CH_PROGRAM "NCP_HLC_PROGRAM" /* ADCBI DP1 */
+#define NCP_DIST_CH_CLOCK "NCP_HLC_CLOCK"   /* answers to the LLCs' clock probes */
 enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTBEAT,
-                      NCP_DIST_AX_RESEND };
+                      NCP_DIST_AX_RESEND, NCP_DIST_AX_CLOCK };
 /* "NCP_AX_<L>_ADVERT" etc. into buf (32 bytes are enough). */
 void ncp_dist_ax_channel(char *buf, size_t size, int axis, enum ncp_dist_ax_ch what);
+/* The clock probes travel on the LCM URL's group and the port after its
+ * (url NULL or "": as ncp_msg_open resolves it): the threads that stamp
+ * them then wake for them alone, not for every setpoint and status. 128
+ * bytes are enough; NCP_OK, or why not in d. */
+int ncp_dist_clock_url(const char *url, char *buf, size_t size, struct ncp_diag *d);
 
 /* The ADCAI points the lcm backend streams at. DP4 (fineIPObuf) is the same
  * message as ADCBI's DP5: every servo period's setpoints, so the LLCs need
@@ -189,5 +197,36 @@ void ncp_dist_ai_init(void);
 int ncp_dist_encode_ai(uint8_t *buf, size_t size, int dp, const struct ncp_dist_ai *r);
 /* 0, or -1 for anything that is not exactly one such message. */
 int ncp_dist_decode_ai(const uint8_t *buf, size_t len, int dp, struct ncp_dist_ai *r);
+
+/* ---- the common time base (clock.c) ------------------------------------
+ * Each LLC probes the HLC's clock (clock_probe_t: t1 and t4 on its clock, t2
+ * and t3 on the HLC's) and keeps the last NCP_DIST_CLOCK_WINDOW probes. Of
+ * those, the one with the shortest round trip waited least in queues and
+ * wake-ups, so its offset is the estimate (NTP's clock filter); the true
+ * offset is within half its round trip of it when the two ways' delays
+ * differ. */
+#define NCP_DIST_CLOCK_WINDOW 8
+
+struct ncp_dist_clock {
+    struct { int64_t offset_ns, rtt_ns; } probe[NCP_DIST_CLOCK_WINDOW];
+    int n, next;
+};
+
+struct ncp_dist_clock_est {
+    int64_t offset_ns;      /* the HLC's clock minus this one's */
+    int64_t rtt_ns;         /* the chosen probe's round trip */
+    int64_t jitter_ns;      /* RMS of the window's offsets about the estimate */
+    int probes;             /* in the window */
+};
+
+void ncp_dist_clock_init(struct ncp_dist_clock *c);
+/* One answered probe: 0, or -1 for times that cannot be (the HLC took
+ * longer than the whole round trip), which are not kept. */
+int ncp_dist_clock_add(struct ncp_dist_clock *c, int64_t t1, int64_t t2, int64_t t3, int64_t t4);
+/* 0 with the estimate, -1 with no probe yet. */
+int ncp_dist_clock_estimate(const struct ncp_dist_clock *c, struct ncp_dist_clock_est *e);
+/* The offset an LLC applies, moved toward target by at most max_step: a grid
+ * in motion is slewed, never stepped. */
+int64_t ncp_dist_clock_slew(int64_t applied, int64_t target, int64_t max_step);
 
 #endif

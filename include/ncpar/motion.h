@@ -37,6 +37,9 @@ enum ncp_profile { NCP_PROFILE_TRAPEZOID, NCP_PROFILE_SCURVE };
  * before interpolating (src/motion/planner.c); ADCAI interpolates at the
  * programmed feed and filters each axis afterwards (ncpar/adcai.h). */
 enum ncp_nck_variant { NCP_NCK_ADCBI, NCP_NCK_ADCAI };
+/* [LCM] CLOCK: the distributed mode's common time base (ax_status_t's
+ * CLOCK_* constants) */
+enum ncp_lcm_clock { NCP_LCM_CLOCK_MONOTONIC, NCP_LCM_CLOCK_PROBE, NCP_LCM_CLOCK_PTP };
 
 /* The largest feed override cnc-run takes (200 %). Corner blends are planned
  * for it, as LinuxCNC plans them for its MAX_FEED_OVERRIDE. */
@@ -171,6 +174,13 @@ struct ncp_machine_cfg {
         double inject_loss;       /* INJECT_LOSS: fraction of received messages dropped (0) */
         int inject_delay_us;      /* INJECT_DELAY_US: every received message held back (0) */
         int inject_seed;          /* INJECT_SEED (1) */
+        /* CLOCK: monotonic (one host: every clock is the HLC's), probe (each
+         * LLC estimates the HLC's clock from probe round trips) or ptp
+         * (CLOCK_REALTIME, kept common by ptp4l/phc2sys); monotonic */
+        enum ncp_lcm_clock clock;
+        int clock_tolerance_us;   /* CLOCK_TOLERANCE_US: under monotonic and ptp, an
+                                     LLC whose probes find the clocks further apart
+                                     stops (1000) */
     } lcm;
     struct ncp_io_cfg io;
     /* [INJECT] and [RT]'s miss keys: timing faults, setpoint policy, miss limits */

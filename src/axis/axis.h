@@ -3,6 +3,7 @@
 #ifndef NCP_AXIS_AXIS_H
 #define NCP_AXIS_AXIS_H
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 
@@ -20,7 +21,34 @@ enum llc_end {
     LLC_END_FERROR,     /* following error past FERROR */
     LLC_END_MISSING,    /* DP4: the next record was not here when needed */
     LLC_END_SIGNAL,     /* SIGINT / SIGTERM */
-    LLC_END_PROGRAM     /* DP1: its own NCK could not run the program (fault says why) */
+    LLC_END_PROGRAM,    /* DP1: its own NCK could not run the program (fault says why) */
+    LLC_END_CLOCK       /* CLOCK = monotonic or ptp, and the probes find the clocks apart */
+};
+
+/* The common time base (clock.c): written by the probe thread (the window
+ * and the estimate's atomics) or by the position loop (applied, slewing). */
+struct llc_clock {
+    struct ncp_msg *msg;          /* the probe thread's own socket */
+    char channel[32];             /* NCP_AX_<L>_CLOCK */
+    enum ncp_lcm_clock mode;
+    int64_t tolerance_ns;
+    int64_t base_ns;              /* ptp: CLOCK_REALTIME - CLOCK_MONOTONIC at start, else 0 */
+    /* cnc-axis --clock-skew-us, --clock-drift-ppm: tests only, another
+     * host's clock simulated on this one */
+    int64_t skew_ns, mono0;
+    double drift_ppm;
+    pthread_t thread;
+    atomic_int run;
+    int started;
+    int32_t seq;
+    struct ncp_dist_clock win;
+    _Atomic int64_t est_offset, est_rtt, est_jitter;
+    atomic_int probes;            /* in the estimate's window: 0 none yet */
+    atomic_int ready;             /* the estimate stands (see clock.c) */
+    atomic_ullong sent, answers;
+    int64_t applied;              /* the HLC's clock minus this one, as the grid runs */
+    int64_t slewed;               /* all the slewing, ns */
+    int slewing;
 };
 
 /* Periods an LLC at DP1 plays behind the HLC: more than the 6 standstill
@@ -103,6 +131,9 @@ struct llc {
     struct llc_dp1_ai *dp1ai;     /* ADCAI's DP1: its NCK's samples (dp1_ai.c) */
     char fault[200];              /* LLC_END_PROGRAM: why */
     char fault_short[64];         /* the same in what its status carries ("": fault) */
+    struct llc_clock clk;
+    int64_t hlc_now;              /* this period's time on the HLC's clock */
+    int fault_reports;            /* LLC_END_CLOCK before motion: statuses saying so */
 };
 
 /* llc_adcai.c: NULL when out of memory or the INI's limits give no filter */
@@ -150,6 +181,21 @@ int llc_dp1_ai_level(const struct llc *l, int inner_done);
 double llc_dp1_ai_play(struct llc *l, int64_t slot);
 double llc_dp1_ai_ahead(struct llc *l, int64_t slot);
 void llc_dp1_ai_report(const struct llc *l);
+
+/* clock.c: the common time base */
+int llc_clock_start(struct llc *l, const char *url, struct ncp_diag *d);
+void llc_clock_stop(struct llc *l);
+/* This LLC's clock (mono_ns: CLOCK_MONOTONIC), and the HLC's as it maps. */
+int64_t llc_clock_local(const struct llc_clock *c, int64_t mono_ns);
+int64_t llc_hlc_time(const struct llc *l, int64_t mono_ns);
+/* The estimate stands: a full window of probes, short round trips or many. */
+int llc_clock_known(const struct llc *l);
+/* Once a period, from the loop: follows the estimate (CLOCK = probe; stepped
+ * until grid_known, then slewed) or checks it: 0, or -1 when the clocks are
+ * further apart than CLOCK_TOLERANCE_US. */
+int llc_clock_cycle(struct llc *l, int grid_known);
+void llc_clock_status(const struct llc *l, ncp_ax_status_t *s);
+void llc_clock_report(const struct llc *l);
 
 /* llc.c */
 int llc_cycle(void *ctx, int64_t now_ns);

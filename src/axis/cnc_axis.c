@@ -31,6 +31,7 @@ static void on_signal(int sig)
 static void usage(FILE *f)
 {
     fputs("usage: cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]\n"
+          "                [--clock-skew-us N] [--clock-drift-ppm P]\n"
           "One axis of the distributed NCK: advertises axis L of the machine INI over LCM,\n"
           "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
           "servo at the HLC's setpoints (every servo period, DP 5) or interpolating the\n"
@@ -44,6 +45,10 @@ static void usage(FILE *f)
           "  --trace CSV   every period: t,slot,cmd,act,state,gap (seconds from the HLC's first\n"
           "                period; slot: the HLC's period played; state: ax_status_t's;\n"
           "                gap: 0 its own setpoint, 1 bridged to the next, 2 held)\n"
+          "Its periods run on the HLC's clock ([LCM] CLOCK: monotonic on one host; probe\n"
+          "estimates the offset from round trips; ptp: CLOCK_REALTIME kept by phc2sys).\n"
+          "  --clock-skew-us N, --clock-drift-ppm P   for tests: simulate another host's\n"
+          "                clock, N us ahead of this one's CLOCK_MONOTONIC and gaining P ppm\n"
           "exit status: 0 the program is done, 1 usage or configuration, 3 stopped\n",
           f);
 }
@@ -51,14 +56,29 @@ static void usage(FILE *f)
 struct opts {
     const char *config, *url, *trace;
     int axis;
+    double skew_us, drift_ppm;
 };
+
+static int number(const char *opt, const char *v, double lo, double hi, double *out)
+{
+    char *end;
+    double x = strtod(v, &end);
+    if (end == v || *end || !(x >= lo && x <= hi))
+        return fprintf(stderr, "cnc-axis: %s is a number from %g to %g, not '%s'\n", opt, lo, hi,
+                       v), -1;
+    *out = x;
+    return 0;
+}
 
 static int parse(int argc, char **argv, struct opts *o)
 {
     static const struct option lo[] = {
         { "axis", required_argument, 0, 'a' },   { "config", required_argument, 0, 'c' },
         { "lcm-url", required_argument, 0, 'u' }, { "trace", required_argument, 0, 't' },
-        { "help", no_argument, 0, 'h' },          { 0, 0, 0, 0 },
+        { "help", no_argument, 0, 'h' },
+        { "clock-skew-us", required_argument, 0, 'S' },
+        { "clock-drift-ppm", required_argument, 0, 'D' },
+        { 0, 0, 0, 0 },
     };
     int c;
     o->axis = -1;
@@ -76,6 +96,14 @@ static int parse(int argc, char **argv, struct opts *o)
         case 'c': o->config = optarg; break;
         case 'u': o->url = optarg; break;
         case 't': o->trace = optarg; break;
+        case 'S':
+            if (number("--clock-skew-us", optarg, -1e12, 1e12, &o->skew_us) != 0)
+                return -1;
+            break;
+        case 'D':
+            if (number("--clock-drift-ppm", optarg, -1000, 1000, &o->drift_ppm) != 0)
+                return -1;
+            break;
         case 'h': usage(stdout); exit(0);
         default: return -1;
         }
@@ -125,6 +153,10 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
                                  (uint64_t)cfg->lcm.inject_seed + 1u + (uint64_t)o->axis };
     if (ncp_msg_set_inject(l->msg, &in) != 0)
         return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
+    l->clk.skew_ns = llround(o->skew_us * 1e3);
+    l->clk.drift_ppm = o->drift_ppm;
+    if (llc_clock_start(l, url, &d) != NCP_OK)
+        return fprintf(stderr, "cnc-axis: error: clock probes: %s\n", d.msg), -1;
     static const double origin[NCP_AXES];
     ncp_sim_init(&l->sim, cfg, origin);
     ncp_dist_rx_init(&l->rx, l->period_ns, 0);
@@ -197,7 +229,14 @@ static int report(const struct llc *l)
                 l->recs.duplicate, l->recs.early);
     llc_ai_report(l);
     llc_dp1_ai_report(l);
+    llc_clock_report(l);
     switch (l->end) {
+    case LLC_END_CLOCK:
+        fprintf(stderr, "cnc-axis %c: error: %s: the HLC's clock and this one are further apart "
+                        "than [LCM] CLOCK_TOLERANCE_US %d; on two hosts use CLOCK = probe, or ptp "
+                        "with ptp4l and phc2sys; stopped at %.4f mm\n",
+                ax, l->fault, l->cfg->lcm.clock_tolerance_us, l->cmd);
+        break;
     case LLC_END_PROGRAM:
         fprintf(stderr, "cnc-axis %c: error: DP 1: %s; held at %.4f mm\n", ax, l->fault, l->cmd);
         break;
@@ -273,6 +312,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "cnc-axis %c: waiting for the HLC\n", NCP_AXIS_LETTERS[o.axis]);
     if (run_loop(l, trace) != 0)
         l->end = LLC_END_SIGNAL;
+    llc_clock_stop(l);
     int rc = report(l);
     llc_dp1_free(l);
     if (trace && fclose(trace) != 0)

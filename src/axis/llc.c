@@ -146,6 +146,9 @@ void llc_publish_status(struct llc *l, int64_t slot)
     if (l->end == LLC_END_PROGRAM)
         snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault_short[0] ? l->fault_short
                                                                           : l->fault);
+    else if (l->end == LLC_END_CLOCK)
+        snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault);
+    llc_clock_status(l, &s);
     /* DP1: its own NCK's records, the HLC waits for the first */
     if (l->dp4 || l->dp == 1) {
         s.buffer_level = (int16_t)(l->dp == 1 ? llc_dp1_level(l)
@@ -175,7 +178,10 @@ void llc_heartbeat(struct llc *l, int64_t now)
     if (now - l->last_hb_ns < l->hb_period_ns)
         return;
     l->last_hb_ns = now;
-    ncp_heartbeat_t h = { l->seq++, (int16_t)(l->axis + 1), now, 0, 0, 0 };
+    /* done once the HLC's is heard: the HLC repeats its own until then */
+    ncp_heartbeat_t h = { l->seq++, (int16_t)(l->axis + 1), llc_clock_local(&l->clk, now), 0,
+                          l->done_req ? NCP_HEARTBEAT_T_COMMAND_DONE : NCP_HEARTBEAT_T_COMMAND_RUN,
+                          0 };
     uint8_t buf[64];
     int n = ncp_heartbeat_t_encode(buf, 0, sizeof buf, &h);
     if (n > 0)
@@ -385,7 +391,8 @@ static void trace(struct llc *l, int64_t now, int64_t slot, int gap)
 {
     if (!l->tracing)
         return;
-    struct llc_row r = { now, slot, l->cmd, l->act, l->state, gap };
+    (void)now;
+    struct llc_row r = { l->hlc_now, slot, l->cmd, l->act, l->state, gap };
     if (ncp_spsc_push(&l->trace_ring, &r) != 0)
         l->trace_dropped++;
 }
@@ -434,6 +441,23 @@ static void period(struct llc *l, int64_t now, int64_t slot)
 
 #define ADVERT_PERIOD_NS 200000000LL   /* 5 a second until the HLC streams */
 #define WAIT_STATUS_PERIODS 10
+#define FAULT_REPORTS 20
+
+/* The clocks are further apart than CLOCK_TOLERANCE_US while the grid takes
+ * them to be one (monotonic: one host; ptp: phc2sys keeps them together). */
+static void clock_fault(struct llc *l)
+{
+    static const char *const mode[] = { "monotonic", "probe", "ptp" };
+    double ms = (double)atomic_load_explicit(&l->clk.est_offset, memory_order_relaxed) * 1e-6;
+    l->end = LLC_END_CLOCK;
+    /* within the status's 64 bytes also for clocks of different kinds */
+    if (fabs(ms) < 1e6)
+        snprintf(l->fault, sizeof l->fault, "the clocks disagree by %+.3f ms ([LCM] CLOCK = %s)",
+                 ms, mode[l->clk.mode]);
+    else
+        snprintf(l->fault, sizeof l->fault, "the clocks disagree by %+.0f s ([LCM] CLOCK = %s)",
+                 ms * 1e-3, mode[l->clk.mode]);
+}
 
 /* Before the HLC's first setpoint: advertise, heartbeat, report the axis at
  * rest, hold the servo where it stands. 1 while waiting, 0 once the grid is
@@ -459,23 +483,31 @@ static int waiting(struct llc *l, int64_t now)
             l->last_hlc_ns = now;
         return 0;
     }
-    if (now - l->last_adv_ns >= ADVERT_PERIOD_NS) {
+    /* the HLC waits for the advertisement: by then this LLC knows its clock */
+    if (llc_clock_known(l) && l->end == LLC_END_NONE && now - l->last_adv_ns >= ADVERT_PERIOD_NS) {
         l->last_adv_ns = now;
         llc_advertise(l);
     }
     if (l->waits++ % WAIT_STATUS_PERIODS == 0)
         llc_publish_status(l, 0);
     llc_heartbeat(l, now);
-    if (atomic_load_explicit(&l->signal, memory_order_relaxed))
-        l->end = LLC_END_SIGNAL;
-    else if (l->last_hlc_ns && now - l->last_hlc_ns > l->hb_timeout_ns)
-        l->end = LLC_END_HLC_SILENT;
-    else if (l->done_req)
-        l->end = LLC_END_DONE;
-    if (l->end == LLC_END_PROGRAM) {
+    if (l->end == LLC_END_NONE) {
+        if (atomic_load_explicit(&l->signal, memory_order_relaxed))
+            l->end = LLC_END_SIGNAL;
+        else if (l->last_hlc_ns && now - l->last_hlc_ns > l->hb_timeout_ns)
+            l->end = LLC_END_HLC_SILENT;
+        else if (l->done_req)
+            l->end = LLC_END_DONE;
+        else if (llc_clock_cycle(l, 0) != 0)
+            clock_fault(l);
+    }
+    if (l->end == LLC_END_PROGRAM || l->end == LLC_END_CLOCK) {
         l->state = NCP_AX_STATUS_T_FAULT;   /* the HLC names the axis and why */
         llc_publish_status(l, 0);
     }
+    /* a fault before motion is said for a while (a status may be lost) */
+    if (l->end == LLC_END_CLOCK && ++l->fault_reports < FAULT_REPORTS)
+        return 1;
     if (l->end != LLC_END_NONE)
         return -1;
     double c[NCP_AXES] = { 0 }, a[NCP_AXES];
@@ -500,14 +532,17 @@ int llc_cycle(void *ctx, int64_t now_ns)
     int w = waiting(l, now);
     if (w)
         return w < 0 ? NCP_RT_STOP : NCP_RT_CONTINUE;
+    if (llc_clock_cycle(l, 1) != 0 && l->end == LLC_END_NONE)
+        clock_fault(l);
     /* the HLC's period NCP_DIST_PLAY_DELAY + 0..1 back: from the loop's
-     * scheduled time, not the clock, so a late wake-up never changes it.
-     * At DP1 only the standstill marks travel, and a start whose marks all
-     * came too late would shift this axis's whole motion run: there the
-     * LLC plays further back, so that every one of the marks the HLC sends
-     * in a row at a start is still in time */
+     * scheduled time on the HLC's clock, not the clock read now, so a late
+     * wake-up never changes it. At DP1 only the standstill marks travel,
+     * and a start whose marks all came too late would shift this axis's
+     * whole motion run: there the LLC plays further back, so that every one
+     * of the marks the HLC sends in a row at a start is still in time */
     int64_t delay = l->dp == 1 ? LLC_DP1_PLAY_DELAY : NCP_DIST_PLAY_DELAY;
-    int64_t slot = now - l->t_first - delay * T - T / 2;
+    l->hlc_now = llc_hlc_time(l, now);
+    int64_t slot = l->hlc_now - l->t_first - delay * T - T / 2;
     slot = l->t_first + (slot < 0 ? -((-slot + T - 1) / T) : slot / T) * T;
     /* periods the loop slept through (a deadline miss) still passed for the
      * simulated plant: it runs them now, a few at most. Where this LLC

@@ -20,12 +20,17 @@
  * stop(): the heartbeat says done (or stop, after a fault) until every LLC
  * still alive reports a standstill.
  *
+ * Every time the HLC sends (its grid, heartbeats) is on its clock: CLOCK_MONOTONIC,
+ * or CLOCK_REALTIME under [LCM] CLOCK = ptp; lcm_clock.c keeps it and answers
+ * the LLCs' probes of it, from which each maps its own clock onto it.
+ *
  * The LLC reports the actual position of a period 1.5-2.5 periods back. The
  * loop gets that position carried forward by what the HLC commanded since
  * (fine setpoints), or its command less the LLC's own following error (where
  * the LLC computes its command), so cmd - act is the LLC's following error,
  * not the transport's delay. */
 #include "lcm_ai.h"
+#include "lcm_clock.h"
 #include "lcm_tx.h"
 #include "ncpar/backend.h"
 #include "ncpar/dist.h"
@@ -46,6 +51,7 @@ struct peer {
     int axis;
     int sub_advert, sub_status, sub_hb, sub_resend;
     int advertised, have_status;
+    int done_heard;              /* its heartbeat says it heard the HLC's done */
     ncp_ax_status_t st;          /* the last status */
     int64_t last_status_ns, last_hb_ns;
     int32_t last_seq;
@@ -77,18 +83,20 @@ struct lcm_be {
     struct lcm_ai *ai;       /* ADCAI's DP2, DP3 */
     int rest;                /* the path stood still last period */
     double prev_cmd[NCP_AXES];
+    struct lcm_clock clk;    /* answers the LLCs' clock probes; the HLC's clock */
+    uint64_t ends_sent;      /* heartbeats saying done (or stop) at the end */
+    int64_t last_cycle_ns, end_gap_ns;   /* the loop's last period; from it to the end said */
 };
 
-static int64_t mono(void)
+/* Every time the HLC sends is on this clock ([LCM] CLOCK), its grid too. */
+static int64_t hlc_now(const struct lcm_be *s)
 {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+    return lcm_clock_now(&s->clk);
 }
 
 static void heartbeat(struct lcm_be *s, int command, char axis)
 {
-    ncp_heartbeat_t h = { s->seq++, NCP_DIST_HLC_ID, mono(), (int8_t)s->cfg->lcm.dp,
+    ncp_heartbeat_t h = { s->seq++, NCP_DIST_HLC_ID, hlc_now(s), (int8_t)s->cfg->lcm.dp,
                           (int8_t)command, (uint8_t)axis };
     uint8_t buf[64];
     int n = ncp_heartbeat_t_encode(buf, 0, sizeof buf, &h);
@@ -126,6 +134,11 @@ static void take(struct lcm_be *s, int64_t now)
             if (sub == p->sub_status) {
                 on_status(p, b, len, now);
             } else if (sub == p->sub_hb) {
+                ncp_heartbeat_t h;
+                memset(&h, 0, sizeof h);
+                if (ncp_heartbeat_t_decode(b, 0, (int)len, &h) == (int)len &&
+                    h.sender == p->axis + 1 && h.command == NCP_HEARTBEAT_T_COMMAND_DONE)
+                    p->done_heard = 1;
                 p->last_hb_ns = now;
             } else if (sub == p->sub_resend && s->tx) {
                 lcm_tx_resend(s->tx, s->msg, b, len);
@@ -169,7 +182,7 @@ static void *idle_main(void *arg)
 {
     struct lcm_be *s = arg;
     while (atomic_load(&s->idle_run)) {
-        int64_t now = mono();
+        int64_t now = hlc_now(s);
         take(s, now);
         if (now - s->last_hb >= s->hb_period) {
             s->last_hb = now;
@@ -188,7 +201,7 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
 {
     int64_t last = 0;
     for (;;) {
-        int64_t now = mono();
+        int64_t now = hlc_now(s);
         if (now - last >= 100000000LL) {   /* again for one that lost it */
             last = now;
             lcm_dp1_send(s->dp1, s->msg);
@@ -198,6 +211,7 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
         for (int i = 0; i < s->n; i++) {
             const struct peer *p = &s->p[i];
             if (p->st.state == NCP_AX_STATUS_T_FAULT) {
+                s->fault_axis = NCP_AXIS_LETTERS[p->axis];
                 snprintf(s->fault, sizeof s->fault, "axis %c's LLC: DP 1: %.*s",
                          NCP_AXIS_LETTERS[p->axis], (int)sizeof p->st.fault,
                          (const char *)p->st.fault);
@@ -220,9 +234,9 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
 static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
 {
     struct lcm_be *s = b->impl;
-    int64_t start = mono(), deadline = start + s->cfg->lcm.axis_wait_ms * 1000000LL;
+    int64_t start = hlc_now(s), deadline = start + s->cfg->lcm.axis_wait_ms * 1000000LL;
     for (;;) {
-        int64_t now = mono();
+        int64_t now = hlc_now(s);
         take(s, now);
         if (s->faulted)
             return -1;
@@ -231,8 +245,19 @@ static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
             heartbeat(s, NCP_HEARTBEAT_T_COMMAND_RUN, 0);
         }
         int ready = 0;
-        for (int i = 0; i < s->n; i++)
-            ready += s->p[i].advertised && s->p[i].have_status;
+        for (int i = 0; i < s->n; i++) {
+            const struct peer *p = &s->p[i];
+            if (p->have_status && p->st.state == NCP_AX_STATUS_T_FAULT && p->st.fault[0]) {
+                /* one that cannot start says why (its clock, ...); the
+                 * others hear which axis stopped them */
+                s->fault_axis = NCP_AXIS_LETTERS[p->axis];
+                snprintf(s->fault, sizeof s->fault, "axis %c's LLC: %.*s", s->fault_axis,
+                         (int)sizeof p->st.fault, (const char *)p->st.fault);
+                s->faulted = 1;
+                return -1;
+            }
+            ready += p->advertised && p->have_status;
+        }
         if (ready == s->n)
             break;
         if (now > deadline) {
@@ -258,7 +283,7 @@ static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
         pos[j] = 0;
     for (int i = 0; i < s->n; i++)
         pos[s->p[i].axis] = ncp_dist_nm_to_mm(s->p[i].st.act_nm);
-    if (s->dp1 && dp1_wait(s, mono() + s->cfg->lcm.axis_wait_ms * 1000000LL) != 0)
+    if (s->dp1 && dp1_wait(s, hlc_now(s) + s->cfg->lcm.axis_wait_ms * 1000000LL) != 0)
         return -1;
     atomic_store(&s->idle_run, 1);
     s->idle_started = pthread_create(&s->idle, NULL, idle_main, s) == 0;
@@ -352,7 +377,7 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
 {
     (void)next;
     struct lcm_be *s = b->impl;
-    int64_t now = mono();
+    int64_t now = hlc_now(s);
     if (s->cycles == 0)
         s->t0 = now;
     /* this period on the grid the LLCs play by: the loop's absolute schedule
@@ -399,6 +424,7 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         before[i] = s->p[i].statuses;
     take(s, now);
     s->cycles++;
+    s->last_cycle_ns = now;
     for (int j = 0; j < NCP_AXES; j++)
         act[j] = cmd[j];
     for (int i = 0; i < s->n; i++) {
@@ -426,21 +452,29 @@ static void lcm_stop(struct ncp_backend *b)
     struct lcm_be *s = b->impl;
     idle_stop(s);
     int command = s->faulted ? NCP_HEARTBEAT_T_COMMAND_STOP : NCP_HEARTBEAT_T_COMMAND_DONE;
-    int64_t end = mono() + STOP_WAIT_NS;
+    int64_t end = hlc_now(s) + STOP_WAIT_NS;
+    /* Said every servo period, not every heartbeat period, until each LLC
+     * still alive has answered (its status says done or stopped, or its
+     * heartbeat says it heard done): an LLC whose setpoints ended in motion
+     * holds them for only MAX_LOST_PERIODS periods, so one lost "done"
+     * must cost a period, not a heartbeat period. */
     for (;;) {
-        int64_t now = mono();
+        int64_t now = hlc_now(s);
         heartbeat(s, command, s->fault_axis);
+        if (s->ends_sent++ == 0 && s->last_cycle_ns)
+            s->end_gap_ns = now - s->last_cycle_ns;
         take(s, now);
         int busy = 0;
         for (int i = 0; i < s->n; i++) {
             const struct peer *p = &s->p[i];
             int alive = now - p->last_hb_ns <= s->hb_timeout;
             busy += alive && p->st.state != NCP_AX_STATUS_T_DONE &&
-                    p->st.state != NCP_AX_STATUS_T_STOPPED;
+                    p->st.state != NCP_AX_STATUS_T_STOPPED &&
+                    !(command == NCP_HEARTBEAT_T_COMMAND_DONE && p->done_heard);
         }
         if (!busy || now > end)
             break;
-        struct timespec ts = { 0, (long)s->hb_period };
+        struct timespec ts = { 0, (long)s->T };
         nanosleep(&ts, NULL);
     }
     struct ncp_msg_stats st;
@@ -473,7 +507,18 @@ static void lcm_stop(struct ncp_backend *b)
                 NCP_AXIS_LETTERS[p->axis], (unsigned long long)p->statuses,
                 (unsigned long long)p->lost, (unsigned long long)p->late, p->st.lost,
                 p->st.held, p->st.stale, p->st.duplicate);
+        static const char *const mode[] = { "monotonic", "probe", "ptp" };
+        int m = p->st.clock_mode >= 0 && p->st.clock_mode <= 2 ? p->st.clock_mode : 0;
+        if (p->st.clock_rtt_ns > 0)
+            fprintf(stderr, "lcm: axis %c: clock %s: the HLC's clock ahead of the LLC's by "
+                            "%+.3f ms (round trip %.1f us, jitter %.1f us)\n",
+                    NCP_AXIS_LETTERS[p->axis], mode[m], (double)p->st.clock_offset_ns * 1e-6,
+                    (double)p->st.clock_rtt_ns * 1e-3, (double)p->st.clock_jitter_ns * 1e-3);
     }
+    fprintf(stderr, "lcm: the end (%s) said %llu times, the first %.1f ms after the loop's "
+                    "last period\n",
+            command == NCP_HEARTBEAT_T_COMMAND_DONE ? "done" : "stop",
+            (unsigned long long)s->ends_sent, (double)s->end_gap_ns * 1e-6);
     fprintf(stderr, "lcm: transport: sent %llu (%llu send errors), taken %llu, injected loss "
                     "%llu, delayed %llu\n",
             (unsigned long long)st.sent, (unsigned long long)st.send_errors,
@@ -514,6 +559,7 @@ static void lcm_close(struct ncp_backend *b)
     if (!s)
         return;
     idle_stop(s);
+    lcm_clock_stop(&s->clk);
     ncp_msg_close(s->msg);
     free_tx(s);
     free(s);
@@ -607,6 +653,15 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
         free_tx(s);
         free(s);
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the lcm backend");
+    }
+    /* the probes are answered from now on: an LLC advertises itself only
+     * once it knows the HLC's clock */
+    rc = lcm_clock_start(&s->clk, cfg, d);
+    if (rc != NCP_OK) {
+        ncp_msg_close(s->msg);
+        free_tx(s);
+        free(s);
+        return rc;
     }
     memset(b, 0, sizeof *b);
     b->ops = &lcm_ops;

@@ -68,6 +68,8 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->lcm.heartbeat_timeout_ms = 200;
     c->lcm.axis_wait_ms = 5000;
     c->lcm.inject_seed = 1;
+    c->lcm.clock = NCP_LCM_CLOCK_MONOTONIC;
+    c->lcm.clock_tolerance_us = 1000;
     ncp_machine_joints_from_axes(c);
 }
 
@@ -369,6 +371,16 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v, char *wh
         return real(v, 0, 1000, &l->status_hz, "Hz (0: only at changes)", why, len);
     if (!strcasecmp(k, "INJECT_LOSS"))
         return real(v, 0, 1, &l->inject_loss, "(a fraction)", why, len);
+    if (!strcasecmp(k, "CLOCK")) {
+        static const char *const names[] = { "monotonic", "probe", "ptp" };
+        for (int i = 0; i < 3; i++)
+            if (!strcasecmp(v, names[i])) {
+                l->clock = (enum ncp_lcm_clock)i;
+                return 1;
+            }
+        return snprintf(why, len, "monotonic (one host), probe (estimated from round trips) "
+                                  "or ptp (CLOCK_REALTIME kept by ptp4l/phc2sys)"), -1;
+    }
     static const struct { const char *name; int lo, hi; const char *unit; } ints[] = {
         { "DP", 1, 5, "(a distribution point)" },
         { "MAX_LOST_PERIODS", 1, 100000, "periods" },
@@ -377,10 +389,11 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v, char *wh
         { "AXIS_WAIT_MS", 1, 600000, "ms" },
         { "INJECT_DELAY_US", 0, 1000000, "us" },
         { "INJECT_SEED", 0, 2147483647, "" },
+        { "CLOCK_TOLERANCE_US", 1, 10000000, "us" },
     };
     int *dst[] = { &l->dp, &l->max_lost_periods, &l->heartbeat_period_ms,
                    &l->heartbeat_timeout_ms, &l->axis_wait_ms, &l->inject_delay_us,
-                   &l->inject_seed };
+                   &l->inject_seed, &l->clock_tolerance_us };
     for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++)
         if (!strcasecmp(k, ints[i].name))
             return whole(v, ints[i].lo, ints[i].hi, dst[i], ints[i].unit, why, len);

@@ -240,6 +240,78 @@ static void la_and_int_round_trip(void **state)
     assert_memory_equal(&o.s, &o2.s, sizeof o.s);
 }
 
+/* A probe whose request took `up` ns and whose answer took `down`, to an HLC
+ * `off` ns ahead that held it `hold` ns. */
+static void probe_with(struct ncp_dist_clock *c, int64_t t1, int64_t off, int64_t up,
+                       int64_t down, int64_t hold)
+{
+    int64_t t2 = t1 + up + off, t3 = t2 + hold, t4 = t3 - off + down;
+    assert_int_equal(ncp_dist_clock_add(c, t1, t2, t3, t4), 0);
+}
+
+static void clock_shortest_round_trip_wins(void **state)
+{
+    (void)state;
+    struct ncp_dist_clock c;
+    struct ncp_dist_clock_est e;
+    ncp_dist_clock_init(&c);
+    assert_int_equal(ncp_dist_clock_estimate(&c, &e), -1);
+    const int64_t off = -50000000;   /* the HLC's clock 50 ms behind */
+    /* symmetric: exact, whatever the HLC's own time */
+    probe_with(&c, 1000000000, off, 40000, 40000, 7000);
+    assert_int_equal(ncp_dist_clock_estimate(&c, &e), 0);
+    assert_int_equal(e.offset_ns, off);
+    assert_int_equal(e.rtt_ns, 80000);
+    assert_int_equal(e.jitter_ns, 0);
+    /* one-sided waits lengthen the round trip and are outweighed */
+    probe_with(&c, 1100000000, off, 300000, 20000, 5000);
+    probe_with(&c, 1200000000, off, 20000, 500000, 5000);
+    probe_with(&c, 1300000000, off, 12000, 10000, 5000);
+    assert_int_equal(ncp_dist_clock_estimate(&c, &e), 0);
+    assert_int_equal(e.offset_ns, off + 1000);   /* within half its round trip */
+    assert_int_equal(e.rtt_ns, 22000);
+    assert_int_equal(e.probes, 4);
+    assert_true(e.jitter_ns > 100000);           /* the scatter the waits made */
+    /* the window forgets: 8 more, each 1 us further on (drift) */
+    for (int i = 0; i < NCP_DIST_CLOCK_WINDOW; i++)
+        probe_with(&c, 2000000000 + i * 50000000LL, off + 1000 * i, 30000, 30000, 5000);
+    assert_int_equal(ncp_dist_clock_estimate(&c, &e), 0);
+    assert_int_equal(e.probes, NCP_DIST_CLOCK_WINDOW);
+    assert_int_equal(e.rtt_ns, 60000);
+    /* of equal round trips the newest */
+    assert_int_equal(e.offset_ns, off + 1000 * (NCP_DIST_CLOCK_WINDOW - 1));
+    /* nonsense is refused: the HLC held it longer than the round trip */
+    assert_int_equal(ncp_dist_clock_add(&c, 0, 10, 1000, 500), -1);
+    assert_int_equal(ncp_dist_clock_add(&c, 100, 10, 5, 500), -1);
+}
+
+static void clock_slew_is_bounded(void **state)
+{
+    (void)state;
+    assert_int_equal(ncp_dist_clock_slew(0, 5000, 1000), 1000);
+    assert_int_equal(ncp_dist_clock_slew(0, -5000, 1000), -1000);
+    assert_int_equal(ncp_dist_clock_slew(4500, 5000, 1000), 5000);
+    /* clocks far apart (a REALTIME against a MONOTONIC) do not wrap */
+    assert_true(ncp_dist_clock_slew(-4000000000000000000LL, 4000000000000000000LL, 1000) ==
+                -4000000000000000000LL + 1000);
+}
+
+static void clock_url_next_port(void **state)
+{
+    (void)state;
+    char buf[128];
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    assert_int_equal(ncp_dist_clock_url("udpm://239.255.76.67:7667?ttl=1&recv_buf_size=65536",
+                                        buf, sizeof buf, &d), NCP_OK);
+    assert_string_equal(buf, "udpm://239.255.76.67:7668?ttl=1");
+    assert_int_equal(ncp_dist_clock_url("udpm://239.1.2.3", buf, sizeof buf, &d), NCP_OK);
+    assert_string_equal(buf, "udpm://239.1.2.3:7668?ttl=0");
+    assert_int_not_equal(ncp_dist_clock_url("udpm://239.1.2.3:65535", buf, sizeof buf, &d),
+                         NCP_OK);
+    assert_non_null(strstr(d.msg, "next port"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -251,6 +323,9 @@ int main(void)
         cmocka_unit_test(dice_same_seed_same_losses),
         cmocka_unit_test(recs_round_trip_and_ring),
         cmocka_unit_test(la_and_int_round_trip),
+        cmocka_unit_test(clock_shortest_round_trip_wins),
+        cmocka_unit_test(clock_slew_is_bounded),
+        cmocka_unit_test(clock_url_next_port),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

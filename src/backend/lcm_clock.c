@@ -1,0 +1,105 @@
+/* Answers the LLCs' clock probes (see lcm_clock.h). */
+#include "lcm_clock.h"
+
+#include "ncpar/dist.h"
+
+#include <poll.h>
+#include <string.h>
+#include <time.h>
+
+static int64_t mono(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+int64_t lcm_clock_now(const struct lcm_clock *c)
+{
+    return mono() + c->off_ns;
+}
+
+static void answer(struct lcm_clock *c, const uint8_t *p, size_t len, int64_t t2)
+{
+    ncp_clock_probe_t q;
+    memset(&q, 0, sizeof q);
+    if (ncp_clock_probe_t_decode(p, 0, (int)len, &q) != (int)len || q.sender < 1 ||
+        q.sender > NCP_AXES || q.peer != 0)
+        return;
+    ncp_clock_probe_t a = { c->seq++, NCP_DIST_HLC_ID, q.sender, q.probe_seq, q.t1_ns, t2, 0 };
+    uint8_t buf[64];
+    a.t3_ns = lcm_clock_now(c);
+    int n = ncp_clock_probe_t_encode(buf, 0, sizeof buf, &a);
+    if (n > 0 && ncp_msg_publish(c->msg, NCP_DIST_CH_CLOCK, buf, (size_t)n) == 0)
+        atomic_fetch_add(&c->answered, 1);
+}
+
+static void *clock_main(void *arg)
+{
+    struct lcm_clock *c = arg;
+    struct pollfd pfd = { .fd = ncp_msg_fd(c->msg), .events = POLLIN };
+    while (atomic_load(&c->run)) {
+        if (poll(&pfd, 1, 50) <= 0)
+            continue;
+        int sub;
+        const uint8_t *p;
+        size_t len;
+        /* stamped as each is read, not on waking: one read after others
+         * waited in the queue, which lengthens its round trip (and the LLC
+         * then trusts it less); stamped early, the wait would shorten it */
+        while (ncp_msg_take(c->msg, mono(), &sub, &p, &len) == 1)
+            answer(c, p, len, lcm_clock_now(c));
+    }
+    return NULL;
+}
+
+int lcm_clock_start(struct lcm_clock *c, const struct ncp_machine_cfg *cfg, struct ncp_diag *d)
+{
+    memset(c, 0, sizeof *c);
+    if (cfg->lcm.clock == NCP_LCM_CLOCK_PTP) {
+        struct timespec r;
+        clock_gettime(CLOCK_REALTIME, &r);
+        c->off_ns = (int64_t)r.tv_sec * 1000000000LL + r.tv_nsec - mono();
+    }
+    char url[128];
+    int rc = ncp_dist_clock_url(cfg->lcm.url, url, sizeof url, d);
+    if (rc == NCP_OK)
+        rc = ncp_msg_open(&c->msg, url, NULL, d);
+    if (rc != NCP_OK)
+        return rc;
+    for (int j = 0; j < NCP_AXES; j++) {
+        char ch[32];
+        if (!(cfg->axis_mask & NCP_AXIS_BIT(j)))
+            continue;
+        ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_CLOCK);
+        ncp_msg_subscribe(c->msg, ch);
+    }
+    /* probes are lost as anything else is ([LCM] INJECT_LOSS); a delay
+     * held back here would only wait for the next wake-up, so none */
+    struct ncp_msg_inject in = { cfg->lcm.inject_loss, 0, (uint64_t)cfg->lcm.inject_seed + 1000u };
+    if (ncp_msg_set_inject(c->msg, &in) != 0) {
+        ncp_msg_close(c->msg);
+        c->msg = NULL;
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the clock probes");
+    }
+    atomic_store(&c->run, 1);
+    if (pthread_create(&c->thread, NULL, clock_main, c) != 0) {
+        ncp_msg_close(c->msg);
+        c->msg = NULL;
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the clock probes' thread");
+    }
+    c->started = 1;
+    return NCP_OK;
+}
+
+void lcm_clock_stop(struct lcm_clock *c)
+{
+    if (c->started) {
+        atomic_store(&c->run, 0);
+        pthread_join(c->thread, NULL);
+        c->started = 0;
+    }
+    if (c->msg)
+        ncp_msg_close(c->msg);
+    c->msg = NULL;
+}
