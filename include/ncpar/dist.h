@@ -13,6 +13,8 @@
 #ifndef NCPAR_DIST_H
 #define NCPAR_DIST_H
 
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -228,5 +230,28 @@ int ncp_dist_clock_estimate(const struct ncp_dist_clock *c, struct ncp_dist_cloc
 /* The offset an LLC applies, moved toward target by at most max_step: a grid
  * in motion is slewed, never stepped. */
 int64_t ncp_dist_clock_slew(int64_t applied, int64_t target, int64_t max_step);
+
+/* The probes travel on a socket of their own (the LCM URL's next port:
+ * ncp_dist_clock_url), read by a thread of their own that blocks in poll()
+ * and stamps each as it reads it: the position loops read their sockets
+ * once a period, which would add up to a period of one-sided delay to every
+ * round trip. open: the socket, with the run's loss injection (subscribe,
+ * then run); run: the thread, which polls while `run` holds; close: joins
+ * it and closes the socket (after a failed open or run too). */
+struct ncp_msg;
+struct ncp_dist_probe_io {
+    struct ncp_msg *msg;
+    pthread_t thread;
+    atomic_int run;
+    int started;
+};
+int ncp_dist_probe_io_open(struct ncp_dist_probe_io *io, const char *lcm_url, double loss,
+                           uint64_t seed, struct ncp_diag *d);
+int ncp_dist_probe_io_run(struct ncp_dist_probe_io *io, void *(*body)(void *), void *arg,
+                          struct ncp_diag *d);
+void ncp_dist_probe_io_close(struct ncp_dist_probe_io *io);
+/* CLOCK_REALTIME minus CLOCK_MONOTONIC now: CLOCK = ptp's time base, which
+ * phc2sys keeps on the grandmaster's. */
+int64_t ncp_dist_realtime_offset(void);
 
 #endif

@@ -28,7 +28,7 @@ enum llc_end {
 /* The common time base (clock.c): written by the probe thread (the window
  * and the estimate's atomics) or by the position loop (applied, slewing). */
 struct llc_clock {
-    struct ncp_msg *msg;          /* the probe thread's own socket */
+    struct ncp_dist_probe_io io;  /* the probe thread and its own socket */
     char channel[32];             /* NCP_AX_<L>_CLOCK */
     enum ncp_lcm_clock mode;
     int64_t tolerance_ns;
@@ -37,9 +37,6 @@ struct llc_clock {
      * host's clock simulated on this one */
     int64_t skew_ns, mono0;
     double drift_ppm;
-    pthread_t thread;
-    atomic_int run;
-    int started;
     int32_t seq;
     struct ncp_dist_clock win;
     _Atomic int64_t est_offset, est_rtt, est_jitter;

@@ -60,7 +60,7 @@ static void probe(struct llc *l)
     uint8_t buf[64];
     q.t1_ns = llc_clock_local(c, mono());
     int n = ncp_clock_probe_t_encode(buf, 0, sizeof buf, &q);
-    if (n > 0 && ncp_msg_publish(c->msg, c->channel, buf, (size_t)n) == 0)
+    if (n > 0 && ncp_msg_publish(c->io.msg, c->channel, buf, (size_t)n) == 0)
         atomic_fetch_add(&c->sent, 1);
 }
 
@@ -90,18 +90,18 @@ static void *clock_main(void *arg)
 {
     struct llc *l = arg;
     struct llc_clock *c = &l->clk;
-    struct pollfd pfd = { .fd = ncp_msg_fd(c->msg), .events = POLLIN };
-    while (atomic_load(&c->run)) {
+    struct pollfd pfd = { .fd = ncp_msg_fd(c->io.msg), .events = POLLIN };
+    while (atomic_load(&c->io.run)) {
         int64_t due = mono() + (atomic_load(&c->ready) ? PROBE_SLOW_NS : PROBE_FAST_NS);
         probe(l);
-        for (int64_t left; (left = due - mono()) > 0 && atomic_load(&c->run);) {
+        for (int64_t left; (left = due - mono()) > 0 && atomic_load(&c->io.run);) {
             if (poll(&pfd, 1, (int)(left / 1000000 + 1)) <= 0)
                 continue;
             int sub;
             const uint8_t *p;
             size_t len;
             /* t4 as each is read (see lcm_clock.c) */
-            while (ncp_msg_take(c->msg, mono(), &sub, &p, &len) == 1)
+            while (ncp_msg_take(c->io.msg, mono(), &sub, &p, &len) == 1)
                 answered(l, p, len, llc_clock_local(c, mono()));
         }
     }
@@ -115,42 +115,21 @@ int llc_clock_start(struct llc *l, const char *url, struct ncp_diag *d)
     c->mode = cfg->lcm.clock;
     c->tolerance_ns = cfg->lcm.clock_tolerance_us * 1000LL;
     c->mono0 = mono();
-    if (c->mode == NCP_LCM_CLOCK_PTP) {
-        struct timespec r;
-        clock_gettime(CLOCK_REALTIME, &r);
-        c->base_ns = (int64_t)r.tv_sec * 1000000000LL + r.tv_nsec - mono();
-    }
+    if (c->mode == NCP_LCM_CLOCK_PTP)
+        c->base_ns = ncp_dist_realtime_offset();
     ncp_dist_clock_init(&c->win);
     ncp_dist_ax_channel(c->channel, sizeof c->channel, l->axis, NCP_DIST_AX_CLOCK);
-    char curl[128];
-    int rc = ncp_dist_clock_url(url, curl, sizeof curl, d);
-    if (rc == NCP_OK)
-        rc = ncp_msg_open(&c->msg, curl, NULL, d);
+    int rc = ncp_dist_probe_io_open(&c->io, url, cfg->lcm.inject_loss,
+                                    (uint64_t)cfg->lcm.inject_seed + 1001u + (uint64_t)l->axis, d);
     if (rc != NCP_OK)
         return rc;
-    ncp_msg_subscribe(c->msg, NCP_DIST_CH_CLOCK);
-    struct ncp_msg_inject in = { cfg->lcm.inject_loss, 0,
-                                 (uint64_t)cfg->lcm.inject_seed + 1001u + (uint64_t)l->axis };
-    if (ncp_msg_set_inject(c->msg, &in) != 0)
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the clock probes");
-    atomic_store(&c->run, 1);
-    if (pthread_create(&c->thread, NULL, clock_main, l) != 0)
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the clock probes' thread");
-    c->started = 1;
-    return NCP_OK;
+    ncp_msg_subscribe(c->io.msg, NCP_DIST_CH_CLOCK);
+    return ncp_dist_probe_io_run(&c->io, clock_main, l, d);
 }
 
 void llc_clock_stop(struct llc *l)
 {
-    struct llc_clock *c = &l->clk;
-    if (c->started) {
-        atomic_store(&c->run, 0);
-        pthread_join(c->thread, NULL);
-        c->started = 0;
-    }
-    if (c->msg)
-        ncp_msg_close(c->msg);
-    c->msg = NULL;
+    ncp_dist_probe_io_close(&l->clk.io);
 }
 
 int llc_clock_known(const struct llc *l)

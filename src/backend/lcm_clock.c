@@ -30,15 +30,15 @@ static void answer(struct lcm_clock *c, const uint8_t *p, size_t len, int64_t t2
     uint8_t buf[64];
     a.t3_ns = lcm_clock_now(c);
     int n = ncp_clock_probe_t_encode(buf, 0, sizeof buf, &a);
-    if (n > 0 && ncp_msg_publish(c->msg, NCP_DIST_CH_CLOCK, buf, (size_t)n) == 0)
+    if (n > 0 && ncp_msg_publish(c->io.msg, NCP_DIST_CH_CLOCK, buf, (size_t)n) == 0)
         atomic_fetch_add(&c->answered, 1);
 }
 
 static void *clock_main(void *arg)
 {
     struct lcm_clock *c = arg;
-    struct pollfd pfd = { .fd = ncp_msg_fd(c->msg), .events = POLLIN };
-    while (atomic_load(&c->run)) {
+    struct pollfd pfd = { .fd = ncp_msg_fd(c->io.msg), .events = POLLIN };
+    while (atomic_load(&c->io.run)) {
         if (poll(&pfd, 1, 50) <= 0)
             continue;
         int sub;
@@ -47,7 +47,7 @@ static void *clock_main(void *arg)
         /* stamped as each is read, not on waking: one read after others
          * waited in the queue, which lengthens its round trip (and the LLC
          * then trusts it less); stamped early, the wait would shorten it */
-        while (ncp_msg_take(c->msg, mono(), &sub, &p, &len) == 1)
+        while (ncp_msg_take(c->io.msg, mono(), &sub, &p, &len) == 1)
             answer(c, p, len, lcm_clock_now(c));
     }
     return NULL;
@@ -56,15 +56,10 @@ static void *clock_main(void *arg)
 int lcm_clock_start(struct lcm_clock *c, const struct ncp_machine_cfg *cfg, struct ncp_diag *d)
 {
     memset(c, 0, sizeof *c);
-    if (cfg->lcm.clock == NCP_LCM_CLOCK_PTP) {
-        struct timespec r;
-        clock_gettime(CLOCK_REALTIME, &r);
-        c->off_ns = (int64_t)r.tv_sec * 1000000000LL + r.tv_nsec - mono();
-    }
-    char url[128];
-    int rc = ncp_dist_clock_url(cfg->lcm.url, url, sizeof url, d);
-    if (rc == NCP_OK)
-        rc = ncp_msg_open(&c->msg, url, NULL, d);
+    if (cfg->lcm.clock == NCP_LCM_CLOCK_PTP)
+        c->off_ns = ncp_dist_realtime_offset();
+    int rc = ncp_dist_probe_io_open(&c->io, cfg->lcm.url, cfg->lcm.inject_loss,
+                                    (uint64_t)cfg->lcm.inject_seed + 1000u, d);
     if (rc != NCP_OK)
         return rc;
     for (int j = 0; j < NCP_AXES; j++) {
@@ -72,34 +67,12 @@ int lcm_clock_start(struct lcm_clock *c, const struct ncp_machine_cfg *cfg, stru
         if (!(cfg->axis_mask & NCP_AXIS_BIT(j)))
             continue;
         ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_CLOCK);
-        ncp_msg_subscribe(c->msg, ch);
+        ncp_msg_subscribe(c->io.msg, ch);
     }
-    /* probes are lost as anything else is ([LCM] INJECT_LOSS); a delay
-     * held back here would only wait for the next wake-up, so none */
-    struct ncp_msg_inject in = { cfg->lcm.inject_loss, 0, (uint64_t)cfg->lcm.inject_seed + 1000u };
-    if (ncp_msg_set_inject(c->msg, &in) != 0) {
-        ncp_msg_close(c->msg);
-        c->msg = NULL;
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the clock probes");
-    }
-    atomic_store(&c->run, 1);
-    if (pthread_create(&c->thread, NULL, clock_main, c) != 0) {
-        ncp_msg_close(c->msg);
-        c->msg = NULL;
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the clock probes' thread");
-    }
-    c->started = 1;
-    return NCP_OK;
+    return ncp_dist_probe_io_run(&c->io, clock_main, c, d);
 }
 
 void lcm_clock_stop(struct lcm_clock *c)
 {
-    if (c->started) {
-        atomic_store(&c->run, 0);
-        pthread_join(c->thread, NULL);
-        c->started = 0;
-    }
-    if (c->msg)
-        ncp_msg_close(c->msg);
-    c->msg = NULL;
+    ncp_dist_probe_io_close(&c->io);
 }

@@ -6,23 +6,20 @@
 #ifndef NCP_BACKEND_LCM_CLOCK_H
 #define NCP_BACKEND_LCM_CLOCK_H
 
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 
 #include "ncpar/diag.h"
+#include "ncpar/dist.h"
 #include "ncpar/motion.h"
 #include "ncpar/msg.h"
 
 struct lcm_clock {
-    struct ncp_msg *msg;
+    struct ncp_dist_probe_io io;
     /* the HLC's clock minus its CLOCK_MONOTONIC: CLOCK = ptp stamps
      * CLOCK_REALTIME (which phc2sys keeps on the grandmaster's time), the
      * others CLOCK_MONOTONIC (0) */
     int64_t off_ns;
-    pthread_t thread;
-    atomic_int run;
-    int started;
     int32_t seq;
     atomic_ullong answered;
 };

@@ -1,0 +1,61 @@
+/* The clock probes' own socket and thread, the same on both sides (the HLC
+ * answers, each LLC asks): see ncpar/dist.h. */
+#include "ncpar/dist.h"
+#include "ncpar/msg.h"
+
+#include <time.h>
+
+int ncp_dist_probe_io_open(struct ncp_dist_probe_io *io, const char *lcm_url, double loss,
+                           uint64_t seed, struct ncp_diag *d)
+{
+    io->msg = NULL;
+    io->started = 0;
+    atomic_store(&io->run, 0);
+    char url[128];
+    int rc = ncp_dist_clock_url(lcm_url, url, sizeof url, d);
+    if (rc == NCP_OK)
+        rc = ncp_msg_open(&io->msg, url, NULL, d);
+    if (rc != NCP_OK)
+        return rc;
+    /* probes are lost as anything else is ([LCM] INJECT_LOSS); a delay
+     * held back would only wait for the thread's next wake-up, so none */
+    struct ncp_msg_inject in = { loss, 0, seed };
+    if (ncp_msg_set_inject(io->msg, &in) != 0) {
+        ncp_dist_probe_io_close(io);
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the clock probes");
+    }
+    return NCP_OK;
+}
+
+int ncp_dist_probe_io_run(struct ncp_dist_probe_io *io, void *(*body)(void *), void *arg,
+                          struct ncp_diag *d)
+{
+    atomic_store(&io->run, 1);
+    if (pthread_create(&io->thread, NULL, body, arg) != 0) {
+        atomic_store(&io->run, 0);
+        ncp_dist_probe_io_close(io);
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot start the clock probes' thread");
+    }
+    io->started = 1;
+    return NCP_OK;
+}
+
+void ncp_dist_probe_io_close(struct ncp_dist_probe_io *io)
+{
+    if (io->started) {
+        atomic_store(&io->run, 0);
+        pthread_join(io->thread, NULL);
+        io->started = 0;
+    }
+    if (io->msg)
+        ncp_msg_close(io->msg);
+    io->msg = NULL;
+}
+
+int64_t ncp_dist_realtime_offset(void)
+{
+    struct timespec r, m;
+    clock_gettime(CLOCK_REALTIME, &r);
+    clock_gettime(CLOCK_MONOTONIC, &m);
+    return ((int64_t)r.tv_sec - m.tv_sec) * 1000000000LL + (r.tv_nsec - m.tv_nsec);
+}
