@@ -318,8 +318,8 @@ static int apply_dp1(const struct run_opts *o, struct ncp_machine_cfg *cfg)
     return 0;
 }
 
-/* --backend lcm: the distributed NCK at the INI's or --dp's point. Points
- * not implemented yet are refused here, before anything is opened. */
+/* --backend lcm: the distributed NCK at the INI's or --dp's point. A point
+ * the variant does not have is refused here, before anything is opened. */
 static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 {
     cfg->backend = NCP_BACKEND_LCM;
@@ -345,9 +345,9 @@ static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
         return apply_dp1(o, cfg);
     if (cfg->nck == NCP_NCK_ADCAI ? !ncp_dist_adcai_dp(cfg->lcm.dp)
                                   : cfg->lcm.dp < 1 || cfg->lcm.dp > 5)
-        return fprintf(stderr, "cnc-run run: --backend lcm: DP %d is not implemented yet for "
-                               "[PLANNER] NCK = %s (ADCBI: DP 1-5; ADCAI: DP 1-4)\n",
-                       cfg->lcm.dp, cfg->nck == NCP_NCK_ADCAI ? "adcai" : "adcbi"), -1;
+        return fprintf(stderr, "cnc-run run: --backend lcm: [PLANNER] NCK = %s has no DP %d "
+                               "(ADCBI: DP 1-5; ADCAI: DP 1-4)\n",
+                       cfg->nck == NCP_NCK_ADCAI ? "adcai" : "adcbi", cfg->lcm.dp), -1;
     return 0;
 }
 
