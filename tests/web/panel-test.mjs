@@ -181,6 +181,24 @@ async function upload(page, file) {
   return page.evaluate(() => window.ncpPanel.lastUpload);
 }
 
+// The panel opened with the session's token, connected and signed in.
+async function openPanel(page, srv, loadMs) {
+  await page.goto(`${srv.base}?token=${srv.token}`, { waitUntil: 'load', timeout: loadMs });
+  await page.waitForFunction(() => window.ncpPanel && window.ncpPanel.status && window.ncpPanel.authed, { timeout: 20000 });
+}
+
+// Home every axis, then load ncprograms/demo.ngc from the file list until its
+// text shows.
+async function loadDemo(page) {
+  await click(page, '#home');
+  await waitFor(page, 'homed', (s) => s.state === 'idle' && Object.values(s.homed).every(Boolean));
+  await page.waitForFunction(() => document.querySelector('#files option[value="demo.ngc"]'), { timeout: 5000 });
+  await page.select('#files', 'demo.ngc');
+  await click(page, '#load');
+  await waitFor(page, 'demo loaded', (s) => (s.program || '').endsWith('demo.ngc'));
+  await page.waitForFunction(() => document.querySelectorAll('#program div').length > 50, { timeout: 8000 });
+}
+
 async function session(browser) {
   let srv;
   try {
@@ -212,8 +230,7 @@ async function session(browser) {
     previewKind = three.status === 200 ? '3d' : '2d';
   });
   await run('connect', async () => {
-    await page.goto(`${srv.base}?token=${srv.token}`, { waitUntil: 'load', timeout: 15000 });
-    await page.waitForFunction(() => window.ncpPanel && window.ncpPanel.status && window.ncpPanel.authed, { timeout: 20000 });
+    await openPanel(page, srv, 15000);
     const s = await status(page);
     check(s.state === 'idle', `state ${s.state}`);
     const dro = await page.$$eval('#dro tbody tr', (rows) => rows.length);
@@ -222,13 +239,7 @@ async function session(browser) {
     await shot(page, '01-connected');
   });
   await run('load', async () => {
-    await click(page, '#home');
-    await waitFor(page, 'homed', (s) => s.state === 'idle' && Object.values(s.homed).every(Boolean));
-    await page.waitForFunction(() => document.querySelector('#files option[value="demo.ngc"]'), { timeout: 5000 });
-    await page.select('#files', 'demo.ngc');
-    await click(page, '#load');
-    await waitFor(page, 'demo loaded', (s) => (s.program || '').endsWith('demo.ngc'));
-    await page.waitForFunction(() => document.querySelectorAll('#program div').length > 50, { timeout: 8000 });
+    await loadDemo(page);
     const src = fs.readFileSync(path.join(ROOT, 'ncprograms', 'demo.ngc'), 'utf8').split('\n');
     const shown = await page.$$eval('#program div', (d) => d.map((e) => e.textContent));
     check(shown.length === src.length && shown[5].trim() === src[5].trim(), 'the program text differs from demo.ngc');
@@ -571,19 +582,12 @@ async function firefox() {
       catch (e) { report(name, 'FAIL', e.message.split('\n')[0]); }
     };
     await run('firefox-connect', async () => {
-      await page.goto(`${srv.base}?token=${srv.token}`, { waitUntil: 'load', timeout: 20000 });
-      await page.waitForFunction(() => window.ncpPanel && window.ncpPanel.status && window.ncpPanel.authed, { timeout: 20000 });
+      await openPanel(page, srv, 20000);
       check((await status(page)).state === 'idle', 'not idle');
       check(await page.$$eval('#dro tbody tr', (r) => r.length) === 3, 'no DRO rows');
     });
     await run('firefox-load', async () => {
-      await click(page, '#home');
-      await waitFor(page, 'homed', (s) => s.state === 'idle' && Object.values(s.homed).every(Boolean));
-      await page.waitForFunction(() => document.querySelector('#files option[value="demo.ngc"]'), { timeout: 5000 });
-      await page.select('#files', 'demo.ngc');
-      await click(page, '#load');
-      await waitFor(page, 'demo loaded', (s) => (s.program || '').endsWith('demo.ngc'));
-      await page.waitForFunction(() => document.querySelectorAll('#program div').length > 50, { timeout: 8000 });
+      await loadDemo(page);
       await page.waitForFunction(() => document.querySelector('#preview canvas'), { timeout: 8000 });
     });
     await run('firefox-cycle-start', async () => {
