@@ -25,6 +25,8 @@ static void usage(FILE *f)
           "  --fault-after K           enter Fault after K SYNCs in Operation enabled\n"
           "  --emcy-after K            send EMCY 0x8611 (following error) and enter Fault\n"
           "  --heartbeat-stop-after K  stop producing heartbeats\n"
+          "  --count-from-motion       count those K SYNCs from the first target that\n"
+          "                            differs from the one at enabling, not from enabling\n"
           "  --slow-sdo MS             answer every SDO MS milliseconds late\n"
           "  --sdo-abort INDEX         abort every SDO access to object INDEX (0x6060...)\n"
           "  --drop-every K            drop every K-th TPDO\n"
@@ -65,7 +67,7 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         {"drop-every", required_argument, 0, 'd'},   {"max-step", required_argument, 0, 'm'},
         {"verbose", no_argument, 0, 'v'},            {"help", no_argument, 0, 'h'},
         {"config", required_argument, 0, 'c'},       {"axis", required_argument, 0, 'x'},
-        {"sync-loss-ms", required_argument, 0, 'L'},
+        {"sync-loss-ms", required_argument, 0, 'L'}, {"count-from-motion", no_argument, 0, 'M'},
         {0, 0, 0, 0}};
     *o = (struct drive_opts){.node = 0, .fault_after = -1, .emcy_after = -1,
                              .hb_stop_after = -1, .abort_index = -1, .max_step = 1000000,
@@ -83,6 +85,7 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         case 'd': o->drop_every = num(optarg, "--drop-every", 1, 1L << 30); break;
         case 'm': o->max_step = (int32_t)num(optarg, "--max-step", 1, 1L << 30); break;
         case 'v': o->verbose = 1; break;
+        case 'M': o->count_from_motion = 1; break;
         case 'L': o->sync_loss_ms = num(optarg, "--sync-loss-ms", 0, 600000); break;
         case 'c': o->config = optarg; break;
         case 'x':

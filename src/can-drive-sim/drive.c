@@ -32,6 +32,7 @@ void drive_boot(struct drive *dv)
     dv->cw = dv->prev_cw = 0;
     dv->target = dv->actual;
     dv->syncs_enabled = 0;
+    dv->syncs_moving = 0;
     dv->heartbeat_on = 1;
     dv->last_master_hb = dv->last_sync = dv->last_rpdo = -1;
     dv->lost = 0;
@@ -68,7 +69,7 @@ static void apply_controlword(struct drive *dv, uint16_t cw)
     if (dv->st == NCP_402_FAULT && next != NCP_402_FAULT)
         od_set(&dv->od, 0x603F, 0, 0);
     if (next == NCP_402_OPERATION_ENABLED && dv->st != next) {
-        dv->target = dv->actual; /* no jump on enabling */
+        dv->target = dv->enabled_at = dv->actual; /* no jump on enabling */
         dv->prev_actual = dv->actual;
         drive_servo_enable(dv);
     }
@@ -104,15 +105,18 @@ static int on_sync(struct drive *dv)
         return 0;
     if (dv->st == NCP_402_OPERATION_ENABLED) {
         dv->syncs_enabled++;
+        if (dv->syncs_moving > 0 || dv->target != dv->enabled_at)
+            dv->syncs_moving++;
+        long k = dv->o.count_from_motion ? dv->syncs_moving : dv->syncs_enabled;
         dv->prev_actual = dv->actual;
         dv->actual = dv->servo ? drive_servo_step(dv)
                                : plant_step(dv->actual, dv->target, dv->o.max_step);
         od_set(&dv->od, 0x6064, 0, (uint32_t)dv->actual);
-        if (dv->syncs_enabled == dv->o.emcy_after && drive_go_fault(dv, 0x8611, 1) < 0)
+        if (k == dv->o.emcy_after && drive_go_fault(dv, 0x8611, 1) < 0)
             return -1;
-        if (dv->syncs_enabled == dv->o.fault_after)
+        if (k == dv->o.fault_after)
             drive_go_fault(dv, 0x7305, 0);
-        if (dv->syncs_enabled == dv->o.hb_stop_after)
+        if (k == dv->o.hb_stop_after)
             dv->heartbeat_on = 0;
     }
     dv->tpdos++;

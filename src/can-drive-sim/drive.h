@@ -24,6 +24,10 @@ struct drive_opts {
     const char *config;
     int axis;             /* 0..2, -1 = none */
     long sync_loss_ms;    /* no SYNC this long while enabled: the drive stops; 0 never */
+    /* the K of --fault-after, --emcy-after and --heartbeat-stop-after counts
+     * SYNCs from the first target that differs from the one at enabling, so
+     * a fault lands at a point of the program however long start-up took */
+    int count_from_motion;
 };
 
 struct drive {
@@ -35,6 +39,8 @@ struct drive {
     uint16_t cw, prev_cw;
     int32_t target, actual;
     long syncs_enabled, tpdos;
+    long syncs_moving;    /* SYNCs since the target first moved, 0 before */
+    int32_t enabled_at;   /* the target at enabling */
     int heartbeat_on;
     /* servo plant (o.config): one axis of the sim backend's machine */
     int servo;
