@@ -135,7 +135,7 @@ int main(int argc, char **argv)
     while (!stop) {
         /* the master's heartbeat joins the filter once 0x1016 names it */
         size_t n_ids = drive_listen_ids(&dv, ids);
-        if (n_ids != n_listening || memcmp(ids, listening, n_ids * sizeof ids[0])) {
+        if (n_ids != n_listening || memcmp(ids, listening, n_ids * sizeof ids[0]) != 0) {
             if (ncp_can_filter(&dv.bus, ids, n_ids, &d) != NCP_OK) {
                 fprintf(stderr, "cnc-drive-sim: %s\n", d.msg);
                 rc = 1;
