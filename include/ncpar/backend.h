@@ -132,5 +132,9 @@ double ncp_counts_to_mm(int32_t counts, double counts_per_mm);
 /* Every axis has a NODE_ID and COUNTS_PER_MM, its soft limits fit in 32-bit
  * counts, [CAN] INTERFACE is set; else d->msg names section and key. */
 int ncp_socketcan_check_cfg(const struct ncp_machine_cfg *cfg, struct ncp_diag *d);
+/* A --backend of sim or socketcan[:IFACE] (cnc-run run, cnc-axis) into
+ * cfg->backend and [CAN] INTERFACE: 0; 1 when spec is neither; -1 for a bad
+ * interface name (d->msg says which). */
+int ncp_backend_spec(const char *spec, struct ncp_machine_cfg *cfg, struct ncp_diag *d);
 
 #endif

@@ -22,7 +22,8 @@ enum llc_end {
     LLC_END_MISSING,    /* DP4: the next record was not here when needed */
     LLC_END_SIGNAL,     /* SIGINT / SIGTERM */
     LLC_END_PROGRAM,    /* DP1: its own NCK could not run the program (fault says why) */
-    LLC_END_CLOCK       /* CLOCK = monotonic or ptp, and the probes find the clocks apart */
+    LLC_END_CLOCK,      /* CLOCK = monotonic or ptp, and the probes find the clocks apart */
+    LLC_END_DRIVE       /* its CiA 402 drive faulted (fault says how) */
 };
 
 /* The common time base (clock.c): written by the probe thread (the window
@@ -72,7 +73,10 @@ struct llc {
     int64_t period_ns, t_first;   /* the HLC's first setpoint period */
     int64_t hb_period_ns, hb_timeout_ns;
     struct ncp_dist_rx rx;
-    struct ncp_sim sim;
+    struct ncp_sim sim;           /* the servo, unless a drive is (drive.c) */
+    struct ncp_machine_cfg drive_cfg;
+    struct ncp_backend drive;
+    int has_drive, drive_failed;
     double cmd, cmd_prev, act, ferr;
     int state;            /* ncp_ax_status_t's constants */
     enum llc_end end;
@@ -126,11 +130,12 @@ struct llc {
     ncp_int_burst_t int_burst;
     struct llc_dp1 *dp1;          /* DP1: its own NCK (dp1.c) */
     struct llc_dp1_ai *dp1ai;     /* ADCAI's DP1: its NCK's samples (dp1_ai.c) */
-    char fault[200];              /* LLC_END_PROGRAM: why */
+    char fault[200];              /* LLC_END_PROGRAM, LLC_END_DRIVE: why */
     char fault_short[64];         /* the same in what its status carries ("": fault) */
     struct llc_clock clk;
     int64_t hlc_now;              /* this period's time on the HLC's clock */
     int fault_reports;            /* LLC_END_CLOCK before motion: statuses saying so */
+    int64_t fault_waits;          /* ... and periods before the HLC came */
 };
 
 /* llc_adcai.c: NULL when out of memory or the INI's limits give no filter */
@@ -193,6 +198,20 @@ int llc_clock_known(const struct llc *l);
 int llc_clock_cycle(struct llc *l, int grid_known);
 void llc_clock_status(const struct llc *l, ncp_ax_status_t *s);
 void llc_clock_report(const struct llc *l);
+
+/* drive.c: the servo, simulated or a CiA 402 drive over SocketCAN */
+/* --backend sim|socketcan[:IFACE]: a drive is started (blocking) and the
+ * axis takes its position. 0, or -1 with a message on stderr. */
+int llc_drive_open(struct llc *l, const char *spec);
+/* Just before the position loop: it takes the drive over from the master's
+ * own thread. */
+void llc_drive_live(struct llc *l);
+/* One servo period at cmd (next: the one after); now 0 for a period the
+ * loop slept through, which only the simulated plant still runs. Sets
+ * l->act and l->ferr, and l->end on a drive fault. */
+void llc_servo(struct llc *l, double cmd, double next, int now);
+/* A controlled stop of the drive (after the loop), then closed. */
+void llc_drive_close(struct llc *l);
 
 /* llc.c */
 int llc_cycle(void *ctx, int64_t now_ns);

@@ -31,7 +31,7 @@ static void on_signal(int sig)
 static void usage(FILE *f)
 {
     fputs("usage: cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]\n"
-          "                [--clock-skew-us N] [--clock-drift-ppm P]\n"
+          "                [--backend sim|socketcan[:IFACE]] [--clock-skew-us N] [--clock-drift-ppm P]\n"
           "One axis of the distributed NCK: advertises axis L of the machine INI over LCM,\n"
           "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
           "servo at the HLC's setpoints (every servo period, DP 5) or interpolating the\n"
@@ -42,6 +42,10 @@ static void usage(FILE *f)
           "when the HLC goes silent ([LCM] HEARTBEAT_TIMEOUT_MS), when MAX_LOST_PERIODS\n"
           "setpoints in a row are missing, on a following error, when its own NCK fails\n"
           "(DP 1) or when the HLC orders it.\n"
+          "  --backend B   sim (default): the simulated servo of cnc-run's sim backend;\n"
+          "                socketcan[:IFACE]: the axis's CiA 402 drive ([AXIS_L] NODE_ID,\n"
+          "                COUNTS_PER_MM; [CAN] keys as for cnc-run), this LLC its CANopen\n"
+          "                master; the drive's position at start is where the program starts\n"
           "  --trace CSV   every period: t,slot,cmd,act,state,gap (seconds from the HLC's first\n"
           "                period; slot: the HLC's period played; state: ax_status_t's;\n"
           "                gap: 0 its own setpoint, 1 bridged to the next, 2 held)\n"
@@ -54,7 +58,7 @@ static void usage(FILE *f)
 }
 
 struct opts {
-    const char *config, *url, *trace;
+    const char *config, *url, *trace, *backend;
     int axis;
     double skew_us, drift_ppm;
 };
@@ -75,7 +79,7 @@ static int parse(int argc, char **argv, struct opts *o)
     static const struct option lo[] = {
         { "axis", required_argument, 0, 'a' },   { "config", required_argument, 0, 'c' },
         { "lcm-url", required_argument, 0, 'u' }, { "trace", required_argument, 0, 't' },
-        { "help", no_argument, 0, 'h' },
+        { "help", no_argument, 0, 'h' },          { "backend", required_argument, 0, 'b' },
         { "clock-skew-us", required_argument, 0, 'S' },
         { "clock-drift-ppm", required_argument, 0, 'D' },
         { 0, 0, 0, 0 },
@@ -96,6 +100,7 @@ static int parse(int argc, char **argv, struct opts *o)
         case 'c': o->config = optarg; break;
         case 'u': o->url = optarg; break;
         case 't': o->trace = optarg; break;
+        case 'b': o->backend = optarg; break;
         case 'S':
             if (number("--clock-skew-us", optarg, -1e12, 1e12, &o->skew_us) != 0)
                 return -1;
@@ -157,8 +162,8 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     l->clk.drift_ppm = o->drift_ppm;
     if (llc_clock_start(l, url, &d) != NCP_OK)
         return fprintf(stderr, "cnc-axis: error: clock probes: %s\n", d.msg), -1;
-    static const double origin[NCP_AXES];
-    ncp_sim_init(&l->sim, cfg, origin);
+    if (llc_drive_open(l, o->backend) != 0)
+        return -1;
     ncp_dist_rx_init(&l->rx, l->period_ns, 0);
     if (ncp_dist_recs_init(&l->recs) != 0 || llc_blocks_init(l) != 0 || llc_dp1_init(l) != 0)
         return fprintf(stderr, "cnc-axis: out of memory\n"), -1;
@@ -190,6 +195,7 @@ static int run_loop(struct llc *l, FILE *trace)
                                             l->cfg->position.cpu, 0, llc_now() };
     l->loop.cycle = llc_cycle;
     l->loop.ctx = l;
+    llc_drive_live(l);
     if (l->cfg->position.policy != SCHED_FIFO)
         l->loop.cfg.priority = 0;
     int rc = ncp_rt_loop_start(&l->loop);
@@ -239,6 +245,10 @@ static int report(const struct llc *l)
         break;
     case LLC_END_PROGRAM:
         fprintf(stderr, "cnc-axis %c: error: DP 1: %s; held at %.4f mm\n", ax, l->fault, l->cmd);
+        break;
+    case LLC_END_DRIVE:
+        fprintf(stderr, "cnc-axis %c: error: %s; the drive stops as its fault reaction says, "
+                        "the other axes ramp to a standstill\n", ax, l->fault);
         break;
     case LLC_END_MISSING:
         fprintf(stderr, "cnc-axis %c: error: record %d was not here when the interpolator "
@@ -313,6 +323,7 @@ int main(int argc, char **argv)
     if (run_loop(l, trace) != 0)
         l->end = LLC_END_SIGNAL;
     llc_clock_stop(l);
+    llc_drive_close(l);
     int rc = report(l);
     llc_dp1_free(l);
     if (trace && fclose(trace) != 0)

@@ -12,6 +12,7 @@
  * which this axis's own stages take (dp1_ai.c). */
 #include "axis.h"
 
+#include <math.h>
 #include <sched.h>
 #include <signal.h>
 #include <string.h>
@@ -177,6 +178,11 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
                  size < 0 ? "cannot read the program"
                           : "not the HLC's program (size or hash differ)");
         snprintf(p->why, sizeof p->why, "%s: %s", p->path, p->why_short);
+    } else if (l->cfg->nck != NCP_NCK_ADCAI && fabs(l->cmd) > 0.5e-6) {
+        /* its records are positions from the origin its NCK starts at */
+        snprintf(p->why_short, sizeof p->why_short, "axis off the origin (DP 1 starts there)");
+        snprintf(p->why, sizeof p->why, "its NCK runs the program from the origin and the axis "
+                 "stands at %.4f mm: bring it to 0 first, or use DP 2-5", l->cmd);
     } else if (l->cfg->nck == NCP_NCK_ADCAI &&
                (!l->ai || !(l->dp1ai = llc_dp1_ai_new(l, &p->quit)))) {
         snprintf(p->why, sizeof p->why, "cannot set up ADCAI's stages for its axis");

@@ -143,7 +143,7 @@ void llc_publish_status(struct llc *l, int64_t slot)
     s.act_nm = nm(l->act);
     s.ferr_nm = nm(l->ferr);
     s.state = (int8_t)l->state;
-    if (l->end == LLC_END_PROGRAM)
+    if (l->end == LLC_END_PROGRAM || l->end == LLC_END_DRIVE)
         snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault_short[0] ? l->fault_short
                                                                           : l->fault);
     else if (l->end == LLC_END_CLOCK)
@@ -398,7 +398,7 @@ static void trace(struct llc *l, int64_t now, int64_t slot, int gap)
 }
 
 /* One period of the axis, slot being the HLC's period it plays. */
-static void period(struct llc *l, int64_t now, int64_t slot)
+static void period(struct llc *l, int64_t now, int64_t slot, int latest)
 {
     int64_t T = l->period_ns;
     check_ends(l, now);
@@ -417,8 +417,7 @@ static void period(struct llc *l, int64_t now, int64_t slot)
     }
     l->cmd_prev = l->cmd;
     l->cmd = next_cmd;
-    double c[NCP_AXES] = { 0 }, x[NCP_AXES] = { 0 }, a[NCP_AXES];
-    c[l->axis] = l->cmd;
+    double x[NCP_AXES] = { 0 };
     /* feed-forward wants the next period's setpoint: it is usually here
      * already (within the velocity limit, as follow() will take it); else
      * the current velocity goes on */
@@ -432,9 +431,7 @@ static void period(struct llc *l, int64_t now, int64_t slot)
         x[l->axis] = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
     else
         x[l->axis] = 2 * l->cmd - l->cmd_prev;
-    ncp_sim_step(&l->sim, c, x, a);
-    l->act = a[l->axis];
-    l->ferr = l->cmd - l->act;
+    llc_servo(l, l->cmd, x[l->axis], latest);
     int gap = l->rx.held + l->rx.bridged == gaps ? 0 : l->rx.bridged != bridged ? 1 : 2;
     trace(l, now, slot, gap);
 }
@@ -501,20 +498,23 @@ static int waiting(struct llc *l, int64_t now)
         else if (llc_clock_cycle(l, 0) != 0)
             clock_fault(l);
     }
-    if (l->end == LLC_END_PROGRAM || l->end == LLC_END_CLOCK) {
+    if (l->end == LLC_END_PROGRAM || l->end == LLC_END_CLOCK || l->end == LLC_END_DRIVE) {
         l->state = NCP_AX_STATUS_T_FAULT;   /* the HLC names the axis and why */
         llc_publish_status(l, 0);
     }
-    /* a fault before motion is said for a while (a status may be lost) */
-    if (l->end == LLC_END_CLOCK && ++l->fault_reports < FAULT_REPORTS)
-        return 1;
+    /* a fault before motion is said for a while (a status may be lost);
+     * one found before the HLC came (a drive's start-up) until it is here,
+     * or for as long as the HLC would wait for this axis */
+    if (l->end == LLC_END_CLOCK || l->end == LLC_END_DRIVE) {
+        if (!l->last_hlc_ns &&
+            l->fault_waits++ * l->period_ns < l->cfg->lcm.axis_wait_ms * 1000000LL)
+            return 1;
+        if (++l->fault_reports < FAULT_REPORTS)
+            return 1;
+    }
     if (l->end != LLC_END_NONE)
         return -1;
-    double c[NCP_AXES] = { 0 }, a[NCP_AXES];
-    c[l->axis] = l->cmd;
-    ncp_sim_step(&l->sim, c, c, a);
-    l->act = a[l->axis];
-    l->ferr = l->cmd - l->act;
+    llc_servo(l, l->cmd, l->cmd, 1);
     return 1;
 }
 
@@ -555,7 +555,7 @@ int llc_cycle(void *ctx, int64_t now_ns)
     if (slot - from > most * T)
         from = slot - most * T;
     for (int64_t s = from; s <= slot; s += T)
-        period(l, now, s);
+        period(l, now, s, s == slot);
     llc_publish_status(l, slot);
     llc_heartbeat(l, now);
     if (l->state != NCP_AX_STATUS_T_RUNNING && l->cmd == l->cmd_prev) {

@@ -14,3 +14,24 @@ int ncp_backend_open(struct ncp_backend *b, const struct ncp_machine_cfg *cfg, F
     }
     return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0, "unknown backend %d", (int)cfg->backend);
 }
+
+int ncp_backend_spec(const char *spec, struct ncp_machine_cfg *cfg, struct ncp_diag *d)
+{
+    if (!spec || !strcmp(spec, "sim")) {
+        cfg->backend = NCP_BACKEND_SIM;
+        return 0;
+    }
+    if (strncmp(spec, "socketcan", 9) != 0 || (spec[9] != 0 && spec[9] != ':'))
+        return 1;
+    if (spec[9] == ':') {
+        const char *ifc = spec + 10;
+        if (!*ifc || strlen(ifc) >= sizeof cfg->can.interface || strpbrk(ifc, " \t/:")) {
+            ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0, "--backend socketcan: bad interface name '%s'",
+                         ifc);
+            return -1;
+        }
+        snprintf(cfg->can.interface, sizeof cfg->can.interface, "%s", ifc);
+    }
+    cfg->backend = NCP_BACKEND_SOCKETCAN;
+    return 0;
+}

@@ -360,26 +360,19 @@ static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
         return fprintf(stderr, "cnc-run run: --dp and --lcm-url go with --backend lcm\n"), -1;
     if (lcm)
         return apply_lcm(o, cfg);
-    if (!b || !strcmp(b, "sim")) {
-        cfg->backend = NCP_BACKEND_SIM;
-        return 0;
-    }
-    if (strncmp(b, "socketcan", 9) != 0 || (b[9] != 0 && b[9] != ':'))
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    int spec = ncp_backend_spec(b, cfg, &d);
+    if (spec > 0)
         return fprintf(stderr, "cnc-run run: --backend is sim, socketcan[:IFACE] or lcm, not '%s'\n",
                        b), -1;
-    cfg->backend = NCP_BACKEND_SOCKETCAN;
-    if (b[9] == ':') {
-        const char *ifc = b + 10;
-        if (!*ifc || strlen(ifc) >= sizeof cfg->can.interface || strpbrk(ifc, " \t/:"))
-            return fprintf(stderr, "cnc-run run: --backend socketcan: bad interface name '%s'\n",
-                           ifc), -1;
-        snprintf(cfg->can.interface, sizeof cfg->can.interface, "%s", ifc);
-    }
+    if (spec < 0)
+        return fprintf(stderr, "cnc-run run: %s\n", d.msg), -1;
+    if (cfg->backend == NCP_BACKEND_SIM)
+        return 0;
     if (o->virtual_clock)
         return fprintf(stderr, "cnc-run run: --backend socketcan drives real hardware: it "
                                "needs --clock real\n"), -1;
-    struct ncp_diag d;
-    memset(&d, 0, sizeof d);
     if (ncp_socketcan_check_cfg(cfg, &d) != NCP_OK)
         return fprintf(stderr, "%s: error: %s\n", o->config ? o->config : "cnc-run run", d.msg),
                -1;
