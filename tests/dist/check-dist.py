@@ -38,6 +38,9 @@ def seg_dist(p, a, b):
 
 def path_dev(points, path):
     """Largest distance of points (in order) to the polyline path."""
+    # a dwell or a pause repeats one point for many periods: as one point,
+    # so that the search window ahead of the last match spans the path
+    path = [p for i, p in enumerate(path) if i == 0 or p != path[i - 1]]
     worst, j = 0.0, 0
     n = len(path)
     for p in points:

@@ -22,7 +22,7 @@ test-can-host: all
 	$(Q)$(CAN_MASTER_TEST) --selftest
 	$(Q)if why=$$(tools/rtvm/can-available); then \
 	    echo "CAN tests on the host ($$why)"; \
-	    tests/rt/vcan && BUILD=$(BUILD) tests/rt/can; \
+	    tests/rt/vcan && BUILD=$(BUILD) tests/rt/can && BUILD=$(BUILD) tests/rt/can-dist; \
 	else \
 	    echo "SKIP: CAN bus tests on the host: $${why#no: }"; \
 	fi
