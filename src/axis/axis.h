@@ -135,7 +135,6 @@ struct llc {
     struct llc_clock clk;
     int64_t hlc_now;              /* this period's time on the HLC's clock */
     int fault_reports;            /* LLC_END_CLOCK before motion: statuses saying so */
-    int64_t fault_waits;          /* ... and periods before the HLC came */
 };
 
 /* llc_adcai.c: NULL when out of memory or the INI's limits give no filter */
@@ -219,6 +218,9 @@ int llc_cycle(void *ctx, int64_t now_ns);
 int64_t llc_start_at(const struct llc *l, int32_t k);
 void llc_take(struct llc *l, int64_t now);
 void llc_publish_status(struct llc *l, int64_t slot);
+/* src as much as a status's fault field (n bytes) carries, cut at a word
+ * with "..." when it does not fit. */
+void llc_fault_short(char *dst, size_t n, const char *src);
 void llc_heartbeat(struct llc *l, int64_t now);
 void llc_advertise(struct llc *l);
 int64_t llc_now(void);

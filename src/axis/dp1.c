@@ -80,14 +80,9 @@ static void why_failed(struct llc_dp1 *p, const struct ncp_nck_result *res)
         snprintf(what, sizeof what, "%s", res->diag.msg[0] ? res->diag.msg : "its NCK stopped");
     }
     snprintf(p->why, sizeof p->why, "%s:%u: %s", p->path, line, what);
-    /* cut at a word, not inside a number the HLC would then show */
-    int n = snprintf(p->why_short, sizeof p->why_short, "its NCK, line %u: %s", line, what);
-    if (n >= (int)sizeof p->why_short) {
-        char *cut = p->why_short + sizeof p->why_short - 4;
-        while (cut > p->why_short && *cut != ' ')
-            cut--;
-        memcpy(cut, "...", 4);
-    }
+    char full[sizeof what + 32];
+    snprintf(full, sizeof full, "its NCK, line %u: %s", line, what);
+    llc_fault_short(p->why_short, sizeof p->why_short, full);
 }
 
 static void *inner_main(void *arg)

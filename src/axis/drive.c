@@ -13,31 +13,7 @@
  * and cannot be given periods that already passed. */
 #include "axis.h"
 
-#include <math.h>
 #include <string.h>
-
-/* What a status's 64 bytes carry of a fault: up to its last "; " or word
- * within them, so that the HLC's message does not end in half a number. */
-static void shorten(char *dst, size_t n, const char *src)
-{
-    size_t len = strlen(src);
-    if (len < n) {
-        memcpy(dst, src, len + 1);
-        return;
-    }
-    size_t cut = n - 1;
-    while (cut > 0 && !(src[cut] == ';' || src[cut] == ' '))
-        cut--;
-    for (size_t k = cut; k > n / 2; k--)
-        if (src[k] == ';') {
-            cut = k;
-            break;
-        }
-    if (cut == 0)
-        cut = n - 1;
-    memcpy(dst, src, cut);
-    dst[cut] = 0;
-}
 
 int llc_drive_open(struct llc *l, const char *spec)
 {
@@ -69,7 +45,7 @@ int llc_drive_open(struct llc *l, const char *spec)
         l->drive_failed = 1;
         l->end = LLC_END_DRIVE;
         snprintf(l->fault, sizeof l->fault, "drive start-up failed, nothing moved: %s", why);
-        shorten(l->fault_short, sizeof l->fault_short, why);
+        llc_fault_short(l->fault_short, sizeof l->fault_short, why);
         return 0;
     }
     /* the axis is where its drive stands: the HLC starts the program there */
@@ -95,7 +71,7 @@ static void drive_fault(struct llc *l)
     char why[NCP_DIAG_MSG_MAX];
     l->drive.ops->describe_fault(&l->drive, why, sizeof why);
     snprintf(l->fault, sizeof l->fault, "drive fault: %s", why);
-    shorten(l->fault_short, sizeof l->fault_short, why);
+    llc_fault_short(l->fault_short, sizeof l->fault_short, why);
     if (l->end == LLC_END_NONE || l->end == LLC_END_DONE)
         l->end = LLC_END_DRIVE;
 }

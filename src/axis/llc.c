@@ -132,6 +132,17 @@ static int32_t nm(double mm)
     return v;
 }
 
+void llc_fault_short(char *dst, size_t n, const char *src)
+{
+    /* cut at a word, not inside a number the HLC would then show */
+    if (snprintf(dst, n, "%s", src) >= (int)n) {
+        char *cut = dst + n - 4;
+        while (cut > dst && *cut != ' ')
+            cut--;
+        memcpy(cut, "...", 4);
+    }
+}
+
 void llc_publish_status(struct llc *l, int64_t slot)
 {
     ncp_ax_status_t s;
@@ -417,21 +428,21 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     }
     l->cmd_prev = l->cmd;
     l->cmd = next_cmd;
-    double x[NCP_AXES] = { 0 };
+    double cmd_ahead;
     /* feed-forward wants the next period's setpoint: it is usually here
      * already (within the velocity limit, as follow() will take it); else
      * the current velocity goes on */
     int32_t ahead;
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
     if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp1ai)
-        x[l->axis] = llc_dp1_ai_ahead(l, slot + T);
+        cmd_ahead = llc_dp1_ai_ahead(l, slot + T);
     else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
-        x[l->axis] = interpolate_ahead(l, slot + T);
+        cmd_ahead = interpolate_ahead(l, slot + T);
     else if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
-        x[l->axis] = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
+        cmd_ahead = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
     else
-        x[l->axis] = 2 * l->cmd - l->cmd_prev;
-    llc_servo(l, l->cmd, x[l->axis], latest);
+        cmd_ahead = 2 * l->cmd - l->cmd_prev;
+    llc_servo(l, l->cmd, cmd_ahead, latest);
     int gap = l->rx.held + l->rx.bridged == gaps ? 0 : l->rx.bridged != bridged ? 1 : 2;
     trace(l, now, slot, gap);
 }
@@ -507,7 +518,7 @@ static int waiting(struct llc *l, int64_t now)
      * or for as long as the HLC would wait for this axis */
     if (l->end == LLC_END_CLOCK || l->end == LLC_END_DRIVE) {
         if (!l->last_hlc_ns &&
-            l->fault_waits++ * l->period_ns < l->cfg->lcm.axis_wait_ms * 1000000LL)
+            (int64_t)l->waits * l->period_ns < l->cfg->lcm.axis_wait_ms * 1000000LL)
             return 1;
         if (++l->fault_reports < FAULT_REPORTS)
             return 1;
