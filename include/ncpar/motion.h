@@ -40,6 +40,9 @@ enum ncp_nck_variant { NCP_NCK_ADCBI, NCP_NCK_ADCAI };
 /* [LCM] CLOCK: the distributed mode's common time base (ax_status_t's
  * CLOCK_* constants) */
 enum ncp_lcm_clock { NCP_LCM_CLOCK_MONOTONIC, NCP_LCM_CLOCK_PROBE, NCP_LCM_CLOCK_PTP };
+/* [LCM] CLOCK's word for mode (as the INI spells it); a value out of range,
+ * as a status from elsewhere may carry, reads as the default, monotonic. */
+const char *ncp_lcm_clock_name(int mode);
 
 /* The largest feed override cnc-run takes (200 %). Corner blends are planned
  * for it, as LinuxCNC plans them for its MAX_FEED_OVERRIDE. */

@@ -18,7 +18,6 @@
 #include <poll.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define PROBE_FAST_NS 5000000LL    /* until the estimate stands */
 /* The estimate stands with a full window whose best round trip is this
@@ -33,13 +32,6 @@
  * not move the grid at all. */
 #define DEADBAND_NS 20000LL
 #define SLEW_NS 1000LL
-
-static int64_t mono(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
-}
 
 int64_t llc_clock_local(const struct llc_clock *c, int64_t mono_ns)
 {
@@ -58,7 +50,7 @@ static void probe(struct llc *l)
     ncp_clock_probe_t q = { c->seq, (int16_t)(l->axis + 1), 0, c->seq, 0, 0, 0 };
     c->seq++;
     uint8_t buf[64];
-    q.t1_ns = llc_clock_local(c, mono());
+    q.t1_ns = llc_clock_local(c, llc_now());
     int n = ncp_clock_probe_t_encode(buf, 0, sizeof buf, &q);
     if (n > 0 && ncp_msg_publish(c->io.msg, c->channel, buf, (size_t)n) == 0)
         atomic_fetch_add(&c->sent, 1);
@@ -92,17 +84,17 @@ static void *clock_main(void *arg)
     struct llc_clock *c = &l->clk;
     struct pollfd pfd = { .fd = ncp_msg_fd(c->io.msg), .events = POLLIN };
     while (atomic_load(&c->io.run)) {
-        int64_t due = mono() + (atomic_load(&c->ready) ? PROBE_SLOW_NS : PROBE_FAST_NS);
+        int64_t due = llc_now() + (atomic_load(&c->ready) ? PROBE_SLOW_NS : PROBE_FAST_NS);
         probe(l);
-        for (int64_t left; (left = due - mono()) > 0 && atomic_load(&c->io.run);) {
+        for (int64_t left; (left = due - llc_now()) > 0 && atomic_load(&c->io.run);) {
             if (poll(&pfd, 1, (int)(left / 1000000 + 1)) <= 0)
                 continue;
             int sub;
             const uint8_t *p;
             size_t len;
             /* t4 as each is read (see lcm_clock.c) */
-            while (ncp_msg_take(c->io.msg, mono(), &sub, &p, &len) == 1)
-                answered(l, p, len, llc_clock_local(c, mono()));
+            while (ncp_msg_take(c->io.msg, llc_now(), &sub, &p, &len) == 1)
+                answered(l, p, len, llc_clock_local(c, llc_now()));
         }
     }
     return NULL;
@@ -114,7 +106,7 @@ int llc_clock_start(struct llc *l, const char *url, struct ncp_diag *d)
     const struct ncp_machine_cfg *cfg = l->cfg;
     c->mode = cfg->lcm.clock;
     c->tolerance_ns = cfg->lcm.clock_tolerance_us * 1000LL;
-    c->mono0 = mono();
+    c->mono0 = llc_now();
     if (c->mode == NCP_LCM_CLOCK_PTP)
         c->base_ns = ncp_dist_realtime_offset();
     ncp_dist_clock_init(&c->win);
@@ -176,9 +168,9 @@ void llc_clock_status(const struct llc *l, ncp_ax_status_t *s)
 void llc_clock_report(const struct llc *l)
 {
     const struct llc_clock *c = &l->clk;
-    static const char *const mode[] = { "monotonic", "probe", "ptp" };
     char ax = NCP_AXIS_LETTERS[l->axis];
-    fprintf(stderr, "cnc-axis %c: clock %s: %llu probes, %llu answered", ax, mode[c->mode],
+    fprintf(stderr, "cnc-axis %c: clock %s: %llu probes, %llu answered", ax,
+            ncp_lcm_clock_name(c->mode),
             (unsigned long long)atomic_load(&c->sent), (unsigned long long)atomic_load(&c->answers));
     if (llc_clock_known(l))
         fprintf(stderr, "; the HLC's clock ahead of this one by %+.3f ms (round trip %.1f us, "
@@ -187,7 +179,7 @@ void llc_clock_report(const struct llc *l)
                 (double)atomic_load(&c->est_jitter) * 1e-3, (double)c->applied * 1e-6,
                 (double)c->slewed * 1e-3);
     if (c->skew_ns || c->drift_ppm != 0) {
-        int64_t m = mono();
+        int64_t m = llc_now();
         fprintf(stderr, "; this clock simulated %+.1f ppm off CLOCK_MONOTONIC, now %+.3f ms",
                 c->drift_ppm, (double)(llc_clock_local(c, m) - m - c->base_ns) * 1e-6);
     }

@@ -455,16 +455,15 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
  * them to be one (monotonic: one host; ptp: phc2sys keeps them together). */
 static void clock_fault(struct llc *l)
 {
-    static const char *const mode[] = { "monotonic", "probe", "ptp" };
     double ms = (double)atomic_load_explicit(&l->clk.est_offset, memory_order_relaxed) * 1e-6;
     l->end = LLC_END_CLOCK;
     /* within the status's 64 bytes also for clocks of different kinds */
     if (fabs(ms) < 1e6)
         snprintf(l->fault, sizeof l->fault, "the clocks disagree by %+.3f ms ([LCM] CLOCK = %s)",
-                 ms, mode[l->clk.mode]);
+                 ms, ncp_lcm_clock_name(l->clk.mode));
     else
         snprintf(l->fault, sizeof l->fault, "the clocks disagree by %+.0f s ([LCM] CLOCK = %s)",
-                 ms * 1e-3, mode[l->clk.mode]);
+                 ms * 1e-3, ncp_lcm_clock_name(l->clk.mode));
 }
 
 /* Before the HLC's first setpoint: advertise, heartbeat, report the axis at

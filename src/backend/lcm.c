@@ -507,12 +507,11 @@ static void lcm_stop(struct ncp_backend *b)
                 NCP_AXIS_LETTERS[p->axis], (unsigned long long)p->statuses,
                 (unsigned long long)p->lost, (unsigned long long)p->late, p->st.lost,
                 p->st.held, p->st.stale, p->st.duplicate);
-        static const char *const mode[] = { "monotonic", "probe", "ptp" };
-        int m = p->st.clock_mode >= 0 && p->st.clock_mode <= 2 ? p->st.clock_mode : 0;
         if (p->st.clock_rtt_ns > 0)
             fprintf(stderr, "lcm: axis %c: clock %s: the HLC's clock ahead of the LLC's by "
                             "%+.3f ms (round trip %.1f us, jitter %.1f us)\n",
-                    NCP_AXIS_LETTERS[p->axis], mode[m], (double)p->st.clock_offset_ns * 1e-6,
+                    NCP_AXIS_LETTERS[p->axis], ncp_lcm_clock_name(p->st.clock_mode),
+                    (double)p->st.clock_offset_ns * 1e-6,
                     (double)p->st.clock_rtt_ns * 1e-3, (double)p->st.clock_jitter_ns * 1e-3);
     }
     fprintf(stderr, "lcm: the end (%s) said %llu times, the first %.1f ms after the loop's "
@@ -581,9 +580,8 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     int blocks = cfg->lcm.dp == 1 || (!adcai && cfg->lcm.dp >= 2 && cfg->lcm.dp <= 4);
     if (adcai ? !ncp_dist_adcai_dp(cfg->lcm.dp) : !fine && !blocks)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
-                            "DP %d is not implemented yet for NCK = %s: the lcm backend streams "
-                            "at ADCBI's DP 1-5 and ADCAI's DP 1-4", cfg->lcm.dp,
-                            adcai ? "adcai" : "adcbi");
+                            "[PLANNER] NCK = %s has no DP %d (ADCBI: DP 1-5; ADCAI: DP 1-4)",
+                            adcai ? "adcai" : "adcbi", cfg->lcm.dp);
     /* ADCAI's LLCs fine-interpolate at every point but its DP 4 */
     if (blocks && !adcai && ncp_machine_cfg_ipo_ratio(cfg) != 1)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,

@@ -349,6 +349,12 @@ static int can_key(struct ncp_can_cfg *c, const char *k, const char *v, char *wh
     return 0;
 }
 
+const char *ncp_lcm_clock_name(int mode)
+{
+    static const char *const names[] = { "monotonic", "probe", "ptp" };
+    return mode >= NCP_LCM_CLOCK_MONOTONIC && mode <= NCP_LCM_CLOCK_PTP ? names[mode] : names[0];
+}
+
 static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v, char *why, size_t len)
 {
     if (!strcasecmp(k, "URL")) {
@@ -372,9 +378,8 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v, char *wh
     if (!strcasecmp(k, "INJECT_LOSS"))
         return real(v, 0, 1, &l->inject_loss, "(a fraction)", why, len);
     if (!strcasecmp(k, "CLOCK")) {
-        static const char *const names[] = { "monotonic", "probe", "ptp" };
-        for (int i = 0; i < 3; i++)
-            if (!strcasecmp(v, names[i])) {
+        for (int i = NCP_LCM_CLOCK_MONOTONIC; i <= NCP_LCM_CLOCK_PTP; i++)
+            if (!strcasecmp(v, ncp_lcm_clock_name(i))) {
                 l->clock = (enum ncp_lcm_clock)i;
                 return 1;
             }
