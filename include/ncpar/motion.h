@@ -283,6 +283,12 @@ int ncp_seg_moves_other(const struct ncp_seg *s);
  * moves slower than the parameter, so the feed holds). */
 void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                   double tangent[NCP_AXES]);
+/* NCP_SEG_PARAB (length > 0): per axis the most its position changes per
+ * unit of the curve's parameter (rate: the larger of the two lines' shares,
+ * where the tangent starts and ends) and its constant second derivative
+ * (curv = |u2 - u1| / length): at parameter speed v the axis moves at most
+ * v rate and its turn takes v^2 curv of its acceleration. */
+void ncp_seg_parab_rates(const struct ncp_seg *s, double rate[NCP_AXES], double curv[NCP_AXES]);
 
 /* ---- kinematics along segments (kins_seg.c) -------------------------------
  * The planner works on axes; the joints follow through cfg->kins. These keep

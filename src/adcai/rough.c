@@ -26,16 +26,19 @@ struct ncp_adcai_rough {
     struct ncp_adcai_rough_rec tag;
 };
 
-/* The largest |d axis / d path| along s, per axis. An arc's X Y Z take the
- * bound of a circle of its larger radius plus the helix's rise. */
-static void axis_rates(const struct ncp_seg *s, double rate[NCP_AXES])
+/* The largest |d axis / d path| along s, per axis, and what of the axis's
+ * acceleration v^2 curv takes at path speed v (a corner parabola's turn; 0
+ * elsewhere). An arc's X Y Z take the bound of a circle of its larger radius
+ * plus the helix's rise. */
+static void axis_rates(const struct ncp_seg *s, double rate[NCP_AXES], double curv[NCP_AXES])
 {
     double len = s->length > 0 ? s->length : 1;
-    for (int j = 0; j < NCP_AXES; j++)
+    for (int j = 0; j < NCP_AXES; j++) {
         rate[j] = fabs(s->end[j] - s->start[j]) / len;
-    if (s->kind == NCP_SEG_PARAB) {  /* its tangent runs from one line's to the other's */
-        for (int j = 0; j < 3; j++)
-            rate[j] = 2 * fmax(fabs(s->center[j] - s->start[j]), fabs(s->end[j] - s->center[j])) / len;
+        curv[j] = 0;
+    }
+    if (s->kind == NCP_SEG_PARAB && s->length > 0) {
+        ncp_seg_parab_rates(s, rate, curv);
         return;
     }
     if (s->kind != NCP_SEG_ARC)
@@ -52,24 +55,20 @@ double ncp_adcai_rough_speed(const struct ncp_machine_cfg *cfg, const struct ncp
     double v = s->feed;
     if (!s->angular)
         v = fmin(v, cfg->max_linear_vel);
-    double rate[NCP_AXES], a_plane = INFINITY;
-    axis_rates(s, rate);
+    double rate[NCP_AXES], curv[NCP_AXES], a_plane = INFINITY;
+    axis_rates(s, rate, curv);
     for (int j = 0; j < NCP_AXES; j++) {
         if (!(cfg->axis_mask & NCP_AXIS_BIT(j)) || rate[j] < 1e-12)
             continue;
         v = fmin(v, cfg->axis[j].max_vel / rate[j]);
+        if (curv[j] > 1e-12)
+            v = fmin(v, sqrt(cfg->axis[j].max_acc / curv[j]));
         if (s->kind == NCP_SEG_ARC && j < 3 && (s->u[j] != 0 || s->w[j] != 0))
             a_plane = fmin(a_plane, cfg->axis[j].max_acc);
     }
     double r = fmin(s->r0, s->r1);
     if (s->kind == NCP_SEG_ARC && r > 0 && isfinite(a_plane))
         v = fmin(v, sqrt(a_plane * r));
-    /* a corner parabola: v^2 times its constant second derivative per axis */
-    for (int j = 0; j < 3 && s->kind == NCP_SEG_PARAB && s->length > 0; j++) {
-        double k = 2 * fabs(s->start[j] - 2 * s->center[j] + s->end[j]) / (s->length * s->length);
-        if ((cfg->axis_mask & NCP_AXIS_BIT(j)) && k > 1e-12)
-            v = fmin(v, sqrt(cfg->axis[j].max_acc / k));
-    }
     /* a speed of 0 would never end the block: the map refuses zero feeds,
      * this only keeps a broken segment from hanging the machine */
     if (!(v > 1e-6))

@@ -260,11 +260,8 @@ static void parab_limits(const struct ncp_planner *p, struct plan_seg *ps, doubl
     const struct ncp_seg *s = &ps->s;
     double vmax = fmin(s->feed, p->cfg.max_linear_vel), acc = INFINITY, jerk = INFINITY;
     double g[NCP_AXES], k[NCP_AXES];
+    ncp_seg_parab_rates(s, g, k);
     for (int j = 0; j < NCP_AXES; j++) {
-        double c = j < 3 ? s->center[j] : 0.5 * (s->start[j] + s->end[j]);
-        double u1 = 2 * (c - s->start[j]) / s->length, u2 = 2 * (s->end[j] - c) / s->length;
-        g[j] = fmax(fabs(u1), fabs(u2));
-        k[j] = fabs(u2 - u1) / s->length;
         const struct ncp_axis_cfg *a = &p->cfg.axis[j];
         if (g[j] > 1e-12)
             vmax = fmin(vmax, a->max_vel / g[j]);

@@ -78,19 +78,39 @@ static void eval_arc(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
     }
 }
 
+/* The corner a parabola turns at: C in X Y Z; the other axes do not turn
+ * in it (start and end agree there), so their midpoint. */
+static void parab_corner(const struct ncp_seg *s, double c[NCP_AXES])
+{
+    for (int i = 0; i < NCP_AXES; i++)
+        c[i] = i < 3 ? s->center[i] : 0.5 * (s->start[i] + s->end[i]);
+}
+
 /* The corner curve: a quadratic through start, the corner and end. Its
  * second derivative is constant, so at a constant parameter speed every
  * axis accelerates constantly, the axes of both lines at once. */
 static void eval_parab(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                        double tan[NCP_AXES])
 {
-    double l = s->length > 0 ? fmin(dist / s->length, 1.0) : 1.0, m = 1 - l;
+    double l = s->length > 0 ? fmin(dist / s->length, 1.0) : 1.0, m = 1 - l, c[NCP_AXES];
+    parab_corner(s, c);
     for (int i = 0; i < NCP_AXES; i++) {
-        double c = i < 3 ? s->center[i] : 0.5 * (s->start[i] + s->end[i]);
-        pos[i] = l >= 1.0 ? s->end[i] : m * m * s->start[i] + 2 * l * m * c + l * l * s->end[i];
+        pos[i] = l >= 1.0 ? s->end[i] : m * m * s->start[i] + 2 * l * m * c[i] + l * l * s->end[i];
         if (tan)
-            tan[i] = s->length > 0 ? 2 * (m * (c - s->start[i]) + l * (s->end[i] - c)) / s->length
-                                   : 0;
+            tan[i] = s->length > 0
+                         ? 2 * (m * (c[i] - s->start[i]) + l * (s->end[i] - c[i])) / s->length
+                         : 0;
+    }
+}
+
+void ncp_seg_parab_rates(const struct ncp_seg *s, double rate[NCP_AXES], double curv[NCP_AXES])
+{
+    double c[NCP_AXES];
+    parab_corner(s, c);
+    for (int j = 0; j < NCP_AXES; j++) {
+        double u1 = 2 * (c[j] - s->start[j]) / s->length, u2 = 2 * (s->end[j] - c[j]) / s->length;
+        rate[j] = fmax(fabs(u1), fabs(u2));
+        curv[j] = fabs(u2 - u1) / s->length;
     }
 }
 
