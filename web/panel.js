@@ -39,26 +39,41 @@ function setOnline(up) {
   if (!up) stopJog();
 }
 
+// Once a link is dropped, nothing it still delivers counts; a stalled link's
+// close handshake can take seconds, and the panel must show it offline at once.
+function dropLink(ws) {
+  if (ui.ws !== ws) return;
+  ui.ws = null;
+  if (!document.body.classList.contains('offline')) log('fault', 'connection to the NCK lost');
+  setOnline(false);
+  setTimeout(connect, 1000);
+}
+
 function connect() {
   const proto = location.protocol === 'https:' ? 'wss:' : 'ws:';
   const url = `${proto}//${location.host}/ws${token ? '?token=' + encodeURIComponent(token) : ''}`;
   const ws = new WebSocket(url, 'ncp-panel');
   ui.ws = ws;
-  ws.onmessage = (m) => onMessage(m.data);
-  ws.onclose = () => {
-    if (ui.ws === ws) {
-      if (!document.body.classList.contains('offline')) log('fault', 'connection to the NCK lost');
-      setOnline(false);
-      setTimeout(connect, 1000);
-    }
-  };
+  ws.onmessage = (m) => { if (ui.ws === ws) onMessage(m.data); };
+  ws.onopen = () => { ui.lastRecv = performance.now(); };
+  ws.onclose = () => dropLink(ws);
   // a stalled link shows as lost too: the status comes at least every 20 ms
   ws.onerror = () => {};
 }
+// The watchdog's own tick runs late when the page itself was busy (a slow
+// first WebGL set-up, a starved or throttled browser); the statuses that came
+// meanwhile are then still queued behind it, so the link gets a fresh 2 s.
+let watchdogTick = performance.now();
 setInterval(() => {
-  if (ui.ws && ui.ws.readyState === WebSocket.OPEN && ui.lastRecv && performance.now() - ui.lastRecv > 2000) {
+  const now = performance.now();
+  const pageStalled = now - watchdogTick > 1500;
+  watchdogTick = now;
+  if (pageStalled && ui.lastRecv) ui.lastRecv = now;
+  if (ui.ws && ui.ws.readyState === WebSocket.OPEN && ui.lastRecv && now - ui.lastRecv > 2000) {
     log('fault', 'no status for 2 s: reconnecting');
-    ui.ws.close();
+    const ws = ui.ws;
+    dropLink(ws);
+    ws.close();
   }
 }, 500);
 

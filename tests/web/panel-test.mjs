@@ -17,7 +17,7 @@ import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
 
-const CASES = ["static", "connect", "load", "cycle-start", "feed-hold", "resume", "status-lag", "status-lag-p99", "touch-layout", "mdi", "modal-codes", "jog", "upload", "upload-refused", "no-token", "bad-input", "readonly", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi"];
+const CASES = ["static", "connect", "page-stall", "load", "cycle-start", "feed-hold", "resume", "status-lag", "status-lag-p99", "touch-layout", "mdi", "modal-codes", "jog", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi"];
 
 const [BUILD, WORK, CHROMIUM, FIREFOX] = process.argv.slice(2);
 const ROOT = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..', '..');
@@ -238,6 +238,18 @@ async function session(browser) {
     check(!(await page.$eval('#run', (b) => b.disabled)), 'cycle start disabled while connected');
     await shot(page, '01-connected');
   });
+  // A page busy for longer than the panel's 2 s watchdog (a slow first WebGL
+  // set-up, a starved browser) has statuses queued behind the watchdog's own
+  // timer: the link must not be called lost for that.
+  await run('page-stall', async () => {
+    const before = await page.$$eval('#log div', (d) => d.length);
+    await page.evaluate(() => { const t = performance.now(); while (performance.now() - t < 2600); });
+    await sleep(600);
+    const after = await page.$$eval('#log div', (d) => d.map((e) => e.textContent));
+    const lost = after.slice(before).filter((t) => /no status|lost/.test(t));
+    check(lost.length === 0, `the panel called the link lost after a 2.6 s stall of its own: ${lost.join(' | ')}`);
+    check(!(await page.$eval('#run', (b) => b.disabled)), 'cycle start disabled after the page stalled');
+  });
   await run('load', async () => {
     await loadDemo(page);
     const src = fs.readFileSync(path.join(ROOT, 'ncprograms', 'demo.ngc'), 'utf8').split('\n');
@@ -283,8 +295,10 @@ async function session(browser) {
     const a = await status(page);
     await sleep(700);
     const b = await status(page);
+    // The plant's servo still settles by nanometres and the status carries
+    // 6 decimals; an axis that did not stop would move millimetres meanwhile.
     for (const k of Object.keys(a.pos_act))
-      check(Math.abs(a.pos_act[k] - b.pos_act[k]) < 1e-6, `${k} moved while paused: ${a.pos_act[k]} -> ${b.pos_act[k]}`);
+      check(Math.abs(a.pos_act[k] - b.pos_act[k]) < 1e-4, `${k} moved while paused: ${a.pos_act[k]} -> ${b.pos_act[k]}`);
     check(b.state === 'paused', `state ${b.state}`);
     const shown = await page.$eval('#state', (e) => e.textContent);
     check(shown === 'paused', `the panel shows ${shown}`);
@@ -517,6 +531,24 @@ async function session(browser) {
   });
   check(pageErrors.length === 0 || true, '');
   if (pageErrors.length) console.log(`# page errors: ${pageErrors.join(' | ')}`);
+  // The other side of page-stall: a server that stops sending (here stopped
+  // outright) is called lost within the watchdog's 2 s, and the panel comes
+  // back by itself once statuses flow again.
+  await run('link-stalled', async () => {
+    const before = await page.$$eval('#log div', (d) => d.length);
+    srv.proc.kill('SIGSTOP');
+    try {
+      await page.waitForFunction((n) => [...document.querySelectorAll('#log div')].slice(n)
+        .some((e) => e.textContent.includes('no status for 2 s')), { timeout: 6000 }, before);
+      check(await page.$eval('body', (b) => b.classList.contains('offline')), 'not shown offline after the link stalled');
+    } finally {
+      srv.proc.kill('SIGCONT');
+    }
+    await page.waitForFunction(() => !document.body.classList.contains('offline'), { timeout: 10000 });
+    const seq = (await status(page)).seq;
+    await sleep(500);
+    check((await status(page)).seq > seq, 'no statuses after reconnecting');
+  });
   await run('connection-lost', async () => {
     const rc = await stopServer(srv);
     check(rc === 0, `serve exited with ${rc}`);
@@ -612,7 +644,7 @@ async function firefox() {
       await sleep(500);
       const b = await status(page);
       for (const k of Object.keys(a.pos_act))
-        check(Math.abs(a.pos_act[k] - b.pos_act[k]) < 1e-6, `${k} moved while paused`);
+        check(Math.abs(a.pos_act[k] - b.pos_act[k]) < 1e-4, `${k} moved while paused`);
       check(await page.$eval('#state', (e) => e.textContent) === 'paused', 'the panel does not show paused');
     });
     await run('firefox-resume', async () => {
