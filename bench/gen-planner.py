@@ -10,6 +10,9 @@ kinds: sharp   CAM-like 1 mm moves with small arcs and sharp turns (60-150 deg)
        helix   helices: full turns of G2 with a Z feed, radius 2-20 mm
        square  squares of 2-20 mm side, 90 deg corners
        walk    random walk: any direction, 0.2-5 mm steps
+       stairs  steps along X and Y in turn, 0.5-5 mm, every corner 90 deg
+               between axis-aligned lines (where tools/planner-bound.py's
+               per-axis floor applies)
 usage: gen-planner.py KIND [BLOCKS]"""
 import math
 import random
@@ -131,9 +134,26 @@ def walk(r, n):
     return out
 
 
+def stairs(r, n):
+    out, x, y = [], 0.0, 0.0
+    sx, sy = 1, 1
+    for i in range(n):
+        d = r.uniform(0.5, 5)
+        if i % 2 == 0:
+            if abs(x + sx * d) > LIM:
+                sx = -sx
+            x += sx * d
+        else:
+            if abs(y + sy * d) > LIM:
+                sy = -sy
+            y += sy * d
+        out.append("G1 " + fmt(x, y))
+    return out
+
+
 KINDS = {"sharp": (sharp, 300), "arcs": (arcs, 100), "tiny": (tiny, 1000),
          "lines": (lines, 15), "helix": (helix, 12), "square": (square, 60),
-         "walk": (walk, 150)}
+         "walk": (walk, 150), "stairs": (stairs, 100)}
 
 
 def main():
