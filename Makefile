@@ -117,7 +117,7 @@ deps:
 	DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
 	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev linuxcnc-uspace \
 	    liblcm-dev liblcm-bin \
-	    python3 python3-matplotlib valgrind cppcheck clang-tidy file podman \
+	    python3 python3-matplotlib python3-scipy valgrind cppcheck clang-tidy file podman \
 	    libwebsockets-dev chromium firefox-esr
 	command -v npm >/dev/null || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
 	    --no-install-recommends nodejs npm
