@@ -266,7 +266,12 @@ struct ncp_seg {
      * NCP_SEG_PARAB: center is the programmed corner C and, with l = dist /
      * length, p(l) = (1-l)^2 start + 2 l (1-l) C + l^2 end: its tangent runs
      * from the line before's direction to the line after's, both unit in
-     * X Y Z when C sits length / 2 from start and from end. */
+     * X Y Z when C sits length / 2 from start and from end. An uneven one
+     * (r0 = |C - start| and r1 = |end - C| differ, both > 0; 0 = even) has
+     * length r0 + r1 and dist = 2 r0 l + (r1 - r0) l^2, so its tangent is
+     * unit at both ends; run from entry speed v0 to r1 / r0 v0 at a constant
+     * path acceleration, l moves at a constant rate and every axis at a
+     * constant acceleration (ncp_seg_ratio). */
     double center[3], normal[3], u[3], w[3];
     double r0, r1, angle, axial;
 };
@@ -289,6 +294,11 @@ void ncp_seg_eval(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
  * (curv = |u2 - u1| / length): at parameter speed v the axis moves at most
  * v rate and its turn takes v^2 curv of its acceleration. */
 void ncp_seg_parab_rates(const struct ncp_seg *s, double rate[NCP_AXES], double curv[NCP_AXES]);
+/* An uneven corner parabola's exit over entry speed (r1 / r0), else 0: such a
+ * blend is run only as a constant-acceleration ramp from v0 to ratio v0, on
+ * which axis j accelerates at v0^2 curv_j (ncp_seg_parab_rates: there curv is
+ * |r1/r0 u2_j - u1_j| / (2 r0), per square of the entry speed). */
+double ncp_seg_ratio(const struct ncp_seg *s);
 
 /* ---- kinematics along segments (kins_seg.c) -------------------------------
  * The planner works on axes; the joints follow through cfg->kins. These keep

@@ -6,11 +6,16 @@
  * of both lines work at once, where on a circle the centripetal acceleration
  * falls on one axis after the other: within the same P the parabola is
  * faster (v^2 <= 8 P a / (|u2 - u1| |u2_j - u1_j|) per axis j against the
- * circle's a r, r = P cos(phi/2) / (1 - cos(phi/2)), always below). Between
- * an arc and a line the blend is a circular arc. Either stays within the
- * tolerance P of the corner and uses at most the rest of the line before it
- * and half of the line after it, so neighbouring blends never overlap; the
- * planner (try_blend) makes it no larger than the speed it is for needs. */
+ * circle's a r, r = P cos(phi/2) / (1 - cos(phi/2)), always below). Where
+ * that even parabola holds the corner below the feed, the planner may take
+ * an uneven one instead (ncp_blend_corner_ratio): entered slower than it is
+ * left, or the other way, its constant acceleration turns towards the axis
+ * the even one leaves idle. Between an arc and a line the blend is the
+ * parabola through the pull of the arc's tangent and the line (a circle
+ * where the cut is too small for one). Each stays within the tolerance P of
+ * the corner and uses at most the rest of the line before it and half of the
+ * line after it, so neighbouring blends never overlap; the planner
+ * (try_blend) makes an even one no larger than the speed it is for needs. */
 #include "planner_int.h"
 
 #include <math.h>
@@ -88,6 +93,68 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
     return 1;
 }
 
+/* How close an uneven parabola with corner C, start C - u1 and end
+ * C + rho u2 (|u1| = |u2| = 1, u1 . u2 = c) passes C: min over l of
+ * |(1-l)^2 u1 - rho l^2 u2|. The curve is scaled by r0 for a real blend. */
+static double ratio_reach(double rho, double c)
+{
+    double best = INFINITY, lo = 0, hi = 1;
+    /* the squared distance is a quartic in l; a coarse scan, then golden
+     * sections around the best sample */
+    for (int k = 0; k <= 32; k++) {
+        double l = k / 32.0, a = (1 - l) * (1 - l), b = rho * l * l;
+        double d2 = a * a + b * b - 2 * a * b * c;
+        if (d2 < best) {
+            best = d2;
+            lo = fmax(0, l - 1 / 32.0);
+            hi = fmin(1, l + 1 / 32.0);
+        }
+    }
+    const double g = 0.5 * (sqrt(5.0) - 1);
+    for (int i = 0; i < 30; i++) {
+        double l1 = hi - g * (hi - lo), l2 = lo + g * (hi - lo);
+        double a1 = (1 - l1) * (1 - l1), b1 = rho * l1 * l1, a2 = (1 - l2) * (1 - l2),
+               b2 = rho * l2 * l2;
+        if (a1 * a1 + b1 * b1 - 2 * a1 * b1 * c < a2 * a2 + b2 * b2 - 2 * a2 * b2 * c)
+            hi = l2;
+        else
+            lo = l1;
+    }
+    double l = 0.5 * (lo + hi), a = (1 - l) * (1 - l), b = rho * l * l;
+    return sqrt(fmax(0, fmin(best, a * a + b * b - 2 * a * b * c)));
+}
+
+int ncp_blend_corner_ratio(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
+                           struct ncp_seg *blend, double *trim_prev, double *trim_cur)
+{
+    if (prev->tolerance <= 0 || rho <= 0 || rho == 1)
+        return 0;
+    double d;
+    if (!ncp_blend_corner(prev, cur, INFINITY, blend, &d))
+        return 0;
+    double u1[3], u2[3];
+    direction(prev, u1);
+    direction(cur, u2);
+    double reach = ratio_reach(rho, dot3(u1, u2));
+    if (!(reach > 0))
+        return 0;
+    /* the largest r0 within P, and within the lines as the even blend is */
+    double r0 = fmin(prev->tolerance / reach,
+                     fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length / rho));
+    if (r0 < 1e-6)
+        return 0;
+    for (int i = 0; i < 3; i++) {
+        blend->start[i] = prev->end[i] - u1[i] * r0;
+        blend->end[i] = prev->end[i] + u2[i] * rho * r0;
+    }
+    blend->r0 = r0;
+    blend->r1 = rho * r0;
+    blend->length = blend->r0 + blend->r1;
+    *trim_prev = blend->r0;
+    *trim_cur = blend->r1;
+    return 1;
+}
+
 /* The same segment run backwards (lines, and arcs without axial travel). */
 static void reverse(const struct ncp_seg *s, struct ncp_seg *o)
 {
@@ -115,10 +182,11 @@ static int plane_arc(const struct ncp_seg *s)
 
 /* An arc (prev) running into a line (cur) in its plane: the arc's last
  * arc_trim of length is given up; the tangent at the cut meets the line at X,
- * and the blend is the circle tangent to both at equal distance e from X.
- * Its distance from the programmed path is at most the circle's from X plus
- * X's from the corner plus the arc's sagitta over the cut. Returns 0 when
- * the cut gives no proper blend. */
+ * and the blend joins the points at equal distance s from X on both: the
+ * corner parabola through the pull of X (a circle tangent at those points
+ * where s is too small for a parabola). Its distance from the programmed
+ * path is at most the blend's from X plus X's from the corner plus the arc's
+ * sagitta over the cut. Returns 0 when the cut gives no proper blend. */
 static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, double arc_trim,
                     struct ncp_seg *arc, struct ncp_seg *prev_out, struct ncp_seg *cur_out,
                     double *dev)
@@ -143,15 +211,21 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
     if (s <= 0 || q < 0 || q + s > 0.5 * cur->length)
         return 0;
     double phi = acos(c), r = s / tan(0.5 * phi);
-    double xc = 0, nin[3], nl = 0;
+    double xc = 0, nin[3], nl = 0, du = 0;
     for (int i = 0; i < 3; i++) {
         double x = q1[i] + s * t1[i];
         xc += (x - prev->end[i]) * (x - prev->end[i]);
         nin[i] = t2[i] - c * t1[i];
         nl += nin[i] * nin[i];
+        du += (t2[i] - t1[i]) * (t2[i] - t1[i]);
     }
     nl = sqrt(nl);
-    *dev = r * (1.0 / cos(0.5 * phi) - 1.0) + sqrt(xc) +
+    /* Between the same two points the corner parabola (through the pull of
+     * X) passes X closer, s |t2 - t1| / 4 against the circle's
+     * r (1 / cos(phi/2) - 1), and faster: both axes turn at once. Only a cut
+     * so small that the parabola would have no length keeps the circle. */
+    int parab = s >= 1e-6;
+    *dev = (parab ? 0.25 * s * sqrt(du) : r * (1.0 / cos(0.5 * phi) - 1.0)) + sqrt(xc) +
            r_arc * (1 - cos(arc_trim / r_arc));
     *prev_out = *prev;
     prev_out->angle = prev->angle * (1 - arc_trim / prev->length);
@@ -161,7 +235,7 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
     *cur_out = *cur;
     cur_out->length = cur->length - (q + s);
     memset(arc, 0, sizeof *arc);
-    arc->kind = NCP_SEG_ARC;
+    arc->kind = parab ? NCP_SEG_PARAB : NCP_SEG_ARC;
     arc->term = NCP_TERM_CONTINUOUS;
     arc->line = cur->line;
     arc->aux = prev->aux;
@@ -180,6 +254,14 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
     for (int i = 3; i < NCP_AXES; i++) {
         arc->start[i] = q1[i];
         arc->end[i] = cur_out->start[i] = cur->start[i];
+    }
+    if (parab) {
+        memset(arc->normal, 0, sizeof arc->normal);
+        memset(arc->u, 0, sizeof arc->u);
+        for (int i = 0; i < 3; i++)
+            arc->center[i] = q1[i] + s * t1[i];
+        arc->length = 2 * s;
+        return 1;
     }
     cross3(arc->normal, arc->u, arc->w);
     arc->r0 = arc->r1 = r;

@@ -29,6 +29,16 @@ void ncp_la_profile(enum ncp_profile profile, const struct ncp_la *la, double v0
         rec->dur = la->s.dwell;
         return;
     }
+    double ratio = ncp_seg_ratio(&la->s);
+    if (ratio > 0 && !scurve) {
+        /* an uneven corner parabola: the ramp from v0 to ratio v0 and nothing
+         * else (the planner's entry caps keep the exit within what follows);
+         * an entry at rest, never planned, would never end: a crawl instead */
+        v0 = fmax(v0, 1e-3);
+        ncp_trap_plan(&rec->trap, la->s.length, v0, ratio * v0, fmax(v0, ratio * v0), 1e-12);
+        rec->dur = ncp_trap_duration(&rec->trap);
+        return;
+    }
     double v1 = fmin(la->v_end, ncp_plan_seg_reach(scurve, &ps, v0, la->s.length));
     double vmax = fmax(la->vmax, v0);
     if (scurve && la->jerk > 0 && isfinite(la->jerk))

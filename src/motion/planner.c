@@ -304,6 +304,49 @@ static void parab_limits(const struct ncp_planner *p, struct plan_seg *ps, doubl
     ps->a_cap = INFINITY;
 }
 
+/* An uneven corner parabola (ncp_seg_ratio): run only as the ramp from entry
+ * v0 to ratio v0, on which axis j moves at most at v0 max(|u1_j|, ratio |u2_j|)
+ * (its velocity turns linearly between the ends) and accelerates at
+ * v0^2 curv_j; the feed holds at both ends and between. vmax is the highest
+ * speed on it, the entry's cap that over max(1, ratio). */
+static void ratio_limits(const struct ncp_planner *p, struct plan_seg *ps, double share)
+{
+    const struct ncp_seg *s = &ps->s;
+    double ratio = ncp_seg_ratio(s), top = fmax(1, ratio);
+    double v0 = fmin(s->feed, p->cfg.max_linear_vel) / top, g[NCP_AXES], k[NCP_AXES];
+    ncp_seg_parab_rates(s, g, k);
+    for (int j = 0; j < 3; j++) {
+        const struct ncp_axis_cfg *a = &p->cfg.axis[j];
+        double u1 = (s->center[j] - s->start[j]) / s->r0, u2 = (s->end[j] - s->center[j]) / s->r1;
+        double vj = fmax(fabs(u1), ratio * fabs(u2));
+        if (vj > 1e-12)
+            v0 = fmin(v0, a->max_vel / vj);
+        if (k[j] > 1e-12)
+            v0 = fmin(v0, sqrt(share * a->max_acc / k[j]));
+    }
+    ps->vmax = v0 * top;
+    ps->acc = v0 * v0 * fabs(ratio - 1) / (2 * s->r0);
+    ps->jerk = INFINITY;
+    ps->a_eff = INFINITY;
+    ps->kappa = 0;
+    ps->a_cap = INFINITY;
+}
+
+/* The exit speed a segment's profile reaches from entry v0, and the highest
+ * entry from which it can end at v1: the same reach both ways, but for an
+ * uneven parabola, whose exit is always ratio times its entry. */
+static double exit_from(int scurve, const struct plan_seg *ps, double v0)
+{
+    double ratio = ncp_seg_ratio(&ps->s);
+    return ratio > 0 ? ratio * v0 : ncp_plan_seg_reach(scurve, ps, v0, ps->s.length);
+}
+
+static double entry_for(int scurve, const struct plan_seg *ps, double v1)
+{
+    double ratio = ncp_seg_ratio(&ps->s);
+    return ratio > 0 ? v1 / ratio : ncp_plan_seg_reach(scurve, ps, v1, ps->s.length);
+}
+
 /* Programmed arcs keep LinuxCNC's split (half the vector for a_t even at full
  * speed); a blend arc is so short that its speed hardly changes on it, so the
  * speed through the corner gets nearly all of it. */
@@ -315,6 +358,9 @@ static void parab_limits(const struct ncp_planner *p, struct plan_seg *ps, doubl
  * the cap the blend's speed need hardly change (bench: 0.99 rather than
  * 0.95 makes sharp 0.5 % faster and no program slower). */
 #define PARAB_TURN_SHARE 0.99
+/* An uneven parabola is only ever run as its ramp: its axes accelerate at
+ * exactly v0^2 curv_j throughout, and the tangent needs nothing beside it. */
+#define RATIO_TURN_SHARE 0.998
 
 /* A corner (kink) turns the velocity vector within one servo period. A servo
  * sample's second difference is a weighted mean of the continuous acceleration
@@ -419,7 +465,7 @@ static int lowering_safe(const struct ncp_planner *p, double v_tail)
             return v >= p->ex.cur.trap.v1;
         k--;
         ps = &p->q[(p->head + k) % p->cap];
-        v = fmin(ps->vjunc, ncp_plan_seg_reach(plan_scurve(p), ps, v, ps->s.length));
+        v = fmin(ps->vjunc, entry_for(plan_scurve(p), ps, v));
     }
 }
 
@@ -452,6 +498,8 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
         ps->acc = 1;
     } else if (ps->s.kind == NCP_SEG_ARC) {
         arc_limits(p, ps, ps->blend ? BLEND_AN_SHARE : ARC_AN_SHARE);
+    } else if (ps->s.kind == NCP_SEG_PARAB && ncp_seg_ratio(&ps->s) > 0) {
+        ratio_limits(p, ps, RATIO_TURN_SHARE);
     } else if (ps->s.kind == NCP_SEG_PARAB) {
         parab_limits(p, ps, PARAB_TURN_SHARE);
     } else {
@@ -474,6 +522,8 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
     /* a junction belongs to both segments: neither's cruise cap may be exceeded */
     double v_cruise = fmin(ps->vmax, p->last_vmax);
     double v = fmin(v_cruise, junction(p, &p->last_pushed, ps, v_cruise, &kink, &beta_small));
+    if (ncp_seg_ratio(&ps->s) > 0)  /* its vmax is its exit's when that is the faster end */
+        v = fmin(v, ps->vmax / fmax(1, ncp_seg_ratio(&ps->s)));
     if (kink) {
         /* The previous segment gives up acceleration for the kink, unless that
          * would cut into a profile already frozen: then stop at the corner.
@@ -501,13 +551,12 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
         }
         struct plan_seg cur_half = *ps, prev_half;
         cur_half.acc = fmin(ps->acc, f_cur * ps->acc_full);
-        double exit_lb = fmin(v, ncp_plan_seg_reach(plan_scurve(p), &cur_half, 0, ps->s.length));
+        double exit_lb = fmin(v, exit_from(plan_scurve(p), &cur_half, 0));
         if (prev) {
             prev_half = *prev;
             prev_half.acc = fmin(prev->acc, f_prev * prev->acc_full);
         }
-        if (!prev || !lowering_safe(p, fmin(prev->vjunc, ncp_plan_seg_reach(plan_scurve(p), &prev_half, exit_lb,
-                                                                            prev->s.length)))) {
+        if (!prev || !lowering_safe(p, fmin(prev->vjunc, entry_for(plan_scurve(p), &prev_half, exit_lb)))) {
             v = 0;
         } else {
             prev->acc = prev_half.acc;
@@ -571,7 +620,7 @@ static void backward_pass(struct ncp_planner *p)
     double exit_v = 0;
     for (size_t k = p->count; k-- > first;) {
         struct plan_seg *ps = plan_at(p, k);
-        double v = fmin(ps->vjunc, ncp_plan_seg_reach(plan_scurve(p), ps, exit_v, ps->s.length));
+        double v = fmin(ps->vjunc, entry_for(plan_scurve(p), ps, exit_v));
         if (k + 1 < p->count && v == ps->v_in)
             break;
         if (k + 1 < p->count)
@@ -628,7 +677,9 @@ static double blend_vmax(const struct ncp_planner *p, const struct ncp_seg *s)
 /* A blend's caps (an arc's or a parabola's). */
 static void blend_limits(const struct ncp_planner *p, struct plan_seg *ps)
 {
-    if (ps->s.kind == NCP_SEG_PARAB)
+    if (ps->s.kind == NCP_SEG_PARAB && ncp_seg_ratio(&ps->s) > 0)
+        ratio_limits(p, ps, RATIO_TURN_SHARE);
+    else if (ps->s.kind == NCP_SEG_PARAB)
         parab_limits(p, ps, PARAB_TURN_SHARE);
     else
         arc_limits(p, ps, BLEND_AN_SHARE);
@@ -665,6 +716,103 @@ static int size_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
             lo = mid;
     }
     return ncp_blend_corner(tol, s, hi, arc, d);
+}
+
+/* A line's path acceleration. */
+static double line_acc(const struct ncp_planner *p, const struct ncp_seg *s)
+{
+    struct plan_seg ps;
+    memset(&ps, 0, sizeof ps);
+    ps.s = *s;
+    line_limits(p, &ps);
+    return ps.acc;
+}
+
+/* Time of a trapezoid from v0 to v1 over len at acceleration a, cruise cap
+ * vmax; INFINITY where v1 cannot be reached from v0. */
+static double trap_time(double len, double v0, double v1, double a, double vmax)
+{
+    if (len <= 0 || a <= 0)
+        return len <= 0 && v0 == v1 ? 0 : INFINITY;
+    if (fabs(v1 * v1 - v0 * v0) > 2 * a * len * (1 + 1e-9))
+        return INFINITY;
+    double vp = fmin(vmax, sqrt(a * len + 0.5 * (v0 * v0 + v1 * v1)));
+    vp = fmax(vp, fmax(v0, v1));
+    double d1 = (vp * vp - v0 * v0) / (2 * a), d3 = (vp * vp - v1 * v1) / (2 * a);
+    return (vp - v0) / a + (vp - v1) / a + fmax(0, len - d1 - d3) / vp;
+}
+
+/* What a blend entered at v1 and left at v2, trimming t1 and t2 off the
+ * lines, costs with the lines around it: the line before from v_n, the
+ * blend (dur), the line after down to v_n, each at most at v_top. Only what
+ * does not change with the feed override goes in (v_n: this corner's even
+ * speed standing for its neighbours'; v_top: the feed at the largest
+ * override), so the path cut never depends on it. */
+static double corner_cost(double len1, double a1, double len2, double a2, double v_n,
+                          double v_top, double v1, double v2, double t1, double t2, double dur)
+{
+    return trap_time(len1 - t1, v_n, v1, a1, v_top) + dur + trap_time(len2 - t2, v2, v_n, a2, v_top);
+}
+
+/* Uneven corner parabolas: the even one's constant acceleration points along
+ * u2 - u1 and so loads one axis fully and the other less; entered slower and
+ * left faster (or the other way) the vector turns, and at the right ratio
+ * both axes give their limit (bench/corner-lp found the fastest motion over
+ * servo samples taking corners so). Tried where the even blend holds the
+ * corner below the feed, over ratios from 1/5 to 5, each as large as P and
+ * the lines allow; kept when the simple cost above says it is faster. Its
+ * profile is rigid (a ramp), so only where nothing else reshapes profiles:
+ * trapezoids, trivial kinematics, no [TRAJ] DEFAULT_LINEAR_ACCELERATION. */
+#define RATIO_STEPS 24
+/* what an uneven blend must save by the cost, s: where both are about as fast
+ * (a corner between two axes, already at the per-axis floor) the even one stays */
+#define RATIO_GAIN_MIN 1e-4
+static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
+                        const struct plan_seg *prev, const struct ncp_seg *s, double v_goal,
+                        const struct ncp_seg *even, double d, struct ncp_seg *out, double *d1,
+                        double *d2)
+{
+    if (plan_scurve(p) || ncp_kins_active(&p->cfg) || p->cfg.default_linear_acc > 0 ||
+        tol->tolerance <= 0 || prev->s.kind != NCP_SEG_LINE || s->kind != NCP_SEG_LINE)
+        return 0;
+    /* the cost below reads the lines around the corner as lines: where blends
+     * take most of them (tiny CAM chords) the even blend keeps its freedom */
+    if (prev->s.length < 10 * d || s->length < 10 * d)
+        return 0;
+    double v_even = fmin(v_goal, arc_speed(p, even));
+    if (v_even >= v_goal * (1 - 1e-9) || v_even <= 0)
+        return 0;
+    double a1 = line_acc(p, &prev->s), a2 = line_acc(p, s);
+    double len1 = prev->s.length, len2 = s->length;
+    /* its acceleration vector may take every axis's whole limit at once, more
+     * than the 1.23 a the chord allowance (p->chord) is for: the servo's
+     * chords (twice a T^2 / 8 with a read between samples) get what it needs */
+    double a_all = 0, T = p->cfg.servo_period;
+    for (int j = 0; j < 3; j++)
+        a_all += p->cfg.axis[j].max_acc * p->cfg.axis[j].max_acc;
+    struct ncp_seg tol_u = *tol;
+    tol_u.tolerance -= fmax(0, 0.25 * sqrt(a_all) * T * T - p->chord);
+    double best = corner_cost(len1, a1, len2, a2, v_even, v_goal, v_even, v_even, d, d, 2 * d / v_even);
+    int found = 0;
+    for (int k = 0; k <= RATIO_STEPS; k++) {
+        double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2;
+        struct ncp_seg b;
+        if (fabs(rho - 1) < 1e-9 || !ncp_blend_corner_ratio(&tol_u, s, rho, &b, &t1, &t2) ||
+            t1 > 0.2 * prev->s.length || t2 > 0.2 * s->length)
+            continue;
+        double v1 = fmin(v_goal / fmax(1, rho), arc_speed(p, &b) / fmax(1, rho));
+        if (v1 <= 0)
+            continue;
+        double c = corner_cost(len1, a1, len2, a2, v_even, v_goal, v1, rho * v1, t1, t2, 2 * t1 / v1);
+        if (c < best - RATIO_GAIN_MIN) {
+            best = c;
+            *out = b;
+            *d1 = t1;
+            *d2 = t2;
+            found = 1;
+        }
+    }
+    return found;
 }
 
 /* The same where an arc meets a line: the arc's cut is searched instead. */
@@ -738,11 +886,15 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     if (prev->s.kind == NCP_SEG_LINE && s->kind == NCP_SEG_LINE) {
         if (!size_blend(p, &tol, s, v_goal, &arc.s, &d))
             return 0;
+        double d1 = d, d2 = d;
+        struct ncp_seg uneven;
+        if (uneven_blend(p, &tol, prev, s, v_goal, &arc.s, d, &uneven, &d1, &d2))
+            arc.s = uneven;
         prev_out = prev->s;
-        prev_out.length -= d;
+        prev_out.length -= d1;
         memcpy(prev_out.end, arc.s.start, sizeof prev_out.end);
         cur_out = *s;
-        cur_out.length -= d;
+        cur_out.length -= d2;
         memcpy(cur_out.start, arc.s.end, sizeof cur_out.start);
     } else if (!size_arc_blend(p, &tol, s, v_goal, &arc.s, &prev_out, &cur_out)) {
         return 0;
@@ -751,7 +903,7 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     arc.blend = 1;
     blend_limits(p, &arc);
     arc.acc_full = arc.acc;
-    double exit_lb = fmin(arc.vmax, ncp_plan_seg_reach(plan_scurve(p), &arc, 0, arc.s.length));
+    double exit_lb = fmin(arc.vmax, exit_from(plan_scurve(p), &arc, 0));
     struct plan_seg cut = *prev;
     cut.s = prev_out;
     if (cut.s.kind == NCP_SEG_ARC) {
@@ -759,7 +911,7 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
         cut.acc_full = cut.acc;
         cut.acc = fmin(prev->acc, cut.acc);
     }
-    double vin = fmin(prev->vjunc, ncp_plan_seg_reach(plan_scurve(p), &cut, exit_lb, prev_out.length));
+    double vin = fmin(prev->vjunc, entry_for(plan_scurve(p), &cut, exit_lb));
     if (!lowering_safe(p, vin))
         return 0;
     prev->s = prev_out;

@@ -100,6 +100,12 @@ double ncp_plan_seg_profile_acc(int scurve, const struct plan_seg *ps, double v0
 int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,
                      struct ncp_seg *arc, double *trim);
 
+/* blend.c: the uneven parabola (ncp_seg_ratio) at that corner whose exit
+ * runs rho times its entry, as large as prev's G64 P and the lines allow; the
+ * lengths trimmed off prev's end and cur's start. 0 when not possible (no P). */
+int ncp_blend_corner_ratio(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
+                           struct ncp_seg *blend, double *trim_prev, double *trim_cur);
+
 /* blend.c: the same where one side is an arc in a plane and the other a line
  * in it: the arc gives up arc_trim of its length, the line what the blend
  * needs; prev_out and cur_out are the trimmed segments. 0 when the cut gives

@@ -89,25 +89,47 @@ static void parab_corner(const struct ncp_seg *s, double c[NCP_AXES])
 /* The corner curve: a quadratic through start, the corner and end. Its
  * second derivative is constant, so at a constant parameter speed every
  * axis accelerates constantly, the axes of both lines at once. */
+double ncp_seg_ratio(const struct ncp_seg *s)
+{
+    return s->kind == NCP_SEG_PARAB && s->r0 > 0 && s->r1 > 0 && s->r0 != s->r1 ? s->r1 / s->r0
+                                                                                  : 0;
+}
+
 static void eval_parab(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                        double tan[NCP_AXES])
 {
-    double l = s->length > 0 ? fmin(dist / s->length, 1.0) : 1.0, m = 1 - l, c[NCP_AXES];
+    double l, dsdl, c[NCP_AXES];
+    dist = fmin(dist, s->length);
+    if (ncp_seg_ratio(s) > 0) {
+        /* dist = 2 r0 l + (r1 - r0) l^2 solved for l, in the form that
+         * stays exact as r1 - r0 goes to 0 */
+        l = s->length > 0 ? dist / (s->r0 + sqrt(s->r0 * s->r0 + (s->r1 - s->r0) * dist)) : 1.0;
+        l = fmin(l, 1.0);
+        dsdl = 2 * s->r0 + 2 * (s->r1 - s->r0) * l;
+    } else {
+        l = s->length > 0 ? fmin(dist / s->length, 1.0) : 1.0;
+        dsdl = s->length;
+    }
+    double m = 1 - l;
     parab_corner(s, c);
     for (int i = 0; i < NCP_AXES; i++) {
         pos[i] = l >= 1.0 ? s->end[i] : m * m * s->start[i] + 2 * l * m * c[i] + l * l * s->end[i];
         if (tan)
-            tan[i] = s->length > 0
-                         ? 2 * (m * (c[i] - s->start[i]) + l * (s->end[i] - c[i])) / s->length
-                         : 0;
+            tan[i] = dsdl > 0 ? 2 * (m * (c[i] - s->start[i]) + l * (s->end[i] - c[i])) / dsdl : 0;
     }
 }
 
 void ncp_seg_parab_rates(const struct ncp_seg *s, double rate[NCP_AXES], double curv[NCP_AXES])
 {
-    double c[NCP_AXES];
+    double c[NCP_AXES], ratio = ncp_seg_ratio(s);
     parab_corner(s, c);
     for (int j = 0; j < NCP_AXES; j++) {
+        if (ratio > 0) {
+            double u1 = (c[j] - s->start[j]) / s->r0, u2 = (s->end[j] - c[j]) / s->r1;
+            rate[j] = fmax(fabs(u1), fabs(u2));
+            curv[j] = fabs(ratio * u2 - u1) / (2 * s->r0);
+            continue;
+        }
         double u1 = 2 * (c[j] - s->start[j]) / s->length, u2 = 2 * (s->end[j] - c[j]) / s->length;
         rate[j] = fmax(fabs(u1), fabs(u2));
         curv[j] = fabs(u2 - u1) / s->length;

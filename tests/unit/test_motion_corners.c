@@ -3,7 +3,9 @@
  * each blend the rest of the chord before it, not half of what the blend
  * before left; a near reversal (no blend possible) stops with the full
  * acceleration of both lines instead of creeping through the kink at half of
- * it; a corner between lines is taken faster than on the circle within P.
+ * it; a corner between lines is taken faster than on the circle within P,
+ * by an uneven parabola where that lets both axes work, and an arc running
+ * into a line by a parabola too.
  * Every run also keeps every axis within its limits and the path within P. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -157,6 +159,94 @@ static void corner_faster_than_circle(double phi_deg)
     free(r);
 }
 
+/* 60 degrees at X5 Y0 from a line along +X: the even parabola's constant
+ * acceleration points along u2 - u1 = (-0.5, 0.87), loading Y fully and X
+ * at 58 %. The planner takes an uneven one here (entered slower than it is
+ * left, or the other way), whose acceleration turns towards X: on the blend
+ * both axes must work at 0.9 of their limit or more, at a constant
+ * acceleration (the ramp it is run as), the corner within P, the path within
+ * P of the lines and every axis within its limits. */
+static void test_uneven_corner_loads_both_axes(void **state)
+{
+    (void)state;
+    const double u2[2] = { 0.5, sqrt(3) / 2 };
+    char prog[160];
+    snprintf(prog, sizeof prog, "G21 G90 G17 G64 P0.01 Q0\nG1 X0 Y0 F3000\nG1 X5\nG1 X%.9f Y%.9f\nM2\n",
+             5 + 5 * u2[0], 5 * u2[1]);
+    static const double pts[3][2] = { { 0, 0 }, { 5, 0 }, { 7.5, 4.330127019 } };
+    struct ncp_machine_cfg cfg;
+    lcnc_like_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(prog, &cfg, &n, &res);
+    const double T = cfg.servo_period;
+    double dev = 0, closest = INFINITY, acc[2] = { 0, 0 }, v_in = -1, v_out = -1;
+    for (size_t k = 1; k + 1 < n; k++) {
+        dev = fmax(dev, dist_polyline(r[k].cmd, pts, 3));
+        closest = fmin(closest, hypot(r[k].cmd[0] - 5, r[k].cmd[1]));
+        double dx = r[k].cmd[0] - 5, dy = r[k].cmd[1];
+        double off1 = dx <= 0 ? fabs(dy) : hypot(dx, dy);
+        double along = dx * u2[0] + dy * u2[1];
+        double off2 = along >= 0 ? fabs(dx * u2[1] - dy * u2[0]) : hypot(dx, dy);
+        if (off1 < 2e-6 || off2 < 2e-6)
+            continue;  /* on a line */
+        double v = hypot(r[k].cmd[0] - r[k - 1].cmd[0], r[k].cmd[1] - r[k - 1].cmd[1]) / T;
+        if (v_in < 0)
+            v_in = v;
+        v_out = v;
+        /* the blend's own samples: both neighbours on it too */
+        for (int j = 0; j < 2; j++)
+            acc[j] = fmax(acc[j],
+                          fabs(r[k + 1].cmd[j] - 2 * r[k].cmd[j] + r[k - 1].cmd[j]) / (T * T));
+    }
+    double w = worst_acc(r, n, T);
+    if (v_in <= 0 || fabs(v_out / v_in - 1) < 0.2 || acc[0] < 0.9 * AMAX || acc[1] < 0.9 * AMAX ||
+        closest > 0.01 + 1e-6 || dev > 0.01 + 1e-6 || w > 1 + 1e-9)
+        fail_msg("60 deg: blend from %.2f to %.2f mm/s (want an uneven one), X at %.0f and Y at "
+                 "%.0f mm/s^2 on it (want both >= %.0f), corner missed by %.5f mm, path %.5f mm "
+                 "off (P 0.01), axis acceleration %.4f of the limit",
+                 v_in, v_out, acc[0], acc[1], 0.9 * AMAX, closest, dev, w);
+    print_message("60 deg uneven: %.2f -> %.2f mm/s, X %.0f Y %.0f mm/s^2\n", v_in, v_out, acc[0],
+                  acc[1]);
+    free(r);
+}
+
+/* An arc running into a line: a G2 of radius 10 ending along +Y at X10 Y10,
+ * then a line along -X. The blend is the corner parabola through the pull of
+ * the arc's tangent and the line, not a circle (tangent at the same points,
+ * the circle took this corner at 4.63 mm/s): through the corner at least 1.05
+ * times what a circle within P of two lines at 90 degrees could (4.72 mm/s),
+ * the corner within P, every axis within its limits. */
+static void test_arc_line_corner_is_a_parabola(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    lcnc_like_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text("G21 G90 G17 G64 P0.01 Q0\nG0 X20 Y0\nG2 X10 Y10 I0 J10 F3000\n"
+                             "G1 X0 Y10\nM2\n",
+                             &cfg, &n, &res);
+    const double T = cfg.servo_period, P = 0.01 - 0.3 * AMAX * T * T;
+    double half = M_PI / 4, r_circle = P * cos(half) / (1 - cos(half));
+    double v_circle = sqrt(0.95 * AMAX * r_circle), v_min = INFINITY, closest = INFINITY;
+    for (size_t k = 1; k < n; k++) {
+        double d = hypot(r[k].cmd[0] - 10, r[k].cmd[1] - 10);
+        closest = fmin(closest, d);
+        if (d < 0.1)
+            v_min = fmin(v_min, hypot(r[k].cmd[0] - r[k - 1].cmd[0], r[k].cmd[1] - r[k - 1].cmd[1]) / T);
+    }
+    double w = worst_acc(r, n, T);
+    if (v_min < 1.05 * v_circle || closest > 0.01 + 1e-6 || w > 1 + 1e-9)
+        fail_msg("arc into a line at 90 deg: %.2f mm/s through the corner (a circle within P: "
+                 "%.2f, want 1.05 times that), corner missed by %.5f mm, axis acceleration %.4f "
+                 "of the limit",
+                 v_min, v_circle, closest, w);
+    print_message("arc into a line: %.2f mm/s through the corner, %.2f on a circle\n", v_min,
+                  v_circle);
+    free(r);
+}
+
 static void test_corner_faster_than_circle_within_p(void **state)
 {
     (void)state;
@@ -172,6 +262,8 @@ int main(void)
         cmocka_unit_test(test_chord_chain_blends_use_whole_chords),
         cmocka_unit_test(test_near_reversal_stops_at_full_acceleration),
         cmocka_unit_test(test_corner_faster_than_circle_within_p),
+        cmocka_unit_test(test_uneven_corner_loads_both_axes),
+        cmocka_unit_test(test_arc_line_corner_is_a_parabola),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

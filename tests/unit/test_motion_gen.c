@@ -451,7 +451,8 @@ static void test_checker_catches_violations(void **state)
     for (int j = 0; j < 3; j++) {
         vmax[j] = 0.9 * cfg.axis[j].max_vel;
         amax[j] = 0.9 * cfg.axis[j].max_acc;
-        jmax[j] = 0.5 * cfg.axis[j].max_jerk;  /* lines plan with half of it */
+        /* lines plan with half of it: below that every line's jerk phase fails */
+        jmax[j] = 0.45 * cfg.axis[j].max_jerk;
     }
     struct trace_worst w = trace_limits(r, n, cfg.servo_period, vmax, amax, jmax);
     if (!(w.acc > 1 && w.jerk > 1))
