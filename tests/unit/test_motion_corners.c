@@ -110,6 +110,17 @@ static void test_near_reversal_stops_at_full_acceleration(void **state)
     free(r);
 }
 
+/* How far p lies off the two lines of a corner at X5 Y0: along +X up to it,
+ * along u2 from it. */
+static double off_lines(const double p[3], const double u2[2])
+{
+    double dx = p[0] - 5, dy = p[1];
+    double off1 = dx <= 0 ? fabs(dy) : hypot(dx, dy);
+    double along = dx * u2[0] + dy * u2[1];
+    double off2 = along >= 0 ? fabs(dx * u2[1] - dy * u2[0]) : hypot(dx, dy);
+    return fmin(off1, off2);
+}
+
 /* Turning phi degrees at X5 Y0 from a line along +X, P0.01: the blend is
  * bounded by P, not by the lines. A circle within P (its servo chords take
  * 0.3 um of P) runs at sqrt(0.95 a r), r = P cos(phi/2) / (1 - cos(phi/2)):
@@ -135,17 +146,14 @@ static void corner_faster_than_circle(double phi_deg)
     double v_blend = 0, dev = 0, v_max = 0;
     int was_on = 1;
     for (size_t k = 1; k < n; k++) {
-        double dx = r[k].cmd[0] - 5, dy = r[k].cmd[1];
-        double off1 = dx <= 0 ? fabs(dy) : hypot(dx, dy);
-        double along = dx * u2[0] + dy * u2[1];
-        double off2 = along >= 0 ? fabs(dx * u2[1] - dy * u2[0]) : hypot(dx, dy);
+        double off = off_lines(r[k].cmd, u2);
         /* off both lines by more than the trace's rounding: on the blend */
-        int on = off1 < 2e-6 || off2 < 2e-6;
+        int on = off < 2e-6;
         if (!on && !was_on)
             v_blend = fmax(v_blend, hypot(r[k].cmd[0] - r[k - 1].cmd[0],
                                           r[k].cmd[1] - r[k - 1].cmd[1]) / T);
         was_on = on;
-        dev = fmax(dev, fmin(off1, off2));
+        dev = fmax(dev, off);
         for (int j = 0; j < 3; j++)
             v_max = fmax(v_max, fabs(r[k].cmd[j] - r[k - 1].cmd[j]) / T);
     }
@@ -184,11 +192,7 @@ static void test_uneven_corner_loads_both_axes(void **state)
     for (size_t k = 1; k + 1 < n; k++) {
         dev = fmax(dev, dist_polyline(r[k].cmd, pts, 3));
         closest = fmin(closest, hypot(r[k].cmd[0] - 5, r[k].cmd[1]));
-        double dx = r[k].cmd[0] - 5, dy = r[k].cmd[1];
-        double off1 = dx <= 0 ? fabs(dy) : hypot(dx, dy);
-        double along = dx * u2[0] + dy * u2[1];
-        double off2 = along >= 0 ? fabs(dx * u2[1] - dy * u2[0]) : hypot(dx, dy);
-        if (off1 < 2e-6 || off2 < 2e-6)
+        if (off_lines(r[k].cmd, u2) < 2e-6)
             continue;  /* on a line */
         double v = hypot(r[k].cmd[0] - r[k - 1].cmd[0], r[k].cmd[1] - r[k - 1].cmd[1]) / T;
         if (v_in < 0)
