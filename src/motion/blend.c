@@ -247,6 +247,10 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
         cur_out->start[i] = q1[i] + s * t1[i] + s * t2[i];
         arc->start[i] = q1[i];
         arc->end[i] = cur_out->start[i];
+        if (parab) {
+            arc->center[i] = q1[i] + s * t1[i];  /* X, the parabola's corner */
+            continue;
+        }
         arc->center[i] = q1[i] + r * nin[i] / nl;
         arc->u[i] = -nin[i] / nl;
         arc->normal[i] = n[i] / sqrt(nn);
@@ -256,10 +260,6 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
         arc->end[i] = cur_out->start[i] = cur->start[i];
     }
     if (parab) {
-        memset(arc->normal, 0, sizeof arc->normal);
-        memset(arc->u, 0, sizeof arc->u);
-        for (int i = 0; i < 3; i++)
-            arc->center[i] = q1[i] + s * t1[i];
         arc->length = 2 * s;
         return 1;
     }

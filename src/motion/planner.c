@@ -55,6 +55,12 @@ struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
     for (int j = 0; j < NCP_AXES; j++)
         a_max = fmax(a_max, cfg->axis[j].max_acc);
     p->chord = 0.3 * a_max * cfg->servo_period * cfg->servo_period;
+    /* an uneven corner parabola's acceleration vector may take every axis's
+     * whole limit at once, more than those 1.23 a: twice its a T^2 / 8 */
+    double a_all = 0;
+    for (int j = 0; j < 3; j++)
+        a_all += cfg->axis[j].max_acc * cfg->axis[j].max_acc;
+    p->chord_all = 0.25 * sqrt(a_all) * cfg->servo_period * cfg->servo_period;
     fine_ipo_margins(&p->cfg);
     /* room for a blend arc per programmed segment: the window is LOOKAHEAD blocks */
     p->cap = 2 * (size_t)(cfg->lookahead > 1 ? cfg->lookahead : 1) + 2;
@@ -332,6 +338,25 @@ static void ratio_limits(const struct ncp_planner *p, struct plan_seg *ps, doubl
     ps->a_cap = INFINITY;
 }
 
+/* A corner parabola's turn loads each axis at a constant rate, exactly, so it
+ * may take nearly all of the limit at the cruise cap: below the cap the
+ * vector bound (parab_limits) leaves the tangent most of it again, and at
+ * the cap the blend's speed need hardly change (bench: 0.99 rather than
+ * 0.95 makes sharp 0.5 % faster and no program slower). */
+#define PARAB_TURN_SHARE 0.99
+/* An uneven parabola is only ever run as its ramp: its axes accelerate at
+ * exactly v0^2 curv_j throughout, and the tangent needs nothing beside it. */
+#define RATIO_TURN_SHARE 0.998
+
+/* A corner parabola's caps, even or uneven. */
+static void parabola_limits(const struct ncp_planner *p, struct plan_seg *ps)
+{
+    if (ncp_seg_ratio(&ps->s) > 0)
+        ratio_limits(p, ps, RATIO_TURN_SHARE);
+    else
+        parab_limits(p, ps, PARAB_TURN_SHARE);
+}
+
 /* The exit speed a segment's profile reaches from entry v0, and the highest
  * entry from which it can end at v1: the same reach both ways, but for an
  * uneven parabola, whose exit is always ratio times its entry. */
@@ -352,15 +377,6 @@ static double entry_for(int scurve, const struct plan_seg *ps, double v1)
  * speed through the corner gets nearly all of it. */
 #define ARC_AN_SHARE 0.866
 #define BLEND_AN_SHARE 0.95
-/* A corner parabola's turn loads each axis at a constant rate, exactly, so it
- * may take nearly all of the limit at the cruise cap: below the cap the
- * vector bound (parab_limits) leaves the tangent most of it again, and at
- * the cap the blend's speed need hardly change (bench: 0.99 rather than
- * 0.95 makes sharp 0.5 % faster and no program slower). */
-#define PARAB_TURN_SHARE 0.99
-/* An uneven parabola is only ever run as its ramp: its axes accelerate at
- * exactly v0^2 curv_j throughout, and the tangent needs nothing beside it. */
-#define RATIO_TURN_SHARE 0.998
 
 /* A corner (kink) turns the velocity vector within one servo period. A servo
  * sample's second difference is a weighted mean of the continuous acceleration
@@ -498,10 +514,8 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
         ps->acc = 1;
     } else if (ps->s.kind == NCP_SEG_ARC) {
         arc_limits(p, ps, ps->blend ? BLEND_AN_SHARE : ARC_AN_SHARE);
-    } else if (ps->s.kind == NCP_SEG_PARAB && ncp_seg_ratio(&ps->s) > 0) {
-        ratio_limits(p, ps, RATIO_TURN_SHARE);
     } else if (ps->s.kind == NCP_SEG_PARAB) {
-        parab_limits(p, ps, PARAB_TURN_SHARE);
+        parabola_limits(p, ps);
     } else {
         line_limits(p, ps);
     }
@@ -677,10 +691,8 @@ static double blend_vmax(const struct ncp_planner *p, const struct ncp_seg *s)
 /* A blend's caps (an arc's or a parabola's). */
 static void blend_limits(const struct ncp_planner *p, struct plan_seg *ps)
 {
-    if (ps->s.kind == NCP_SEG_PARAB && ncp_seg_ratio(&ps->s) > 0)
-        ratio_limits(p, ps, RATIO_TURN_SHARE);
-    else if (ps->s.kind == NCP_SEG_PARAB)
-        parab_limits(p, ps, PARAB_TURN_SHARE);
+    if (ps->s.kind == NCP_SEG_PARAB)
+        parabola_limits(p, ps);
     else
         arc_limits(p, ps, BLEND_AN_SHARE);
 }
@@ -759,7 +771,7 @@ static double corner_cost(double len1, double a1, double len2, double a2, double
  * left faster (or the other way) the vector turns, and at the right ratio
  * both axes give their limit (bench/corner-lp found the fastest motion over
  * servo samples taking corners so). Tried where the even blend holds the
- * corner below the feed, over ratios from 1/5 to 5, each as large as P and
+ * corner below the feed, over ratios from 1/3 to 3, each as large as P and
  * the lines allow; kept when the simple cost above says it is faster. Its
  * profile is rigid (a ramp), so only where nothing else reshapes profiles:
  * trapezoids, trivial kinematics, no [TRAJ] DEFAULT_LINEAR_ACCELERATION. */
@@ -784,14 +796,8 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
         return 0;
     double a1 = line_acc(p, &prev->s), a2 = line_acc(p, s);
     double len1 = prev->s.length, len2 = s->length;
-    /* its acceleration vector may take every axis's whole limit at once, more
-     * than the 1.23 a the chord allowance (p->chord) is for: the servo's
-     * chords (twice a T^2 / 8 with a read between samples) get what it needs */
-    double a_all = 0, T = p->cfg.servo_period;
-    for (int j = 0; j < 3; j++)
-        a_all += p->cfg.axis[j].max_acc * p->cfg.axis[j].max_acc;
     struct ncp_seg tol_u = *tol;
-    tol_u.tolerance -= fmax(0, 0.25 * sqrt(a_all) * T * T - p->chord);
+    tol_u.tolerance -= fmax(0, p->chord_all - p->chord);
     double best = corner_cost(len1, a1, len2, a2, v_even, v_goal, v_even, v_even, d, d, 2 * d / v_even);
     int found = 0;
     for (int k = 0; k <= RATIO_STEPS; k++) {

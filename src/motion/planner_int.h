@@ -40,6 +40,7 @@ struct ncp_planner {
     struct ncp_seg last_pushed;
     double last_vmax;        /* its cruise cap */
     double chord;            /* how far a servo chord of a blend arc cuts inside it, mm */
+    double chord_all;        /* the same for an uneven corner parabola (uneven_blend) */
     /* G64 Q (LinuxCNC's naive CAM detector): feed lines held back and joined
      * into one while every programmed point stays within Q of it */
     int chain_n;                        /* programmed points in the chain, 0 = none */

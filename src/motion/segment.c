@@ -86,15 +86,16 @@ static void parab_corner(const struct ncp_seg *s, double c[NCP_AXES])
         c[i] = i < 3 ? s->center[i] : 0.5 * (s->start[i] + s->end[i]);
 }
 
-/* The corner curve: a quadratic through start, the corner and end. Its
- * second derivative is constant, so at a constant parameter speed every
- * axis accelerates constantly, the axes of both lines at once. */
 double ncp_seg_ratio(const struct ncp_seg *s)
 {
     return s->kind == NCP_SEG_PARAB && s->r0 > 0 && s->r1 > 0 && s->r0 != s->r1 ? s->r1 / s->r0
                                                                                   : 0;
 }
 
+/* The corner curve: a quadratic through start, the corner and end. Its
+ * second derivative is constant, so at a constant parameter speed every
+ * axis accelerates constantly, the axes of both lines at once (an uneven
+ * one: on its ramp, see ncp_seg_ratio). */
 static void eval_parab(const struct ncp_seg *s, double dist, double pos[NCP_AXES],
                        double tan[NCP_AXES])
 {
