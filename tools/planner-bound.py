@@ -158,9 +158,10 @@ def axis_corner_saving(tol, ai, aj):
     return best
 
 
-def axis_floor(segs, tol, vmax, amax):
+def axis_floor(segs, g, tol, amax):
     """A tighter bound where every line moves one axis alone and every corner
-    is between two different axes (staircases, squares), or None.
+    is between two different axes (staircases, squares), or None (g: the
+    segments' geometry()).
 
     Each axis then runs from rest to rest over its side: on the line before
     a corner the other axis stands still, and after it this one does. Where
@@ -175,7 +176,6 @@ def axis_floor(segs, tol, vmax, amax):
     less, per corner, the most that sum of square roots can be."""
     if tol <= 0 or any(s[0] != "line" for s in segs):
         return None
-    g = [geometry(s, vmax, amax) for s in segs]
     axes = [single_axis(x[3]) for x in g]
     if any(a is None for a in axes) or any(x[0] < 2 * tol for x in g):
         return None
@@ -244,7 +244,7 @@ def bound(segs, tol, vmax, amax):
                 length[k] -= cut / 2
         vj[k] = cap
     t = profile(g, length, (), vj)
-    floor = axis_floor(segs, tol, vmax, amax)
+    floor = axis_floor(segs, g, tol, amax)
     return t if floor is None else max(t, floor)
 
 
