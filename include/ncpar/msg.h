@@ -81,7 +81,9 @@ int ncp_msg_publish(struct ncp_msg *m, const char *channel, const void *payload,
 int ncp_msg_take(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t **payload,
                  size_t *len);
 
-/* Seeded dice for the injected loss: the same seed loses the same messages. */
+/* Seeded dice for the injected loss: the same seed loses the same messages
+ * (ncp_msg_take throws one per subscribed channel, so the same ones of each
+ * channel, whatever else came in between). */
 struct ncp_msg_dice {
     uint64_t s;
 };

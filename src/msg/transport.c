@@ -45,7 +45,9 @@ struct ncp_msg {
     int n_subs;
     char subs[SUBS_MAX][NCP_MSG_CHANNEL_MAX + 1];
     struct ncp_msg_inject inj;
-    struct ncp_msg_dice dice;
+    /* one per channel: a channel's losses do not depend on how much other
+     * traffic (statuses, clock probes, heartbeats) came in between */
+    struct ncp_msg_dice dice[SUBS_MAX];
     unsigned dq_head, dq_count;   /* FIFO: one delay for all, so due times ascend */
     struct delayed *dq;
     struct sockaddr_in group;
@@ -263,12 +265,23 @@ int ncp_msg_send_event(struct ncp_msg *m, const ncp_event_t *e)
 
 /* ---- any channel: the distributed mode's subscriptions ------------------- */
 
+/* The channel's dice: seeded by INJECT_SEED and the channel's name (FNV-1a),
+ * not by the order of the subscriptions. */
+static void channel_dice(struct ncp_msg *m, int sub)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (const char *c = m->subs[sub]; *c; c++)
+        h = (h ^ (unsigned char)*c) * 0x100000001b3ull;
+    ncp_msg_dice_seed(&m->dice[sub], m->inj.seed ^ h);
+}
+
 int ncp_msg_subscribe(struct ncp_msg *m, const char *channel)
 {
     size_t n = strlen(channel);
     if (m->n_subs >= SUBS_MAX || n == 0 || n > NCP_MSG_CHANNEL_MAX)
         return -1;
     memcpy(m->subs[m->n_subs], channel, n + 1);
+    channel_dice(m, m->n_subs);
     return m->n_subs++;
 }
 
@@ -280,7 +293,8 @@ int ncp_msg_set_inject(struct ncp_msg *m, const struct ncp_msg_inject *in)
             return -1;
     }
     m->inj = *in;
-    ncp_msg_dice_seed(&m->dice, in->seed);
+    for (int i = 0; i < m->n_subs; i++)
+        channel_dice(m, i);
     return 0;
 }
 
@@ -344,7 +358,7 @@ int ncp_msg_take(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t **pa
             continue;   /* other LCM traffic on the group */
         m->stats.taken++;
         m->stats.taken_bytes += (uint64_t)n;
-        if (m->inj.loss > 0 && ncp_msg_dice_drop(&m->dice, m->inj.loss)) {
+        if (m->inj.loss > 0 && ncp_msg_dice_drop(&m->dice[s], m->inj.loss)) {
             m->stats.inject_lost++;
             continue;
         }

@@ -476,6 +476,74 @@ static void test_loopback(void **state)
     ncp_msg_close(m);
 }
 
+/* Which of 40 messages on channel A come through INJECT_LOSS 0.5 (a bit
+ * each), with i % 3 messages on channel B before the i-th where mixed; -1
+ * where this machine has no multicast. *lost: all the messages lost. */
+static int64_t arrivals_on_a(int mixed, int *lost)
+{
+    char prefix[32], ch_a[64], ch_b[64];
+    snprintf(prefix, sizeof prefix, "D%d_", (int)getpid());
+    snprintf(ch_a, sizeof ch_a, "%sA", prefix);
+    snprintf(ch_b, sizeof ch_b, "%sB", prefix);
+    static const char url[] = "udpm://239.255.76.68:7771?ttl=0";
+    struct ncp_msg *rx, *tx;
+    struct ncp_diag d;
+    if (ncp_msg_open(&rx, url, prefix, &d) != 0)
+        return -1;
+    assert_int_equal(ncp_msg_open(&tx, url, prefix, &d), 0);
+    assert_int_equal(ncp_msg_subscribe(rx, ch_b), 0);
+    assert_int_equal(ncp_msg_subscribe(rx, ch_a), 1);
+    const struct ncp_msg_inject in = { 0.5, 0, 9 };
+    assert_int_equal(ncp_msg_set_inject(rx, &in), 0);
+    uint64_t sent = 0;
+    for (int i = 0; i < 40; i++) {
+        uint8_t k = (uint8_t)i;
+        for (int j = 0; j < (mixed ? i % 3 : 0); j++, sent++)
+            assert_int_equal(ncp_msg_publish(tx, ch_b, &k, 1), 0);
+        assert_int_equal(ncp_msg_publish(tx, ch_a, &k, 1), 0);
+        sent++;
+    }
+    int64_t got = 0;
+    struct ncp_msg_stats st;
+    for (int tries = 0; tries < 500; tries++) {
+        int sub;
+        const uint8_t *p;
+        size_t len;
+        int r = ncp_msg_take(rx, 0, &sub, &p, &len);
+        assert_true(r >= 0);
+        if (r == 1 && sub == 1 && len == 1 && p[0] < 40)
+            got |= (int64_t)1 << p[0];
+        ncp_msg_get_stats(rx, &st);
+        if (st.taken >= sent && r == 0)
+            break;
+        if (r == 0)
+            usleep(1000);
+    }
+    assert_int_equal(st.taken, sent);
+    *lost = (int)st.inject_lost;
+    ncp_msg_close(tx);
+    ncp_msg_close(rx);
+    return got;
+}
+
+static void test_loss_per_channel(void **state)
+{
+    (void)state;
+    int lost_alone, lost_mixed;
+    int64_t alone = arrivals_on_a(0, &lost_alone);
+    if (alone < 0) {
+        printf("no multicast here\n");
+        skip();
+    }
+    int64_t mixed = arrivals_on_a(1, &lost_mixed);
+    /* about half of A's came through, the same ones with and without B's
+     * traffic between them (B's own messages are diced apart) */
+    int n = __builtin_popcountll((unsigned long long)alone);
+    assert_in_range(n, 8, 32);
+    assert_true(alone == mixed);
+    assert_true(lost_mixed > lost_alone);
+}
+
 static void test_open_errors(void **state)
 {
     (void)state;
@@ -498,6 +566,7 @@ int main(void)
         cmocka_unit_test(test_state_names),   cmocka_unit_test(test_status_json),
         cmocka_unit_test(test_active_codes),
         cmocka_unit_test(test_open_errors),   cmocka_unit_test(test_loopback),
+        cmocka_unit_test(test_loss_per_channel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
