@@ -52,6 +52,11 @@ struct llc_clock {
 /* Periods an LLC at DP1 plays behind the HLC: more than the 6 standstill
  * marks the HLC sends in a row as its path leaves a standstill (lcm_tx.c). */
 #define LLC_DP1_PLAY_DELAY 8
+/* Periods an LLC at ADCBI's block-level points (DP4-DP2) plays behind the
+ * HLC: a motion's first records leave the HLC as it starts them, so this is
+ * the time a lost one has to be asked for again and resent (every 3 periods
+ * while missing: 4 tries; with 3 periods, 20 % loss stopped one run in 6). */
+#define LLC_BLOCK_PLAY_DELAY 12
 
 struct llc_ai;
 struct llc_dp1_ai;
@@ -61,7 +66,7 @@ struct llc_row {          /* one period of the trace, handed to the main thread 
     int64_t t_ns, slot_ns;
     double cmd, act;
     int state;
-    int gap;              /* 0 its own setpoint, 1 bridged, 2 held */
+    int gap;              /* 0 its own setpoint, 1 bridged, 2 held, 3 left out (late loop) */
 };
 
 struct llc {
@@ -85,12 +90,14 @@ struct llc {
     uint32_t held_seen;
     int held_moving;      /* the axis was moving when the setpoints stopped */
     uint32_t clamped;     /* setpoints limited to MAX_VELOCITY */
+    uint32_t left_out;    /* periods the loop woke too late to play (llc.c) */
     int64_t last_hlc_ns, last_hb_ns, last_adv_ns, settle;
-    int64_t lost_at_ns;
+    int64_t lost_at_ns;   /* when LLC_END_LOST was decided */
     uint64_t waits;       /* periods before the HLC's first setpoint */
-    double fault_ferr;    /* the following error LLC_END_FERROR saw */   /* when LLC_END_LOST was decided */
+    double fault_ferr;    /* the following error LLC_END_FERROR saw */
     int32_t seq;
     int done_req;
+    int64_t done_at;      /* the HLC's last period, as its done said */
     _Atomic int signal;   /* set by the signal handler */
     struct ncp_spsc trace_ring;
     int tracing;

@@ -56,8 +56,10 @@ static void on_hlc_heartbeat(struct llc *l, const uint8_t *p, size_t len, int64_
     l->last_hlc_ns = now;
     if (!l->dp && h.dp >= 1 && h.dp <= 4)
         l->dp = (unsigned char)h.dp;
-    if (h.command == NCP_HEARTBEAT_T_COMMAND_DONE)
+    if (h.command == NCP_HEARTBEAT_T_COMMAND_DONE && !l->done_req) {
         l->done_req = 1;
+        l->done_at = h.t_ns;
+    }
     else if (h.command == NCP_HEARTBEAT_T_COMMAND_STOP && l->end == LLC_END_NONE) {
         l->end = LLC_END_HLC_STOP;
         l->hlc_axis = (char)h.axis;
@@ -415,7 +417,10 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     check_ends(l, now);
     double next_cmd;
     uint32_t gaps = l->rx.held + l->rx.bridged, bridged = l->rx.bridged;
-    if (l->end == LLC_END_NONE && !l->done_req) {
+    /* where this LLC computes its command, it runs up to the HLC's last
+     * period (it plays further behind than the HLC's done takes to come) */
+    int play_on = l->done_req && (l->dp4 || l->dp1ai) && slot <= l->done_at;
+    if (l->end == LLC_END_NONE && (!l->done_req || play_on)) {
         l->state = NCP_AX_STATUS_T_RUNNING;
         next_cmd = l->dp1ai ? play_ai(l, slot) : l->dp4 ? interpolate(l, slot) : follow(l, slot);
         if (l->dp4 || l->dp1ai)
@@ -445,6 +450,20 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     llc_servo(l, l->cmd, cmd_ahead, latest);
     int gap = l->rx.held + l->rx.bridged == gaps ? 0 : l->rx.bridged != bridged ? 1 : 2;
     trace(l, now, slot, gap);
+}
+
+/* Periods [from, to) the loop woke too late to play: no setpoint went out
+ * in them, so the drive held the last one while the plant's time passed.
+ * The trace says so (gap 3): the step the next period takes, limited to
+ * MAX_VELOCITY, is a disturbance of the host, not of the path. */
+static void left_out(struct llc *l, int64_t from, int64_t to)
+{
+    for (int64_t s = from; s < to; s += l->period_ns) {
+        l->cmd_prev = l->cmd;
+        llc_servo(l, l->cmd, l->cmd, 0);
+        l->left_out++;
+        trace(l, s, s, 3);
+    }
 }
 
 #define ADVERT_PERIOD_NS 200000000LL   /* 5 a second until the HLC streams */
@@ -549,8 +568,12 @@ int llc_cycle(void *ctx, int64_t now_ns)
      * wake-up never changes it. At DP1 only the standstill marks travel,
      * and a start whose marks all came too late would shift this axis's
      * whole motion run: there the LLC plays further back, so that every one
-     * of the marks the HLC sends in a row at a start is still in time */
-    int64_t delay = l->dp == 1 ? LLC_DP1_PLAY_DELAY : NCP_DIST_PLAY_DELAY;
+     * of the marks the HLC sends in a row at a start is still in time; at
+     * the other block-level points, so that a motion's first record, sent
+     * as the HLC starts it, can still be resent (axis.h) */
+    int64_t delay = l->dp == 1 ? LLC_DP1_PLAY_DELAY
+                    : l->dp4   ? LLC_BLOCK_PLAY_DELAY
+                               : NCP_DIST_PLAY_DELAY;
     l->hlc_now = llc_hlc_time(l, now);
     int64_t slot = l->hlc_now - l->t_first - delay * T - T / 2;
     slot = l->t_first + (slot < 0 ? -((-slot + T - 1) / T) : slot / T) * T;
@@ -562,8 +585,10 @@ int llc_cycle(void *ctx, int64_t now_ns)
      * a loop for 10 ms skipped one of them at 8) */
     int64_t from = l->rx.played_t ? l->rx.played_t + T : slot;
     int64_t most = l->dp4 || l->dp1ai ? 64 : 8;
-    if (slot - from > most * T)
+    if (slot - from > most * T) {
+        left_out(l, from, slot - most * T);
         from = slot - most * T;
+    }
     for (int64_t s = from; s <= slot; s += T)
         period(l, now, s, s == slot);
     llc_publish_status(l, slot);

@@ -96,7 +96,10 @@ static int64_t hlc_now(const struct lcm_be *s)
 
 static void heartbeat(struct lcm_be *s, int command, char axis)
 {
-    ncp_heartbeat_t h = { s->seq++, NCP_DIST_HLC_ID, hlc_now(s), (int8_t)s->cfg->lcm.dp,
+    /* done names the loop's last period: an LLC that plays further behind
+     * (block-level points) runs its own command up to there */
+    int64_t t = command == NCP_HEARTBEAT_T_COMMAND_DONE && s->cycles ? s->last_t : hlc_now(s);
+    ncp_heartbeat_t h = { s->seq++, NCP_DIST_HLC_ID, t, (int8_t)s->cfg->lcm.dp,
                           (int8_t)command, (uint8_t)axis };
     uint8_t buf[64];
     int n = ncp_heartbeat_t_encode(buf, 0, sizeof buf, &h);

@@ -7,10 +7,11 @@
  * planner runs ahead of the loop whenever it can) a record is tapped up to
  * [PLANNER] SETPOINT_RING periods before its first sample plays; at the
  * program's start the ring is still filling and the first records go out
- * at once. Bursts of NCP_DIST_BURST then, or whatever waited HOLD periods:
- * the LLCs play LAG periods behind the HLC, so either way a record is there
- * before its first sample is needed, unless the planner ran dry mid-program
- * (then the LLC stops and says which record it missed). */
+ * at once: the LLCs play LLC_BLOCK_PLAY_DELAY periods behind the HLC, time
+ * for a lost one to be asked for and resent. Bursts of NCP_DIST_BURST then,
+ * or whatever waited HOLD periods: either way a record is there before its
+ * first sample is needed, unless the planner ran dry mid-program (then the
+ * LLC stops and says which record it missed). */
 #include "lcm_tx.h"
 
 #include <stdlib.h>
