@@ -115,7 +115,9 @@ enum ncp_dist_rx_verdict ncp_dist_rx_put(struct ncp_dist_rx *r, int32_t seq, int
  * started to come, the point on the way to the next one received (bridged),
  * or with none yet the last one again (held). */
 int32_t ncp_dist_rx_play(struct ncp_dist_rx *r, int64_t t_ns);
-/* The setpoint of period t_ns if it is here (1), without playing it. */
+/* The setpoint of period t_ns without playing it: 1 it is here; 2 it is
+ * not, but it is the next to play and a later one is here, *nm then what
+ * ncp_dist_rx_play will bridge to; 0 neither. */
 int ncp_dist_rx_peek(const struct ncp_dist_rx *r, int64_t t_ns, int32_t *nm);
 /* Setpoints held for periods after t_ns. */
 int ncp_dist_rx_level(const struct ncp_dist_rx *r, int64_t t_ns);

@@ -66,7 +66,8 @@ struct llc_row {          /* one period of the trace, handed to the main thread 
     int64_t t_ns, slot_ns;
     double cmd, act;
     int state;
-    int gap;              /* 0 its own setpoint, 1 bridged, 2 held, 3 left out (late loop) */
+    int gap;              /* 0 its own setpoint, 1 bridged, 2 held, 3 left out (late loop),
+                           * 4 the next one late (feed-forward guessed) */
 };
 
 struct llc {
@@ -91,6 +92,7 @@ struct llc {
     int held_moving;      /* the axis was moving when the setpoints stopped */
     uint32_t clamped;     /* setpoints limited to MAX_VELOCITY */
     uint32_t left_out;    /* periods the loop woke too late to play (llc.c) */
+    uint32_t ff_guessed;  /* periods in motion without the next setpoint for feed-forward */
     int64_t last_hlc_ns, last_hb_ns, last_adv_ns, settle;
     int64_t lost_at_ns;   /* when LLC_END_LOST was decided */
     uint64_t waits;       /* periods before the HLC's first setpoint */

@@ -49,7 +49,8 @@ static void usage(FILE *f)
           "  --trace CSV   every period: t,slot,cmd,act,state,gap (seconds from the HLC's first\n"
           "                period; slot: the HLC's period played; state: ax_status_t's;\n"
           "                gap: 0 its own setpoint, 1 bridged to the next, 2 held, 3 left\n"
-          "                out: the loop woke too late to play it, the servo held)\n"
+          "                out: the loop woke too late to play it, the servo held, 4 the\n"
+          "                next setpoint late: the servo's feed-forward guessed it)\n"
           "Its periods run on the HLC's clock ([LCM] CLOCK: monotonic on one host; probe\n"
           "estimates the offset from round trips; ptp: CLOCK_REALTIME kept by phc2sys).\n"
           "  --clock-skew-us N, --clock-drift-ppm P   for tests: simulate another host's\n"
@@ -225,10 +226,11 @@ static int report(const struct llc *l)
     fprintf(stderr,
             "cnc-axis %c: %llu periods, %u misses (periods left out %u); setpoints lost %u, "
             "held %u, stale %u, duplicate %u, bridged %u, reordered %u, limited to MAX_VELOCITY "
-            "%u; injected loss %llu, delayed %llu\n",
+            "%u, next one late for feed-forward %u; injected loss %llu, delayed %llu\n",
             ax, (unsigned long long)l->loop.stats.cycles, (unsigned)l->loop.stats.misses,
             l->left_out,
-            l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.bridged, l->rx.reordered, l->clamped,
+            l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.bridged,
+            l->rx.reordered, l->clamped, l->ff_guessed,
             (unsigned long long)st.inject_lost, (unsigned long long)st.inject_delayed);
     if (l->dp4 && !l->dp1ai)
         fprintf(stderr, "cnc-axis %c: DP %d: records taken %d, gaps %u, resend requests %u, "

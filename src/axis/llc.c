@@ -436,8 +436,11 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     double cmd_ahead;
     /* feed-forward wants the next period's setpoint: it is usually here
      * already (within the velocity limit, as follow() will take it); else
-     * the current velocity goes on */
+     * the current velocity goes on, a guess that changes what the servo
+     * does (one period's acceleration in its velocity: ~10 um of contour
+     * at 1 m/s^2), so it is traced (gap 4) and counted */
     int32_t ahead;
+    int guessed = 0;
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
     if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp1ai)
         cmd_ahead = llc_dp1_ai_ahead(l, slot + T);
@@ -445,10 +448,15 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
         cmd_ahead = interpolate_ahead(l, slot + T);
     else if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
         cmd_ahead = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
-    else
+    else {
         cmd_ahead = 2 * l->cmd - l->cmd_prev;
+        guessed = l->state == NCP_AX_STATUS_T_RUNNING && l->cmd != l->cmd_prev;
+        l->ff_guessed += (uint32_t)guessed;
+    }
     llc_servo(l, l->cmd, cmd_ahead, latest);
-    int gap = l->rx.held + l->rx.bridged == gaps ? 0 : l->rx.bridged != bridged ? 1 : 2;
+    int gap = l->rx.held + l->rx.bridged != gaps ? (l->rx.bridged != bridged ? 1 : 2)
+              : guessed                          ? 4
+                                                 : 0;
     trace(l, now, slot, gap);
 }
 

@@ -62,6 +62,23 @@ enum ncp_dist_rx_verdict ncp_dist_rx_put(struct ncp_dist_rx *r, int32_t seq, int
     return NCP_DIST_RX_NEW;
 }
 
+/* A period with no setpoint of its own, the last one played before it:
+ * with a later one here already it lies on the straight line to it (exact
+ * on a line, a chord on an arc), no stop and no double step afterwards (1,
+ * *nm set); else 0. */
+static int bridge(const struct ncp_dist_rx *r, int64_t t_ns, int32_t *nm)
+{
+    for (int j = 2; j < NCP_DIST_RX_SLOTS; j++) {
+        int64_t tj = t_ns + (j - 1) * r->period_ns;
+        unsigned kj = slot_of(r, tj);
+        if (r->slot[kj].t_ns == tj) {
+            *nm = r->last_nm + (int32_t)(((int64_t)r->slot[kj].nm - r->last_nm) / j);
+            return 1;
+        }
+    }
+    return 0;
+}
+
 int32_t ncp_dist_rx_play(struct ncp_dist_rx *r, int64_t t_ns)
 {
     unsigned k = slot_of(r, t_ns);
@@ -69,18 +86,7 @@ int32_t ncp_dist_rx_play(struct ncp_dist_rx *r, int64_t t_ns)
         r->last_nm = r->slot[k].nm;
         r->primed = 1;
     } else if (r->primed) {
-        /* a later one here already: the missing period lies on the straight
-         * line to it (exact on a line, a chord on an arc), no stop and no
-         * double step afterwards */
-        int found = 0;
-        for (int j = 2; j < NCP_DIST_RX_SLOTS && !found; j++) {
-            unsigned kj = slot_of(r, t_ns + (j - 1) * r->period_ns);
-            if (r->slot[kj].t_ns == t_ns + (j - 1) * r->period_ns) {
-                r->last_nm += (int32_t)(((int64_t)r->slot[kj].nm - r->last_nm) / j);
-                found = 1;
-            }
-        }
-        if (found)
+        if (bridge(r, t_ns, &r->last_nm))
             r->bridged++;
         else
             r->held++;
@@ -100,8 +106,9 @@ int ncp_dist_rx_level(const struct ncp_dist_rx *r, int64_t t_ns)
 int ncp_dist_rx_peek(const struct ncp_dist_rx *r, int64_t t_ns, int32_t *nm)
 {
     unsigned k = slot_of(r, t_ns);
-    if (r->slot[k].t_ns != t_ns)
-        return 0;
-    *nm = r->slot[k].nm;
-    return 1;
+    if (r->slot[k].t_ns == t_ns) {
+        *nm = r->slot[k].nm;
+        return 1;
+    }
+    return r->primed && t_ns == r->played_t + r->period_ns && bridge(r, t_ns, nm) ? 2 : 0;
 }

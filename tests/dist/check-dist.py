@@ -17,7 +17,8 @@ Checks (each prints one line; exit 1 if one fails):
    commanded path) is within --contour-pct of the central run's (same
    measure on the central trace's cmd/act), or --contour-floor, whichever is
    larger, over the periods at least 50 periods after a bridged, held or left
-   out one (the LLC trace's gap column), which must be at least a quarter
+   out one, or one whose next setpoint was late for the servo's feed-forward
+   (the LLC trace's gap column: any but 0), which must be at least a quarter
    of them.
 """
 import argparse

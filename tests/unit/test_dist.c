@@ -95,6 +95,33 @@ static void rx_gap_held_and_counted(void **state)
     assert_int_equal(r.stale, 1);
 }
 
+/* Feed-forward looks one period ahead: where that one is lost and a later
+ * one here, the look is what the play will bridge to, not a guess. */
+static void rx_peek_sees_the_bridge(void **state)
+{
+    (void)state;
+    struct ncp_dist_rx r;
+    ncp_dist_rx_init(&r, T, 0);
+    int32_t nm = -1;
+    assert_int_equal(ncp_dist_rx_put(&r, 1, 1 * T, 100), NCP_DIST_RX_NEW);
+    assert_int_equal(ncp_dist_rx_put(&r, 2, 2 * T, 200), NCP_DIST_RX_NEW);
+    assert_int_equal(ncp_dist_rx_peek(&r, 1 * T, &nm), 1);
+    assert_int_equal(nm, 100);
+    assert_int_equal(ncp_dist_rx_play(&r, 1 * T), 100);
+    assert_int_equal(ncp_dist_rx_play(&r, 2 * T), 200);
+    /* nothing after 2T yet: no look ahead */
+    assert_int_equal(ncp_dist_rx_peek(&r, 3 * T, &nm), 0);
+    assert_int_equal(ncp_dist_rx_put(&r, 4, 4 * T, 500), NCP_DIST_RX_NEW);
+    assert_int_equal(ncp_dist_rx_peek(&r, 3 * T, &nm), 2);
+    assert_int_equal(nm, 350);
+    /* only the next period: one further on is not looked at */
+    assert_int_equal(ncp_dist_rx_peek(&r, 5 * T, &nm), 0);
+    assert_int_equal(ncp_dist_rx_play(&r, 3 * T), 350);
+    assert_int_equal(r.bridged, 1);
+    assert_int_equal(ncp_dist_rx_peek(&r, 4 * T, &nm), 1);
+    assert_int_equal(nm, 500);
+}
+
 static void rx_duplicates_and_stale_ignored(void **state)
 {
     (void)state;
@@ -319,7 +346,7 @@ int main(void)
         cmocka_unit_test(nm_range),
         cmocka_unit_test(rx_in_order),
         cmocka_unit_test(rx_gap_held_and_counted),
-        cmocka_unit_test(rx_duplicates_and_stale_ignored),
+        cmocka_unit_test(rx_peek_sees_the_bridge), cmocka_unit_test(rx_duplicates_and_stale_ignored),
         cmocka_unit_test(dice_same_seed_same_losses),
         cmocka_unit_test(recs_round_trip_and_ring),
         cmocka_unit_test(la_and_int_round_trip),
