@@ -59,8 +59,7 @@ static void on_hlc_heartbeat(struct llc *l, const uint8_t *p, size_t len, int64_
     if (h.command == NCP_HEARTBEAT_T_COMMAND_DONE && !l->done_req) {
         l->done_req = 1;
         l->done_at = h.t_ns;
-    }
-    else if (h.command == NCP_HEARTBEAT_T_COMMAND_STOP && l->end == LLC_END_NONE) {
+    } else if (h.command == NCP_HEARTBEAT_T_COMMAND_STOP && l->end == LLC_END_NONE) {
         l->end = LLC_END_HLC_STOP;
         l->hlc_axis = (char)h.axis;
     }
@@ -463,15 +462,19 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
 /* Periods [from, to) the loop woke too late to play: no setpoint went out
  * in them, so the drive held the last one while the plant's time passed.
  * The trace says so (gap 3): the step the next period takes, limited to
- * MAX_VELOCITY, is a disturbance of the host, not of the path. */
+ * MAX_VELOCITY, is a disturbance of the host, not of the path. A servo
+ * holding a point has settled long before LEFT_OUT_RUN periods: a longer
+ * stall (a debugger, SIGSTOP) only counts the rest, within one cycle's time. */
+#define LEFT_OUT_RUN 1000
 static void left_out(struct llc *l, int64_t from, int64_t to)
 {
-    for (int64_t s = from; s < to; s += l->period_ns) {
+    int64_t n = (to - from) / l->period_ns;
+    for (int64_t i = 0; i < n && i < LEFT_OUT_RUN; i++) {
         l->cmd_prev = l->cmd;
         llc_servo(l, l->cmd, l->cmd, 0);
-        l->left_out++;
-        trace(l, s, s, 3);
+        trace(l, from + i * l->period_ns, from + i * l->period_ns, 3);
     }
+    l->left_out += (uint32_t)n;
 }
 
 #define ADVERT_PERIOD_NS 200000000LL   /* 5 a second until the HLC streams */
