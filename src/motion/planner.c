@@ -536,8 +536,9 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
     /* a junction belongs to both segments: neither's cruise cap may be exceeded */
     double v_cruise = fmin(ps->vmax, p->last_vmax);
     double v = fmin(v_cruise, junction(p, &p->last_pushed, ps, v_cruise, &kink, &beta_small));
-    if (ncp_seg_ratio(&ps->s) > 0)  /* its vmax is its exit's when that is the faster end */
-        v = fmin(v, ps->vmax / fmax(1, ncp_seg_ratio(&ps->s)));
+    double ratio = ncp_seg_ratio(&ps->s);
+    if (ratio > 0)  /* its vmax is its exit's when that is the faster end */
+        v = fmin(v, ps->vmax / fmax(1, ratio));
     if (kink) {
         /* The previous segment gives up acceleration for the kink, unless that
          * would cut into a profile already frozen: then stop at the corner.
@@ -806,7 +807,7 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
         if (fabs(rho - 1) < 1e-9 || !ncp_blend_corner_ratio(&tol_u, s, rho, &b, &t1, &t2) ||
             t1 > 0.2 * prev->s.length || t2 > 0.2 * s->length)
             continue;
-        double v1 = fmin(v_goal / fmax(1, rho), arc_speed(p, &b) / fmax(1, rho));
+        double v1 = fmin(v_goal, arc_speed(p, &b)) / fmax(1, rho);
         if (v1 <= 0)
             continue;
         double c = corner_cost(len1, a1, len2, a2, v_even, v_goal, v1, rho * v1, t1, t2, 2 * t1 / v1);
