@@ -4,6 +4,7 @@
 #ifndef NCPAR_ANALYZER_H
 #define NCPAR_ANALYZER_H
 
+#include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -61,6 +62,10 @@ struct ncp_analyzer_cfg {
      * (#5399) the interpreter reads back at a queue buster (see
      * ncp_machine_sync). 0 (parse, check): no call, rs274 -g's stand-in. */
     int m66_on_machine;
+    /* A stop request (a signal's flag): a loop stops within a few thousand
+     * iterations with NCP_ERR_LIMIT "stopped on request", rather than
+     * running its millions of laps first. NULL: none. */
+    const volatile sig_atomic_t *cancel;
 };
 
 /* Queue busters. The interpreter runs far ahead of motion; after a G38.x

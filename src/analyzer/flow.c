@@ -100,6 +100,7 @@ struct ncp_flow {
     struct ncp_flow_frames hooks;
     struct ncp_flow_m98_reader m98_reader;
     uint32_t max_loops, max_depth;
+    const volatile sig_atomic_t *cancel;
 
     struct flow_pos cur;              /* next block to execute */
     struct flow_pos feed_pos;         /* next block the feed will deliver */
@@ -560,12 +561,27 @@ static int ncp_flow_runaway(const struct ncp_flow *f, const struct ncp_block *b,
                         name, op->line, f->max_loops);
 }
 
+/* Looked at every CANCEL_LAPS laps: a lap is about a quarter of a
+ * microsecond, so a stop is seen within a millisecond or so. */
+#define CANCEL_LAPS 4096u
+
+static int ncp_flow_cancelled(const struct ncp_flow *f, const struct ncp_block *b,
+                              const struct flow_label *op, uint32_t laps, struct ncp_diag *d)
+{
+    if (!f->cancel || laps % CANCEL_LAPS != 0 || !*f->cancel)
+        return NCP_OK;
+    char name[80];
+    ncp_flow_display_name(f, b, name, sizeof name);
+    return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
+                        "stopped on request in loop %s at line %u", name, op->line);
+}
+
 static int ncp_flow_count_iteration(struct ncp_flow *f, const struct ncp_block *b,
                            struct flow_label *op, struct ncp_diag *d)
 {
-    if (++op->iterations <= f->max_loops)
-        return NCP_OK;
-    return ncp_flow_runaway(f, b, op, d);
+    if (++op->iterations > f->max_loops)
+        return ncp_flow_runaway(f, b, op, d);
+    return ncp_flow_cancelled(f, b, op, op->iterations, d);
 }
 
 /* A loop head reached by a jump back whose test ends the loop: once per run
@@ -576,9 +592,11 @@ static int ncp_flow_count_iteration(struct ncp_flow *f, const struct ncp_block *
 static int ncp_flow_count_idle_lap(struct ncp_flow *f, const struct ncp_block *b,
                           struct flow_label *op, struct ncp_diag *d)
 {
-    if (!f->by_jump || ++op->idle_laps <= f->max_loops)
+    if (!f->by_jump)
         return NCP_OK;
-    return ncp_flow_runaway(f, b, op, d);
+    if (++op->idle_laps > f->max_loops)
+        return ncp_flow_runaway(f, b, op, d);
+    return ncp_flow_cancelled(f, b, op, op->idle_laps, d);
 }
 
 /* What rs274 does while reading an O-word line: evaluate its expressions unless
@@ -1441,6 +1459,7 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
     f->max_loops = cfg && cfg->max_loop_iterations ? cfg->max_loop_iterations
                                                    : NCP_DEFAULT_MAX_LOOPS;
     f->max_depth = cfg && cfg->max_call_depth ? cfg->max_call_depth : FLOW_DEFAULT_MAX_DEPTH;
+    f->cancel = cfg ? cfg->cancel : NULL;
     f->cur.off = f->src->begin;
     f->cur.line = f->src->begin_line;
     f->feed_pos = f->cur;

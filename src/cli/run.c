@@ -575,7 +575,8 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
 {
     struct ncp_cli_interp ic = { src,
                              { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path,
-                               .max_loop_iterations = o->max_loops, .m66_on_machine = 1 },
+                               .max_loop_iterations = o->max_loops, .m66_on_machine = 1,
+                               .cancel = &run_signal },
                              o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
@@ -636,7 +637,8 @@ int ncp_cli_run(int argc, char **argv)
             .virtual_clock = o.virtual_clock, .for_s = o.for_s,
             .feed_override = o.feed_override, .mode = o.mode, .trace = o.trace,
             .interp = { .tool_table_path = o.tool_table, .subroutine_path = o.sub_path,
-                        .max_loop_iterations = o.max_loops, .m66_on_machine = 1 },
+                        .max_loop_iterations = o.max_loops, .m66_on_machine = 1,
+                        .cancel = &run_signal },
             .backend = o.backend, .inject = o.inject, .seed = o.seed,
             .interrupt = &run_signal, .trace_rings = o.trace_rings,
         };

@@ -119,7 +119,8 @@ static enum precheck_end precheck(const struct ncp_nck_opts *o, const double sta
     memset(&id, 0, sizeof id);
     int rc = o->interpret(o->interp_ctx, &out, &id);
     enum precheck_end end = PC_OK;
-    if (pc->interrupted) {
+    if (pc->interrupted || (rc != NCP_OK && o->interrupt && *o->interrupt)) {
+        /* a loop the interpreter left on the same request ends here too */
         end = PC_INTERRUPTED;
     } else if (pc->failed) {
         *d = pc->d;

@@ -394,6 +394,35 @@ static void test_loop_limit(void **state)
     assert_int_equal(r.blocks, 151);
 }
 
+/* A stop request ends a loop in a few thousand laps, not at its end; a
+ * loop that never asks (too short) and a flag that stays clear change
+ * nothing. */
+static void test_loop_cancel(void **state)
+{
+    (void)state;
+    volatile sig_atomic_t stop = 1;
+    struct ncp_analyzer_cfg cfg = { .cancel = &stop };
+    struct result r;
+    run_cfg("#1=0\no1 while [#1 lt 1000000]\n#1=[#1+1]\no1 endwhile\ng0x1\nm2", &cfg, &r);
+    assert_int_equal(r.rc, NCP_ERR_LIMIT);
+    assert_int_equal(r.d.line, 2);
+    assert_non_null(strstr(r.d.msg, "stopped on request in loop o1 at line 2"));
+    assert_true(r.blocks < 3 * 4096 + 3);
+
+    /* the laps of a loop sent back by a jump count too */
+    run_cfg("o1 repeat [1000000]\no1 endrepeat\nm2", &cfg, &r);
+    assert_int_equal(r.rc, NCP_ERR_LIMIT);
+    assert_non_null(strstr(r.d.msg, "stopped on request"));
+
+    run_cfg("o1 repeat [4000]\ng0x1\no1 endrepeat\nm2", &cfg, &r);
+    assert_int_equal(r.rc, NCP_END);
+    assert_int_equal(r.blocks, 4001);
+
+    stop = 0;
+    run_cfg("#1=0\no1 while [#1 lt 100000]\n#1=[#1+1]\no1 endwhile\nm2", &cfg, &r);
+    assert_int_equal(r.rc, NCP_END);
+}
+
 /* ---- subroutine files ---------------------------------------------------- */
 
 static void write_file(const char *dir, const char *name, const char *text)
@@ -583,6 +612,7 @@ int main(void)
         cmocka_unit_test(test_line_endings_and_block_delete),
         cmocka_unit_test(test_big_and_long_loops),
         cmocka_unit_test(test_loop_limit),
+        cmocka_unit_test(test_loop_cancel),
         cmocka_unit_test(test_call_depth),
         cmocka_unit_test(test_sub_files),
         cmocka_unit_test(test_diag_file_names),
