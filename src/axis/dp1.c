@@ -88,9 +88,6 @@ static void why_failed(struct llc_dp1 *p, const struct ncp_nck_result *res)
 static void *inner_main(void *arg)
 {
     struct llc_dp1 *p = arg;
-    /* the leftovers of the CPU: its threads (which inherit this) must never
-     * take a period from the position loops of this host */
-    (void)setpriority(PRIO_PROCESS, (id_t)gettid(), 19);
     struct llc_dp1_ai *ai = p->l->dp1ai;
     struct ncp_nck_opts no = {
         .cfg = &p->cfg, .interpret = interpret, .interp_ctx = p, .virtual_clock = 1,
@@ -193,6 +190,7 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
         p->acfg.tool_table_path = p->tool_table[0] ? p->tool_table : NULL;
         p->acfg.subroutine_path = p->sub_path[0] ? p->sub_path : NULL;
         p->acfg.m66_on_machine = 1;
+        p->acfg.cancel = &p->stop;   /* leaving: a long loop ends too */
         /* not the position loop's SCHED_FIFO, which a thread inherits */
         pthread_attr_t at;
         struct sched_param sp = { 0 };

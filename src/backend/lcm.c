@@ -199,7 +199,9 @@ static void *idle_main(void *arg)
 
 /* DP1: the LLCs' NCKs start on the program message; this one waits (up to
  * AXIS_WAIT_MS) until each has its first record, as its own planner would
- * have before moving. */
+ * have before moving. Starting without one would only stop the run a few
+ * periods later at that LLC ("record 0 missing"): nothing moves instead,
+ * and the message names the axes and the wait. */
 static int dp1_wait(struct lcm_be *s, int64_t deadline)
 {
     int64_t last = 0;
@@ -211,7 +213,8 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
         }
         take(s, now);
         int ready = 0;
-        for (int i = 0; i < s->n; i++) {
+        char missing[2 * NCP_AXES + 1] = "";
+        for (int i = 0, k = 0; i < s->n; i++) {
             const struct peer *p = &s->p[i];
             if (p->st.state == NCP_AX_STATUS_T_FAULT) {
                 s->fault_axis = NCP_AXIS_LETTERS[p->axis];
@@ -221,10 +224,35 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
                 s->faulted = 1;
                 return -1;
             }
-            ready += p->st.buffer_level > 0;
+            if (now - p->last_hb_ns > s->hb_timeout) {
+                s->fault_axis = NCP_AXIS_LETTERS[p->axis];
+                snprintf(s->fault, sizeof s->fault,
+                         "axis %c's LLC: heartbeat lost (silent for %lld ms) while its NCK "
+                         "started on the program",
+                         s->fault_axis, (long long)((now - p->last_hb_ns) / 1000000));
+                s->faulted = 1;
+                return -1;
+            }
+            if (p->st.buffer_level > 0) {
+                ready++;
+            } else {
+                missing[k++] = NCP_AXIS_LETTERS[p->axis];
+                missing[k++] = ' ';
+                missing[k] = 0;
+            }
         }
-        if (ready == s->n || now > deadline)
+        if (ready == s->n)
             return 0;
+        if (now > deadline) {
+            missing[strlen(missing) - 1] = 0;
+            snprintf(s->fault, sizeof s->fault,
+                     "DP 1: the NCK of axis %s's LLC had no record within %d ms ([LCM] "
+                     "AXIS_WAIT_MS): a busy host, or a program that computes long before "
+                     "its first move",
+                     missing, s->cfg->lcm.axis_wait_ms);
+            s->faulted = 1;
+            return -1;
+        }
         if (now - s->last_hb >= s->hb_period) {
             s->last_hb = now;
             heartbeat(s, NCP_HEARTBEAT_T_COMMAND_RUN, 0);
