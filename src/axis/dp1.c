@@ -30,7 +30,9 @@ struct llc_dp1 {
     struct llc *l;
     struct ncp_machine_cfg cfg;      /* the INI's, on the simulated machine */
     char path[256], tool_table[256], sub_path[256];
+    int64_t size, hash;              /* the HLC's file's */
     struct ncp_source src;
+    int src_open;
     struct ncp_analyzer_cfg acfg;
     struct ncp_spsc ring;            /* inner planner thread -> position loop */
     pthread_t th;
@@ -85,9 +87,37 @@ static void why_failed(struct llc_dp1 *p, const struct ncp_nck_result *res)
     llc_fault_short(p->why_short, sizeof p->why_short, full);
 }
 
+/* The file is the HLC's and opens: read here, not on the position loop (a
+ * program of megabytes takes tens of milliseconds to hash). */
+static int open_program(struct llc_dp1 *p)
+{
+    int64_t size;
+    uint64_t h = ncp_dist_file_hash(p->path, &size);
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (size != p->size || h != (uint64_t)p->hash) {
+        snprintf(p->why_short, sizeof p->why_short, "%s",
+                 size < 0 ? "cannot read the program"
+                          : "not the HLC's program (size or hash differ)");
+        snprintf(p->why, sizeof p->why, "%s: %s", p->path, p->why_short);
+        return -1;
+    }
+    if (ncp_source_open(&p->src, p->path, &d) != NCP_OK) {
+        snprintf(p->why, sizeof p->why, "%s: %s", p->path, d.msg);
+        llc_fault_short(p->why_short, sizeof p->why_short, p->why);
+        return -1;
+    }
+    p->src_open = 1;
+    return 0;
+}
+
 static void *inner_main(void *arg)
 {
     struct llc_dp1 *p = arg;
+    if (open_program(p) != 0) {
+        atomic_store(&p->done, -1);
+        return NULL;
+    }
     struct llc_dp1_ai *ai = p->l->dp1ai;
     struct ncp_nck_opts no = {
         .cfg = &p->cfg, .interpret = interpret, .interp_ctx = p, .virtual_clock = 1,
@@ -137,7 +167,8 @@ void llc_dp1_free(struct llc *l)
             nanosleep(&ts, NULL);
         }
         pthread_join(p->th, NULL);
-        ncp_source_close(&p->src);
+        if (p->src_open)
+            ncp_source_close(&p->src);
     }
     ncp_spsc_destroy(&p->ring);
     free(p);
@@ -159,18 +190,9 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
     memcpy(p->path, m.path, sizeof p->path - 1);
     memcpy(p->tool_table, m.tool_table, sizeof p->tool_table - 1);
     memcpy(p->sub_path, m.sub_path, sizeof p->sub_path - 1);
-    /* one look at the file, on the loop: a program is read once, and the
-     * HLC waits for the records anyway */
-    int64_t size;
-    uint64_t h = ncp_dist_file_hash(p->path, &size);
-    struct ncp_diag d;
-    memset(&d, 0, sizeof d);
-    if (size != m.size || h != (uint64_t)m.hash) {
-        snprintf(p->why_short, sizeof p->why_short, "%s",
-                 size < 0 ? "cannot read the program"
-                          : "not the HLC's program (size or hash differ)");
-        snprintf(p->why, sizeof p->why, "%s: %s", p->path, p->why_short);
-    } else if (l->cfg->nck != NCP_NCK_ADCAI && fabs(l->cmd) > 0.5e-6) {
+    p->size = m.size;
+    p->hash = m.hash;
+    if (l->cfg->nck != NCP_NCK_ADCAI && fabs(l->cmd) > 0.5e-6) {
         /* its records are positions from the origin its NCK starts at */
         snprintf(p->why_short, sizeof p->why_short, "axis off the origin (DP 1 starts there)");
         snprintf(p->why, sizeof p->why, "its NCK runs the program from the origin and the axis "
@@ -178,8 +200,6 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
     } else if (l->cfg->nck == NCP_NCK_ADCAI &&
                (!l->ai || !(l->dp1ai = llc_dp1_ai_new(l, &p->quit)))) {
         snprintf(p->why, sizeof p->why, "cannot set up ADCAI's stages for its axis");
-    } else if (ncp_source_open(&p->src, p->path, &d) != NCP_OK) {
-        snprintf(p->why, sizeof p->why, "%s: %s", p->path, d.msg);
     } else {
         p->cfg = *l->cfg;
         p->cfg.backend = NCP_BACKEND_SIM;
@@ -200,10 +220,8 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
         pthread_attr_setschedparam(&at, &sp);
         p->started = pthread_create(&p->th, &at, inner_main, p) == 0;
         pthread_attr_destroy(&at);
-        if (!p->started) {
-            ncp_source_close(&p->src);
+        if (!p->started)
             snprintf(p->why, sizeof p->why, "cannot start its NCK thread");
-        }
     }
     if (!p->started) {
         l->end = LLC_END_PROGRAM;
