@@ -4,7 +4,6 @@
 #ifndef NCPAR_ANALYZER_H
 #define NCPAR_ANALYZER_H
 
-#include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -62,10 +61,12 @@ struct ncp_analyzer_cfg {
      * (#5399) the interpreter reads back at a queue buster (see
      * ncp_machine_sync). 0 (parse, check): no call, rs274 -g's stand-in. */
     int m66_on_machine;
-    /* A stop request (a signal's flag): a loop stops within a few thousand
-     * iterations with NCP_ERR_LIMIT "stopped on request", rather than
-     * running its millions of laps first. NULL: none. */
-    const volatile sig_atomic_t *cancel;
+    /* A stop request (a signal, an operator's abort), asked every 4096
+     * laps of a loop (about a millisecond): nonzero ends the run there
+     * with NCP_ERR_LIMIT "stopped on request", rather than after the
+     * loop's millions of laps. NULL: never asked. */
+    int (*cancel)(void *ctx);
+    void *cancel_ctx;
 };
 
 /* Queue busters. The interpreter runs far ahead of motion; after a G38.x

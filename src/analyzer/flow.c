@@ -100,7 +100,8 @@ struct ncp_flow {
     struct ncp_flow_frames hooks;
     struct ncp_flow_m98_reader m98_reader;
     uint32_t max_loops, max_depth;
-    const volatile sig_atomic_t *cancel;
+    int (*cancel)(void *ctx);
+    void *cancel_ctx;
 
     struct flow_pos cur;              /* next block to execute */
     struct flow_pos feed_pos;         /* next block the feed will deliver */
@@ -568,7 +569,7 @@ static int ncp_flow_runaway(const struct ncp_flow *f, const struct ncp_block *b,
 static int ncp_flow_cancelled(const struct ncp_flow *f, const struct ncp_block *b,
                               const struct flow_label *op, uint32_t laps, struct ncp_diag *d)
 {
-    if (!f->cancel || laps % CANCEL_LAPS != 0 || !*f->cancel)
+    if (!f->cancel || laps % CANCEL_LAPS != 0 || !f->cancel(f->cancel_ctx))
         return NCP_OK;
     char name[80];
     ncp_flow_display_name(f, b, name, sizeof name);
@@ -1460,6 +1461,7 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
                                                    : NCP_DEFAULT_MAX_LOOPS;
     f->max_depth = cfg && cfg->max_call_depth ? cfg->max_call_depth : FLOW_DEFAULT_MAX_DEPTH;
     f->cancel = cfg ? cfg->cancel : NULL;
+    f->cancel_ctx = cfg ? cfg->cancel_ctx : NULL;
     f->cur.off = f->src->begin;
     f->cur.line = f->src->begin_line;
     f->feed_pos = f->cur;

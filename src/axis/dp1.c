@@ -16,9 +16,7 @@
 #include <sched.h>
 #include <signal.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "ncpar/inject.h"
 #include "ncpar/nck.h"
@@ -109,6 +107,12 @@ static int open_program(struct llc_dp1 *p)
     }
     p->src_open = 1;
     return 0;
+}
+
+static int stop_asked(void *ctx)
+{
+    const struct llc_dp1 *p = ctx;
+    return p->stop != 0;
 }
 
 static void *inner_main(void *arg)
@@ -210,7 +214,8 @@ void llc_on_program(struct llc *l, const uint8_t *b, size_t len)
         p->acfg.tool_table_path = p->tool_table[0] ? p->tool_table : NULL;
         p->acfg.subroutine_path = p->sub_path[0] ? p->sub_path : NULL;
         p->acfg.m66_on_machine = 1;
-        p->acfg.cancel = &p->stop;   /* leaving: a long loop ends too */
+        p->acfg.cancel = stop_asked;   /* leaving: a long loop ends too */
+        p->acfg.cancel_ctx = p;
         /* not the position loop's SCHED_FIFO, which a thread inherits */
         pthread_attr_t at;
         struct sched_param sp = { 0 };

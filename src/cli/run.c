@@ -570,13 +570,19 @@ static void on_signal(int sig)
     run_signal = sig;
 }
 
+static int run_stop_asked(void *ctx)
+{
+    (void)ctx;
+    return run_signal != 0;
+}
+
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
 {
     struct ncp_cli_interp ic = { src,
                              { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path,
                                .max_loop_iterations = o->max_loops, .m66_on_machine = 1,
-                               .cancel = &run_signal },
+                               .cancel = run_stop_asked },
                              o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
@@ -638,7 +644,7 @@ int ncp_cli_run(int argc, char **argv)
             .feed_override = o.feed_override, .mode = o.mode, .trace = o.trace,
             .interp = { .tool_table_path = o.tool_table, .subroutine_path = o.sub_path,
                         .max_loop_iterations = o.max_loops, .m66_on_machine = 1,
-                        .cancel = &run_signal },
+                        .cancel = run_stop_asked },
             .backend = o.backend, .inject = o.inject, .seed = o.seed,
             .interrupt = &run_signal, .trace_rings = o.trace_rings,
         };

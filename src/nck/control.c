@@ -81,6 +81,12 @@ static int need_homing(const struct ncp_nck *s)
 
 /* ---- the interpreter ---------------------------------------------------------------- */
 
+static int job_abort_asked(void *ctx)
+{
+    struct nck *n = ctx;
+    return atomic_load(&n->job.abort);
+}
+
 static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
 {
     struct ncp_nck *s = ctx;
@@ -256,6 +262,7 @@ static int cmd_load(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     struct ncp_analyzer_cfg acfg = s->acfg;
     acfg.resident = 0;
     acfg.instance = NULL;
+    acfg.cancel = NULL;   /* not a job: the last one's abort may still stand */
     struct ncp_output out = { .ctx = s, .emit = emit_nothing };
     struct ncp_run_stats st;
     int rc = ncp_serial_run(&src, &acfg, &out, &st, &d);
@@ -761,6 +768,10 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->acfg.resident = 1;
     s->acfg.m66_on_machine = 1;   /* M66 waits on the machine's inputs */
     s->acfg.instance = NULL;
+    /* an abort ends a long loop of the job's interpreter at once: the
+     * control thread waits for that job before it answers anything else */
+    s->acfg.cancel = job_abort_asked;
+    s->acfg.cancel_ctx = n;
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
     if (s->interp)   /* no run yet: the codes the first one starts in */
