@@ -227,8 +227,16 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *s, struct ncp_diag *d);
  * control, and frees everything. */
 void ncp_nck_free(struct ncp_nck *n);
 
-/* Accepted (0), or refused (-1) with the reason in reason[len]. */
+/* Accepted (0), or refused (-1) with the reason in reason[len], or
+ * NCP_NCK_CMD_PENDING: a load, whose program is checked in a thread of its
+ * own while the caller goes on (status, other channels, E-stop); its answer
+ * comes from ncp_nck_pending. Other loads, runs, MDI, jogs and homing are
+ * refused until then. */
+#define NCP_NCK_CMD_PENDING 1
 int ncp_nck_command(struct ncp_nck *n, const struct ncp_nck_cmd *c, char *reason, size_t len);
+/* The pending load's answer once its check has ended: 0 (the program is
+ * loaded) or -1 with the reason; NCP_NCK_CMD_PENDING while it runs. */
+int ncp_nck_pending(struct ncp_nck *n, char *reason, size_t len);
 /* Moves the NCK on: reads the position loop's cycles (trace, status), ends
  * jobs whose motion is complete, goes through the steps of a stop, notices
  * faults and lost keep-alives. Call it at least every 10 ms. Returns 1 when

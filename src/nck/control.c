@@ -248,36 +248,89 @@ static int emit_nothing(void *ctx, const struct ncp_cmd *cmd)
     return 0;
 }
 
+static int load_cancelled(void *ctx)
+{
+    struct ncp_nck *s = ctx;
+    return atomic_load(&s->load_cancel);
+}
+
+/* Every program error a fresh interpreter finds is refused at the load,
+ * with its place, rather than after the machine has run half the part. */
+static void *load_main(void *arg)
+{
+    struct ncp_nck *s = arg;
+    struct ncp_analyzer_cfg acfg = s->acfg;
+    acfg.resident = 0;
+    acfg.instance = NULL;
+    acfg.cancel = load_cancelled;   /* a shutdown does not wait for the check */
+    acfg.cancel_ctx = s;
+    struct ncp_output out = { .ctx = s, .emit = emit_nothing };
+    struct ncp_run_stats st;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    int rc = ncp_serial_run(&s->load_src, &acfg, &out, &st, &d);
+    s->load_why[0] = 0;
+    if (rc != NCP_OK && rc != NCP_END)
+        snprintf(s->load_why, sizeof s->load_why, "%s:%u:%u: %s",
+                 d.file ? d.file : s->load_path, d.line, d.col ? d.col : 1u, d.msg);
+    atomic_store(&s->load_done, 1);
+    return NULL;
+}
+
 static int cmd_load(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
 {
     if (s->state != NCP_ST_IDLE)
         return refuse(why, len, "cannot load a program while %s", ncp_nck_state_name(s->state));
-    struct ncp_source src;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
-    if (ncp_source_open(&src, c->text, &d) != NCP_OK)
+    if (strlen(c->text) >= sizeof s->load_path)
+        return refuse(why, len, "program path longer than %zu characters",
+                      sizeof s->load_path - 1);
+    if (ncp_source_open(&s->load_src, c->text, &d) != NCP_OK)
         return refuse(why, len, "%s: %s", c->text, d.msg);
-    /* every program error a fresh interpreter finds is refused now, with its
-     * place, rather than after the machine has run half the part */
-    struct ncp_analyzer_cfg acfg = s->acfg;
-    acfg.resident = 0;
-    acfg.instance = NULL;
-    acfg.cancel = NULL;   /* not a job: the last one's abort may still stand */
-    struct ncp_output out = { .ctx = s, .emit = emit_nothing };
-    struct ncp_run_stats st;
-    int rc = ncp_serial_run(&src, &acfg, &out, &st, &d);
-    if (rc != NCP_OK && rc != NCP_END) {
-        ncp_source_close(&src);
-        return refuse(why, len, "%s:%u:%u: %s", d.file ? d.file : c->text, d.line,
-                      d.col ? d.col : 1u, d.msg);
+    snprintf(s->load_path, sizeof s->load_path, "%s", c->text);
+    atomic_store(&s->load_done, 0);
+    atomic_store(&s->load_cancel, 0);
+    if (pthread_create(&s->load_th, NULL, load_main, s) != 0) {
+        ncp_source_close(&s->load_src);
+        return refuse(why, len, "cannot start the program's check");
+    }
+    s->loading = 1;
+    return NCP_NCK_CMD_PENDING;
+}
+
+int ncp_nck_pending(struct ncp_nck *s, char *why, size_t len)
+{
+    if (len)
+        why[0] = 0;
+    if (!s->loading)
+        return refuse(why, len, "no command is pending");
+    if (!atomic_load(&s->load_done))
+        return NCP_NCK_CMD_PENDING;
+    pthread_join(s->load_th, NULL);
+    s->loading = 0;
+    if (atomic_load(&s->load_cancel) || s->load_why[0]) {
+        ncp_source_close(&s->load_src);
+        s->rejected++;
+        return refuse(why, len, "%s", atomic_load(&s->load_cancel)
+                                          ? "the service is shutting down: not loaded"
+                                          : s->load_why);
     }
     if (s->have_prog)
         ncp_source_close(&s->prog);
-    s->prog = src;
+    s->prog = s->load_src;
     s->have_prog = 1;
-    snprintf(s->program, sizeof s->program, "%s", c->text);
+    snprintf(s->program, sizeof s->program, "%s", s->load_path);
     nck_post(&s->n, NCP_EV_INFO, s->program, 0, 0, "loaded %s", s->program);
     return 0;
+}
+
+/* A load being checked: the commands that would use the program, or start
+ * anything else, wait for its answer. */
+static int waits_for_load(int kind)
+{
+    return kind == NCP_CMD_LOAD || kind == NCP_CMD_RUN || kind == NCP_CMD_MDI ||
+           kind == NCP_CMD_JOG || kind == NCP_CMD_HOME;
 }
 
 static int cmd_run(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
@@ -594,6 +647,11 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
                         s->state == NCP_ST_STOPPING ? "" : " (cnc-ctl reset first)");
             break;
         }
+        if (s->loading && waits_for_load(c->kind)) {
+            rc = refuse(why, len, "%s is being checked: wait for its load's answer",
+                        s->load_path);
+            break;
+        }
         switch (c->kind) {
         case NCP_CMD_LOAD: rc = cmd_load(s, c, why, len); break;
         case NCP_CMD_RUN: rc = cmd_run(s, c, why, len); break;
@@ -614,7 +672,7 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
         default: rc = refuse(why, len, "unknown command %d", c->kind); break;
         }
     }
-    if (rc)
+    if (rc < 0)
         s->rejected++;
     return rc;
 }
@@ -743,7 +801,10 @@ int ncp_nck_poll(struct ncp_nck *s)
             begin_drop(s, 1, 0, NCP_ST_IDLE, 0);
         }
     }
-    if (s->shutdown_pending && s->drop == NCK_DROP_NONE && !moving_state(s->state))
+    if (s->shutdown_pending && s->loading)
+        atomic_store(&s->load_cancel, 1);   /* answered by ncp_nck_pending */
+    if (s->shutdown_pending && s->drop == NCK_DROP_NONE && !moving_state(s->state) &&
+        !s->loading)
         s->shutdown = 1;
     int changed = s->changed;
     s->changed = 0;
@@ -796,6 +857,12 @@ void ncp_nck_free(struct ncp_nck *s)
     if (!s)
         return;
     struct nck *n = &s->n;
+    if (s->loading) {
+        atomic_store(&s->load_cancel, 1);
+        pthread_join(s->load_th, NULL);
+        ncp_source_close(&s->load_src);
+        s->loading = 0;
+    }
     nck_finish(n);
     nck_read_cycles(n);
     if (n->setup.trace)

@@ -422,6 +422,15 @@ struct ncp_nck {
     struct ncp_source prog;
     int have_prog;
     char program[256];
+    /* load: the program's check runs in load_th, off the caller's thread
+     * (a program of millions of blocks takes seconds); the answer is
+     * ncp_nck_pending()'s */
+    pthread_t load_th;
+    int loading;
+    _Atomic int load_done, load_cancel;
+    struct ncp_source load_src;
+    char load_path[256];
+    char load_why[256];
     char mdi[NCP_NCK_TEXT_MAX + 2];
     struct ncp_source mdi_src;
     const struct ncp_source *run_src;

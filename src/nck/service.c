@@ -22,12 +22,15 @@ struct client {
     int32_t id, seq;
     int64_t last_ns;
     ncp_ack_t ack;
+    int pending;                     /* seq's answer is not known yet: a resend waits */
 };
 
 struct serve_channel {
     struct ncp_nck *nck;
     int num;                         /* the messages' channel field */
     int32_t jog_client;              /* whose keep-alives hold a continuous jog */
+    int pending;                     /* a command answered later (a load's check) */
+    int32_t pending_client, pending_seq;
 };
 
 struct serve {
@@ -186,6 +189,9 @@ static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *
     send_ack(sv, a);
 }
 
+static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int32_t client,
+                   int32_t seq, int rc, const char *why);
+
 static void on_command(void *ctx, const ncp_command_t *c)
 {
     struct serve *sv = ctx;
@@ -205,7 +211,8 @@ static void on_command(void *ctx, const ncp_command_t *c)
     cl->last_ns = mono_ns();
     if (cl->seq && c->seq == cl->seq) {
         sv->duplicates++;
-        send_ack(sv, &cl->ack);
+        if (!cl->pending)
+            send_ack(sv, &cl->ack);
         return;
     }
     if (cl->seq && c->seq < cl->seq) {
@@ -231,22 +238,56 @@ static void on_command(void *ctx, const ncp_command_t *c)
     memset(a, 0, sizeof *a);
     char why[sizeof a->reason];
     int rc = ncp_nck_command(ch->nck, &k, why, sizeof why);
+    cl->seq = c->seq;
+    if (rc == NCP_NCK_CMD_PENDING) {
+        cl->pending = 1;
+        ch->pending = 1;
+        ch->pending_client = c->client_id;
+        ch->pending_seq = c->seq;
+        return;
+    }
+    cl->pending = 0;
     if (rc == 0 && c->kind == NCP_CMD_JOG && !(c->value[1] > 0))
         ch->jog_client = c->client_id;
-    /* the command may change the state at once: the ACK says the new one */
+    answer(sv, ch, a, c->client_id, c->seq, rc, why);
+}
+
+/* The ACK of a command, with the state it leaves (it may change it at
+ * once), and the status after it. */
+static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int32_t client,
+                   int32_t seq, int rc, const char *why)
+{
     ncp_nck_poll(ch->nck);
     struct ncp_nck_snapshot st;
     ncp_nck_get_status(ch->nck, &st);
-    cl->seq = c->seq;
     a->utime = utime_now();
-    a->client_id = c->client_id;
-    a->seq = c->seq;
-    a->channel = c->channel;
+    a->client_id = client;
+    a->seq = seq;
+    a->channel = (int8_t)ch->num;
     a->result = rc == 0 ? NCP_ACK_T_ACCEPTED : NCP_ACK_T_REJECTED;
     a->state = (int8_t)st.state;
     snprintf((char *)a->reason, sizeof a->reason, "%s", rc == 0 ? "" : why);
     send_ack(sv, a);
     send_status(sv, ch);
+}
+
+/* A command answered later: once its NCK has the answer, the ACK goes out
+ * and its client's resends get the same one. */
+static void answer_pending(struct serve *sv, struct serve_channel *ch)
+{
+    char why[sizeof ((ncp_ack_t *)0)->reason];
+    int rc = ncp_nck_pending(ch->nck, why, sizeof why);
+    if (rc == NCP_NCK_CMD_PENDING)
+        return;
+    ch->pending = 0;
+    struct client *cl = client_of(sv, ch->pending_client);
+    ncp_ack_t a;
+    memset(&a, 0, sizeof a);
+    answer(sv, ch, &a, ch->pending_client, ch->pending_seq, rc, why);
+    if (cl->seq == ch->pending_seq) {
+        cl->ack = a;
+        cl->pending = 0;
+    }
 }
 
 /* One channel's shutdown (a command, or a stop signal) is the service's:
@@ -278,7 +319,7 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
     if (!sv)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory"), -1;
     for (int k = 0; k < n; k++)
-        sv->ch[k] = (struct serve_channel){ ncks[k], nums[k], 0 };
+        sv->ch[k] = (struct serve_channel){ .nck = ncks[k], .num = nums[k] };
     sv->n_ch = n;
     sv->hook = o->hook;
     /* the transport is one for all: the first channel's machine INI says where */
@@ -319,6 +360,8 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
         now = mono_ns();
         int due = now >= next_status;
         for (int k = 0; k < n; k++) {
+            if (sv->ch[k].pending)
+                answer_pending(sv, &sv->ch[k]);
             int changed = ncp_nck_poll(sv->ch[k].nck);
             send_events(sv, &sv->ch[k]);
             if (changed || due)

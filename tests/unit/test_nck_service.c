@@ -56,7 +56,7 @@ static void stop(struct svc *s)
         unlink(s->prog);
 }
 
-static int cmd(struct svc *s, int kind, const char *text, double v0, int i0, char *why)
+static int cmd_now(struct svc *s, int kind, const char *text, double v0, int i0, char *why)
 {
     struct ncp_nck_cmd c;
     memset(&c, 0, sizeof c);
@@ -66,6 +66,21 @@ static int cmd(struct svc *s, int kind, const char *text, double v0, int i0, cha
     c.ivalue[0] = i0;
     char local[256];
     return ncp_nck_command(s->nck, &c, why ? why : local, 256);
+}
+
+static void nap_ms(int ms);
+
+/* A command and its answer: a load's comes once its check has ended. */
+static int cmd(struct svc *s, int kind, const char *text, double v0, int i0, char *why)
+{
+    char local[256];
+    int rc = cmd_now(s, kind, text, v0, i0, why ? why : local);
+    for (int i = 0; rc == NCP_NCK_CMD_PENDING && i < 60000; i++) {
+        rc = ncp_nck_pending(s->nck, why ? why : local, 256);
+        if (rc == NCP_NCK_CMD_PENDING)
+            nap_ms(1);
+    }
+    return rc;
 }
 
 static int state(struct svc *s)
@@ -141,6 +156,73 @@ static void test_refusals(void **state_)
     assert_int_equal(cmd(&s, NCP_CMD_HOME, "all", 0, 0, why), -1);
     wait_state(&s, NCP_ST_IDLE);
     stop(&s);
+}
+
+static double mono_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
+}
+
+/* A load's check runs beside the caller: the NCK answers everything else
+ * meanwhile, refuses what would use the program, and a shutdown or a free
+ * does not wait for the check to end. */
+static void test_load_in_background(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    char why[256];
+    start(&s, 0);
+    home_all(&s);
+    write_prog(&s, "#1=0\no1 while [#1 lt 3000000]\n#1=[#1+1]\no1 endwhile\nG1 X5 F3000\nM2\n");
+    assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), NCP_NCK_CMD_PENDING);
+    assert_int_equal(ncp_nck_pending(s.nck, why, sizeof why), NCP_NCK_CMD_PENDING);
+    assert_int_equal(cmd_now(&s, NCP_CMD_RUN, NULL, 0, 0, why), -1);
+    assert_non_null(strstr(why, "is being checked"));
+    assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), -1);
+    assert_int_equal(cmd_now(&s, NCP_CMD_MDI, "G0 X1", 0, 0, why), -1);
+    assert_int_equal(cmd_now(&s, NCP_CMD_OVERRIDE, NULL, 50, 0, why), 0);
+    ncp_nck_poll(s.nck);
+    assert_int_equal(state(&s), NCP_ST_IDLE);
+    int rc;
+    while ((rc = ncp_nck_pending(s.nck, why, sizeof why)) == NCP_NCK_CMD_PENDING)
+        nap_ms(1);
+    assert_int_equal(rc, 0);
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    double p[3];
+    pos(&s, p);
+    assert_true(fabs(p[0] - 5) < 1e-9);
+
+    /* an error after the loop is the load's answer, with its line */
+    write_prog(&s, "#1=0\no1 while [#1 lt 3000000]\n#1=[#1+1]\no1 endwhile\nG1 X5 Y\nM2\n");
+    assert_int_equal(cmd(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), -1);
+    assert_non_null(strstr(why, ":5:"));
+
+    /* a shutdown ends the check at once and refuses the load */
+    write_prog(&s, "#1=0\no1 while [#1 lt 9000000]\n#1=[#1+1]\no1 endwhile\nM2\n");
+    assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), NCP_NCK_CMD_PENDING);
+    double t0 = mono_s();
+    ncp_nck_request_shutdown(s.nck);
+    ncp_nck_poll(s.nck);
+    assert_false(ncp_nck_shutdown_requested(s.nck));   /* not before the answer */
+    while ((rc = ncp_nck_pending(s.nck, why, sizeof why)) == NCP_NCK_CMD_PENDING)
+        nap_ms(1);
+    assert_int_equal(rc, -1);
+    assert_non_null(strstr(why, "shutting down"));
+    assert_true(mono_s() - t0 < 0.5);
+    ncp_nck_poll(s.nck);
+    assert_true(ncp_nck_shutdown_requested(s.nck));
+    stop(&s);
+
+    /* freed during a check: no wait for it either */
+    start(&s, 0);
+    write_prog(&s, "#1=0\no1 while [#1 lt 9000000]\n#1=[#1+1]\no1 endwhile\nM2\n");
+    assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), NCP_NCK_CMD_PENDING);
+    t0 = mono_s();
+    stop(&s);
+    assert_true(mono_s() - t0 < 0.5);
 }
 
 /* The path of a paused and resumed run is the uninterrupted run's. */
@@ -409,6 +491,7 @@ int main(int argc, char **argv)
         cmocka_set_test_filter(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_load_in_background),
         cmocka_unit_test(test_pause_resume_path),
         cmocka_unit_test(test_stop_then_run_again),
         cmocka_unit_test(test_mdi_keeps_modal_state),
