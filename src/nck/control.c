@@ -241,17 +241,18 @@ static int moving_state(int st)
            st == NCP_ST_MDI || st == NCP_ST_JOGGING || st == NCP_ST_HOMING;
 }
 
-static int emit_nothing(void *ctx, const struct ncp_cmd *cmd)
-{
-    (void)ctx;
-    (void)cmd;
-    return 0;
-}
-
 static int load_cancelled(void *ctx)
 {
     struct ncp_nck *s = ctx;
     return atomic_load(&s->load_cancel);
+}
+
+/* The check keeps nothing; a shutdown ends it at the next block, as the
+ * analyzer's cancel ends it inside a loop. */
+static int emit_unless_cancelled(void *ctx, const struct ncp_cmd *cmd)
+{
+    (void)cmd;
+    return load_cancelled(ctx);
 }
 
 /* Every program error a fresh interpreter finds is refused at the load,
@@ -264,7 +265,7 @@ static void *load_main(void *arg)
     acfg.instance = NULL;
     acfg.cancel = load_cancelled;   /* a shutdown does not wait for the check */
     acfg.cancel_ctx = s;
-    struct ncp_output out = { .ctx = s, .emit = emit_nothing };
+    struct ncp_output out = { .ctx = s, .emit = emit_unless_cancelled };
     struct ncp_run_stats st;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
