@@ -197,6 +197,39 @@ static void *idle_main(void *arg)
     return NULL;
 }
 
+static void fail(struct lcm_be *s, const struct peer *p, const char *why)
+{
+    if (s->faulted)
+        return;
+    s->faulted = 1;
+    s->fault_axis = NCP_AXIS_LETTERS[p->axis];
+    snprintf(s->fault, sizeof s->fault, "axis %c's LLC: %s", s->fault_axis, why);
+}
+
+/* "X Z": the letters of the axes whose LLC is not ready, for a message. */
+static void axes_not(const struct lcm_be *s, int (*ready)(const struct peer *), char *out,
+                     size_t len)
+{
+    size_t k = 0;
+    for (int i = 0; i < s->n && k + 2 < len; i++)
+        if (!ready(&s->p[i])) {
+            if (k)
+                out[k++] = ' ';
+            out[k++] = NCP_AXIS_LETTERS[s->p[i].axis];
+        }
+    out[k] = 0;
+}
+
+static int has_record(const struct peer *p)
+{
+    return p->st.buffer_level > 0;
+}
+
+static int answered(const struct peer *p)
+{
+    return p->advertised && p->have_status;
+}
+
 /* DP1: the LLCs' NCKs start on the program message; this one waits (up to
  * AXIS_WAIT_MS) until each has its first record, as its own planner would
  * have before moving. Starting without one would only stop the run a few
@@ -213,8 +246,7 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
         }
         take(s, now);
         int ready = 0;
-        char missing[2 * NCP_AXES + 1] = "";
-        for (int i = 0, k = 0; i < s->n; i++) {
+        for (int i = 0; i < s->n; i++) {
             const struct peer *p = &s->p[i];
             if (p->st.state == NCP_AX_STATUS_T_FAULT) {
                 s->fault_axis = NCP_AXIS_LETTERS[p->axis];
@@ -225,26 +257,19 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
                 return -1;
             }
             if (now - p->last_hb_ns > s->hb_timeout) {
-                s->fault_axis = NCP_AXIS_LETTERS[p->axis];
-                snprintf(s->fault, sizeof s->fault,
-                         "axis %c's LLC: heartbeat lost (silent for %lld ms) while its NCK "
-                         "started on the program",
-                         s->fault_axis, (long long)((now - p->last_hb_ns) / 1000000));
-                s->faulted = 1;
+                char why[120];
+                snprintf(why, sizeof why, "heartbeat lost (silent for %lld ms) while its NCK "
+                         "started on the program", (long long)((now - p->last_hb_ns) / 1000000));
+                fail(s, p, why);
                 return -1;
             }
-            if (p->st.buffer_level > 0) {
-                ready++;
-            } else {
-                missing[k++] = NCP_AXIS_LETTERS[p->axis];
-                missing[k++] = ' ';
-                missing[k] = 0;
-            }
+            ready += has_record(p);
         }
         if (ready == s->n)
             return 0;
         if (now > deadline) {
-            missing[strlen(missing) - 1] = 0;
+            char missing[2 * NCP_AXES];
+            axes_not(s, has_record, missing, sizeof missing);
             snprintf(s->fault, sizeof s->fault,
                      "DP 1: the NCK of axis %s's LLC had no record within %d ms ([LCM] "
                      "AXIS_WAIT_MS): a busy host, or a program that computes long before "
@@ -287,19 +312,13 @@ static int lcm_start(struct ncp_backend *b, double pos[NCP_AXES])
                 s->faulted = 1;
                 return -1;
             }
-            ready += p->advertised && p->have_status;
+            ready += answered(p);
         }
         if (ready == s->n)
             break;
         if (now > deadline) {
-            char missing[40] = "";
-            for (int i = 0, k = 0; i < s->n; i++)
-                if (!(s->p[i].advertised && s->p[i].have_status)) {
-                    missing[k++] = NCP_AXIS_LETTERS[s->p[i].axis];
-                    missing[k++] = ' ';
-                    missing[k] = 0;
-                }
-            missing[strlen(missing) - 1] = 0;
+            char missing[2 * NCP_AXES];
+            axes_not(s, answered, missing, sizeof missing);
             snprintf(s->fault, sizeof s->fault,
                      "no LLC answered for axis %s within %d ms ([LCM] AXIS_WAIT_MS): start "
                      "`cnc-axis --axis L --config INI` for each, on the same LCM URL",
@@ -335,14 +354,6 @@ static void lcm_live(struct ncp_backend *b)
     idle_stop(b->impl);
 }
 
-static void fail(struct lcm_be *s, const struct peer *p, const char *why)
-{
-    if (s->faulted)
-        return;
-    s->faulted = 1;
-    s->fault_axis = NCP_AXIS_LETTERS[p->axis];
-    snprintf(s->fault, sizeof s->fault, "axis %c's LLC: %s", s->fault_axis, why);
-}
 
 static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_t now)
 {
