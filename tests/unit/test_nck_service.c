@@ -70,17 +70,25 @@ static int cmd_now(struct svc *s, int kind, const char *text, double v0, int i0,
 
 static void nap_ms(int ms);
 
+/* A pending command's answer, once there (60 s of wall time at most). */
+static int answer(struct svc *s, char *why)
+{
+    for (int i = 0; i < 60000; i++) {
+        int rc = ncp_nck_pending(s->nck, why, 256);
+        if (rc != NCP_NCK_CMD_PENDING)
+            return rc;
+        nap_ms(1);
+    }
+    fail_msg("a pending command got no answer within 60 s");
+    return NCP_NCK_CMD_PENDING;
+}
+
 /* A command and its answer: a load's comes once its check has ended. */
 static int cmd(struct svc *s, int kind, const char *text, double v0, int i0, char *why)
 {
     char local[256];
     int rc = cmd_now(s, kind, text, v0, i0, why ? why : local);
-    for (int i = 0; rc == NCP_NCK_CMD_PENDING && i < 60000; i++) {
-        rc = ncp_nck_pending(s->nck, why ? why : local, 256);
-        if (rc == NCP_NCK_CMD_PENDING)
-            nap_ms(1);
-    }
-    return rc;
+    return rc == NCP_NCK_CMD_PENDING ? answer(s, why ? why : local) : rc;
 }
 
 static int state(struct svc *s)
@@ -185,10 +193,7 @@ static void test_load_in_background(void **state_)
     assert_int_equal(cmd_now(&s, NCP_CMD_OVERRIDE, NULL, 50, 0, why), 0);
     ncp_nck_poll(s.nck);
     assert_int_equal(state(&s), NCP_ST_IDLE);
-    int rc;
-    while ((rc = ncp_nck_pending(s.nck, why, sizeof why)) == NCP_NCK_CMD_PENDING)
-        nap_ms(1);
-    assert_int_equal(rc, 0);
+    assert_int_equal(answer(&s, why), 0);
     assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, why), 0);
     wait_state(&s, NCP_ST_IDLE);
     double p[3];
@@ -207,9 +212,7 @@ static void test_load_in_background(void **state_)
     ncp_nck_request_shutdown(s.nck);
     ncp_nck_poll(s.nck);
     assert_false(ncp_nck_shutdown_requested(s.nck));   /* not before the answer */
-    while ((rc = ncp_nck_pending(s.nck, why, sizeof why)) == NCP_NCK_CMD_PENDING)
-        nap_ms(1);
-    assert_int_equal(rc, -1);
+    assert_int_equal(answer(&s, why), -1);
     assert_non_null(strstr(why, "shutting down"));
     assert_true(mono_s() - t0 < 0.5);
     ncp_nck_poll(s.nck);
