@@ -16,7 +16,8 @@ CPPFLAGS += -Iinclude -I$(BUILD)/gen -D_GNU_SOURCE -MMD -MP
 ALL_CFLAGS   = -std=c11 $(WARN) $(CFLAGS) -pthread
 ALL_CXXFLAGS = -std=c++17 $(WARN) $(CXXFLAGS) -pthread -fno-exceptions -fno-rtti \
                -I/usr/include/eigen3
-LDLIBS   += -lm -linih -pthread
+# libcrypto: the MAC on every LCM message (src/auth); -ldl for its static archive
+LDLIBS   += -lm -linih -lcrypto -ldl -pthread
 # cnc-run itself is linked statically: the dynamic loader's mapping and
 # relocating of libstdc++, libm and libc cost every start ~1.7 ms here (a
 # shadow-paging fault for each page it touches), 2-4 ms of a 1M-block run
@@ -115,7 +116,7 @@ $(FUZZ_REPLAY): tests/fuzz/replay.c tests/fuzz/fuzz_pipeline.c $(LIB)
 deps:
 	apt-get update -qq
 	DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev linuxcnc-uspace \
+	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev libssl-dev linuxcnc-uspace \
 	    liblcm-dev liblcm-bin \
 	    python3 python3-matplotlib python3-scipy valgrind cppcheck clang-tidy file podman \
 	    libwebsockets-dev chromium firefox-esr
@@ -145,10 +146,10 @@ sanitize: all
 	RUN_TIMEOUT=100 $(MAKE) BUILD=build-asan CC=clang CXX=clang++ CLI_LDFLAGS= \
 	    CFLAGS="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
 	    CXXFLAGS="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
-	    LDLIBS="-lm -linih -pthread -fsanitize=address,undefined" test
+	    LDLIBS="-lm -linih -lcrypto -pthread -fsanitize=address,undefined" test
 	$(MAKE) BUILD=build-tsan CC=clang CXX=clang++ CLI_LDFLAGS= \
 	    CFLAGS="$(SAN_FLAGS) -fsanitize=thread" CXXFLAGS="$(SAN_FLAGS) -fsanitize=thread" \
-	    LDLIBS="-lm -linih -pthread -fsanitize=thread" all build-tsan/tests/test_nck_service
+	    LDLIBS="-lm -linih -lcrypto -pthread -fsanitize=thread" all build-tsan/tests/test_nck_service
 	TSAN_OPTIONS=halt_on_error=1 tests/tools/equivalence --bin build-tsan/cnc-run ncprograms/*.ngc
 	TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/test_nck_service
 	# the serving NCK under TSan, driven by the plain cnc-ctl (liblcm's glib is not
@@ -166,7 +167,7 @@ $(BUILD)-fuzz/fuzz_pipeline: tests/fuzz/fuzz_pipeline.c FORCE
 	    CXXFLAGS="$(FUZZ_FLAGS) -fsanitize=fuzzer-no-link" $(BUILD)-fuzz/libncpar.a
 	clang $(filter-out -I$(BUILD)/gen,$(CPPFLAGS)) -I$(BUILD)-fuzz/gen -std=c11 $(FUZZ_FLAGS) \
 	    -fsanitize=fuzzer -pthread -o $@ $< \
-	    $(BUILD)-fuzz/libncpar.a -lm -linih -lstdc++
+	    $(BUILD)-fuzz/libncpar.a -lm -linih -lcrypto -lstdc++
 fuzz: $(BUILD)-fuzz/fuzz_pipeline
 	mkdir -p $(BUILD)-fuzz/corpus
 	cp ncprograms/*.ngc tests/bad/*.ngc $(BUILD)-fuzz/corpus/ 2>/dev/null || true

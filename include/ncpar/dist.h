@@ -241,14 +241,27 @@ int64_t ncp_dist_clock_slew(int64_t applied, int64_t target, int64_t max_step);
  * then run); run: the thread, which polls while `run` holds; close: joins
  * it and closes the socket (after a failed open or run too). */
 struct ncp_msg;
+
+/* The transport's options as [LCM] says (URL, CHANNEL_PREFIX, the key file
+ * as ncp_auth_key_path resolves KEY_FILE, INTERFACE, STATUS_NEEDS_KEY,
+ * MAX_AGE_MS); the caller may change url, prefix and create_key after.
+ * 0, or an error with d set. */
+#include "ncpar/msg.h"
+struct ncp_dist_msg_opts {
+    struct ncp_msg_opts opts;
+    char key_file[512];
+};
+int ncp_dist_msg_opts(const struct ncp_lcm_cfg *l, struct ncp_dist_msg_opts *o,
+                      struct ncp_diag *d);
+
 struct ncp_dist_probe_io {
     struct ncp_msg *msg;
     pthread_t thread;
     atomic_int run;
     int started;
 };
-int ncp_dist_probe_io_open(struct ncp_dist_probe_io *io, const char *lcm_url, double loss,
-                           uint64_t seed, struct ncp_diag *d);
+int ncp_dist_probe_io_open(struct ncp_dist_probe_io *io, const struct ncp_lcm_cfg *l,
+                           const char *lcm_url, uint64_t seed, struct ncp_diag *d);
 int ncp_dist_probe_io_run(struct ncp_dist_probe_io *io, void *(*body)(void *), void *arg,
                           struct ncp_diag *d);
 void ncp_dist_probe_io_close(struct ncp_dist_probe_io *io);

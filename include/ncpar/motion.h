@@ -163,6 +163,13 @@ struct ncp_machine_cfg {
         char prefix[32];          /* CHANNEL_PREFIX, default NCP_ */
         double status_hz;         /* STATUS_HZ, default 50; 0: only at state changes
                                      and after each command */
+        /* who may command the machine (ncpar/auth.h) */
+        char key_file[512];       /* KEY_FILE ("": --key-file, else the user's
+                                     ~/.config/ncpar/lcm.key) */
+        char interface[16];       /* INTERFACE: the group joined there only (lo) */
+        int status_needs_key;     /* STATUS_NEEDS_KEY: status and events encrypted (0) */
+        int max_age_ms;           /* MAX_AGE_MS: the distributed NCK's messages
+                                     sealed longer ago are dropped (2000) */
         /* the distributed mode (cnc-run run --backend lcm, cnc-axis; seed 002) */
         int dp;                   /* DP: distribution point 1..5 (5) */
         /* DP 1: the program and what it needs, absolute (not from the INI:

@@ -6,7 +6,11 @@
  * the static cnc-run, receives into one fixed buffer (a flood of datagrams
  * allocates nothing) and counts what it cannot use. Channels are
  * <prefix>CMD (in), <prefix>ACK, <prefix>STATUS and <prefix>EVENT (out).
- * Not for the real-time threads: the service thread calls it. */
+ * Not for the real-time threads: the service thread calls it.
+ *
+ * Every datagram sent is sealed with the key (ncpar/auth.h); every datagram
+ * taken in (a command, a subscribed channel) must carry a valid seal, else it
+ * is dropped and counted (auth_failed) before anything decodes it. */
 #ifndef NCPAR_MSG_H
 #define NCPAR_MSG_H
 
@@ -30,6 +34,9 @@ struct ncp_msg_stats {
     uint64_t commands;    /* valid commands handed on */
     uint64_t garbage;     /* on <prefix>CMD, or unreadable at all: bad magic,
                              truncated, wrong fingerprint, bad fields */
+    uint64_t auth_failed; /* on a channel taken in, without the key's valid MAC:
+                             keyless, forged or tampered; never decoded */
+    uint64_t stale;       /* ncp_msg_take: sealed longer ago than max_age_ms */
     uint64_t sent, send_errors;
     /* ncp_msg_take's channels (the distributed mode) */
     uint64_t taken, taken_bytes;       /* datagrams on a subscribed channel, with headers */
@@ -39,10 +46,23 @@ struct ncp_msg_stats {
     uint64_t inject_undelayed;         /* too large or no room to hold back: passed on */
 };
 
-/* url NULL or "": $LCM_DEFAULT_URL, else NCP_MSG_DEFAULT_URL. Only udpm://
- * is understood (host must be a multicast group; ?ttl=N, ?recv_buf_size=N).
- * prefix NULL: NCP_MSG_DEFAULT_PREFIX. On error d->msg says why. */
-int ncp_msg_open(struct ncp_msg **m, const char *url, const char *prefix, struct ncp_diag *d);
+struct ncp_msg_opts {
+    /* NULL or "": $LCM_DEFAULT_URL, else NCP_MSG_DEFAULT_URL. Only udpm://
+     * is understood (host must be a multicast group; ?ttl=N, ?recv_buf_size=N). */
+    const char *url;
+    const char *prefix;      /* NULL: NCP_MSG_DEFAULT_PREFIX */
+    const char *key_file;    /* required: ncp_auth_key_path's choice */
+    int create_key;          /* make the key file when it does not exist (the NCK) */
+    /* [LCM] INTERFACE: the group is joined on this interface only and the
+     * socket bound to the group; NULL or "": any (the route decides) */
+    const char *interface;
+    int encrypt_public;      /* [LCM] STATUS_NEEDS_KEY: STATUS and EVENT encrypted */
+    int max_age_ms;          /* ncp_msg_take drops datagrams sealed longer ago or
+                                further ahead than this (0: no limit) */
+};
+
+/* Opens the transport with the key of o->key_file. On error d->msg says why. */
+int ncp_msg_open(struct ncp_msg **m, const struct ncp_msg_opts *o, struct ncp_diag *d);
 void ncp_msg_close(struct ncp_msg *m);
 
 /* Waits up to timeout_ms (0: only what is queued) and hands every valid

@@ -111,7 +111,7 @@ int llc_clock_start(struct llc *l, const char *url, struct ncp_diag *d)
         c->base_ns = ncp_dist_realtime_offset();
     ncp_dist_clock_init(&c->win);
     ncp_dist_ax_channel(c->channel, sizeof c->channel, l->axis, NCP_DIST_AX_CLOCK);
-    int rc = ncp_dist_probe_io_open(&c->io, url, cfg->lcm.inject_loss,
+    int rc = ncp_dist_probe_io_open(&c->io, &cfg->lcm, url,
                                     (uint64_t)cfg->lcm.inject_seed + 1001u + (uint64_t)l->axis, d);
     if (rc != NCP_OK)
         return rc;

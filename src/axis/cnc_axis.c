@@ -30,7 +30,7 @@ static void on_signal(int sig)
 
 static void usage(FILE *f)
 {
-    fputs("usage: cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]\n"
+    fputs("usage: cnc-axis --axis L --config INI [--lcm-url URL] [--key-file F] [--trace CSV]\n"
           "                [--backend sim|socketcan[:IFACE]] [--clock-skew-us N] [--clock-drift-ppm P]\n"
           "One axis of the distributed NCK: advertises axis L of the machine INI over LCM,\n"
           "waits for `cnc-run run --backend lcm`, runs its position loop on the simulated\n"
@@ -46,6 +46,9 @@ static void usage(FILE *f)
           "                socketcan[:IFACE]: the axis's CiA 402 drive ([AXIS_L] NODE_ID,\n"
           "                COUNTS_PER_MM; [CAN] keys as for cnc-run), this LLC its CANopen\n"
           "                master; the drive's position at start is where the program starts\n"
+          "  --key-file F  the NCK's key (default: [LCM] KEY_FILE, else\n"
+          "                ~/.config/ncpar/lcm.key): every message is sealed with it, and\n"
+          "                one without its seal is dropped and counted, never obeyed\n"
           "  --trace CSV   every period: t,slot,cmd,act,state,gap (seconds from the HLC's first\n"
           "                period; slot: the HLC's period played; state: ax_status_t's;\n"
           "                gap: 0 its own setpoint, 1 bridged to the next, 2 held, 3 left\n"
@@ -60,7 +63,7 @@ static void usage(FILE *f)
 }
 
 struct opts {
-    const char *config, *url, *trace, *backend;
+    const char *config, *url, *trace, *backend, *key_file;
     int axis;
     double skew_us, drift_ppm;
 };
@@ -84,6 +87,7 @@ static int parse(int argc, char **argv, struct opts *o)
         { "help", no_argument, 0, 'h' },          { "backend", required_argument, 0, 'b' },
         { "clock-skew-us", required_argument, 0, 'S' },
         { "clock-drift-ppm", required_argument, 0, 'D' },
+        { "key-file", required_argument, 0, 'k' },
         { 0, 0, 0, 0 },
     };
     int c;
@@ -103,6 +107,7 @@ static int parse(int argc, char **argv, struct opts *o)
         case 'u': o->url = optarg; break;
         case 't': o->trace = optarg; break;
         case 'b': o->backend = optarg; break;
+        case 'k': o->key_file = optarg; break;
         case 'S':
             if (number("--clock-skew-us", optarg, -1e12, 1e12, &o->skew_us) != 0)
                 return -1;
@@ -142,7 +147,12 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     ncp_dist_ax_channel(l->ch_advert, sizeof l->ch_advert, o->axis, NCP_DIST_AX_ADVERT);
     ncp_dist_ax_channel(l->ch_resend, sizeof l->ch_resend, o->axis, NCP_DIST_AX_RESEND);
     const char *url = o->url ? o->url : cfg->lcm.url;
-    if (ncp_msg_open(&l->msg, url, NULL, &d) != NCP_OK)
+    struct ncp_dist_msg_opts mo;
+    if (ncp_dist_msg_opts(&cfg->lcm, &mo, &d) != NCP_OK)
+        return fprintf(stderr, "cnc-axis: error: %s\n", d.msg), -1;
+    mo.opts.url = url;
+    mo.opts.prefix = NULL;
+    if (ncp_msg_open(&l->msg, &mo.opts, &d) != NCP_OK)
         return fprintf(stderr, "cnc-axis: error: %s\n", d.msg), -1;
     /* the order llc_take expects */
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_FINE);
@@ -305,6 +315,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s:%u: error: %s\n", o.config, d.line, d.msg);
         return EXIT_USAGE;
     }
+    if (o.key_file && snprintf(cfg.lcm.key_file, sizeof cfg.lcm.key_file, "%s", o.key_file) >=
+                          (int)sizeof cfg.lcm.key_file)
+        return fprintf(stderr, "cnc-axis: --key-file: the path is too long\n"), EXIT_USAGE;
     struct llc *l = calloc(1, sizeof *l);
     if (!l)
         return EXIT_FAULT;

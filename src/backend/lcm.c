@@ -665,7 +665,13 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
     s->hb_period = cfg->lcm.heartbeat_period_ms * 1000000LL;
     s->hb_timeout = cfg->lcm.heartbeat_timeout_ms * 1000000LL;
     ncp_dist_init();
-    int rc = ncp_msg_open(&s->msg, cfg->lcm.url, NULL, d);
+    struct ncp_dist_msg_opts mo;
+    int rc = ncp_dist_msg_opts(&cfg->lcm, &mo, d);
+    if (rc == NCP_OK) {
+        mo.opts.prefix = NULL;   /* the distributed channels have their own names */
+        mo.opts.create_key = 1;  /* the HLC is the NCK: as serve, it makes the key */
+        rc = ncp_msg_open(&s->msg, &mo.opts, d);
+    }
     if (rc != NCP_OK) {
         free_tx(s);
         free(s);

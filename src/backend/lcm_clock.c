@@ -58,7 +58,7 @@ int lcm_clock_start(struct lcm_clock *c, const struct ncp_machine_cfg *cfg, stru
     memset(c, 0, sizeof *c);
     if (cfg->lcm.clock == NCP_LCM_CLOCK_PTP)
         c->off_ns = ncp_dist_realtime_offset();
-    int rc = ncp_dist_probe_io_open(&c->io, cfg->lcm.url, cfg->lcm.inject_loss,
+    int rc = ncp_dist_probe_io_open(&c->io, &cfg->lcm, cfg->lcm.url,
                                     (uint64_t)cfg->lcm.inject_seed + 1000u, d);
     if (rc != NCP_OK)
         return rc;

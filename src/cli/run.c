@@ -4,6 +4,7 @@
 #include "run.h"
 #include "channels.h"
 #include "inject_opts.h"
+#include "key_opts.h"
 #include "machine.h"
 #include "outfile.h"
 #include "signals.h"
@@ -39,6 +40,7 @@ struct run_opts {
     const char *backend;        /* --backend as given, NULL = sim */
     int dp;                     /* --dp, 0 = the INI's [LCM] DP */
     const char *lcm_url;        /* --lcm-url, NULL = the INI's [LCM] URL */
+    const char *key_file;       /* --key-file, NULL = the INI's [LCM] KEY_FILE */
     uint32_t max_loops;         /* --max-loops, 0 = the interpreter's default */
     const char *inject, *seed;  /* --inject SPECS, --seed N (NULL: the INI's) */
     int home;                   /* --home: home the machine before the program */
@@ -107,6 +109,9 @@ static void usage(FILE *f)
           "                      ADCBI 4, 3, 2 (ACCDECbuf, LAbuf, INTbuf records) and 1\n"
           "                      (each LLC runs the program itself, from its path)\n"
           "  --lcm-url URL       udpm://GROUP:PORT?ttl=N (default: [LCM] URL, $LCM_DEFAULT_URL)\n"
+          "  --key-file F        the key that seals every message to and from the axes\n"
+          "                      (default: [LCM] KEY_FILE, else ~/.config/ncpar/lcm.key;\n"
+          "                      made when missing, as cnc-run serve does)\n"
           "  --inject SPECS      timing faults in the position loop (over the INI's [INJECT]\n"
           "                      SPEC): miss=RATIO, miss@CYCLE, latency=US, latency=MIN-MAX,\n"
           "                      io-latency=US, jitter=US[:normal], lose-setpoint=RATIO,\n"
@@ -152,6 +157,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         { "backend", required_argument, 0, 'b' },
         { "dp", required_argument, 0, 'D' },
         { "lcm-url", required_argument, 0, 'U' },
+        { "key-file", required_argument, 0, 'K' },
         { "max-loops", required_argument, 0, 'L' },
         { "inject", required_argument, 0, 'I' },
         { "seed", required_argument, 0, 'R' },
@@ -180,6 +186,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
             o->dp = (int)pct;
             break;
         case 'U': o->lcm_url = optarg; break;
+        case 'K': o->key_file = optarg; break;
         case 'I': o->inject = optarg; break;
         case 'R': o->seed = optarg; break;
         case 'H': o->home = 1; break;
@@ -356,10 +363,14 @@ static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 {
     const char *b = o->backend;
     int lcm = b && !strcmp(b, "lcm");
-    if (!lcm && (o->dp || o->lcm_url))
-        return fprintf(stderr, "cnc-run run: --dp and --lcm-url go with --backend lcm\n"), -1;
+    if (!lcm && (o->dp || o->lcm_url || o->key_file))
+        return fprintf(stderr, "cnc-run run: --dp, --lcm-url and --key-file go with --backend "
+                               "lcm\n"), -1;
     if (lcm)
-        return apply_lcm(o, cfg);
+        return ncp_cli_apply_key_file("cnc-run run", o->key_file, cfg) || apply_lcm(o, cfg) ||
+                       ncp_cli_check_key("cnc-run run", cfg)
+                   ? -1
+                   : 0;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     int spec = ncp_backend_spec(b, cfg, &d);

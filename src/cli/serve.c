@@ -4,6 +4,7 @@
 #include "cell.h"
 #include "channels.h"
 #include "inject_opts.h"
+#include "key_opts.h"
 #include "outfile.h"
 #include "machine.h"
 #include "signals.h"
@@ -45,7 +46,7 @@ static void ready(void *ctx, const char *prefix)
 
 static void usage(FILE *f)
 {
-    fputs("usage: cnc-run serve [--config INI] [--lcm-url URL] [--prefix P]\n"
+    fputs("usage: cnc-run serve [--config INI] [--lcm-url URL] [--prefix P] [--key-file F]\n"
           "                     [--clock real|virtual] [--trace CSV] [--mode serial|det|att]\n"
           "                     [--tool-table FILE] [--subroutine-path DIR[:DIR...]]\n"
           "                     [--inject SPEC[,SPEC...]] [--seed N]\n"
@@ -62,6 +63,10 @@ static void usage(FILE *f)
           "  --lcm-url URL       LCM URL (default: the INI's, else $LCM_DEFAULT_URL, else\n"
           "                      udpm://239.255.76.67:7667?ttl=0)\n"
           "  --prefix P          channel prefix (channels PCMD, PACK, PSTATUS, PEVENT)\n"
+          "  --key-file F        the key every command must be sealed with (default: [LCM]\n"
+          "                      KEY_FILE, else ~/.config/ncpar/lcm.key); made (32 random\n"
+          "                      bytes, mode 0600) when missing; refused when group or\n"
+          "                      others may read it. Give clients a copy (README)\n"
           "  --clock virtual     simulated clock: as fast as the CPU allows while moving,\n"
           "                      real time while idle\n"
           "  --trace CSV         per-cycle trace of the whole service life\n"
@@ -81,7 +86,7 @@ static void usage(FILE *f)
 
 struct serve_args {
     const char *config, *url, *prefix, *trace, *tool_table, *sub_path, *inject, *seed;
-    const char *http, *web;
+    const char *http, *web, *key_file;
     int virtual_clock, http_readonly;
     enum ncp_thread_mode mode;
 };
@@ -96,7 +101,8 @@ static int parse(int argc, char **argv, struct serve_args *a)
         { "subroutine-path", required_argument, 0, 'S' }, { "help", no_argument, 0, 'h' },
         { "inject", required_argument, 0, 'I' }, { "seed", required_argument, 0, 'R' },
         { "http", required_argument, 0, 'H' }, { "http-readonly", no_argument, 0, 'O' },
-        { "web", required_argument, 0, 'W' }, { 0, 0, 0, 0 },
+        { "web", required_argument, 0, 'W' }, { "key-file", required_argument, 0, 'K' },
+        { 0, 0, 0, 0 },
     };
     int c;
     optind = 1;
@@ -113,6 +119,7 @@ static int parse(int argc, char **argv, struct serve_args *a)
         case 'H': a->http = optarg; break;
         case 'O': a->http_readonly = 1; break;
         case 'W': a->web = optarg; break;
+        case 'K': a->key_file = optarg; break;
         case 'k':
             if (strcmp(optarg, "real") != 0 && strcmp(optarg, "virtual") != 0)
                 return fprintf(stderr, "cnc-run serve: --clock is real or virtual\n"), -1;
@@ -181,7 +188,8 @@ struct serve_channel {
 static int load_channel(struct serve_channel *ch, const struct serve_args *a)
 {
     return ncp_cli_load_machine(ch->config, &ch->cfg) ||
-                   ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg)
+                   ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
+                   ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg)
                ? -1
                : 0;
 }
@@ -273,6 +281,14 @@ int ncp_cli_serve(int argc, char **argv)
     struct serve_channel *chs = load_channels(&a, &n);
     if (!chs)
         return SERVE_USAGE;
+    /* the key before anything is powered: made when missing, refused when
+     * others may read it (the service opens it again with the transport) */
+    if (ncp_cli_check_key("cnc-run serve", &chs[0].cfg)) {
+        for (int k = 0; k < n; k++)
+            close_trace(&chs[k]);
+        free(chs);
+        return SERVE_USAGE;
+    }
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     struct ncp_http *http = NULL;

@@ -24,7 +24,7 @@ enum {
 };
 
 struct args {
-    const char *url, *prefix;
+    const char *url, *prefix, *key_file;
     double timeout;
     long channel;
     unsigned opts; /* OPT_* given */
@@ -48,15 +48,20 @@ struct command {
 static const struct command *find_command(const char *name);
 
 static const char global_usage[] =
-    "usage: cnc-ctl [--lcm-url URL] [--prefix P] [--timeout S] [--channel N] COMMAND ...\n"
+    "usage: cnc-ctl [--lcm-url URL] [--prefix P] [--key-file F] [--timeout S] [--channel N]\n"
+    "               COMMAND ...\n"
     "\n"
     "The operator's client of a serving NCK (cnc-run serve), one command per call.\n"
     "\n"
     "  --lcm-url URL   LCM URL (default: $LCM_DEFAULT_URL, else\n"
     "                  udpm://239.255.76.67:7667?ttl=0)\n"
     "  --prefix P      channel prefix of the NCK (default NCP_)\n"
+    "  --key-file F    the NCK's key (default: $XDG_CONFIG_HOME/ncpar/lcm.key, else\n"
+    "                  ~/.config/ncpar/lcm.key): commands are sealed with it, and\n"
+    "                  ACKs and statuses without its seal are ignored\n"
     "  --timeout S     seconds to wait for an answer (default 5; for wait and\n"
-    "                  status --watch 0 waits for ever)\n"
+    "                  status --watch 0 waits for ever). A command the NCK has not\n"
+    "                  taken by then is never acted on (its deadline travels with it)\n"
     "  --channel N     NC channel (default 0)\n"
     "\n"
     "commands (cnc-ctl COMMAND --help for each):\n"
@@ -149,6 +154,9 @@ static int parse_args(int argc, char **argv, struct args *a)
         } else if (is_opt(s, "--lcm-url")) {
             if ((a->url = opt_value(argc, argv, &i, "--lcm-url")) == NULL)
                 return usage_error("%s needs a URL", s);
+        } else if (is_opt(s, "--key-file")) {
+            if ((a->key_file = opt_value(argc, argv, &i, "--key-file")) == NULL)
+                return usage_error("%s needs a file", s);
         } else if (is_opt(s, "--prefix")) {
             if ((a->prefix = opt_value(argc, argv, &i, "--prefix")) == NULL)
                 return usage_error("%s needs a channel prefix", s);
@@ -557,7 +565,7 @@ int main(int argc, char **argv)
     c.timeout = a.timeout;
     if (k->run == run_status && !(a.opts & OPT_WATCH) && c.timeout == 0)
         c.timeout = 5.0;
-    int rc = ctl_open(&c, a.url, a.prefix);
+    int rc = ctl_open(&c, a.url, a.prefix, a.key_file);
     if (rc == CTL_OK) {
         ctl_catch_signals();
         rc = k->run(&c, &a);

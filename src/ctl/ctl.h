@@ -19,8 +19,11 @@ enum ctl_exit {
     CTL_NO_ANSWER = 4, /* nothing within the timeout */
 };
 
+struct ncp_auth;
 struct ctl {
     lcm_t *lcm;
+    struct ncp_auth *auth;   /* the NCK's key: seals commands, checks ACKs and status */
+    uint64_t unsealed;       /* ACKs and statuses ignored: not sealed with the key */
     const char *url; /* as given, for messages; NULL: liblcm's default */
     char ch_cmd[NCP_MSG_PREFIX_MAX + 8];
     char ch_ack[NCP_MSG_PREFIX_MAX + 8];
@@ -43,7 +46,8 @@ extern volatile sig_atomic_t ctl_interrupted;
 void ctl_catch_signals(void);
 
 double ctl_now(void);
-int ctl_open(struct ctl *c, const char *url, const char *prefix);
+/* key_file NULL: $XDG_CONFIG_HOME/ncpar/lcm.key or ~/.config/ncpar/lcm.key */
+int ctl_open(struct ctl *c, const char *url, const char *prefix, const char *key_file);
 void ctl_close(struct ctl *c);
 
 /* A command with its fields of the kind filled in: sent with our client id

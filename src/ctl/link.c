@@ -9,8 +9,15 @@
 #include <unistd.h>
 
 #include "ctl.h"
+#include "ncpar/auth.h"
 
 #define RESEND_S 0.5
+#define KEEPALIVE_FRESH_S 0.5  /* a keep-alive holds a jog this long (the NCK's limit) */
+#define FRESH_MAX_S 600.0      /* the longest the NCK lets a command stay fresh */
+/* The command's deadline lies this much before the moment cnc-ctl gives up
+ * (at most): a command the NCK takes just before its deadline has its ACK
+ * back before the client reports no answer. */
+#define DEADLINE_MARGIN_S 0.1
 
 volatile sig_atomic_t ctl_interrupted;
 
@@ -45,13 +52,31 @@ static int64_t utime_now(void)
     return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
 }
 
+/* The message's encoding when it carries the key's seal (decrypted where it
+ * was encrypted), copied into buf: its length, or -1 (not from the NCK:
+ * ignored, as a forged ACK or status must change nothing here either). */
+static int sealed_body(struct ctl *c, const lcm_recv_buf_t *rbuf, const char *channel,
+                       uint8_t *buf, size_t size)
+{
+    if (rbuf->data_size > size)
+        return -1;
+    memcpy(buf, rbuf->data, rbuf->data_size);
+    size_t n;
+    int64_t sent_ns;
+    if (ncp_auth_check(c->auth, channel, buf, rbuf->data_size, &n, &sent_ns) != NCP_AUTH_OK) {
+        c->unsealed++;
+        return -1;
+    }
+    return (int)n;
+}
+
 static void on_ack(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    (void)channel;
     struct ctl *c = user;
     ncp_ack_t a;
-    if (rbuf->data_size > (uint32_t)INT32_MAX ||
-        ncp_ack_t_decode(rbuf->data, 0, (int)rbuf->data_size, &a) != (int)rbuf->data_size)
+    uint8_t buf[4096];
+    int n = sealed_body(c, rbuf, channel, buf, sizeof buf);
+    if (n < 0 || ncp_ack_t_decode(buf, 0, n, &a) != n)
         return;
     if (a.client_id != c->client_id || a.seq != c->want_seq || c->want_seq == 0)
         return;
@@ -61,11 +86,11 @@ static void on_ack(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 
 static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    (void)channel;
     struct ctl *c = user;
     ncp_status_t s;
-    if (rbuf->data_size > (uint32_t)INT32_MAX ||
-        ncp_status_t_decode(rbuf->data, 0, (int)rbuf->data_size, &s) != (int)rbuf->data_size)
+    uint8_t buf[8192];
+    int n = sealed_body(c, rbuf, channel, buf, sizeof buf);
+    if (n < 0 || ncp_status_t_decode(buf, 0, n, &s) != n)
         return;
     if (s.channel != c->channel)
         return;
@@ -84,8 +109,23 @@ static int32_t random_client_id(void)
     return id;
 }
 
-int ctl_open(struct ctl *c, const char *url, const char *prefix)
+int ctl_open(struct ctl *c, const char *url, const char *prefix, const char *key_file)
 {
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    char path[NCP_AUTH_PATH_MAX];
+    uint8_t key[NCP_AUTH_KEY_BYTES];
+    if (ncp_auth_key_path(path, sizeof path, key_file, NULL, &d) != 0 ||
+        ncp_auth_load_key(path, 0, key, &d) != 0) {
+        fprintf(stderr, "cnc-ctl: error: %s\n", d.msg);
+        return CTL_USAGE;
+    }
+    c->auth = ncp_auth_new(key);
+    explicit_bzero(key, sizeof key);
+    if (c->auth == NULL) {
+        fprintf(stderr, "cnc-ctl: out of memory\n");
+        return CTL_USAGE;
+    }
     if (strlen(prefix) > NCP_MSG_PREFIX_MAX) {
         fprintf(stderr, "cnc-ctl: the channel prefix '%s' is longer than %d characters\n",
                 prefix, NCP_MSG_PREFIX_MAX);
@@ -115,12 +155,16 @@ void ctl_close(struct ctl *c)
     if (c->lcm)
         lcm_destroy(c->lcm);
     c->lcm = NULL;
+    ncp_auth_free(c->auth);
+    c->auth = NULL;
 }
 
 static int publish(struct ctl *c, const ncp_command_t *cmd)
 {
-    uint8_t buf[1024];
-    int n = ncp_command_t_encode(buf, 0, (int)sizeof buf, cmd);
+    uint8_t buf[1024 + NCP_AUTH_TRAILER_BYTES];
+    int n = ncp_command_t_encode(buf, 0, (int)sizeof buf - (int)NCP_AUTH_TRAILER_BYTES, cmd);
+    if (n >= 0)
+        n = (int)ncp_auth_seal(c->auth, c->ch_cmd, buf, (size_t)n, 0, ncp_auth_now_ns());
     if (n < 0 || lcm_publish(c->lcm, c->ch_cmd, buf, (unsigned)n) != 0) {
         fprintf(stderr, "cnc-ctl: cannot send on %s (see README: LCM and multicast)\n",
                 c->ch_cmd);
@@ -129,9 +173,22 @@ static int publish(struct ctl *c, const ncp_command_t *cmd)
     return 0;
 }
 
+/* How long the command may still act: a keep-alive its window, any other
+ * until just before cnc-ctl gives up waiting for its ACK. */
+static double fresh_s(const struct ctl *c, const ncp_command_t *cmd)
+{
+    if (cmd->kind == NCP_COMMAND_T_KEEPALIVE)
+        return KEEPALIVE_FRESH_S;
+    if (c->timeout <= 0 || c->timeout > FRESH_MAX_S)
+        return FRESH_MAX_S;
+    double margin = c->timeout / 10 < DEADLINE_MARGIN_S ? c->timeout / 10 : DEADLINE_MARGIN_S;
+    return c->timeout - margin;
+}
+
 int ctl_send(struct ctl *c, ncp_command_t *cmd)
 {
     cmd->utime = utime_now();
+    cmd->deadline_utime = cmd->utime + (int64_t)(fresh_s(c, cmd) * 1e6);
     cmd->client_id = c->client_id;
     cmd->seq = ++c->seq;
     cmd->channel = c->channel;

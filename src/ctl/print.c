@@ -61,4 +61,6 @@ void ctl_print_status(const ncp_status_t *s)
            "misses, %.1f us worst latency\n",
            (long long)s->commands, (long long)s->garbage, (long long)s->rejected,
            (long long)s->cycles, (long long)s->deadline_misses, s->latency_max_us);
+    printf("dropped   %lld without the key's seal, %lld past their deadline, %lld replayed\n",
+           (long long)s->auth_failed, (long long)s->stale, (long long)s->replayed);
 }

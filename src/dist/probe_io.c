@@ -5,21 +5,27 @@
 
 #include <time.h>
 
-int ncp_dist_probe_io_open(struct ncp_dist_probe_io *io, const char *lcm_url, double loss,
-                           uint64_t seed, struct ncp_diag *d)
+int ncp_dist_probe_io_open(struct ncp_dist_probe_io *io, const struct ncp_lcm_cfg *l,
+                           const char *lcm_url, uint64_t seed, struct ncp_diag *d)
 {
     io->msg = NULL;
     io->started = 0;
     atomic_store(&io->run, 0);
     char url[128];
+    struct ncp_dist_msg_opts o;
     int rc = ncp_dist_clock_url(lcm_url, url, sizeof url, d);
     if (rc == NCP_OK)
-        rc = ncp_msg_open(&io->msg, url, NULL, d);
+        rc = ncp_dist_msg_opts(l, &o, d);
+    if (rc == NCP_OK) {
+        o.opts.url = url;
+        o.opts.prefix = NULL;
+        rc = ncp_msg_open(&io->msg, &o.opts, d);
+    }
     if (rc != NCP_OK)
         return rc;
     /* probes are lost as anything else is ([LCM] INJECT_LOSS); a delay
      * held back would only wait for the thread's next wake-up, so none */
-    struct ncp_msg_inject in = { loss, 0, seed };
+    struct ncp_msg_inject in = { l->inject_loss, 0, seed };
     if (ncp_msg_set_inject(io->msg, &in) != 0) {
         ncp_dist_probe_io_close(io);
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the clock probes");

@@ -375,6 +375,24 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v, char *wh
     }
     if (!strcasecmp(k, "STATUS_HZ"))
         return real(v, 0, 1000, &l->status_hz, "Hz (0: only at changes)", why, len);
+    if (!strcasecmp(k, "KEY_FILE")) {
+        size_t n = strlen(v);
+        if (n == 0 || n >= sizeof l->key_file)
+            return snprintf(why, len, "a path of 1 to %zu characters", sizeof l->key_file - 1),
+                   -1;
+        memcpy(l->key_file, v, n + 1);
+        return 1;
+    }
+    if (!strcasecmp(k, "INTERFACE")) {
+        size_t n = strlen(v);
+        if (n >= sizeof l->interface || strpbrk(v, "/ \t") != NULL)
+            return snprintf(why, len, "a network interface's name (lo, eth0, ...), up to %zu "
+                                      "characters, or empty for any",
+                            sizeof l->interface - 1),
+                   -1;
+        memcpy(l->interface, v, n + 1);
+        return 1;
+    }
     if (!strcasecmp(k, "INJECT_LOSS"))
         return real(v, 0, 1, &l->inject_loss, "(a fraction)", why, len);
     if (!strcasecmp(k, "CLOCK")) {
@@ -395,10 +413,14 @@ static int lcm_key(struct ncp_lcm_cfg *l, const char *k, const char *v, char *wh
         { "INJECT_DELAY_US", 0, 1000000, "us" },
         { "INJECT_SEED", 0, 2147483647, "" },
         { "CLOCK_TOLERANCE_US", 1, 10000000, "us" },
+        { "STATUS_NEEDS_KEY", 0, 1, "(0 or 1)" },
+        { "MAX_AGE_MS", 0, 3600000, "ms (0: no limit)" },
     };
     int *dst[] = { &l->dp, &l->max_lost_periods, &l->heartbeat_period_ms,
                    &l->heartbeat_timeout_ms, &l->axis_wait_ms, &l->inject_delay_us,
-                   &l->inject_seed, &l->clock_tolerance_us };
+                   &l->inject_seed, &l->clock_tolerance_us, &l->status_needs_key,
+                   &l->max_age_ms };
+    _Static_assert(sizeof ints / sizeof ints[0] == sizeof dst / sizeof dst[0], "one each");
     for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++)
         if (!strcasecmp(k, ints[i].name))
             return whole(v, ints[i].lo, ints[i].hi, dst[i], ints[i].unit, why, len);

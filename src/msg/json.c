@@ -151,9 +151,11 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
     put(&o, "}, \"step\": %s, \"error\": ", s->step_mode ? "true" : "false");
     put_text(&o, s->error, sizeof s->error);
     put(&o,
-        ", \"seq\": %lld, \"commands\": %lld, \"garbage\": %lld, \"rejected\": %lld, "
+        ", \"seq\": %lld, \"commands\": %lld, \"garbage\": %lld, \"auth_failed\": %lld, "
+        "\"stale\": %lld, \"replayed\": %lld, \"rejected\": %lld, "
         "\"cycles\": %lld, \"deadline_misses\": %lld, \"latency_max_us\": ",
         (long long)s->seq, (long long)s->commands, (long long)s->garbage,
+        (long long)s->auth_failed, (long long)s->stale, (long long)s->replayed,
         (long long)s->rejected, (long long)s->cycles, (long long)s->deadline_misses);
     put_num(&o, "%.3f", s->latency_max_us);
     put(&o, "}");

@@ -8,6 +8,7 @@
  * encodes into another. Nothing is allocated after ncp_msg_open. */
 #include <arpa/inet.h>
 #include <errno.h>
+#include <net/if.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <stdio.h>
@@ -17,6 +18,7 @@
 #include <unistd.h>
 
 #include "msg_int.h"
+#include "ncpar/auth.h"
 #include "ncpar/msg.h"
 
 /* At most this many datagrams per ncp_msg_poll: a flood on the group must
@@ -26,7 +28,8 @@
 
 #define CHANNEL_SIZE (NCP_MSG_PREFIX_MAX + 8)
 #define UDP_DATAGRAM_MAX 65536
-#define SEND_BUF_SIZE 8192 /* header + the largest type (accdec_burst_t) */
+/* header + the largest type (accdec_burst_t) + the MAC's trailer */
+#define SEND_BUF_SIZE (8192 + NCP_AUTH_TRAILER_BYTES)
 #define SUBS_MAX 32
 /* Held back by INJECT_DELAY_US: our own messages are far smaller than this;
  * a larger one is passed on undelayed (and counted) rather than cut. */
@@ -55,13 +58,26 @@ struct ncp_msg {
     char ch_cmd[CHANNEL_SIZE], ch_ack[CHANNEL_SIZE], ch_status[CHANNEL_SIZE],
         ch_event[CHANNEL_SIZE];
     struct ncp_msg_stats stats;
+    struct ncp_auth *auth;
+    int encrypt_public;   /* STATUS and EVENT encrypted ([LCM] STATUS_NEEDS_KEY) */
+    int64_t max_age_ns;   /* ncp_msg_take: older datagrams are stale (0: no limit) */
     uint8_t sbuf[SEND_BUF_SIZE];
     uint8_t rbuf[UDP_DATAGRAM_MAX];
 };
 
-/* The socket as liblcm's udpm sets up its own (receive and send in one). */
-static int open_socket(struct ncp_msg *m, const struct ncp_msg_url *u, struct ncp_diag *d)
+/* The socket as liblcm's udpm sets up its own (receive and send in one),
+ * but bound to the group and joined on one interface only ([LCM] INTERFACE):
+ * a datagram sent to this host's own address, or arriving on another
+ * interface, never reaches it (IP_MULTICAST_ALL off: not even when another
+ * program joined the group there). */
+static int open_socket(struct ncp_msg *m, const struct ncp_msg_url *u, const char *ifname,
+                       struct ncp_diag *d)
 {
+    unsigned ifindex = 0;
+    if (ifname && *ifname && (ifindex = if_nametoindex(ifname)) == 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
+                            "[LCM] INTERFACE = %s: no such network interface (ip link lists them)",
+                            ifname);
     int one = 1;
     int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     if (fd < 0)
@@ -84,22 +100,29 @@ static int open_socket(struct ncp_msg *m, const struct ncp_msg_url *u, struct nc
     struct sockaddr_in addr;
     memset(&addr, 0, sizeof addr);
     addr.sin_family = AF_INET;
-    addr.sin_addr.s_addr = htonl(INADDR_ANY);
+    addr.sin_addr = ifindex ? m->group.sin_addr : (struct in_addr){ htonl(INADDR_ANY) };
     addr.sin_port = htons(u->port);
     if (bind(fd, (struct sockaddr *)&addr, sizeof addr) < 0)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
                             "cannot bind UDP port %u for LCM: %s (another program that uses "
                             "the port without sharing it?)",
                             u->port, strerror(errno));
-    struct ip_mreq mreq;
+    struct ip_mreqn mreq;
     memset(&mreq, 0, sizeof mreq);
     mreq.imr_multiaddr = m->group.sin_addr;
-    mreq.imr_interface.s_addr = htonl(INADDR_ANY);
+    mreq.imr_address.s_addr = htonl(INADDR_ANY);
+    mreq.imr_ifindex = (int)ifindex;
+    int all = 0;
     if (setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) < 0)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
-                            "cannot join multicast group %s on port %u: %s (is there a "
+                            "cannot join multicast group %s on port %u%s%s: %s (is there a "
                             "multicast route? see README)",
-                            u->group, u->port, strerror(errno));
+                            u->group, u->port, ifindex ? " on " : "", ifindex ? ifname : "",
+                            strerror(errno));
+    if (ifindex && (setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &mreq, sizeof mreq) < 0 ||
+                    setsockopt(fd, IPPROTO_IP, IP_MULTICAST_ALL, &all, sizeof all) < 0))
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot keep LCM on interface %s: %s", ifname,
+                            strerror(errno));
     unsigned char ttl = (unsigned char)u->ttl, loop = 1;
     if (setsockopt(fd, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl) < 0 ||
         setsockopt(fd, IPPROTO_IP, IP_MULTICAST_LOOP, &loop, sizeof loop) < 0)
@@ -109,9 +132,10 @@ static int open_socket(struct ncp_msg *m, const struct ncp_msg_url *u, struct nc
     return NCP_OK;
 }
 
-int ncp_msg_open(struct ncp_msg **mp, const char *url, const char *prefix, struct ncp_diag *d)
+int ncp_msg_open(struct ncp_msg **mp, const struct ncp_msg_opts *o, struct ncp_diag *d)
 {
     *mp = NULL;
+    const char *url = o->url, *prefix = o->prefix;
     if (url == NULL || url[0] == 0) {
         url = getenv("LCM_DEFAULT_URL");
         if (url == NULL || url[0] == 0)
@@ -127,10 +151,22 @@ int ncp_msg_open(struct ncp_msg **mp, const char *url, const char *prefix, struc
     int rc = ncp_msg_parse_url(url, &u, d);
     if (rc != NCP_OK)
         return rc;
+    uint8_t key[NCP_AUTH_KEY_BYTES];
+    if (o->key_file == NULL || *o->key_file == 0)
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "LCM without a key file: refused");
+    if (ncp_auth_load_key(o->key_file, o->create_key, key, d) != 0)
+        return NCP_ERR_IO;
     struct ncp_msg *m = calloc(1, sizeof *m);
-    if (m == NULL)
+    if (m != NULL)
+        m->auth = ncp_auth_new(key);
+    explicit_bzero(key, sizeof key);
+    if (m == NULL || m->auth == NULL) {
+        free(m);
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the LCM transport");
+    }
     m->fd = -1;
+    m->encrypt_public = o->encrypt_public;
+    m->max_age_ns = (int64_t)o->max_age_ms * 1000000;
     m->group.sin_family = AF_INET;
     m->group.sin_port = htons(u.port);
     (void)inet_pton(AF_INET, u.group, &m->group.sin_addr);
@@ -138,7 +174,7 @@ int ncp_msg_open(struct ncp_msg **mp, const char *url, const char *prefix, struc
     snprintf(m->ch_ack, sizeof m->ch_ack, "%sACK", prefix);
     snprintf(m->ch_status, sizeof m->ch_status, "%sSTATUS", prefix);
     snprintf(m->ch_event, sizeof m->ch_event, "%sEVENT", prefix);
-    rc = open_socket(m, &u, d);
+    rc = open_socket(m, &u, o->interface, d);
     if (rc != NCP_OK) {
         ncp_msg_close(m);
         return rc;
@@ -153,6 +189,7 @@ void ncp_msg_close(struct ncp_msg *m)
         return;
     if (m->fd >= 0)
         close(m->fd);
+    ncp_auth_free(m->auth);
     free(m->dq);
     free(m);
 }
@@ -190,6 +227,13 @@ static int take_datagram(struct ncp_msg *m, size_t len,
     }
     if (strcmp(channel, m->ch_cmd) != 0)
         return 0;
+    /* nothing unauthenticated is decoded, let alone answered */
+    int64_t sent_ns;
+    if (ncp_auth_check(m->auth, channel, (uint8_t *)payload, plen, &plen, &sent_ns) !=
+        NCP_AUTH_OK) {
+        m->stats.auth_failed++;
+        return 0;
+    }
     ncp_command_t cmd;
     if (ncp_msg_decode_command(payload, plen, &cmd) != 0) {
         m->stats.garbage++;
@@ -223,14 +267,17 @@ int ncp_msg_poll(struct ncp_msg *m, int timeout_ms,
     return handed;
 }
 
-/* Sends the header already in sbuf plus its encoded payload (n < 0: the
- * encoding failed). Never blocks: a full socket buffer is a send error. */
-static int send_frame(struct ncp_msg *m, int header, int n)
+/* Seals and sends the header already in sbuf plus its encoded payload (n <
+ * 0: the encoding failed; the encoders are given room for the trailer).
+ * Never blocks: a full socket buffer is a send error. */
+static int send_frame(struct ncp_msg *m, const char *channel, int header, int n, int encrypt)
 {
     if (header < 0 || n < 0) {
         m->stats.send_errors++;
         return -1;
     }
+    n = (int)ncp_auth_seal(m->auth, channel, m->sbuf + header, (size_t)n, encrypt,
+                           ncp_auth_now_ns());
     ssize_t sent = sendto(m->fd, m->sbuf, (size_t)header + (size_t)n, MSG_DONTWAIT,
                           (const struct sockaddr *)&m->group, sizeof m->group);
     if (sent < 0) {
@@ -242,25 +289,28 @@ static int send_frame(struct ncp_msg *m, int header, int n)
     return 0;
 }
 
+/* what an encoder may fill after a header of h bytes: the trailer follows */
+#define ROOM(h) ((int)sizeof m->sbuf - (h) - (int)NCP_AUTH_TRAILER_BYTES)
+
 int ncp_msg_send_ack(struct ncp_msg *m, const ncp_ack_t *a)
 {
     int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, m->ch_ack);
-    int n = h < 0 ? -1 : ncp_ack_t_encode(m->sbuf, h, (int)sizeof m->sbuf - h, a);
-    return send_frame(m, h, n);
+    int n = h < 0 ? -1 : ncp_ack_t_encode(m->sbuf, h, ROOM(h), a);
+    return send_frame(m, m->ch_ack, h, n, 0);
 }
 
 int ncp_msg_send_status(struct ncp_msg *m, const ncp_status_t *s)
 {
     int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, m->ch_status);
-    int n = h < 0 ? -1 : ncp_status_t_encode(m->sbuf, h, (int)sizeof m->sbuf - h, s);
-    return send_frame(m, h, n);
+    int n = h < 0 ? -1 : ncp_status_t_encode(m->sbuf, h, ROOM(h), s);
+    return send_frame(m, m->ch_status, h, n, m->encrypt_public);
 }
 
 int ncp_msg_send_event(struct ncp_msg *m, const ncp_event_t *e)
 {
     int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, m->ch_event);
-    int n = h < 0 ? -1 : ncp_event_t_encode(m->sbuf, h, (int)sizeof m->sbuf - h, e);
-    return send_frame(m, h, n);
+    int n = h < 0 ? -1 : ncp_event_t_encode(m->sbuf, h, ROOM(h), e);
+    return send_frame(m, m->ch_event, h, n, m->encrypt_public);
 }
 
 /* ---- any channel: the distributed mode's subscriptions ------------------- */
@@ -301,15 +351,15 @@ int ncp_msg_set_inject(struct ncp_msg *m, const struct ncp_msg_inject *in)
 int ncp_msg_publish(struct ncp_msg *m, const char *channel, const void *payload, size_t len)
 {
     int h = ncp_msg_frame_header(m->sbuf, sizeof m->sbuf, m->seqno, channel);
-    if (h < 0 || len > sizeof m->sbuf - (size_t)h) {
+    if (h < 0 || len > sizeof m->sbuf - (size_t)h - NCP_AUTH_TRAILER_BYTES) {
         m->stats.send_errors++;
         return -1;
     }
     memcpy(m->sbuf + h, payload, len);
-    int rc = send_frame(m, h, (int)len);
+    int rc = send_frame(m, channel, h, (int)len, 0);
     if (rc == 0) {
-        m->stats.sent_bytes += (uint64_t)h + len;
-        m->stats.sent_payload_bytes += len;
+        m->stats.sent_bytes += (uint64_t)h + len + NCP_AUTH_TRAILER_BYTES;
+        m->stats.sent_payload_bytes += len + NCP_AUTH_TRAILER_BYTES;
     }
     return rc;
 }
@@ -336,11 +386,35 @@ static int take_due(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t *
     return 1;
 }
 
+/* A datagram on a subscribed channel that is not ncpar's (no key, or a
+ * forged or changed one), or from too long ago (a recording played back):
+ * counted, and as if it had not come. */
+static int refused(struct ncp_msg *m, const char *channel, uint8_t *p, size_t *plen,
+                   int64_t *real_now)
+{
+    int64_t sent_ns;
+    if (ncp_auth_check(m->auth, channel, p, *plen, plen, &sent_ns) != NCP_AUTH_OK) {
+        m->stats.auth_failed++;
+        return 1;
+    }
+    if (m->max_age_ns > 0) {
+        if (*real_now == 0)
+            *real_now = ncp_auth_now_ns();
+        int64_t age = *real_now - sent_ns;
+        if (age > m->max_age_ns || age < -m->max_age_ns) {
+            m->stats.stale++;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 int ncp_msg_take(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t **payload,
                  size_t *len)
 {
     if (take_due(m, now_ns, sub, payload, len))
         return 1;
+    int64_t real_now = 0;   /* read once per call, when a datagram needs it */
     for (int i = 0; i < POLL_DATAGRAMS_MAX; i++) {
         ssize_t n = recv(m->fd, m->rbuf, sizeof m->rbuf, MSG_DONTWAIT);
         if (n < 0)
@@ -356,6 +430,8 @@ int ncp_msg_take(struct ncp_msg *m, int64_t now_ns, int *sub, const uint8_t **pa
         int s = sub_index(m, channel);
         if (s < 0)
             continue;   /* other LCM traffic on the group */
+        if (refused(m, channel, (uint8_t *)p, &plen, &real_now))
+            continue;
         m->stats.taken++;
         m->stats.taken_bytes += (uint64_t)n;
         if (m->inj.loss > 0 && ncp_msg_dice_drop(&m->dice[s], m->inj.loss)) {

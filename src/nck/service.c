@@ -5,6 +5,7 @@
  * channel, a command goes to the NCK of its channel only. */
 #include "nck_int.h"
 
+#include "ncpar/dist.h"
 #include "ncpar/msg.h"
 
 #include <math.h>
@@ -15,12 +16,17 @@
 #include <sys/time.h>
 #include <time.h>
 
-/* The last command of each client: a repeated seq is a resend (answered
- * with the same ACK, not acted on twice), an older one is out of order. */
-#define SERVE_CLIENTS 64
+/* Each client's last command, kept for as long as one of its commands can
+ * still be fresh (its latest deadline): a repeated seq is a resend (answered
+ * with the same ACK, not acted on twice), an older one a replay (dropped).
+ * A command past its deadline is refused anyway, so after it the entry is
+ * of no use and is dropped: the table holds the clients of the last
+ * FRESH_MAX_US at most, and only clients that hold the key can add one. */
+#define FRESH_MAX_US (600LL * 1000000)  /* the longest a command may stay fresh */
+#define CLOCK_AHEAD_MAX_US (5LL * 1000000) /* a client's clock ahead of ours, at most */
 struct client {
     int32_t id, seq;
-    int64_t last_ns;
+    int64_t keep_until_us;           /* CLOCK_REALTIME: its latest deadline */
     ncp_ack_t ack;
     int pending;                     /* seq's answer is not known yet: a resend waits */
 };
@@ -37,8 +43,9 @@ struct serve {
     struct serve_channel ch[NCP_NCK_CHANNELS_MAX];
     int n_ch;
     struct ncp_msg *msg;
-    struct client clients[SERVE_CLIENTS];
-    uint64_t out_of_order, duplicates;
+    struct client *clients;
+    size_t n_clients, cap_clients;
+    uint64_t replayed, duplicates, stale, late_estops;
     int64_t status_seq, event_seq;
     int fault_seen;
     const struct ncp_nck_serve_hook *hook;   /* another front end, or NULL */
@@ -58,19 +65,30 @@ static int64_t utime_now(void)
     return (int64_t)tv.tv_sec * 1000000 + tv.tv_usec;
 }
 
-static struct client *client_of(struct serve *sv, int32_t id)
+/* The client's entry, made when new (NULL: out of memory). Entries whose
+ * every command is past its deadline make room first. */
+static struct client *client_of(struct serve *sv, int32_t id, int64_t now_us)
 {
-    struct client *oldest = &sv->clients[0];
-    for (int i = 0; i < SERVE_CLIENTS; i++) {
-        struct client *c = &sv->clients[i];
-        if (c->id == id)
-            return c;
-        if (c->last_ns < oldest->last_ns)
-            oldest = c;
+    for (size_t i = 0; i < sv->n_clients; i++)
+        if (sv->clients[i].id == id)
+            return &sv->clients[i];
+    size_t kept = 0;
+    for (size_t i = 0; i < sv->n_clients; i++)
+        if (sv->clients[i].pending || sv->clients[i].keep_until_us >= now_us)
+            sv->clients[kept++] = sv->clients[i];
+    sv->n_clients = kept;
+    if (sv->n_clients == sv->cap_clients) {
+        size_t cap = sv->cap_clients ? 2 * sv->cap_clients : 16;
+        struct client *grown = realloc(sv->clients, cap * sizeof *grown);
+        if (grown == NULL)
+            return NULL;
+        sv->clients = grown;
+        sv->cap_clients = cap;
     }
-    memset(oldest, 0, sizeof *oldest);
-    oldest->id = id;
-    return oldest;
+    struct client *c = &sv->clients[sv->n_clients++];
+    memset(c, 0, sizeof *c);
+    c->id = id;
+    return c;
 }
 
 static struct serve_channel *channel_of(struct serve *sv, int num)
@@ -122,7 +140,10 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.step_mode = (int8_t)st.step_mode;
     snprintf((char *)m.error, sizeof m.error, "%s", st.error);
     m.commands = (int64_t)ms.commands;
-    m.garbage = (int64_t)(ms.garbage + sv->out_of_order);
+    m.garbage = (int64_t)ms.garbage;
+    m.auth_failed = (int64_t)ms.auth_failed;
+    m.stale = (int64_t)sv->stale;
+    m.replayed = (int64_t)sv->replayed;
     m.rejected = (int64_t)st.rejected;
     m.cycles = (int64_t)st.cycles;
     m.deadline_misses = (int64_t)st.deadline_misses;
@@ -192,31 +213,98 @@ static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *
 static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int32_t client,
                    int32_t seq, int rc, const char *why);
 
-static void on_command(void *ctx, const ncp_command_t *c)
+/* Why a command cannot act now (NULL: it may): its deadline passed, or it
+ * claims more than a command may. local: the panel's, handed over in this
+ * process (no clock of another host, no network in between). */
+static const char *unfresh(const ncp_command_t *c, int64_t now_us, char *why, size_t len)
 {
-    struct serve *sv = ctx;
+    if (c->deadline_utime <= c->utime || c->deadline_utime - c->utime > FRESH_MAX_US)
+        return snprintf(why, len, "the command's deadline is not within %lld s of its "
+                                  "sending: refused",
+                        FRESH_MAX_US / 1000000), why;
+    if (c->utime > now_us + CLOCK_AHEAD_MAX_US)
+        return snprintf(why, len, "the command was sent %.1f s in this NCK's future: are the "
+                                  "two hosts' clocks in step (NTP, PTP)?",
+                        (double)(c->utime - now_us) * 1e-6), why;
+    if (now_us > c->deadline_utime)
+        return snprintf(why, len, "the command came %.0f ms after its deadline (its client "
+                                  "had given up): not acted on",
+                        (double)(now_us - c->deadline_utime) * 1e-3), why;
+    return NULL;
+}
+
+static void act(struct serve *sv, struct serve_channel *ch, struct client *cl,
+                const ncp_command_t *c);
+
+/* An E-stop is never conditional: whatever its sequence number, however
+ * often it comes and however late, an authenticated one acts (stopping is
+ * never the wrong answer to it), and it is answered. */
+static void on_estop(struct serve *sv, struct serve_channel *ch, struct client *cl,
+                     const ncp_command_t *c, int64_t now_us, int local)
+{
+    if (!local && now_us > c->deadline_utime)
+        sv->late_estops++;
+    if (c->seq > cl->seq)
+        cl->seq = c->seq;
+    if (!ch) {
+        refuse_channel(sv, c, &cl->ack);
+        return;
+    }
+    act(sv, ch, cl, c);
+}
+
+static void take_command(struct serve *sv, const ncp_command_t *c, int local)
+{
     struct serve_channel *ch = channel_of(sv, c->channel);
+    int64_t now_us = utime_now();
+    struct client *cl = client_of(sv, c->client_id, now_us);
+    if (cl == NULL)
+        return;   /* out of memory: as if lost; the client resends */
+    int64_t until = local ? now_us + FRESH_MAX_US : c->deadline_utime;
+    if (until > cl->keep_until_us)
+        cl->keep_until_us = until;
+    if (c->kind == NCP_CMD_ESTOP) {
+        on_estop(sv, ch, cl, c, now_us, local);
+        return;
+    }
+    if (cl->seq && c->seq == cl->seq) {
+        sv->duplicates++;
+        if (!cl->pending && c->kind != NCP_CMD_KEEPALIVE)
+            send_ack(sv, &cl->ack);
+        return;
+    }
+    if (cl->seq && c->seq < cl->seq) {
+        sv->replayed++;
+        return;
+    }
+    char why[sizeof cl->ack.reason];
+    if (!local && unfresh(c, now_us, why, sizeof why)) {
+        sv->stale++;
+        cl->seq = c->seq;
+        if (c->kind != NCP_CMD_KEEPALIVE) {
+            ncp_ack_t *a = &cl->ack;
+            memset(a, 0, sizeof *a);
+            a->utime = now_us;
+            a->client_id = c->client_id;
+            a->seq = c->seq;
+            a->channel = c->channel;
+            a->result = NCP_ACK_T_REJECTED;
+            a->state = -1;
+            snprintf((char *)a->reason, sizeof a->reason, "%s", why);
+            send_ack(sv, a);
+        }
+        return;
+    }
     if (c->kind == NCP_CMD_KEEPALIVE) {
+        cl->seq = c->seq;
         /* only the jogging client's keep-alives hold its jog */
         if (ch && c->client_id == ch->jog_client) {
             struct ncp_nck_cmd k;
             memset(&k, 0, sizeof k);
             k.kind = NCP_CMD_KEEPALIVE;
-            char why[8];
-            ncp_nck_command(ch->nck, &k, why, sizeof why);
+            char kwhy[8];
+            ncp_nck_command(ch->nck, &k, kwhy, sizeof kwhy);
         }
-        return;
-    }
-    struct client *cl = client_of(sv, c->client_id);
-    cl->last_ns = mono_ns();
-    if (cl->seq && c->seq == cl->seq) {
-        sv->duplicates++;
-        if (!cl->pending)
-            send_ack(sv, &cl->ack);
-        return;
-    }
-    if (cl->seq && c->seq < cl->seq) {
-        sv->out_of_order++;
         return;
     }
     if (!ch) {
@@ -224,6 +312,18 @@ static void on_command(void *ctx, const ncp_command_t *c)
         refuse_channel(sv, c, &cl->ack);
         return;
     }
+    act(sv, ch, cl, c);
+}
+
+static void on_command(void *ctx, const ncp_command_t *c)
+{
+    take_command(ctx, c, 0);
+}
+
+/* The command, acted on: its ACK now, or when its NCK has the answer. */
+static void act(struct serve *sv, struct serve_channel *ch, struct client *cl,
+                const ncp_command_t *c)
+{
     struct ncp_nck_cmd k;
     memset(&k, 0, sizeof k);
     k.kind = c->kind;
@@ -238,7 +338,8 @@ static void on_command(void *ctx, const ncp_command_t *c)
     memset(a, 0, sizeof *a);
     char why[sizeof a->reason];
     int rc = ncp_nck_command(ch->nck, &k, why, sizeof why);
-    cl->seq = c->seq;
+    if (c->seq > cl->seq)   /* an E-stop's may be older: it never winds the table back */
+        cl->seq = c->seq;
     if (rc == NCP_NCK_CMD_PENDING) {
         cl->pending = 1;
         ch->pending = 1;
@@ -280,11 +381,11 @@ static void answer_pending(struct serve *sv, struct serve_channel *ch)
     if (rc == NCP_NCK_CMD_PENDING)
         return;
     ch->pending = 0;
-    struct client *cl = client_of(sv, ch->pending_client);
+    struct client *cl = client_of(sv, ch->pending_client, utime_now());
     ncp_ack_t a;
     memset(&a, 0, sizeof a);
     answer(sv, ch, &a, ch->pending_client, ch->pending_seq, rc, why);
-    if (cl->seq == ch->pending_seq) {
+    if (cl != NULL && cl->seq == ch->pending_seq) {
         cl->ack = a;
         cl->pending = 0;
     }
@@ -324,9 +425,18 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
     sv->hook = o->hook;
     /* the transport is one for all: the first channel's machine INI says where */
     const struct ncp_machine_cfg *cfg = ncks[0]->n.cfg;
-    const char *url = o->url && *o->url ? o->url : cfg->lcm.url;
     const char *prefix = o->prefix && *o->prefix ? o->prefix : cfg->lcm.prefix;
-    if (ncp_msg_open(&sv->msg, url, prefix, d) != 0) {
+    struct ncp_dist_msg_opts mo;
+    if (ncp_dist_msg_opts(&cfg->lcm, &mo, d) != NCP_OK) {
+        free(sv);
+        return -1;
+    }
+    if (o->url && *o->url)
+        mo.opts.url = o->url;
+    mo.opts.prefix = prefix;
+    mo.opts.create_key = 1;
+    mo.opts.max_age_ms = 0;   /* commands carry their own deadline */
+    if (ncp_msg_open(&sv->msg, &mo.opts, d) != 0) {
         free(sv);
         return -1;
     }
@@ -356,7 +466,7 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
         /* the other front end's commands take the same path as LCM's */
         ncp_command_t hc;
         while (sv->hook && sv->hook->next_command && sv->hook->next_command(sv->hook->ctx, &hc))
-            on_command(sv, &hc);
+            take_command(sv, &hc, 1);
         now = mono_ns();
         int due = now >= next_status;
         for (int k = 0; k < n; k++) {
@@ -379,6 +489,7 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
     }
     int fault = sv->fault_seen;
     ncp_msg_close(sv->msg);
+    free(sv->clients);
     free(sv);
     return fault ? 1 : 0;
 }

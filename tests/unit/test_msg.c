@@ -10,11 +10,47 @@
 #include <math.h>
 #include <netinet/in.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "ncpar/auth.h"
 #include "ncpar/msg.h"
+
+/* A key file of the tests' own (the transport refuses to open without one). */
+static char path[64];
+static void remove_key_file(void)
+{
+    unlink(path);
+}
+
+static const char *test_key_file(void)
+{
+    if (path[0])
+        return path;
+    snprintf(path, sizeof path, "/tmp/test_msg-%d.key", (int)getpid());
+    atexit(remove_key_file);
+    struct ncp_diag d;
+    uint8_t key[NCP_AUTH_KEY_BYTES];
+    unlink(path);
+    assert_int_equal(ncp_auth_load_key(path, 1, key, &d), 0);
+    return path;
+}
+
+static struct ncp_auth *test_auth(void)
+{
+    uint8_t key[NCP_AUTH_KEY_BYTES];
+    struct ncp_diag d;
+    assert_int_equal(ncp_auth_load_key(test_key_file(), 0, key, &d), 0);
+    return ncp_auth_new(key);
+}
+
+static int open_msg(struct ncp_msg **m, const char *url, const char *prefix, struct ncp_diag *d)
+{
+    const struct ncp_msg_opts o = { .url = url, .prefix = prefix, .key_file = test_key_file() };
+    return ncp_msg_open(m, &o, d);
+}
 
 static const uint8_t lc02[4] = {0x4c, 0x43, 0x30, 0x32};
 
@@ -402,7 +438,7 @@ static void test_loopback(void **state)
     static const char url[] = "udpm://239.255.76.68:7769?ttl=0";
     struct ncp_msg *m;
     struct ncp_diag d;
-    if (ncp_msg_open(&m, url, prefix, &d) != 0) {
+    if (open_msg(&m, url, prefix, &d) != 0) {
         printf("no multicast here (%s)\n", d.msg);
         skip();
     }
@@ -428,15 +464,26 @@ static void test_loopback(void **state)
     snprintf(ch_cmd, sizeof ch_cmd, "%sCMD", prefix);
     snprintf(ch_other, sizeof ch_other, "%sSTATUSX", prefix);
     uint8_t buf[2048];
+    struct ncp_auth *a = test_auth();
     ncp_command_t c = good_command();
     int h = ncp_msg_frame_header(buf, sizeof buf, 1, ch_cmd);
     int n = ncp_command_t_encode(buf, h, (int)sizeof buf - h, &c);
-    send_raw(fd, &to, buf, (size_t)(h + n));
-    send_raw(fd, &to, buf, (size_t)(h + n - 3));    /* truncated: garbage */
+    send_raw(fd, &to, buf, (size_t)(h + n));        /* no seal: auth_failed */
+    size_t sealed = ncp_auth_seal(a, ch_cmd, buf + h, (size_t)n, 0, ncp_auth_now_ns());
+    send_raw(fd, &to, buf, (size_t)h + sealed);     /* the one handed on */
+    send_raw(fd, &to, buf, (size_t)h + sealed - 3); /* truncated: auth_failed */
+    buf[h + 20] ^= 1;
+    send_raw(fd, &to, buf, (size_t)h + sealed);     /* one bit changed: auth_failed */
+    buf[h + 20] ^= 1;
     send_raw(fd, &to, (const uint8_t *)"hello", 5); /* not LCM: garbage */
     h = ncp_msg_frame_header(buf, sizeof buf, 2, ch_other);
     n = ncp_command_t_encode(buf, h, (int)sizeof buf - h, &c);
     send_raw(fd, &to, buf, (size_t)(h + n)); /* another channel: skipped */
+    /* a valid command sealed for another channel, sent on CMD: refused */
+    h = ncp_msg_frame_header(buf, sizeof buf, 3, ch_cmd);
+    n = ncp_command_t_encode(buf, h, (int)sizeof buf - h, &c);
+    sealed = ncp_auth_seal(a, ch_other, buf + h, (size_t)n, 0, ncp_auth_now_ns());
+    send_raw(fd, &to, buf, (size_t)h + sealed);
 
     ncp_status_t s;
     memset(&s, 0, sizeof s);
@@ -448,15 +495,16 @@ static void test_loopback(void **state)
     for (int i = 0; i < 50; i++) {
         assert_true(ncp_msg_poll(m, 20, on_cmd, &g) >= 0);
         ncp_msg_get_stats(m, &st);
-        if (st.received >= 5)
+        if (st.received >= 8)
             break;
     }
     assert_int_equal(g.n, 1);
     assert_int_equal(g.last.client_id, 12345);
     assert_int_equal(g.last.kind, NCP_COMMAND_T_JOG);
-    assert_int_equal(st.received, 5); /* four sent here, and our own status */
+    assert_int_equal(st.received, 8); /* seven sent here, and our own status */
     assert_int_equal(st.commands, 1);
-    assert_int_equal(st.garbage, 2);
+    assert_int_equal(st.auth_failed, 4);
+    assert_int_equal(st.garbage, 1);
     assert_int_equal(st.sent, 1);
 
     /* the other socket reads our status as an LCM client would */
@@ -470,8 +518,12 @@ static void test_loopback(void **state)
                        strstr(ch, "STATUS") == NULL || strstr(ch, "STATUSX") != NULL));
     assert_true(r > 0);
     ncp_status_t s2;
-    assert_int_equal(ncp_status_t_decode(p, 0, (int)plen, &s2), (int)plen);
+    size_t body;
+    int64_t sent_ns;
+    assert_int_equal(ncp_auth_check(a, ch, (uint8_t *)p, plen, &body, &sent_ns), NCP_AUTH_OK);
+    assert_int_equal(ncp_status_t_decode(p, 0, (int)body, &s2), (int)body);
     assert_int_equal(s2.seq, 5);
+    ncp_auth_free(a);
     close(fd);
     ncp_msg_close(m);
 }
@@ -488,9 +540,9 @@ static int64_t arrivals_on_a(int mixed, int *lost)
     static const char url[] = "udpm://239.255.76.68:7771?ttl=0";
     struct ncp_msg *rx, *tx;
     struct ncp_diag d;
-    if (ncp_msg_open(&rx, url, prefix, &d) != 0)
+    if (open_msg(&rx, url, prefix, &d) != 0)
         return -1;
-    assert_int_equal(ncp_msg_open(&tx, url, prefix, &d), 0);
+    assert_int_equal(open_msg(&tx, url, prefix, &d), 0);
     assert_int_equal(ncp_msg_subscribe(rx, ch_b), 0);
     assert_int_equal(ncp_msg_subscribe(rx, ch_a), 1);
     const struct ncp_msg_inject in = { 0.5, 0, 9 };
@@ -549,12 +601,16 @@ static void test_open_errors(void **state)
     (void)state;
     struct ncp_msg *m;
     struct ncp_diag d;
-    assert_int_not_equal(ncp_msg_open(&m, "udpm://10.0.0.1:7667", NULL, &d), 0);
+    assert_int_not_equal(open_msg(&m, "udpm://10.0.0.1:7667", NULL, &d), 0);
     assert_null(m);
     assert_non_null(strstr(d.msg, "not a multicast group"));
     assert_int_not_equal(
-        ncp_msg_open(&m, NULL, "A_PREFIX_LONGER_THAN_THIRTY_TWO_CHARACTERS_", &d), 0);
+        open_msg(&m, NULL, "A_PREFIX_LONGER_THAN_THIRTY_TWO_CHARACTERS_", &d), 0);
     assert_non_null(strstr(d.msg, "prefix"));
+    const struct ncp_msg_opts nokey = { .url = NULL };
+    assert_int_not_equal(ncp_msg_open(&m, &nokey, &d), 0);
+    assert_null(m);
+    assert_non_null(strstr(d.msg, "key"));
 }
 
 int main(void)
