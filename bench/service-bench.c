@@ -5,7 +5,11 @@
  *                     accepted in every state): command-to-ACK latency
  *   final             the next STATUS: the position loop's cycles, deadline
  *                     misses and worst latency so far
- * Prints one line of key=value pairs. Links liblcm, as any client would. */
+ *   mac N             (no NCK needed) N seals and N checks of a command, a
+ *                     status and a fine-setpoint record: ns per message,
+ *                     what the key costs a sender and a receiver
+ * Prints one line of key=value pairs. Links liblcm, as any client would, and
+ * seals its commands with the NCK's key ($NCP_KEY_FILE, else the default). */
 #include <lcm/lcm.h>
 #include <math.h>
 #include <stdio.h>
@@ -16,10 +20,13 @@
 
 #include "ncp_ack_t.h"
 #include "ncp_command_t.h"
+#include "ncp_fine_ipo_t.h"
 #include "ncp_status_t.h"
+#include "ncpar/auth.h"
 
 struct bench {
     lcm_t *lcm;
+    struct ncp_auth *auth;
     char prefix[64];
     int statuses;
     ncp_status_t last;
@@ -34,22 +41,71 @@ static double now_s(void)
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
+/* The message's encoding when sealed with the key (copied to buf): length, or -1. */
+static int opened(const struct bench *b, const lcm_recv_buf_t *rb, const char *ch, uint8_t *buf,
+                  size_t size)
+{
+    size_t n;
+    int64_t sent;
+    if (rb->data_size > size)
+        return -1;
+    memcpy(buf, rb->data, rb->data_size);
+    return ncp_auth_check(b->auth, ch, buf, rb->data_size, &n, &sent) == NCP_AUTH_OK ? (int)n
+                                                                                      : -1;
+}
+
 static void on_status(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
-    (void)ch;
     struct bench *b = user;
-    if (ncp_status_t_decode(rb->data, 0, (int)rb->data_size, &b->last) >= 0)
+    uint8_t buf[8192];
+    int n = opened(b, rb, ch, buf, sizeof buf);
+    if (n >= 0 && ncp_status_t_decode(buf, 0, n, &b->last) >= 0)
         b->statuses++;
 }
 
 static void on_ack(const lcm_recv_buf_t *rb, const char *ch, void *user)
 {
-    (void)ch;
     struct bench *b = user;
     ncp_ack_t a;
-    if (ncp_ack_t_decode(rb->data, 0, (int)rb->data_size, &a) >= 0 && a.client_id == b->client &&
+    uint8_t buf[4096];
+    int n = opened(b, rb, ch, buf, sizeof buf);
+    if (n >= 0 && ncp_ack_t_decode(buf, 0, n, &a) >= 0 && a.client_id == b->client &&
         a.seq == b->want_seq)
         b->acked = 1;
+}
+
+/* ns per seal and per check of one encoded message of len bytes. */
+static void time_mac(struct ncp_auth *a, const char *what, const char *ch, size_t len, int n)
+{
+    uint8_t buf[8192];
+    memset(buf, 0x5a, sizeof buf);
+    double t0 = now_s();
+    size_t sealed = 0;
+    for (int i = 0; i < n; i++)
+        sealed = ncp_auth_seal(a, ch, buf, len, 0, (int64_t)i);
+    double t1 = now_s();
+    size_t body;
+    int64_t sent;
+    int bad = 0;
+    for (int i = 0; i < n; i++)
+        bad += ncp_auth_check(a, ch, buf, sealed, &body, &sent) != NCP_AUTH_OK;
+    double t2 = now_s();
+    printf("mac %s bytes=%zu seal_ns=%.0f check_ns=%.0f%s\n", what, len, (t1 - t0) / n * 1e9,
+           (t2 - t1) / n * 1e9, bad ? " CHECK-FAILED" : "");
+}
+
+static int mac_costs(struct ncp_auth *a, int n)
+{
+    ncp_command_t c;
+    ncp_status_t s;
+    ncp_fine_ipo_t f;
+    memset(&c, 0, sizeof c);
+    memset(&s, 0, sizeof s);
+    memset(&f, 0, sizeof f);
+    time_mac(a, "command", "NCP_CMD", (size_t)ncp_command_t_encoded_size(&c), n);
+    time_mac(a, "status", "NCP_STATUS", (size_t)ncp_status_t_encoded_size(&s), n);
+    time_mac(a, "fine_setpoint", "NCP_HLC_FINE", (size_t)ncp_fine_ipo_t_encoded_size(&f), n);
+    return 0;
 }
 
 static void handle_for(struct bench *b, double seconds)
@@ -80,10 +136,16 @@ static int acks(struct bench *b, int n, int quiet)
         c.seq = ++b->want_seq;
         c.kind = NCP_COMMAND_T_OVERRIDE;
         c.value[0] = 100;
-        uint8_t buf[1024];
-        int len = ncp_command_t_encode(buf, 0, sizeof buf, &c);
+        uint8_t buf[1024 + NCP_AUTH_TRAILER_BYTES];
         b->acked = 0;
         double t0 = now_s();
+        /* the seal and the deadline are part of what a command costs: timed */
+        struct timespec rt;
+        clock_gettime(CLOCK_REALTIME, &rt);
+        c.utime = (int64_t)rt.tv_sec * 1000000 + rt.tv_nsec / 1000;
+        c.deadline_utime = c.utime + 1000000;
+        int len = ncp_command_t_encode(buf, 0, 1024, &c);
+        len = (int)ncp_auth_seal(b->auth, ch, buf, (size_t)len, 0, ncp_auth_now_ns());
         lcm_publish(b->lcm, ch, buf, (unsigned)len);
         while (!b->acked && now_s() - t0 < 1.0)
             lcm_handle_timeout(b->lcm, 100);
@@ -109,11 +171,21 @@ static int acks(struct bench *b, int n, int quiet)
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(stderr, "usage: service-bench URL PREFIX status SECONDS | acks N | final\n");
+        fprintf(stderr, "usage: service-bench URL PREFIX status SECONDS | acks N | final | mac N\n");
         return 1;
     }
     struct bench b;
     memset(&b, 0, sizeof b);
+    struct ncp_diag d;
+    char path[NCP_AUTH_PATH_MAX];
+    uint8_t key[NCP_AUTH_KEY_BYTES];
+    if (ncp_auth_key_path(path, sizeof path, getenv("NCP_KEY_FILE"), NULL, &d) != 0 ||
+        ncp_auth_load_key(path, 0, key, &d) != 0 || !(b.auth = ncp_auth_new(key))) {
+        fprintf(stderr, "service-bench: %s\n", d.msg);
+        return 1;
+    }
+    if (!strcmp(argv[3], "mac"))
+        return argc > 4 ? mac_costs(b.auth, atoi(argv[4])) : 1;
     b.lcm = lcm_create(argv[1]);
     if (!b.lcm) {
         fprintf(stderr, "service-bench: cannot open LCM at %s\n", argv[1]);
@@ -155,5 +227,6 @@ int main(int argc, char **argv)
         }
     }
     lcm_destroy(b.lcm);
+    ncp_auth_free(b.auth);
     return rc;
 }

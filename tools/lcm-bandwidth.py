@@ -8,7 +8,10 @@ the 8-byte type fingerprint LCM puts in front of every message: what seed
 002's Tables I-II count), and LCM's own overhead per message beside it: the
 fingerprint, the LC02 header (magic, sequence number, channel name and its
 NUL) and IPv4 + UDP (28 bytes). A message bigger than one datagram is sent
-in LC03 fragments, each with its own headers: counted as such.
+in LC03 fragments, each with its own headers: counted as such. ncpar's seal
+(the 32-byte trailer with the key's MAC after the encoded fields, see
+include/ncpar/auth.h) is overhead too, not payload: it is counted beside
+LCM's, so the payload stays the paper's figure.
 
 usage: lcm-bandwidth.py LOGFILE [--channel REGEX]... [--json]
        lcm-bandwidth.py --listen [URL] --seconds S [--channel REGEX]... [--json]
@@ -27,6 +30,13 @@ LOG_SYNC = 0xEDA1DA01
 LC02, LC03 = 0x4C433032, 0x4C433033
 FINGERPRINT = 8
 IP_UDP = 28
+SEAL = 32                  # ncpar's trailer: magic, sent_ns, salt, 16-byte MAC
+SEAL_MAGICS = (b"NCA1", b"NCE1")
+
+
+def seal_of(body):
+    """The bytes of ncpar's seal at the end of an encoded message (0: none)."""
+    return SEAL if len(body) >= FINGERPRINT + SEAL and body[-SEAL:-SEAL + 4] in SEAL_MAGICS else 0
 MAX_DATAGRAM = 65507   # a message up to this (with its LC02 header) is not fragmented
 FRAG_PAYLOAD = 65507 - 20  # LC03 header is 20 bytes before the data of each fragment
 
@@ -43,7 +53,7 @@ def wire_overhead(channel, size):
 
 
 def read_log(path):
-    """(timestamp_s, channel, encoded size) of every event in an LCM log file."""
+    """(timestamp_s, channel, encoded size, seal bytes) of every event in an LCM log file."""
     data = open(path, "rb").read()
     out, i = [], 0
     while i + 28 <= len(data):
@@ -52,10 +62,11 @@ def read_log(path):
             sys.exit("lcm-bandwidth: %s: not an LCM log at byte %d" % (path, i))
         i += 28
         ch = data[i:i + clen].decode(errors="replace")
+        body = data[i + clen:i + clen + dlen]
         i += clen + dlen
         if i > len(data):
             break   # the logger was stopped mid-event
-        out.append((utime * 1e-6, ch, dlen))
+        out.append((utime * 1e-6, ch, dlen, seal_of(body)))
     return out
 
 
@@ -91,23 +102,27 @@ def listen(url, seconds):
             nul = buf.find(b"\0", 8)
             if nul < 0:
                 continue
-            out.append((now, buf[8:nul].decode(errors="replace"), len(buf) - nul - 1))
+            out.append((now, buf[8:nul].decode(errors="replace"), len(buf) - nul - 1,
+                        seal_of(buf[nul + 1:])))
         elif magic == LC03 and len(buf) >= 20:
             size, _, no, _ = struct.unpack_from(">IIHH", buf, 8)
             if no == 0:
                 nul = buf.find(b"\0", 20)
                 if nul >= 0:
                     frags[seq] = buf[20:nul].decode(errors="replace")
-                    out.append((now, frags[seq], size))
+                    out.append((now, frags[seq], size, 0))
     return out
 
 
 def summarise(events, patterns):
     chans = {}
-    for t, ch, size in events:
+    for t, ch, size, seal in events:
         if patterns and not any(re.search(p, ch) for p in patterns):
             continue
-        c = chans.setdefault(ch, {"messages": 0, "t0": t, "t1": t, "bytes": 0, "min": size, "max": size})
+        size -= seal
+        c = chans.setdefault(ch, {"messages": 0, "t0": t, "t1": t, "bytes": 0, "min": size,
+                                  "max": size, "seals": 0})
+        c["seals"] += seal
         c["messages"] += 1
         c["t1"] = t
         c["bytes"] += size
@@ -118,10 +133,12 @@ def summarise(events, patterns):
         span = c["t1"] - c["t0"]
         rate = (c["messages"] - 1) / span if span > 0 and c["messages"] > 1 else 0.0
         payload = c["bytes"] / c["messages"] - FINGERPRINT
-        over = wire_overhead(ch, int(round(c["bytes"] / c["messages"])))
+        seal = c["seals"] / c["messages"]
+        over = wire_overhead(ch, int(round(c["bytes"] / c["messages"] + seal))) + seal
         rows.append({"channel": ch, "messages": c["messages"], "seconds": span, "per_second": rate,
                      "payload_bytes": payload, "payload_min": c["min"] - FINGERPRINT,
                      "payload_max": c["max"] - FINGERPRINT, "lcm_overhead_bytes": over,
+                     "seal_bytes": seal,
                      "payload_kbps": payload * 8 * rate / 1000.0,
                      "wire_kbps": (payload + over) * 8 * rate / 1000.0})
     return rows
