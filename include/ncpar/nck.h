@@ -204,7 +204,8 @@ struct ncp_nck_setup {
     struct ncp_analyzer_cfg interp;  /* tool table, subroutine path of the interpreter */
     enum ncp_thread_mode mode;       /* how programs are interpreted */
     double jog_keepalive_s;          /* a continuous jog stops this long after the last
-                                        keep-alive (0: 0.5 s) */
+                                        keep-alive (0: 0.3 s, three of
+                                        cnc-ctl's keep-alive periods) */
     double virtual_pace;             /* virtual clock: machine seconds per real second
                                         while moving (0: as fast as the CPU allows) */
     int trace_rings;                 /* ring and task columns in the trace (or [SCHED]'s) */

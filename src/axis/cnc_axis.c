@@ -242,6 +242,10 @@ static int report(const struct llc *l)
             l->rx.lost, l->rx.held, l->rx.stale, l->rx.duplicate, l->rx.bridged,
             l->rx.reordered, l->clamped, l->ff_guessed,
             (unsigned long long)st.inject_lost, (unsigned long long)st.inject_delayed);
+    /* what never reached the loop: without the key's seal, or too old */
+    fprintf(stderr, "cnc-axis %c: dropped %llu messages without the key's seal, %llu older than "
+                    "[LCM] MAX_AGE_MS\n",
+            ax, (unsigned long long)st.auth_failed, (unsigned long long)st.stale);
     if (l->dp4 && !l->dp1ai)
         fprintf(stderr, "cnc-axis %c: DP %d: records taken %d, gaps %u, resend requests %u, "
                         "stale %u, duplicate %u, too early %u\n",

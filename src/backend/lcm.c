@@ -561,10 +561,12 @@ static void lcm_stop(struct ncp_backend *b)
             command == NCP_HEARTBEAT_T_COMMAND_DONE ? "done" : "stop",
             (unsigned long long)s->ends_sent, (double)s->end_gap_ns * 1e-6);
     fprintf(stderr, "lcm: transport: sent %llu (%llu send errors), taken %llu, injected loss "
-                    "%llu, delayed %llu\n",
+                    "%llu, delayed %llu; dropped %llu without the key's seal, %llu older than "
+                    "MAX_AGE_MS\n",
             (unsigned long long)st.sent, (unsigned long long)st.send_errors,
             (unsigned long long)st.taken, (unsigned long long)st.inject_lost,
-            (unsigned long long)st.inject_delayed);
+            (unsigned long long)st.inject_delayed, (unsigned long long)st.auth_failed,
+            (unsigned long long)st.stale);
 }
 
 static void lcm_describe(const struct ncp_backend *b, char *buf, size_t len)

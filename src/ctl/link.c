@@ -12,7 +12,7 @@
 #include "ncpar/auth.h"
 
 #define RESEND_S 0.5
-#define KEEPALIVE_FRESH_S 0.5  /* a keep-alive holds a jog this long (the NCK's limit) */
+#define KEEPALIVE_FRESH_S 0.3  /* a keep-alive holds a jog this long (the NCK's limit) */
 #define FRESH_MAX_S 600.0      /* the longest the NCK lets a command stay fresh */
 /* The command's deadline lies this much before the moment cnc-ctl gives up
  * (at most): a command the NCK takes just before its deadline has its ACK

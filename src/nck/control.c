@@ -795,7 +795,7 @@ int ncp_nck_poll(struct ncp_nck *s)
         s->waits_seen = n->last_fb.waits;
     }
     if (s->state == NCP_ST_JOGGING && s->jog_continuous && s->drop == NCK_DROP_NONE) {
-        double limit = n->setup.jog_keepalive_s > 0 ? n->setup.jog_keepalive_s : 0.5;
+        double limit = n->setup.jog_keepalive_s > 0 ? n->setup.jog_keepalive_s : 0.3;
         if ((double)(mono_ns() - s->jog_last_ns) * 1e-9 > limit) {
             nck_post(n, NCP_EV_INFO, NULL, 0, 0,
                      "jog stopped: no keep-alive from its client for %.1f s", limit);

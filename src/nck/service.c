@@ -267,13 +267,16 @@ static void take_command(struct serve *sv, const ncp_command_t *c, int local)
         on_estop(sv, ch, cl, c, now_us, local);
         return;
     }
-    if (cl->seq && c->seq == cl->seq) {
+    /* the panel's keep-alives carry no sequence number: it hands them over
+     * in this process, where nothing can replay them */
+    int numbered = !(local && c->kind == NCP_CMD_KEEPALIVE);
+    if (numbered && cl->seq && c->seq == cl->seq) {
         sv->duplicates++;
         if (!cl->pending && c->kind != NCP_CMD_KEEPALIVE)
             send_ack(sv, &cl->ack);
         return;
     }
-    if (cl->seq && c->seq < cl->seq) {
+    if (numbered && cl->seq && c->seq < cl->seq) {
         sv->replayed++;
         return;
     }
@@ -296,7 +299,8 @@ static void take_command(struct serve *sv, const ncp_command_t *c, int local)
         return;
     }
     if (c->kind == NCP_CMD_KEEPALIVE) {
-        cl->seq = c->seq;
+        if (numbered)
+            cl->seq = c->seq;
         /* only the jogging client's keep-alives hold its jog */
         if (ch && c->client_id == ch->jog_client) {
             struct ncp_nck_cmd k;
