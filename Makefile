@@ -102,6 +102,17 @@ $(BUILD)/tests/test_ring_race: tests/unit/test_ring_race.c src/pipeline/ring.c $
 
 unit: $(UNIT_BINS)
 
+# --version of every binary (tools/version: git describe, or a tarball's
+# release). Rewritten only when the version changes, so a new commit
+# recompiles the four main files, not the tree.
+VERSION_H = $(GEN_DIR)/ncp_version.h
+$(VERSION_H): FORCE
+	@mkdir -p $(@D)
+	$(Q)printf '#define NCP_VERSION "%s"\n' "$$(tools/version)" >$@.tmp && \
+	    if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+$(BUILD)/src/cli/cnc_run.o $(BUILD)/src/ctl/cnc_ctl.o $(BUILD)/src/axis/cnc_axis.o \
+    $(BUILD)/src/can-drive-sim/cnc_drive_sim.o: $(VERSION_H)
+
 # The fuzz target as a plain program (tests/fuzz/replay.c): `make` compiles and
 # links it, so an API change that breaks it stops the build, not `make fuzz` later.
 FUZZ_REPLAY = $(BUILD)/tests/fuzz-replay
