@@ -144,6 +144,7 @@ clean:
 include tools/rtvm/rtvm.mk
 include bench/bench.mk
 include web/web.mk
+include docs/man/man.mk
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 
