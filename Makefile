@@ -145,6 +145,7 @@ include tools/rtvm/rtvm.mk
 include bench/bench.mk
 include web/web.mk
 include docs/man/man.mk
+include deploy/install.mk
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 

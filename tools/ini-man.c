@@ -322,6 +322,7 @@ static void print_page(const char *version, const char *date)
         fputs(".SS [", stdout);
         roff(sec->name);
         fputs("]\n", stdout);
+        fputs("\\&", stdout);   /* a text line may start with '.' */
         roff(sec->doc);
         putchar('\n');
         for (size_t i = 0; i < ncp_ini_n_keys; i++) {
@@ -337,7 +338,7 @@ static void print_page(const char *version, const char *date)
                 roff(k->def);
                 fputs("\\fR", stdout);
             }
-            fputs("\n", stdout);
+            fputs("\n\\&", stdout);
             roff(k->doc);
             putchar('\n');
         }
