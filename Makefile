@@ -129,7 +129,8 @@ deps:
 	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev linuxcnc-uspace \
 	    liblcm-dev liblcm-bin \
 	    python3 python3-matplotlib python3-scipy valgrind cppcheck clang-tidy file podman \
-	    libwebsockets-dev chromium firefox-esr
+	    libwebsockets-dev chromium firefox-esr \
+	    debhelper lintian man-db curl debootstrap
 	command -v npm >/dev/null || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
 	    --no-install-recommends nodejs npm
 	tools/rtvm/install-deps
