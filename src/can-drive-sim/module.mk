@@ -11,7 +11,7 @@ DRIVE_SIM_OBJS = $(patsubst %.c,$(BUILD)/%.o,$(wildcard src/can-drive-sim/*.c) \
                  $(BUILD)/src/kins/trt.o
 
 $(BUILD)/cnc-drive-sim: $(DRIVE_SIM_OBJS) $(BUILD)/libncpar-can.a
-	$(Q)$(CC) $(ALL_CFLAGS) -o $@ $^ -lm -linih
+	$(Q)$(CC) $(ALL_CFLAGS) $(LDFLAGS) -o $@ $^ -lm -linih
 
 # The drive's guarding of its master, tested on the host over a socket pair
 # (no CAN needed): the drive's objects without its main.
