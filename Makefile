@@ -103,6 +103,17 @@ $(BUILD)/tests/test_ring_race: tests/unit/test_ring_race.c src/pipeline/ring.c $
 
 unit: $(UNIT_BINS)
 
+# --version of every binary (tools/version: git describe, or a tarball's
+# release). Rewritten only when the version changes, so a new commit
+# recompiles the four main files, not the tree.
+VERSION_H = $(GEN_DIR)/ncp_version.h
+$(VERSION_H): FORCE
+	@mkdir -p $(@D)
+	$(Q)printf '#define NCP_VERSION "%s"\n' "$$(tools/version)" >$@.tmp && \
+	    if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+$(BUILD)/src/cli/cnc_run.o $(BUILD)/src/ctl/cnc_ctl.o $(BUILD)/src/axis/cnc_axis.o \
+    $(BUILD)/src/can-drive-sim/cnc_drive_sim.o: $(VERSION_H)
+
 # The fuzz target as a plain program (tests/fuzz/replay.c): `make` compiles and
 # links it, so an API change that breaks it stops the build, not `make fuzz` later.
 FUZZ_REPLAY = $(BUILD)/tests/fuzz-replay
@@ -119,7 +130,8 @@ deps:
 	    gcc g++ make clang libeigen3-dev libcmocka-dev libinih-dev libssl-dev linuxcnc-uspace \
 	    liblcm-dev liblcm-bin \
 	    python3 python3-matplotlib python3-scipy valgrind cppcheck clang-tidy file podman \
-	    libwebsockets-dev chromium firefox-esr
+	    libwebsockets-dev chromium firefox-esr \
+	    debhelper lintian man-db curl debootstrap
 	command -v npm >/dev/null || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
 	    --no-install-recommends nodejs npm
 	tools/rtvm/install-deps
@@ -134,6 +146,8 @@ clean:
 include tools/rtvm/rtvm.mk
 include bench/bench.mk
 include web/web.mk
+include docs/man/man.mk
+include deploy/install.mk
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 

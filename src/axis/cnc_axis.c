@@ -10,6 +10,7 @@
  * until the HLC says the program is done (exit 0) or something makes it stop
  * (exit 3, after a ramp to standstill). */
 #include "axis.h"
+#include "ncp_version.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -309,6 +310,10 @@ static int report(const struct llc *l)
 int main(int argc, char **argv)
 {
     struct opts o = { 0 };
+    if (argc == 2 && !strcmp(argv[1], "--version")) {
+        printf("cnc-axis (ncpar) %s\n", NCP_VERSION);
+        return EXIT_OK;
+    }
     if (parse(argc, argv, &o) != 0)
         return usage(stderr), EXIT_USAGE;
     static struct ncp_machine_cfg cfg;

@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "drive.h"
+#include "ncp_version.h"
 
 static volatile sig_atomic_t stop;
 
@@ -116,6 +117,10 @@ static long long now_ms(void)
 int main(int argc, char **argv)
 {
     static struct drive dv;
+    if (argc == 2 && !strcmp(argv[1], "--version")) {
+        printf("cnc-drive-sim (ncpar) %s\n", NCP_VERSION);
+        return 0;
+    }
     const char *ifname = parse(argc, argv, &dv.o);
     if (drive_servo_load(&dv))
         return 1;

@@ -4,14 +4,14 @@
 all: $(BUILD)/cnc-drive-sim
 
 DRIVE_SIM_OBJS = $(patsubst %.c,$(BUILD)/%.o,$(wildcard src/can-drive-sim/*.c) \
-                   src/backend/sim.c src/backend/scale.c src/motion/config.c \
+                   src/backend/sim.c src/backend/scale.c src/motion/config.c src/motion/ini_keys.c \
                    src/motion/config_io.c src/motion/config_kins.c src/motion/config_home.c \
                    src/adcai/windows.c $(wildcard src/inject/*.c) \
                    src/sched/config.c src/sched/policy.c) \
                  $(BUILD)/src/kins/trt.o
 
 $(BUILD)/cnc-drive-sim: $(DRIVE_SIM_OBJS) $(BUILD)/libncpar-can.a
-	$(Q)$(CC) $(ALL_CFLAGS) -o $@ $^ -lm -linih
+	$(Q)$(CC) $(ALL_CFLAGS) $(LDFLAGS) -o $@ $^ -lm -linih
 
 # The drive's guarding of its master, tested on the host over a socket pair
 # (no CAN needed): the drive's objects without its main.

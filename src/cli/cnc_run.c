@@ -10,6 +10,7 @@
 #include "run.h"
 #include "signals.h"
 #include "serve.h"
+#include "ncp_version.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -140,6 +141,8 @@ static void usage(FILE *f)
           "serve  the NCK as a service: operator commands, status and events over LCM\n"
           "       (cnc-ctl is its client); `cnc-run serve --help` for details.\n"
           "\n"
+          "\n"
+          "cnc-run --version prints the version; every command takes --help.\n"
           "exit status: 0 ok, 1 usage, 2 program error, 3 runtime fault\n",
           f);
 }
@@ -416,6 +419,10 @@ int main(int argc, char **argv)
         return ncp_cli_serve(argc - 1, argv + 1);
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
         usage(stdout);
+        return EXIT_OK;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("cnc-run (ncpar) %s\n", NCP_VERSION);
         return EXIT_OK;
     }
     fprintf(stderr, "cnc-run: unknown command '%s'\n", argv[1]);

@@ -2,6 +2,7 @@
  * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
 #include "serve.h"
 #include "cell.h"
+#include "datadir.h"
 #include "channels.h"
 #include "inject_opts.h"
 #include "key_opts.h"
@@ -13,7 +14,6 @@
 #include "ncpar/nck.h"
 
 #include <getopt.h>
-#include <libgen.h>
 #include <unistd.h>
 #include <signal.h>
 #include <errno.h>
@@ -76,7 +76,8 @@ static void usage(FILE *f)
           "                      (ADDR: numeric, default 127.0.0.1; [::1] for IPv6); the\n"
           "                      URL printed at start carries the token commands need\n"
           "  --http-readonly     the panel shows the status but takes no commands\n"
-          "  --web DIR           the panel's files (default: web/ beside cnc-run)\n"
+          "  --web DIR           the panel's files (default: web/ beside cnc-run, else\n"
+          "                      share/ncpar/web/ of its install prefix)\n"
           "SIGINT/SIGTERM: a controlled stop along the path, then shutdown.\n"
           "exit status: 0 ok, 1 usage or set-up, 3 a fault happened while serving\n",
           f);
@@ -152,13 +153,10 @@ static int start_http(const struct serve_args *a, struct ncp_http **out)
     if (n <= 0)
         return fprintf(stderr, "cnc-run serve: --http: cannot find cnc-run itself\n"), -1;
     exe[n] = 0;
-    if (a->web) {
+    if (a->web)
         snprintf(web, sizeof web, "%s", a->web);
-    } else {
-        char dir[PATH_MAX];
-        snprintf(dir, sizeof dir, "%s", exe);
-        snprintf(web, sizeof web, "%s/web", dirname(dir));
-    }
+    else if (ncp_cli_data_dir(exe, "web", "index.html", web, sizeof web))
+        return fprintf(stderr, "cnc-run serve: --http: the path of cnc-run is too long\n"), -1;
     char index[PATH_MAX + 16];
     snprintf(index, sizeof index, "%s/index.html", web);
     if (ncp_http_available() && access(index, R_OK) != 0)

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "ctl.h"
+#include "ncp_version.h"
 
 #define MAX_WORDS 64
 
@@ -525,6 +526,10 @@ static void command_help(const struct command *k)
 int main(int argc, char **argv)
 {
     struct args a;
+    if (argc == 2 && strcmp(argv[1], "--version") == 0) {
+        printf("cnc-ctl (ncpar) %s\n", NCP_VERSION);
+        return CTL_OK;
+    }
     if (parse_args(argc, argv, &a) != CTL_OK)
         return CTL_USAGE;
     if (a.name && strcmp(a.name, "help") == 0) {

@@ -8,4 +8,4 @@ all: $(BUILD)/cnc-ctl
 
 # (the library by its path: $(LIB) is defined after the fragments are read)
 $(BUILD)/cnc-ctl: $(CTL_OBJS) $(BUILD)/libncpar.a
-	$(Q)$(CC) $(ALL_CFLAGS) -o $@ $(CTL_OBJS) $(BUILD)/libncpar.a -llcm $(LDLIBS)
+	$(Q)$(CC) $(ALL_CFLAGS) $(LDFLAGS) -o $@ $(CTL_OBJS) $(BUILD)/libncpar.a -llcm $(LDLIBS)

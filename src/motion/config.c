@@ -2,6 +2,7 @@
  * machine file must not silently fall back to a default. */
 #include "ncpar/motion.h"
 #include "ncpar/adcai.h"
+#include "ncpar/ini_keys.h"
 #include "ini_num.h"
 #include "kins_cfg.h"
 
@@ -578,7 +579,8 @@ static int on_key(void *user, const char *sec, const char *k, const char *v)
     if (!*sec)
         return fail_at(lc, lc->line, "%s outside of a [section]", k);
     char why[112] = "";
-    int r = dispatch(lc, sec, k, v, why, sizeof why);
+    /* a key ncpar.ini(5) does not list is unknown, whatever dispatch knows */
+    int r = ncp_ini_key_find(sec, k) ? dispatch(lc, sec, k, v, why, sizeof why) : 0;
     if (r == 1)
         return duplicate(lc, sec, k) ? 0 : 1;
     if (r == -2)
