@@ -71,6 +71,8 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->lcm.inject_seed = 1;
     c->lcm.clock = NCP_LCM_CLOCK_MONOTONIC;
     c->lcm.clock_tolerance_us = 1000;
+    snprintf(c->lcm.interface, sizeof c->lcm.interface, "lo");
+    c->lcm.max_age_ms = 2000;
     ncp_machine_joints_from_axes(c);
 }
 

@@ -206,6 +206,19 @@ const struct ncp_ini_key ncp_ini_keys[] = {
     INT("LCM", "INJECT_DELAY_US", 0, 1000000, "us", "0",
         "Every received message held back this long (tests)."),
     INT("LCM", "INJECT_SEED", 0, 2147483647, "", "1", "Seed of INJECT_LOSS."),
+    TEXT("LCM", "KEY_FILE", "a path, up to 511 characters", NULL, "/etc/ncpar/lcm.key",
+         "The shared key that seals every LCM message (32 random bytes or 64 hex digits, "
+         "mode 0600). Not given: --key-file, else $XDG_CONFIG_HOME/ncpar/lcm.key, else "
+         "~/.config/ncpar/lcm.key. cnc-run serve makes it when it does not exist."),
+    TEXT("LCM", "INTERFACE", "a network interface's name, or empty for any", "lo", "eth0",
+         "The multicast group is joined on this interface only, and the socket bound to the "
+         "group: datagrams sent to this host's own address or arriving elsewhere never "
+         "reach the NCK."),
+    INT("LCM", "STATUS_NEEDS_KEY", 0, 1, "", "0",
+        "1: STATUS and EVENT are encrypted with the key; a display then needs the key too."),
+    INT("LCM", "MAX_AGE_MS", 0, 3600000, "ms", "2000",
+        "The distributed NCK drops a message sealed longer ago (or further ahead) than this: "
+        "a recording played back moves nothing. 0: no limit."),
 
     TEXT("INJECT", "SPEC", "specs separated by commas, as cnc-run run --inject", NULL,
          "miss=0.01", "The faults."),
