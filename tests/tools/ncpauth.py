@@ -49,3 +49,21 @@ def unseal(key, channel, msg):
     body, head, mac = msg[:-TRAILER], msg[-TRAILER:-16], msg[-16:]
     want = hmac.new(key, DOMAIN + channel + b"\0" + body + head, hashlib.sha256).digest()[:16]
     return body if hmac.compare_digest(mac, want) else None
+
+
+def ensure_key(fallback_dir):
+    """The key file the binaries will find, made (0600, folder 0700) when
+    missing; with neither XDG_CONFIG_HOME nor HOME set (a bare test guest),
+    XDG_CONFIG_HOME is set to fallback_dir for this process and its children."""
+    if not os.environ.get("XDG_CONFIG_HOME", "").startswith("/") and not os.environ.get("HOME"):
+        os.environ["XDG_CONFIG_HOME"] = os.path.abspath(fallback_dir)
+    path = key_path()
+    if not os.path.exists(path):
+        os.makedirs(os.path.dirname(path), mode=0o700, exist_ok=True)
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        except FileExistsError:
+            return path
+        with os.fdopen(fd, "wb") as f:
+            f.write(os.urandom(32))
+    return path
