@@ -512,7 +512,8 @@ static void submit(struct ncp_http *h, struct conn *c, const ncp_command_t *cmd)
         }
         h->estops[(h->estop_head + h->estop_n++) % ESTOP_QUEUE] = *cmd;
         h->stats.commands++;
-    } else if ((full = h->cmd_n == CMD_QUEUE)) {
+    } else if (h->cmd_n == CMD_QUEUE) {
+        full = 1;
         h->stats.busy++;
     } else {
         h->cmds[(h->cmd_head + h->cmd_n++) % CMD_QUEUE] = *cmd;
