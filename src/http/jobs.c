@@ -63,9 +63,9 @@ static void *worker(void *arg)
          * (both queues together hold at most JOB_QUEUE) */
         j->job_head = (j->job_head + 1) % JOB_QUEUE;
         j->job_n--;
-        if (!bad)
-            j->done[(j->done_head + j->done_n++) % JOB_QUEUE] =
-                (struct done){ job.serial, msg };
+        /* out of memory: an empty answer, so that its socket may ask again */
+        j->done[(j->done_head + j->done_n++) % JOB_QUEUE] =
+            (struct done){ job.serial, bad ? (struct ncp_http_msg){ NULL, 0 } : msg };
         pthread_mutex_unlock(&j->mu);
         j->env.wake(j->env.ctx);
         pthread_mutex_lock(&j->mu);

@@ -391,7 +391,8 @@ static void take_answers(struct ncp_http *h)
             continue;
         }
         c->queries--;
-        enqueue(h, c, m.buf, m.len);
+        if (m.buf)
+            enqueue(h, c, m.buf, m.len);
     }
 }
 

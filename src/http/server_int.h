@@ -55,7 +55,8 @@ struct ncp_http_jobs_env {
 struct ncp_http_jobs *ncp_http_jobs_start(const struct ncp_http_jobs_env *env);
 /* 0, or -1 when the queue is full. */
 int ncp_http_jobs_submit(struct ncp_http_jobs *j, uint64_t serial, enum ncp_http_req r);
-/* A finished answer: 1 (the caller owns msg->buf), or 0 when none. */
+/* A finished answer: 1 (the caller owns msg->buf; NULL when there was no
+ * memory to build it), or 0 when none. */
 int ncp_http_jobs_take(struct ncp_http_jobs *j, uint64_t *serial, struct ncp_http_msg *msg);
 void ncp_http_jobs_stop(struct ncp_http_jobs *j);
 
