@@ -182,6 +182,8 @@ $(BUILD)-fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(BUILD)-fuzz/libncpar.a
 	clang $(filter-out -I$(BUILD)/gen,$(CPPFLAGS)) -I$(BUILD)-fuzz/gen -std=c11 $(FUZZ_FLAGS) \
 	    -fsanitize=fuzzer -pthread -o $@ $< \
 	    $(BUILD)-fuzz/libncpar.a -lm -linih -lstdc++
+# the targets are kept for reruns and replays, not removed as intermediates
+.PRECIOUS: $(BUILD)-fuzz/fuzz_%
 fuzz:
 	$(foreach t,$(FUZZ_TARGETS),$(MAKE) fuzz-$(t) &&) true
 fuzz-%: $(BUILD)-fuzz/fuzz_%

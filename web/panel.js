@@ -92,8 +92,18 @@ function onMessage(text) {
   let m;
   try { m = JSON.parse(text); } catch { return; }
   switch (m.type) {
+    case 'part': {
+      // a large answer comes in parts, so that acks and statuses are not
+      // held behind it: joined, it is read as one message
+      ui.parts = ui.parts || {};
+      const t = (ui.parts[m.id] || '') + m.data;
+      if (!m.last) { ui.parts[m.id] = t; break; }
+      delete ui.parts[m.id];
+      onMessage(t);
+      break;
+    }
     case 'hello':
-      ui.authed = m.authed; ui.readonly = m.readonly; ui.loadedPath = null;
+      ui.authed = m.authed; ui.readonly = m.readonly; ui.loadedPath = null; ui.parts = {};
       setOnline(true);
       log('info', m.authed ? (m.readonly ? 'connected, read-only' : 'connected') : 'connected without a valid token: watching only');
       if (m.authed) send({ cmd: 'list' });

@@ -40,15 +40,16 @@
 #define UNAUTH_MAX 4            /* sockets without the token, */
 #define UNAUTH_MS 2000          /* each closed this long after it opened */
 #define QUERIES_PER_CONN 2      /* slow queries one socket may have waiting */
-#define FRAGMENT 65536
+#define PART 65536              /* a larger message goes out in parts of this much */
 #define STR_(x) #x
-#define NCP_HTTP_STR(x) STR_(x)          /* a large message goes out this much per write */
+#define NCP_HTTP_STR(x) STR_(x)
 #define RATE_PER_S 50.0         /* commands per socket: a continuous jog's keep-alive */
 #define RATE_BURST 100.0        /* is 10/s, a person's clicking far less */
 
 struct outmsg {
     unsigned char *buf;         /* LWS_PRE bytes, then the message */
-    size_t len, off;            /* off: bytes already written (fragments) */
+    size_t len, off;            /* off: bytes already written (parts) */
+    uint64_t id;                /* names its parts */
 };
 
 struct conn {
@@ -57,6 +58,7 @@ struct conn {
     int authed;
     int evicted;                /* an unauthenticated socket being closed */
     int queries;                /* waiting for the worker */
+    uint64_t parts;             /* messages queued: the id of a large one's parts */
     uint64_t serial;            /* names it to the worker */
     lws_sorted_usec_list_t sul; /* the unauthenticated socket's end */
     int32_t client_id;
@@ -259,20 +261,24 @@ static void wake(void *ctx)
 
 /* ---- this thread: sockets ----------------------------------------------------------- */
 
+static void pop(struct conn *c, unsigned i)
+{
+    free(c->out[(c->out_head + i) % OUT_QUEUE].buf);
+    for (; i > 0; i--)
+        c->out[(c->out_head + i) % OUT_QUEUE] = c->out[(c->out_head + i - 1) % OUT_QUEUE];
+    c->out_head = (c->out_head + 1) % OUT_QUEUE;
+    c->out_n--;
+}
+
 static void enqueue(struct ncp_http *h, struct conn *c, unsigned char *b, size_t len)
 {
     if (c->out_n == OUT_QUEUE) {
-        /* the oldest waiting message goes, unless it is half written: then
-         * the one after it (a message cut short would break the stream) */
-        unsigned victim = c->out[c->out_head].off ? (c->out_head + 1) % OUT_QUEUE : c->out_head;
-        free(c->out[victim].buf);
-        if (victim != c->out_head)
-            c->out[victim] = c->out[c->out_head];
-        c->out_head = (c->out_head + 1) % OUT_QUEUE;
-        c->out_n--;
+        /* the oldest waiting message goes, unless it is partly sent: then
+         * the one after it (the panel would wait for its last part) */
+        pop(c, c->out[c->out_head].off ? 1 : 0);
         count(h, &h->stats.dropped);
     }
-    c->out[(c->out_head + c->out_n++) % OUT_QUEUE] = (struct outmsg){ b, len, 0 };
+    c->out[(c->out_head + c->out_n++) % OUT_QUEUE] = (struct outmsg){ b, len, 0, ++c->parts };
     lws_callback_on_writable(c->wsi);
 }
 
@@ -453,37 +459,78 @@ static void take_notes(struct ncp_http *h)
             lws_callback_on_writable(c->wsi);
 }
 
-/* One write per call: a queued message (a large one a fragment at a time,
- * so that no socket holds this thread long), else the newest status. */
+static int write_status(struct ncp_http *h, struct conn *c)
+{
+    if (c->status_sent && h->status_msg_seq > c->status_sent + 1)
+        count(h, &h->stats.status_skipped);
+    c->status_sent = h->status_msg_seq;
+    if (lws_write(c->wsi, h->status_msg + LWS_PRE, h->status_len, LWS_WRITE_TEXT) <
+        (int)h->status_len)
+        return -1;
+    count(h, &h->stats.status_sent);
+    return 0;
+}
+
+/* The next part of a large message: {"type": "part", "id", "last", "data"}
+ * with up to PART bytes of its text, cut between UTF-8 characters; the
+ * panel joins the parts and reads the whole. */
+static int write_part(struct conn *c, struct outmsg *m)
+{
+    const unsigned char *text = m->buf + LWS_PRE;
+    size_t n = m->len - m->off < PART ? m->len - m->off : PART;
+    while (m->off + n < m->len && n > 1 && (text[m->off + n] & 0xc0) == 0x80)
+        n--;
+    int last = m->off + n == m->len;
+    size_t size = LWS_PRE + 64 + 6 * n + 8;
+    unsigned char *b = malloc(size);
+    if (!b)
+        return -1;
+    char *p = (char *)b + LWS_PRE;
+    size_t k = (size_t)snprintf(p, 64, "{\"type\": \"part\", \"id\": %llu, \"last\": %s, \"data\": ",
+                                (unsigned long long)m->id, last ? "true" : "false");
+    ncp_http_json_string(p, size - LWS_PRE - 2, &k, (const char *)text + m->off, n);
+    p[k++] = '}';
+    int rc = lws_write(c->wsi, b + LWS_PRE, k, LWS_WRITE_TEXT);
+    free(b);
+    m->off += n;
+    if (last)
+        pop(c, 0);
+    return rc < (int)k ? -1 : 0;
+}
+
+/* One message per call. A large one goes in parts, each a message of its
+ * own, so that what is queued behind it (an E-stop's ack above all) and the
+ * status go out between them: WebSocket cannot interleave the fragments of
+ * one message with another, and a preview of megabytes would otherwise hold
+ * the ack for as long as it takes to send. */
 static int write_next(struct ncp_http *h, struct conn *c)
 {
+    int status_due = h->status_len && c->status_sent != h->status_msg_seq;
+    int rc = 0;
     if (c->out_n) {
         struct outmsg *m = &c->out[c->out_head];
-        size_t n = m->len - m->off < FRAGMENT ? m->len - m->off : FRAGMENT;
-        int last = m->off + n == m->len;
-        int flags = (m->off ? LWS_WRITE_CONTINUATION : LWS_WRITE_TEXT) |
-                    (last ? 0 : LWS_WRITE_NO_FIN);
-        /* libwebsockets writes the frame's header into the LWS_PRE bytes
-         * before the fragment: for a later fragment those are bytes of this
-         * message already sent */
-        int rc = lws_write(c->wsi, m->buf + LWS_PRE + m->off, n, (enum lws_write_protocol)flags);
-        m->off += n;
-        if (last) {
-            free(m->buf);
-            c->out_head = (c->out_head + 1) % OUT_QUEUE;
-            c->out_n--;
+        unsigned small = 0;
+        if (m->len > PART)
+            for (unsigned i = 1; i < c->out_n && !small; i++)
+                if (c->out[(c->out_head + i) % OUT_QUEUE].len <= PART)
+                    small = i;
+        if (small) {
+            m = &c->out[(c->out_head + small) % OUT_QUEUE];
+            rc = lws_write(c->wsi, m->buf + LWS_PRE, m->len, LWS_WRITE_TEXT) < (int)m->len;
+            pop(c, small);
+        } else if (m->len > PART && m->off && status_due) {
+            rc = write_status(h, c);
+        } else if (m->len > PART) {
+            rc = write_part(c, m);
+        } else {
+            rc = lws_write(c->wsi, m->buf + LWS_PRE, m->len, LWS_WRITE_TEXT) < (int)m->len;
+            pop(c, 0);
         }
-        if (rc < (int)n)
-            return -1;
-    } else if (h->status_len && c->status_sent != h->status_msg_seq) {
-        if (c->status_sent && h->status_msg_seq > c->status_sent + 1)
-            count(h, &h->stats.status_skipped);
-        c->status_sent = h->status_msg_seq;
-        if (lws_write(c->wsi, h->status_msg + LWS_PRE, h->status_len, LWS_WRITE_TEXT) <
-            (int)h->status_len)
-            return -1;
-        count(h, &h->stats.status_sent);
+    } else if (status_due) {
+        rc = write_status(h, c);
     }
+    if (rc)
+        return -1;
     if (c->out_n || (h->status_len && c->status_sent != h->status_msg_seq))
         lws_callback_on_writable(c->wsi);
     return 0;
