@@ -114,13 +114,24 @@ $(VERSION_H): FORCE
 $(BUILD)/src/cli/cnc_run.o $(BUILD)/src/ctl/cnc_ctl.o $(BUILD)/src/axis/cnc_axis.o \
     $(BUILD)/src/can-drive-sim/cnc_drive_sim.o: $(VERSION_H)
 
-# The fuzz target as a plain program (tests/fuzz/replay.c): `make` compiles and
-# links it, so an API change that breaks it stops the build, not `make fuzz` later.
-FUZZ_REPLAY = $(BUILD)/tests/fuzz-replay
+# libFuzzer targets, tests/fuzz/fuzz_NAME.c, each run FUZZ_SECONDS by `make fuzz`
+# from its seeds FUZZ_SEEDS_NAME (none: an empty corpus). Adding a target is a
+# line here (and its seeds, if it has any).
+FUZZ_TARGETS = pipeline http command
+FUZZ_SEEDS_pipeline = ncprograms/*.ngc tests/bad/*.ngc
+FUZZ_SEEDS_http = tests/fuzz/seeds-http/*
+
+# Each fuzz target as a plain program (tests/fuzz/replay.c): `make` compiles and
+# links them, so an API change that breaks one stops the build, not `make fuzz`
+# later. fuzz-replay is the pipeline's, fuzz-replay-NAME another target's.
+FUZZ_REPLAY = $(BUILD)/tests/fuzz-replay \
+              $(patsubst %,$(BUILD)/tests/fuzz-replay-%,$(filter-out pipeline,$(FUZZ_TARGETS)))
 all: $(FUZZ_REPLAY)
-$(FUZZ_REPLAY): tests/fuzz/replay.c tests/fuzz/fuzz_pipeline.c $(LIB)
+$(BUILD)/tests/fuzz-replay: $(BUILD)/tests/fuzz-replay-pipeline
+	$(Q)cp $< $@
+$(BUILD)/tests/fuzz-replay-%: tests/fuzz/replay.c tests/fuzz/fuzz_%.c $(LIB)
 	@mkdir -p $(@D)
-	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -o $@ tests/fuzz/replay.c tests/fuzz/fuzz_pipeline.c \
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -o $@ tests/fuzz/replay.c tests/fuzz/fuzz_$*.c \
 	    $(LIB) $(LDLIBS) -lstdc++
 
 # Build and test dependencies on Debian 12 (run as root).
@@ -173,20 +184,28 @@ sanitize: all
 	    | tee build-tsan/service.log
 	! grep -q '^FAIL' build-tsan/service.log
 
-FUZZ_SECONDS ?= 600
+# `make fuzz`: every target of FUZZ_TARGETS in turn, FUZZ_SECONDS each (`make fuzz
+# FUZZ_SECONDS=60`); `make fuzz-NAME` one of them. The library is built once,
+# instrumented, in $(BUILD)-fuzz; each target keeps its corpus there.
+FUZZ_SECONDS ?= 60
 FUZZ_FLAGS = -O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all
-$(BUILD)-fuzz/fuzz_pipeline: tests/fuzz/fuzz_pipeline.c FORCE
+$(BUILD)-fuzz/libncpar.a: FORCE
 	$(MAKE) BUILD=$(BUILD)-fuzz CC=clang CXX=clang++ \
 	    CFLAGS="$(FUZZ_FLAGS) -fsanitize=fuzzer-no-link" \
 	    CXXFLAGS="$(FUZZ_FLAGS) -fsanitize=fuzzer-no-link" $(BUILD)-fuzz/libncpar.a
+$(BUILD)-fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(BUILD)-fuzz/libncpar.a
 	clang $(filter-out -I$(BUILD)/gen,$(CPPFLAGS)) -I$(BUILD)-fuzz/gen -std=c11 $(FUZZ_FLAGS) \
 	    -fsanitize=fuzzer -pthread -o $@ $< \
 	    $(BUILD)-fuzz/libncpar.a -lm -linih -lcrypto -lstdc++
-fuzz: $(BUILD)-fuzz/fuzz_pipeline
-	mkdir -p $(BUILD)-fuzz/corpus
-	cp ncprograms/*.ngc tests/bad/*.ngc $(BUILD)-fuzz/corpus/ 2>/dev/null || true
+# the targets are kept for reruns and replays, not removed as intermediates
+.PRECIOUS: $(BUILD)-fuzz/fuzz_%
+fuzz:
+	$(foreach t,$(FUZZ_TARGETS),$(MAKE) fuzz-$(t) &&) true
+fuzz-%: $(BUILD)-fuzz/fuzz_%
+	mkdir -p $(BUILD)-fuzz/corpus-$*
+	$(if $(FUZZ_SEEDS_$*),cp $(FUZZ_SEEDS_$*) $(BUILD)-fuzz/corpus-$*/ 2>/dev/null || true)
 	$< -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=10 -rss_limit_mb=2048 \
-	    $(BUILD)-fuzz/corpus
+	    $(BUILD)-fuzz/corpus-$*
 
 bench-parse: all $(BUILD)/bench/core-latency $(BUILD)/bench/cpu-speed
 	bench/bench-parse $(BUILD)

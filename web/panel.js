@@ -46,6 +46,9 @@ function dropLink(ws) {
   ui.ws = null;
   if (!document.body.classList.contains('offline')) log('fault', 'connection to the NCK lost');
   setOnline(false);
+  // without the token the server closes the socket after a moment: asking
+  // again and again would only fill the log
+  if (!token) { log('fault', 'no token: open the address cnc-run serve printed (with ?token=...)'); return; }
   setTimeout(connect, 1000);
 }
 
@@ -89,8 +92,18 @@ function onMessage(text) {
   let m;
   try { m = JSON.parse(text); } catch { return; }
   switch (m.type) {
+    case 'part': {
+      // a large answer comes in parts, so that acks and statuses are not
+      // held behind it: joined, it is read as one message
+      ui.parts = ui.parts || {};
+      const t = (ui.parts[m.id] || '') + m.data;
+      if (!m.last) { ui.parts[m.id] = t; break; }
+      delete ui.parts[m.id];
+      onMessage(t);
+      break;
+    }
     case 'hello':
-      ui.authed = m.authed; ui.readonly = m.readonly;
+      ui.authed = m.authed; ui.readonly = m.readonly; ui.loadedPath = null; ui.parts = {};
       setOnline(true);
       log('info', m.authed ? (m.readonly ? 'connected, read-only' : 'connected') : 'connected without a valid token: watching only');
       if (m.authed) send({ cmd: 'list' });
@@ -106,6 +119,12 @@ function onMessage(text) {
       break;
     }
     case 'list': fillFiles(m.files); break;
+    case 'loaded':
+      // a load was checked: its text and preview are the NCK's copy, anew
+      // even when the path is the same one
+      ui.loadedPath = m.path;
+      if (ui.authed) { send({ cmd: 'program' }); send({ cmd: 'preview' }); }
+      break;
     case 'program': showProgram(m.path, m.text); break;
     case 'preview': preview.setCanon(m.canon); break;
   }
@@ -162,7 +181,7 @@ function onStatus(m) {
     $('ov-' + w + '-v').textContent = `${Math.round(s[w + '_override'])} %`;
   }
   if (!prev || prev.program !== s.program) {
-    if (s.program && ui.authed) { send({ cmd: 'program' }); send({ cmd: 'preview' }); }
+    if (s.program && ui.authed && s.program !== ui.loadedPath) { send({ cmd: 'program' }); send({ cmd: 'preview' }); }
     else if (!s.program) { showProgram('', ''); preview.setCanon(''); }
   }
   if (s.line !== ui.currentLine) highlight(s.line);

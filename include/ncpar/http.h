@@ -35,6 +35,8 @@ struct ncp_http_opts {
     int readonly;                   /* status only: every command refused */
     const char *web_root;           /* the panel's files */
     const char *self_exe;           /* cnc-run, for the preview's `parse --canon` */
+    /* the machine INI's [HTTP] ALLOW_ORIGIN and ALLOW_HOST (NULL: none) */
+    const char *allow_origin, *allow_host;
 };
 
 /* Counters of the socket's input (all since start). */
@@ -45,6 +47,10 @@ struct ncp_http_stats {
     uint64_t uploads, upload_bad;        /* programs stored; refused for their name, size
                                             or content (no token, read-only: counted above) */
     uint64_t status_sent, status_skipped; /* skipped: a slow client got a newer one */
+    uint64_t foreign_origin, bad_host;   /* requests refused with 403, 421 */
+    uint64_t bad_request;                /* ambiguous framing: 400, 411 */
+    uint64_t unauth_closed;              /* sockets without the token closed (2 s, or
+                                            evicted by a newer one) */
 };
 
 /* Whether this build has the HTTP server (built with libwebsockets). */
@@ -84,5 +90,46 @@ int ncp_http_upload_name_ok(const char *name, char *why, size_t why_len);
 /* s as a JSON string (quoted, escaped) appended to buf at *len; -1 if it
  * does not fit (buf then holds a truncated prefix). */
 int ncp_http_json_string(char *buf, size_t size, size_t *len, const char *s, size_t n);
+
+/* Who may talk to the panel at all (policy.c). A page's Origin must be the
+ * panel's own (http:// and the request's Host) or one of ALLOW_ORIGIN; the
+ * Host must name the panel: its bound address, a loopback name (localhost,
+ * 127.0.0.1, [::1]), with the bound port or none, or one of ALLOW_HOST. A
+ * rebinding attacker's page has neither. */
+#define NCP_HTTP_ALLOW_MAX 16
+#define NCP_HTTP_NAME_MAX 256
+struct ncp_http_origin {
+    int https;
+    char host[NCP_HTTP_NAME_MAX];   /* lower case; IPv6 in brackets */
+    int port;                       /* 0: not given */
+};
+struct ncp_http_policy {
+    char addr[64];                  /* the bound address as a Host names it; "" for a
+                                       wildcard (0.0.0.0, ::) */
+    int port;
+    struct ncp_http_origin allow_origin[NCP_HTTP_ALLOW_MAX], allow_host[NCP_HTTP_ALLOW_MAX];
+    int n_allow_origin, n_allow_host;
+};
+/* The headers that decide whether a request is served at all: each one's
+ * first value (NULL when absent) and how many times it came. */
+struct ncp_http_head {
+    const char *host, *origin, *content_length, *transfer_encoding;
+    int n_host, n_origin, n_content_length, n_transfer_encoding;
+};
+/* The policy for a panel bound to addr:port with the INI's lists (space- or
+ * comma-separated; NULL or "" for none): 0, or -1 with why naming the entry. */
+int ncp_http_policy_init(struct ncp_http_policy *p, const char *addr, int port,
+                         const char *allow_origin, const char *allow_host, char *why,
+                         size_t why_len);
+/* One ALLOW_ORIGIN or ALLOW_HOST list as the INI gives it: 0, or -1 with why
+ * naming the first bad entry (the machine INI's check, before any socket). */
+int ncp_http_allow_list_ok(const char *list, int origins, char *why, size_t why_len);
+/* 0 when the request may go on (to the token check, the files, the socket);
+ * else the HTTP status that refuses it, with why: 403 a foreign Origin
+ * (checked first: nothing else of such a request is looked at), 421 a Host
+ * that does not name the panel, 400 ambiguous framing (two Content-Lengths,
+ * Content-Length with Transfer-Encoding, two Hosts), 411 a chunked body. */
+int ncp_http_head_verdict(const struct ncp_http_policy *p, const struct ncp_http_head *h,
+                          char *why, size_t why_len);
 
 #endif

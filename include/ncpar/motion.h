@@ -192,6 +192,12 @@ struct ncp_machine_cfg {
                                      LLC whose probes find the clocks further apart
                                      stops (1000) */
     } lcm;
+    struct ncp_http_cfg {         /* [HTTP]: cnc-run serve --http's panel */
+        /* ALLOW_ORIGIN: pages of other origins that may use the panel, and
+         * ALLOW_HOST: names besides its address and localhost it answers to;
+         * space- or comma-separated lists, "" for none (both default) */
+        char allow_origin[512], allow_host[512];
+    } http;
     struct ncp_io_cfg io;
     /* [INJECT] and [RT]'s miss keys: timing faults, setpoint policy, miss limits */
     struct ncp_inject_cfg inject;

@@ -282,6 +282,10 @@ struct ncp_nck_event {
 };
 /* The next event, oldest first: 1, or 0 when there is none. */
 int ncp_nck_next_event(struct ncp_nck *n, struct ncp_nck_event *ev);
+/* The loaded program's whole text as the NCK read and checked it (the file
+ * may have changed since): 0, or -1 when none is loaded. Valid until the
+ * next load; the serving thread's (the caller of ncp_nck_command). */
+int ncp_nck_program_text(const struct ncp_nck *n, const char **text, size_t *len);
 /* A shutdown command was accepted: the caller should free the NCK. */
 int ncp_nck_shutdown_requested(const struct ncp_nck *n);
 /* SIGINT/SIGTERM: a controlled stop along the path, as the stop command, from
@@ -299,6 +303,9 @@ struct ncp_nck_serve_hook {
     void (*ack)(void *ctx, const ncp_ack_t *a);
     void (*status)(void *ctx, const ncp_status_t *s);
     void (*event)(void *ctx, const ncp_event_t *e);
+    /* a load was accepted: path and the text the NCK checked and will run
+     * (valid during the call only; NULL when the front end needs none) */
+    void (*loaded)(void *ctx, int channel, const char *path, const char *text, size_t len);
     void *ctx;
 };
 

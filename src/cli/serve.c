@@ -142,11 +142,15 @@ static int parse(int argc, char **argv, struct serve_args *a)
 }
 
 /* The panel's server, started before the NCK so that a port in use or a
- * build without it is a usage error before any axis is powered. */
-static int start_http(const struct serve_args *a, struct ncp_http **out)
+ * build without it is a usage error before any axis is powered. Its [HTTP]
+ * keys are the first channel's machine INI's. */
+static int start_http(const struct serve_args *a, const struct ncp_machine_cfg *cfg,
+                      struct ncp_http **out)
 {
     static char exe[PATH_MAX], web[PATH_MAX];
-    struct ncp_http_opts ho = { .readonly = a->http_readonly };
+    struct ncp_http_opts ho = { .readonly = a->http_readonly,
+                                .allow_origin = cfg->http.allow_origin,
+                                .allow_host = cfg->http.allow_host };
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
@@ -290,7 +294,7 @@ int ncp_cli_serve(int argc, char **argv)
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     struct ncp_http *http = NULL;
-    if (a.http && start_http(&a, &http)) {
+    if (a.http && start_http(&a, &chs[0].cfg, &http)) {
         for (int k = 0; k < n; k++)
             close_trace(&chs[k]);
         free(chs);

@@ -1,19 +1,31 @@
 /* The panel's HTTP and WebSocket server on libwebsockets' own thread.
  *
- * Two threads meet here, under one mutex, never holding it across I/O:
+ * Three threads meet here, under one mutex, never holding it across I/O:
  *   the serving thread (ncp_nck_serve's hook) copies each STATUS, ACK and
  *   EVENT in and takes the queued commands out, then wakes this thread with
  *   lws_cancel_service();
  *   this thread (lws_service) turns them into JSON for the sockets, and the
- *   sockets' messages into commands for the queue.
+ *   sockets' messages into commands for the queue;
+ *   the worker (jobs.c) answers the slow queries, so that nothing this
+ *   thread does takes long: an E-stop read from a socket is in the serving
+ *   thread's queue at once, ahead of every other command.
  * A full queue refuses (counted) rather than waits: neither thread blocks
- * the other, and the NCK's real-time threads never see any of it. */
+ * the other, and the NCK's real-time threads never see any of it.
+ *
+ * Slots: MAX_CONNS sockets for operators (opened with the token), and apart
+ * from them a small pool of UNAUTH_MAX sockets without it, each closed
+ * UNAUTH_MS after it opened; when the pool is full the oldest goes to make
+ * room. Sockets that never authenticate thus cannot keep an operator out,
+ * however many are opened: an operator with the token gets in while fewer
+ * than MAX_CONNS operators are connected, and a watcher without it still
+ * sees the status for a moment (and is told it has no token). */
 #include "server_int.h"
 
 #include <libwebsockets.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,19 +35,32 @@
 #define CMD_QUEUE 64            /* commands waiting for the serving thread */
 #define NOTE_QUEUE 64           /* acks and events waiting for this thread */
 #define OUT_QUEUE 64            /* messages waiting for one socket */
-#define MAX_CONNS 16
+#define ESTOP_QUEUE 16          /* E-stops: ahead of every other command */
+#define MAX_CONNS 16            /* operators' sockets */
+#define UNAUTH_MAX 4            /* sockets without the token, */
+#define UNAUTH_MS 2000          /* each closed this long after it opened */
+#define QUERIES_PER_CONN 2      /* slow queries one socket may have waiting */
+#define PART 65536              /* a larger message goes out in parts of this much */
+#define STR_(x) #x
+#define NCP_HTTP_STR(x) STR_(x)
 #define RATE_PER_S 50.0         /* commands per socket: a continuous jog's keep-alive */
 #define RATE_BURST 100.0        /* is 10/s, a person's clicking far less */
 
 struct outmsg {
     unsigned char *buf;         /* LWS_PRE bytes, then the message */
-    size_t len;
+    size_t len, off;            /* off: bytes already written (parts) */
+    uint64_t id;                /* names its parts */
 };
 
 struct conn {
     struct lws *wsi;
     struct conn *next;
     int authed;
+    int evicted;                /* an unauthenticated socket being closed */
+    int queries;                /* waiting for the worker */
+    uint64_t parts;             /* messages queued: the id of a large one's parts */
+    uint64_t serial;            /* names it to the worker */
+    lws_sorted_usec_list_t sul; /* the unauthenticated socket's end */
     int32_t client_id;
     char rx[NCP_HTTP_MSG_MAX + 1];
     size_t rx_len;
@@ -58,9 +83,18 @@ struct ncp_http {
     atomic_int stop;
     int32_t next_client;
 
-    pthread_mutex_t mu;         /* guards what the two threads share: */
+    struct ncp_http_policy policy;
+    struct ncp_http_jobs *jobs;
+    pthread_mutex_t prog_mu;    /* guards prog: the serving thread swaps it */
+    struct ncp_http_prog *prog;
+
+    pthread_mutex_t mu;         /* guards what the threads share: */
     ncp_command_t cmds[CMD_QUEUE];
     unsigned cmd_head, cmd_n;
+    ncp_command_t estops[ESTOP_QUEUE];
+    unsigned estop_head, estop_n;
+    uint64_t loads;             /* loads accepted */
+    char loaded_path[256];
     ncp_status_t status;
     int64_t status_seq;         /* 0: none yet */
     ncp_ack_t acks[NOTE_QUEUE];
@@ -70,8 +104,10 @@ struct ncp_http {
     struct ncp_http_stats stats;
 
     /* this thread's own */
-    struct conn *conns;
-    int n_conns;
+    struct conn *conns;         /* newest first */
+    int n_authed, n_unauth;
+    uint64_t next_serial;
+    uint64_t loads_told;
     unsigned char *status_msg;  /* LWS_PRE + the newest status as JSON */
     size_t status_len;
     int64_t status_msg_seq;
@@ -97,7 +133,12 @@ void ncp_http_count(struct ncp_http *h, enum ncp_http_stat which)
     uint64_t *field = which == NCP_HTTP_STAT_NO_TOKEN ? &st->no_token
                     : which == NCP_HTTP_STAT_READONLY ? &st->readonly
                     : which == NCP_HTTP_STAT_OVERSIZED ? &st->oversized
-                    : which == NCP_HTTP_STAT_UPLOADS ? &st->uploads : &st->upload_bad;
+                    : which == NCP_HTTP_STAT_UPLOADS ? &st->uploads
+                    : which == NCP_HTTP_STAT_FOREIGN_ORIGIN ? &st->foreign_origin
+                    : which == NCP_HTTP_STAT_BAD_HOST ? &st->bad_host
+                    : which == NCP_HTTP_STAT_BAD_REQUEST ? &st->bad_request
+                    : which == NCP_HTTP_STAT_UNAUTH_CLOSED ? &st->unauth_closed
+                                                           : &st->upload_bad;
     count(h, field);
 }
 
@@ -107,8 +148,12 @@ static int hook_next_command(void *ctx, ncp_command_t *c)
 {
     struct ncp_http *h = ctx;
     pthread_mutex_lock(&h->mu);
-    int got = h->cmd_n > 0;
-    if (got) {
+    int got = h->estop_n > 0 || h->cmd_n > 0;
+    if (h->estop_n) {
+        *c = h->estops[h->estop_head];
+        h->estop_head = (h->estop_head + 1) % ESTOP_QUEUE;
+        h->estop_n--;
+    } else if (got) {
         *c = h->cmds[h->cmd_head];
         h->cmd_head = (h->cmd_head + 1) % CMD_QUEUE;
         h->cmd_n--;
@@ -158,33 +203,103 @@ static void hook_event(void *ctx, const ncp_event_t *e)
     lws_cancel_service(h->ctx);
 }
 
+void ncp_http_prog_put(struct ncp_http_prog *p)
+{
+    if (atomic_fetch_sub(&p->refs, 1) == 1)
+        free(p);
+}
+
+/* The worker's reference to the program's copy. */
+static struct ncp_http_prog *prog_get(void *ctx)
+{
+    struct ncp_http *h = ctx;
+    pthread_mutex_lock(&h->prog_mu);
+    struct ncp_http_prog *p = h->prog;
+    if (p)
+        atomic_fetch_add(&p->refs, 1);
+    pthread_mutex_unlock(&h->prog_mu);
+    return p;
+}
+
+/* A load was accepted: a copy of the very text the NCK checked, taken on
+ * the serving thread before its next command can load another. Reading
+ * the file again instead would show whatever was written over it since. */
+static void hook_loaded(void *ctx, int channel, const char *path, const char *text, size_t len)
+{
+    (void)channel;
+    struct ncp_http *h = ctx;
+    int too_large = len > NCP_HTTP_PROGRAM_MAX;
+    struct ncp_http_prog *p = malloc(sizeof *p + (too_large ? 0 : len) + 1);
+    if (p) {
+        atomic_init(&p->refs, 1);
+        snprintf(p->path, sizeof p->path, "%s", path);
+        p->len = len;
+        p->too_large = too_large;
+        if (!too_large)
+            memcpy(p->text, text, len);
+        p->text[too_large ? 0 : len] = 0;
+    }
+    /* out of memory: no copy at all rather than the previous program's */
+    pthread_mutex_lock(&h->prog_mu);
+    struct ncp_http_prog *old = h->prog;
+    h->prog = p;
+    pthread_mutex_unlock(&h->prog_mu);
+    if (old)
+        ncp_http_prog_put(old);
+    pthread_mutex_lock(&h->mu);
+    h->loads++;
+    snprintf(h->loaded_path, sizeof h->loaded_path, "%s", path);
+    pthread_mutex_unlock(&h->mu);
+    lws_cancel_service(h->ctx);
+}
+
+static void wake(void *ctx)
+{
+    struct ncp_http *h = ctx;
+    lws_cancel_service(h->ctx);
+}
+
 /* ---- this thread: sockets ----------------------------------------------------------- */
 
+static void pop(struct conn *c, unsigned i)
+{
+    free(c->out[(c->out_head + i) % OUT_QUEUE].buf);
+    for (; i > 0; i--)
+        c->out[(c->out_head + i) % OUT_QUEUE] = c->out[(c->out_head + i - 1) % OUT_QUEUE];
+    c->out_head = (c->out_head + 1) % OUT_QUEUE;
+    c->out_n--;
+}
+
+static void enqueue(struct ncp_http *h, struct conn *c, unsigned char *b, size_t len)
+{
+    if (c->out_n == OUT_QUEUE) {
+        /* the oldest waiting message goes, unless it is partly sent: then
+         * the one after it (the panel would wait for its last part) */
+        pop(c, c->out[c->out_head].off ? 1 : 0);
+        count(h, &h->stats.dropped);
+    }
+    c->out[(c->out_head + c->out_n++) % OUT_QUEUE] = (struct outmsg){ b, len, 0, ++c->parts };
+    lws_callback_on_writable(c->wsi);
+}
+
 /* Queues msg[len] (copied) for c; the oldest waiting message goes when full. */
-void ncp_http_send(struct ncp_http *h, struct conn *c, const char *msg, size_t len)
+static void send_copy(struct ncp_http *h, struct conn *c, const char *msg, size_t len)
 {
     unsigned char *b = malloc(LWS_PRE + len);
     if (!b)
         return;
     memcpy(b + LWS_PRE, msg, len);
-    if (c->out_n == OUT_QUEUE) {
-        free(c->out[c->out_head].buf);
-        c->out_head = (c->out_head + 1) % OUT_QUEUE;
-        c->out_n--;
-        count(h, &h->stats.dropped);
-    }
-    c->out[(c->out_head + c->out_n++) % OUT_QUEUE] = (struct outmsg){ b, len };
-    lws_callback_on_writable(c->wsi);
+    enqueue(h, c, b, len);
 }
 
-void ncp_http_refuse(struct ncp_http *h, struct conn *c, int32_t seq, const char *why)
+static void refuse(struct ncp_http *h, struct conn *c, int32_t seq, const char *why)
 {
     char msg[512];
     size_t n = (size_t)snprintf(msg, sizeof msg, "{\"type\": \"refused\", \"seq\": %d, \"reason\": ",
                                 (int)seq);
     ncp_http_json_string(msg, sizeof msg - 2, &n, why, strlen(why));
     msg[n++] = '}';
-    ncp_http_send(h, c, msg, n);
+    send_copy(h, c, msg, n);
 }
 
 static void render_status(struct ncp_http *h)
@@ -210,13 +325,16 @@ static void render_status(struct ncp_http *h)
                   ", \"http\": {\"connections\": %llu, \"commands\": %llu, \"bad_json\": %llu, "
                   "\"unknown\": %llu, \"oversized\": %llu, \"flood\": %llu, \"no_token\": "
                   "%llu, \"readonly\": %llu, \"busy\": %llu, \"dropped\": %llu, "
-                  "\"uploads\": %llu, \"upload_bad\": %llu}}",
+                  "\"uploads\": %llu, \"upload_bad\": %llu, \"foreign_origin\": %llu, "
+                  "\"bad_host\": %llu, \"bad_request\": %llu, \"unauth_closed\": %llu}}",
                   (unsigned long long)st.connections, (unsigned long long)st.commands,
                   (unsigned long long)st.bad_json, (unsigned long long)st.unknown,
                   (unsigned long long)st.oversized, (unsigned long long)st.flood,
                   (unsigned long long)st.no_token, (unsigned long long)st.readonly,
                   (unsigned long long)st.busy, (unsigned long long)st.dropped,
-                  (unsigned long long)st.uploads, (unsigned long long)st.upload_bad);
+                  (unsigned long long)st.uploads, (unsigned long long)st.upload_bad,
+                  (unsigned long long)st.foreign_origin, (unsigned long long)st.bad_host,
+                  (unsigned long long)st.bad_request, (unsigned long long)st.unauth_closed);
     h->status_len = (size_t)n < size ? (size_t)n : 0;
 }
 
@@ -236,7 +354,7 @@ static void render_ack(struct ncp_http *h, const ncp_ack_t *a)
         const char *why = (const char *)a->reason;
         ncp_http_json_string(msg, sizeof msg - 2, &n, why, strnlen(why, sizeof a->reason));
         msg[n++] = '}';
-        ncp_http_send(h, c, msg, n);
+        send_copy(h, c, msg, n);
     }
 }
 
@@ -255,12 +373,61 @@ static void render_event(struct ncp_http *h, const ncp_event_t *e)
                          strnlen((const char *)e->text, sizeof e->text));
     msg[n++] = '}';
     for (struct conn *c = h->conns; c; c = c->next)
-        ncp_http_send(h, c, msg, n);
+        send_copy(h, c, msg, n);
 }
 
 /* The serving thread left something: acks, events, a newer status. */
+static struct conn *conn_of(struct ncp_http *h, uint64_t serial)
+{
+    for (struct conn *c = h->conns; c; c = c->next)
+        if (c->serial == serial)
+            return c;
+    return NULL;
+}
+
+/* The worker's finished answers to their sockets (if still there). */
+static void take_answers(struct ncp_http *h)
+{
+    uint64_t serial;
+    struct ncp_http_msg m;
+    while (ncp_http_jobs_take(h->jobs, &serial, &m)) {
+        struct conn *c = conn_of(h, serial);
+        if (!c) {
+            free(m.buf);
+            continue;
+        }
+        c->queries--;
+        if (m.buf)
+            enqueue(h, c, m.buf, m.len);
+    }
+}
+
+/* A load was accepted: the operators' panels ask for its text and preview
+ * again (the path alone may not have changed: the file was loaded anew). */
+static void tell_loads(struct ncp_http *h)
+{
+    pthread_mutex_lock(&h->mu);
+    uint64_t loads = h->loads;
+    char path[sizeof h->loaded_path];
+    memcpy(path, h->loaded_path, sizeof path);
+    pthread_mutex_unlock(&h->mu);
+    if (loads == h->loads_told)
+        return;
+    h->loads_told = loads;
+    char msg[600];
+    size_t n = (size_t)snprintf(msg, sizeof msg, "{\"type\": \"loaded\", \"path\": ");
+    ncp_http_json_string(msg, sizeof msg - 2, &n, path, strlen(path));
+    msg[n++] = '}';
+    for (struct conn *c = h->conns; c; c = c->next)
+        if (c->authed)
+            send_copy(h, c, msg, n);
+}
+
+/* The serving thread or the worker left something: acks, events, loads,
+ * answers, a newer status. */
 static void take_notes(struct ncp_http *h)
 {
+    tell_loads(h);
     for (;;) {
         ncp_ack_t a;
         ncp_event_t e;
@@ -285,52 +452,116 @@ static void take_notes(struct ncp_http *h)
         else
             break;
     }
+    take_answers(h);
     render_status(h);
     for (struct conn *c = h->conns; c; c = c->next)
         if (c->status_sent != h->status_msg_seq && h->status_len)
             lws_callback_on_writable(c->wsi);
 }
 
+static int write_status(struct ncp_http *h, struct conn *c)
+{
+    if (c->status_sent && h->status_msg_seq > c->status_sent + 1)
+        count(h, &h->stats.status_skipped);
+    c->status_sent = h->status_msg_seq;
+    if (lws_write(c->wsi, h->status_msg + LWS_PRE, h->status_len, LWS_WRITE_TEXT) <
+        (int)h->status_len)
+        return -1;
+    count(h, &h->stats.status_sent);
+    return 0;
+}
+
+/* The next part of a large message: {"type": "part", "id", "last", "data"}
+ * with up to PART bytes of its text, cut between UTF-8 characters; the
+ * panel joins the parts and reads the whole. */
+static int write_part(struct conn *c, struct outmsg *m)
+{
+    const unsigned char *text = m->buf + LWS_PRE;
+    size_t n = m->len - m->off < PART ? m->len - m->off : PART;
+    while (m->off + n < m->len && n > 1 && (text[m->off + n] & 0xc0) == 0x80)
+        n--;
+    int last = m->off + n == m->len;
+    size_t size = LWS_PRE + 64 + 6 * n + 8;
+    unsigned char *b = malloc(size);
+    if (!b)
+        return -1;
+    char *p = (char *)b + LWS_PRE;
+    size_t k = (size_t)snprintf(p, 64, "{\"type\": \"part\", \"id\": %llu, \"last\": %s, \"data\": ",
+                                (unsigned long long)m->id, last ? "true" : "false");
+    ncp_http_json_string(p, size - LWS_PRE - 2, &k, (const char *)text + m->off, n);
+    p[k++] = '}';
+    int rc = lws_write(c->wsi, b + LWS_PRE, k, LWS_WRITE_TEXT);
+    free(b);
+    m->off += n;
+    if (last)
+        pop(c, 0);
+    return rc < (int)k ? -1 : 0;
+}
+
+/* One message per call. A large one goes in parts, each a message of its
+ * own, so that what is queued behind it (an E-stop's ack above all) and the
+ * status go out between them: WebSocket cannot interleave the fragments of
+ * one message with another, and a preview of megabytes would otherwise hold
+ * the ack for as long as it takes to send. */
 static int write_next(struct ncp_http *h, struct conn *c)
 {
+    int status_due = h->status_len && c->status_sent != h->status_msg_seq;
+    int rc = 0;
     if (c->out_n) {
         struct outmsg *m = &c->out[c->out_head];
-        int rc = lws_write(c->wsi, m->buf + LWS_PRE, m->len, LWS_WRITE_TEXT);
-        free(m->buf);
-        c->out_head = (c->out_head + 1) % OUT_QUEUE;
-        c->out_n--;
-        if (rc < (int)m->len)
-            return -1;
-    } else if (h->status_len && c->status_sent != h->status_msg_seq) {
-        if (c->status_sent && h->status_msg_seq > c->status_sent + 1)
-            count(h, &h->stats.status_skipped);
-        c->status_sent = h->status_msg_seq;
-        if (lws_write(c->wsi, h->status_msg + LWS_PRE, h->status_len, LWS_WRITE_TEXT) <
-            (int)h->status_len)
-            return -1;
-        count(h, &h->stats.status_sent);
+        unsigned small = 0;
+        if (m->len > PART)
+            for (unsigned i = 1; i < c->out_n && !small; i++)
+                if (c->out[(c->out_head + i) % OUT_QUEUE].len <= PART)
+                    small = i;
+        if (small) {
+            m = &c->out[(c->out_head + small) % OUT_QUEUE];
+            rc = lws_write(c->wsi, m->buf + LWS_PRE, m->len, LWS_WRITE_TEXT) < (int)m->len;
+            pop(c, small);
+        } else if (m->len > PART && m->off && status_due) {
+            rc = write_status(h, c);
+        } else if (m->len > PART) {
+            rc = write_part(c, m);
+        } else {
+            rc = lws_write(c->wsi, m->buf + LWS_PRE, m->len, LWS_WRITE_TEXT) < (int)m->len;
+            pop(c, 0);
+        }
+    } else if (status_due) {
+        rc = write_status(h, c);
     }
+    if (rc)
+        return -1;
     if (c->out_n || (h->status_len && c->status_sent != h->status_msg_seq))
         lws_callback_on_writable(c->wsi);
     return 0;
 }
 
-/* A socket's command, if its rate allows, into the serving thread's queue. */
+/* A socket's command into the serving thread's queue; an E-stop into its
+ * own, which the serving thread empties first and which never refuses one. */
 static void submit(struct ncp_http *h, struct conn *c, const ncp_command_t *cmd)
 {
     if (!c->authed) {
         count(h, &h->stats.no_token);
-        ncp_http_refuse(h, c, cmd->seq, "no valid token: this panel may only watch");
+        refuse(h, c, cmd->seq, "no valid token: this panel may only watch");
         return;
     }
     if (h->o.readonly) {
         count(h, &h->stats.readonly);
-        ncp_http_refuse(h, c, cmd->seq, "the panel is read-only (--http-readonly)");
+        refuse(h, c, cmd->seq, "the panel is read-only (--http-readonly)");
         return;
     }
     pthread_mutex_lock(&h->mu);
-    int full = h->cmd_n == CMD_QUEUE;
-    if (full) {
+    int full = 0;
+    if (cmd->kind == NCP_CMD_ESTOP) {
+        /* full of E-stops already: the oldest of them is as good as this one */
+        if (h->estop_n == ESTOP_QUEUE) {
+            h->estop_head = (h->estop_head + 1) % ESTOP_QUEUE;
+            h->estop_n--;
+        }
+        h->estops[(h->estop_head + h->estop_n++) % ESTOP_QUEUE] = *cmd;
+        h->stats.commands++;
+    } else if (h->cmd_n == CMD_QUEUE) {
+        full = 1;
         h->stats.busy++;
     } else {
         h->cmds[(h->cmd_head + h->cmd_n++) % CMD_QUEUE] = *cmd;
@@ -338,7 +569,7 @@ static void submit(struct ncp_http *h, struct conn *c, const ncp_command_t *cmd)
     }
     pthread_mutex_unlock(&h->mu);
     if (full)
-        ncp_http_refuse(h, c, cmd->seq, "the NCK is busy: command not taken");
+        refuse(h, c, cmd->seq, "the NCK is busy: command not taken");
 }
 
 /* Token bucket per socket: 0 when this message may be taken. */
@@ -355,15 +586,33 @@ static int over_rate(struct conn *c)
     return 0;
 }
 
+/* A slow query to the worker, a few per socket at most. */
+static void query(struct ncp_http *h, struct conn *c, enum ncp_http_req r)
+{
+    if (!c->authed) {
+        count(h, &h->stats.no_token);
+        refuse(h, c, 0, "no valid token: this panel may only watch");
+        return;
+    }
+    if (c->queries >= QUERIES_PER_CONN || ncp_http_jobs_submit(h->jobs, c->serial, r)) {
+        count(h, &h->stats.busy);
+        refuse(h, c, 0, "the panel is still answering earlier queries: ask again later");
+        return;
+    }
+    c->queries++;
+}
+
 static void on_message(struct ncp_http *h, struct conn *c)
 {
     if (c->rx_over) {
         count(h, &h->stats.oversized);
-        ncp_http_refuse(h, c, 0, "message too large");
+        refuse(h, c, 0, "message too large");
         return;
     }
-    if (over_rate(c)) {
-        /* no answer: answering a flood would be one more */
+    /* no answer to a flood: answering would be one more. An E-stop is
+     * never held back by its socket's rate: only one that names it is
+     * parsed past the limit. */
+    if (over_rate(c) && !memmem(c->rx, c->rx_len, "estop", 5)) {
         count(h, &h->stats.flood);
         return;
     }
@@ -378,19 +627,10 @@ static void on_message(struct ncp_http *h, struct conn *c)
         break;
     case NCP_HTTP_REQ_BAD:
         count(h, unknown ? &h->stats.unknown : &h->stats.bad_json);
-        ncp_http_refuse(h, c, 0, why);
+        refuse(h, c, 0, why);
         break;
     default:
-        if (!c->authed) {
-            count(h, &h->stats.no_token);
-            ncp_http_refuse(h, c, 0, "no valid token: this panel may only watch");
-            break;
-        }
-        pthread_mutex_lock(&h->mu);
-        char program[sizeof h->status.program + 1];
-        snprintf(program, sizeof program, "%s", (const char *)h->status.program);
-        pthread_mutex_unlock(&h->mu);
-        ncp_http_answer_query(h, c, r, program);
+        query(h, c, r);
         break;
     }
 }
@@ -407,14 +647,56 @@ int ncp_http_token_ok(const struct ncp_http *h, struct lws *wsi)
     return diff == 0;
 }
 
+/* An unauthenticated socket's time is up, or a newer one needs its place. */
+static void close_unauth(struct ncp_http *h, struct conn *c)
+{
+    if (c->evicted)
+        return;
+    c->evicted = 1;
+    h->n_unauth--;
+    lws_sul_cancel(&c->sul);
+    count(h, &h->stats.unauth_closed);
+    lws_close_reason(c->wsi, LWS_CLOSE_STATUS_POLICY_VIOLATION,
+                     (unsigned char *)"no valid token", 14);
+    lws_set_timeout(c->wsi, PENDING_TIMEOUT_USER_OK, LWS_TO_KILL_ASYNC);
+}
+
+static void unauth_expired(lws_sorted_usec_list_t *sul)
+{
+    struct conn *c = (struct conn *)(void *)((char *)sul - offsetof(struct conn, sul));
+    close_unauth(lws_context_user(lws_get_context(c->wsi)), c);
+}
+
+/* A new socket without the token: into the small pool, the oldest out if
+ * it is full, and a time limit on it. */
+static void admit_unauth(struct ncp_http *h, struct conn *c)
+{
+    while (h->n_unauth >= UNAUTH_MAX) {
+        struct conn *oldest = NULL;
+        for (struct conn *o = h->conns; o; o = o->next)
+            if (!o->authed && !o->evicted && o != c)
+                oldest = o;
+        if (!oldest)
+            break;
+        close_unauth(h, oldest);
+    }
+    h->n_unauth++;
+    lws_sul_schedule(lws_get_context(c->wsi), 0, &c->sul, unauth_expired,
+                     (lws_usec_t)UNAUTH_MS * 1000);
+}
+
 static void drop_conn(struct ncp_http *h, struct conn *c)
 {
     for (struct conn **p = &h->conns; *p; p = &(*p)->next)
         if (*p == c) {
             *p = c->next;
-            h->n_conns--;
+            if (c->authed)
+                h->n_authed--;
+            else if (!c->evicted)
+                h->n_unauth--;
             break;
         }
+    lws_sul_cancel(&c->sul);
     while (c->out_n) {
         free(c->out[c->out_head].buf);
         c->out_head = (c->out_head + 1) % OUT_QUEUE;
@@ -429,25 +711,31 @@ static int on_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, 
     struct conn *c = user;
     switch (reason) {
     case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
-        return h->n_conns >= MAX_CONNS;
+        /* only operators count against MAX_CONNS; others take the pool */
+        return ncp_http_token_ok(h, wsi) && h->n_authed >= MAX_CONNS;
     case LWS_CALLBACK_ESTABLISHED:
         /* the session's memory is new here; the URL's query still readable */
         memset(c, 0, sizeof *c);
         c->authed = ncp_http_token_ok(h, wsi);
         c->wsi = wsi;
+        c->serial = ++h->next_serial;
         c->client_id = NCP_HTTP_CLIENT_TAG | (h->next_client++ & ~NCP_HTTP_CLIENT_MASK);
         c->bucket = RATE_BURST;
         c->bucket_ns = mono_ns();
         c->next = h->conns;
         h->conns = c;
-        h->n_conns++;
+        if (c->authed)
+            h->n_authed++;
+        else
+            admit_unauth(h, c);
         count(h, &h->stats.connections);
         {
-            char hello[160];
+            char hello[200];
             int n = snprintf(hello, sizeof hello,
-                             "{\"type\": \"hello\", \"authed\": %s, \"readonly\": %s}",
-                             c->authed ? "true" : "false", h->o.readonly ? "true" : "false");
-            ncp_http_send(h, c, hello, (size_t)n);
+                             "{\"type\": \"hello\", \"authed\": %s, \"readonly\": %s%s}",
+                             c->authed ? "true" : "false", h->o.readonly ? "true" : "false",
+                             c->authed ? "" : ", \"closes_in_ms\": " NCP_HTTP_STR(UNAUTH_MS));
+            send_copy(h, c, hello, (size_t)n);
         }
         break;
     case LWS_CALLBACK_CLOSED:
@@ -515,18 +803,27 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
         return NULL;
     }
     h->o = *o;
+    char why[240];
+    if (ncp_http_policy_init(&h->policy, o->addr, o->port, o->allow_origin, o->allow_host, why,
+                             sizeof why)) {
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: [HTTP] %s", why);
+        goto fail;
+    }
     if (make_token(h->token)) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: no random numbers for the token");
         goto fail;
     }
     h->next_client = (int32_t)(h->token[0] * 4099 + h->token[1]);
     pthread_mutex_init(&h->mu, NULL);
-    h->hook = (struct ncp_nck_serve_hook){ hook_next_command, hook_ack, hook_status,
-                                           hook_event, h };
+    pthread_mutex_init(&h->prog_mu, NULL);
+    h->hook = (struct ncp_nck_serve_hook){ .next_command = hook_next_command, .ack = hook_ack,
+                                           .status = hook_status, .event = hook_event,
+                                           .loaded = hook_loaded, .ctx = h };
     h->mount = (struct lws_http_mount){ .mountpoint = "/", .origin = h->o.web_root,
                                         .def = "index.html",
                                         .origin_protocol = LWSMPRO_FILE, .mountpoint_len = 1 };
-    h->protocols[0] = (struct lws_protocols){ "http", lws_callback_http_dummy, 0, 0, 0, NULL, 0 };
+    /* the gate is the default protocol: every request and upgrade meets it first */
+    h->protocols[0] = (struct lws_protocols){ "http", ncp_http_on_gate, 0, 0, 0, NULL, 0 };
     h->protocols[1] = (struct lws_protocols){ "ncp-panel", on_ws, sizeof(struct conn),
                                               NCP_HTTP_MSG_MAX, 0, NULL, 0 };
     h->protocols[2] = (struct lws_protocols){ "ncp-upload", ncp_http_on_upload,
@@ -535,6 +832,12 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
                                                .origin_protocol = LWSMPRO_CALLBACK,
                                                .mountpoint_len = 7 };
     h->mount.mount_next = &h->upload_mount;
+    /* what a serve killed mid-upload left behind: every temporary, as one
+     * folder has one serve (a second one's upload in flight would fail and
+     * say so, never store a part) */
+    ncp_http_sweep_uploads(0);
+    struct ncp_http_jobs_env env = { .self_exe = h->o.self_exe, .prog_get = prog_get,
+                                     .wake = wake, .ctx = h };
     lws_set_log_level(LLL_ERR, NULL);
     struct lws_context_creation_info info;
     memset(&info, 0, sizeof info);
@@ -544,13 +847,20 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
     info.mounts = &h->mount;
     info.user = h;
     info.options = LWS_SERVER_OPTION_VALIDATE_UTF8;
+    /* a connection that holds a half-sent request holds it this long */
+    info.timeout_secs_ah_idle = 2;
     if (!strchr(h->o.addr, ':'))
         info.options |= LWS_SERVER_OPTION_DISABLE_IPV6;
     h->ctx = lws_create_context(&info);
     if (!h->ctx) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: cannot listen on %s port %d (in use?)",
                      o->addr, o->port);
-        goto fail;
+        goto fail_locks;
+    }
+    if (!(h->jobs = ncp_http_jobs_start(&env))) {
+        lws_context_destroy(h->ctx);
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: cannot start its worker thread");
+        goto fail_locks;
     }
     /* signals stay with the main thread, which turns them into a stop */
     sigset_t all, old;
@@ -559,11 +869,15 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
     int rc = pthread_create(&h->thread, NULL, serve_loop, h);
     pthread_sigmask(SIG_SETMASK, &old, NULL);
     if (rc) {
+        ncp_http_jobs_stop(h->jobs);
         lws_context_destroy(h->ctx);
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: cannot start its thread");
-        goto fail;
+        goto fail_locks;
     }
     return h;
+fail_locks:
+    pthread_mutex_destroy(&h->prog_mu);
+    pthread_mutex_destroy(&h->mu);
 fail:
     free(h->status_msg);
     free(h);
@@ -577,7 +891,11 @@ void ncp_http_stop(struct ncp_http *h)
     atomic_store(&h->stop, 1);
     lws_cancel_service(h->ctx);
     pthread_join(h->thread, NULL);
+    ncp_http_jobs_stop(h->jobs);   /* a running preview is killed */
     lws_context_destroy(h->ctx);   /* closes the sockets: CLOSED frees their queues */
+    if (h->prog)
+        ncp_http_prog_put(h->prog);
+    pthread_mutex_destroy(&h->prog_mu);
     pthread_mutex_destroy(&h->mu);
     free(h->status_msg);
     free(h);
@@ -603,4 +921,9 @@ void ncp_http_get_stats(struct ncp_http *h, struct ncp_http_stats *st)
 const struct ncp_http_opts *ncp_http_opts_of(const struct ncp_http *h)
 {
     return &h->o;
+}
+
+const struct ncp_http_policy *ncp_http_policy_of(const struct ncp_http *h)
+{
+    return &h->policy;
 }

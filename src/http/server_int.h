@@ -1,37 +1,87 @@
-/* src/http's private contract between the socket code (server.c) and the
- * panel's queries (query.c). */
+/* src/http's private contract between the socket thread (server.c, gate.c,
+ * upload.c) and the slow queries' worker (jobs.c, query.c). */
 #ifndef NCP_HTTP_SERVER_INT_H
 #define NCP_HTTP_SERVER_INT_H
 
 #include "ncpar/http.h"
 
 #include <libwebsockets.h>
+#include <stdatomic.h>
 
 /* The panel's LCM client ids: a tag in the top bits, so its acks are told
  * from cnc-ctl's (whose ids are random) well enough for routing. */
 #define NCP_HTTP_CLIENT_TAG ((int32_t)0x57000000)
 #define NCP_HTTP_CLIENT_MASK ((int32_t)0x7f000000)
 #define NCP_HTTP_STATUS_MAX 8192
+#define NCP_HTTP_PROGRAM_MAX (4u << 20)   /* program text the panel shows */
 
-struct conn;
-/* Queues a message for one socket (copied). */
-void ncp_http_send(struct ncp_http *h, struct conn *c, const char *msg, size_t len);
-void ncp_http_refuse(struct ncp_http *h, struct conn *c, int32_t seq, const char *why);
-/* The program list, the loaded program's text or its preview, answered on c. */
-void ncp_http_answer_query(struct ncp_http *h, struct conn *c, enum ncp_http_req r,
-                           const char *program);
+struct ncp_http;
+
+/* The loaded program as the NCK checked it, copied on the serving thread at
+ * the load's answer: shared read-only, freed with its last reference. */
+struct ncp_http_prog {
+    atomic_int refs;
+    char path[256];
+    size_t len;
+    int too_large;              /* over NCP_HTTP_PROGRAM_MAX: text not kept */
+    char text[];
+};
+void ncp_http_prog_put(struct ncp_http_prog *p);
+
+/* A message built off the socket thread: LWS_PRE bytes, then len bytes. */
+struct ncp_http_msg {
+    unsigned char *buf;
+    size_t len;
+};
+
+/* The answer to a slow query (list, program, preview) or its refusal, on
+ * the worker thread (query.c). prog may be NULL (nothing loaded). stop is
+ * polled while the preview's interpreter runs. 0, or -1 out of memory. */
+int ncp_http_build_answer(const char *self_exe, const struct ncp_http_prog *prog,
+                          enum ncp_http_req r, const atomic_int *stop,
+                          struct ncp_http_msg *out);
+
+/* The worker (jobs.c): slow queries in order, one at a time, at a lower
+ * priority than the socket thread; their answers wait for the socket thread
+ * (wake() tells it). A connection is named by its serial number: it may be
+ * gone by the time its answer is ready. */
+struct ncp_http_jobs;
+struct ncp_http_jobs_env {
+    const char *self_exe;
+    struct ncp_http_prog *(*prog_get)(void *ctx);   /* a reference, or NULL */
+    void (*wake)(void *ctx);
+    void *ctx;
+};
+struct ncp_http_jobs *ncp_http_jobs_start(const struct ncp_http_jobs_env *env);
+/* 0, or -1 when the queue is full. */
+int ncp_http_jobs_submit(struct ncp_http_jobs *j, uint64_t serial, enum ncp_http_req r);
+/* A finished answer: 1 (the caller owns msg->buf; NULL when there was no
+ * memory to build it), or 0 when none. */
+int ncp_http_jobs_take(struct ncp_http_jobs *j, uint64_t *serial, struct ncp_http_msg *msg);
+void ncp_http_jobs_stop(struct ncp_http_jobs *j);
+
+/* ---- the socket thread's -------------------------------------------------------- */
 const struct ncp_http_opts *ncp_http_opts_of(const struct ncp_http *h);
+const struct ncp_http_policy *ncp_http_policy_of(const struct ncp_http *h);
 
 /* Whether the request's URL carries the token (?token=...). */
 int ncp_http_token_ok(const struct ncp_http *h, struct lws *wsi);
 enum ncp_http_stat {
     NCP_HTTP_STAT_NO_TOKEN, NCP_HTTP_STAT_READONLY, NCP_HTTP_STAT_OVERSIZED,
-    NCP_HTTP_STAT_UPLOADS, NCP_HTTP_STAT_UPLOAD_BAD
+    NCP_HTTP_STAT_UPLOADS, NCP_HTTP_STAT_UPLOAD_BAD, NCP_HTTP_STAT_FOREIGN_ORIGIN,
+    NCP_HTTP_STAT_BAD_HOST, NCP_HTTP_STAT_BAD_REQUEST, NCP_HTTP_STAT_UNAUTH_CLOSED
 };
 void ncp_http_count(struct ncp_http *h, enum ncp_http_stat which);
+/* The first callback every HTTP request and upgrade meets (gate.c): Origin,
+ * Host and framing (ncp_http_head_verdict) before anything else. */
+int ncp_http_on_gate(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in,
+                     size_t len);
 /* POST /upload (upload.c): libwebsockets' callback and its session's size. */
 int ncp_http_on_upload(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in,
                        size_t len);
 size_t ncp_http_upload_session_size(void);
+/* Removes upload temporaries older than max_age_s left by a serve that was
+ * killed mid-upload: the number removed. */
+int ncp_http_sweep_uploads(int max_age_s);
 
 #endif

@@ -9,12 +9,14 @@
  * both win), rename() when the operator asked to overwrite. */
 #include "server_int.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <libwebsockets.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 struct upload {
@@ -226,4 +228,25 @@ int ncp_http_on_upload(struct lws *wsi, enum lws_callback_reasons reason, void *
 size_t ncp_http_upload_session_size(void)
 {
     return sizeof(struct upload);
+}
+
+int ncp_http_sweep_uploads(int max_age_s)
+{
+    DIR *dir = opendir(".");
+    if (!dir)
+        return 0;
+    int removed = 0;
+    time_t now = time(NULL);
+    struct dirent *e;
+    while ((e = readdir(dir))) {
+        struct stat st;
+        /* mkstemp's names only: ".upload-" and six characters */
+        if (strncmp(e->d_name, ".upload-", 8) != 0 || strlen(e->d_name) != 14 ||
+            lstat(e->d_name, &st) != 0 || !S_ISREG(st.st_mode) ||
+            now - st.st_mtime < max_age_s)
+            continue;
+        removed += unlink(e->d_name) == 0;
+    }
+    closedir(dir);
+    return removed;
 }

@@ -2,6 +2,7 @@
  * machine file must not silently fall back to a default. */
 #include "ncpar/motion.h"
 #include "ncpar/adcai.h"
+#include "ncpar/http.h"
 #include "ncpar/ini_keys.h"
 #include "ini_num.h"
 #include "kins_cfg.h"
@@ -486,11 +487,27 @@ static int coordinates_key(struct load_ctx *lc, const char *v, char *why, size_t
     return 1;
 }
 
+/* [HTTP]: the lists are checked here, so that a mistyped origin is an
+ * error naming its line before anything listens. */
+static int http_key(struct ncp_http_cfg *h, const char *k, const char *v, char *why, size_t len)
+{
+    int origins = !strcasecmp(k, "ALLOW_ORIGIN");
+    if (!origins && strcasecmp(k, "ALLOW_HOST") != 0)
+        return 0;
+    char *dst = origins ? h->allow_origin : h->allow_host;
+    if (strlen(v) >= sizeof h->allow_origin)
+        return snprintf(why, len, "at most %zu characters", sizeof h->allow_origin - 1), -1;
+    if (ncp_http_allow_list_ok(v, origins, why, len))
+        return -1;
+    snprintf(dst, sizeof h->allow_origin, "%s", v);
+    return 1;
+}
+
 static int known_section(const char *sec)
 {
     static const char *const names[] = { "EMCMOT", "TRAJ",   "LCM",   "PLANNER",
                                          "SIM",    "RT",     "CAN",   "SPINDLE_0",
-                                         "EMCIO",  "INJECT", "SCHED" };
+                                         "EMCIO",  "INJECT", "SCHED", "HTTP" };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcasecmp(sec, names[i]))
             return 1;
@@ -516,6 +533,8 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
                                              : traj_key(c, k, v, why, len);
     if (!strcasecmp(sec, "LCM"))
         return lcm_key(&c->lcm, k, v, why, len);
+    if (!strcasecmp(sec, "HTTP"))
+        return http_key(&c->http, k, v, why, len);
     int ax = axis_index(sec);
     if (ax >= 0 && !strcasecmp(k, "WRAPPED_ROTARY")) {
         if (!ncp_axis_rotary(ax))

@@ -36,6 +36,8 @@ const struct ncp_ini_section ncp_ini_sections[] = {
              "(cnc-run run --backend lcm, cnc-axis)." },
     { "INJECT", "Timing faults injected into the real position loop (tests and experiments)." },
     { "SCHED", "Priorities of the soft real-time tasks below the position loop." },
+    { "HTTP", "The operator's panel in a browser (cnc-run serve --http): who may reach it "
+              "besides its own origin and address (docs/panel-security.md)." },
 };
 const size_t ncp_ini_n_sections = sizeof ncp_ini_sections / sizeof ncp_ini_sections[0];
 
@@ -219,6 +221,15 @@ const struct ncp_ini_key ncp_ini_keys[] = {
     INT("LCM", "MAX_AGE_MS", 0, 3600000, "ms", "2000",
         "The distributed NCK drops a message sealed longer ago (or further ahead) than this: "
         "a recording played back moves nothing. 0: no limit."),
+
+    TEXT("HTTP", "ALLOW_ORIGIN", "origins (http://host[:port]) separated by spaces or commas",
+         NULL, "http://panel.example:8080",
+         "Pages from these origins may use the panel as well as its own; any other Origin "
+         "is refused (403), token or not."),
+    TEXT("HTTP", "ALLOW_HOST", "host names or addresses, with or without a port, separated by "
+         "spaces or commas", NULL, "cnc1.shop.example",
+         "Host headers accepted besides the bound address and localhost; any other gets 421 "
+         "(DNS rebinding). A panel bound to 0.0.0.0 lists the machine's own names here."),
 
     TEXT("INJECT", "SPEC", "specs separated by commas, as cnc-run run --inject", NULL,
          "miss=0.01", "The faults."),

@@ -386,6 +386,14 @@ static void answer_pending(struct serve *sv, struct serve_channel *ch)
         return;
     ch->pending = 0;
     struct client *cl = client_of(sv, ch->pending_client, utime_now());
+    const char *text;
+    size_t len;
+    if (rc == 0 && sv->hook && sv->hook->loaded &&
+        ncp_nck_program_text(ch->nck, &text, &len) == 0) {
+        struct ncp_nck_snapshot st;
+        ncp_nck_get_status(ch->nck, &st);
+        sv->hook->loaded(sv->hook->ctx, ch->num, st.program, text, len);
+    }
     ncp_ack_t a;
     memset(&a, 0, sizeof a);
     answer(sv, ch, &a, ch->pending_client, ch->pending_seq, rc, why);

@@ -1,4 +1,4 @@
-/* fuzz-replay FILE...: runs the libFuzzer target (fuzz_pipeline.c) once on each
+/* fuzz-replay[-NAME] FILE...: runs a libFuzzer target (fuzz_NAME.c) once on each
  * file, without libFuzzer: a crash or corpus file found by `make fuzz` replays
  * in an ordinary build (gdb, valgrind). Built by `make`, so the fuzz target is
  * compiled and linked against the library on every build and cannot drift
