@@ -191,6 +191,7 @@ static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *
 
 static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int32_t client,
                    int32_t seq, int rc, const char *why);
+static void answer_pending(struct serve *sv, struct serve_channel *ch);
 
 static void on_command(void *ctx, const ncp_command_t *c)
 {
@@ -240,6 +241,8 @@ static void on_command(void *ctx, const ncp_command_t *c)
     int rc = ncp_nck_command(ch->nck, &k, why, sizeof why);
     cl->seq = c->seq;
     if (rc == NCP_NCK_CMD_PENDING) {
+        if (ch->pending)   /* a new load ended the check of the one before: its answer first */
+            answer_pending(sv, ch);
         cl->pending = 1;
         ch->pending = 1;
         ch->pending_client = c->client_id;
