@@ -446,14 +446,24 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
         have[k ? k - 1 : 0] = '\0';
         return refuse(why, len, "no axis '%s' on this machine (it has %s)", c->text, have);
     }
-    int dir = c->ivalue[0] > 0 ? 1 : c->ivalue[0] < 0 ? -1 : 0;
-    if (!dir)
-        return refuse(why, len, "jog wants a direction, + or -");
+    int dir = c->ivalue[0];
+    if (dir != 1 && dir != -1)
+        return refuse(why, len, "jog direction is +1 or -1, not %d", (int)dir);
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
+    const char *unit = ncp_axis_rotary(j) ? "deg" : "mm";
+    if (!isfinite(c->value[0]) || c->value[0] < 0)
+        return refuse(why, len, "jog speed is a %s/min above 0 (0: the default), not %g", unit,
+                      c->value[0]);
+    if (!isfinite(c->value[1]) || c->value[1] < 0)
+        return refuse(why, len, "jog distance is a %s above 0 (0: continuous), not %g", unit,
+                      c->value[1]);
     double speed = c->value[0] > 0 ? c->value[0] / 60.0 : n->cfg->default_linear_vel;
-    if (!isfinite(speed) || !isfinite(c->value[1]) || c->value[1] < 0)
-        return refuse(why, len, "jog speed and distance must be positive numbers");
-    speed = fmin(speed, a->max_vel);
+    /* as a real controller: no axis jogs faster than its MAX_VELOCITY */
+    if (speed > a->max_vel) {
+        nck_post(n, NCP_EV_INFO, NULL, 0, 0, "jog of %c at %g %s/min, its MAX_VELOCITY, not %g",
+                 NCP_AXIS_LETTERS[j], a->max_vel * 60, unit, speed * 60);
+        speed = a->max_vel;
+    }
     double target[NCP_AXES];
     memcpy(target, n->map.pos, sizeof target);
     double limit = dir > 0 ? a->max_limit : a->min_limit;

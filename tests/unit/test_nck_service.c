@@ -516,6 +516,68 @@ static void test_jogs(void **state_)
     stop(&s);
 }
 
+/* A jog that makes no sense is refused with the reason, never run at the
+ * default speed; a speed above the axis's MAX_VELOCITY jogs at it and
+ * says so. */
+static void test_jog_input(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    start(&s, 0);
+    static const struct { int dir; double speed, dist; const char *why; } bad[] = {
+        { 5, 600, 1, "direction is +1 or -1, not 5" },
+        { 0, 600, 1, "direction" },
+        { -2, 600, 1, "direction" },
+        { 1, -1e308, 1, "speed" },
+        { 1, -1, 0, "speed" },
+        { 1, NAN, 1, "speed" },
+        { 1, INFINITY, 1, "speed" },
+        { 1, 600, -1, "distance" },
+        { 1, 600, NAN, "distance" },
+        { -1, 600, INFINITY, "distance" },
+    };
+    char why[256];
+    struct ncp_nck_cmd c;
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        memset(&c, 0, sizeof c);
+        c.kind = NCP_CMD_JOG;
+        strcpy(c.text, "x");
+        c.ivalue[0] = bad[k].dir;
+        c.value[0] = bad[k].speed;
+        c.value[1] = bad[k].dist;
+        assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), -1);
+        assert_non_null(strstr(why, bad[k].why));
+        ncp_nck_poll(s.nck);
+        assert_int_equal(state(&s), NCP_ST_IDLE);
+    }
+    /* 1e308 mm/min: at MAX_VELOCITY, said in an event */
+    memset(&c, 0, sizeof c);
+    c.kind = NCP_CMD_JOG;
+    strcpy(c.text, "x");
+    c.ivalue[0] = 1;
+    c.value[0] = 1e308;
+    c.value[1] = 50;
+    assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), 0);
+    double vmax = 0;
+    for (int i = 0; i < 60000 && state(&s) != NCP_ST_IDLE; i++) {
+        struct ncp_nck_snapshot st;
+        ncp_nck_poll(s.nck);
+        ncp_nck_get_status(s.nck, &st);
+        vmax = fmax(vmax, st.vel);
+        nap_ms(1);
+    }
+    assert_true(vmax > 0 && vmax <= s.cfg.axis[0].max_vel * 60 * (1 + 1e-9));
+    struct ncp_nck_event ev;
+    int said = 0;
+    while (ncp_nck_next_event(s.nck, &ev))
+        said |= strstr(ev.text, "MAX_VELOCITY") != NULL;
+    assert_true(said);
+    double p[3];
+    pos(&s, p);
+    assert_true(fabs(p[0] - 50) < 1e-9);
+    stop(&s);
+}
+
 static void test_estop_reset(void **state_)
 {
     (void)state_;
@@ -608,6 +670,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_stop_then_run_again),
         cmocka_unit_test(test_mdi_keeps_modal_state),
         cmocka_unit_test(test_jogs),
+        cmocka_unit_test(test_jog_input),
         cmocka_unit_test(test_estop_reset),
         cmocka_unit_test(test_single_block_and_from_line),
     };
