@@ -268,6 +268,7 @@ struct nck_job {
     struct nck_aux_pack aux;
     int aux_stop;
     int need_at_speed;           /* a spindle start or S: the next feed waits */
+    double capped_said;          /* the last S above MAX_RPM the operator was told of */
     struct nck_sync_run run;     /* synchronised lines gathered, not sent yet */
     int spindle_dir;             /* as the program has set it */
     double origin[NCP_AXES];     /* where the machine was when the job started */
