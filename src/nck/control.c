@@ -877,6 +877,13 @@ int ncp_nck_poll(struct ncp_nck *s)
             begin_drop(s, 1, 0, NCP_ST_IDLE, 0);
         }
     }
+    if (n->sum.trace_errno && !s->trace_said) {
+        /* the service goes on (an E-stop must not wait for a disk); the
+         * operator learns that what follows is not recorded */
+        s->trace_said = 1;
+        nck_post(n, NCP_EV_ERROR, NULL, 0, 0, "the trace ended early at t %.3f s: %s (its rows "
+                 "so far are whole)", n->sum.t, strerror(n->sum.trace_errno));
+    }
     if (s->shutdown_pending)
         end_check(s, NCK_CHECK_BY_SHUTDOWN);   /* answered by ncp_nck_pending */
     if (s->shutdown_pending && s->drop == NCK_DROP_NONE && !moving_state(s->state) &&

@@ -451,6 +451,7 @@ struct ncp_nck {
      * stop) whose answer ncp_nck_pending has yet to give */
     int ended_answer;
     char ended_why[256];
+    int trace_said;                  /* the trace's early end was told */
     char mdi[NCP_NCK_TEXT_MAX + 2];
     struct ncp_source mdi_src;
     const struct ncp_source *run_src;
