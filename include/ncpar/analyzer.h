@@ -61,10 +61,13 @@ struct ncp_analyzer_cfg {
      * (#5399) the interpreter reads back at a queue buster (see
      * ncp_machine_sync). 0 (parse, check): no call, rs274 -g's stand-in. */
     int m66_on_machine;
-    /* A stop request (a signal, an operator's abort), asked every 4096
-     * laps of a loop (about a millisecond): nonzero ends the run there
-     * with NCP_ERR_LIMIT "stopped on request", rather than after the
-     * loop's millions of laps. NULL: never asked. */
+    /* A stop request (a signal, an operator's abort), asked every 64
+     * blocks the interpreter reads, laps of loops and skipped lines
+     * included (well under a millisecond): nonzero ends the run there with
+     * NCP_ERR_LIMIT "stopped on request", rather than after a loop's
+     * millions of laps or a long file's last line. Called from the
+     * interpreter's thread: it must be cheap (an atomic load). NULL: never
+     * asked. */
     int (*cancel)(void *ctx);
     void *cancel_ctx;
 };

@@ -100,10 +100,12 @@ struct ncp_can_cfg {
  * simulated spindle, the tool changer's position and the simulated inputs.
  * Every key is optional; the defaults are an ideal spindle (at any speed in
  * one servo period), no tool change move and pauses that resume at once. */
+#define NCP_SPINDLE_TOP_RPM 1e6   /* the highest MAX_RPM, and the default */
 #define NCP_DIO_MAX 64  /* digital inputs and outputs, P0..P63 */
 #define NCP_AIO_MAX 16  /* analog inputs and outputs, E0..E15 */
 struct ncp_io_cfg {
-    double spindle_max_rpm;       /* [SPINDLE_0] MAX_RPM: S above it runs at it (0: no cap) */
+    double spindle_max_rpm;       /* [SPINDLE_0] MAX_RPM: S above it runs at it, said to the
+                                     operator (absent or 0: NCP_SPINDLE_TOP_RPM) */
     double spindle_acc;           /* [SPINDLE_0] MAX_ACCELERATION, rpm/s (0: ideal) */
     double orient_rpm;            /* [SPINDLE_0] ORIENT_RPM: M19's top speed (60) */
     double at_speed_tol;          /* [SPINDLE_0] AT_SPEED_TOLERANCE: fraction of S (0.01) */

@@ -231,12 +231,18 @@ void ncp_nck_free(struct ncp_nck *n);
 /* Accepted (0), or refused (-1) with the reason in reason[len], or
  * NCP_NCK_CMD_PENDING: a load, whose program is checked in a thread of its
  * own while the caller goes on (status, other channels, E-stop); its answer
- * comes from ncp_nck_pending. Other loads, runs, MDI, jogs and homing are
- * refused until then. */
+ * comes from ncp_nck_pending. Runs, MDI, jogs and homing are refused until
+ * then. Stop, abort, E-stop, reset, a shutdown, a new load and
+ * ncp_nck_free end the check within a few blocks of its program (a
+ * millisecond at most), in a loop or not: the load is then refused, naming
+ * what ended its check. A new load waits that long for the old check to
+ * end, and ncp_nck_pending gives the old load's answer before the new
+ * one's. */
 #define NCP_NCK_CMD_PENDING 1
 int ncp_nck_command(struct ncp_nck *n, const struct ncp_nck_cmd *c, char *reason, size_t len);
 /* The pending load's answer once its check has ended: 0 (the program is
- * loaded) or -1 with the reason; NCP_NCK_CMD_PENDING while it runs. */
+ * loaded) or -1 with the reason; NCP_NCK_CMD_PENDING while it runs. A
+ * load whose check a new load ended is answered first (-1). */
 int ncp_nck_pending(struct ncp_nck *n, char *reason, size_t len);
 /* Moves the NCK on: reads the position loop's cycles (trace, status), ends
  * jobs whose motion is complete, goes through the steps of a stop, notices

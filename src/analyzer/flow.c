@@ -102,6 +102,7 @@ struct ncp_flow {
     uint32_t max_loops, max_depth;
     int (*cancel)(void *ctx);
     void *cancel_ctx;
+    uint32_t ticks;                   /* blocks seen, for the stop request */
 
     struct flow_pos cur;              /* next block to execute */
     struct flow_pos feed_pos;         /* next block the feed will deliver */
@@ -562,19 +563,20 @@ static int ncp_flow_runaway(const struct ncp_flow *f, const struct ncp_block *b,
                         name, op->line, f->max_loops);
 }
 
-/* Looked at every CANCEL_LAPS laps: a lap is about a quarter of a
- * microsecond, so a stop is seen within a millisecond or so. */
-#define CANCEL_LAPS 4096u
+/* A stop request is asked every CANCEL_BLOCKS blocks the flow hands on or
+ * passes over (the laps of a loop, the lines a skip or a search reads):
+ * a block costs a microsecond or so, a lap of a loop at least two blocks,
+ * so a stop is seen well within a millisecond, in a loop or not, at the
+ * cost of a counter per block. */
+#define CANCEL_BLOCKS 64u
 
 static int ncp_flow_cancelled(const struct ncp_flow *f, const struct ncp_block *b,
-                              const struct flow_label *op, uint32_t laps, struct ncp_diag *d)
+                              struct ncp_diag *d)
 {
-    if (!f->cancel || laps % CANCEL_LAPS != 0 || !f->cancel(f->cancel_ctx))
+    if (!f->cancel(f->cancel_ctx))
         return NCP_OK;
-    char name[80];
-    ncp_flow_display_name(f, b, name, sizeof name);
-    return ncp_diag_set(d, NCP_ERR_LIMIT, op->line, 0,
-                        "stopped on request in loop %s at line %u", name, op->line);
+    return ncp_diag_set(d, NCP_ERR_LIMIT, b->line, 0, "stopped on request at line %u",
+                        b->line);
 }
 
 static int ncp_flow_count_iteration(struct ncp_flow *f, const struct ncp_block *b,
@@ -582,7 +584,7 @@ static int ncp_flow_count_iteration(struct ncp_flow *f, const struct ncp_block *
 {
     if (++op->iterations > f->max_loops)
         return ncp_flow_runaway(f, b, op, d);
-    return ncp_flow_cancelled(f, b, op, op->iterations, d);
+    return NCP_OK;
 }
 
 /* A loop head reached by a jump back whose test ends the loop: once per run
@@ -597,7 +599,7 @@ static int ncp_flow_count_idle_lap(struct ncp_flow *f, const struct ncp_block *b
         return NCP_OK;
     if (++op->idle_laps > f->max_loops)
         return ncp_flow_runaway(f, b, op, d);
-    return ncp_flow_cancelled(f, b, op, op->idle_laps, d);
+    return NCP_OK;
 }
 
 /* What rs274 does while reading an O-word line: evaluate its expressions unless
@@ -1376,7 +1378,12 @@ static int ncp_flow_step(struct ncp_flow *f, const struct ncp_block **out,
             return ncp_flow_at_end(f, d);
         if (rc != NCP_OK)
             return rc;
-        if (!b || (FLOW_BLOCK_DELETE && b->block_delete))
+        if (!b)
+            continue;
+        if (f->cancel && (++f->ticks & (CANCEL_BLOCKS - 1)) == 0 &&
+            (rc = ncp_flow_cancelled(f, b, d)) != NCP_OK)
+            return rc;
+        if (FLOW_BLOCK_DELETE && b->block_delete)
             continue;
         f->by_jump = b->offset == target;
         int kind = b->oword.kind;

@@ -178,7 +178,8 @@ static int report_channel(struct channel *ch)
     if (ch->res.warning[0])
         fprintf(mem ? mem : stderr, "warning: %s\n", ch->res.warning);
     if (ch->res.trace_errno) {
-        fprintf(mem ? mem : stderr, "error writing the trace %s: %s (the run stopped there)\n",
+        fprintf(mem ? mem : stderr, "error writing the trace %s: %s (the run stopped there; "
+                                    "the trace ends at its last whole row)\n",
                 ch->trace_path, strerror(ch->res.trace_errno));
         rc = rc ? rc : CH_FAULT;
     }

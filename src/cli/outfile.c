@@ -157,7 +157,49 @@ static int open_beside(struct ncp_outfile *of, const struct stat *old)
     return 0;
 }
 
-/* A live record: truncated only once no other run holds it. */
+/* The record of the run before (a crash's, perhaps) is kept as NAME.1
+ * (one generation): the old file, locked by us, is renamed, and a new one
+ * made in its place and locked. Through a symlink the target is rotated and
+ * the link kept. A run that makes NAME meanwhile holds it: refused. */
+static int rotate_live(struct ncp_outfile *of, const struct stat *st)
+{
+    char *target = realpath(of->path, NULL);
+    if (!target)
+        return refuse(of->path, strerror(errno));
+    size_t n = strlen(target) + 3;
+    char *kept = malloc(n);
+    int fd = -1, e = 0;
+    if (!kept) {
+        e = ENOMEM;
+    } else {
+        snprintf(kept, n, "%s.1", target);
+        if (rename(target, kept) != 0 ||
+            (fd = open(target, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644)) < 0)
+            e = errno;
+        else if (flock(fd, LOCK_EX | LOCK_NB) != 0)
+            e = errno == EWOULDBLOCK ? EEXIST : errno;
+    }
+    if (e) {
+        if (fd >= 0)
+            close(fd);
+        char why[PATH_MAX + 96] = "another run is writing it";
+        if (e != EEXIST)
+            snprintf(why, sizeof why, "cannot keep the last run's trace as %s: %s",
+                     kept ? kept : "NAME.1", strerror(e));
+        free(kept);
+        free(target);
+        return refuse(of->path, why);
+    }
+    (void)fchmod(fd, st->st_mode & 07777);
+    close(of->fd);
+    of->fd = fd;
+    free(kept);
+    free(target);
+    return 0;
+}
+
+/* A live record: made afresh only once no other run holds it, the last
+ * run's kept beside it. */
 static int open_live(struct ncp_outfile *of)
 {
     of->fd = open(of->path, O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
@@ -172,11 +214,10 @@ static int open_live(struct ncp_outfile *of)
             return refuse(of->path, e == EWOULDBLOCK ? "another run is writing it"
                                                      : strerror(e));
         }
-        if (ftruncate(of->fd, 0) != 0) {
-            int e = errno;
+        if (st.st_size > 0 && rotate_live(of, &st) != 0) {
             close(of->fd);
             of->fd = -1;
-            return refuse(of->path, strerror(e));
+            return -1;
         }
     }
     return 0;

@@ -74,7 +74,8 @@ static void usage(FILE *f)
           "look-ahead planner -> interpolator -> position loop (SCHED_FIFO when permitted).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill)\n"
           "  --trace CSV         per-cycle trace: t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n"
-          "                      (motion: 0 rapid, 1 feed, 2 arc)\n"
+          "                      (motion: 0 rapid, 1 feed, 2 arc); an existing CSV (the\n"
+          "                      last run's) is kept as CSV.1\n"
           "  --trace-rings       add the task chain to the trace: seg_fill,seg_cap,sp_fill,\n"
           "                      sp_cap (segment and setpoint rings), job_cycle_us,\n"
           "                      plan_resp_us, plan_cycle_us, loop_cycle_us (as [SCHED]\n"
@@ -614,7 +615,8 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
     int rc = ncp_cli_run_report(o->prog, cfg, res, stderr);
     if (res->trace_errno) {
-        fprintf(stderr, "cnc-run run: error writing the trace%s%s: %s (the run stopped there)\n",
+        fprintf(stderr, "cnc-run run: error writing the trace%s%s: %s (the run stopped there; "
+                        "the trace ends at its last whole row)\n",
                 o->trace ? " " : " for --plot", o->trace ? o->trace : "",
                 strerror(res->trace_errno));
         rc = rc ? rc : RUN_FAULT;

@@ -14,6 +14,7 @@
 void ncp_io_cfg_default(struct ncp_io_cfg *io)
 {
     memset(io, 0, sizeof *io);
+    io->spindle_max_rpm = NCP_SPINDLE_TOP_RPM;
     io->orient_rpm = 60.0;
     io->at_speed_tol = 0.01;
 }
@@ -37,8 +38,13 @@ static int indexed(const char *k, const char *prefix, int max)
 
 static int spindle_key(struct ncp_io_cfg *io, const char *k, const char *v)
 {
-    if (!strcasecmp(k, "MAX_RPM"))
-        return number(v, 0, 1e6, &io->spindle_max_rpm);
+    if (!strcasecmp(k, "MAX_RPM")) {
+        /* 0 once meant no cap: no spindle turns at any speed */
+        int rc = number(v, 0, NCP_SPINDLE_TOP_RPM, &io->spindle_max_rpm);
+        if (rc > 0 && io->spindle_max_rpm == 0)
+            io->spindle_max_rpm = NCP_SPINDLE_TOP_RPM;
+        return rc;
+    }
     if (!strcasecmp(k, "MAX_ACCELERATION"))
         return number(v, 0, 1e9, &io->spindle_acc);
     if (!strcasecmp(k, "ORIENT_RPM"))

@@ -244,11 +244,11 @@ static int moving_state(int st)
 static int load_cancelled(void *ctx)
 {
     struct ncp_nck *s = ctx;
-    return atomic_load(&s->load_cancel);
+    return atomic_load_explicit(&s->load_cancel, memory_order_relaxed) != NCK_CHECK_RUNS;
 }
 
-/* The check keeps nothing; a shutdown ends it at the next block, as the
- * analyzer's cancel ends it inside a loop. */
+/* The check keeps nothing; an end asked for ends it at the next block, as
+ * the analyzer's cancel does every few blocks (in a loop too). */
 static int emit_unless_cancelled(void *ctx, const struct ncp_cmd *cmd)
 {
     (void)cmd;
@@ -263,7 +263,7 @@ static void *load_main(void *arg)
     struct ncp_analyzer_cfg acfg = s->acfg;
     acfg.resident = 0;
     acfg.instance = NULL;
-    acfg.cancel = load_cancelled;   /* a shutdown does not wait for the check */
+    acfg.cancel = load_cancelled;   /* stop, E-stop, a new load: no waiting for the check */
     acfg.cancel_ctx = s;
     struct ncp_output out = { .ctx = s, .emit = emit_unless_cancelled };
     struct ncp_run_stats st;
@@ -274,8 +274,67 @@ static void *load_main(void *arg)
     if (rc != NCP_OK && rc != NCP_END)
         snprintf(s->load_why, sizeof s->load_why, "%s:%u:%u: %s",
                  d.file ? d.file : s->load_path, d.line, d.col ? d.col : 1u, d.msg);
+    s->load_end_ns = mono_ns();
     atomic_store(&s->load_done, 1);
     return NULL;
+}
+
+static const char *check_end_name(int why)
+{
+    switch (why) {
+    case NCK_CHECK_BY_STOP: return "stop";
+    case NCK_CHECK_BY_ABORT: return "abort";
+    case NCK_CHECK_BY_ESTOP: return "E-stop";
+    case NCK_CHECK_BY_RESET: return "reset";
+    case NCK_CHECK_BY_LOAD: return "a new load";
+    default: return "the NCK's end";
+    }
+}
+
+/* Ends a load's check early: its interpreter sees it within a few blocks.
+ * The first cause asked is the one the load's answer names. */
+static void end_check(struct ncp_nck *s, int why)
+{
+    int none = NCK_CHECK_RUNS;
+    if (s->loading && atomic_compare_exchange_strong(&s->load_cancel, &none, why))
+        s->cancel_ns = mono_ns();
+}
+
+/* The answer of a check that has ended: 0 with the program taken, or -1
+ * with the reason (a program error, or what ended it). Joins its thread. */
+static int check_answer(struct ncp_nck *s, char *why, size_t len)
+{
+    pthread_join(s->load_th, NULL);
+    s->loading = 0;
+    int cancel = atomic_load(&s->load_cancel);
+    if (cancel || s->load_why[0]) {
+        ncp_source_close(&s->load_src);
+        s->rejected++;
+        if (cancel == NCK_CHECK_BY_SHUTDOWN)
+            return refuse(why, len, "the service is shutting down: %s not loaded (its check "
+                          "was cancelled)", s->load_path);
+        if (cancel)
+            return refuse(why, len, "%s not loaded: its check was cancelled by %s (ended "
+                          "%.2f ms after it)", s->load_path, check_end_name(cancel),
+                          (double)(s->load_end_ns - s->cancel_ns) * 1e-6);
+        return refuse(why, len, "%s", s->load_why);
+    }
+    if (s->have_prog)
+        ncp_source_close(&s->prog);
+    s->prog = s->load_src;
+    s->have_prog = 1;
+    snprintf(s->program, sizeof s->program, "%s", s->load_path);
+    nck_post(&s->n, NCP_EV_INFO, s->program, 0, 0, "loaded %s", s->program);
+    return 0;
+}
+
+/* A check asked to end and its answer kept for ncp_nck_pending: the NCK
+ * takes the next load, MDI, jog or homing at once (a check sees the request
+ * within a few blocks, a fraction of a millisecond). */
+static void finish_ended_check(struct ncp_nck *s)
+{
+    s->ended_answer = 1;
+    (void)check_answer(s, s->ended_why, sizeof s->ended_why);
 }
 
 static int cmd_load(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
@@ -287,11 +346,17 @@ static int cmd_load(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     if (strlen(c->text) >= sizeof s->load_path)
         return refuse(why, len, "program path longer than %zu characters",
                       sizeof s->load_path - 1);
-    if (ncp_source_open(&s->load_src, c->text, &d) != NCP_OK)
+    struct ncp_source src;
+    if (ncp_source_open(&src, c->text, &d) != NCP_OK)
         return refuse(why, len, "%s: %s", c->text, d.msg);
+    if (s->loading) {   /* the newer load wins: the older one's answer comes first */
+        end_check(s, NCK_CHECK_BY_LOAD);
+        finish_ended_check(s);
+    }
+    s->load_src = src;
     snprintf(s->load_path, sizeof s->load_path, "%s", c->text);
     atomic_store(&s->load_done, 0);
-    atomic_store(&s->load_cancel, 0);
+    atomic_store(&s->load_cancel, NCK_CHECK_RUNS);
     if (pthread_create(&s->load_th, NULL, load_main, s) != 0) {
         ncp_source_close(&s->load_src);
         return refuse(why, len, "cannot start the program's check");
@@ -304,34 +369,23 @@ int ncp_nck_pending(struct ncp_nck *s, char *why, size_t len)
 {
     if (len)
         why[0] = 0;
+    if (s->ended_answer) {
+        s->ended_answer = 0;
+        return refuse(why, len, "%s", s->ended_why);
+    }
     if (!s->loading)
         return refuse(why, len, "no command is pending");
     if (!atomic_load(&s->load_done))
         return NCP_NCK_CMD_PENDING;
-    pthread_join(s->load_th, NULL);
-    s->loading = 0;
-    if (atomic_load(&s->load_cancel) || s->load_why[0]) {
-        ncp_source_close(&s->load_src);
-        s->rejected++;
-        return refuse(why, len, "%s", atomic_load(&s->load_cancel)
-                                          ? "the service is shutting down: not loaded"
-                                          : s->load_why);
-    }
-    if (s->have_prog)
-        ncp_source_close(&s->prog);
-    s->prog = s->load_src;
-    s->have_prog = 1;
-    snprintf(s->program, sizeof s->program, "%s", s->load_path);
-    nck_post(&s->n, NCP_EV_INFO, s->program, 0, 0, "loaded %s", s->program);
-    return 0;
+    return check_answer(s, why, len);
 }
 
 /* A load being checked: the commands that would use the program, or start
- * anything else, wait for its answer. */
+ * anything else, wait for its answer (a new load ends the check). */
 static int waits_for_load(int kind)
 {
-    return kind == NCP_CMD_LOAD || kind == NCP_CMD_RUN || kind == NCP_CMD_MDI ||
-           kind == NCP_CMD_JOG || kind == NCP_CMD_HOME;
+    return kind == NCP_CMD_RUN || kind == NCP_CMD_MDI || kind == NCP_CMD_JOG ||
+           kind == NCP_CMD_HOME;
 }
 
 static int cmd_run(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
@@ -392,14 +446,24 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
         have[k ? k - 1 : 0] = '\0';
         return refuse(why, len, "no axis '%s' on this machine (it has %s)", c->text, have);
     }
-    int dir = c->ivalue[0] > 0 ? 1 : c->ivalue[0] < 0 ? -1 : 0;
-    if (!dir)
-        return refuse(why, len, "jog wants a direction, + or -");
+    int dir = c->ivalue[0];
+    if (dir != 1 && dir != -1)
+        return refuse(why, len, "jog direction is +1 or -1, not %d", (int)dir);
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
+    const char *unit = ncp_axis_rotary(j) ? "deg" : "mm";
+    if (!isfinite(c->value[0]) || c->value[0] < 0)
+        return refuse(why, len, "jog speed is a %s/min above 0 (0: the default), not %g", unit,
+                      c->value[0]);
+    if (!isfinite(c->value[1]) || c->value[1] < 0)
+        return refuse(why, len, "jog distance is a %s above 0 (0: continuous), not %g", unit,
+                      c->value[1]);
     double speed = c->value[0] > 0 ? c->value[0] / 60.0 : n->cfg->default_linear_vel;
-    if (!isfinite(speed) || !isfinite(c->value[1]) || c->value[1] < 0)
-        return refuse(why, len, "jog speed and distance must be positive numbers");
-    speed = fmin(speed, a->max_vel);
+    /* as a real controller: no axis jogs faster than its MAX_VELOCITY */
+    if (speed > a->max_vel) {
+        nck_post(n, NCP_EV_INFO, NULL, 0, 0, "jog of %c at %g %s/min, its MAX_VELOCITY, not %g",
+                 NCP_AXIS_LETTERS[j], a->max_vel * 60, unit, speed * 60);
+        speed = a->max_vel;
+    }
     double target[NCP_AXES];
     memcpy(target, n->map.pos, sizeof target);
     double limit = dir > 0 ? a->max_limit : a->min_limit;
@@ -622,6 +686,17 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     if (memchr(c->text, 0, sizeof c->text) == NULL)
         return refuse(why, len, "command text not terminated");
     int rc;
+    /* whatever stops the machine ends a load's check too */
+    switch (c->kind) {
+    case NCP_CMD_STOP: end_check(s, NCK_CHECK_BY_STOP); break;
+    case NCP_CMD_ABORT: end_check(s, NCK_CHECK_BY_ABORT); break;
+    case NCP_CMD_ESTOP: end_check(s, NCK_CHECK_BY_ESTOP); break;
+    case NCP_CMD_RESET: end_check(s, NCK_CHECK_BY_RESET); break;
+    default: break;
+    }
+    if (s->loading && atomic_load(&s->load_cancel) != NCK_CHECK_RUNS &&
+        waits_for_load(c->kind))
+        finish_ended_check(s);
     int locked = s->state == NCP_ST_ESTOP || s->state == NCP_ST_FAULT ||
                  s->state == NCP_ST_STOPPING;
     switch (c->kind) {
@@ -649,8 +724,8 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
             break;
         }
         if (s->loading && waits_for_load(c->kind)) {
-            rc = refuse(why, len, "%s is being checked: wait for its load's answer",
-                        s->load_path);
+            rc = refuse(why, len, "%s is being checked: wait for its load's answer (a stop "
+                        "ends the check)", s->load_path);
             break;
         }
         switch (c->kind) {
@@ -802,10 +877,17 @@ int ncp_nck_poll(struct ncp_nck *s)
             begin_drop(s, 1, 0, NCP_ST_IDLE, 0);
         }
     }
-    if (s->shutdown_pending && s->loading)
-        atomic_store(&s->load_cancel, 1);   /* answered by ncp_nck_pending */
+    if (n->sum.trace_errno && !s->trace_said) {
+        /* the service goes on (an E-stop must not wait for a disk); the
+         * operator learns that what follows is not recorded */
+        s->trace_said = 1;
+        nck_post(n, NCP_EV_ERROR, NULL, 0, 0, "the trace ended early at t %.3f s: %s (its rows "
+                 "so far are whole)", n->sum.t, strerror(n->sum.trace_errno));
+    }
+    if (s->shutdown_pending)
+        end_check(s, NCK_CHECK_BY_SHUTDOWN);   /* answered by ncp_nck_pending */
     if (s->shutdown_pending && s->drop == NCK_DROP_NONE && !moving_state(s->state) &&
-        !s->loading)
+        !s->loading && !s->ended_answer)
         s->shutdown = 1;
     int changed = s->changed;
     s->changed = 0;
@@ -859,7 +941,7 @@ void ncp_nck_free(struct ncp_nck *s)
         return;
     struct nck *n = &s->n;
     if (s->loading) {
-        atomic_store(&s->load_cancel, 1);
+        end_check(s, NCK_CHECK_BY_FREE);
         pthread_join(s->load_th, NULL);
         ncp_source_close(&s->load_src);
         s->loading = 0;

@@ -349,11 +349,33 @@ static int tool_change(struct nck *n, const struct ncp_canon *op, uint32_t line)
            aux_add(n, NCK_AUX_TOOL, 0, op->tool.tool, 0, line, 1);
 }
 
+/* An S above the spindle's top speed runs at the top, as LinuxCNC's
+ * spindle does, and the operator is told once per such S. */
+static double spindle_capped(struct nck *n, double s, uint32_t line)
+{
+    double top = n->cfg->io.spindle_max_rpm;
+    if (!(top > 0) || s <= top)
+        return s;
+    if (s != n->job.capped_said) {
+        n->job.capped_said = s;
+        if (n->batch)
+            fprintf(stderr, "%sline %u: S%g is above the spindle's top speed ([SPINDLE_0] "
+                            "MAX_RPM): it turns at %.0f rpm\n", n->label ? n->label : "", line,
+                    s, top);
+        else
+            nck_post(n, NCP_EV_INFO, NULL, line, 0, "S%g is above the spindle's top speed "
+                     "([SPINDLE_0] MAX_RPM): it turns at %.0f rpm", s, top);
+    }
+    return top;
+}
+
 static int spindle_cmd(struct nck *n, uint32_t line)
 {
     double s = n->map.speed;
     if (n->map.css_max > 0 && s > n->map.css_max)
         s = n->map.css_max;
+    if (n->map.spindle_dir != 0)
+        s = spindle_capped(n, s, line);
     n->job.need_at_speed = n->map.spindle_dir != 0;
     return aux_add(n, NCK_AUX_SPINDLE, 0, 0, n->map.spindle_dir * s, line, 1);
 }
@@ -743,6 +765,7 @@ int nck_job_start(struct nck *n)
     j->aux.n = 0;
     j->aux_stop = 0;
     j->need_at_speed = 0;
+    j->capped_said = 0;
     j->run.n = 0;
     atomic_store(&j->busters_done, 0);
     j->busters_asked = 0;

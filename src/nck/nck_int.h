@@ -268,6 +268,7 @@ struct nck_job {
     struct nck_aux_pack aux;
     int aux_stop;
     int need_at_speed;           /* a spindle start or S: the next feed waits */
+    double capped_said;          /* the last S above MAX_RPM the operator was told of */
     struct nck_sync_run run;     /* synchronised lines gathered, not sent yet */
     int spindle_dir;             /* as the program has set it */
     double origin[NCP_AXES];     /* where the machine was when the job started */
@@ -402,6 +403,18 @@ struct nck {
     int have_fb;
 };
 
+/* What ended a load's check before its end (control.c): the ACK names it. */
+enum nck_check_end {
+    NCK_CHECK_RUNS = 0,
+    NCK_CHECK_BY_STOP,
+    NCK_CHECK_BY_ABORT,
+    NCK_CHECK_BY_ESTOP,
+    NCK_CHECK_BY_RESET,
+    NCK_CHECK_BY_LOAD,
+    NCK_CHECK_BY_SHUTDOWN,
+    NCK_CHECK_BY_FREE,
+};
+
 /* The steps of dropping what is queued (control.c). */
 enum nck_drop {
     NCK_DROP_NONE,
@@ -427,10 +440,18 @@ struct ncp_nck {
      * ncp_nck_pending()'s */
     pthread_t load_th;
     int loading;
+    /* load_cancel: what ended the check (enum nck_check_end, 0: nothing),
+     * asked by the check's interpreter every few blocks */
     _Atomic int load_done, load_cancel;
+    int64_t cancel_ns, load_end_ns;  /* when it was asked to end, when it ended */
     struct ncp_source load_src;
     char load_path[256];
     char load_why[256];
+    /* a check ended and joined here (a new load, a command right after a
+     * stop) whose answer ncp_nck_pending has yet to give */
+    int ended_answer;
+    char ended_why[256];
+    int trace_said;                  /* the trace's early end was told */
     char mdi[NCP_NCK_TEXT_MAX + 2];
     struct ncp_source mdi_src;
     const struct ncp_source *run_src;

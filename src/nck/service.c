@@ -212,6 +212,7 @@ static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *
 
 static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int32_t client,
                    int32_t seq, int rc, const char *why);
+static void answer_pending(struct serve *sv, struct serve_channel *ch);
 
 /* Why a command cannot act now (NULL: it may): its deadline passed, or it
  * claims more than a command may. local: the panel's, handed over in this
@@ -345,6 +346,8 @@ static void act(struct serve *sv, struct serve_channel *ch, struct client *cl,
     if (c->seq > cl->seq)   /* an E-stop's may be older: it never winds the table back */
         cl->seq = c->seq;
     if (rc == NCP_NCK_CMD_PENDING) {
+        if (ch->pending)   /* a new load ended the check of the one before: its answer first */
+            answer_pending(sv, ch);
         cl->pending = 1;
         ch->pending = 1;
         ch->pending_client = c->client_id;

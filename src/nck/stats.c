@@ -222,18 +222,35 @@ void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints
     fflush(trace);
 }
 
+/* A write cut short (a full disk takes what fits) leaves part of a row:
+ * the file is cut back to the end of the last whole row, which frees the
+ * room it needs. */
+static void trace_cut_to_rows(const struct nck_summary *s, int fd, size_t done)
+{
+    const char *nl = memrchr(s->tbuf, '\n', done);
+    size_t torn = done - (nl ? (size_t)(nl - s->tbuf) + 1 : 0);
+    off_t end = lseek(fd, 0, SEEK_CUR);
+    if (torn == 0 || end < (off_t)torn)
+        return;
+    if (ftruncate(fd, end - (off_t)torn) == 0)
+        (void)lseek(fd, end - (off_t)torn, SEEK_SET);
+}
+
 int nck_trace_flush(struct nck_summary *s, FILE *trace)
 {
     const char *p = s->tbuf;
-    size_t left = s->tlen;
+    const size_t all = s->tlen;
+    size_t left = all;
     s->tlen = 0;
+    if (s->trace_errno)   /* it ended early: no rows after a gap */
+        return -1;
     while (left > 0) {
         ssize_t w = write(fileno(trace), p, left);
         if (w < 0 && errno == EINTR)
             continue;
         if (w <= 0) {
-            if (!s->trace_errno)
-                s->trace_errno = w < 0 ? errno : ENOSPC;
+            s->trace_errno = w < 0 ? errno : ENOSPC;
+            trace_cut_to_rows(s, fileno(trace), all - left);
             return -1;
         }
         p += w;

@@ -188,7 +188,6 @@ static void test_load_in_background(void **state_)
     assert_int_equal(ncp_nck_pending(s.nck, why, sizeof why), NCP_NCK_CMD_PENDING);
     assert_int_equal(cmd_now(&s, NCP_CMD_RUN, NULL, 0, 0, why), -1);
     assert_non_null(strstr(why, "is being checked"));
-    assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), -1);
     assert_int_equal(cmd_now(&s, NCP_CMD_MDI, "G0 X1", 0, 0, why), -1);
     assert_int_equal(cmd_now(&s, NCP_CMD_OVERRIDE, NULL, 50, 0, why), 0);
     ncp_nck_poll(s.nck);
@@ -232,6 +231,109 @@ static void test_load_in_background(void **state_)
     t0 = mono_s();
     stop(&s);
     assert_true(mono_s() - t0 < 0.5);
+}
+
+/* The NCK's own measure of how long a cancelled check took to end, from
+ * its load's refusal: "(ended 0.3 ms after it)". */
+static double ended_ms(const char *why)
+{
+    const char *p = strstr(why, "(ended ");
+    return p ? strtod(p + 7, NULL) : 1e9;
+}
+
+/* A check that never ends (two nested loops of 9 million laps each, or a
+ * program of millions of blocks without loops) is ended by stop, abort,
+ * E-stop, reset or a new load within 100 ms; the load's answer names what
+ * ended it, and the NCK takes a new load at once. */
+static void test_check_ended(void **state_)
+{
+    (void)state_;
+    static const char *const endless =
+        "#1=0\no1 while [#1 lt 9000000]\n#2=0\no2 while [#2 lt 9000000]\n"
+        "#2=[#2+1]\no2 endwhile\n#1=[#1+1]\no1 endwhile\nM2\n";
+    static const struct { int kind; const char *name; } ends[] = {
+        { NCP_CMD_STOP, "stop" }, { NCP_CMD_ABORT, "abort" }, { NCP_CMD_ESTOP, "E-stop" },
+        { NCP_CMD_RESET, "reset" }, { NCP_CMD_LOAD, "a new load" },
+    };
+    struct svc s;
+    char why[256], path[80], small[80];
+    start(&s, 0);
+    home_all(&s);
+    snprintf(path, sizeof path, "/tmp/ncp-svc-endless-%d.ngc", (int)getpid());
+    snprintf(small, sizeof small, "/tmp/ncp-svc-small-%d.ngc", (int)getpid());
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(endless, f);
+    fclose(f);
+    f = fopen(small, "w");
+    assert_non_null(f);
+    fputs("G1 X3 F3000\nM2\n", f);
+    fclose(f);
+    for (size_t k = 0; k < sizeof ends / sizeof ends[0]; k++) {
+        assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, path, 0, 0, why), NCP_NCK_CMD_PENDING);
+        nap_ms(50);
+        assert_int_equal(ncp_nck_pending(s.nck, why, sizeof why), NCP_NCK_CMD_PENDING);
+        double t0 = mono_s();
+        int rc = cmd_now(&s, ends[k].kind, ends[k].kind == NCP_CMD_LOAD ? small : NULL, 0, 0,
+                         why);
+        assert_int_equal(rc, ends[k].kind == NCP_CMD_LOAD ? NCP_NCK_CMD_PENDING : 0);
+        /* the ended load's answer, then (after a new load) the new one's */
+        assert_int_equal(answer(&s, why), -1);
+        double wall = mono_s() - t0;
+        print_message("check ended by %s: %s (%.1f ms wall)\n", ends[k].name, why,
+                      wall * 1e3);
+        assert_non_null(strstr(why, "cancelled by"));
+        assert_non_null(strstr(why, ends[k].name));
+        assert_true(ended_ms(why) < 100);
+        assert_true(wall < 1.0);
+        if (ends[k].kind == NCP_CMD_ESTOP) {
+            wait_state(&s, NCP_ST_ESTOP);
+            assert_int_equal(cmd(&s, NCP_CMD_RESET, NULL, 0, 0, why), 0);
+            wait_state(&s, NCP_ST_IDLE);
+        }
+        /* usable at once: the next load is checked and taken */
+        rc = ends[k].kind == NCP_CMD_LOAD ? answer(&s, why)
+                                          : cmd(&s, NCP_CMD_LOAD, small, 0, 0, why);
+        assert_int_equal(rc, 0);
+    }
+    /* right after a stop, an MDI line is taken without waiting for the
+     * service to collect the ended load's answer */
+    assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, path, 0, 0, why), NCP_NCK_CMD_PENDING);
+    nap_ms(20);
+    assert_int_equal(cmd_now(&s, NCP_CMD_STOP, NULL, 0, 0, why), 0);
+    assert_int_equal(cmd_now(&s, NCP_CMD_MDI, "G0 X1", 0, 0, why), 0);
+    assert_int_equal(ncp_nck_pending(s.nck, why, sizeof why), -1);
+    assert_non_null(strstr(why, "cancelled by stop"));
+    wait_state(&s, NCP_ST_IDLE);
+    stop(&s);
+    unlink(path);
+    unlink(small);
+
+    /* between the blocks of a long program without loops, and at free */
+    for (int by_free = 0; by_free < 2; by_free++) {
+        start(&s, 0);
+        f = fopen(path, "w");
+        assert_non_null(f);
+        for (int i = 0; i < 1000000; i++)
+            fprintf(f, "G1 X%d F1000\n", i % 100);
+        fputs("M2\n", f);
+        fclose(f);
+        assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, path, 0, 0, why), NCP_NCK_CMD_PENDING);
+        nap_ms(30);
+        assert_int_equal(ncp_nck_pending(s.nck, why, sizeof why), NCP_NCK_CMD_PENDING);
+        double t0 = mono_s();
+        if (by_free) {
+            stop(&s);
+            assert_true(mono_s() - t0 < 0.1);
+        } else {
+            assert_int_equal(cmd_now(&s, NCP_CMD_STOP, NULL, 0, 0, why), 0);
+            assert_int_equal(answer(&s, why), -1);
+            assert_non_null(strstr(why, "cancelled by stop"));
+            assert_true(ended_ms(why) < 100);
+            stop(&s);
+        }
+        unlink(path);
+    }
 }
 
 /* The path of a paused and resumed run is the uninterrupted run's. */
@@ -414,6 +516,68 @@ static void test_jogs(void **state_)
     stop(&s);
 }
 
+/* A jog that makes no sense is refused with the reason, never run at the
+ * default speed; a speed above the axis's MAX_VELOCITY jogs at it and
+ * says so. */
+static void test_jog_input(void **state_)
+{
+    (void)state_;
+    struct svc s;
+    start(&s, 0);
+    static const struct { int dir; double speed, dist; const char *why; } bad[] = {
+        { 5, 600, 1, "direction is +1 or -1, not 5" },
+        { 0, 600, 1, "direction" },
+        { -2, 600, 1, "direction" },
+        { 1, -1e308, 1, "speed" },
+        { 1, -1, 0, "speed" },
+        { 1, NAN, 1, "speed" },
+        { 1, INFINITY, 1, "speed" },
+        { 1, 600, -1, "distance" },
+        { 1, 600, NAN, "distance" },
+        { -1, 600, INFINITY, "distance" },
+    };
+    char why[256];
+    struct ncp_nck_cmd c;
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        memset(&c, 0, sizeof c);
+        c.kind = NCP_CMD_JOG;
+        strcpy(c.text, "x");
+        c.ivalue[0] = bad[k].dir;
+        c.value[0] = bad[k].speed;
+        c.value[1] = bad[k].dist;
+        assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), -1);
+        assert_non_null(strstr(why, bad[k].why));
+        ncp_nck_poll(s.nck);
+        assert_int_equal(state(&s), NCP_ST_IDLE);
+    }
+    /* 1e308 mm/min: at MAX_VELOCITY, said in an event */
+    memset(&c, 0, sizeof c);
+    c.kind = NCP_CMD_JOG;
+    strcpy(c.text, "x");
+    c.ivalue[0] = 1;
+    c.value[0] = 1e308;
+    c.value[1] = 50;
+    assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), 0);
+    double vmax = 0;
+    for (int i = 0; i < 60000 && state(&s) != NCP_ST_IDLE; i++) {
+        struct ncp_nck_snapshot st;
+        ncp_nck_poll(s.nck);
+        ncp_nck_get_status(s.nck, &st);
+        vmax = fmax(vmax, st.vel);
+        nap_ms(1);
+    }
+    assert_true(vmax > 0 && vmax <= s.cfg.axis[0].max_vel * 60 * (1 + 1e-9));
+    struct ncp_nck_event ev;
+    int said = 0;
+    while (ncp_nck_next_event(s.nck, &ev))
+        said |= strstr(ev.text, "MAX_VELOCITY") != NULL;
+    assert_true(said);
+    double p[3];
+    pos(&s, p);
+    assert_true(fabs(p[0] - 50) < 1e-9);
+    stop(&s);
+}
+
 static void test_estop_reset(void **state_)
 {
     (void)state_;
@@ -501,10 +665,12 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_load_in_background),
+        cmocka_unit_test(test_check_ended),
         cmocka_unit_test(test_pause_resume_path),
         cmocka_unit_test(test_stop_then_run_again),
         cmocka_unit_test(test_mdi_keeps_modal_state),
         cmocka_unit_test(test_jogs),
+        cmocka_unit_test(test_jog_input),
         cmocka_unit_test(test_estop_reset),
         cmocka_unit_test(test_single_block_and_from_line),
     };
