@@ -45,7 +45,7 @@ struct serve {
     struct ncp_msg *msg;
     struct client *clients;
     size_t n_clients, cap_clients;
-    uint64_t replayed, duplicates, stale, late_estops;
+    uint64_t replayed, duplicates, stale;
     int64_t status_seq, event_seq;
     int fault_seen;
     const struct ncp_nck_serve_hook *hook;   /* another front end, or NULL */
@@ -189,9 +189,9 @@ static void send_ack(struct serve *sv, const ncp_ack_t *a)
         sv->hook->ack(sv->hook->ctx, a);
 }
 
-/* A command for a channel this service does not have: refused, so that a
- * client with a wrong --channel hears why instead of waiting. */
-static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *a)
+/* A refusal that needs no NCK (state -1: none asked), sent and kept as the
+ * client's last ACK. */
+static void refuse(struct serve *sv, const ncp_command_t *c, ncp_ack_t *a, const char *why)
 {
     memset(a, 0, sizeof *a);
     a->utime = utime_now();
@@ -200,14 +200,22 @@ static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *
     a->channel = c->channel;
     a->result = NCP_ACK_T_REJECTED;
     a->state = -1;
+    snprintf((char *)a->reason, sizeof a->reason, "%s", why);
+    send_ack(sv, a);
+}
+
+/* A command for a channel this service does not have: refused, so that a
+ * client with a wrong --channel hears why instead of waiting. */
+static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *a)
+{
     char list[64] = "";
     for (int k = 0, at = 0; k < sv->n_ch && at < (int)sizeof list; k++) {
         int w = snprintf(list + at, sizeof list - (size_t)at, "%s%d", k ? ", " : "", sv->ch[k].num);
         at += w > 0 ? w : 0;
     }
-    snprintf((char *)a->reason, sizeof a->reason, "no NC channel %d here (channels: %s)",
-             c->channel, list);
-    send_ack(sv, a);
+    char why[sizeof a->reason];
+    snprintf(why, sizeof why, "no NC channel %d here (channels: %s)", c->channel, list);
+    refuse(sv, c, a, why);
 }
 
 static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int32_t client,
@@ -241,10 +249,8 @@ static void act(struct serve *sv, struct serve_channel *ch, struct client *cl,
  * often it comes and however late, an authenticated one acts (stopping is
  * never the wrong answer to it), and it is answered. */
 static void on_estop(struct serve *sv, struct serve_channel *ch, struct client *cl,
-                     const ncp_command_t *c, int64_t now_us, int local)
+                     const ncp_command_t *c)
 {
-    if (!local && now_us > c->deadline_utime)
-        sv->late_estops++;
     if (c->seq > cl->seq)
         cl->seq = c->seq;
     if (!ch) {
@@ -261,11 +267,14 @@ static void take_command(struct serve *sv, const ncp_command_t *c, int local)
     struct client *cl = client_of(sv, c->client_id, now_us);
     if (cl == NULL)
         return;   /* out of memory: as if lost; the client resends */
-    int64_t until = local ? now_us + FRESH_MAX_US : c->deadline_utime;
+    /* kept while its latest command could be fresh; a deadline further
+     * out is refused below and keeps it no longer than any other */
+    int64_t longest = now_us + FRESH_MAX_US + CLOCK_AHEAD_MAX_US;
+    int64_t until = local || c->deadline_utime > longest ? longest : c->deadline_utime;
     if (until > cl->keep_until_us)
         cl->keep_until_us = until;
     if (c->kind == NCP_CMD_ESTOP) {
-        on_estop(sv, ch, cl, c, now_us, local);
+        on_estop(sv, ch, cl, c);
         return;
     }
     /* the panel's keep-alives carry no sequence number: it hands them over
@@ -285,18 +294,8 @@ static void take_command(struct serve *sv, const ncp_command_t *c, int local)
     if (!local && unfresh(c, now_us, why, sizeof why)) {
         sv->stale++;
         cl->seq = c->seq;
-        if (c->kind != NCP_CMD_KEEPALIVE) {
-            ncp_ack_t *a = &cl->ack;
-            memset(a, 0, sizeof *a);
-            a->utime = now_us;
-            a->client_id = c->client_id;
-            a->seq = c->seq;
-            a->channel = c->channel;
-            a->result = NCP_ACK_T_REJECTED;
-            a->state = -1;
-            snprintf((char *)a->reason, sizeof a->reason, "%s", why);
-            send_ack(sv, a);
-        }
+        if (c->kind != NCP_CMD_KEEPALIVE)
+            refuse(sv, c, &cl->ack, why);
         return;
     }
     if (c->kind == NCP_CMD_KEEPALIVE) {
