@@ -120,6 +120,7 @@ $(BUILD)/src/cli/cnc_run.o $(BUILD)/src/ctl/cnc_ctl.o $(BUILD)/src/axis/cnc_axis
 FUZZ_TARGETS = pipeline http command
 FUZZ_SEEDS_pipeline = ncprograms/*.ngc tests/bad/*.ngc
 FUZZ_SEEDS_http = tests/fuzz/seeds-http/*
+FUZZ_SEEDS_command = tests/fuzz/seeds-command/*
 
 # Each fuzz target as a plain program (tests/fuzz/replay.c): `make` compiles and
 # links them, so an API change that breaks one stops the build, not `make fuzz`
