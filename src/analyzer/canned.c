@@ -111,7 +111,7 @@ static void ncp_cyc_body(struct ncp_cyc *c, int motion, double x, double y, doub
         /* tapping, right hand (G84) or left hand (G74): overrides off, the
          * spindle reversed to come out, then turned back and restored. In
          * G18/G19 at the hole, where rs274 2.9 feeds to the plane's
-         * coordinates taken as X Y Z (README: deliberate differences). */
+         * coordinates taken as X Y Z (docs/differences-from-rs274.md). */
         enum ncp_canon_kind in = motion == 840 ? NCP_C_START_SPINDLE_CLOCKWISE
                                                : NCP_C_START_SPINDLE_COUNTERCLOCKWISE;
         enum ncp_canon_kind out = motion == 840 ? NCP_C_START_SPINDLE_COUNTERCLOCKWISE

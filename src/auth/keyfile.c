@@ -89,7 +89,7 @@ static int create_key(const char *path, struct ncp_diag *d)
                -1;
     }
     close(fd);
-    fprintf(stderr, "ncpar: created key file %s (give it to every client, see README)\n", path);
+    fprintf(stderr, "ncpar: created key file %s (give it to every client, see docs/security.md)\n", path);
     return 0;
 }
 
@@ -134,8 +134,8 @@ int ncp_auth_load_key(const char *path, int create, uint8_t key[NCP_AUTH_KEY_BYT
         fd = open(path, O_RDONLY | O_CLOEXEC);   /* a symlink is fine; its target is judged */
     if (fd < 0)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
-                            "cannot read key file %s: %s (the NCK's key: see README, "
-                            "\"Who may command the machine\")",
+                            "cannot read key file %s: %s (the NCK's key: see "
+                            "docs/security.md)",
                             path, strerror(errno)),
                -1;
     struct stat st;

@@ -102,7 +102,7 @@ static void usage(FILE *f)
           "                      The trace's actual positions are then the drives' TPDOs,\n"
           "                      one servo period old\n"
           "  --backend lcm       the distributed NCK: one `cnc-axis` per axis of the INI\n"
-          "                      over LCM (README \"Distributed mode\"); real clock only.\n"
+          "                      over LCM (docs/distributed.md); real clock only.\n"
           "                      An axis lost (no status for [LCM] MAX_LOST_PERIODS, no\n"
           "                      heartbeat) stops the others: exit 3\n"
           "  --dp N              distribution point 1..5 (default: the INI's [LCM] DP, 5);\n"

@@ -138,7 +138,7 @@ int ctl_open(struct ctl *c, const char *url, const char *prefix, const char *key
     c->client_id = random_client_id();
     c->lcm = lcm_create(url);
     if (c->lcm == NULL) {
-        fprintf(stderr, "cnc-ctl: cannot open LCM at %s (see README: LCM and multicast)\n",
+        fprintf(stderr, "cnc-ctl: cannot open LCM at %s (see docs/operator.md: LCM and multicast)\n",
                 url ? url : "the default URL");
         return CTL_USAGE;
     }
@@ -166,7 +166,7 @@ static int publish(struct ctl *c, const ncp_command_t *cmd)
     if (n >= 0)
         n = (int)ncp_auth_seal(c->auth, c->ch_cmd, buf, (size_t)n, 0, ncp_auth_now_ns());
     if (n < 0 || lcm_publish(c->lcm, c->ch_cmd, buf, (unsigned)n) != 0) {
-        fprintf(stderr, "cnc-ctl: cannot send on %s (see README: LCM and multicast)\n",
+        fprintf(stderr, "cnc-ctl: cannot send on %s (see docs/operator.md: LCM and multicast)\n",
                 c->ch_cmd);
         return -1;
     }
@@ -201,7 +201,7 @@ int ctl_handle(struct ctl *c, double seconds)
     int r = lcm_handle_timeout(c->lcm, ms);
     if (r < 0 && errno != EINTR) {
         fprintf(stderr, "cnc-ctl: cannot receive LCM messages (is there a multicast route? "
-                        "see README: LCM and multicast)\n");
+                        "see docs/operator.md: LCM and multicast)\n");
         return -1;
     }
     return 0;

@@ -116,7 +116,7 @@ static int open_socket(struct ncp_msg *m, const struct ncp_msg_url *u, const cha
     if (setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) < 0)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
                             "cannot join multicast group %s on port %u%s%s: %s (is there a "
-                            "multicast route? see README)",
+                            "multicast route? see docs/operator.md: LCM and multicast)",
                             u->group, u->port, ifindex ? " on " : "", ifindex ? ifname : "",
                             strerror(errno));
     if (ifindex && (setsockopt(fd, IPPROTO_IP, IP_MULTICAST_IF, &mreq, sizeof mreq) < 0 ||

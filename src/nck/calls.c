@@ -1,7 +1,7 @@
 /* How the NCK takes each canonical call: as motion, as state of the canon
  * map, as a machine function (aux.c), as text for the operator, or refused
  * before anything moves. Nothing the interpreter says is dropped silently:
- * README.md's table of calls is this file in prose. */
+ * docs/operator.md's table of calls is this file in prose. */
 #include "nck_int.h"
 
 #include <string.h>
