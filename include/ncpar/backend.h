@@ -18,10 +18,32 @@ struct ncp_sim_axis {
 };
 
 /* Each axis: G(s) = K / (s (s + p)), K = 250, p = 25 (seed 003), discretised
- * exactly with a zero-order hold over the servo period. */
+ * exactly with a zero-order hold over the servo period.
+ *
+ * The drive saturates as a servo amplifier does, whatever the gains: its
+ * current limit caps the acceleration K u - p v at a_peak, its speed limit
+ * the velocity at v_peak. With u constant the acceleration only decays and
+ * the velocity moves monotonically towards K u / p, so a u checked where it
+ * starts to act (the acceleration) and where it stops (the velocity) keeps
+ * both within their caps all the time it acts: the axis never moves more
+ * than v_peak T in a period, and a loop that cannot follow is stopped by the
+ * following-error check, not thrown across the table.
+ *
+ * The caps are NCP_SIM_PEAK times the joint's MAX_VELOCITY and
+ * MAX_ACCELERATION (ncpar.ini(5) states the factor: src/motion/ini_keys.c).
+ * Three, as an AC servo's peak torque is about three times its rated one;
+ * and far enough above the limits that a run within them stays linear, as
+ * Wan et al.'s plant is ("Performance analysis model for real-time
+ * Ethernet-based CNC system"): a planned profile with feed-forward asks up
+ * to 1.2 times the limits, their 1000 mm circle without feed-forward under
+ * a burst of missed periods 2.2 times its acceleration. Only FF2 on a missed
+ * or lost setpoint asks for a hundredfold acceleration for a period, which
+ * no drive gives. */
+#define NCP_SIM_PEAK 3.0
 struct ncp_sim {
     double T, K, p, E;   /* E = exp(-p T) */
     double kp, ki, kd, ff1, ff2;
+    double v_peak[NCP_AXES], a_peak[NCP_AXES];  /* mm/s, mm/s^2 (deg for A B C) */
     int disabled;        /* drives off (E-stop): no controller output */
     struct ncp_sim_axis ax[NCP_AXES];
 };

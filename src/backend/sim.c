@@ -7,6 +7,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "sim_drive.h"
+
 void ncp_sim_init(struct ncp_sim *s, const struct ncp_machine_cfg *cfg,
                   const double start[NCP_AXES])
 {
@@ -20,8 +22,12 @@ void ncp_sim_init(struct ncp_sim *s, const struct ncp_machine_cfg *cfg,
     s->kd = cfg->kd;
     s->ff1 = cfg->ff1;
     s->ff2 = cfg->ff2;
-    for (int i = 0; i < NCP_AXES; i++)
+    for (int i = 0; i < NCP_AXES; i++) {
+        const struct ncp_joint_cfg *j = &cfg->joint[i];
+        s->v_peak[i] = j->max_vel > 0 ? NCP_SIM_PEAK * j->max_vel : INFINITY;
+        s->a_peak[i] = j->max_acc > 0 ? NCP_SIM_PEAK * j->max_acc : INFINITY;
         s->ax[i].x = start ? start[i] : 0;
+    }
 }
 
 /* x' = v, v' = -p v + K u with u constant over T */
@@ -56,6 +62,6 @@ void ncp_sim_step(struct ncp_sim *s, const double cmd[NCP_AXES], const double ne
                    s->ff1 * vff + s->ff2 * aff;
         a->e_prev = e;
         a->vff_prev = vff;
-        plant(s, a, u);
+        plant(s, a, ncp_sim_drive(s, i, u, a->v, s->E));
     }
 }

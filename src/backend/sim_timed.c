@@ -8,6 +8,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "sim_drive.h"
+
 /* x' = v, v' = -p v + K u, u constant over dt (ZOH, exact) */
 static void evolve(const struct ncp_sim *s, double *x, double *v, double u, double dt)
 {
@@ -80,9 +82,15 @@ void ncp_sim_step_timed(struct ncp_sim *s, struct ncp_sim_timed *tm,
             a->e_prev = e;
             a->vff_prev = vff;
         }
-        *h = (struct ncp_sim_period){ a->x, a->v, u0, ta, u };
+        double x0 = a->x, v0 = a->v;
         evolve(s, &a->x, &a->v, u0, ta);
+        /* the drive saturates against the speed it meets when u takes over
+         * (off, it gives no torque at all); u acts until the next period's
+         * output does, at most a period from now */
+        if (!s->disabled)
+            u = ncp_sim_drive(s, i, u, a->v, exp(-s->p * (2.0 * s->T - ta)));
         evolve(s, &a->x, &a->v, u, s->T - ta);
+        *h = (struct ncp_sim_period){ x0, v0, u0, ta, u };
         tm->u_prev[i] = u;
     }
     tm->k++;

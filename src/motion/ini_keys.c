@@ -28,7 +28,10 @@ const struct ncp_ini_section ncp_ini_sections[] = {
     { "PLANNER", "Look-ahead and acceleration profile." },
     { "RT", "The real-time threads (the thread map of the NCK) and the policy for a late or "
             "lost position-loop period." },
-    { "SIM", "The simulated machine: its servo, switches, probe workpiece and inputs." },
+    { "SIM", "The simulated machine: its servo, switches, probe workpiece and inputs. "
+             "The servo's drive saturates as an amplifier does, at 3 times each joint's "
+             "MAX_VELOCITY and MAX_ACCELERATION, so any gain in range is safe: a loop "
+             "that cannot follow is stopped by FERROR." },
     { "SPINDLE_0", "The simulated spindle." },
     { "EMCIO", "The tool changer (LinuxCNC's keys)." },
     { "CAN", "The socketcan backend: CiA 402 drives on a CAN interface." },

@@ -156,18 +156,90 @@ static void test_sim_steady_following(void **state)
         vel = nv;
     }
     assert_true(worst < 0.01);
-    /* and 1 m/s as well */
+    /* and 1 m/s as well, on an axis made for that speed and ramped within
+     * its acceleration, as the planner would (the drive saturates at a
+     * multiple of the axis's limits, so a step to 1 m/s is no steady line) */
+    cfg.axis[0].max_vel = 1000.0;
+    ncp_machine_joints_from_axes(&cfg);
     ncp_sim_init(&s, &cfg, zero);
     x = 0;
+    vel = 0;
     worst = 0;
     for (int k = 0; k < 3000; k++) {
-        double cmd[NCP_AXES] = { x, 0, 0 }, next[NCP_AXES] = { x + 1000 * T, 0, 0 };
+        double cmd[NCP_AXES] = { x, 0, 0 };
+        double nv = fmin(1000.0, vel + 2000 * T);
+        double nx = x + 0.5 * (vel + nv) * T;
+        double next[NCP_AXES] = { nx, 0, 0 };
         ncp_sim_step(&s, cmd, next, act);
         if (k > 1000)
             worst = fmax(worst, fabs(cmd[0] - act[0]));
-        x += 1000 * T;
+        x = nx;
+        vel = nv;
     }
     assert_true(worst < 0.01);
+}
+
+/* The worst of a period's travel over v_peak T, the speed over v_peak and a
+ * period's change of speed over a_peak T, on X and Y, along a planned ramp
+ * (X out, Y back) that a setpoint jump interrupts at period 300, as a lost
+ * or late setpoint does; timed: under io latency and late sampling. */
+static double drive_worst(const struct ncp_machine_cfg *cfg, int timed, double jump)
+{
+    struct ncp_sim s;
+    static struct ncp_sim_timed tm;
+    memset(&tm, 0, sizeof tm);
+    double zero[NCP_AXES] = { 0 }, act[NCP_AXES], T = cfg->servo_period;
+    ncp_sim_init(&s, cfg, zero);
+    const struct ncp_inject_ev ev = { .sample_s = 0.2 * T, .io_s = 0.3 * T };
+    double x = 0, vel = 0, worst = 0;
+    for (int k = 0; k < 600; k++) {
+        double nv = fmin(1000.0 / 60.0, vel + 400 * T);
+        double nx = x + 0.5 * (vel + nv) * T + (k == 300 ? jump : 0.0);
+        double cmd[NCP_AXES] = { x, -x, 0 }, next[NCP_AXES] = { nx, -nx, 0 };
+        struct ncp_sim_axis was[2] = { s.ax[0], s.ax[1] };
+        if (timed)
+            ncp_sim_step_timed(&s, &tm, &ev, cmd, next, act);
+        else
+            ncp_sim_step(&s, cmd, next, act);
+        for (int i = 0; i < 2; i++) {
+            double vp = NCP_SIM_PEAK * cfg->joint[i].max_vel;
+            double ap = NCP_SIM_PEAK * cfg->joint[i].max_acc;
+            worst = fmax(worst, fabs(s.ax[i].x - was[i].x) / (vp * T));
+            worst = fmax(worst, fabs(s.ax[i].v) / vp);
+            worst = fmax(worst, fabs(s.ax[i].v - was[i].v) / (ap * T));
+        }
+        x = nx;
+        vel = nv;
+    }
+    return worst;
+}
+
+/* Every gain in its documented range ([SIM] KP .. FF2 up to 1e9) leaves the
+ * axis within what its saturating drive can do in each period: KP = 1e9 once
+ * threw it 30 mm in a period on a 1 um error. */
+static void test_sim_drive_saturates(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    ncp_machine_cfg_default(&cfg);
+    cfg.axis[1].max_vel = 50.0;     /* the joints' own limits, not one for all */
+    cfg.axis[1].max_acc = 500.0;
+    ncp_machine_joints_from_axes(&cfg);
+    /* the shipped gains on a planned path stay far from the peak */
+    assert_true(drive_worst(&cfg, 0, 0.0) < 1.5 / NCP_SIM_PEAK);
+    assert_true(drive_worst(&cfg, 1, 0.0) < 1.5 / NCP_SIM_PEAK);
+    for (int g = 0; g < 5; g++) {
+        struct ncp_machine_cfg c = cfg;
+        double *gain[5] = { &c.kp, &c.ki, &c.kd, &c.ff1, &c.ff2 };
+        *gain[g] = 1e9;
+        for (int timed = 0; timed < 2; timed++) {
+            double w = drive_worst(&c, timed, 5.0);
+            if (!(w <= 1.0 + 1e-9))
+                print_error("gain %d = 1e9, %s step: %.3g times the drive's peak\n", g,
+                            timed ? "timed" : "plain", w);
+            assert_true(w <= 1.0 + 1e-9);
+        }
+    }
 }
 
 /* ---- underrun: slow down along the path and resume ------------------------------ */
@@ -522,6 +594,7 @@ int main(void)
         cmocka_unit_test(test_loop_virtual),
         cmocka_unit_test(test_loop_real),
         cmocka_unit_test(test_sim_steady_following),
+        cmocka_unit_test(test_sim_drive_saturates),
         cmocka_unit_test(test_scaler_slows_along_path),
         cmocka_unit_test(test_run_long_line_time),
         cmocka_unit_test(test_run_arc_radius_in_trace),
