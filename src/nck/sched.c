@@ -45,13 +45,6 @@ static int applies(const struct nck *n)
     return n->cfg->sched.strategy != NCP_SCHED_NONE && !n->setup.virtual_clock;
 }
 
-int64_t nck_mono_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
-}
-
 /* Static: by distance from the position loop along the whole chain, the
  * planner just below the loop. */
 static int static_prio(const struct nck *n, int rank)
