@@ -5,8 +5,8 @@
  *
  * Context: any thread, real-time path included (clock_gettime through the
  * vDSO: no allocation, no blocking, no system call on x86-64 and arm64).
- * Header-only, so the tools that link no ncpar library (cnc-ctl,
- * cnc-drive-sim) read the same clock. */
+ * Header-only, so cnc-drive-sim, which links only libncpar-can.a, reads
+ * the same clock. */
 #ifndef NCPAR_CLOCK_H
 #define NCPAR_CLOCK_H
 

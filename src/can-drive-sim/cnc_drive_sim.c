@@ -11,6 +11,7 @@
 #include "drive.h"
 #include "ncp_version.h"
 #include "ncpar/clock.h"
+#include "ncpar/num.h"
 
 static volatile sig_atomic_t stop;
 
@@ -49,14 +50,13 @@ static void usage(FILE *f)
 
 static long num(const char *s, const char *opt, long lo, long hi)
 {
-    char *end;
-    long v = strtol(s, &end, 0);
-    if (*s == '\0' || *end != '\0' || v < lo || v > hi) {
-        fprintf(stderr, "cnc-drive-sim: %s wants a number in %ld..%ld, not '%s'\n", opt, lo,
-                hi, s);
-        exit(1);
-    }
-    return v;
+    char why[160];
+    long v;
+    if (ncp_num_long(s, 0, lo, hi, &v) == 0)
+        return v;
+    ncp_num_why(why, sizeof why, opt, s, (double)lo, (double)hi);
+    fprintf(stderr, "cnc-drive-sim: %s\n", why);
+    exit(1);
 }
 
 static const char *parse(int argc, char **argv, struct drive_opts *o)
