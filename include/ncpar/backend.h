@@ -17,7 +17,7 @@ struct ncp_sim_axis {
     double vff_prev;     /* feed-forward velocity of the previous cycle */
 };
 
-/* Each axis: G(s) = K / (s (s + p)), K = 250, p = 25 (seed 003), discretised
+/* Each axis: G(s) = K / (s (s + p)), K = 250, p = 25 (the timing-faults paper), discretised
  * exactly with a zero-order hold over the servo period. */
 struct ncp_sim {
     double T, K, p, E;   /* E = exp(-p T) */

@@ -1,5 +1,5 @@
 /* cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]: one low-level
- * axis controller of the distributed NCK (seed 002). It advertises its axis,
+ * axis controller of the distributed NCK (the distributed-NCK paper). It advertises its axis,
  * waits for the HLC (cnc-run run --backend lcm), then runs the axis's
  * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5), or
  * interpolating the records the HLC's planner starts (ADCBI DP4; DP3 after

@@ -1,4 +1,4 @@
-/* [SCHED] for one NCK: the soft-RT tasks of seed 000's chain (the
+/* [SCHED] for one NCK: the soft-RT tasks of the task-scheduling paper's chain (the
  * interpreter pipeline's threads, the job thread that hands its commands on,
  * the planner), their priorities below the position loop, and what they ran
  * at for the summary. The position loop itself is never touched. */
