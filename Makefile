@@ -5,8 +5,10 @@ BUILD    ?= build
 CC       ?= gcc
 CXX      ?= g++
 # Link-time optimisation: the ring and stage calls the pipeline makes per
-# block cross files (ring.c, stages.c, lex, analyzer); inlined they cost the
-# analyzer thread about 8 % less on the 1M-block benchmark.
+# block cross files (ring.c, stages.c, lex, analyzer), and only LTO inlines
+# them into the analyzer thread's loop. Measure what it buys with
+# `make bench-parse` built with and without it (bench/RESULTS.md,
+# "Interpreter throughput", records the machine and date of a run).
 CFLAGS   ?= -O2 -g -flto=auto
 CXXFLAGS ?= -O2 -g -flto=auto
 # gcc-ar: an archive of LTO objects needs the linker plugin's symbol index
@@ -19,9 +21,10 @@ ALL_CXXFLAGS = -std=c++17 $(WARN) $(CXXFLAGS) -pthread -fno-exceptions -fno-rtti
 # libcrypto: the MAC on every LCM message (src/auth); -ldl for its static archive
 LDLIBS   += -lm -linih -lcrypto -ldl -pthread
 # cnc-run itself is linked statically: the dynamic loader's mapping and
-# relocating of libstdc++, libm and libc cost every start ~1.7 ms here (a
-# shadow-paging fault for each page it touches), 2-4 ms of a 1M-block run
-# (bench/RESULTS.md). Sanitizer builds cannot be static; `make CLI_LDFLAGS=`
+# relocating of libstdc++, libm and libc is paid at every start (a page fault
+# for each page it touches, dearer still under shadow paging in a VM), which
+# short programs and the start-up floor of bench/RESULTS.md ("Against
+# LinuxCNC") feel most. Sanitizer builds cannot be static; `make CLI_LDFLAGS=`
 # links it dynamically.
 CLI_LDFLAGS ?= -static
 

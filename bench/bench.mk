@@ -1,8 +1,9 @@
 # `make bench`: the benchmark suite of bench/ (not part of `make test`). It
-# reproduces seed 001's Table 3, compares with LinuxCNC's rs274 and measures the
-# position loop's latency beside cyclictest, runs seed 003's circle under timing
-# faults (bench/seed003), measures the distributed NCK's messages and accuracy
-# (bench/dist, seed 002's Tables I-IV) and seed 000's task chain under both
+# reproduces the interpreter-pipeline paper's Table 3, compares with LinuxCNC's
+# rs274 and measures the position loop's latency beside cyclictest, runs the
+# timing-faults paper's circle under timing faults (bench/seed003), measures the
+# distributed NCK's messages and accuracy (bench/dist, the distributed-NCK
+# paper's Tables I-IV) and the task-scheduling paper's task chain under both
 # scheduling strategies (bench/seed000), then rewrites its sections of
 # bench/RESULTS.md and the PNGs in bench/. RUNS, RUNS_BIG, LAT_SECONDS, ... scale it down (bench/run-bench).
 .PHONY: bench

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """bench.py OUTDIR: the measurements of `make bench`, into OUTDIR/data.json.
 
-1. Table 3 of seed 001: every configuration (serial, DETn, ATTn; n = 2, 4, 8;
+1. Table 3 of the interpreter-pipeline paper: every configuration (serial, DETn, ATTn; n = 2, 4, 8;
    normal and SCHED_FIFO 90) RUNS times on part998 and RUNS_BIG times on the
    1M-block program (build/bench/table3: many runs in one process), the runs of
    each configuration split into rounds that visit every configuration.

@@ -324,7 +324,7 @@ def head_section(data):
 def table3_section(data, run_dir):
     F = data["facts"]
     bigname = os.path.basename(data["programs"]["big"])
-    L = ["## Table 3 of seed 001: serial, DETn, ATTn (`make bench`)", "",
+    L = ["## Table 3 of the interpreter-pipeline paper: serial, DETn, ATTn (`make bench`)", "",
          "**Measures** the paper's Table 3 on our interpreter: the time from the start of a",
          "run (thread creation included) to the last canonical command out, for the serial",
          "reference and each thread map, on part998.ngc (996 blocks) and on %s;" % bigname,

@@ -1,16 +1,16 @@
-/* Seed 000's six-task load (its Table 1) under the static or the data-flow
+/* The task-scheduling paper's six-task load (its Table 1) under the static or the data-flow
  * strategy of src/sched/, on 1..4 channels at once.
  *
- * Each channel is the seed's chain: receive -> B1 -> interpret -> B2 ->
+ * Each channel is the paper's chain: receive -> B1 -> interpret -> B2 ->
  * discrete -> B3 -> look-ahead -> B4 -> fine interpolation -> B5 -> position
- * control, with ncp_spsc rings. Our own tasks are far faster than the seed's,
+ * control, with ncp_spsc rings. Our own tasks are far faster than the paper's,
  * so each task only emulates its cost: per item it burns its execution time
  * of CPU (thread CPU time, so a preempted task still costs what it should),
  * times --scale, then passes one item on. The soft-RT tasks are released
- * every cycle (the seed's 5 ms, unscaled: the data rate stays the seed's),
+ * every cycle (the paper's 5 ms, unscaled: the data rate stays the paper's),
  * receive is aperiodic; position control runs every --period ms on an
  * absolute schedule at SCHED_FIFO 90 and counts an underrun when B5 is empty
- * (after its first item). Jitter is the seed's: max - min of the actual cycle.
+ * (after its first item). Jitter is the paper's: max - min of the actual cycle.
  *
  * usage: sched-load --strategy static|dataflow --period MS --channels N
  *        [--seconds S] [--scale X] [--cpu C] [--cap N] [--fill CSV]
@@ -89,7 +89,7 @@ static void nap_us(long us)
     sleep_until(ns_of(CLOCK_MONOTONIC) + us * 1000);
 }
 
-/* The seed's execution time, as CPU time of this thread. */
+/* The paper's execution time, as CPU time of this thread. */
 static void burn(int64_t ns)
 {
     int64_t end = ns_of(CLOCK_THREAD_CPUTIME_ID) + ns;

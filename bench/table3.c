@@ -1,5 +1,5 @@
 /* table3: runs one interpreter configuration RUNS times in one process, for the
- * Table 3 reproduction (seed 001) in `make bench`.
+ * Table 3 reproduction (the interpreter-pipeline paper) in `make bench`.
  *
  *   table3 PROG MAP.ini RUNS [--tool-table FILE] [--warmup N] [--max-seconds S]
  *

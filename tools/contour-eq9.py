@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Contour error of a circle from a cnc-run trace, as seed 003's Eq. (9) takes
+"""Contour error of a circle from a cnc-run trace, as the timing-faults paper's Eq. (9) takes
 it beside ncpar's own.
 
 Eq. (9): C is the midpoint of two successive actual positions A and B, D the

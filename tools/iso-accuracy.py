@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Accuracy figures of a run from its trace, as seed 002's Tables III-IV take them:
+"""Accuracy figures of a run from its trace, as the distributed-NCK paper's Tables III-IV take them:
 ISO 230-6 diagonal positioning (the ISO 230-2 statistics along a diagonal) and
 ISO 10791-7 contour features, from the feedback signal (the trace's actual
 positions), which ISO 230-4 Annex D permits in place of an interferometer.
@@ -17,7 +17,7 @@ positions), which ISO 230-4 Annex D permits in place of an interferometer.
     it moves along it.
   contour: ncprograms/iso10791-7-contour.ngc. A comment "(feature line NAME)"
     or "(feature circle NAME)" on a program line names the feature its samples
-    (trace column `line`) belong to. Lines: straightness as seed 002 measures
+    (trace column `line`) belong to. Lines: straightness as the distributed-NCK paper measures
     it (largest distances on both sides of the straight line through the
     feature's first and last actual sample, added) and angularity (the width
     of the band at the programmed angle that holds every sample). Circles:

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seed 003's loop as its listings describe it, outside ncpar, one ingredient
+"""The timing-faults paper's loop as its listings describe it, outside ncpar, one ingredient
 switched at a time, to show which of them sets the contour error it reports
 (Table 5: 2.93 mm without misses, 11.05 mm with one miss in 500 periods).
 

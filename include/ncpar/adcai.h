@@ -1,4 +1,4 @@
-/* ADCAI: the NCK variant with acc/dec after interpolation (seed 002, Fig. 3).
+/* ADCAI: the NCK variant with acc/dec after interpolation (the distributed-NCK paper, Fig. 3).
  *
  *   segments -> rough interpolator -> [roughIPObuf] -> per-axis ACC/DEC
  *            -> [ACCDECbuf] -> fine interpolator -> [fineIPObuf] -> position control

@@ -17,7 +17,7 @@ struct ncp_sim_axis {
     double vff_prev;     /* feed-forward velocity of the previous cycle */
 };
 
-/* Each axis: G(s) = K / (s (s + p)), K = 250, p = 25 (seed 003), discretised
+/* Each axis: G(s) = K / (s (s + p)), K = 250, p = 25 (the timing-faults paper), discretised
  * exactly with a zero-order hold over the servo period.
  *
  * The drive saturates as a servo amplifier does, whatever the gains: its
@@ -140,7 +140,10 @@ int ncp_backend_open(struct ncp_backend *b, const struct ncp_machine_cfg *cfg, F
 int ncp_backend_open_sim(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d);
 /* cnc-axis LLCs over LCM ([LCM] URL, DP, heartbeat and injection keys; the
- * distributed mode, ncpar/dist.h). Only DP 5 so far: others are refused. */
+ * distributed mode, ncpar/dist.h). [PLANNER] NCK = adcbi takes DP 1-5 and
+ * adcai DP 1-4; another DP is refused here, as is a block-level ADCBI point
+ * (DP 2-4) whose PLANNING_PERIOD differs from SERVO_PERIOD. Not real-time:
+ * it allocates and opens the LCM transport. */
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d);
 int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,

@@ -1,4 +1,4 @@
-/* The distributed NCK (seed 002): what the HLC (cnc-run run --backend lcm)
+/* The distributed NCK (the distributed-NCK paper): what the HLC (cnc-run run --backend lcm)
  * and its LLCs (cnc-axis) share: channel names, the setpoint message without
  * allocation, and the LLC's receive buffer with its loss accounting.
  *

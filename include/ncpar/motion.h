@@ -33,7 +33,7 @@ static inline int ncp_axis_rotary(int i) { return i >= 3 && i < 6; }
 
 enum ncp_profile { NCP_PROFILE_TRAPEZOID, NCP_PROFILE_SCURVE };
 
-/* [PLANNER] NCK (seed 002): ADCBI plans acc/dec on the path with look-ahead
+/* [PLANNER] NCK (the distributed-NCK paper): ADCBI plans acc/dec on the path with look-ahead
  * before interpolating (src/motion/planner.c); ADCAI interpolates at the
  * programmed feed and filters each axis afterwards (ncpar/adcai.h). */
 enum ncp_nck_variant { NCP_NCK_ADCBI, NCP_NCK_ADCAI };
@@ -172,7 +172,8 @@ struct ncp_machine_cfg {
         int status_needs_key;     /* STATUS_NEEDS_KEY: status and events encrypted (0) */
         int max_age_ms;           /* MAX_AGE_MS: the distributed NCK's messages
                                      sealed longer ago are dropped (2000) */
-        /* the distributed mode (cnc-run run --backend lcm, cnc-axis; seed 002) */
+        /* the distributed mode (cnc-run run --backend lcm, cnc-axis) of the
+           distributed-NCK paper */
         int dp;                   /* DP: distribution point 1..5 (5) */
         /* DP 1: the program and what it needs, absolute (not from the INI:
          * cnc-run run's PROG, --tool-table, --sub-path) */
@@ -491,7 +492,7 @@ double ncp_trap_eval(const struct ncp_trap *tp, double t, double *v);
 
 /* ---- the interpolator on its own (exec.c) ---------------------------------
  * One segment as the interpolator runs it, its profile frozen when it starts:
- * seed 002's ACCDECbuf record of the ADCBI NCK. The planner hands these to its
+ * the distributed-NCK paper's ACCDECbuf record of the ADCBI NCK. The planner hands these to its
  * own interpolator; an LLC at ADCBI's DP4 receives them and runs the same
  * code, so its samples equal the central run's. */
 struct ncp_accdec {
@@ -530,7 +531,7 @@ int ncp_exec_step(struct ncp_exec *e, const struct ncp_exec_source *src,
                   struct ncp_setpoint *out);
 
 /* The look-ahead's word on one segment as its profile is about to be frozen:
- * seed 002's LAbuf of the ADCBI NCK. Beside the block, the limits the look-
+ * the distributed-NCK paper's LAbuf of the ADCBI NCK. Beside the block, the limits the look-
  * ahead gave it (cruise cap, path acceleration before and after a corner took
  * its share, jerk, an arc's acceleration bound, curvature and cap) and the end
  * speed it allows (the next segment's entry speed; 0 before a stop). */

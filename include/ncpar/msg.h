@@ -82,7 +82,7 @@ void ncp_msg_get_stats(const struct ncp_msg *m, struct ncp_msg_stats *st);
  * ncp_msg_poll with timeout 0). */
 int ncp_msg_fd(const struct ncp_msg *m);
 
-/* ---- any channel (the distributed mode, seed 002) ------------------------
+/* ---- any channel (the distributed mode, the distributed-NCK paper) ------------------------
  * Several channels on one socket; encoded payloads in and out. What comes in
  * may be lost or delayed on purpose ([LCM] INJECT_*): on the receiving side,
  * so each receiver has its own losses and counts them. Nothing here blocks:

@@ -65,7 +65,7 @@ int ncp_cpus_usable(void);
 /* Load an INI thread map; fills d (file:line) on error. */
 int ncp_thread_map_load(struct ncp_thread_map *m, const char *path, struct ncp_diag *d);
 
-/* The pipeline's threads as tasks of seed 000's chain, for a scheduler that
+/* The pipeline's threads as tasks of the task-scheduling paper's chain, for a scheduler that
  * ranks them (the NCK's [SCHED]): each thread is announced on itself as it
  * starts a run and again as it ends it, with what it is and a handle to read
  * its rings' fill without locks while it runs. */

@@ -1,4 +1,4 @@
-/* Priorities of the NCK's soft-real-time tasks (seed 000): the interpreter
+/* Priorities of the NCK's soft-real-time tasks (the task-scheduling paper): the interpreter
  * pipeline's threads, the job thread and the planner (look-ahead, acc/dec,
  * rough interpolation), each fed by a ring, all below the position loop.
  *

@@ -53,7 +53,7 @@ static void ncp_cyc_peck(struct ncp_cyc *c, int motion, double x, double y, doub
     double d = r - delta;
     while (d > bottom) {
         FEED(c, x, y, d);
-        if (motion == 830)
+        if (motion == NCP_G83)
             TRAV(c, x, y, r);
         TRAV(c, x, y, d + clr);
         d -= delta;
@@ -99,22 +99,22 @@ static void ncp_cyc_body(struct ncp_cyc *c, int motion, double x, double y, doub
                          double clear, double bottom, double p, double q)
 {
     switch (motion) {
-    case 860:
+    case NCP_G86:
         FEED(c, x, y, bottom);
         ncp_cyc_dwell(c, p);
         ncp_an_emit(c->a, NCP_C_STOP_SPINDLE_TURNING);
         TRAV(c, x, y, clear);
         ncp_cyc_spindle_on(c);
         break;
-    case 840:
-    case 740: {
+    case NCP_G84:
+    case NCP_G74: {
         /* tapping, right hand (G84) or left hand (G74): overrides off, the
          * spindle reversed to come out, then turned back and restored. In
          * G18/G19 at the hole, where rs274 2.9 feeds to the plane's
          * coordinates taken as X Y Z (docs/differences-from-rs274.md). */
-        enum ncp_canon_kind in = motion == 840 ? NCP_C_START_SPINDLE_CLOCKWISE
+        enum ncp_canon_kind in = motion == NCP_G84 ? NCP_C_START_SPINDLE_CLOCKWISE
                                                : NCP_C_START_SPINDLE_COUNTERCLOCKWISE;
-        enum ncp_canon_kind out = motion == 840 ? NCP_C_START_SPINDLE_COUNTERCLOCKWISE
+        enum ncp_canon_kind out = motion == NCP_G84 ? NCP_C_START_SPINDLE_COUNTERCLOCKWISE
                                                 : NCP_C_START_SPINDLE_CLOCKWISE;
         ncp_an_emit(c->a, NCP_C_DISABLE_FEED_OVERRIDE);
         ncp_an_emit(c->a, NCP_C_DISABLE_SPEED_OVERRIDE);
@@ -131,28 +131,28 @@ static void ncp_cyc_body(struct ncp_cyc *c, int motion, double x, double y, doub
             ncp_an_emit(c->a, NCP_C_ENABLE_SPEED_OVERRIDE);
         break;
     }
-    case 880:
+    case NCP_G88:
         FEED(c, x, y, bottom);
         ncp_cyc_dwell(c, p);
         ncp_an_emit(c->a, NCP_C_STOP_SPINDLE_TURNING);
         ncp_an_emit(c->a, NCP_C_PROGRAM_STOP);
         ncp_cyc_spindle_on(c);
         break;
-    case 810:
+    case NCP_G81:
         FEED(c, x, y, bottom);
         TRAV(c, x, y, clear);
         break;
-    case 820:
+    case NCP_G82:
         FEED(c, x, y, bottom);
         ncp_cyc_dwell(c, p);
         TRAV(c, x, y, clear);
         break;
-    case 850:
+    case NCP_G85:
         FEED(c, x, y, bottom);
         FEED(c, x, y, r);
         TRAV(c, x, y, clear);
         break;
-    case 890:
+    case NCP_G89:
         FEED(c, x, y, bottom);
         ncp_cyc_dwell(c, p);
         FEED(c, x, y, clear);
@@ -175,9 +175,10 @@ static int ncp_cyc_pq(struct ncp_analyzer *a, int motion, double *p, double *q)
     int hq = NCP_HAS(w, 'Q') && w->v[NCP_LETTER('Q')] != -1.0;
     *p = hp ? w->v[NCP_LETTER('P')] : s->cycle_p;
     *q = hq ? w->v[NCP_LETTER('Q')] : s->cycle_q;
-    if ((motion == 820 || motion == 860 || motion == 880 || motion == 890) && first && !hp)
+    if ((motion == NCP_G82 || motion == NCP_G86 || motion == NCP_G88 || motion == NCP_G89) &&
+        first && !hp)
         return ncp_an_error(a, col, "Dwell time p word missing with g%d", motion / 10);
-    if ((motion == 830 || motion == 730) && first && !hq)
+    if ((motion == NCP_G83 || motion == NCP_G73) && first && !hq)
         return ncp_an_error(a, col, "Q word missing with g%d", motion / 10);
     return NCP_OK;
 }
@@ -186,7 +187,7 @@ static int ncp_cyc_spindle_check(struct ncp_analyzer *a, int motion)
 {
     const struct ncp_words *w = &a->w;
     uint16_t col = NCP_MOTION_COL(w);
-    if ((motion == 860 || motion == 870 || motion == 880) && a->st.m.spindle_dir == 0)
+    if ((motion == NCP_G86 || motion == NCP_G87 || motion == NCP_G88) && a->st.m.spindle_dir == 0)
         return ncp_an_error(a, col, "Spindle not turning in g%d", motion / 10);
     return NCP_OK;
 }
@@ -196,12 +197,12 @@ static int ncp_cyc_spindle_check(struct ncp_analyzer *a, int motion)
 static int ncp_cyc_tap_check(struct ncp_analyzer *a, int motion)
 {
     uint16_t col = NCP_MOTION_COL(&a->w);
-    int dir = a->st.m.spindle_dir, want = motion == 840 ? 1 : -1;
+    int dir = a->st.m.spindle_dir, want = motion == NCP_G84 ? 1 : -1;
     if (dir == 0)
         return ncp_an_error(a, col, "Spindle not turning in G%d", motion / 10);
     if (dir != want)
         return ncp_an_error(a, col, "Spindle turning %s in G%d",
-                            motion == 840 ? "counterclockwise" : "clockwise", motion / 10);
+                            motion == NCP_G84 ? "counterclockwise" : "clockwise", motion / 10);
     return NCP_OK;
 }
 
@@ -221,7 +222,7 @@ static int ncp_cyc_g87_words(struct ncp_analyzer *a, const int *ax, double botto
                                         "K word missing with g87"};
     double by_letter[3];
     for (int k = 0; k < 3; k++) {
-        if (s->m.motion != 870 && !NCP_HAS(w, l[k]))
+        if (s->m.motion != NCP_G87 && !NCP_HAS(w, l[k]))
             return ncp_an_error(a, col, "%s", miss[k]);
         by_letter[k] = NCP_HAS(w, l[k]) ? w->v[NCP_LETTER(l[k])] : s->cycle_ijk[k];
         s->cycle_ijk[k] = by_letter[k];
@@ -346,7 +347,7 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
     double ijk[3] = {0}; /* read by G87 only, which sets them */
     if (rc == NCP_OK)
         rc = ncp_cyc_spindle_check(a, motion);
-    if (rc == NCP_OK && motion == 870)
+    if (rc == NCP_OK && motion == NCP_G87)
         rc = ncp_cyc_g87_words(a, ax, cc, ijk);
     if (rc != NCP_OK)
         return rc;
@@ -375,12 +376,13 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
             if (clear > rr)
                 TRAV(&c, aa, bb, rr);
         }
-        if ((motion == 830 || motion == 730) && q <= 0.0)
+        if ((motion == NCP_G83 || motion == NCP_G73) && q <= 0.0)
             return ncp_an_error(a, NCP_MOTION_COL(w),
                                 "Negative or zero q value used");
-        if ((motion == 840 || motion == 740) && (rc = ncp_cyc_tap_check(a, motion)) != NCP_OK)
+        if ((motion == NCP_G84 || motion == NCP_G74) &&
+            (rc = ncp_cyc_tap_check(a, motion)) != NCP_OK)
             return rc;
-        if (motion == 870) {
+        if (motion == NCP_G87) {
             double off[3] = {aa + ijk[0], bb + ijk[1], ijk[2]};
             ncp_cyc_g87(&c, aa, bb, off, rr, clear, cc);
         } else {
@@ -395,10 +397,10 @@ int ncp_canned_run(struct ncp_analyzer *a, int motion)
     s->cycle_cc = depth;
     s->cycle_r = r;
     s->cycle_l = l;
-    if (motion == 820 || motion == 840 || motion == 740 || motion == 860 || motion == 880 ||
-        motion == 890)
+    if (motion == NCP_G82 || motion == NCP_G84 || motion == NCP_G74 || motion == NCP_G86 ||
+        motion == NCP_G88 || motion == NCP_G89)
         s->cycle_p = p;
-    if (motion == 830 || motion == 730)
+    if (motion == NCP_G83 || motion == NCP_G73)
         s->cycle_q = q;
     s->m.motion = motion;
     return NCP_OK;

@@ -41,7 +41,7 @@ int ncp_comp_gcode(struct ncp_analyzer *a, int g)
     int rc = ncp_an_commit(a);
     if (rc != NCP_OK)
         return rc;
-    if (g == 400) {
+    if (g == NCP_G40) {
         rc = ncp_cutcomp_off(&a->comp, &sink, &a->err, a->line);
         a->st.m.comp_side = 0;
         return rc;
@@ -64,11 +64,13 @@ int ncp_comp_move_straight(struct ncp_analyzer *a, int motion, const double *end
     int rc = ncp_an_commit(a);
     if (rc != NCP_OK)
         return rc;
-    struct ncp_comp_move m = {.motion = motion == 330 || motion == 331 || motion == 760
-                                            ? NCP_COMP_SYNCED
-                                            : motion / 10,
-                              .inches = a->st.m.inches,
-                              .g53 = g53, .line = a->line, .turns = 1};
+    struct ncp_comp_move m = {
+        .motion = motion == NCP_G33 || motion == NCP_G33_1 || motion == NCP_G76 ? NCP_COMP_SYNCED
+                                                                                : motion / 10,
+        .inches = a->st.m.inches,
+        .g53 = g53,
+        .line = a->line,
+        .turns = 1};
     ncp_comp_plane(a->comp.plane, a->st.pos, m.start);
     ncp_comp_plane(a->comp.plane, end, m.end);
     m.abc[0] = end[NCP_A];

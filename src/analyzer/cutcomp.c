@@ -1,6 +1,7 @@
 /* The sequential half of cutter compensation: rs274's queue of calls held back
  * until the next move fixes the corner. See cutcomp.h. */
 #include "cutcomp.h"
+#include "codes.h"
 #include "ncpar/geom.h"
 
 #include <math.h>
@@ -287,7 +288,7 @@ static int ncp_comp_radius(const struct ncp_comp_on_req *req, double *radius, in
                            struct ncp_diag *d)
 {
     int g = req->gcode / 10;
-    if (req->gcode % 10 == 1) {
+    if (req->gcode == NCP_G41_1 || req->gcode == NCP_G42_1) {
         if (!req->has_d)
             return ncp_diag_set(d, NCP_ERR_SEMANTIC, req->line, 0, "G%d.1 with no D word", g);
         *radius = req->d / 2;
@@ -338,7 +339,7 @@ int ncp_cutcomp_on(struct ncp_cutcomp *c, const struct ncp_comp_on_req *req,
     int rc = ncp_comp_radius(req, &radius, &orientation, d);
     if (rc != NCP_OK)
         return rc;
-    int side = req->gcode / 10 == 41 ? NCP_COMP_LEFT : NCP_COMP_RIGHT;
+    int side = req->gcode == NCP_G41 || req->gcode == NCP_G41_1 ? NCP_COMP_LEFT : NCP_COMP_RIGHT;
     if (radius < 0.0) { /* a negative table entry cuts on the other side */
         radius = -radius;
         side = side == NCP_COMP_LEFT ? NCP_COMP_RIGHT : NCP_COMP_LEFT;

@@ -45,7 +45,8 @@ static inline void ncp_an_publish(struct ncp_analyzer *a)
 {
     if (a->cmd) {
         /* only a machine (a run with busters to wait for) shows the codes:
-         * a translation to text would pay about 8 % for them */
+         * a translation to text would pay for them on every block, in the
+         * hot loop bench-parse measures */
         if (a->sai.sync)
             ncp_analyzer_active_codes(a, &a->cmd->active);
         a->sink->publish(a->sink->ctx, a->cmd);

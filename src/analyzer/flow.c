@@ -8,6 +8,7 @@
  * text; a jump back re-reads the text from the jump target (with a small cache
  * of lexed blocks for loop bodies) until it is back at the feed's position. */
 #include "flow.h"
+#include "codes.h"
 
 #include "ncpar/blocks.h"
 
@@ -1354,7 +1355,7 @@ static int ncp_flow_resolve_m_value(struct ncp_flow *f, const struct ncp_block *
     int m;
     struct ncp_diag unread;
     if (ncp_flow_eval(f, blk, &blk->words[0].v, &v, &unread) != NCP_OK ||
-        ncp_rs274_int(v, &m) != 0 || !(m == 98 || (m == 99 && f->level > 0)))
+        ncp_rs274_int(v, &m) != 0 || !(m == NCP_M98 || (m == NCP_M99 && f->level > 0)))
         return NCP_OK;
     if (!f->fanuc_blk && !(f->fanuc_blk = malloc(sizeof *f->fanuc_blk)))
         return ncp_diag_set(d, NCP_ERR_IO, blk->line, 0, "out of memory");

@@ -73,7 +73,7 @@ static int g7x_line(void *ctx, int rapid, double complex end)
 {
     struct ncp_analyzer *a = ctx;
     g7x_end_words(&a->w, end);
-    return ncp_motion_straight(a, rapid ? 0 : 10);
+    return ncp_motion_straight(a, rapid ? NCP_G0 : NCP_G1);
 }
 
 /* rs274 skips an arc that ends where it starts (within 0.0001). */
@@ -88,7 +88,7 @@ static int g7x_arc(void *ctx, int ccw, double complex centre, double complex end
     double complex cur = g7x_current(a);
     if (fabs(creal(cur) - creal(end)) < 0.0001 && fabs(cimag(cur) - cimag(end)) < 0.0001)
         return NCP_OK;
-    return ncp_motion_arc(a, ccw ? 30 : 20);
+    return ncp_motion_arc(a, ccw ? NCP_G3 : NCP_G2);
 }
 
 /* ---------------------------------------------------------------------
@@ -189,13 +189,13 @@ static int g7x_record_block(struct ncp_analyzer *a, struct g7x_rec *r,
     if (r->start == end)
         return NCP_OK;
     int motion = a->st.m.motion, rc = NCP_OK;
-    int drawn = motion == 0 || motion == 10 || motion == 20 || motion == 30;
-    if (motion == 0 || motion == 10) {
+    int drawn = motion == NCP_G0 || motion == NCP_G1 || motion == NCP_G2 || motion == NCP_G3;
+    if (motion == NCP_G0 || motion == NCP_G1) {
         rc = ncp_g7x_add_line(path, r->start, end);
-    } else if (motion == 20 || motion == 30) {
+    } else if (motion == NCP_G2 || motion == NCP_G3) {
         rc = g7x_arc_centre(a, r, end, &centre);
         if (rc == NCP_OK)
-            rc = ncp_g7x_add_arc(path, motion == 30, r->start, centre, end);
+            rc = ncp_g7x_add_arc(path, motion == NCP_G3, r->start, centre, end);
     }
     if (rc == NCP_G7X_EGEOM)
         return ncp_an_error(a, NCP_MOTION_COL(w), "G7X error: %s", path->err);
@@ -278,7 +278,7 @@ static int g7x_checks(struct ncp_analyzer *a, int motion)
     uint16_t col = NCP_MOTION_COL(w);
     if (!NCP_HAS(w, 'Q'))
         return ncp_an_error(a, col, "G7x.x  requires a Q word");
-    if (a->st.m.comp_side != 0 && motion / 10 != 70)
+    if (a->st.m.comp_side != 0 && motion != NCP_G70)
         return ncp_an_error(a, col, "G%d.%d cannot be used with cutter compensation enabled",
                             motion / 10, motion % 10);
     if (a->st.m.plane != 2)
@@ -300,11 +300,12 @@ static int g7x_passes(struct ncp_analyzer *a, int motion, const struct ncp_words
         return ncp_an_error(a, a->w.line_col, "G7X error: I must be greater than zero.");
     struct ncp_g7x_out out = {a, g7x_line, g7x_arc};
     int rc;
-    if (motion == 700) {
+    if (motion == NCP_G70) {
         rc = ncp_g7x_finish(path, &out, start, d, g7x_word(w, 'E', 0), g7x_word(w, 'P', 1));
     } else {
         double complex uw = CMPLX(g7x_word(w, 'W', 0), g7x_word(w, 'U', 0));
-        rc = ncp_g7x_rough(path, &out, motion % 10, motion / 10 == 72, start, uw, d, i,
+        int facing = motion == NCP_G72 || motion == NCP_G72_1 || motion == NCP_G72_2;
+        rc = ncp_g7x_rough(path, &out, motion % 10, facing, start, uw, d, i,
                            g7x_word(w, 'R', 0.5));
     }
     if (rc == NCP_G7X_EGEOM)

@@ -42,18 +42,19 @@ void ncp_analyzer_active_codes(const struct ncp_analyzer *a, struct ncp_active_c
     for (int ax = 0; ax < NCP_NAX; ax++)
         tlo |= a->st.tlo[ax] != 0.0;
     o->g[NCP_AG_MOTION] = (int16_t)m->motion;
-    o->g[NCP_AG_PLANE] = m->plane == 0 ? 170 : m->plane == 1 ? 190 : 180;
-    o->g[NCP_AG_DIST] = m->incremental ? 910 : 900;
-    o->g[NCP_AG_ARCDIST] = m->arc_incremental ? 911 : 901;
-    o->g[NCP_AG_FEEDMODE] = m->feed_mode == 1 ? 930 : m->feed_mode == 0 ? 940 : 950;
-    o->g[NCP_AG_UNITS] = m->inches ? 200 : 210;
-    o->g[NCP_AG_COMP] = m->comp_side == 1 ? 410 : m->comp_side == 2 ? 420 : 400;
-    o->g[NCP_AG_TLO] = tlo ? 430 : 490;
-    o->g[NCP_AG_RETRACT] = m->retract_r ? 990 : 980;
-    o->g[NCP_AG_COORD] = (int16_t)(m->origin < 7 ? 530 + 10 * m->origin : 584 + m->origin);
-    o->g[NCP_AG_CONTROL] = m->control == 2 ? 640 : m->control == 1 ? 610 : 611;
-    o->g[NCP_AG_SPINDLE] = m->css ? 960 : 970;
-    o->g[NCP_AG_LATHE] = m->lathe_diameter ? 70 : 80;
+    o->g[NCP_AG_PLANE] = m->plane == 0 ? NCP_G17 : m->plane == 1 ? NCP_G19 : NCP_G18;
+    o->g[NCP_AG_DIST] = m->incremental ? NCP_G91 : NCP_G90;
+    o->g[NCP_AG_ARCDIST] = m->arc_incremental ? NCP_G91_1 : NCP_G90_1;
+    o->g[NCP_AG_FEEDMODE] = m->feed_mode == 1 ? NCP_G93 : m->feed_mode == 0 ? NCP_G94 : NCP_G95;
+    o->g[NCP_AG_UNITS] = m->inches ? NCP_G20 : NCP_G21;
+    o->g[NCP_AG_COMP] = m->comp_side == 1 ? NCP_G41 : m->comp_side == 2 ? NCP_G42 : NCP_G40;
+    o->g[NCP_AG_TLO] = tlo ? NCP_G43 : NCP_G49;
+    o->g[NCP_AG_RETRACT] = m->retract_r ? NCP_G99 : NCP_G98;
+    o->g[NCP_AG_COORD] =
+        (int16_t)(m->origin < 7 ? NCP_G53 + 10 * m->origin : NCP_G59 + (m->origin - 6));
+    o->g[NCP_AG_CONTROL] = m->control == 2 ? NCP_G64 : m->control == 1 ? NCP_G61 : NCP_G61_1;
+    o->g[NCP_AG_SPINDLE] = m->css ? NCP_G96 : NCP_G97;
+    o->g[NCP_AG_LATHE] = m->lathe_diameter ? NCP_G7 : NCP_G8;
     o->m[NCP_AM_SPINDLE] = m->spindle_dir == 0 ? 5 : m->spindle_dir == 1 ? 3 : 4;
     o->m[NCP_AM_MIST] = m->mist ? 7 : m->flood ? -1 : 9;
     o->m[NCP_AM_FLOOD] = m->flood ? 8 : -1;
@@ -88,8 +89,8 @@ static void ncp_m7x_snapshot(const struct ncp_analyzer *a, struct ncp_m7x_state 
     o->m[M_MIST] = ac.m[NCP_AM_MIST];
     o->m[M_FLOOD] = ac.m[NCP_AM_FLOOD];
     o->m[M_OVERRIDE] = ac.m[NCP_AM_OVERRIDE];
-    o->m[M_ADAPTIVE] = m->adaptive ? 52 : -1;
-    o->m[M_HOLD] = m->feed_hold ? 53 : -1;
+    o->m[M_ADAPTIVE] = m->adaptive ? NCP_M52 : -1;
+    o->m[M_HOLD] = m->feed_hold ? NCP_M53 : -1;
     o->feed = a->st.feed;
     o->speed = a->st.speed;
     o->tol = m->g64_p;
@@ -157,14 +158,14 @@ static void ncp_m7x_text(const struct ncp_m7x_state *cur, const struct ncp_m7x_s
         int v = saved->g[i];
         if (i == G_UNITS || v == cur->g[i] || v == -1)
             continue;
-        if (i == G_CONTROL && v == 640)
+        if (i == G_CONTROL && v == NCP_G64)
             g64_changed = 1;
         else if (v % 10)
             M7X_PUT(" G%d.%d", v / 10, v % 10);
         else
             M7X_PUT(" G%d", v / 10);
     }
-    if (saved->g[G_CONTROL] == 640 && g64_changed) {
+    if (saved->g[G_CONTROL] == NCP_G64 && g64_changed) {
         if (saved->tol < 0)
             M7X_PUT(" G64");
         else if (saved->naive < 0)
@@ -226,14 +227,14 @@ int ncp_m7x_run(struct ncp_analyzer *a, int m)
     struct ncp_m7x_frame *fr = ncp_m7x_frame_at(a, level);
     if (!fr)
         return a->err.code;
-    if (m == 70 || m == 73) {
+    if (m == NCP_M70 || m == NCP_M73) {
         ncp_m7x_snapshot(a, &fr->s);
         fr->status |= M7X_VALID;
-        if (m == 73 && level > 0) /* at level 0 rs274 only warns: nothing returns there */
+        if (m == NCP_M73 && level > 0) /* at level 0 rs274 only warns: nothing returns there */
             fr->status |= M7X_RESTORE_ON_RETURN;
         return NCP_OK;
     }
-    if (m == 71) {
+    if (m == NCP_M71) {
         fr->status &= ~M7X_VALID;
         return NCP_OK;
     }

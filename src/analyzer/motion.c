@@ -102,13 +102,13 @@ int ncp_motion_straight(struct ncp_analyzer *a, int motion)
     struct ncp_state *s = &a->st;
     const struct ncp_words *w = &a->w;
     double end[NCP_NAX];
-    int g53 = w->g[NCP_GG_NONMODAL] == 530;
+    int g53 = w->g[NCP_GG_NONMODAL] == NCP_G53;
     int rc = ncp_cutcomp_check_motion(&a->comp, 0, &a->err, a->line);
     if (rc == NCP_OK)
         rc = ncp_motion_ends(a, g53, end);
     if (rc != NCP_OK)
         return rc;
-    if (motion == 0) {
+    if (motion == NCP_G0) {
         if (ncp_cutcomp_engaged(&a->comp))
             rc = ncp_comp_move_straight(a, motion, end, g53);
         else
@@ -245,7 +245,7 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
         op->arc.first_centre = o1;
         op->arc.second_centre = o2;
     }
-    op->arc.dir = motion == 30 ? 1 : -1;
+    op->arc.dir = motion == NCP_G3 ? 1 : -1;
     op->arc.turns = NCP_HAS(w, 'P') ? ncp_trunc_int_round(w->v[NCP_LETTER('P')]) : 1;
     op->arc.plane = pl;
     op->flags = s->m.inches ? 1 : 0;
@@ -295,7 +295,7 @@ int ncp_motion_probe(struct ncp_analyzer *a, int motion)
     int rc = ncp_motion_ends(a, 0, end);
     if (rc != NCP_OK)
         return rc;
-    int errors_if_missed = (motion - 382) % 2 == 0;
+    int errors_if_missed = (motion - NCP_G38_2) % 2 == 0;
     if (errors_if_missed) {
         int same = 1;
         for (int ax = 0; ax < NCP_NAX; ax++)
@@ -306,7 +306,7 @@ int ncp_motion_probe(struct ncp_analyzer *a, int motion)
     ncp_an_emit(a, NCP_C_TURN_PROBE_ON);
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_STRAIGHT_PROBE);
     memcpy(op->move.end, end, 6 * sizeof(double));
-    op->flags = (uint16_t)((motion >= 384 ? NCP_PROBE_F_AWAY : 0) |
+    op->flags = (uint16_t)((motion >= NCP_G38_4 ? NCP_PROBE_F_AWAY : 0) |
                            (errors_if_missed ? NCP_PROBE_F_ERROR : 0));
     ncp_sai_probe(a, end);
     ncp_an_emit(a, NCP_C_TURN_PROBE_OFF);
@@ -335,10 +335,10 @@ int ncp_motion_synced(struct ncp_analyzer *a, int motion)
     }
     uint16_t col = NCP_MOTION_COL(&a->w);
     if (s->m.spindle_dir == 0)
-        return ncp_an_error(a, col, motion == 330   ? "Spindle not turning in G33"
-                                    : motion == 331 ? "Spindle not turning in G33.1"
+        return ncp_an_error(a, col, motion == NCP_G33   ? "Spindle not turning in G33"
+                                    : motion == NCP_G33_1 ? "Spindle not turning in G33.1"
                                                     : "Chosen spindle (0) not turning in G76");
-    if (motion == 760) {
+    if (motion == NCP_G76) {
         for (int ax = NCP_A; ax < NCP_NAX; ax++)
             if (end[ax] != s->pos[ax])
                 return ncp_an_error(a, col, "Cannot move rotary axes with G76");
@@ -346,7 +346,7 @@ int ncp_motion_synced(struct ncp_analyzer *a, int motion)
     }
     struct ncp_canon *sync = ncp_an_emit(a, NCP_C_START_SPEED_FEED_SYNCH);
     sync->synch.per_rev = a->w.v[NCP_LETTER('K')];
-    if (motion == 330) {
+    if (motion == NCP_G33) {
         ncp_an_emit6(a, NCP_C_STRAIGHT_FEED, end);
         memcpy(s->pos, end, sizeof end);
     } else {
@@ -377,7 +377,7 @@ int ncp_motion_spline(struct ncp_analyzer *a, int motion)
         return ncp_an_error(a, col, "Splines must be in the XY plane");
     if (NCP_HAS(w, 'Z') || NCP_HAS(w, 'A') || NCP_HAS(w, 'B') || NCP_HAS(w, 'C'))
         return ncp_an_error(a, col, "Splines may not have motion in Z, A, B, or C");
-    if (motion == 51) {
+    if (motion == NCP_G5_1) {
         if (!NCP_HAS(w, 'I') || !NCP_HAS(w, 'J'))
             return ncp_an_error(a, col, "Must specify both I and J with G5.1");
     } else {
@@ -394,7 +394,7 @@ int ncp_motion_spline(struct ncp_analyzer *a, int motion)
      * start + IJ, [end + PQ,] end; a G5 without I J continues the last G5's
      * direction (-P, -Q), as LinuxCNC draws it */
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_NURBS_FEED);
-    op->nurbs.n_points = motion == 51 ? 3 : 4;
+    op->nurbs.n_points = motion == NCP_G5_1 ? 3 : 4;
     memcpy(op->nurbs.end, end, sizeof op->nurbs.end);
     double i = NCP_HAS(w, 'I') ? w->v[NCP_LETTER('I')] : -s->g5_pq[0];
     double j = NCP_HAS(w, 'J') ? w->v[NCP_LETTER('J')] : -s->g5_pq[1];
@@ -402,7 +402,7 @@ int ncp_motion_spline(struct ncp_analyzer *a, int motion)
     op->nurbs.start[1] = s->pos[NCP_Y];
     op->nurbs.ctrl[0][0] = s->pos[NCP_X] + i;
     op->nurbs.ctrl[0][1] = s->pos[NCP_Y] + j;
-    if (motion == 50) {
+    if (motion == NCP_G5) {
         s->g5_pq[0] = w->v[NCP_LETTER('P')];
         s->g5_pq[1] = w->v[NCP_LETTER('Q')];
         op->nurbs.ctrl[1][0] = end[NCP_X] + s->g5_pq[0];

@@ -57,7 +57,7 @@ int ncp_g52_point(struct ncp_analyzer *a)
         return ncp_an_error(a, col, "Must specify positive weight P for every Control Point");
     if (s->m.feed_mode == 0 && s->feed == 0.0)
         return ncp_an_error(a, col, "Cannot make a NURBS with 0 feedrate");
-    if (s->m.motion != 52)
+    if (s->m.motion != NCP_G5_2)
         nb->n = 0;
     int rc;
     if (nb->n == 0) {
@@ -73,13 +73,13 @@ int ncp_g52_point(struct ncp_analyzer *a)
     }
     if (has_x) {
         double end[NCP_NAX];
-        rc = ncp_motion_ends(a, w->g[NCP_GG_NONMODAL] == 530, end);
+        rc = ncp_motion_ends(a, w->g[NCP_GG_NONMODAL] == NCP_G53, end);
         if (rc == NCP_OK)
             rc = ncp_g52_push(a, end[NCP_X], end[NCP_Y], p);
         if (rc != NCP_OK)
             return rc;
     }
-    s->m.motion = 52;
+    s->m.motion = NCP_G5_2;
     return NCP_OK;
 }
 
@@ -88,7 +88,7 @@ int ncp_g52_draw(struct ncp_analyzer *a)
     struct ncp_state *s = &a->st;
     struct ncp_g52_points *nb = &a->nurbs;
     uint16_t col = a->w.gcol[NCP_GG_NONMODAL];
-    if (s->m.motion != 52)
+    if (s->m.motion != NCP_G5_2)
         return ncp_an_error(a, col, "Cannot use G5.3 without G5.2 first");
     if (nb->n < (uint32_t)nb->order)
         return ncp_an_error(a, col,

@@ -212,7 +212,7 @@ int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
         return ncp_an_error(a, w->gcol[NCP_GG_TLO],
                             "Cannot change tool offset with cutter radius compensation on");
     double nw[NCP_NAX] = {0};
-    if (g == 430) {
+    if (g == NCP_G43) {
         int idx = -1;
         if (NCP_HAS(w, 'H')) {
             int rc = ncp_tlo_tool_index(a, ncp_trunc_int_round(w->v[NCP_LETTER('H')]), &idx);
@@ -227,11 +227,11 @@ int ncp_offsets_tlo(struct ncp_analyzer *a, int g)
             double u = ncp_tool_offset(a, idx, ax);
             nw[ax] = ncp_is_linear(ax) ? ncp_tool_len(a, u) : u;
         }
-    } else if (g == 431) {
+    } else if (g == NCP_G43_1) {
         memcpy(nw, s->tlo, sizeof nw);
         for (int ax = 0; ax < NCP_NAX; ax++)
             ncp_axis_word(w, ax, &nw[ax]);
-    } else if (g == 432) {
+    } else if (g == NCP_G43_2) {
         int rc = ncp_offsets_tlo_add(a, nw);
         if (rc != NCP_OK)
             return rc;
@@ -285,19 +285,19 @@ static int ncp_g92(struct ncp_analyzer *a, int g)
     if (s->m.comp_side != 0)
         return ncp_an_error(a, a->w.gcol[NCP_GG_NONMODAL],
                             "Cannot change axis offsets with cutter radius comp");
-    if (g == 920 || g == 520) {
-        ncp_g92_words(a, g == 520);
+    if (g == NCP_G92 || g == NCP_G52) {
+        ncp_g92_words(a, g == NCP_G52);
         ncp_emit_g92(a);
         ncp_store_g92_params(a, 1);
         return NCP_OK;
     }
     double *applied = ncp_par(a, 5210);
-    if (g == 921 || g == 922) {
+    if (g == NCP_G92_1 || g == NCP_G92_2) {
         for (int ax = 0; ax < NCP_NAX; ax++) {
             s->pos[ax] = s->pos[ax] + s->g92[ax];
             s->g92[ax] = 0.0;
         }
-        if (g == 921)
+        if (g == NCP_G92_1)
             ncp_store_g92_params(a, 0);
     } else {
         for (int ax = 0; ax < NCP_NAX; ax++) {
@@ -324,7 +324,7 @@ static int ncp_home(struct ncp_analyzer *a, int g)
     if (s->m.comp_side != 0)
         return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
                             "Cannot use G28 or G30 with cutter radius compensation");
-    int base = g == 280 ? 5161 : 5181;
+    int base = g == NCP_G28 ? 5161 : 5181;
     for (int ax = 0; ax < NCP_NAX; ax++)
         home[ax] = ncp_frame_user(a, ax, base + ax);
     ncp_frame_relative(a, home, end);
@@ -348,7 +348,7 @@ static int ncp_home_store(struct ncp_analyzer *a, int g)
     if (s->m.comp_side != 0)
         return ncp_an_error(a, a->w.gcol[NCP_GG_NONMODAL],
                             "Cannot set reference point with cutter compensation in effect");
-    int base = g == 281 ? 5161 : 5181;
+    int base = g == NCP_G28_1 ? 5161 : 5181;
     double m[NCP_NAX];
     m[NCP_X] = s->pos[NCP_X] + s->g92[NCP_X];
     m[NCP_Y] = s->pos[NCP_Y] + s->g92[NCP_Y];
@@ -368,9 +368,9 @@ static int ncp_home_store(struct ncp_analyzer *a, int g)
 int ncp_offsets_modal0(struct ncp_analyzer *a, int g)
 {
     switch (g) {
-    case 100: return ncp_g10_run(a);
-    case 280: case 300: return ncp_home(a, g);
-    case 281: case 301: return ncp_home_store(a, g);
+    case NCP_G10: return ncp_g10_run(a);
+    case NCP_G28: case NCP_G30: return ncp_home(a, g);
+    case NCP_G28_1: case NCP_G30_1: return ncp_home_store(a, g);
     default: return ncp_g92(a, g);
     }
 }

@@ -46,8 +46,8 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     switch (k) {
     case P_LINE: return a->line;
     case P_MOTION: return m->motion; /* -1 after G5.3, as rs274 */
-    case P_PLANE: return m->plane == 0 ? 170 : m->plane == 1 ? 190 : 180;
-    case P_CCOMP: return m->comp_side == 0 ? 400 : m->comp_side == 1 ? 410 : 420;
+    case P_PLANE: return m->plane == 0 ? NCP_G17 : m->plane == 1 ? NCP_G19 : NCP_G18;
+    case P_CCOMP: return m->comp_side == 0 ? NCP_G40 : m->comp_side == 1 ? NCP_G41 : NCP_G42;
     case P_METRIC: return !m->inches;
     case P_IMPERIAL: return m->inches;
     case P_ABSOLUTE: return !m->incremental;
@@ -55,7 +55,7 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     case P_INVERSE: return m->feed_mode == 1;
     case P_UPM: return m->feed_mode == 0;
     case P_UPR: return m->feed_mode == 2;
-    case P_COORD: return m->origin <= 6 ? 530 + 10 * m->origin : 590 + (m->origin - 6);
+    case P_COORD: return m->origin <= 6 ? NCP_G53 + 10 * m->origin : NCP_G59 + (m->origin - 6);
     case P_TOOL_OFFSET: return s->tlo[NCP_Z] != 0.0 || s->tlo[NCP_X] != 0.0;
     case P_RETRACT_R: return m->retract_r;
     case P_RETRACT_OLD: return !m->retract_r;

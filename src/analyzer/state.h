@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <string.h>
 #include "ncpar/analyzer.h"
+#include "codes.h"
 #include "cutcomp.h"
 #include "flow.h"
 #include "params.h"
@@ -20,7 +21,7 @@ enum ncp_axis { NCP_X, NCP_Y, NCP_Z, NCP_A, NCP_B, NCP_C, NCP_U, NCP_V, NCP_W, N
  * list for the word checks and the motion dispatch alike. */
 static inline int ncp_is_canned_cycle(int motion)
 {
-    return motion == 730 || motion == 740 || (motion >= 810 && motion <= 890);
+    return motion == NCP_G73 || motion == NCP_G74 || (motion >= NCP_G81 && motion <= NCP_G89);
 }
 
 /* Modal group slots of the per-block G-code record. */
@@ -48,8 +49,9 @@ enum ncp_mgroup {
     (1u << NCP_LETTER('C')) | (1u << NCP_LETTER('U')) | (1u << NCP_LETTER('V')) | \
     (1u << NCP_LETTER('W')))
 
-/* One block's words after evaluation. G/M codes are stored as code*10
- * (G38.2 -> 382); -1 = none in that group. */
+/* One block's words after evaluation. G codes are stored as code*10
+ * (G38.2 -> 382), M codes whole, both named in codes.h; -1 = none in that
+ * group. */
 struct ncp_words {
     uint32_t has;                 /* bit per NCP_LETTER slot (not G, M) */
     double v[NCP_WORD_SLOTS];
@@ -65,7 +67,7 @@ struct ncp_words {
 };
 
 struct ncp_modal {
-    int motion;                   /* G code*10 of the active motion mode: 800 G80, -1 none
+    int motion;                   /* G code*10 of the active motion mode (NCP_G80 ...), -1 none
                                      (after G5.3) */
     int plane;                    /* 0 XY, 1 YZ, 2 XZ */
     int incremental, arc_incremental;

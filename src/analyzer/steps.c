@@ -16,7 +16,7 @@ static int ncp_step_feed_mode(struct ncp_analyzer *a, int g)
         "interpreter: feed mode set to inverse time",
         "interpreter: feed mode set to units per revolution",
     };
-    int mode = g == 930 ? 1 : g == 940 ? 0 : 2;
+    int mode = g == NCP_G93 ? 1 : g == NCP_G94 ? 0 : 2;
     const char *m = msg[mode];
     size_t n = 0;
     while (m[n])
@@ -42,15 +42,15 @@ static void ncp_step_comment_lit(struct ncp_analyzer *a, const char *m)
 
 static int ncp_step_spindle(struct ncp_analyzer *a, int m)
 {
-    if (m >= 70)
+    if (m >= NCP_M70)
         return ncp_m7x_run(a, m);
-    if (m == 3) {
+    if (m == NCP_M3) {
         ncp_an_emit(a, NCP_C_START_SPINDLE_CLOCKWISE);
         a->st.m.spindle_dir = 1;
-    } else if (m == 4) {
+    } else if (m == NCP_M4) {
         ncp_an_emit(a, NCP_C_START_SPINDLE_COUNTERCLOCKWISE);
         a->st.m.spindle_dir = -1;
-    } else if (m == 5) {
+    } else if (m == NCP_M5) {
         ncp_an_emit(a, NCP_C_STOP_SPINDLE_TURNING);
         a->st.m.spindle_dir = 0;
     } else {
@@ -76,10 +76,10 @@ static int ncp_step_spindle(struct ncp_analyzer *a, int m)
 
 static int ncp_step_coolant(struct ncp_analyzer *a, int m)
 {
-    if (m == 7) {
+    if (m == NCP_M7) {
         ncp_an_emit(a, NCP_C_MIST_ON);
         a->st.m.mist = 1;
-    } else if (m == 8) {
+    } else if (m == NCP_M8) {
         ncp_an_emit(a, NCP_C_FLOOD_ON);
         a->st.m.flood = 1;
     } else {
@@ -94,25 +94,25 @@ static int ncp_step_override(struct ncp_analyzer *a, int m)
 {
     int on = !NCP_HAS(&a->w, 'P') || W(a, 'P') != 0.0;
     switch (m) {
-    case 48:
+    case NCP_M48:
         ncp_an_emit(a, NCP_C_ENABLE_FEED_OVERRIDE);
         ncp_an_emit(a, NCP_C_ENABLE_SPEED_OVERRIDE);
         a->st.m.feed_override = a->st.m.speed_override = 1;
         break;
-    case 49:
+    case NCP_M49:
         ncp_an_emit(a, NCP_C_DISABLE_FEED_OVERRIDE);
         ncp_an_emit(a, NCP_C_DISABLE_SPEED_OVERRIDE);
         a->st.m.feed_override = a->st.m.speed_override = 0;
         break;
-    case 50:
+    case NCP_M50:
         ncp_an_emit(a, on ? NCP_C_ENABLE_FEED_OVERRIDE : NCP_C_DISABLE_FEED_OVERRIDE);
         a->st.m.feed_override = on;
         break;
-    case 51:
+    case NCP_M51:
         ncp_an_emit(a, on ? NCP_C_ENABLE_SPEED_OVERRIDE : NCP_C_DISABLE_SPEED_OVERRIDE);
         a->st.m.speed_override = on;
         break;
-    case 52:
+    case NCP_M52:
         ncp_an_emit(a, on ? NCP_C_ENABLE_ADAPTIVE_FEED : NCP_C_DISABLE_ADAPTIVE_FEED);
         a->st.m.adaptive = on;
         break;
@@ -172,31 +172,31 @@ static int ncp_step_io(struct ncp_analyzer *a, int m)
         NCP_C_SET_MOTION_OUTPUT_BIT, NCP_C_CLEAR_MOTION_OUTPUT_BIT,
         NCP_C_SET_AUX_OUTPUT_BIT, NCP_C_CLEAR_AUX_OUTPUT_BIT,
     };
-    if (m >= 62 && m <= 65) {
+    if (m >= NCP_M62 && m <= NCP_M65) {
         if (!NCP_HAS(&a->w, 'P'))
             return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "No valid P word with M%d", m);
         ncp_an_emit(a, bits[m - 62])->output.index = ncp_trunc_int_round(W(a, 'P'));
         return NCP_OK;
     }
-    if (m == 67 || m == 68) {
+    if (m == NCP_M67 || m == NCP_M68) {
         if (!NCP_HAS(&a->w, 'E') || lround(W(a, 'E')) < 0)
             return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "Invalid analog index with M%d", m);
-        struct ncp_canon *op = ncp_an_emit(a, m == 67 ? NCP_C_SET_MOTION_OUTPUT_VALUE
+        struct ncp_canon *op = ncp_an_emit(a, m == NCP_M67 ? NCP_C_SET_MOTION_OUTPUT_VALUE
                                                       : NCP_C_SET_AUX_OUTPUT_VALUE);
         op->output.index = ncp_trunc_int_round(W(a, 'E'));
         op->output.value = NCP_HAS(&a->w, 'Q') ? W(a, 'Q') : -1.0;
         return NCP_OK;
     }
-    if (m == 66)
+    if (m == NCP_M66)
         return ncp_step_wait_input(a);
     return ncp_an_error(a, a->w.mcol[NCP_MG_IO], "M%d is not supported", m);
 }
 
 static int ncp_step_plane(struct ncp_analyzer *a, int g)
 {
-    if (g != 170 && g != 180 && g != 190)
+    if (g != NCP_G17 && g != NCP_G18 && g != NCP_G19)
         return ncp_an_error(a, a->w.gcol[NCP_GG_PLANE], "G%d.1 planes are not supported", g / 10);
-    int p = g == 170 ? 0 : g == 190 ? 1 : 2;
+    int p = g == NCP_G17 ? 0 : g == NCP_G19 ? 1 : 2;
     ncp_an_emit(a, NCP_C_SELECT_PLANE)->plane.plane = p;
     a->st.m.plane = p;
     return NCP_OK;
@@ -211,11 +211,11 @@ static int ncp_step_control(struct ncp_analyzer *a, int g)
 {
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_MOTION_CONTROL_MODE);
     /* the canon keeps the naivecam tolerance across G61/G61.1 */
-    if (g == 610) {
+    if (g == NCP_G61) {
         op->motion_control.mode = 1;
         a->st.m.control = 1;
         a->st.m.p_tol = 0.0;
-    } else if (g == 611) {
+    } else if (g == NCP_G61_1) {
         op->motion_control.mode = 0;
         a->st.m.control = 0;
         a->st.m.p_tol = 0.0;
@@ -239,7 +239,7 @@ static int ncp_step_control(struct ncp_analyzer *a, int g)
 
 static void ncp_step_distance(struct ncp_analyzer *a, int g)
 {
-    int inc = g == 910;
+    int inc = g == NCP_G91;
     if (inc != a->st.m.incremental)
         ncp_step_comment_lit(a, inc ? "interpreter: distance mode changed to incremental"
                                     : "interpreter: distance mode changed to absolute");
@@ -248,7 +248,7 @@ static void ncp_step_distance(struct ncp_analyzer *a, int g)
 
 static void ncp_step_arc_distance(struct ncp_analyzer *a, int g)
 {
-    int inc = g == 911;
+    int inc = g == NCP_G91_1;
     if (inc != a->st.m.arc_incremental)
         ncp_step_comment_lit(a, inc ? "interpreter: IJK distance mode changed to incremental"
                                     : "interpreter: IJK distance mode changed to absolute");
@@ -257,8 +257,8 @@ static void ncp_step_arc_distance(struct ncp_analyzer *a, int g)
 
 static void ncp_step_retract(struct ncp_analyzer *a, int g)
 {
-    a->st.m.retract_r = g == 990;
-    ncp_step_comment_lit(a, g == 990 ? "interpreter: retract mode set to r_plane"
+    a->st.m.retract_r = g == NCP_G99;
+    ncp_step_comment_lit(a, g == NCP_G99 ? "interpreter: retract mode set to r_plane"
                                      : "interpreter: retract mode set to old_z");
 }
 
@@ -298,27 +298,28 @@ static int ncp_step_motion(struct ncp_analyzer *a, int motion)
     if (!ncp_is_canned_cycle(motion))
         a->st.cycle_il_flag = 0;
     switch (motion) {
-    case 0: case 10:
+    case NCP_G0: case NCP_G1:
         return ncp_motion_straight(a, motion);
-    case 20: case 30:
+    case NCP_G2: case NCP_G3:
         return ncp_motion_arc(a, motion);
-    case 800:
-        a->st.m.motion = 800;
+    case NCP_G80:
+        a->st.m.motion = NCP_G80;
         ncp_an_emit_text(a, NCP_C_COMMENT, "interpreter: motion mode set to none",
                          sizeof "interpreter: motion mode set to none" - 1);
         return NCP_OK;
-    case 50: case 51:
+    case NCP_G5: case NCP_G5_1:
         return ncp_motion_spline(a, motion);
-    case 52:
+    case NCP_G5_2:
         return ncp_g52_point(a);
-    case 330: case 331: case 760:
+    case NCP_G33: case NCP_G33_1: case NCP_G76:
         return ncp_motion_synced(a, motion);
-    case 382: case 383: case 384: case 385:
+    case NCP_G38_2: case NCP_G38_3: case NCP_G38_4: case NCP_G38_5:
         return ncp_motion_probe(a, motion);
-    case 700: case 710: case 711: case 712: case 720: case 721: case 722:
+    case NCP_G70: case NCP_G71: case NCP_G71_1: case NCP_G71_2:
+    case NCP_G72: case NCP_G72_1: case NCP_G72_2:
         return ncp_g7x_run(a, motion);
-    case 730: case 740: case 810: case 820: case 830: case 840: case 850: case 860: case 870: case 880:
-    case 890:
+    case NCP_G73: case NCP_G74: case NCP_G81: case NCP_G82: case NCP_G83: case NCP_G84:
+    case NCP_G85: case NCP_G86: case NCP_G87: case NCP_G88: case NCP_G89:
         return ncp_canned_run(a, motion);
     default: {
         uint16_t col = NCP_MOTION_COL(&a->w);
@@ -333,20 +334,20 @@ static int ncp_step_g_codes(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int rc = NCP_OK;
-    if (w->g[NCP_GG_NONMODAL] == 40)
+    if (w->g[NCP_GG_NONMODAL] == NCP_G4)
         ncp_an_emit(a, NCP_C_DWELL)->dwell.seconds = W(a, 'P');
     if (w->g[NCP_GG_PLANE] != -1)
         rc = ncp_step_plane(a, w->g[NCP_GG_PLANE]);
     if (rc == NCP_OK && w->g[NCP_GG_UNITS] != -1)
-        rc = ncp_offsets_units(a, w->g[NCP_GG_UNITS] == 200);
+        rc = ncp_offsets_units(a, w->g[NCP_GG_UNITS] == NCP_G20);
     if (rc == NCP_OK && w->g[NCP_GG_LATHE] != -1)
-        ncp_step_lathe_mode(a, w->g[NCP_GG_LATHE] == 70);
+        ncp_step_lathe_mode(a, w->g[NCP_GG_LATHE] == NCP_G7);
     if (rc == NCP_OK && w->g[NCP_GG_COMP] != -1)
         rc = ncp_step_comp(a, w->g[NCP_GG_COMP]);
     if (rc == NCP_OK && w->g[NCP_GG_TLO] != -1)
         rc = ncp_offsets_tlo(a, w->g[NCP_GG_TLO]);
     if (rc == NCP_OK && w->g[NCP_GG_COORD] != -1)
-        rc = ncp_offsets_coord(a, 1 + (w->g[NCP_GG_COORD] >= 590
+        rc = ncp_offsets_coord(a, 1 + (w->g[NCP_GG_COORD] >= NCP_G59
                                        ? 5 + w->g[NCP_GG_COORD] - 590
                                        : (w->g[NCP_GG_COORD] - 540) / 10));
     if (rc == NCP_OK && w->g[NCP_GG_CONTROL] != -1)
@@ -359,10 +360,10 @@ static int ncp_step_g_codes(struct ncp_analyzer *a)
         ncp_step_arc_distance(a, w->g[NCP_GG_ARCDIST]);
     if (w->g[NCP_GG_RETRACT] != -1)
         ncp_step_retract(a, w->g[NCP_GG_RETRACT]);
-    if (w->g[NCP_GG_NONMODAL] == 53)
+    if (w->g[NCP_GG_NONMODAL] == NCP_G5_3)
         rc = ncp_g52_draw(a);
-    else if (w->g[NCP_GG_NONMODAL] != -1 && w->g[NCP_GG_NONMODAL] != 40 &&
-             w->g[NCP_GG_NONMODAL] != 530)
+    else if (w->g[NCP_GG_NONMODAL] != -1 && w->g[NCP_GG_NONMODAL] != NCP_G4 &&
+             w->g[NCP_GG_NONMODAL] != NCP_G53)
         rc = ncp_offsets_modal0(a, w->g[NCP_GG_NONMODAL]);
     if (rc == NCP_OK && w->motion_to_be != -1)
         rc = ncp_step_motion(a, w->motion_to_be);
@@ -378,8 +379,8 @@ int ncp_an_steps(struct ncp_analyzer *a)
     if (rc == NCP_OK && w->g[NCP_GG_SPINDLE] != -1) {
         /* G96 without D: rs274 passes 1e30 as "no limit" */
         struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_SPINDLE_MODE);
-        a->st.m.css = w->g[NCP_GG_SPINDLE] == 960;
-        if (w->g[NCP_GG_SPINDLE] == 960)
+        a->st.m.css = w->g[NCP_GG_SPINDLE] == NCP_G96;
+        if (w->g[NCP_GG_SPINDLE] == NCP_G96)
             op->spindle_mode.css_max = NCP_HAS(w, 'D') ? W(a, 'D') : 1e30;
     }
     if (rc == NCP_OK && w->g[NCP_GG_FEEDMODE] != -1)
@@ -427,9 +428,9 @@ static void ncp_lathe_x_word(struct ncp_analyzer *a)
     double *x = &w->v[NCP_LETTER('X')];
     if (before)
         *x /= 2;
-    if (g == 70 && !before)
+    if (g == NCP_G7 && !before)
         *x /= 2;
-    else if (g == 80 && before)
+    else if (g == NCP_G8 && before)
         *x *= 2;
 }
 

@@ -10,7 +10,7 @@ void ncp_state_init(struct ncp_analyzer *a)
 {
     struct ncp_state *s = &a->st;
     memset(s, 0, sizeof *s);
-    s->m.motion = 800;
+    s->m.motion = NCP_G80;
     s->m.origin = 1;
     s->m.control = 2;
     s->m.retract_r = 1;
@@ -78,7 +78,7 @@ static int ncp_stop_end(struct ncp_analyzer *a, int m)
     s->m.spindle_dir = 0;
     s->m.speed_override = 1;
     ncp_an_emit(a, NCP_C_SET_SPINDLE_MODE);
-    s->m.motion = 10;
+    s->m.motion = NCP_G1;
     if (s->m.mist) {
         ncp_an_emit(a, NCP_C_MIST_OFF);
         s->m.mist = 0;
@@ -87,7 +87,7 @@ static int ncp_stop_end(struct ncp_analyzer *a, int m)
         ncp_an_emit(a, NCP_C_FLOOD_OFF);
         s->m.flood = 0;
     }
-    if (m == 30)
+    if (m == NCP_M30)
         ncp_an_emit(a, NCP_C_PALLET_SHUTTLE);
     ncp_an_emit(a, NCP_C_PROGRAM_END);
     if (a->src && a->src->has_percent && a->src->end >= a->src->len)
@@ -103,20 +103,20 @@ static int ncp_stop_end(struct ncp_analyzer *a, int m)
  * that gets here stood after other words, which rs274 calls a bug of its own. */
 int ncp_stop_run(struct ncp_analyzer *a, int m)
 {
-    int rc = ncp_comp_stop(a, m == 2 || m == 30 || m == 99);
+    int rc = ncp_comp_stop(a, m == NCP_M2 || m == NCP_M30 || m == NCP_M99);
     if (rc != NCP_OK)
         return rc;
-    if (m == 99 && ncp_flow_call_depth(a->flow) > 0)
+    if (m == NCP_M99 && ncp_flow_call_depth(a->flow) > 0)
         return ncp_an_error(a, a->w.mcol[NCP_MG_STOP],
                             "Bug:  Reached convert_stop() from M99 as subprogram return");
     switch (m) {
-    case 0:
+    case NCP_M0:
         ncp_an_emit(a, NCP_C_PROGRAM_STOP);
         return NCP_OK;
-    case 1:
+    case NCP_M1:
         ncp_an_emit(a, NCP_C_OPTIONAL_PROGRAM_STOP);
         return NCP_OK;
-    case 60:
+    case NCP_M60:
         ncp_an_emit(a, NCP_C_PALLET_SHUTTLE);
         ncp_an_emit(a, NCP_C_PROGRAM_STOP);
         return NCP_OK;

@@ -273,7 +273,7 @@ static int ncp_tools_m61(struct ncp_analyzer *a)
 int ncp_tools_change(struct ncp_analyzer *a)
 {
     struct ncp_state *s = &a->st;
-    if (a->w.m[NCP_MG_TOOL] == 61)
+    if (a->w.m[NCP_MG_TOOL] == NCP_M61)
         return ncp_tools_m61(a);
     /* No "Txx missing" check: rs274 starts with tool 0 selected, so an M6
      * before any T empties the spindle as T0 M6 does. */

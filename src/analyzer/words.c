@@ -29,37 +29,40 @@ static pthread_once_t ncp_g_group_once = PTHREAD_ONCE_INIT;
 static void ncp_g_table_init(void)
 {
     static const struct { int16_t code; int8_t group; } tab[] = {
-        {40, NCP_GG_NONMODAL}, {100, NCP_GG_NONMODAL}, {280, NCP_GG_NONMODAL},
-        {281, NCP_GG_NONMODAL}, {300, NCP_GG_NONMODAL}, {301, NCP_GG_NONMODAL},
-        {520, NCP_GG_NONMODAL}, {530, NCP_GG_NONMODAL}, {920, NCP_GG_NONMODAL},
-        {921, NCP_GG_NONMODAL}, {922, NCP_GG_NONMODAL}, {923, NCP_GG_NONMODAL},
-        {53, NCP_GG_NONMODAL}, /* G5.3: draw the G5.2 points */
-        {0, NCP_GG_MOTION}, {10, NCP_GG_MOTION}, {20, NCP_GG_MOTION}, {30, NCP_GG_MOTION},
-        {382, NCP_GG_MOTION}, {383, NCP_GG_MOTION}, {384, NCP_GG_MOTION},
-        {385, NCP_GG_MOTION}, {730, NCP_GG_MOTION}, {740, NCP_GG_MOTION}, {800, NCP_GG_MOTION},
-        {810, NCP_GG_MOTION}, {820, NCP_GG_MOTION}, {830, NCP_GG_MOTION},
-        {840, NCP_GG_MOTION}, {850, NCP_GG_MOTION}, {860, NCP_GG_MOTION},
-        {870, NCP_GG_MOTION}, {880, NCP_GG_MOTION}, {890, NCP_GG_MOTION},
-        {330, NCP_GG_MOTION}, {331, NCP_GG_MOTION}, {760, NCP_GG_MOTION},
-        {50, NCP_GG_MOTION}, {51, NCP_GG_MOTION}, {52, NCP_GG_MOTION},
+        {NCP_G4, NCP_GG_NONMODAL}, {NCP_G10, NCP_GG_NONMODAL}, {NCP_G28, NCP_GG_NONMODAL},
+        {NCP_G28_1, NCP_GG_NONMODAL}, {NCP_G30, NCP_GG_NONMODAL}, {NCP_G30_1, NCP_GG_NONMODAL},
+        {NCP_G52, NCP_GG_NONMODAL}, {NCP_G53, NCP_GG_NONMODAL}, {NCP_G92, NCP_GG_NONMODAL},
+        {NCP_G92_1, NCP_GG_NONMODAL}, {NCP_G92_2, NCP_GG_NONMODAL},
+        {NCP_G92_3, NCP_GG_NONMODAL},
+        {NCP_G5_3, NCP_GG_NONMODAL}, /* G5.3: draw the G5.2 points */
+        {NCP_G0, NCP_GG_MOTION}, {NCP_G1, NCP_GG_MOTION}, {NCP_G2, NCP_GG_MOTION},
+        {NCP_G3, NCP_GG_MOTION}, {NCP_G38_2, NCP_GG_MOTION}, {NCP_G38_3, NCP_GG_MOTION},
+        {NCP_G38_4, NCP_GG_MOTION}, {NCP_G38_5, NCP_GG_MOTION}, {NCP_G73, NCP_GG_MOTION},
+        {NCP_G74, NCP_GG_MOTION}, {NCP_G80, NCP_GG_MOTION}, {NCP_G81, NCP_GG_MOTION},
+        {NCP_G82, NCP_GG_MOTION}, {NCP_G83, NCP_GG_MOTION}, {NCP_G84, NCP_GG_MOTION},
+        {NCP_G85, NCP_GG_MOTION}, {NCP_G86, NCP_GG_MOTION}, {NCP_G87, NCP_GG_MOTION},
+        {NCP_G88, NCP_GG_MOTION}, {NCP_G89, NCP_GG_MOTION}, {NCP_G33, NCP_GG_MOTION},
+        {NCP_G33_1, NCP_GG_MOTION}, {NCP_G76, NCP_GG_MOTION}, {NCP_G5, NCP_GG_MOTION},
+        {NCP_G5_1, NCP_GG_MOTION}, {NCP_G5_2, NCP_GG_MOTION},
         /* lathe profile cycles (g7x.c) */
-        {700, NCP_GG_MOTION}, {710, NCP_GG_MOTION}, {711, NCP_GG_MOTION},
-        {712, NCP_GG_MOTION}, {720, NCP_GG_MOTION}, {721, NCP_GG_MOTION},
-        {722, NCP_GG_MOTION},
-        {170, NCP_GG_PLANE}, {180, NCP_GG_PLANE}, {190, NCP_GG_PLANE},
-        {171, NCP_GG_PLANE}, {181, NCP_GG_PLANE}, {191, NCP_GG_PLANE},
-        {900, NCP_GG_DIST}, {910, NCP_GG_DIST}, {901, NCP_GG_ARCDIST}, {911, NCP_GG_ARCDIST},
-        {930, NCP_GG_FEEDMODE}, {940, NCP_GG_FEEDMODE}, {950, NCP_GG_FEEDMODE},
-        {200, NCP_GG_UNITS}, {210, NCP_GG_UNITS},
-        {400, NCP_GG_COMP}, {410, NCP_GG_COMP}, {411, NCP_GG_COMP}, {420, NCP_GG_COMP},
-        {421, NCP_GG_COMP},
-        {430, NCP_GG_TLO}, {431, NCP_GG_TLO}, {432, NCP_GG_TLO}, {490, NCP_GG_TLO},
-        {980, NCP_GG_RETRACT}, {990, NCP_GG_RETRACT},
-        {540, NCP_GG_COORD}, {550, NCP_GG_COORD}, {560, NCP_GG_COORD},
-        {570, NCP_GG_COORD}, {580, NCP_GG_COORD}, {590, NCP_GG_COORD},
-        {591, NCP_GG_COORD}, {592, NCP_GG_COORD}, {593, NCP_GG_COORD},
-        {610, NCP_GG_CONTROL}, {611, NCP_GG_CONTROL}, {640, NCP_GG_CONTROL},
-        {960, NCP_GG_SPINDLE}, {970, NCP_GG_SPINDLE}, {70, NCP_GG_LATHE}, {80, NCP_GG_LATHE},
+        {NCP_G70, NCP_GG_MOTION}, {NCP_G71, NCP_GG_MOTION}, {NCP_G71_1, NCP_GG_MOTION},
+        {NCP_G71_2, NCP_GG_MOTION}, {NCP_G72, NCP_GG_MOTION}, {NCP_G72_1, NCP_GG_MOTION},
+        {NCP_G72_2, NCP_GG_MOTION},
+        {NCP_G17, NCP_GG_PLANE}, {NCP_G18, NCP_GG_PLANE}, {NCP_G19, NCP_GG_PLANE},
+        {NCP_G17_1, NCP_GG_PLANE}, {NCP_G18_1, NCP_GG_PLANE}, {NCP_G19_1, NCP_GG_PLANE},
+        {NCP_G90, NCP_GG_DIST}, {NCP_G91, NCP_GG_DIST}, {NCP_G90_1, NCP_GG_ARCDIST},
+        {NCP_G91_1, NCP_GG_ARCDIST}, {NCP_G93, NCP_GG_FEEDMODE}, {NCP_G94, NCP_GG_FEEDMODE},
+        {NCP_G95, NCP_GG_FEEDMODE}, {NCP_G20, NCP_GG_UNITS}, {NCP_G21, NCP_GG_UNITS},
+        {NCP_G40, NCP_GG_COMP}, {NCP_G41, NCP_GG_COMP}, {NCP_G41_1, NCP_GG_COMP},
+        {NCP_G42, NCP_GG_COMP}, {NCP_G42_1, NCP_GG_COMP},
+        {NCP_G43, NCP_GG_TLO}, {NCP_G43_1, NCP_GG_TLO}, {NCP_G43_2, NCP_GG_TLO},
+        {NCP_G49, NCP_GG_TLO}, {NCP_G98, NCP_GG_RETRACT}, {NCP_G99, NCP_GG_RETRACT},
+        {NCP_G54, NCP_GG_COORD}, {NCP_G55, NCP_GG_COORD}, {NCP_G56, NCP_GG_COORD},
+        {NCP_G57, NCP_GG_COORD}, {NCP_G58, NCP_GG_COORD}, {NCP_G59, NCP_GG_COORD},
+        {NCP_G59_1, NCP_GG_COORD}, {NCP_G59_2, NCP_GG_COORD}, {NCP_G59_3, NCP_GG_COORD},
+        {NCP_G61, NCP_GG_CONTROL}, {NCP_G61_1, NCP_GG_CONTROL}, {NCP_G64, NCP_GG_CONTROL},
+        {NCP_G96, NCP_GG_SPINDLE}, {NCP_G97, NCP_GG_SPINDLE}, {NCP_G7, NCP_GG_LATHE},
+        {NCP_G8, NCP_GG_LATHE},
     };
     memset(ncp_g_group, -1, sizeof ncp_g_group);
     for (size_t k = 0; k < sizeof tab / sizeof tab[0]; k++)
@@ -75,14 +78,17 @@ static int ncp_m_group(int m)
 {
     switch (m) {
     /* M99: a return where it is first on a line in a sub (flow.c); else an end */
-    case 0: case 1: case 2: case 30: case 60: case 99: return NCP_MG_STOP;
-    case 6: case 61: return NCP_MG_TOOL;
-    case 3: case 4: case 5: case 19:
-    case 70: case 71: case 72: case 73: /* rs274's group 7 holds M70-M73 too */
+    case NCP_M0: case NCP_M1: case NCP_M2: case NCP_M30: case NCP_M60: case NCP_M99:
+        return NCP_MG_STOP;
+    case NCP_M6: case NCP_M61: return NCP_MG_TOOL;
+    case NCP_M3: case NCP_M4: case NCP_M5: case NCP_M19:
+    case NCP_M70: case NCP_M71: case NCP_M72: case NCP_M73: /* rs274's group 7 holds M70-M73 too */
         return NCP_MG_SPINDLE;
-    case 7: case 8: case 9: return NCP_MG_COOLANT;
-    case 48: case 49: case 50: case 51: case 52: case 53: return NCP_MG_OVERRIDE;
-    case 62: case 63: case 64: case 65: case 66: case 67: case 68: return NCP_MG_IO;
+    case NCP_M7: case NCP_M8: case NCP_M9: return NCP_MG_COOLANT;
+    case NCP_M48: case NCP_M49: case NCP_M50: case NCP_M51: case NCP_M52: case NCP_M53:
+        return NCP_MG_OVERRIDE;
+    case NCP_M62: case NCP_M63: case NCP_M64: case NCP_M65: case NCP_M66: case NCP_M67: case NCP_M68:
+        return NCP_MG_IO;
     default: return -1;
     }
 }
@@ -118,9 +124,9 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
     int g = (int)ncp_g_group[code]; /* -1: no such code */
     if (g < 0)
         return ncp_an_error(a, col, "Unknown g code used");
-    if (code == 800 && w->g[g] != -1)
+    if (code == NCP_G80 && w->g[g] != -1)
         return NCP_OK;
-    if (w->g[g] != -1 && w->g[g] != 800)
+    if (w->g[g] != -1 && w->g[g] != NCP_G80)
         return ncp_an_error(a, col, "Two g codes used from same modal group");
     w->g[g] = (int16_t)code;
     w->gcol[g] = col;

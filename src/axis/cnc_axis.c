@@ -1,5 +1,5 @@
 /* cnc-axis --axis L --config INI [--lcm-url URL] [--trace CSV]: one low-level
- * axis controller of the distributed NCK (seed 002). It advertises its axis,
+ * axis controller of the distributed NCK (the distributed-NCK paper). It advertises its axis,
  * waits for the HLC (cnc-run run --backend lcm), then runs the axis's
  * position loop on the simulated servo at the HLC's setpoints (ADCBI DP5), or
  * interpolating the records the HLC's planner starts (ADCBI DP4; DP3 after
@@ -11,6 +11,7 @@
  * (exit 3, after a ramp to standstill). */
 #include "axis.h"
 #include "ncp_version.h"
+#include "ncpar/num.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -71,13 +72,11 @@ struct opts {
 
 static int number(const char *opt, const char *v, double lo, double hi, double *out)
 {
-    char *end;
-    double x = strtod(v, &end);
-    if (end == v || *end || !(x >= lo && x <= hi))
-        return fprintf(stderr, "cnc-axis: %s is a number from %g to %g, not '%s'\n", opt, lo, hi,
-                       v), -1;
-    *out = x;
-    return 0;
+    char why[160];
+    if (ncp_num_double(v, lo, hi, out) == 0)
+        return 0;
+    ncp_num_why(why, sizeof why, opt, v, lo, hi);
+    return fprintf(stderr, "cnc-axis: %s\n", why), -1;
 }
 
 static int parse(int argc, char **argv, struct opts *o)

@@ -27,6 +27,7 @@
  * step after a gap is limited and counted), and every stop is a ramp at
  * MAX_ACCELERATION from the velocity the axis has, never a jump. */
 #include "axis.h"
+#include "ncpar/clock.h"
 
 #include <math.h>
 #include <string.h>
@@ -34,9 +35,7 @@
 
 int64_t llc_now(void)
 {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+    return ncp_mono_ns();
 }
 
 static void on_fine(struct llc *l, const uint8_t *p, size_t len)

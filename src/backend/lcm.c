@@ -1,4 +1,4 @@
-/* The distributed NCK's high-level end (seed 002): the position loop's
+/* The distributed NCK's high-level end (the distributed-NCK paper): the position loop's
  * setpoints go to one cnc-axis LLC per axis over LCM, and the actual positions
  * come back in their statuses. Implemented: ADCBI DP5 (fineIPObuf, a message
  * every servo period carrying every axis), the block-level DP4 (ACCDECbuf:

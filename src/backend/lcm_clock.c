@@ -2,21 +2,15 @@
 #include "lcm_clock.h"
 
 #include "ncpar/dist.h"
+#include "ncpar/clock.h"
 
 #include <poll.h>
 #include <string.h>
 #include <time.h>
 
-static int64_t mono(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
-}
-
 int64_t lcm_clock_now(const struct lcm_clock *c)
 {
-    return mono() + c->off_ns;
+    return ncp_mono_ns() + c->off_ns;
 }
 
 static void answer(struct lcm_clock *c, const uint8_t *p, size_t len, int64_t t2)
@@ -47,7 +41,7 @@ static void *clock_main(void *arg)
         /* stamped as each is read, not on waking: one read after others
          * waited in the queue, which lengthens its round trip (and the LLC
          * then trusts it less); stamped early, the wait would shorten it */
-        while (ncp_msg_take(c->io.msg, mono(), &sub, &p, &len) == 1)
+        while (ncp_msg_take(c->io.msg, ncp_mono_ns(), &sub, &p, &len) == 1)
             answer(c, p, len, lcm_clock_now(c));
     }
     return NULL;

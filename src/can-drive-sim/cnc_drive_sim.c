@@ -10,6 +10,8 @@
 
 #include "drive.h"
 #include "ncp_version.h"
+#include "ncpar/clock.h"
+#include "ncpar/num.h"
 
 static volatile sig_atomic_t stop;
 
@@ -48,14 +50,13 @@ static void usage(FILE *f)
 
 static long num(const char *s, const char *opt, long lo, long hi)
 {
-    char *end;
-    long v = strtol(s, &end, 0);
-    if (*s == '\0' || *end != '\0' || v < lo || v > hi) {
-        fprintf(stderr, "cnc-drive-sim: %s wants a number in %ld..%ld, not '%s'\n", opt, lo,
-                hi, s);
-        exit(1);
-    }
-    return v;
+    char why[160];
+    long v;
+    if (ncp_num_long(s, 0, lo, hi, &v) == 0)
+        return v;
+    ncp_num_why(why, sizeof why, opt, s, (double)lo, (double)hi);
+    fprintf(stderr, "cnc-drive-sim: %s\n", why);
+    exit(1);
 }
 
 static const char *parse(int argc, char **argv, struct drive_opts *o)
@@ -107,13 +108,6 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
     return argv[optind];
 }
 
-static long long now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
-}
-
 int main(int argc, char **argv)
 {
     static struct drive dv;
@@ -133,7 +127,7 @@ int main(int argc, char **argv)
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     drive_boot(&dv);
-    long long next_hb = now_ms();
+    long long next_hb = ncp_mono_ms();
     uint32_t ids[6], listening[6];
     size_t n_listening = 0;
     int rc = 0;
@@ -149,7 +143,7 @@ int main(int argc, char **argv)
             memcpy(listening, ids, n_ids * sizeof ids[0]);
             n_listening = n_ids;
         }
-        long long t = now_ms();
+        long long t = ncp_mono_ms();
         if (drive_guard_tick(&dv, t) < 0) {
             rc = 1;
             break;
@@ -171,7 +165,7 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
-        if (r > 0 && drive_on_frame(&dv, &f, now_ms()) < 0) {
+        if (r > 0 && drive_on_frame(&dv, &f, ncp_mono_ms()) < 0) {
             rc = 1;
             break;
         }

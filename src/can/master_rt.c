@@ -8,12 +8,11 @@
 #include <time.h>
 
 #include "ncpar/can.h"
+#include "ncpar/clock.h"
 
 int64_t ncp_co_now_ms(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+    return ncp_mono_ms();
 }
 
 static void set_bus_fault(struct ncp_co_master *m, uint32_t cob, int err)

@@ -4,6 +4,7 @@
 
 #include "bytes.h"
 #include "ncpar/can.h"
+#include "ncpar/clock.h"
 
 /* Command specifiers of byte 0. */
 #define CS_UPLOAD_REQ     0x40u
@@ -99,13 +100,6 @@ const char *ncp_sdo_abort_text(uint32_t code)
     return "unknown abort code";
 }
 
-static int64_t now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
-}
-
 /* Sends req and waits for the server's frame about the same object. */
 static int sdo_exchange(struct ncp_can_bus *bus, uint8_t node, const struct ncp_can_frame *req,
                         struct ncp_can_frame *resp, int timeout_ms, const char *what,
@@ -119,9 +113,9 @@ static int sdo_exchange(struct ncp_can_bus *bus, uint8_t node, const struct ncp_
     int rc = ncp_can_send(bus, req, d);
     if (rc != NCP_OK)
         return rc;
-    int64_t deadline = now_ms() + timeout_ms;
+    int64_t deadline = ncp_mono_ms() + timeout_ms;
     for (;;) {
-        int64_t left = deadline - now_ms();
+        int64_t left = deadline - ncp_mono_ms();
         if (left <= 0)
             return ncp_diag_set(d, NCP_ERR_IO, 0, 0,
                                 "node %u: SDO %s 0x%04X:%02X: no answer within %d ms",

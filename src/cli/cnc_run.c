@@ -11,6 +11,7 @@
 #include "signals.h"
 #include "serve.h"
 #include "ncp_version.h"
+#include "ncpar/num.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -160,17 +161,6 @@ struct parse_opts {
     struct ncp_analyzer_cfg acfg;
 };
 
-static int parse_int(const char *s, int lo, int hi, int *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || end == s || v < lo || v > hi)
-        return -1;
-    *out = (int)v;
-    return 0;
-}
-
 static int parse_args(int argc, char **argv, struct parse_opts *o)
 {
     static const struct option longopts[] = {
@@ -193,12 +183,12 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         switch (c) {
         case 'j':
             o->counts_given = 1;
-            if (parse_int(optarg, 0, NCP_MAX_LEXERS, &o->lexers))
+            if (ncp_num_int(optarg, 0, NCP_MAX_LEXERS, &o->lexers))
                 return fprintf(stderr, "cnc-run: -j wants 0..%d lexer threads (0: the analyzer lexes)\n", NCP_MAX_LEXERS), -1;
             break;
         case 'e':
             o->counts_given = 1;
-            if (parse_int(optarg, 0, NCP_MAX_EXECUTORS, &o->executors))
+            if (ncp_num_int(optarg, 0, NCP_MAX_EXECUTORS, &o->executors))
                 return fprintf(stderr, "cnc-run: --executors wants 0..%d (0: the output thread executes)\n", NCP_MAX_EXECUTORS), -1;
             break;
         case 'm':
@@ -213,7 +203,7 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         case 's': o->stats = 1; break;
         case 'I': o->inline_output = 1; break;
         case 'L':
-            if (parse_int(optarg, 1, 2000000000, &v))
+            if (ncp_num_int(optarg, 1, 2000000000, &v))
                 return fprintf(stderr, "cnc-run: --max-loops wants a positive count\n"), -1;
             o->acfg.max_loop_iterations = (uint32_t)v;
             break;

@@ -16,6 +16,7 @@
 #include "ncpar/msg.h"
 #include "ncpar/pipeline.h"
 #include "ncpar/nck.h"
+#include "ncpar/num.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -132,17 +133,6 @@ static void usage(FILE *f)
           f);
 }
 
-static int parse_num(const char *s, double lo, double hi, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || end == s || *end || !(v >= lo && v <= hi))
-        return -1;
-    *out = v;
-    return 0;
-}
-
 static int parse_opts(int argc, char **argv, struct run_opts *o)
 {
     static const struct option longopts[] = {
@@ -180,7 +170,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
         case 'S': o->sub_path = optarg; break;
         case 'b': o->backend = optarg; break;
         case 'D':
-            if (parse_num(optarg, 1, 5, &pct) || pct != floor(pct) || strchr(optarg, '.') ||
+            if (ncp_num_double(optarg, 1, 5, &pct) || pct != floor(pct) || strchr(optarg, '.') ||
                 strpbrk(optarg, "eE"))
                 return fprintf(stderr, "cnc-run run: --dp is a distribution point 1..5, not "
                                        "'%s'\n", optarg), -1;
@@ -199,17 +189,17 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
             o->channel[o->n_channels++] = optarg;
             break;
         case 'L':
-            if (parse_num(optarg, 1, 2000000000, &pct) || pct != floor(pct))
+            if (ncp_num_double(optarg, 1, 2000000000, &pct) || pct != floor(pct))
                 return fprintf(stderr, "cnc-run run: --max-loops wants a positive count\n"), -1;
             o->max_loops = (uint32_t)pct;
             break;
         case 'f':
-            if (parse_num(optarg, 1e-6, 1e9, &o->for_s))
+            if (ncp_num_double(optarg, 1e-6, 1e9, &o->for_s))
                 return fprintf(stderr, "cnc-run run: --for wants a positive number of seconds\n"), -1;
             break;
         case 'o':
             /* 0 % would never finish: a static override starts at 1 % */
-            if (parse_num(optarg, 1, 200, &pct))
+            if (ncp_num_double(optarg, 1, 200, &pct))
                 return fprintf(stderr, "cnc-run run: --feed-override wants 1..200 (%%)\n"), -1;
             o->feed_override = pct / 100.0;
             break;

@@ -5,6 +5,7 @@
  * fault, 4 no answer within the timeout. */
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -13,6 +14,7 @@
 
 #include "ctl.h"
 #include "ncp_version.h"
+#include "ncpar/num.h"
 
 #define MAX_WORDS 64
 
@@ -84,28 +86,6 @@ static int usage_error(const char *fmt, const char *arg)
     return CTL_USAGE;
 }
 
-static int parse_double(const char *s, double *v)
-{
-    char *end;
-    errno = 0;
-    double d = strtod(s, &end);
-    if (end == s || *end != 0 || errno != 0 || !isfinite(d))
-        return -1;
-    *v = d;
-    return 0;
-}
-
-static int parse_long(const char *s, long lo, long hi, long *v)
-{
-    char *end;
-    errno = 0;
-    long n = strtol(s, &end, 10);
-    if (end == s || *end != 0 || errno != 0 || n < lo || n > hi)
-        return -1;
-    *v = n;
-    return 0;
-}
-
 /* --name VALUE or --name=VALUE: the value, or NULL (and *i moved on). */
 static const char *opt_value(int argc, char **argv, int *i, const char *name)
 {
@@ -163,25 +143,27 @@ static int parse_args(int argc, char **argv, struct args *a)
                 return usage_error("%s needs a channel prefix", s);
         } else if (is_opt(s, "--timeout")) {
             v = opt_value(argc, argv, &i, "--timeout");
-            if (v == NULL || parse_double(v, &a->timeout) != 0 || a->timeout < 0)
+            if (v == NULL || ncp_num_double(v, 0, DBL_MAX, &a->timeout) != 0)
                 return usage_error("--timeout needs seconds (0 or more), not '%s'", v ? v : "");
         } else if (is_opt(s, "--channel")) {
             v = opt_value(argc, argv, &i, "--channel");
-            if (v == NULL || parse_long(v, 0, 127, &a->channel) != 0)
+            if (v == NULL || ncp_num_long(v, 10, 0, 127, &a->channel) != 0)
                 return usage_error("--channel needs an NC channel 0..127, not '%s'", v ? v : "");
         } else if (is_opt(s, "--from-line")) {
             v = opt_value(argc, argv, &i, "--from-line");
-            if (v == NULL || parse_long(v, 0, INT32_MAX, &a->from_line) != 0)
+            if (v == NULL || ncp_num_long(v, 10, 0, INT32_MAX, &a->from_line) != 0)
                 return usage_error("--from-line needs a line number, not '%s'", v ? v : "");
             a->opts |= OPT_FROM_LINE;
         } else if (is_opt(s, "--speed")) {
             v = opt_value(argc, argv, &i, "--speed");
-            if (v == NULL || parse_double(v, &a->speed) != 0 || a->speed <= 0)
+            if (v == NULL || ncp_num_double(v, -DBL_MAX, DBL_MAX, &a->speed) != 0 ||
+                a->speed <= 0)
                 return usage_error("--speed needs mm/min above 0, not '%s'", v ? v : "");
             a->opts |= OPT_SPEED;
         } else if (is_opt(s, "--distance")) {
             v = opt_value(argc, argv, &i, "--distance");
-            if (v == NULL || parse_double(v, &a->distance) != 0 || a->distance <= 0)
+            if (v == NULL || ncp_num_double(v, -DBL_MAX, DBL_MAX, &a->distance) != 0 ||
+                a->distance <= 0)
                 return usage_error("--distance needs mm above 0, not '%s'", v ? v : "");
             a->opts |= OPT_DISTANCE;
         } else {
@@ -306,9 +288,9 @@ static int run_set_input(struct ctl *c, const struct args *a)
     ncp_command_t cmd;
     long i, v;
     init_cmd(&cmd, NCP_COMMAND_T_SET_INPUT);
-    if (parse_long(a->words[0], 0, 63, &i) != 0)
+    if (ncp_num_long(a->words[0], 10, 0, 63, &i) != 0)
         return usage_error("set-input: a digital input 0..63, not '%s'", a->words[0]);
-    if (parse_long(a->words[1], 0, 1, &v) != 0)
+    if (ncp_num_long(a->words[1], 10, 0, 1, &v) != 0)
         return usage_error("set-input: the value is 0 or 1, not '%s'", a->words[1]);
     cmd.ivalue[0] = (int32_t)i;
     cmd.ivalue[1] = (int32_t)v;
@@ -378,7 +360,7 @@ static int run_override(struct ctl *c, const struct args *a)
     size_t n = strlen(pct);
     if (n > 0 && pct[n - 1] == '%')
         pct[n - 1] = 0;
-    if (parse_double(pct, &cmd.value[0]) != 0 || cmd.value[0] < 0)
+    if (ncp_num_double(pct, 0, DBL_MAX, &cmd.value[0]) != 0)
         return usage_error("override: a percentage (0 or more), not '%s'", a->words[1]);
     cmd.ivalue[0] = k;
     return ctl_command(c, &cmd);

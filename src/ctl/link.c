@@ -10,6 +10,7 @@
 
 #include "ctl.h"
 #include "ncpar/auth.h"
+#include "ncpar/clock.h"
 
 #define RESEND_S 0.5
 #define KEEPALIVE_FRESH_S 0.3  /* a keep-alive holds a jog this long (the NCK's limit) */
@@ -40,9 +41,7 @@ void ctl_catch_signals(void)
 
 double ctl_now(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+    return (double)ncp_mono_ns() * 1e-9;
 }
 
 static int64_t utime_now(void)

@@ -1,21 +1,12 @@
 /* --http's argument: [ADDR:]PORT. Only a numeric address: a name would need
  * a resolver at start and says less clearly which interface is exposed. */
 #include "ncpar/http.h"
+#include "ncpar/num.h"
 
 #include <arpa/inet.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int parse_port(const char *s, int *port)
-{
-    char *end;
-    long v = strtol(s, &end, 10);
-    if (!*s || *end || v < 1 || v > 65535)
-        return -1;
-    *port = (int)v;
-    return 0;
-}
 
 int ncp_http_parse_listen(const char *spec, struct ncp_http_opts *o, struct ncp_diag *d)
 {
@@ -43,7 +34,7 @@ int ncp_http_parse_listen(const char *spec, struct ncp_http_opts *o, struct ncp_
                      "--http: '%s' is no numeric IPv4 or [IPv6] address", host);
         return -1;
     }
-    if (parse_port(port, &o->port)) {
+    if (ncp_num_int(port, 1, 65535, &o->port)) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: '%s' is no port (1-65535)", port);
         return -1;
     }

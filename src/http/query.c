@@ -11,6 +11,7 @@
  * time (killed after PREVIEW_TIMEOUT_MS), in CPU time (RLIMIT_CPU) and in
  * output (CANON_MAX), niced below the service. */
 #include "server_int.h"
+#include "ncpar/clock.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -188,13 +189,6 @@ static int program(const struct ncp_http_prog *prog, struct ncp_http_msg *out)
     return finish(&b, bad, out);
 }
 
-static int64_t mono_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000;
-}
-
 /* The checked text where the child can open it by name: an unnamed file in
  * memory (nothing lands in the program folder, nothing outlives us). */
 static int text_file(const struct ncp_http_prog *prog)
@@ -258,10 +252,10 @@ static int run_parse(const char *self, const struct ncp_http_prog *prog, const a
         return snprintf(why, wl, "preview: cannot run %s: %s", self, strerror(rc)), -1;
     }
     bound_child(pid);
-    int64_t deadline = mono_ms() + PREVIEW_TIMEOUT_MS;
+    int64_t deadline = ncp_mono_ms() + PREVIEW_TIMEOUT_MS;
     int fail = 0;
     for (;;) {
-        int64_t left = deadline - mono_ms();
+        int64_t left = deadline - ncp_mono_ms();
         if (atomic_load(stop)) {
             fail = snprintf(why, wl, "preview: the panel is shutting down");
             break;

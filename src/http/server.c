@@ -20,6 +20,7 @@
  * than MAX_CONNS operators are connected, and a watcher without it still
  * sees the status for a moment (and is told it has no token). */
 #include "server_int.h"
+#include "ncpar/clock.h"
 
 #include <libwebsockets.h>
 #include <pthread.h>
@@ -112,13 +113,6 @@ struct ncp_http {
     size_t status_len;
     int64_t status_msg_seq;
 };
-
-static int64_t mono_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
-}
 
 static void count(struct ncp_http *h, uint64_t *field)
 {
@@ -575,7 +569,7 @@ static void submit(struct ncp_http *h, struct conn *c, const ncp_command_t *cmd)
 /* Token bucket per socket: 0 when this message may be taken. */
 static int over_rate(struct conn *c)
 {
-    int64_t now = mono_ns();
+    int64_t now = ncp_mono_ns();
     c->bucket += (double)(now - c->bucket_ns) * 1e-9 * RATE_PER_S;
     if (c->bucket > RATE_BURST)
         c->bucket = RATE_BURST;
@@ -721,7 +715,7 @@ static int on_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, 
         c->serial = ++h->next_serial;
         c->client_id = NCP_HTTP_CLIENT_TAG | (h->next_client++ & ~NCP_HTTP_CLIENT_MASK);
         c->bucket = RATE_BURST;
-        c->bucket_ns = mono_ns();
+        c->bucket_ns = ncp_mono_ns();
         c->next = h->conns;
         h->conns = c;
         if (c->authed)

@@ -2,6 +2,7 @@
  * tests script against them, so a spec that is not exactly one of them is an
  * error naming it, never a silent no-op. */
 #include "ncpar/inject.h"
+#include "ncpar/num.h"
 
 #include <errno.h>
 #include <math.h>
@@ -35,13 +36,7 @@ static int number(const char *s, size_t n, double lo, double hi, double *out)
         return -1;
     memcpy(buf, s, n);
     buf[n] = 0;
-    char *end;
-    errno = 0;
-    double v = strtod(buf, &end);
-    if (errno || *end || !(v >= lo && v <= hi))
-        return -1;
-    *out = v;
-    return 0;
+    return ncp_num_double(buf, lo, hi, out);
 }
 
 static int bad(char *why, size_t len, const char *spec, size_t n, const char *want)

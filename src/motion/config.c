@@ -6,6 +6,7 @@
 #include "ncpar/ini_keys.h"
 #include "ini_num.h"
 #include "kins_cfg.h"
+#include "ncpar/num.h"
 
 #include <errno.h>
 #include <ini.h>
@@ -174,13 +175,7 @@ int ncp_ini_number(const char *v, double lo, double hi, double *out)
 {
     if (!ncp_ini_decimal(v))
         return -1;
-    char *end;
-    errno = 0;
-    double x = strtod(v, &end);
-    if (errno || end == v || !isfinite(x) || x < lo || x > hi)
-        return -1;
-    *out = x;
-    return 0;
+    return ncp_num_double(v, lo, hi, out);
 }
 
 static int real(const char *v, double lo, double hi, double *out, const char *unit, char *why,

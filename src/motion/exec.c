@@ -1,5 +1,5 @@
 /* The interpolator on its own: runs segments whose profiles are frozen
- * (ncp_accdec, seed 002's ACCDECbuf), one sample per planning period. Time
+ * (ncp_accdec, the distributed-NCK paper's ACCDECbuf), one sample per planning period. Time
  * left over at a segment's end carries into the next so the path speed has no
  * gaps, except at a stop, where the end point itself is the sample (exact
  * stop). The planner feeds it as each segment starts (interp.c); an LLC at

@@ -341,8 +341,10 @@ static void ratio_limits(const struct ncp_planner *p, struct plan_seg *ps, doubl
 /* A corner parabola's turn loads each axis at a constant rate, exactly, so it
  * may take nearly all of the limit at the cruise cap: below the cap the
  * vector bound (parab_limits) leaves the tangent most of it again, and at
- * the cap the blend's speed need hardly change (bench: 0.99 rather than
- * 0.95 makes sharp 0.5 % faster and no program slower). */
+ * the cap the blend's speed need hardly change. The share is the turn's part
+ * of each axis's acceleration limit; arcs keep a wider margin. Chosen with
+ * bench-motion's programs, where a larger share made none slower
+ * (bench/RESULTS.md, "Planner against LinuxCNC 2.9's"). */
 #define PARAB_TURN_SHARE 0.99
 /* An uneven parabola is only ever run as its ramp: its axes accelerate at
  * exactly v0^2 curv_j throughout, and the tangent needs nothing beside it. */

@@ -2,6 +2,7 @@
  * program job; the position loop ends by itself once the plant has settled
  * after the program (or after --for's hold, or at a fault). */
 #include "nck_int.h"
+#include "ncpar/clock.h"
 
 #include <errno.h>
 #include <math.h>
@@ -29,13 +30,6 @@ struct precheck {
     int64_t t0, next_note;
 };
 
-static int64_t mono_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
-}
-
 /* A lower bound on the time a segment takes: blending may shorten a path a
  * little, which t_bound's margin covers. */
 static double seg_time(const struct precheck *pc, const struct ncp_seg *s)
@@ -52,7 +46,7 @@ static void note_progress(struct precheck *pc, uint32_t line)
 {
     if ((pc->blocks & 1023) != 0 || !pc->o->notes)
         return;
-    int64_t now = mono_ns();
+    int64_t now = ncp_mono_ns();
     if (now < pc->next_note)
         return;
     pc->next_note = now + 1000000000LL;
@@ -112,7 +106,7 @@ static enum precheck_end precheck(const struct ncp_nck_opts *o, const double sta
         pc->v_top += o->cfg->axis[j].max_vel * o->cfg->axis[j].max_vel;
     pc->v_top = sqrt(pc->v_top);
     pc->t_bound = o->for_s > 0 ? 2 * o->for_s + 1 : 0;
-    pc->t0 = mono_ns();
+    pc->t0 = ncp_mono_ns();
     pc->next_note = pc->t0 + 1000000000LL;
     struct ncp_output out = { .ctx = pc, .emit = emit_check };
     struct ncp_diag id;
@@ -223,8 +217,8 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o, struct batch_home
             atomic_fetch_add(&n->ctl->resume_go, 1);
             atomic_fetch_add(&n->ctl->tool_go, 1);
         }
-        if (o->progress && mono_ns() - last_print > 200000000) {
-            last_print = mono_ns();
+        if (o->progress && ncp_mono_ns() - last_print > 200000000) {
+            last_print = ncp_mono_ns();
             progress(n, o);
         }
         if (!got) {

@@ -2,6 +2,7 @@
  * does, and how the NCK moves on between commands (ncp_nck_poll). Runs on the
  * caller's thread only (the service thread). */
 #include "nck_int.h"
+#include "ncpar/clock.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -30,13 +31,6 @@ int ncp_nck_state_parse(const char *name)
         if (!strcmp(name, state_names[s]))
             return s;
     return -1;
-}
-
-static int64_t mono_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
 }
 
 static int refuse(char *reason, size_t len, const char *fmt, ...)
@@ -274,7 +268,7 @@ static void *load_main(void *arg)
     if (rc != NCP_OK && rc != NCP_END)
         snprintf(s->load_why, sizeof s->load_why, "%s:%u:%u: %s",
                  d.file ? d.file : s->load_path, d.line, d.col ? d.col : 1u, d.msg);
-    s->load_end_ns = mono_ns();
+    s->load_end_ns = ncp_mono_ns();
     atomic_store(&s->load_done, 1);
     return NULL;
 }
@@ -297,7 +291,7 @@ static void end_check(struct ncp_nck *s, int why)
 {
     int none = NCK_CHECK_RUNS;
     if (s->loading && atomic_compare_exchange_strong(&s->load_cancel, &none, why))
-        s->cancel_ns = mono_ns();
+        s->cancel_ns = ncp_mono_ns();
 }
 
 /* The answer of a check that has ended: 0 with the program taken, or -1
@@ -479,7 +473,7 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
         return refuse(why, len, "cannot start the jog");
     memcpy(n->map.pos, target, sizeof n->map.pos);
     s->jog_continuous = dist <= 0;
-    s->jog_last_ns = mono_ns();
+    s->jog_last_ns = ncp_mono_ns();
     set_state(s, NCP_ST_JOGGING);
     return 0;
 }
@@ -714,7 +708,7 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
         break;
     case NCP_CMD_SET_INPUT: rc = cmd_set_input(s, c, why, len); break;
     case NCP_CMD_KEEPALIVE:
-        s->jog_last_ns = mono_ns();
+        s->jog_last_ns = ncp_mono_ns();
         rc = 0;
         break;
     default:
@@ -871,7 +865,7 @@ int ncp_nck_poll(struct ncp_nck *s)
     }
     if (s->state == NCP_ST_JOGGING && s->jog_continuous && s->drop == NCK_DROP_NONE) {
         double limit = n->setup.jog_keepalive_s > 0 ? n->setup.jog_keepalive_s : 0.3;
-        if ((double)(mono_ns() - s->jog_last_ns) * 1e-9 > limit) {
+        if ((double)(ncp_mono_ns() - s->jog_last_ns) * 1e-9 > limit) {
             nck_post(n, NCP_EV_INFO, NULL, 0, 0,
                      "jog stopped: no keep-alive from its client for %.1f s", limit);
             begin_drop(s, 1, 0, NCP_ST_IDLE, 0);

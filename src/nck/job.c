@@ -5,6 +5,7 @@
 #include "nck_int.h"
 
 #include "ncpar/executor.h"
+#include "ncpar/clock.h"
 
 #include <math.h>
 #include <sched.h>
@@ -36,7 +37,7 @@ static int push_wait(struct nck *n, const struct nck_seg_msg *m)
     int rc = ring_push(n, &n->segs, m);
     if (n->trace_rings) {
         static _Thread_local int64_t last;
-        int64_t now = nck_mono_ns();
+        int64_t now = ncp_mono_ns();
         if (last)
             atomic_store_explicit(&n->job_cycle_ns, now - last, memory_order_relaxed);
         last = now;

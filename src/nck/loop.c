@@ -3,6 +3,7 @@
  * No allocation, locks or I/O: requests from other threads arrive as atomic
  * counters and are answered the same way. */
 #include "nck_int.h"
+#include "ncpar/clock.h"
 
 #include <math.h>
 #include <string.h>
@@ -224,7 +225,7 @@ static void ring_columns(struct nck *n, int64_t now_ns, struct nck_fb *fb)
     fb->plan_resp_ns = atomic_load_explicit(&n->plan_resp_ns, memory_order_relaxed);
     fb->plan_cycle_ns = atomic_load_explicit(&n->plan_cycle_ns, memory_order_relaxed);
     fb->job_cycle_ns = atomic_load_explicit(&n->job_cycle_ns, memory_order_relaxed);
-    int64_t t = n->setup.virtual_clock ? now_ns : nck_mono_ns();
+    int64_t t = n->setup.virtual_clock ? now_ns : ncp_mono_ns();
     fb->loop_cycle_ns = n->loop_last_ns ? t - n->loop_last_ns : 0;
     n->loop_last_ns = t;
 }

@@ -595,7 +595,6 @@ int nck_read_cycles(struct nck *n);
 void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints, int rings);
 /* sched.c: [SCHED] for this NCK (task 0 the job thread, 1 the planner) */
 void nck_sched_setup(struct nck *n);
-int64_t nck_mono_ns(void);
 int nck_sched_start(struct nck *n);
 void nck_sched_enter(struct nck *n, int task);
 void nck_sched_leave(struct nck *n, int task);

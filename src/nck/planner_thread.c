@@ -1,6 +1,7 @@
 /* The planner/interpolator thread: segments in, one setpoint per planning
  * period out. It lives as long as the NCK; between jobs it waits. */
 #include "nck_int.h"
+#include "ncpar/clock.h"
 
 #include <math.h>
 #include <sched.h>
@@ -13,13 +14,6 @@ static void nap_ns(long ns)
 {
     struct timespec ts = { 0, ns };
     nanosleep(&ts, NULL);
-}
-
-static int64_t mono_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
 }
 
 /* END and SYNC both make the planner run what it has to a stop; after the
@@ -59,7 +53,7 @@ static int may_step(struct nck *n, int finishing, int64_t *wait_since)
         return 0;
     if (!nck_plan_idle(n))
         return 1;
-    int64_t now = mono_ns();
+    int64_t now = ncp_mono_ns();
     if (!*wait_since)
         *wait_since = now;
     return now - *wait_since > START_WAIT_NS;
@@ -113,7 +107,7 @@ void *nck_planner_main(void *arg)
             continue;
         }
         struct ncp_setpoint sp;
-        int64_t t0 = n->trace_rings ? mono_ns() : 0;
+        int64_t t0 = n->trace_rings ? ncp_mono_ns() : 0;
         int more = nck_plan_step(n, &sp);
         if (!more) {
             /* the stop's sample: the machine functions due there; an AUX
@@ -126,7 +120,7 @@ void *nck_planner_main(void *arg)
         ncp_spsc_push(&n->sps, &sp);
         if (n->trace_rings) {
             /* response: one step's work; cycle: from one setpoint to the next */
-            int64_t t1 = mono_ns();
+            int64_t t1 = ncp_mono_ns();
             atomic_store_explicit(&n->plan_resp_ns, t1 - t0, memory_order_relaxed);
             if (last_step)
                 atomic_store_explicit(&n->plan_cycle_ns, t1 - last_step, memory_order_relaxed);

@@ -1,4 +1,4 @@
-/* [SCHED] for one NCK: the soft-RT tasks of seed 000's chain (the
+/* [SCHED] for one NCK: the soft-RT tasks of the task-scheduling paper's chain (the
  * interpreter pipeline's threads, the job thread that hands its commands on,
  * the planner), their priorities below the position loop, and what they ran
  * at for the summary. The position loop itself is never touched. */
@@ -43,13 +43,6 @@ static size_t sps_fill(void *ctx)
 static int applies(const struct nck *n)
 {
     return n->cfg->sched.strategy != NCP_SCHED_NONE && !n->setup.virtual_clock;
-}
-
-int64_t nck_mono_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
 }
 
 /* Static: by distance from the position loop along the whole chain, the

@@ -7,6 +7,7 @@
 
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
+#include "ncpar/clock.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -50,13 +51,6 @@ struct serve {
     int fault_seen;
     const struct ncp_nck_serve_hook *hook;   /* another front end, or NULL */
 };
-
-static int64_t mono_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
-}
 
 static int64_t utime_now(void)
 {
@@ -457,7 +451,7 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
     /* STATUS_HZ 0: no periodic status (state changes and acks still send one) */
     double hz = cfg->lcm.status_hz;
     int64_t period = hz > 0 ? (int64_t)llround(1e9 / hz) : INT64_MAX / 4;
-    int64_t next_status = hz > 0 ? mono_ns() : INT64_MAX / 2;
+    int64_t next_status = hz > 0 ? ncp_mono_ns() : INT64_MAX / 2;
     int stopping = 0, spread = 0;
     if (o->ready)
         o->ready(o->ctx, prefix);
@@ -467,7 +461,7 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
             for (int k = 0; k < n; k++)
                 ncp_nck_request_shutdown(sv->ch[k].nck);
         }
-        int64_t now = mono_ns();
+        int64_t now = ncp_mono_ns();
         int64_t wait_ms = (next_status - now) / 1000000;
         if (wait_ms > 5)
             wait_ms = 5;   /* the NCK is polled at least every 5 ms */
@@ -481,7 +475,7 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
         ncp_command_t hc;
         while (sv->hook && sv->hook->next_command && sv->hook->next_command(sv->hook->ctx, &hc))
             take_command(sv, &hc, 1);
-        now = mono_ns();
+        now = ncp_mono_ns();
         int due = now >= next_status;
         for (int k = 0; k < n; k++) {
             if (sv->ch[k].pending)

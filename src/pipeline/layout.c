@@ -14,10 +14,11 @@
  *     bytes * serial cost per byte * (1 - 1 / speed-up)  >  start cost,
  *
  * and the threshold sits well above that point, so that a program just past
- * it gains clearly rather than breaking even within the noise. Measured on
- * 2 CPUs (bench/size-curve): the two-thread layout breaks even at about
- * 2-3 MB of CAM text (70,000-100,000 blocks of ~29 bytes) on a quiet host;
- * from 8 MB on it wins by a margin that shows. */
+ * it gains clearly rather than breaking even within the noise.
+ * PARALLEL_FROM_BYTES_2CPU is that threshold for a machine with two usable
+ * CPUs, in bytes of program text: bench/size-curve measures the break-even
+ * point, and bench/RESULTS.md ("Program size") records it with the machine
+ * and date the constant was chosen from. */
 #define PARALLEL_FROM_BYTES_2CPU ((size_t)8 << 20)
 
 int ncp_cpus_usable(void)

@@ -1,7 +1,7 @@
 /* A pre-started pipeline: the threads of a thread map are created once and run
- * program after program. Seed 001 times each run with thread creation; a user
- * interpreting many short programs (or a benchmark that wants the pipeline's
- * own speed) should not pay it every time. Every run uses the very stage code
+ * program after program. The interpreter-pipeline paper times each run with
+ * thread creation; a user interpreting many short programs (or a benchmark
+ * that wants the pipeline's own speed) should not pay it every time. Every run uses the very stage code
  * of ncp_pipeline_run, on rings reset between runs, so its output and errors
  * are the same. */
 #include "pipe.h"

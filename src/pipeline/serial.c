@@ -5,6 +5,7 @@
 #include "ncpar/pipeline.h"
 #include "emit.h"
 #include "ncpar/blocks.h"
+#include "ncpar/clock.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -48,18 +49,11 @@ static void serial_publish(void *ctx, struct ncp_cmd *cmd)
         s->stopped = 1;
 }
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
-}
-
 int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *acfg,
                    const struct ncp_output *out, struct ncp_run_stats *stats,
                    struct ncp_diag *d)
 {
-    double t0 = now_ms();
+    double t0 = (double)ncp_mono_ns() / 1e6;
     struct ncp_text_feed *feed = malloc(sizeof *feed);
     struct serial_sink *sink = malloc(sizeof *sink);
     struct ncp_analyzer *an = NULL;
@@ -107,7 +101,7 @@ done:
     if (stats) {
         stats->blocks = feed ? feed->blocks : 0;
         stats->commands = sink ? sink->emitted : 0;
-        stats->wall_ms = now_ms() - t0;
+        stats->wall_ms = (double)ncp_mono_ns() / 1e6 - t0;
         stats->threads = 1;
     }
     if (!acfg || an != acfg->instance)

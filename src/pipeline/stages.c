@@ -7,6 +7,7 @@
 #include "futex.h"
 #include "ncpar/executor.h"
 #include "ncpar/lex.h"
+#include "ncpar/clock.h"
 
 #include <stddef.h>
 #include <time.h>
@@ -20,7 +21,7 @@ static double clock_ms(clockid_t clock)
 
 double ncp_pipe_now_ms(void)
 {
-    return clock_ms(CLOCK_MONOTONIC);
+    return (double)ncp_mono_ns() / 1e6;
 }
 
 double ncp_pipe_thread_cpu_ms(void)

@@ -1,5 +1,6 @@
 /* Thread maps: built-in defaults per mode, and INI files (see rt-config). */
 #include "ncpar/pipeline.h"
+#include "ncpar/num.h"
 
 #include <errno.h>
 #include <ini.h>
@@ -126,17 +127,6 @@ static int fail(struct map_loader *L, int line, const char *fmt, ...)
     return 0;
 }
 
-static int parse_int(const char *s, long lo, long hi, int *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (end == s || *end != '\0' || errno != 0 || v < lo || v > hi)
-        return -1;
-    *out = (int)v;
-    return 0;
-}
-
 static const char *const pipe_keys[] = { "mode", "lexers", "executors", "string_rows",
                                          "parsed_rows", "cmd_slots", "start_timeout_us",
                                          "inline_output", "lex_ahead_bytes" };
@@ -162,12 +152,12 @@ static int pipeline_key(struct map_loader *L, const char *name, const char *valu
                         name);
         break;
     case 1:
-        if (parse_int(value, 0, NCP_MAX_LEXERS, &L->lexers))
+        if (ncp_num_int(value, 0, NCP_MAX_LEXERS, &L->lexers))
             return fail(L, L->line, "bad value '%s' for %s (0 to 16; 0: the analyzer lexes)",
                         value, name);
         break;
     case 2:
-        if (parse_int(value, 0, NCP_MAX_EXECUTORS, &L->executors))
+        if (ncp_num_int(value, 0, NCP_MAX_EXECUTORS, &L->executors))
             return fail(L, L->line, "bad value '%s' for %s (0 to 16; 0: the output thread executes)",
                         value, name);
         break;
@@ -175,22 +165,22 @@ static int pipeline_key(struct map_loader *L, const char *name, const char *valu
     case 4:
     case 5: {
         int *dst = k == 3 ? &L->string_rows : k == 4 ? &L->parsed_rows : &L->cmd_slots;
-        if (parse_int(value, 1, MAX_ROWS, dst))
+        if (ncp_num_int(value, 1, MAX_ROWS, dst))
             return fail(L, L->line, "bad value '%s' for %s (1 to 1048576)", value, name);
         break;
     }
     case 8:
-        if (parse_int(value, 0, MAX_LEX_AHEAD_BYTES, &L->lex_ahead))
+        if (ncp_num_int(value, 0, MAX_LEX_AHEAD_BYTES, &L->lex_ahead))
             return fail(L, L->line, "bad value '%s' for %s (0 to %d; 0: the output thread never lexes)",
                         value, name, MAX_LEX_AHEAD_BYTES);
         break;
     case 7:
-        if (parse_int(value, 0, 1, &L->inline_out))
+        if (ncp_num_int(value, 0, 1, &L->inline_out))
             return fail(L, L->line, "bad value '%s' for %s (0 or 1)", value, name);
         L->inline_line = L->line;
         break;
     default:
-        if (parse_int(value, 0, MAX_START_TIMEOUT_US, &L->timeout))
+        if (ncp_num_int(value, 0, MAX_START_TIMEOUT_US, &L->timeout))
             return fail(L, L->line, "bad value '%s' for %s (0 to 10000000)", value, name);
         break;
     }
@@ -204,7 +194,7 @@ static int spec_key(struct map_loader *L, struct loaded_spec *s, const char *sec
     if (!s->line)
         s->line = L->section_line;
     if (!strcmp(name, "cpu")) {
-        if (parse_int(value, -1, CPU_SETSIZE - 1, &s->v.cpu))
+        if (ncp_num_int(value, -1, CPU_SETSIZE - 1, &s->v.cpu))
             return fail(L, L->line, "bad value '%s' for cpu (-1 = any, or a CPU number)",
                         value);
         s->set |= KEY_CPU;
@@ -218,7 +208,7 @@ static int spec_key(struct map_loader *L, struct loaded_spec *s, const char *sec
                         value, name);
         s->set |= KEY_POLICY;
     } else if (!strcmp(name, "priority")) {
-        if (parse_int(value, 0, 99, &s->v.priority))
+        if (ncp_num_int(value, 0, 99, &s->v.priority))
             return fail(L, L->line, "bad value '%s' for %s (0 to 99)", value, name);
         s->set |= KEY_PRIORITY;
     } else {
@@ -234,7 +224,7 @@ static int section_index(const char *section, const char *prefix, int max)
     int idx;
     if (strncmp(section, prefix, n) != 0 || section[n] != '.')
         return -1;
-    if (parse_int(section + n + 1, 0, max - 1, &idx))
+    if (ncp_num_int(section + n + 1, 0, max - 1, &idx))
         return -1;
     return idx;
 }

@@ -2,6 +2,7 @@
  * done once, before the loop; inside the loop there is no allocation, no lock
  * and no I/O: only the clock, the cycle callback and the thread's own stats. */
 #include "ncpar/rt.h"
+#include "ncpar/clock.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -17,22 +18,10 @@
 #define NCP_RT_STACK_PREFAULT (64 * 1024)
 #define NS_PER_S 1000000000LL
 
-static int64_t ts_ns(const struct timespec *t)
-{
-    return (int64_t)t->tv_sec * NS_PER_S + t->tv_nsec;
-}
-
 static struct timespec ns_ts(int64_t ns)
 {
     struct timespec t = { (time_t)(ns / NS_PER_S), (long)(ns % NS_PER_S) };
     return t;
-}
-
-static int64_t mono_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return ts_ns(&t);
 }
 
 /* Touch the stack the loop will use so that its pages are resident (and,
@@ -66,7 +55,7 @@ static void run_virtual(struct ncp_rt_loop *l)
 static void run_real(struct ncp_rt_loop *l)
 {
     const int64_t period = l->cfg.period_ns;
-    const int64_t base = l->cfg.start_ns > 0 ? l->cfg.start_ns : mono_ns();
+    const int64_t base = l->cfg.start_ns > 0 ? l->cfg.start_ns : ncp_mono_ns();
     int64_t next = base;
     while (!atomic_load_explicit(&l->stop, memory_order_relaxed)) {
         next += period;
@@ -74,7 +63,7 @@ static void run_real(struct ncp_rt_loop *l)
         /* clock_nanosleep returns its error instead of setting errno */
         while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR)
             ;
-        int64_t late = mono_ns() - next;
+        int64_t late = ncp_mono_ns() - next;
         ncp_rt_stats_add(&l->stats, late);
         if (late > period) {
             /* skip the periods we slept through instead of running them back

@@ -1,5 +1,6 @@
 /* [SCHED] of the machine INI. */
 #include "ncpar/sched.h"
+#include "ncpar/num.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,16 +19,6 @@ const char *ncp_sched_strategy_name(enum ncp_sched_strategy s)
     return s == NCP_SCHED_STATIC ? "static" : s == NCP_SCHED_DATAFLOW ? "dataflow" : "none";
 }
 
-static int whole(const char *v, int lo, int hi, int *out)
-{
-    char *end;
-    long x = strtol(v, &end, 10);
-    if (end == v || *end || x < lo || x > hi)
-        return -1;
-    *out = (int)x;
-    return 0;
-}
-
 int ncp_sched_ini_key(struct ncp_sched_cfg *c, const char *k, const char *v, char *why,
                       size_t len)
 {
@@ -43,10 +34,10 @@ int ncp_sched_ini_key(struct ncp_sched_cfg *c, const char *k, const char *v, cha
         return 1;
     }
     if (!strcasecmp(k, "PERIOD_MS"))
-        return whole(v, 1, 1000, &c->period_ms) ? snprintf(why, len, "1..1000 ms"), -1 : 1;
+        return ncp_num_int(v, 1, 1000, &c->period_ms) ? snprintf(why, len, "1..1000 ms"), -1 : 1;
     if (!strcasecmp(k, "PRIORITY_MIN"))
-        return whole(v, 1, 97, &c->floor) ? snprintf(why, len, "1..97 (SCHED_FIFO)"), -1 : 1;
+        return ncp_num_int(v, 1, 97, &c->floor) ? snprintf(why, len, "1..97 (SCHED_FIFO)"), -1 : 1;
     if (!strcasecmp(k, "TRACE_RINGS"))
-        return whole(v, 0, 1, &c->trace_rings) ? snprintf(why, len, "0 or 1"), -1 : 1;
+        return ncp_num_int(v, 0, 1, &c->trace_rings) ? snprintf(why, len, "0 or 1"), -1 : 1;
     return 0;
 }

@@ -1,4 +1,4 @@
-/* The two priority assignments of seed 000, as pure functions of the chain. */
+/* The two priority assignments of the task-scheduling paper, as pure functions of the chain. */
 #include "ncpar/sched.h"
 
 static int clamp(int p, int floor, int ceiling)
@@ -18,7 +18,7 @@ void ncp_sched_static(int n, int floor, int ceiling, int *prio)
 }
 
 /* Input waiting minus output ready, both as shares of their rings: the
- * seed's difference of upstream and downstream data, made comparable
+ * task-scheduling paper's difference of upstream and downstream data, made comparable
  * between rings of different sizes. */
 static double pressure(const struct ncp_sched_fill *f)
 {

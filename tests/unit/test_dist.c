@@ -20,7 +20,8 @@ static void fine_round_trip(void **state)
     struct ncp_dist_fine f = { 42, NCP_DIST_HLC_ID, 123456789000LL, 3, { -5, 2147483647, -2147483647 - 1 } };
     uint8_t buf[256];
     int n = ncp_dist_encode_fine(buf, sizeof buf, &f);
-    /* the payload of seed 002's fineIPObuf is 4N; ours adds fingerprint, seq, sender, period, n */
+    /* the payload of the distributed-NCK paper's fineIPObuf is 4N; ours adds
+     * fingerprint, seq, sender, period, n */
     assert_int_equal(n, 8 + 4 + 2 + 8 + 1 + 4 * 3);
     ncp_fine_ipo_t g;
     memset(&g, 0, sizeof g);

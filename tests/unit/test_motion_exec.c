@@ -1,5 +1,5 @@
 /* The stages below the look-ahead on their own: fed the records the planner
- * started (its tap: seed 002's ACCDECbuf of the ADCBI NCK), the interpolator
+ * started (its tap: the distributed-NCK paper's ACCDECbuf of the ADCBI NCK), the interpolator
  * (ncp_exec, exec.c) gives the planner's samples bit for bit, and so does the
  * ACC/DEC stage (ncp_la_profile) run on the look-ahead's records (LAbuf):
  * what lets an LLC at DP4 or DP3 run the stages below for its axis. A source

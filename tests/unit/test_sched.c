@@ -1,4 +1,4 @@
-/* The scheduling strategies of seed 000: the static and data-flow priority
+/* The scheduling strategies of the task-scheduling paper: the static and data-flow priority
  * functions (fills in, priorities out), [SCHED]'s keys, and one data-flow
  * round on real threads where SCHED_FIFO is permitted. */
 #include <setjmp.h>
