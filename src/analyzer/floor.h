@@ -47,7 +47,7 @@ static inline void ncp_an_publish(struct ncp_analyzer *a)
         /* only a machine (a run with busters to wait for) shows the codes:
          * a translation to text would pay about 8 % for them */
         if (a->sai.sync)
-            ncp_analyzer_active_codes(a, &a->cmd->active);
+            a->active_codes(a, &a->cmd->active);
         a->sink->publish(a->sink->ctx, a->cmd);
         a->cmd = NULL;
     }
