@@ -217,6 +217,18 @@ bench-parse: all $(BUILD)/bench/core-latency $(BUILD)/bench/cpu-speed
 .PHONY: FORCE
 FORCE:
 
+# Layering (tests/tools/call-layers): in every folder of src/ the calls
+# between files, a header's inline functions included, form no cycle (the
+# run loop calls the handlers, the handlers the ground floor, nothing calls
+# back up). And no file of src/ reaches another module's private header by a
+# ../ path.
+lint: lint-layers
+lint-layers:
+	$(Q)tests/tools/call-layers-test
+	$(Q)tests/tools/call-layers $(wildcard src/*/) >/dev/null
+	$(Q)! grep -rn '#include *"\.\./' src || { echo "src/: a private header of another module included by ../ path"; exit 1; }
+.PHONY: lint-layers
+
 # Static analysis: both must stay quiet on our sources (not on lcm-gen's
 # code in $(GEN_DIR), which is in neither list; its headers are only read).
 lint: $(GEN_STAMP)

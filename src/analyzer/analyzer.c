@@ -33,6 +33,7 @@ struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
     }
     ncp_state_init(a);
     a->execute = ncp_an_execute;
+    a->active_codes = ncp_analyzer_active_codes;
     ncp_cutcomp_init(&a->comp, NULL);
     ncp_m7x_reset(a);
     return a;

@@ -48,7 +48,7 @@ static inline void ncp_an_publish(struct ncp_analyzer *a)
          * a translation to text would pay for them on every block, in the
          * hot loop bench-parse measures */
         if (a->sai.sync)
-            ncp_analyzer_active_codes(a, &a->cmd->active);
+            a->active_codes(a, &a->cmd->active);
         a->sink->publish(a->sink->ctx, a->cmd);
         a->cmd = NULL;
     }

@@ -14,6 +14,7 @@
  * block in hand is its return line, so the G7x line's own later steps (an M2
  * on it) are lost and errors of the passes name that return line. */
 #include "floor.h"
+#include "offsets.h"
 #include "state.h"
 
 #include "ncpar/blocks.h"

@@ -3,6 +3,7 @@
  * that mirror them. Parameters hold rs274's user unit (inch); the state holds
  * program units. */
 #include "floor.h"
+#include "offsets.h"
 #include "state.h"
 
 #include <math.h>

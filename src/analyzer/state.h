@@ -176,6 +176,10 @@ struct ncp_analyzer {
      * ncp_an_execute, handed down by the run loop so that no handler calls
      * back up into the file that calls it. */
     int (*execute)(struct ncp_analyzer *a, const struct ncp_block *b);
+    /* How the floor shows a machine the active codes with each slot it
+     * publishes (floor.h): ncp_analyzer_active_codes (m7x.c, a handler),
+     * handed down by the run loop for the same reason. */
+    void (*active_codes)(const struct ncp_analyzer *a, struct ncp_active_codes *out);
 };
 
 /* comp.c: the analyzer side of cutter compensation */
@@ -240,18 +244,6 @@ int ncp_offsets_coord(struct ncp_analyzer *a, int origin);
 int ncp_offsets_tlo(struct ncp_analyzer *a, int g);
 int ncp_offsets_modal0(struct ncp_analyzer *a, int g);
 void ncp_comp_reported_pos(const struct ncp_analyzer *a, double *pos);
-double *ncp_offsets_param_pos(struct ncp_analyzer *a);
-/* #5420..#5428 (and #<_x>...) read where the tool is: the current point, or
- * under cutter compensation the compensated one. Every block ends here, so
- * the common case (no compensation) stays one copy. */
-static inline void ncp_offsets_sync_params(struct ncp_analyzer *a)
-{
-    double *p = a->par_pos ? a->par_pos : ncp_offsets_param_pos(a);
-    if (a->comp.side != 0)
-        ncp_comp_reported_pos(a, p);
-    else
-        memcpy(p, a->st.pos, sizeof a->st.pos);
-}
 /* what the canon did since the last block (a probe, a tool change), read back
  * into the state and the parameters before the next block reads them */
 int ncp_offsets_resync(struct ncp_analyzer *a);

@@ -2,6 +2,7 @@
  * by group, then G codes by group, motion, and the stop codes last. Each step
  * is a small function; the order lives in ncp_an_steps only. */
 #include "floor.h"
+#include "offsets.h"
 #include "state.h"
 
 #include <math.h>

@@ -2,6 +2,7 @@
  * reset rs274 performs: back to G54, XY plane, G90, G94, F0, spindle off,
  * coolant off, feed override on). */
 #include "floor.h"
+#include "offsets.h"
 #include "state.h"
 
 #include <string.h>

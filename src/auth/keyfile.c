@@ -111,9 +111,9 @@ static int key_of(const uint8_t *buf, size_t n, uint8_t key[NCP_AUTH_KEY_BYTES])
         memcpy(key, buf, n);
         return 0;
     }
-    if (n == 2 * NCP_AUTH_KEY_BYTES + 1 && buf[n - 1] == '\n')
+    if (n == 2 * (size_t)NCP_AUTH_KEY_BYTES + 1 && buf[n - 1] == '\n')
         n--;
-    if (n != 2 * NCP_AUTH_KEY_BYTES)
+    if (n != 2 * (size_t)NCP_AUTH_KEY_BYTES)
         return -1;
     for (size_t i = 0; i < NCP_AUTH_KEY_BYTES; i++) {
         int hi = hex_digit(buf[2 * i]), lo = hex_digit(buf[2 * i + 1]);

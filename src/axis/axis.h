@@ -223,15 +223,17 @@ void llc_drive_close(struct llc *l);
 
 /* llc.c */
 int llc_cycle(void *ctx, int64_t now_ns);
-/* The HLC's period its path left its k-th standstill, 0 not known (yet). */
-int64_t llc_start_at(const struct llc *l, int32_t k);
 void llc_take(struct llc *l, int64_t now);
 void llc_publish_status(struct llc *l, int64_t slot);
+void llc_heartbeat(struct llc *l, int64_t now);
+void llc_advertise(struct llc *l);
+
+/* llc_floor.c: what llc.c and its stages share, calling none of them */
+/* The HLC's period its path left its k-th standstill, 0 not known (yet). */
+int64_t llc_start_at(const struct llc *l, int32_t k);
 /* src as much as a status's fault field (n bytes) carries, cut at a word
  * with "..." when it does not fit. */
 void llc_fault_short(char *dst, size_t n, const char *src);
-void llc_heartbeat(struct llc *l, int64_t now);
-void llc_advertise(struct llc *l);
 int64_t llc_now(void);
 
 #endif

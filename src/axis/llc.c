@@ -33,11 +33,6 @@
 #include <string.h>
 #include <time.h>
 
-int64_t llc_now(void)
-{
-    return ncp_mono_ns();
-}
-
 static void on_fine(struct llc *l, const uint8_t *p, size_t len)
 {
     struct ncp_dist_fine f;
@@ -130,17 +125,6 @@ static int32_t nm(double mm)
     int32_t v = 0;
     (void)ncp_dist_mm_to_nm(mm, &v);
     return v;
-}
-
-void llc_fault_short(char *dst, size_t n, const char *src)
-{
-    /* cut at a word, not inside a number the HLC would then show */
-    if (snprintf(dst, n, "%s", src) >= (int)n) {
-        char *cut = dst + n - 4;
-        while (cut > dst && *cut != ' ')
-            cut--;
-        memcpy(cut, "...", 4);
-    }
 }
 
 void llc_publish_status(struct llc *l, int64_t slot)
@@ -252,12 +236,6 @@ static int rec_next(void *ctx, double v0, struct ncp_accdec *rec)
         l->missing_rec = llc_exec_ring(l)->next;
     }
     return 0;
-}
-
-int64_t llc_start_at(const struct llc *l, int32_t k)
-{
-    unsigned i = (unsigned)k % LLC_STARTS;
-    return l->start_k[i] == k ? l->start_t[i] : 0;
 }
 
 static void rec_done(void *ctx)

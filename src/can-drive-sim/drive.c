@@ -6,6 +6,11 @@
 
 #include "drive.h"
 
+unsigned drive_master_node(struct drive *dv)
+{
+    return od_get(&dv->od, 0x1016, 1) >> 16 & 0x7Fu;
+}
+
 int drive_send(struct drive *dv, const struct ncp_can_frame *f)
 {
     struct ncp_diag d;

@@ -70,7 +70,9 @@ int32_t drive_servo_step(struct drive *dv);
 void drive_boot(struct drive *dv);
 /* Handles one received frame at now_ms (the drive's clock); -1 on a bus error. */
 int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f, long long now_ms);
-/* Shared with guard.c. */
+/* Shared with guard.c, which stands on drive.c and is not called back. */
+/* The master's node-ID the drive consumes the heartbeat of (0x1016:01), 0 none. */
+unsigned drive_master_node(struct drive *dv);
 void drive_set_state(struct drive *dv, enum ncp_cia402_state s);
 int drive_send(struct drive *dv, const struct ncp_can_frame *f);
 int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy);
@@ -79,8 +81,6 @@ int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy);
  * drive's own reaction (0x6007, 0x605E) when one passes: called whenever the
  * drive wakes; -1 on a bus error. */
 int drive_guard_tick(struct drive *dv, long long now_ms);
-/* The master's node-ID the drive consumes the heartbeat of (0x1016:01), 0 none. */
-unsigned drive_master_node(struct drive *dv);
 /* How long the drive may sleep before the next deadline or ramp step, ms. */
 int drive_guard_wait_ms(struct drive *dv, long long now_ms);
 /* The CAN identifiers the drive listens to (its filter): n returned. */

@@ -17,11 +17,6 @@
 #define EMCY_RPDO_TIMEOUT 0x8250u
 #define EMCY_SYNC_LOST 0x8700u
 
-unsigned drive_master_node(struct drive *dv)
-{
-    return od_get(&dv->od, 0x1016, 1) >> 16 & 0x7Fu;
-}
-
 size_t drive_listen_ids(struct drive *dv, uint32_t ids[6])
 {
     uint8_t n = dv->o.node;

@@ -7,8 +7,8 @@
 #include "channels.h"
 #include "inject_opts.h"
 #include "machine.h"
+#include "nck_run.h"
 #include "outfile.h"
-#include "run.h"
 #include "signals.h"
 
 #include "ncpar/feeder.h"

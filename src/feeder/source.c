@@ -17,14 +17,6 @@
 #include <emmintrin.h>
 #endif
 
-int ncp_source_percent_line(const char *s, size_t n)
-{
-    size_t i = 0;
-    while (i < n && (s[i] == ' ' || s[i] == '\t'))
-        i++;
-    return i < n && s[i] == '%';
-}
-
 static int is_blank_line(const char *s, size_t n)
 {
     for (size_t i = 0; i < n; i++)

@@ -6,6 +6,17 @@
 
 #include <string.h>
 
+/* The '%' line test (ncpar/feeder.h) lives here, at the bottom of the
+ * feeder: the block splitter (source.c) calls this scan and the test, and
+ * this file calls nothing of source.c back. */
+int ncp_source_percent_line(const char *s, size_t n)
+{
+    size_t i = 0;
+    while (i < n && (s[i] == ' ' || s[i] == '\t'))
+        i++;
+    return i < n && s[i] == '%';
+}
+
 static int is_blank(const char *s, size_t n)
 {
     for (size_t i = 0; i < n; i++)

@@ -78,7 +78,7 @@ int ncp_http_on_gate(struct lws *wsi, enum lws_callback_reasons reason, void *us
     if (reason != LWS_CALLBACK_FILTER_HTTP_CONNECTION &&
         reason != LWS_CALLBACK_HTTP_CONFIRM_UPGRADE)
         return lws_callback_http_dummy(wsi, reason, user, in, len);
-    struct ncp_http *h = lws_context_user(lws_get_context(wsi));
+    const struct ncp_http_floor *f = ncp_http_floor_of(wsi);
     char host[VALUE_MAX], origin[VALUE_MAX], cl[VALUE_MAX], te[VALUE_MAX];
     struct ncp_http_head hd;
     hd.n_host = header(wsi, WSI_TOKEN_HOST, host, sizeof host, &hd.host);
@@ -88,10 +88,10 @@ int ncp_http_on_gate(struct lws *wsi, enum lws_callback_reasons reason, void *us
     hd.n_transfer_encoding =
         header(wsi, WSI_TOKEN_HTTP_TRANSFER_ENCODING, te, sizeof te, &hd.transfer_encoding);
     char why[300];
-    int status = ncp_http_head_verdict(ncp_http_policy_of(h), &hd, why, sizeof why);
+    int status = ncp_http_head_verdict(f->policy, &hd, why, sizeof why);
     if (!status)
         return 0;
-    ncp_http_count(h, stat_of(status));
+    f->count(f->ctx, stat_of(status));
     refuse_http(wsi, status, why);
     /* an upgrade's refusal: -1 hangs up (libwebsockets would otherwise wait
      * for a next request on this connection); a request's: any non-zero */

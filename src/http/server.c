@@ -74,6 +74,7 @@ struct conn {
 };
 
 struct ncp_http {
+    struct ncp_http_floor floor; /* first: the handlers' view (server_int.h) */
     struct ncp_http_opts o;
     char token[NCP_HTTP_TOKEN_LEN + 1];
     struct ncp_nck_serve_hook hook;
@@ -121,8 +122,13 @@ static void count(struct ncp_http *h, uint64_t *field)
     pthread_mutex_unlock(&h->mu);
 }
 
-void ncp_http_count(struct ncp_http *h, enum ncp_http_stat which)
+_Static_assert(offsetof(struct ncp_http, floor) == 0,
+               "the handlers find the floor at the context's user (server_int.h)");
+
+/* the floor's count: any thread */
+static void count_stat(void *ctx, enum ncp_http_stat which)
 {
+    struct ncp_http *h = ctx;
     struct ncp_http_stats *st = &h->stats;
     uint64_t *field = which == NCP_HTTP_STAT_NO_TOKEN ? &st->no_token
                     : which == NCP_HTTP_STAT_READONLY ? &st->readonly
@@ -195,12 +201,6 @@ static void hook_event(void *ctx, const ncp_event_t *e)
     h->events[(h->ev_head + h->ev_n++) % NOTE_QUEUE] = *e;
     pthread_mutex_unlock(&h->mu);
     lws_cancel_service(h->ctx);
-}
-
-void ncp_http_prog_put(struct ncp_http_prog *p)
-{
-    if (atomic_fetch_sub(&p->refs, 1) == 1)
-        free(p);
 }
 
 /* The worker's reference to the program's copy. */
@@ -629,8 +629,10 @@ static void on_message(struct ncp_http *h, struct conn *c)
     }
 }
 
-int ncp_http_token_ok(const struct ncp_http *h, struct lws *wsi)
+/* the floor's token check */
+static int token_ok(void *ctx, struct lws *wsi)
 {
+    const struct ncp_http *h = ctx;
     char buf[128];
     const char *t = lws_get_urlarg_by_name(wsi, "token=", buf, (int)sizeof buf);
     if (!t || strlen(t) != NCP_HTTP_TOKEN_LEN)
@@ -706,11 +708,11 @@ static int on_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, 
     switch (reason) {
     case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
         /* only operators count against MAX_CONNS; others take the pool */
-        return ncp_http_token_ok(h, wsi) && h->n_authed >= MAX_CONNS;
+        return token_ok(h, wsi) && h->n_authed >= MAX_CONNS;
     case LWS_CALLBACK_ESTABLISHED:
         /* the session's memory is new here; the URL's query still readable */
         memset(c, 0, sizeof *c);
-        c->authed = ncp_http_token_ok(h, wsi);
+        c->authed = token_ok(h, wsi);
         c->wsi = wsi;
         c->serial = ++h->next_serial;
         c->client_id = NCP_HTTP_CLIENT_TAG | (h->next_client++ & ~NCP_HTTP_CLIENT_MASK);
@@ -808,6 +810,8 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
         goto fail;
     }
     h->next_client = (int32_t)(h->token[0] * 4099 + h->token[1]);
+    h->floor = (struct ncp_http_floor){ .opts = &h->o, .policy = &h->policy,
+                                        .count = count_stat, .token_ok = token_ok, .ctx = h };
     pthread_mutex_init(&h->mu, NULL);
     pthread_mutex_init(&h->prog_mu, NULL);
     h->hook = (struct ncp_nck_serve_hook){ .next_command = hook_next_command, .ack = hook_ack,
@@ -910,14 +914,4 @@ void ncp_http_get_stats(struct ncp_http *h, struct ncp_http_stats *st)
     pthread_mutex_lock(&h->mu);
     *st = h->stats;
     pthread_mutex_unlock(&h->mu);
-}
-
-const struct ncp_http_opts *ncp_http_opts_of(const struct ncp_http *h)
-{
-    return &h->o;
-}
-
-const struct ncp_http_policy *ncp_http_policy_of(const struct ncp_http *h)
-{
-    return &h->policy;
 }

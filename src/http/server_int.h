@@ -7,6 +7,7 @@
 
 #include <libwebsockets.h>
 #include <stdatomic.h>
+#include <stdlib.h>
 
 /* The panel's LCM client ids: a tag in the top bits, so its acks are told
  * from cnc-ctl's (whose ids are random) well enough for routing. */
@@ -26,7 +27,14 @@ struct ncp_http_prog {
     int too_large;              /* over NCP_HTTP_PROGRAM_MAX: text not kept */
     char text[];
 };
-void ncp_http_prog_put(struct ncp_http_prog *p);
+/* Lets go of a reference (the serving thread's, or the worker's): the last
+ * one frees the copy. Inline: both sides let go, and neither is the other's
+ * floor. */
+static inline void ncp_http_prog_put(struct ncp_http_prog *p)
+{
+    if (atomic_fetch_sub(&p->refs, 1) == 1)
+        free(p);
+}
 
 /* A message built off the socket thread: LWS_PRE bytes, then len bytes. */
 struct ncp_http_msg {
@@ -61,17 +69,29 @@ int ncp_http_jobs_take(struct ncp_http_jobs *j, uint64_t *serial, struct ncp_htt
 void ncp_http_jobs_stop(struct ncp_http_jobs *j);
 
 /* ---- the socket thread's -------------------------------------------------------- */
-const struct ncp_http_opts *ncp_http_opts_of(const struct ncp_http *h);
-const struct ncp_http_policy *ncp_http_policy_of(const struct ncp_http *h);
-
-/* Whether the request's URL carries the token (?token=...). */
-int ncp_http_token_ok(const struct ncp_http *h, struct lws *wsi);
 enum ncp_http_stat {
     NCP_HTTP_STAT_NO_TOKEN, NCP_HTTP_STAT_READONLY, NCP_HTTP_STAT_OVERSIZED,
     NCP_HTTP_STAT_UPLOADS, NCP_HTTP_STAT_UPLOAD_BAD, NCP_HTTP_STAT_FOREIGN_ORIGIN,
     NCP_HTTP_STAT_BAD_HOST, NCP_HTTP_STAT_BAD_REQUEST, NCP_HTTP_STAT_UNAUTH_CLOSED
 };
-void ncp_http_count(struct ncp_http *h, enum ncp_http_stat which);
+/* What the handlers server.c registers with libwebsockets (gate.c,
+ * upload.c) may read of the server, and its calls they may make, handed
+ * down as pointers: they call nothing of server.c, which calls them. It is
+ * the first member of struct ncp_http, the libwebsockets context's user
+ * (server.c asserts that), so a handler finds it from any wsi. */
+struct ncp_http_floor {
+    const struct ncp_http_opts *opts;
+    const struct ncp_http_policy *policy;
+    /* one more refusal or upload in the panel's statistics */
+    void (*count)(void *ctx, enum ncp_http_stat which);
+    /* whether the request's URL carries the token (?token=...) */
+    int (*token_ok)(void *ctx, struct lws *wsi);
+    void *ctx;
+};
+static inline const struct ncp_http_floor *ncp_http_floor_of(struct lws *wsi)
+{
+    return lws_context_user(lws_get_context(wsi));
+}
 /* The first callback every HTTP request and upgrade meets (gate.c): Origin,
  * Host and framing (ncp_http_head_verdict) before anything else. */
 int ncp_http_on_gate(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in,

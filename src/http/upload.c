@@ -39,14 +39,14 @@ static void discard(struct upload *u)
     }
 }
 
-static void refuse(struct ncp_http *h, struct upload *u, unsigned status, enum ncp_http_stat st,
-                   const char *why)
+static void refuse(const struct ncp_http_floor *f, struct upload *u, unsigned status,
+                   enum ncp_http_stat st, const char *why)
 {
     if (u->status)
         return;   /* counted once, for the first reason */
     u->status = status;
     snprintf(u->why, sizeof u->why, "%s", why);
-    ncp_http_count(h, st);
+    f->count(f->ctx, st);
     discard(u);
 }
 
@@ -77,28 +77,28 @@ static int answer(struct lws *wsi, struct upload *u)
 }
 
 /* The headers are in: the verdict on everything but the content. */
-static void begin(struct ncp_http *h, struct lws *wsi, struct upload *u)
+static void begin(const struct ncp_http_floor *f, struct lws *wsi, struct upload *u)
 {
     memset(u, 0, sizeof *u);
     char arg[NCP_HTTP_UPLOAD_NAME_MAX + 16], why[200];
-    if (!ncp_http_token_ok(h, wsi)) {
-        refuse(h, u, HTTP_STATUS_FORBIDDEN, NCP_HTTP_STAT_NO_TOKEN,
+    if (!f->token_ok(f->ctx, wsi)) {
+        refuse(f, u, HTTP_STATUS_FORBIDDEN, NCP_HTTP_STAT_NO_TOKEN,
                "no valid token: this panel may only watch");
         return;
     }
-    if (ncp_http_opts_of(h)->readonly) {
-        refuse(h, u, HTTP_STATUS_FORBIDDEN, NCP_HTTP_STAT_READONLY,
+    if (f->opts->readonly) {
+        refuse(f, u, HTTP_STATUS_FORBIDDEN, NCP_HTTP_STAT_READONLY,
                "the panel is read-only (--http-readonly)");
         return;
     }
     if (lws_hdr_total_length(wsi, WSI_TOKEN_POST_URI) <= 0) {
-        refuse(h, u, HTTP_STATUS_METHOD_NOT_ALLOWED, NCP_HTTP_STAT_UPLOAD_BAD,
+        refuse(f, u, HTTP_STATUS_METHOD_NOT_ALLOWED, NCP_HTTP_STAT_UPLOAD_BAD,
                "an upload is a POST");
         return;
     }
     const char *name = lws_get_urlarg_by_name(wsi, "name=", arg, (int)sizeof arg);
     if (!name || !ncp_http_upload_name_ok(name, why, sizeof why)) {
-        refuse(h, u, HTTP_STATUS_BAD_REQUEST, NCP_HTTP_STAT_UPLOAD_BAD,
+        refuse(f, u, HTTP_STATUS_BAD_REQUEST, NCP_HTTP_STAT_UPLOAD_BAD,
                name ? why : "no name= for the program");
         return;
     }
@@ -110,13 +110,13 @@ static void begin(struct ncp_http *h, struct lws *wsi, struct upload *u)
         strtoull(len, NULL, 10) > NCP_HTTP_UPLOAD_MAX) {
         snprintf(why, sizeof why, "%s is too large (%s bytes, at most %u)", u->name, len,
                  NCP_HTTP_UPLOAD_MAX);
-        refuse(h, u, HTTP_STATUS_REQ_ENTITY_TOO_LARGE, NCP_HTTP_STAT_OVERSIZED, why);
+        refuse(f, u, HTTP_STATUS_REQ_ENTITY_TOO_LARGE, NCP_HTTP_STAT_OVERSIZED, why);
         return;
     }
     if (!u->overwrite && access(u->name, F_OK) == 0) {
         snprintf(why, sizeof why, "%s exists: upload it again with overwrite to replace it",
                  u->name);
-        refuse(h, u, HTTP_STATUS_CONFLICT, NCP_HTTP_STAT_UPLOAD_BAD, why);
+        refuse(f, u, HTTP_STATUS_CONFLICT, NCP_HTTP_STAT_UPLOAD_BAD, why);
         return;
     }
     snprintf(u->tmp, sizeof u->tmp, ".upload-XXXXXX");
@@ -126,11 +126,11 @@ static void begin(struct ncp_http *h, struct lws *wsi, struct upload *u)
         (void)fchmod(u->fd, 0644);   /* a program as any other, not mkstemp's 0600 */
     if (!u->open) {
         snprintf(why, sizeof why, "cannot write in the program folder: %s", strerror(errno));
-        refuse(h, u, HTTP_STATUS_INTERNAL_SERVER_ERROR, NCP_HTTP_STAT_UPLOAD_BAD, why);
+        refuse(f, u, HTTP_STATUS_INTERNAL_SERVER_ERROR, NCP_HTTP_STAT_UPLOAD_BAD, why);
     }
 }
 
-static void take_body(struct ncp_http *h, struct upload *u, const char *in, size_t len)
+static void take_body(const struct ncp_http_floor *f, struct upload *u, const char *in, size_t len)
 {
     if (u->status)
         return;
@@ -139,11 +139,11 @@ static void take_body(struct ncp_http *h, struct upload *u, const char *in, size
         char why[200];
         snprintf(why, sizeof why, "%s is too large (over %u bytes)", u->name,
                  NCP_HTTP_UPLOAD_MAX);
-        refuse(h, u, HTTP_STATUS_REQ_ENTITY_TOO_LARGE, NCP_HTTP_STAT_OVERSIZED, why);
+        refuse(f, u, HTTP_STATUS_REQ_ENTITY_TOO_LARGE, NCP_HTTP_STAT_OVERSIZED, why);
         return;
     }
     if (memchr(in, 0, len)) {
-        refuse(h, u, HTTP_STATUS_BAD_REQUEST, NCP_HTTP_STAT_UPLOAD_BAD,
+        refuse(f, u, HTTP_STATUS_BAD_REQUEST, NCP_HTTP_STAT_UPLOAD_BAD,
                "not a text file (it holds NUL bytes)");
         return;
     }
@@ -154,7 +154,7 @@ static void take_body(struct ncp_http *h, struct upload *u, const char *in, size
         if (w <= 0) {
             char why[200];
             snprintf(why, sizeof why, "cannot write %s: %s", u->name, strerror(errno));
-            refuse(h, u, HTTP_STATUS_INTERNAL_SERVER_ERROR, NCP_HTTP_STAT_UPLOAD_BAD, why);
+            refuse(f, u, HTTP_STATUS_INTERNAL_SERVER_ERROR, NCP_HTTP_STAT_UPLOAD_BAD, why);
             return;
         }
         in += w;
@@ -162,12 +162,12 @@ static void take_body(struct ncp_http *h, struct upload *u, const char *in, size
     }
 }
 
-static void finish(struct ncp_http *h, struct upload *u)
+static void finish(const struct ncp_http_floor *f, struct upload *u)
 {
     if (u->status)
         return;
     if (u->got == 0) {
-        refuse(h, u, HTTP_STATUS_BAD_REQUEST, NCP_HTTP_STAT_UPLOAD_BAD, "the file is empty");
+        refuse(f, u, HTTP_STATUS_BAD_REQUEST, NCP_HTTP_STAT_UPLOAD_BAD, "the file is empty");
         return;
     }
     int rc = close(u->fd);
@@ -183,21 +183,21 @@ static void finish(struct ncp_http *h, struct upload *u)
                      u->name);
         else
             snprintf(why, sizeof why, "cannot store %s: %s", u->name, strerror(err));
-        refuse(h, u, err == EEXIST ? HTTP_STATUS_CONFLICT : HTTP_STATUS_INTERNAL_SERVER_ERROR,
+        refuse(f, u, err == EEXIST ? HTTP_STATUS_CONFLICT : HTTP_STATUS_INTERNAL_SERVER_ERROR,
                NCP_HTTP_STAT_UPLOAD_BAD, why);
         return;
     }
-    ncp_http_count(h, NCP_HTTP_STAT_UPLOADS);
+    f->count(f->ctx, NCP_HTTP_STAT_UPLOADS);
 }
 
 int ncp_http_on_upload(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in,
                        size_t len)
 {
-    struct ncp_http *h = lws_context_user(lws_get_context(wsi));
+    const struct ncp_http_floor *f = ncp_http_floor_of(wsi);
     struct upload *u = user;
     switch (reason) {
     case LWS_CALLBACK_HTTP:
-        begin(h, wsi, u);
+        begin(f, wsi, u);
         /* a body follows a POST; anything else is answered now */
         if (lws_hdr_total_length(wsi, WSI_TOKEN_POST_URI) <= 0)
             return answer(wsi, u);
@@ -205,16 +205,16 @@ int ncp_http_on_upload(struct lws *wsi, enum lws_callback_reasons reason, void *
             char cl[32];
             if (lws_hdr_copy(wsi, cl, (int)sizeof cl, WSI_TOKEN_HTTP_CONTENT_LENGTH) <= 0 ||
                 !strcmp(cl, "0")) {
-                finish(h, u);
+                finish(f, u);
                 return answer(wsi, u);
             }
         }
         return 0;
     case LWS_CALLBACK_HTTP_BODY:
-        take_body(h, u, in, len);
+        take_body(f, u, in, len);
         return 0;
     case LWS_CALLBACK_HTTP_BODY_COMPLETION:
-        finish(h, u);
+        finish(f, u);
         return answer(wsi, u);
     case LWS_CALLBACK_CLOSED_HTTP:
         if (u)

@@ -37,9 +37,9 @@ struct ncp_lex_val {
     uint8_t is_const;
 };
 
-/* lex_block.c: a block as it is before anything was read from its line */
+/* lex_floor.c: a block as it is before anything was read from its line */
 void ncp_lex_init_block(struct ncp_block *b, size_t len, uint32_t line, uint64_t offset);
-/* ncp_lex_block without the fast path (the differential test calls it) */
+/* lex_block.c: ncp_lex_block without the fast path (the differential test calls it) */
 int ncp_lex_block_general(const char *text, size_t len, uint32_t line, uint64_t offset,
                           struct ncp_block *out);
 
@@ -114,7 +114,8 @@ static inline void ncp_plain_put_word(unsigned char *wp, double value, uint16_t 
     wp[10] = (unsigned char)letter;
 }
 
-/* Stores a syntax error at buf position pos; returns NCP_ERR_SYNTAX. */
+/* lex_floor.c: stores a syntax error at buf position pos; returns
+ * NCP_ERR_SYNTAX. */
 int ncp_lex_fail(struct ncp_lexer *lx, int pos, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

@@ -121,33 +121,6 @@ static int fail_at(struct load_ctx *lc, unsigned line, const char *fmt, ...)
     return 0;
 }
 
-int ncp_ini_decimal(const char *v)
-{
-    const char *p = v;
-    if (*p == '+' || *p == '-')
-        p++;
-    size_t digits = strspn(p, "0123456789");
-    p += digits;
-    if (*p == '.') {
-        size_t frac = strspn(p + 1, "0123456789");
-        digits += frac;
-        p += 1 + frac;
-    }
-    if (!digits)
-        return 0;
-    if (*p == 'e' || *p == 'E') {
-        p++;
-        if (*p == '+' || *p == '-')
-            p++;
-        size_t e = strspn(p, "0123456789");
-        if (!e)
-            return 0;
-        p += e;
-    }
-    p += strspn(p, " \t");
-    return *p == '\0';
-}
-
 /* x as the INI would write it: no exponent, no trailing zeros */
 static void plain(char *buf, size_t len, double x)
 {
@@ -169,13 +142,6 @@ static void range(char *why, size_t len, const char *unit, double lo, double hi)
     plain(a, sizeof a, lo);
     plain(b, sizeof b, hi);
     snprintf(why, len, "%s%sfrom %s to %s", unit, *unit ? " " : "", a, b);
-}
-
-int ncp_ini_number(const char *v, double lo, double hi, double *out)
-{
-    if (!ncp_ini_decimal(v))
-        return -1;
-    return ncp_num_double(v, lo, hi, out);
 }
 
 static int real(const char *v, double lo, double hi, double *out, const char *unit, char *why,

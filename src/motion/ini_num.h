@@ -1,4 +1,5 @@
-/* Numbers in the machine INI, shared by its readers (config.c, config_io.c). */
+/* Numbers in the machine INI (ini_num.c), shared by its readers (config.c,
+ * config_home.c, config_io.c, config_kins.c). */
 #ifndef NCPAR_MOTION_INI_NUM_H
 #define NCPAR_MOTION_INI_NUM_H
 

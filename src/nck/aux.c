@@ -11,18 +11,6 @@
 #include <math.h>
 #include <string.h>
 
-static double speed_target(const struct nck *n)
-{
-    const struct nck_mach *m = &n->mach;
-    double ov = m->en[NCK_EN_SPEED_OVERRIDE]
-                    ? atomic_load_explicit(&n->ctl->spindle_permille, memory_order_relaxed) / 1000.0
-                    : 1.0;
-    double t = m->rpm_cmd * ov, cap = n->cfg->io.spindle_max_rpm;
-    if (cap > 0 && fabs(t) > cap)
-        t = copysign(cap, t);
-    return t;
-}
-
 static double ramp(double from, double to, double step)
 {
     if (step <= 0)
@@ -72,14 +60,8 @@ static void spindle_step(struct nck *n)
         orient_step(n, dt);
         return;
     }
-    m->rpm = ramp(m->rpm, speed_target(n), n->cfg->io.spindle_acc * dt);
+    m->rpm = ramp(m->rpm, nck_spindle_target(n), n->cfg->io.spindle_acc * dt);
     m->rev += m->rpm / 60 * dt;
-}
-
-int nck_spindle_at_speed(const struct nck *n)
-{
-    double t = speed_target(n);
-    return fabs(n->mach.rpm - t) <= fmax(1e-6, n->cfg->io.at_speed_tol * fabs(t));
 }
 
 /* A pause for the operator: resume (tool: tool-changed) goes on; a batch run

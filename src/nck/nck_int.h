@@ -535,6 +535,9 @@ void nck_note_state(struct nck *n, const struct ncp_canon *op);
  * hold where it is (a pack waits), else 0. */
 int nck_aux_cycle(struct nck *n);
 void nck_aux_discard(struct nck *n);
+/* spindle.c: the speed the spindle ramps to (rpm, signed), and whether it
+ * is there, within [SPINDLE_0]'s at-speed tolerance */
+double nck_spindle_target(const struct nck *n);
 int nck_spindle_at_speed(const struct nck *n);
 
 /* sync.c (real-time path): one period of the run an NCK_AUX_SYNC starts; 1
