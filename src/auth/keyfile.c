@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <openssl/crypto.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -93,17 +94,6 @@ static int create_key(const char *path, struct ncp_diag *d)
     return 0;
 }
 
-static int hex_digit(int c)
-{
-    if (c >= '0' && c <= '9')
-        return c - '0';
-    if (c >= 'a' && c <= 'f')
-        return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F')
-        return c - 'A' + 10;
-    return -1;
-}
-
 /* 32 raw bytes, or 64 hex digits with an optional newline: 0, or -1. */
 static int key_of(const uint8_t *buf, size_t n, uint8_t key[NCP_AUTH_KEY_BYTES])
 {
@@ -116,7 +106,7 @@ static int key_of(const uint8_t *buf, size_t n, uint8_t key[NCP_AUTH_KEY_BYTES])
     if (n != 2 * (size_t)NCP_AUTH_KEY_BYTES)
         return -1;
     for (size_t i = 0; i < NCP_AUTH_KEY_BYTES; i++) {
-        int hi = hex_digit(buf[2 * i]), lo = hex_digit(buf[2 * i + 1]);
+        int hi = OPENSSL_hexchar2int(buf[2 * i]), lo = OPENSSL_hexchar2int(buf[2 * i + 1]);
         if (hi < 0 || lo < 0)
             return -1;
         key[i] = (uint8_t)(hi << 4 | lo);
