@@ -480,18 +480,25 @@ static void test_mdi_keeps_modal_state(void **state_)
     stop(&s);
 }
 
+/* A jog of X: dir, speed mm/min (0: the default), distance mm (0: continuous). */
+static struct ncp_nck_cmd jog_x(int dir, double speed, double distance)
+{
+    struct ncp_nck_cmd c;
+    memset(&c, 0, sizeof c);
+    c.kind = NCP_CMD_JOG;
+    strcpy(c.text, "x");
+    c.ivalue[0] = dir;
+    c.value[0] = speed;
+    c.value[1] = distance;
+    return c;
+}
+
 static void test_jogs(void **state_)
 {
     (void)state_;
     struct svc s;
     start(&s, 0);
-    struct ncp_nck_cmd c;
-    memset(&c, 0, sizeof c);
-    c.kind = NCP_CMD_JOG;
-    strcpy(c.text, "x");
-    c.ivalue[0] = 1;
-    c.value[0] = 600;
-    c.value[1] = 2.5;
+    struct ncp_nck_cmd c = jog_x(1, 600, 2.5);
     char why[256];
     assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), 0);
     wait_state(&s, NCP_ST_IDLE);
@@ -539,24 +546,14 @@ static void test_jog_input(void **state_)
     char why[256];
     struct ncp_nck_cmd c;
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
-        memset(&c, 0, sizeof c);
-        c.kind = NCP_CMD_JOG;
-        strcpy(c.text, "x");
-        c.ivalue[0] = bad[k].dir;
-        c.value[0] = bad[k].speed;
-        c.value[1] = bad[k].dist;
+        c = jog_x(bad[k].dir, bad[k].speed, bad[k].dist);
         assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), -1);
         assert_non_null(strstr(why, bad[k].why));
         ncp_nck_poll(s.nck);
         assert_int_equal(state(&s), NCP_ST_IDLE);
     }
     /* 1e308 mm/min: at MAX_VELOCITY, said in an event */
-    memset(&c, 0, sizeof c);
-    c.kind = NCP_CMD_JOG;
-    strcpy(c.text, "x");
-    c.ivalue[0] = 1;
-    c.value[0] = 1e308;
-    c.value[1] = 50;
+    c = jog_x(1, 1e308, 50);
     assert_int_equal(ncp_nck_command(s.nck, &c, why, sizeof why), 0);
     double vmax = 0;
     for (int i = 0; i < 60000 && state(&s) != NCP_ST_IDLE; i++) {
