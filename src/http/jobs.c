@@ -10,7 +10,6 @@
 #include "server_int.h"
 
 #include <pthread.h>
-#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
@@ -82,12 +81,7 @@ struct ncp_http_jobs *ncp_http_jobs_start(const struct ncp_http_jobs_env *env)
     j->env = *env;
     pthread_mutex_init(&j->mu, NULL);
     pthread_cond_init(&j->wake, NULL);
-    /* signals stay with the main thread */
-    sigset_t all, old;
-    sigfillset(&all);
-    pthread_sigmask(SIG_BLOCK, &all, &old);
-    int rc = pthread_create(&j->thread, NULL, worker, j);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    int rc = ncp_http_spawn(&j->thread, worker, j);
     if (rc) {
         pthread_cond_destroy(&j->wake);
         pthread_mutex_destroy(&j->mu);

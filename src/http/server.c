@@ -24,7 +24,6 @@
 
 #include <libwebsockets.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -860,12 +859,7 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: cannot start its worker thread");
         goto fail_locks;
     }
-    /* signals stay with the main thread, which turns them into a stop */
-    sigset_t all, old;
-    sigfillset(&all);
-    pthread_sigmask(SIG_BLOCK, &all, &old);
-    int rc = pthread_create(&h->thread, NULL, serve_loop, h);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    int rc = ncp_http_spawn(&h->thread, serve_loop, h);
     if (rc) {
         ncp_http_jobs_stop(h->jobs);
         lws_context_destroy(h->ctx);

@@ -6,6 +6,8 @@
 #include "ncpar/http.h"
 
 #include <libwebsockets.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 
@@ -91,6 +93,18 @@ struct ncp_http_floor {
 static inline const struct ncp_http_floor *ncp_http_floor_of(struct lws *wsi)
 {
     return lws_context_user(lws_get_context(wsi));
+}
+/* A thread of the panel's (the server's loop, the query worker) started with
+ * every signal blocked: signals stay with the main thread, which turns them
+ * into a controlled stop. pthread_create's result. */
+static inline int ncp_http_spawn(pthread_t *t, void *(*fn)(void *), void *arg)
+{
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &old);
+    int rc = pthread_create(t, NULL, fn, arg);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    return rc;
 }
 /* The first callback every HTTP request and upgrade meets (gate.c): Origin,
  * Host and framing (ncp_http_head_verdict) before anything else. */
