@@ -177,10 +177,7 @@ int main(int argc, char **argv)
     struct bench b;
     memset(&b, 0, sizeof b);
     struct ncp_diag d;
-    char path[NCP_AUTH_PATH_MAX];
-    uint8_t key[NCP_AUTH_KEY_BYTES];
-    if (ncp_auth_key_path(path, sizeof path, getenv("NCP_KEY_FILE"), NULL, &d) != 0 ||
-        ncp_auth_load_key(path, 0, key, &d) != 0 || !(b.auth = ncp_auth_new(key))) {
+    if (!(b.auth = ncp_auth_open(getenv("NCP_KEY_FILE"), NULL, 0, &d))) {
         fprintf(stderr, "service-bench: %s\n", d.msg);
         return 1;
     }

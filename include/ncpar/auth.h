@@ -56,6 +56,10 @@ int ncp_auth_load_key(const char *path, int create, uint8_t key[NCP_AUTH_KEY_BYT
 /* A sealing and checking context for key (NULL: out of memory). The key's
  * copy is wiped on free. */
 struct ncp_auth *ncp_auth_new(const uint8_t key[NCP_AUTH_KEY_BYTES]);
+/* The context of the key file ncp_auth_key_path finds (made when create and
+ * missing): the key is read, used and wiped here. NULL with d set. */
+struct ncp_auth *ncp_auth_open(const char *explicit_path, const char *ini, int create,
+                               struct ncp_diag *d);
 void ncp_auth_free(struct ncp_auth *a);
 
 /* ---- sealing and checking (no allocation, no system call) -------------- */

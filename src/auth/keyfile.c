@@ -153,3 +153,18 @@ int ncp_auth_load_key(const char *path, int create, uint8_t key[NCP_AUTH_KEY_BYT
                -1;
     return 0;
 }
+
+struct ncp_auth *ncp_auth_open(const char *explicit_path, const char *ini, int create,
+                               struct ncp_diag *d)
+{
+    char path[NCP_AUTH_PATH_MAX];
+    uint8_t key[NCP_AUTH_KEY_BYTES];
+    if (ncp_auth_key_path(path, sizeof path, explicit_path, ini, d) != 0 ||
+        ncp_auth_load_key(path, create, key, d) != 0)
+        return NULL;
+    struct ncp_auth *a = ncp_auth_new(key);
+    explicit_bzero(key, sizeof key);
+    if (a == NULL)
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the key of %s", path);
+    return a;
+}

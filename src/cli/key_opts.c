@@ -21,12 +21,9 @@ int ncp_cli_check_key(const char *who, const struct ncp_machine_cfg *cfg)
 {
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
-    char path[NCP_AUTH_PATH_MAX];
-    uint8_t key[NCP_AUTH_KEY_BYTES];
-    int rc = ncp_auth_key_path(path, sizeof path, NULL, cfg->lcm.key_file, &d) ||
-             ncp_auth_load_key(path, 1, key, &d);
-    explicit_bzero(key, sizeof key);
-    if (rc)
-        fprintf(stderr, "%s: error: %s\n", who, d.msg);
-    return rc ? -1 : 0;
+    struct ncp_auth *a = ncp_auth_open(NULL, cfg->lcm.key_file, 1, &d);
+    if (a == NULL)
+        return fprintf(stderr, "%s: error: %s\n", who, d.msg), -1;
+    ncp_auth_free(a);
+    return 0;
 }

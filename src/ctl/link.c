@@ -112,17 +112,8 @@ int ctl_open(struct ctl *c, const char *url, const char *prefix, const char *key
 {
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
-    char path[NCP_AUTH_PATH_MAX];
-    uint8_t key[NCP_AUTH_KEY_BYTES];
-    if (ncp_auth_key_path(path, sizeof path, key_file, NULL, &d) != 0 ||
-        ncp_auth_load_key(path, 0, key, &d) != 0) {
+    if ((c->auth = ncp_auth_open(key_file, NULL, 0, &d)) == NULL) {
         fprintf(stderr, "cnc-ctl: error: %s\n", d.msg);
-        return CTL_USAGE;
-    }
-    c->auth = ncp_auth_new(key);
-    explicit_bzero(key, sizeof key);
-    if (c->auth == NULL) {
-        fprintf(stderr, "cnc-ctl: out of memory\n");
         return CTL_USAGE;
     }
     if (strlen(prefix) > NCP_MSG_PREFIX_MAX) {

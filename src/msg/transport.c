@@ -151,19 +151,17 @@ int ncp_msg_open(struct ncp_msg **mp, const struct ncp_msg_opts *o, struct ncp_d
     int rc = ncp_msg_parse_url(url, &u, d);
     if (rc != NCP_OK)
         return rc;
-    uint8_t key[NCP_AUTH_KEY_BYTES];
     if (o->key_file == NULL || *o->key_file == 0)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "LCM without a key file: refused");
-    if (ncp_auth_load_key(o->key_file, o->create_key, key, d) != 0)
+    struct ncp_auth *auth = ncp_auth_open(o->key_file, NULL, o->create_key, d);
+    if (auth == NULL)
         return NCP_ERR_IO;
     struct ncp_msg *m = calloc(1, sizeof *m);
-    if (m != NULL)
-        m->auth = ncp_auth_new(key);
-    explicit_bzero(key, sizeof key);
-    if (m == NULL || m->auth == NULL) {
-        free(m);
+    if (m == NULL) {
+        ncp_auth_free(auth);
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the LCM transport");
     }
+    m->auth = auth;
     m->fd = -1;
     m->encrypt_public = o->encrypt_public;
     m->max_age_ns = (int64_t)o->max_age_ms * 1000000;

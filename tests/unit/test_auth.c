@@ -63,6 +63,18 @@ static void test_key_made_once(void **state)
     assert_int_equal(st.st_mode & 07777, 0700);
     assert_int_equal(ncp_auth_load_key(path, 1, k2, &d), 0);        /* the same, not a new one */
     assert_memory_equal(k1, k2, sizeof k1);
+    /* the file's context seals as one made from its bytes checks */
+    struct ncp_auth *from_file = ncp_auth_open(path, NULL, 0, &d), *from_key = ncp_auth_new(k1);
+    assert_non_null(from_file);
+    uint8_t msg[4 + NCP_AUTH_TRAILER_BYTES] = "abc";
+    size_t n = ncp_auth_seal(from_file, "CH", msg, 4, 0, 1), body;
+    int64_t sent;
+    assert_int_equal(ncp_auth_check(from_key, "CH", msg, n, &body, &sent), NCP_AUTH_OK);
+    ncp_auth_free(from_file);
+    ncp_auth_free(from_key);
+    strcat(path, ".missing");
+    assert_null(ncp_auth_open(path, NULL, 0, &d));
+    assert_non_null(strstr(d.msg, path));
 }
 
 static void test_key_refused(void **state)
