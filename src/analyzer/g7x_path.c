@@ -30,17 +30,18 @@ struct hits {
     double z[2];
 };
 
+/* Written as rs274's complex products (I * p, not a swap of parts): the
+ * products' signed zeros are what rs274 prints, -0.0000 included. */
 static double complex unturn(int flip, double complex p)
 {
-    double z = creal(p), x = cimag(p);
     switch (flip) {
-    case 1: return CMPLX(-z, x);
-    case 2: return CMPLX(z, -x);
-    case 3: return CMPLX(-z, -x);
-    case 4: return CMPLX(-x, z);
-    case 5: return CMPLX(-x, -z);
-    case 6: return CMPLX(x, z);
-    case 7: return CMPLX(x, -z);
+    case 1: return -conj(p);
+    case 2: return conj(p);
+    case 3: return -p;
+    case 4: return I * p;
+    case 5: return conj(I * p);
+    case 6: return -conj(I * p);
+    case 7: return -I * p;
     default: return p;
     }
 }
@@ -226,10 +227,11 @@ static void seg_flip_z(struct ncp_g7x_seg *g)
     }
 }
 
-/* A quarter turn: z + i x -> x - i z. */
+/* A quarter turn: z + i x -> x - i z, as rs274's product -v * I (its
+ * signed zeros included). */
 static double complex quarter(double complex v)
 {
-    return CMPLX(cimag(v), -creal(v));
+    return -v * I;
 }
 
 static void seg_rotate(struct ncp_g7x_seg *g)
