@@ -97,6 +97,11 @@ static double ncp_straight_length(const double *p, const double *q)
     return l > 0.0 ? sqrt(l) : sqrt(r);
 }
 
+/* G1 and G2/G3 (G7x passes too) in G95 need the S word's speed, turning or
+ * not: rs274 checks the speed it was given, after the feed rate. */
+static const char ncp_zero_speed_per_rev[] =
+    "Cannot feed with zero spindle speed in feed per rev mode";
+
 int ncp_motion_straight(struct ncp_analyzer *a, int motion)
 {
     struct ncp_state *s = &a->st;
@@ -124,6 +129,8 @@ int ncp_motion_straight(struct ncp_analyzer *a, int motion)
         } else if (s->feed == 0.0) {
             return ncp_an_error(a, NCP_MOTION_COL(w),
                                 "Cannot do g1 with zero feed rate");
+        } else if (s->m.feed_mode == 2 && s->speed == 0.0) {
+            return ncp_an_error(a, NCP_MOTION_COL(w), "%s", ncp_zero_speed_per_rev);
         }
         if (ncp_cutcomp_engaged(&a->comp))
             rc = ncp_comp_move_straight(a, motion, end, g53);
@@ -208,6 +215,8 @@ int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end)
             return ncp_an_error(a, col, "F word missing with inverse time arc move");
     } else if (s->feed == 0.0) {
         return ncp_an_error(a, col, "Cannot make arc with zero feed rate");
+    } else if (s->m.feed_mode == 2 && s->speed == 0.0) {
+        return ncp_an_error(a, col, "%s", ncp_zero_speed_per_rev);
     }
     if (s->m.feed_mode == 1) {
         struct ncp_canon *f = ncp_an_emit(a, NCP_C_SET_FEED_RATE);
