@@ -123,6 +123,10 @@ struct ncp_flow {
      * (its "current sub" is then an empty name, no longer none) */
     int in_sub_context;
     uint32_t skip_start;
+    /* the call that started the seek: where an end of file before the sub
+     * is reported (rs274 counts a subroutine file's lines from 0) */
+    struct flow_pos seek_call;
+    uint16_t seek_call_col;
     int executed_if, doing_break, doing_continue;
     uint64_t jump_target;             /* offset of the block a loop jumped to */
     int by_jump;                      /* the current block was reached that way */
@@ -837,6 +841,8 @@ static int ncp_flow_go_to_sub(struct ncp_flow *f, const struct ncp_block *b, str
         return rc;
     ncp_flow_skip_to_label(f, b);
     ncp_flow_name_set(&f->seek_sub, f->label, f->label_len);
+    f->seek_call = (struct flow_pos){ b->offset, b->line, f->cur.file };
+    f->seek_call_col = b->oword.col;
     if (file) {
         const struct ncp_source *s = ncp_flow_file_src(f, file);
         ncp_flow_go_to(f, (struct flow_pos){ s->begin, s->begin_line, file });
@@ -1327,10 +1333,14 @@ static int ncp_flow_at_end(struct ncp_flow *f, struct ncp_diag *d)
         return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->cur.line, 0,
                             "Failed to find sub 'O%s' before EOF", f->skip.s);
     }
-    if (f->seek_sub.on)
-        return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->skip_start, 0,
+    if (f->seek_sub.on) {
+        /* the error is at the call, in the file that holds it */
+        uint32_t file = f->cur.file;
+        f->cur.file = f->seek_call.file;
+        return ncp_diag_set(d, NCP_ERR_SEMANTIC, f->seek_call.line, f->seek_call_col,
                             "EOF in file:%s seeking o-word: o<%s> from line: %u",
-                            ncp_flow_file_name(f, f->cur.file), f->seek_sub.s, f->skip_start);
+                            ncp_flow_file_name(f, file), f->seek_sub.s, f->skip_start);
+    }
     /* a subroutine file read to its end without endsub or return: the
      * program has no end either */
     if (f->cur.file != 0)

@@ -483,11 +483,13 @@ static void test_sub_files(void **state)
     /* without the path, the files are not found */
     run_cfg("o<tflow_a> call [1]\nm2", NULL, &r);
     assert_int_equal(r.rc, NCP_ERR_SEMANTIC);
-    /* a file without the sub: searched to its end, from its line 0 */
+    /* a file without the sub: searched to its end, from its line 0 as
+     * rs274 says, and reported at the call */
     write_file(dir, "tflow_c.ngc", "g0x7\n");
-    run_cfg("o<tflow_c> call\nm2", &cfg, &r);
+    run_cfg("g0x1\n  o<tflow_c> call\nm2", &cfg, &r);
     assert_int_equal(r.rc, NCP_ERR_SEMANTIC);
-    assert_int_equal(r.d.line, 0);
+    assert_int_equal(r.d.line, 2);
+    assert_int_equal(r.d.col, 3);
     assert_non_null(strstr(r.d.msg, "tflow_c.ngc seeking o-word: o<tflow_c> from line: 0"));
     const char *names[] = { "tflow_a.ngc", "tflow_b.ngc", "tflow_bad.ngc", "tflow_c.ngc" };
     for (unsigned k = 0; k < 4; k++) {
