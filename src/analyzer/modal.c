@@ -204,6 +204,9 @@ int ncp_modal_check(struct ncp_analyzer *a)
     int rc = ncp_motion_to_be(a);
     if (rc == NCP_OK)
         rc = ncp_check_g(a);
+    /* rs274 checks the M count after the G codes: at most MAX_EMS, 4 */
+    if (rc == NCP_OK && a->w.n_m > 4)
+        rc = ncp_an_error(a, a->w.line_col, "Too many m codes on line");
     if (rc == NCP_OK)
         rc = ncp_check_other(a);
     return rc;

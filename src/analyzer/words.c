@@ -334,8 +334,6 @@ static int ncp_words_collect_upto(struct ncp_analyzer *a, const struct ncp_block
         if (rc != NCP_OK)
             return rc;
     }
-    if (w->n_m > 5)
-        return ncp_an_error(a, w->line_col, "Too many m codes on line");
     return NCP_OK;
 }
 
