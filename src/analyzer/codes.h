@@ -34,6 +34,8 @@ enum ncp_mcode {
     NCP_M61 = 61, NCP_M62 = 62, NCP_M63 = 63, NCP_M64 = 64, NCP_M65 = 65, NCP_M66 = 66,
     NCP_M67 = 67, NCP_M68 = 68, NCP_M70 = 70, NCP_M71 = 71, NCP_M72 = 72, NCP_M73 = 73,
     NCP_M98 = 98, NCP_M99 = 99,
+    /* rs274's group 10: user M codes, the machine's programs M100..M199 */
+    NCP_M100 = 100, NCP_M199 = 199,
 };
 
 #endif

@@ -158,7 +158,7 @@ static int ncp_check_other(struct ncp_analyzer *a)
             mt != NCP_G86 && mt != NCP_G88 && mt != NCP_G89 && mt != NCP_G5 && mt != NCP_G5_2 &&
             mt != NCP_G2 && mt != NCP_G3 && mt != NCP_G84 && mt != NCP_G74 && !g70 &&
             (mo < NCP_M50 || mo > NCP_M53) && (mi < NCP_M62 || mi > NCP_M66) &&
-            w->m[NCP_MG_SPINDLE] != NCP_M19 && !w->m98)
+            w->m[NCP_MG_SPINDLE] != NCP_M19 && !w->m98 && w->m[NCP_MG_USER] == -1)
             return ncp_an_error(a, COL('P'), "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 M63 M64 M65 M66 M98 or user M code to use it");
         double p = w->v[NCP_LETTER('P')];
         int pv = ncp_trunc_int_round(p);
@@ -173,7 +173,7 @@ static int ncp_check_other(struct ncp_analyzer *a)
     if (NCP_HAS(w, 'Q') && mt != NCP_G83 && mt != NCP_G73 && mt != NCP_G5 && mt != NCP_G76 &&
         !ncp_is_g7x(mt) && w->m[NCP_MG_IO] != NCP_M66 && w->m[NCP_MG_IO] != NCP_M67 &&
         w->m[NCP_MG_IO] != NCP_M68 && !g10 && w->m[NCP_MG_TOOL] != NCP_M61 && ctl != NCP_G64 &&
-        w->m[NCP_MG_SPINDLE] != NCP_M19)
+        w->m[NCP_MG_SPINDLE] != NCP_M19 && w->m[NCP_MG_USER] == -1)
         return ncp_an_error(a, COL('Q'), "Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it");
     if (NCP_HAS(w, 'R') && mt != NCP_G2 && mt != NCP_G3 && mt != NCP_G76 &&
         !ncp_is_canned_cycle(mt) && !rough && comp != NCP_G41_1 && comp != NCP_G42_1 && !g10 &&

@@ -33,7 +33,7 @@ enum ncp_ggroup {
 
 enum ncp_mgroup {
     NCP_MG_STOP, NCP_MG_TOOL, NCP_MG_SPINDLE, NCP_MG_COOLANT, NCP_MG_OVERRIDE,
-    NCP_MG_IO, NCP_MG__N
+    NCP_MG_IO, NCP_MG_USER, NCP_MG__N
 };
 
 /* letters A..Z, then the polar radius '@', angle '^' and spindle '$' words */

@@ -279,6 +279,11 @@ static int ncp_step_m_codes(struct ncp_analyzer *a)
         rc = ncp_step_coolant(a, w->m[NCP_MG_COOLANT]);
     if (rc == NCP_OK && w->m[NCP_MG_OVERRIDE] != -1)
         rc = ncp_step_override(a, w->m[NCP_MG_OVERRIDE]);
+    /* M100-M199 run the machine's programs of that name; rs274 -g has none
+     * (its canon knows no user function), so it refuses them here, after
+     * the block's other M codes */
+    if (rc == NCP_OK && w->m[NCP_MG_USER] != -1)
+        rc = ncp_an_error(a, w->mcol[NCP_MG_USER], "Unknown m code used: M%d", w->m[NCP_MG_USER]);
     return rc;
 }
 

@@ -89,7 +89,7 @@ static int ncp_m_group(int m)
         return NCP_MG_OVERRIDE;
     case NCP_M62: case NCP_M63: case NCP_M64: case NCP_M65: case NCP_M66: case NCP_M67: case NCP_M68:
         return NCP_MG_IO;
-    default: return -1;
+    default: return m >= NCP_M100 && m <= NCP_M199 ? NCP_MG_USER : -1;
     }
 }
 
