@@ -39,6 +39,15 @@ int ncp_tool_table_check(const char *path, FILE *warn, struct ncp_diag *d);
 
 #define NCP_DEFAULT_MAX_LOOPS 10000000u
 
+/* One REMAP line of LinuxCNC's [RS274NGC] section ("M400 modalgroup=10
+ * argspec=Pq ngc=m400"): its text after "REMAP =", and where it was read,
+ * for the errors that name it. */
+struct ncp_remap_line {
+    const char *text;
+    const char *file;
+    uint32_t line;
+};
+
 struct ncp_analyzer_cfg {
     const char *tool_table_path; /* NULL: empty table (as rs274 without -t) */
     uint32_t max_loop_iterations;/* runaway guard for while/do/repeat loops and the passes
@@ -48,6 +57,12 @@ struct ncp_analyzer_cfg {
      * defined yet: the current folder, then these (colon-separated), as
      * rs274 with [RS274NGC]SUBROUTINE_PATH. NULL: the current folder only. */
     const char *subroutine_path;
+    /* REMAP lines (as rs274 -i reads them): M codes whose meaning becomes an
+     * O-word subroutine. None (0): no remapping, and no cost for it. */
+    const struct ncp_remap_line *remaps;
+    int n_remaps;
+    /* rs274 run with an INI (-i) closes with one ON_RESET, not two */
+    int ini_given;
     /* The NCK's resident interpreter: modal state, parameters, offsets and
      * tool carry over from one run to the next (programs and MDI lines run one
      * after another, as on a controller), so a run emits no rs274 start-up

@@ -31,6 +31,10 @@ struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
         ncp_analyzer_free(a);
         return NULL;
     }
+    if (ncp_remaps_new(&a->cfg, &a->remaps, d) != NCP_OK) {
+        ncp_analyzer_free(a);
+        return NULL;
+    }
     ncp_state_init(a);
     a->execute = ncp_an_execute;
     a->active_codes = ncp_analyzer_active_codes;
@@ -47,6 +51,7 @@ void ncp_analyzer_free(struct ncp_analyzer *a)
         ncp_flow_free(a->flow);
     ncp_m7x_free(a);
     ncp_g52_free(a);
+    ncp_remaps_free(a->remaps);
     ncp_params_free(a->params);
     free(a);
 }
@@ -63,7 +68,8 @@ static void ncp_an_preamble(struct ncp_analyzer *a)
     ncp_an_emit(a, NCP_C_ON_RESET);
 }
 
-/* rs274's driver resets the canon twice when it exits, whatever the outcome. */
+/* rs274's driver resets the canon twice when it exits, whatever the outcome
+ * (once when it was given an INI). */
 static void ncp_an_finish(struct ncp_analyzer *a, uint16_t flag)
 {
     if (flag & NCP_CMD_F_ERROR)
@@ -74,7 +80,8 @@ static void ncp_an_finish(struct ncp_analyzer *a, uint16_t flag)
     ncp_cutcomp_reset(&a->comp);
     if (!a->cfg.resident) {
         ncp_an_emit(a, NCP_C_ON_RESET);
-        ncp_an_emit(a, NCP_C_ON_RESET);
+        if (!a->cfg.ini_given)
+            ncp_an_emit(a, NCP_C_ON_RESET);
     }
     struct ncp_cmd *c = ncp_an_slot(a, 0);
     if (c) {

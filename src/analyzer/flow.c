@@ -67,6 +67,8 @@ struct flow_frame {
                                          this level (rs274's m98_loop_counter), -1 */
     uint16_t name_len;
     char name[FLOW_NAME_MAX];         /* the called sub: scope of its labels */
+    int inline_prev;                  /* an inline call into this level: the
+                                         inline level it interrupted, -1 */
 };
 
 /* A skip from a loop's head to its end line, noting whether what lies
@@ -1433,7 +1435,8 @@ static int ncp_flow_step(struct ncp_flow *f, const struct ncp_block **out,
         if (rc != NCP_OK)
             return rc;
         if (f->inline_level >= 0 && f->level == f->inline_level) {
-            f->inline_level = -1;
+            /* a remap's sub may run inside another's */
+            f->inline_level = f->frames[f->level + 1].inline_prev;
             *out = b;
             return NCP_FLOW_RETURNED;
         }
@@ -1443,10 +1446,13 @@ static int ncp_flow_step(struct ncp_flow *f, const struct ncp_block **out,
 int ncp_flow_call_inline(struct ncp_flow *f, const struct ncp_block *call,
                          struct ncp_diag *d)
 {
-    int level = f->level;
+    int level = f->level, prev = f->inline_level;
     int rc = ncp_flow_run_oword(f, call, d);
-    if (rc == NCP_OK)
+    if (rc == NCP_OK) {
+        if (f->level > level)
+            f->frames[level + 1].inline_prev = prev;
         f->inline_level = level;
+    }
     return rc;
 }
 

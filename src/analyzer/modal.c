@@ -109,6 +109,8 @@ static int ncp_check_other(struct ncp_analyzer *a)
 {
     const struct ncp_words *w = &a->w;
     int mt = w->motion_to_be;
+    if (w->remapped) /* rs274: the remap's argspec takes care of its words */
+        return NCP_OK;
 #define BIT(c) (1u << NCP_LETTER(c))
     /* every check below needs one of these words, G96 or G33/G33.1/G76: a
      * plain move (X Y Z F) has none of them, one test instead of the list */

@@ -80,7 +80,7 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     case P_LATHE_RAD: return !m->lathe_diameter;
     case P_CALL_LEVEL: return a->flow ? ncp_flow_call_depth(a->flow) : 0;
     case P_VMAJOR: return 2.9;
-    case P_REMAP_LEVEL: return 0; /* no remapping here, the top level */
+    case P_REMAP_LEVEL: return a->remap_level;
     /* rs274 without a machine behind it: the canon answers no unit */
     case P_METRIC_MACHINE: return -1;
     case P_VMINOR: /* 2.9.0: 0, as for names not listed */

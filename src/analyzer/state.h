@@ -11,6 +11,7 @@
 #include "cutcomp.h"
 #include "flow.h"
 #include "params.h"
+#include "remap.h"
 
 enum ncp_axis { NCP_X, NCP_Y, NCP_Z, NCP_A, NCP_B, NCP_C, NCP_U, NCP_V, NCP_W, NCP_NAX };
 
@@ -64,6 +65,8 @@ struct ncp_words {
     uint16_t line_col;            /* col of the first word, for block-level errors */
     int motion_to_be;             /* motion this block performs (x10), -1 none */
     int m98;                      /* 1 while an M98 line is checked: P and L are its */
+    int remapped;                 /* an M code of the block runs a remap: rs274 then
+                                     skips its word checks (the argspec's are the ones) */
 };
 
 struct ncp_modal {
@@ -172,6 +175,11 @@ struct ncp_analyzer {
     int block_consumed;           /* an M72 ran restore lines in this block's place */
     struct ncp_block *m7x_block;  /* the restore line being run */
     struct ncp_g52_points nurbs;
+    /* REMAP (remap_run.c): NULL without REMAP lines; the remaps running,
+     * innermost last (#<_remap_level> is their count) */
+    struct ncp_remaps *remaps;
+    int remap_level;
+    const struct ncp_remap *remap_running[NCP_REMAP_DEPTH];
     /* How a handler runs a line of its own as a block (M72's restore lines):
      * ncp_an_execute, handed down by the run loop so that no handler calls
      * back up into the file that calls it. */
@@ -289,6 +297,11 @@ void ncp_sai_g92(struct ncp_analyzer *a, const double *v);
 void ncp_sai_units(struct ncp_analyzer *a, int inches);
 void ncp_sai_probe(struct ncp_analyzer *a, const double *end);
 void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op);
+
+/* remap_run.c: the block's M code in slot `slot` (enum ncp_mgroup) when its
+ * remap runs there (not in its own remap, for the codes rs274 then runs
+ * built in): *ran = 1 and the remap's result. */
+int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran);
 
 /* stop.c */
 int ncp_stop_run(struct ncp_analyzer *a, int m);

@@ -263,27 +263,55 @@ static void ncp_step_retract(struct ncp_analyzer *a, int g)
                                      : "interpreter: retract mode set to old_z");
 }
 
-static int ncp_step_m_codes(struct ncp_analyzer *a)
+/* The M codes of the block in rs274's order of groups: 5 (I/O), 6 (tool),
+ * 7 (spindle, M70-M73), 8 (coolant), 9 (overrides), 10 (user); a remapped
+ * code runs its remap in its group's turn (see ncp_m_step). */
+static int ncp_m_group_run(struct ncp_analyzer *a, int slot)
 {
     const struct ncp_words *w = &a->w;
-    int rc = NCP_OK;
-    if (w->m[NCP_MG_IO] != -1)
-        rc = ncp_step_io(a, w->m[NCP_MG_IO]);
-    if (rc == NCP_OK && w->m[NCP_MG_TOOL] != -1)
-        rc = ncp_tools_change(a);
-    if (rc == NCP_OK && w->m[NCP_MG_SPINDLE] != -1)
-        rc = ncp_step_spindle(a, w->m[NCP_MG_SPINDLE]);
+    int m = w->m[slot];
+    switch (slot) {
+    case NCP_MG_IO: return ncp_step_io(a, m);
+    case NCP_MG_TOOL: return ncp_tools_change(a);
+    case NCP_MG_SPINDLE: return ncp_step_spindle(a, m);
+    case NCP_MG_COOLANT: return ncp_step_coolant(a, m);
+    case NCP_MG_OVERRIDE: return ncp_step_override(a, m);
+    default:
+        /* M100-M199 run the machine's programs of that name; rs274 -g has
+         * none (its canon knows no user function), so it refuses them here,
+         * after the block's other M codes */
+        return ncp_an_error(a, w->mcol[slot], "Unknown m code used: M%d", m);
+    }
+}
+
+static int ncp_m_step(struct ncp_analyzer *a, int slot)
+{
+    if (a->w.m[slot] == -1)
+        return NCP_OK;
+    if (a->remaps) {
+        int ran;
+        int rc = ncp_remap_step(a, slot, &ran);
+        if (ran || rc != NCP_OK)
+            return rc;
+    }
+    return ncp_m_group_run(a, slot);
+}
+
+static int ncp_step_m_codes(struct ncp_analyzer *a)
+{
+    int rc = ncp_m_step(a, NCP_MG_IO);
+    if (rc == NCP_OK)
+        rc = ncp_m_step(a, NCP_MG_TOOL);
+    if (rc == NCP_OK)
+        rc = ncp_m_step(a, NCP_MG_SPINDLE);
     if (a->block_consumed) /* see ncp_an_steps */
         return rc;
-    if (rc == NCP_OK && w->m[NCP_MG_COOLANT] != -1)
-        rc = ncp_step_coolant(a, w->m[NCP_MG_COOLANT]);
-    if (rc == NCP_OK && w->m[NCP_MG_OVERRIDE] != -1)
-        rc = ncp_step_override(a, w->m[NCP_MG_OVERRIDE]);
-    /* M100-M199 run the machine's programs of that name; rs274 -g has none
-     * (its canon knows no user function), so it refuses them here, after
-     * the block's other M codes */
-    if (rc == NCP_OK && w->m[NCP_MG_USER] != -1)
-        rc = ncp_an_error(a, w->mcol[NCP_MG_USER], "Unknown m code used: M%d", w->m[NCP_MG_USER]);
+    if (rc == NCP_OK)
+        rc = ncp_m_step(a, NCP_MG_COOLANT);
+    if (rc == NCP_OK)
+        rc = ncp_m_step(a, NCP_MG_OVERRIDE);
+    if (rc == NCP_OK)
+        rc = ncp_m_step(a, NCP_MG_USER);
     return rc;
 }
 
@@ -412,8 +440,13 @@ int ncp_an_steps(struct ncp_analyzer *a)
     }
     if (rc == NCP_OK)
         rc = ncp_step_g_codes(a);
-    if (rc == NCP_OK && w->m[NCP_MG_STOP] != -1)
-        rc = ncp_stop_run(a, w->m[NCP_MG_STOP]);
+    if (rc == NCP_OK && w->m[NCP_MG_STOP] != -1) {
+        int ran = 0;
+        if (a->remaps)
+            rc = ncp_remap_step(a, NCP_MG_STOP, &ran);
+        if (rc == NCP_OK && !ran)
+            rc = ncp_stop_run(a, w->m[NCP_MG_STOP]);
+    }
     ncp_offsets_sync_params(a);
     return rc;
 }

@@ -156,11 +156,22 @@ static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
         return rc;
     if (m < 0)
         return ncp_an_error(a, col, "Negative m code used");
-    if (m > 199)
-        return ncp_an_error(a, col, "M-code greater than 199: M%d", m);
-    int g = ncp_m_group(m);
-    if (g < 0)
-        return ncp_an_error(a, col, "Unknown m code used: M%d", m);
+    int g;
+    const struct ncp_remap *r = a->remaps ? ncp_remap_of_m(a->remaps, m) : NULL;
+    if (r) { /* its group is the REMAP line's */
+        static const signed char slot[11] = {
+            -1, -1, -1, -1, NCP_MG_STOP, NCP_MG_IO, NCP_MG_TOOL, NCP_MG_SPINDLE,
+            NCP_MG_COOLANT, NCP_MG_OVERRIDE, NCP_MG_USER,
+        };
+        g = slot[r->group];
+        w->remapped |= r->remappable;
+    } else {
+        if (m > 199)
+            return ncp_an_error(a, col, "M-code greater than 199: M%d", m);
+        g = ncp_m_group(m);
+        if (g < 0)
+            return ncp_an_error(a, col, "Unknown m code used: M%d", m);
+    }
     if (w->m[g] != -1)
         return ncp_an_error(a, col, "Two m codes used from same modal group");
     w->m[g] = (int16_t)m;
@@ -297,6 +308,7 @@ static int ncp_words_collect_upto(struct ncp_analyzer *a, const struct ncp_block
     struct ncp_words *w = &a->w;
     w->has = 0;
     w->n_m = 0;
+    w->remapped = 0;
     w->line_col = b->n_words ? b->words[0].col : 1;
     memset(w->g, 0xff, sizeof w->g);
     memset(w->m, 0xff, sizeof w->m);

@@ -1,0 +1,169 @@
+/* REMAP lines read as rs274 -i reads them (its parse_remap): the code, then
+ * options kw=value. ncpar runs M codes remapped to ngc= subroutines; what
+ * needs LinuxCNC's Python plugin (python=, prolog=, epilog=) and remaps of
+ * T, S, F and G codes are refused here, naming the INI line, so that nothing
+ * of the configuration is silently dropped. */
+#include "remap.h"
+
+#include <ctype.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+static int remap_error(struct ncp_diag *d, const struct ncp_remap_line *l, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static int remap_error(struct ncp_diag *d, const struct ncp_remap_line *l, const char *fmt, ...)
+{
+    char msg[NCP_DIAG_MSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    int rc = ncp_diag_set(d, NCP_ERR_SEMANTIC, l->line, 0, "REMAP: %s", msg);
+    d->file = l->file ? ncp_diag_file_of_tag(ncp_diag_file_tag(l->file)) : NULL;
+    return rc;
+}
+
+/* rs274's is_m_code_remappable: codes with no meaning of their own, and the
+ * listed ones whose built-in step a remap may take over. */
+static int remappable_m(int m)
+{
+    switch (m) {
+    case 0: case 1: case 6: case 7: case 8: case 9: case 60: case 61: case 62: case 63:
+    case 64: case 65: case 66: case 67: case 68:
+        return 1;
+    case 2: case 3: case 4: case 5: case 19: case 30: case 48: case 49: case 50: case 51:
+    case 52: case 53: case 70: case 71: case 72: case 73: case 98: case 99:
+        return 0;
+    default:
+        return (m > 0 && m < 100) || (m > 199 && m < NCP_REMAP_M_MAX);
+    }
+}
+
+/* Like rs274: NAME.ngc in the current folder or a subroutine path folder. */
+static int ngc_found(const char *sub_path, const char *name)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s.ngc", name);
+    if (access(path, R_OK) == 0)
+        return 1;
+    const char *p = sub_path;
+    while (p && *p) {
+        const char *end = strchr(p, ':');
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        if (n > 0 && n < sizeof path - 8 - strlen(name)) {
+            snprintf(path, sizeof path, "%.*s/%s.ngc", (int)n, p, name);
+            if (access(path, R_OK) == 0)
+                return 1;
+        }
+        p = end ? end + 1 : NULL;
+    }
+    return 0;
+}
+
+static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
+                       struct ncp_remap *r, struct ncp_diag *d)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", l->text ? l->text : "");
+    char *hash = strchr(buf, '#'); /* rs274 strips a trailing comment */
+    if (hash)
+        *hash = '\0';
+    char *save = NULL;
+    char *code = strtok_r(buf, " \t", &save);
+    if (!code)
+        return remap_error(d, l, "no code to remap");
+    memset(r, 0, sizeof *r);
+    r->group = -1;
+    snprintf(r->code, sizeof r->code, "%s", code);
+    int has_ngc = 0;
+    for (char *kw = strtok_r(NULL, " \t", &save); kw; kw = strtok_r(NULL, " \t", &save)) {
+        char *arg = strchr(kw, '=');
+        if (!arg)
+            return remap_error(d, l, "option '%s' - missing '=<value>'", kw);
+        size_t kwlen = (size_t)(arg - kw);
+        arg++;
+        if (!*arg)
+            return remap_error(d, l, "option '%s' - zero length value", kw);
+        if (!strncasecmp(kw, "modalgroup", kwlen)) {
+            r->group = atoi(arg);
+        } else if (!strncasecmp(kw, "argspec", kwlen)) {
+            size_t pos = strspn(arg, "ABCDEFGHIJKLMNPQRSTUVWXYZabcdefghijklmnpqrstuvwxyz>^@");
+            if (arg[pos])
+                return remap_error(d, l, "argspec: illegal word '%c'", arg[pos]);
+            if (strchr(arg, 'N') || strchr(arg, 'n'))
+                return remap_error(d, l, "argspec: N (the line number) is not supported by ncpar");
+            snprintf(r->argspec, sizeof r->argspec, "%s", arg);
+        } else if (!strncasecmp(kw, "ngc", kwlen)) {
+            if (!ngc_found(sub_path, arg))
+                return remap_error(d, l, "NGC file not found: ngc=%s", arg);
+            snprintf(r->ngc, sizeof r->ngc, "%s", arg);
+            has_ngc = 1;
+        } else if (!strncasecmp(kw, "python", kwlen) || !strncasecmp(kw, "prolog", kwlen) ||
+                   !strncasecmp(kw, "epilog", kwlen)) {
+            return remap_error(d, l, "%.*s=%s needs LinuxCNC's Python plugin, which ncpar does "
+                               "not have", (int)kwlen, kw, arg);
+        } else {
+            return remap_error(d, l, "unrecognized option '%.*s'", (int)kwlen, kw);
+        }
+    }
+    if (!has_ngc)
+        return remap_error(d, l, "code '%s' - no remap function given, use 'ngc=<basename>'",
+                           r->code);
+    if (toupper((unsigned char)code[0]) != 'M')
+        return remap_error(d, l, "code '%s': ncpar remaps M codes only", r->code);
+    char *end = NULL;
+    long m = strtol(code + 1, &end, 10);
+    if (end == code + 1 || *end || m < 0 || m >= NCP_REMAP_M_MAX)
+        return remap_error(d, l, "parsing M-code: expecting integer like 'M420', got '%s'",
+                           r->code);
+    r->m = (int)m;
+    if (r->group == -1)
+        r->group = 10; /* rs274's default, with a warning */
+    if (r->group < 4 || r->group > 10)
+        return remap_error(d, l, "code '%s' : invalid modalgroup=<int> given (currently "
+                           "valid: 4..10)", r->code);
+    r->remappable = remappable_m(r->m);
+    return NCP_OK;
+}
+
+int ncp_remaps_new(const struct ncp_analyzer_cfg *cfg, struct ncp_remaps **out,
+                   struct ncp_diag *d)
+{
+    *out = NULL;
+    if (!cfg || cfg->n_remaps <= 0)
+        return NCP_OK;
+    struct ncp_remaps *rs = calloc(1, sizeof *rs);
+    if (rs)
+        rs->r = calloc((size_t)cfg->n_remaps, sizeof *rs->r);
+    if (!rs || !rs->r) {
+        ncp_remaps_free(rs);
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
+    }
+    memset(rs->by_m, 0xff, sizeof rs->by_m);
+    for (int k = 0; k < cfg->n_remaps; k++) {
+        struct ncp_remap *r = &rs->r[rs->n];
+        int rc = remap_parse(&cfg->remaps[k], cfg->subroutine_path, r, d);
+        if (rc == NCP_OK && rs->by_m[r->m] >= 0)
+            rc = remap_error(d, &cfg->remaps[k], "code '%s' already remapped", r->code);
+        if (rc != NCP_OK) {
+            ncp_remaps_free(rs);
+            return rc;
+        }
+        rs->by_m[r->m] = (int16_t)rs->n++;
+    }
+    *out = rs;
+    return NCP_OK;
+}
+
+void ncp_remaps_free(struct ncp_remaps *rs)
+{
+    if (!rs)
+        return;
+    free(rs->r);
+    free(rs);
+}

@@ -1,0 +1,41 @@
+/* LinuxCNC's REMAP of M codes (module-internal header): an M code runs an
+ * O-word subroutine (ngc=NAME, NAME.ngc) in its step of the line, with the
+ * words its argspec names as the sub's local parameters (#<p>, #<q>...), as
+ * rs274 -i runs it. Built only when the configuration has REMAP lines: a
+ * program without them pays one NULL test per M word. */
+#ifndef NCP_ANALYZER_REMAP_H
+#define NCP_ANALYZER_REMAP_H
+
+#include "ncpar/analyzer.h"
+
+#define NCP_REMAP_M_MAX 1000 /* rs274 remaps M0..M999 */
+#define NCP_REMAP_DEPTH 16   /* remaps running inside remaps (calls stop at 10) */
+
+struct ncp_remap {
+    char code[16];      /* as written: "M400" */
+    int m;
+    int group;          /* rs274's M modal group, 4..10 */
+    int remappable;     /* rs274 runs it (else it only moves the code's group) */
+    char argspec[64];
+    char ngc[128];
+};
+
+struct ncp_remaps {
+    struct ncp_remap *r;
+    int n;
+    int16_t by_m[NCP_REMAP_M_MAX]; /* index into r, -1 none */
+};
+
+/* Reads cfg's REMAP lines; *out NULL when there are none. An error names the
+ * INI file and line (d->file, d->line). */
+int ncp_remaps_new(const struct ncp_analyzer_cfg *cfg, struct ncp_remaps **out,
+                   struct ncp_diag *d);
+void ncp_remaps_free(struct ncp_remaps *rs);
+
+/* The remap of M code m, or NULL. */
+static inline const struct ncp_remap *ncp_remap_of_m(const struct ncp_remaps *rs, int m)
+{
+    return rs && m >= 0 && m < NCP_REMAP_M_MAX && rs->by_m[m] >= 0 ? &rs->r[rs->by_m[m]] : NULL;
+}
+
+#endif
