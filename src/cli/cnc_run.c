@@ -7,6 +7,7 @@
 #include "canon_writer.h"
 #include "machine.h"
 #include "outfile.h"
+#include "rs274_ini.h"
 #include "run.h"
 #include "signals.h"
 #include "serve.h"
@@ -118,8 +119,8 @@ static void usage(FILE *f)
     fputs("usage: cnc-run parse PROG [-j N] [--executors M] [--mode serial|det|att]\n"
           "                          [--config INI] [--tool-table FILE] [--canon FILE|-]\n"
           "                          [--stats] [--max-loops N] [--inline-output]\n"
-          "                          [--subroutine-path DIR[:DIR...]]\n"
-          "       cnc-run check PROG [--tool-table FILE] [--subroutine-path DIRS]\n"
+          "                          [--subroutine-path DIR[:DIR...]] [--ini INI]\n"
+          "       cnc-run check PROG [--tool-table FILE] [--subroutine-path DIRS] [--ini INI]\n"
           "       cnc-run run PROG [--config INI] [--trace CSV] [--for SECONDS]\n"
           "                        [--feed-override PCT] [--clock real|virtual]\n"
           "       cnc-run serve [--config INI] [--lcm-url URL] [--clock real|virtual] [--trace CSV]\n"
@@ -136,6 +137,8 @@ static void usage(FILE *f)
           "       alone: -j 2 --executors 1, on 2 CPUs or fewer -j 0 --executors 0.\n"
           "       `o<name> call` of a sub not defined yet reads name.ngc from the\n"
           "       current folder, then from the --subroutine-path folders (as rs274).\n"
+          "       --ini: LinuxCNC's [RS274NGC] as rs274 -i reads it: SUBROUTINE_PATH\n"
+          "       (after --subroutine-path) and REMAP lines of M codes to ngc= subs.\n"
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
           "run    run PROG on the machine: planner, interpolator, position loop, backend\n"
           "       (the simulated servo by default); `cnc-run run --help` for details.\n"
@@ -158,6 +161,9 @@ struct parse_opts {
     int mode_given;
     int counts_given;   /* -j or --executors on the command line */
     int stats;
+    const char *ini_path;
+    struct rs274_ini ini;
+    char *sub_path;      /* --subroutine-path and the INI's, joined */
     struct ncp_analyzer_cfg acfg;
 };
 
@@ -174,6 +180,7 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         { "inline-output", no_argument, 0, 'I' },
         { "max-loops", required_argument, 0, 'L' },
         { "subroutine-path", required_argument, 0, 'P' },
+        { "ini", required_argument, 0, 'N' },
         { "help", no_argument, 0, 'h' },
         { 0, 0, 0, 0 },
     };
@@ -200,6 +207,7 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         case 't': o->acfg.tool_table_path = optarg; break;
         case 'o': o->canon = optarg; break;
         case 'P': o->acfg.subroutine_path = optarg; break;
+        case 'N': o->ini_path = optarg; break;
         case 's': o->stats = 1; break;
         case 'I': o->inline_output = 1; break;
         case 'L':
@@ -216,7 +224,26 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
         return -1;
     }
     o->prog = argv[optind];
+    if (o->ini_path) {
+        if (rs274_ini_load(o->ini_path, &o->ini) != 0)
+            return -1;
+        if (o->ini.sub_path) {
+            o->sub_path = rs274_ini_join_paths(o->acfg.subroutine_path, o->ini.sub_path);
+            if (!o->sub_path)
+                return fprintf(stderr, "cnc-run: out of memory\n"), -1;
+            o->acfg.subroutine_path = o->sub_path;
+        }
+        o->acfg.ini_given = 1;
+        o->acfg.remaps = o->ini.remaps;
+        o->acfg.n_remaps = o->ini.n_remaps;
+    }
     return 0;
+}
+
+static void parse_opts_free(struct parse_opts *o)
+{
+    rs274_ini_free(&o->ini);
+    free(o->sub_path);
 }
 
 /* The files a run reads: none of them may be an output. */
@@ -231,19 +258,18 @@ static int program_ids(const struct ncp_source *src, const struct parse_opts *o,
     }
     n = ncp_file_id_add(ids, n, o->config, "the thread map INI");
     n = ncp_file_id_add(ids, n, o->acfg.tool_table_path, "the tool table");
+    n = ncp_file_id_add(ids, n, o->ini_path, "the INI");
     return n;
 }
 
-static int cmd_parse(int argc, char **argv)
+static int parse_run(struct parse_opts *o, int argc, char **argv)
 {
-    struct parse_opts o;
-    memset(&o, 0, sizeof o);
-    o.lexers = 2;
-    o.executors = 1;
-    o.mode = NCP_MODE_DET;
-    if (parse_args(argc, argv, &o))
+    o->lexers = 2;
+    o->executors = 1;
+    o->mode = NCP_MODE_DET;
+    if (parse_args(argc, argv, o))
         return usage(stderr), EXIT_USAGE;
-    if (ncp_cli_check_tool_table(o.acfg.tool_table_path))
+    if (ncp_cli_check_tool_table(o->acfg.tool_table_path))
         return EXIT_USAGE;
 
     struct ncp_thread_map map;
@@ -252,27 +278,27 @@ static int cmd_parse(int argc, char **argv)
     int cpus = ncp_cpus_usable();
     /* no flag names a layout: it is chosen from the program's size once the
      * program is read (a pipe is read to its end before the run) */
-    int automatic = !o.config && !o.mode_given && !o.counts_given && !o.inline_output;
-    if (o.config) {
-        if (ncp_thread_map_load(&map, o.config, &d) != NCP_OK) {
+    int automatic = !o->config && !o->mode_given && !o->counts_given && !o->inline_output;
+    if (o->config) {
+        if (ncp_thread_map_load(&map, o->config, &d) != NCP_OK) {
             if (d.line)
-                fprintf(stderr, "%s:%u: error: %s\n", o.config, d.line, d.msg);
+                fprintf(stderr, "%s:%u: error: %s\n", o->config, d.line, d.msg);
             else
-                fprintf(stderr, "%s: error: %s\n", o.config, d.msg);
+                fprintf(stderr, "%s: error: %s\n", o->config, d.msg);
             return EXIT_USAGE;
         }
-        if (o.mode_given)
-            map.mode = o.mode;
+        if (o->mode_given)
+            map.mode = o->mode;
     } else if (!automatic) {
         /* --mode without counts on two CPUs or fewer: the two-thread layout
          * of ncp_thread_map_auto */
-        if (!o.counts_given && cpus <= 2) {
-            o.lexers = 0;
-            o.executors = 0;
+        if (!o->counts_given && cpus <= 2) {
+            o->lexers = 0;
+            o->executors = 0;
         }
-        ncp_thread_map_default(&map, o.mode, o.lexers, o.executors);
+        ncp_thread_map_default(&map, o->mode, o->lexers, o->executors);
     }
-    if (!automatic && o.inline_output) {
+    if (!automatic && o->inline_output) {
         if (map.n_executors > 0) {
             fprintf(stderr, "cnc-run: --inline-output needs --executors 0 (the analyzer then executes)\n");
             return EXIT_USAGE;
@@ -281,28 +307,28 @@ static int cmd_parse(int argc, char **argv)
     }
 
     struct ncp_source src;
-    if (ncp_source_open(&src, o.prog, &d) != NCP_OK) {
-        print_diag(o.prog, &d);
+    if (ncp_source_open(&src, o->prog, &d) != NCP_OK) {
+        print_diag(o->prog, &d);
         return EXIT_PROGRAM;
     }
     size_t prog_bytes = src.end - src.begin;
     if (automatic)
         ncp_thread_map_auto(&map, prog_bytes, cpus);
-    struct ncp_file_id inputs[4];
-    int n_inputs = program_ids(&src, &o, inputs);
+    struct ncp_file_id inputs[5];
+    int n_inputs = program_ids(&src, o, inputs);
     struct canon_writer *w = NULL;
-    if (o.canon && !(w = canon_writer_open(o.canon, inputs, n_inputs))) {
+    if (o->canon && !(w = canon_writer_open(o->canon, inputs, n_inputs))) {
         ncp_source_close(&src);
         return EXIT_USAGE;
     }
-    ncp_cli_catch_input_faults(o.prog, 1);
+    ncp_cli_catch_input_faults(o->prog, 1);
     struct ncp_output out = { .ctx = w, .emit = canon_writer_emit,
                               .reserve = canon_writer_reserve, .commit = canon_writer_commit };
     struct ncp_run_stats st;
     memset(&st, 0, sizeof st);
     int rc = map.mode == NCP_MODE_SERIAL
-                 ? ncp_serial_run(&src, &o.acfg, &out, &st, &d)
-                 : ncp_pipeline_run(&src, &map, &o.acfg, &out, &st, &d);
+                 ? ncp_serial_run(&src, &o->acfg, &out, &st, &d)
+                 : ncp_pipeline_run(&src, &map, &o->acfg, &out, &st, &d);
     int status = EXIT_OK;
     uint32_t warnings = st.warnings;
     const char *warning;
@@ -313,7 +339,7 @@ static int cmd_parse(int argc, char **argv)
     int changed = ncp_source_changed(&src);
     int write_err = w ? canon_writer_close(w, !changed) : 0;
     if (changed) {
-        fprintf(stderr, "%s: error: input changed while reading\n", o.prog);
+        fprintf(stderr, "%s: error: input changed while reading\n", o->prog);
         status = EXIT_PROGRAM;
         write_err = 0;
         rc = NCP_OK;
@@ -325,10 +351,10 @@ static int cmd_parse(int argc, char **argv)
         status = EXIT_RUNTIME;
     }
     if (rc != NCP_OK && !(write_err && rc == NCP_ERR_IO)) {
-        print_diag(o.prog, &d);
+        print_diag(o->prog, &d);
         status = EXIT_PROGRAM;
     }
-    if (o.stats) {
+    if (o->stats) {
         print_stats(&st, &map);
         if (automatic)
             print_choice(&map, prog_bytes, cpus);
@@ -337,27 +363,34 @@ static int cmd_parse(int argc, char **argv)
     return status;
 }
 
-/* Syntax errors are independent of each other, so check reports every one of
- * them; the interpreter itself stops at its first error, which is reported too
- * unless it is one of the syntax errors already listed. */
-static int cmd_check(int argc, char **argv)
+static int cmd_parse(int argc, char **argv)
 {
     struct parse_opts o;
     memset(&o, 0, sizeof o);
-    if (parse_args(argc, argv, &o))
+    int rc = parse_run(&o, argc, argv);
+    parse_opts_free(&o);
+    return rc;
+}
+
+/* Syntax errors are independent of each other, so check reports every one of
+ * them; the interpreter itself stops at its first error, which is reported too
+ * unless it is one of the syntax errors already listed. */
+static int check_run(struct parse_opts *o, int argc, char **argv)
+{
+    if (parse_args(argc, argv, o))
         return usage(stderr), EXIT_USAGE;
-    if (ncp_cli_check_tool_table(o.acfg.tool_table_path))
+    if (ncp_cli_check_tool_table(o->acfg.tool_table_path))
         return EXIT_USAGE;
     struct ncp_source src;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
-    if (ncp_source_open(&src, o.prog, &d) != NCP_OK) {
-        print_diag(o.prog, &d);
+    if (ncp_source_open(&src, o->prog, &d) != NCP_OK) {
+        print_diag(o->prog, &d);
         return EXIT_PROGRAM;
     }
-    ncp_cli_catch_input_faults(o.prog, 0);
+    ncp_cli_catch_input_faults(o->prog, 0);
     struct ncp_run_stats st;
-    int rc = ncp_serial_run(&src, &o.acfg, NULL, &st, &d);
+    int rc = ncp_serial_run(&src, &o->acfg, NULL, &st, &d);
     struct ncp_block *b = malloc(sizeof *b);
     struct ncp_blocks_lines lines;
     struct ncp_span sp;
@@ -369,28 +402,37 @@ static int cmd_check(int argc, char **argv)
      * run knows, and reports that case */
     while (b && ncp_blocks_check_next(&lines, &sp, b, &bad) == 0) {
         if (rc != NCP_OK && !printed_run_error && d.line <= sp.line) {
-            print_diag(o.prog, &d);
+            print_diag(o->prog, &d);
             printed_run_error = 1;
             errors++;
             if (d.line == sp.line)
                 continue;
         }
         if (bad) {
-            print_diag(o.prog, &b->err);
+            print_diag(o->prog, &b->err);
             errors++;
         }
     }
     if (rc != NCP_OK && !printed_run_error) {
-        print_diag(o.prog, &d);
+        print_diag(o->prog, &d);
         errors++;
     }
     free(b);
     if (ncp_source_changed(&src)) {
-        fprintf(stderr, "%s: error: input changed while reading\n", o.prog);
+        fprintf(stderr, "%s: error: input changed while reading\n", o->prog);
         errors++;
     }
     ncp_source_close(&src);
     return errors ? EXIT_PROGRAM : EXIT_OK;
+}
+
+static int cmd_check(int argc, char **argv)
+{
+    struct parse_opts o;
+    memset(&o, 0, sizeof o);
+    int rc = check_run(&o, argc, argv);
+    parse_opts_free(&o);
+    return rc;
 }
 
 int main(int argc, char **argv)

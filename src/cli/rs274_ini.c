@@ -1,0 +1,164 @@
+/* [RS274NGC] of a LinuxCNC INI, read as rs274 -i reads it. rs274 -i itself
+ * reads SUBROUTINE_PATH and REMAP; PARAMETER_FILE, USER_M_PATH and the
+ * logging keys are its task's or GUI's, so they change nothing in rs274 -g
+ * and are taken without effect here; any other key would change what rs274
+ * prints in a way ncpar does not follow, so it is refused. */
+#include "rs274_ini.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+static const char *const no_effect[] = {
+    "PARAMETER_FILE", "USER_M_PATH", "FEATURES", "LOG_LEVEL", "LOG_FILE",
+    "ON_ABORT_COMMAND", "RS274NGC_STARTUP_CODE", "INI_VARS", "HAL_PIN_VARS",
+};
+
+static char *trim(char *s)
+{
+    while (isspace((unsigned char)*s))
+        s++;
+    size_t n = strlen(s);
+    while (n > 0 && isspace((unsigned char)s[n - 1]))
+        s[--n] = '\0';
+    return s;
+}
+
+static char *read_file(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return NULL;
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    size_t got;
+    while (buf && (got = fread(buf + len, 1, cap - len - 1, f)) > 0) {
+        len += got;
+        if (len + 1 == cap) {
+            char *more = cap < (64u << 20) ? realloc(buf, cap *= 2) : NULL;
+            if (!more) {
+                free(buf);
+                buf = NULL;
+            }
+            buf = more;
+        }
+    }
+    if (buf)
+        buf[len] = '\0';
+    if (ferror(f)) {
+        free(buf);
+        buf = NULL;
+    }
+    fclose(f);
+    return buf;
+}
+
+/* The INI's folders, relative ones taken from the INI's own folder (LinuxCNC
+ * runs from the configuration's folder). */
+static char *absolute_dirs(const char *ini_path, const char *value)
+{
+    const char *slash = strrchr(ini_path, '/');
+    size_t base = slash ? (size_t)(slash - ini_path) : 0;
+    size_t cap = strlen(value) * 2 + 64, len = 0;
+    for (const char *p = value; *p; p++)
+        cap += *p == ':' ? base + 2 : 0;
+    cap += base + 2;
+    char *out = malloc(cap);
+    if (!out)
+        return NULL;
+    const char *p = value;
+    while (*p) {
+        const char *end = strchr(p, ':');
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        if (len)
+            out[len++] = ':';
+        if (n && p[0] != '/' && slash)
+            len += (size_t)snprintf(out + len, cap - len, "%.*s/", (int)base, ini_path);
+        len += (size_t)snprintf(out + len, cap - len, "%.*s", (int)n, p);
+        p = end ? end + 1 : p + n;
+    }
+    out[len] = '\0';
+    return out;
+}
+
+int rs274_ini_load(const char *path, struct rs274_ini *ini)
+{
+    memset(ini, 0, sizeof *ini);
+    ini->text = read_file(path);
+    if (!ini->text) {
+        fprintf(stderr, "%s: error: cannot read: %s\n", path, strerror(errno ? errno : EIO));
+        return -1;
+    }
+    int in_section = 0, cap = 0;
+    uint32_t line = 0;
+    char *next = ini->text;
+    while (next) {
+        char *s = next;
+        line++;
+        next = strchr(s, '\n');
+        if (next)
+            *next++ = '\0';
+        s = trim(s);
+        if (!*s || *s == '#' || *s == ';')
+            continue;
+        if (*s == '[') {
+            in_section = !strncmp(s, "[RS274NGC]", 10);
+            continue;
+        }
+        if (!in_section)
+            continue;
+        char *eq = strchr(s, '=');
+        if (!eq) {
+            fprintf(stderr, "%s:%u: error: [RS274NGC] line without '=': %s\n", path, line, s);
+            return -1;
+        }
+        *eq = '\0';
+        char *key = trim(s), *value = trim(eq + 1);
+        if (!strcmp(key, "REMAP")) {
+            if (ini->n_remaps == cap) {
+                cap = cap ? cap * 2 : 8;
+                struct ncp_remap_line *more = realloc(ini->remaps, (size_t)cap * sizeof *more);
+                if (!more)
+                    return fprintf(stderr, "%s: error: out of memory\n", path), -1;
+                ini->remaps = more;
+            }
+            ini->remaps[ini->n_remaps++] = (struct ncp_remap_line){ value, path, line };
+        } else if (!strcmp(key, "SUBROUTINE_PATH")) {
+            free(ini->sub_path);
+            if (!(ini->sub_path = absolute_dirs(path, value)))
+                return fprintf(stderr, "%s: error: out of memory\n", path), -1;
+        } else {
+            size_t k = 0;
+            while (k < sizeof no_effect / sizeof no_effect[0] && strcmp(key, no_effect[k]))
+                k++;
+            if (k == sizeof no_effect / sizeof no_effect[0]) {
+                fprintf(stderr, "%s:%u: error: [RS274NGC]%s is not supported by ncpar\n", path,
+                        line, key);
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+void rs274_ini_free(struct rs274_ini *ini)
+{
+    free(ini->sub_path);
+    free(ini->remaps);
+    free(ini->text);
+    memset(ini, 0, sizeof *ini);
+}
+
+char *rs274_ini_join_paths(const char *cli, const char *ini)
+{
+    if (!cli && !ini)
+        return NULL;
+    size_t n = (cli ? strlen(cli) : 0) + (ini ? strlen(ini) : 0) + 2;
+    char *out = malloc(n);
+    if (out)
+        snprintf(out, n, "%s%s%s", cli ? cli : "", cli && ini ? ":" : "", ini ? ini : "");
+    return out;
+}
