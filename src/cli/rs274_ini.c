@@ -2,7 +2,10 @@
  * reads SUBROUTINE_PATH and REMAP; PARAMETER_FILE, USER_M_PATH and the
  * logging keys are its task's or GUI's, so they change nothing in rs274 -g
  * and are taken without effect here; any other key would change what rs274
- * prints in a way ncpar does not follow, so it is refused. */
+ * prints in a way ncpar does not follow, so it is refused. rs274 -i also
+ * reads a few keys of the machine's sections (the tool change, the units,
+ * wrapped rotaries): set to anything but their default, they are refused
+ * too, the rest of those sections being the machine's. */
 #include "rs274_ini.h"
 
 #include <ctype.h>
@@ -16,6 +19,40 @@ static const char *const no_effect[] = {
     "PARAMETER_FILE", "USER_M_PATH", "FEATURES", "LOG_LEVEL", "LOG_FILE",
     "ON_ABORT_COMMAND", "RS274NGC_STARTUP_CODE", "INI_VARS", "HAL_PIN_VARS",
 };
+
+enum section { SEC_OTHER, SEC_RS274NGC, SEC_EMCIO, SEC_TRAJ, SEC_AXIS_ABC };
+
+static int ini_true(const char *v)
+{
+    return !strcasecmp(v, "TRUE") || !strcasecmp(v, "YES") || !strcasecmp(v, "ON") ||
+           !strcmp(v, "1");
+}
+
+/* A machine section's key that rs274 -i reads: 1 when its value is not the
+ * default that ncpar follows. */
+static int machine_key_changes(enum section sec, const char *key, const char *value)
+{
+    switch (sec) {
+    case SEC_EMCIO:
+        if (!strcmp(key, "TOOL_CHANGE_AT_G30") || !strcmp(key, "TOOL_CHANGE_QUILL_UP") ||
+            !strcmp(key, "TOOL_CHANGE_WITH_SPINDLE_ON") || !strcmp(key, "RANDOM_TOOLCHANGER"))
+            return ini_true(value);
+        return 0;
+    case SEC_TRAJ:
+        /* LINEAR_UNITS sets rs274 -g's external unit, which nothing it
+         * prints depends on (tool offsets, #5221, #5403 and G92's measured
+         * alike with mm and inch) */
+        if (!strcmp(key, "SPINDLES"))
+            return atoi(value) != 1;
+        return 0;
+    case SEC_AXIS_ABC:
+        if (!strcmp(key, "WRAPPED_ROTARY"))
+            return ini_true(value);
+        return !strcmp(key, "LOCKING_INDEXER_JOINT");
+    default:
+        return 0;
+    }
+}
 
 static char *trim(char *s)
 {
@@ -92,7 +129,9 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
         fprintf(stderr, "%s: error: cannot read: %s\n", path, strerror(errno ? errno : EIO));
         return -1;
     }
-    int in_section = 0, cap = 0;
+    enum section sec = SEC_OTHER;
+    char sec_name[32] = "";
+    int cap = 0;
     uint32_t line = 0;
     char *next = ini->text;
     while (next) {
@@ -105,18 +144,34 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
         if (!*s || *s == '#' || *s == ';')
             continue;
         if (*s == '[') {
-            in_section = !strncmp(s, "[RS274NGC]", 10);
+            sec = !strcmp(s, "[RS274NGC]") ? SEC_RS274NGC
+                  : !strcmp(s, "[EMCIO]")  ? SEC_EMCIO
+                  : !strcmp(s, "[TRAJ]")   ? SEC_TRAJ
+                  : (!strcmp(s, "[AXIS_A]") || !strcmp(s, "[AXIS_B]") || !strcmp(s, "[AXIS_C]"))
+                      ? SEC_AXIS_ABC
+                      : SEC_OTHER;
+            snprintf(sec_name, sizeof sec_name, "%s", s);
             continue;
         }
-        if (!in_section)
+        if (sec == SEC_OTHER)
             continue;
         char *eq = strchr(s, '=');
+        if (!eq && sec != SEC_RS274NGC)
+            continue;
         if (!eq) {
             fprintf(stderr, "%s:%u: error: [RS274NGC] line without '=': %s\n", path, line, s);
             return -1;
         }
         *eq = '\0';
         char *key = trim(s), *value = trim(eq + 1);
+        if (sec != SEC_RS274NGC) {
+            if (machine_key_changes(sec, key, value)) {
+                fprintf(stderr, "%s:%u: error: %s%s = %s changes what rs274 -i makes of a "
+                        "program; ncpar does not follow it\n", path, line, sec_name, key, value);
+                return -1;
+            }
+            continue;
+        }
         if (!strcmp(key, "REMAP")) {
             if (ini->n_remaps == cap) {
                 cap = cap ? cap * 2 : 8;
