@@ -23,7 +23,8 @@ void ncp_state_init(struct ncp_analyzer *a)
     s->selected_pocket_no = -1;
     s->selected_tool = 0;
     s->current_pocket = 1; /* rs274 -g starts with pocket 1 as the current one */
-    s->current_pocket_no = 1;
+    /* and #<_current_pocket> reads that entry's P (1 with no table) */
+    s->current_pocket_no = a->n_tools > 1 ? a->tools[1].pocket : 1;
     s->current_tool = 0;
     double *p = ncp_params_slot(a->params, 5599);
     if (p)
