@@ -164,6 +164,8 @@ static int ncp_an_block(struct ncp_analyzer *a, const struct ncp_block *b)
         a->err = b->err;
         return b->err.code;
     }
+    if (a->remaps) /* a new line of the program: its builtin_used is clear */
+        a->remap_builtin[0] = 0;
     /* rs274 -g runs with the block delete switch off: '/' lines execute */
     int rc = ncp_m7x_pending(a);
     if (rc == NCP_OK)

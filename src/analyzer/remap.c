@@ -1,8 +1,9 @@
 /* REMAP lines read as rs274 -i reads them (its parse_remap): the code, then
- * options kw=value. ncpar runs M codes remapped to ngc= subroutines; what
- * needs LinuxCNC's Python plugin (python=, prolog=, epilog=) and remaps of
- * T, S, F and G codes are refused here, naming the INI line, so that nothing
- * of the configuration is silently dropped. */
+ * options kw=value. ncpar runs M codes and T remapped to ngc= subroutines,
+ * with stdglue.py's prepare_* and change_* prologs and epilogs built in; what
+ * needs LinuxCNC's Python plugin otherwise (python=, other prologs) and
+ * remaps of S, F and G codes are refused here, naming the INI line, so that
+ * nothing of the configuration is silently dropped. */
 #include "remap.h"
 
 #include <ctype.h>
@@ -65,6 +66,17 @@ static int ngc_found(const char *sub_path, const char *name)
     return 0;
 }
 
+static int glue_of(const char *name, int epilog, enum ncp_glue *out)
+{
+    if (!strcmp(name, epilog ? "prepare_epilog" : "prepare_prolog"))
+        *out = NCP_GLUE_PREPARE;
+    else if (!strcmp(name, epilog ? "change_epilog" : "change_prolog"))
+        *out = NCP_GLUE_CHANGE;
+    else
+        return -1;
+    return 0;
+}
+
 static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
                        struct ncp_remap *r, struct ncp_diag *d)
 {
@@ -103,10 +115,14 @@ static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
                 return remap_error(d, l, "NGC file not found: ngc=%s", arg);
             snprintf(r->ngc, sizeof r->ngc, "%s", arg);
             has_ngc = 1;
+        } else if ((!strncasecmp(kw, "prolog", kwlen) && !glue_of(arg, 0, &r->prolog)) ||
+                   (!strncasecmp(kw, "epilog", kwlen) && !glue_of(arg, 1, &r->epilog))) {
+            /* stdglue's, built in */
         } else if (!strncasecmp(kw, "python", kwlen) || !strncasecmp(kw, "prolog", kwlen) ||
                    !strncasecmp(kw, "epilog", kwlen)) {
             return remap_error(d, l, "%.*s=%s needs LinuxCNC's Python plugin, which ncpar does "
-                               "not have", (int)kwlen, kw, arg);
+                               "not have (its built-in stdglue prologs and epilogs: "
+                               "prepare_*, change_*)", (int)kwlen, kw, arg);
         } else {
             return remap_error(d, l, "unrecognized option '%.*s'", (int)kwlen, kw);
         }
@@ -114,8 +130,17 @@ static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
     if (!has_ngc)
         return remap_error(d, l, "code '%s' - no remap function given, use 'ngc=<basename>'",
                            r->code);
+    if (toupper((unsigned char)code[0]) == 'T') {
+        if (code[1])
+            return remap_error(d, l, "%s remap - only single letter code allowed", r->code);
+        if (r->group != -1)
+            return remap_error(d, l, "T remap - modal group setting ignored - fixed sequencing");
+        r->m = -1;
+        r->remappable = 1;
+        return NCP_OK;
+    }
     if (toupper((unsigned char)code[0]) != 'M')
-        return remap_error(d, l, "code '%s': ncpar remaps M codes only", r->code);
+        return remap_error(d, l, "code '%s': ncpar remaps M codes and T only", r->code);
     char *end = NULL;
     long m = strtol(code + 1, &end, 10);
     if (end == code + 1 || *end || m < 0 || m >= NCP_REMAP_M_MAX)
@@ -145,16 +170,20 @@ int ncp_remaps_new(const struct ncp_analyzer_cfg *cfg, struct ncp_remaps **out,
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
     }
     memset(rs->by_m, 0xff, sizeof rs->by_m);
+    rs->t = -1;
     for (int k = 0; k < cfg->n_remaps; k++) {
         struct ncp_remap *r = &rs->r[rs->n];
         int rc = remap_parse(&cfg->remaps[k], cfg->subroutine_path, r, d);
-        if (rc == NCP_OK && rs->by_m[r->m] >= 0)
+        if (rc == NCP_OK && (r->m >= 0 ? rs->by_m[r->m] : rs->t) >= 0)
             rc = remap_error(d, &cfg->remaps[k], "code '%s' already remapped", r->code);
         if (rc != NCP_OK) {
             ncp_remaps_free(rs);
             return rc;
         }
-        rs->by_m[r->m] = (int16_t)rs->n++;
+        if (r->m >= 0)
+            rs->by_m[r->m] = (int16_t)rs->n++;
+        else
+            rs->t = rs->n++;
     }
     *out = rs;
     return NCP_OK;

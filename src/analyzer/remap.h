@@ -11,9 +11,14 @@
 #define NCP_REMAP_M_MAX 1000 /* rs274 remaps M0..M999 */
 #define NCP_REMAP_DEPTH 16   /* remaps running inside remaps (calls stop at 10) */
 
+/* The stdglue.py prologs and epilogs LinuxCNC ships for tool changes,
+ * built in (their Python is not run): T with prepare_*, M6 with change_*. */
+enum ncp_glue { NCP_GLUE_NONE, NCP_GLUE_PREPARE, NCP_GLUE_CHANGE };
+
 struct ncp_remap {
-    char code[16];      /* as written: "M400" */
-    int m;
+    char code[16];      /* as written: "M400", "T" */
+    int m;              /* -1 for T */
+    enum ncp_glue prolog, epilog;
     int group;          /* rs274's M modal group, 4..10 */
     int remappable;     /* rs274 runs it (else it only moves the code's group) */
     char argspec[64];
@@ -24,6 +29,15 @@ struct ncp_remaps {
     struct ncp_remap *r;
     int n;
     int16_t by_m[NCP_REMAP_M_MAX]; /* index into r, -1 none */
+    int t;                         /* T's remap, -1 none */
+};
+
+/* A remap running: what its prolog gave the sub (stdglue's params, which
+ * its epilog reads back) */
+struct ncp_remap_frame {
+    const struct ncp_remap *r;
+    double tool, pocket;          /* prepare_prolog */
+    double selected_pocket;       /* change_prolog */
 };
 
 /* Reads cfg's REMAP lines; *out NULL when there are none. An error names the

@@ -24,7 +24,7 @@ static int builtin_in_own_remap(int m)
 static int remap_in_progress(const struct ncp_analyzer *a, const struct ncp_remap *r)
 {
     for (int k = 0; k < a->remap_level; k++)
-        if (a->remap_running[k] == r)
+        if (a->remap_frames[k].r == r)
             return 1;
     return 0;
 }
@@ -131,6 +131,7 @@ static int remap_body(struct ncp_analyzer *a)
         a->blk = b;
         a->line = b->line;
         a->file_tag = ncp_flow_file_tag(a->flow);
+        a->remap_builtin[a->remap_level] = 0; /* a new line at this level */
         ncp_an_reline(a);
         if (b->err.code != NCP_OK) {
             a->err = b->err;
@@ -149,14 +150,95 @@ static int remap_body(struct ncp_analyzer *a)
     }
 }
 
-int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran)
+/* ---------------------------------------------------------------------
+ * stdglue.py's prologs and epilogs, as LinuxCNC 2.9 ships them
+ * --------------------------------------------------------------------- */
+
+static int glue_prolog(struct ncp_analyzer *a, struct ncp_remap_frame *fr, uint16_t col)
 {
-    *ran = 0;
-    const struct ncp_remap *r = ncp_remap_of_m(a->remaps, a->w.m[slot]);
-    if (!r || !r->remappable || (builtin_in_own_remap(r->m) && remap_in_progress(a, r)))
+    struct ncp_state *s = &a->st;
+    const char *names[4];
+    double values[4];
+    int n = 0;
+    if (fr->r->prolog == NCP_GLUE_PREPARE) {
+        if (!NCP_HAS(&a->w, 'T'))
+            return ncp_an_error(a, col, "T requires a tool number");
+        int tool = ncp_trunc_int_round(a->w.v[NCP_LETTER('T')]);
+        double pocket = -1; /* T0: an unload */
+        if (tool) {
+            int idx = ncp_tools_find(a, tool);
+            if (idx < 0)
+                return ncp_an_error(a, col, "T%d: pocket not found", tool);
+            pocket = a->tools[idx].pocket; /* find_tool_pocket: the P number */
+        }
+        fr->tool = tool;
+        fr->pocket = pocket;
+        names[n] = "tool", values[n++] = tool;
+        names[n] = "pocket", values[n++] = pocket;
+    } else if (fr->r->prolog == NCP_GLUE_CHANGE) {
+        if (s->selected_pocket < 0)
+            return ncp_an_error(a, col, "M6: no tool prepared");
+        if (s->m.comp_side != 0)
+            return ncp_an_error(a, col, "Cannot change tools with cutter radius compensation on");
+        fr->selected_pocket = s->selected_pocket;
+        /* stdglue's current_tool: the spindle entry's tool, -1 empty */
+        names[n] = "tool_in_spindle", values[n++] = a->tool_no[0] > 0 ? a->tool_no[0] : -1;
+        names[n] = "selected_tool", values[n++] = s->selected_tool;
+        names[n] = "current_pocket", values[n++] = s->current_pocket;
+        names[n] = "selected_pocket", values[n++] = s->selected_pocket;
+    }
+    int rc = NCP_OK;
+    for (int k = 0; rc == NCP_OK && k < n; k++)
+        rc = ncp_params_set_named(a->params, names[k], strlen(names[k]), values[k], &a->err);
+    return rc;
+}
+
+/* After the sub's return; builtin is the controlling line's builtin_used. */
+static int glue_epilog(struct ncp_analyzer *a, const struct ncp_remap_frame *fr, uint16_t col,
+                       int builtin)
+{
+    struct ncp_state *s = &a->st;
+    double value = 0, returned = 0;
+    struct ncp_diag ignore;
+    ncp_params_get_named(a->params, "_value", 6, &value, &ignore);
+    ncp_params_get_named(a->params, "_value_returned", 15, &returned, &ignore);
+    if (returned == 0.0)
+        return ncp_an_error(a, col, "the %s remap procedure %s did not return a value",
+                            fr->r->code, fr->r->ngc);
+    if (builtin)
         return NCP_OK;
-    *ran = 1;
-    uint16_t col = a->w.mcol[slot];
+    if (fr->r->epilog == NCP_GLUE_PREPARE) {
+        if (value <= 0)
+            return ncp_an_error(a, col, "T%d: aborted (return code %.1f)", (int)fr->tool, value);
+        s->selected_tool = (int)fr->tool;
+        s->selected_pocket = (int)fr->pocket;
+        int idx = s->selected_pocket;
+        s->selected_pocket_no = idx >= 0 && idx < a->n_tools ? a->tools[idx].pocket : -1;
+        ncp_an_emit(a, NCP_C_SELECT_TOOL)->tool.tool = s->selected_tool;
+        return NCP_OK;
+    }
+    if (value <= 0)
+        return ncp_an_error(a, col, "M6 aborted (return code %.1f)", value);
+    int pocket = (int)fr->selected_pocket;
+    ncp_an_emit(a, NCP_C_CHANGE_TOOL)->tool.tool = pocket;
+    if (pocket > 0 && pocket < a->n_tools)
+        ncp_tools_copy(a, 0, pocket);
+    s->current_pocket = pocket;
+    s->current_pocket_no = pocket >= 0 && pocket < a->n_tools ? a->tools[pocket].pocket : -1;
+    s->current_tool = a->tool_no[0];
+    s->selected_pocket = -1;
+    s->selected_pocket_no = -1;
+    s->selected_tool = -1;
+    ncp_tools_sync_params(a, 1); /* set_tool_parameters() */
+    s->toolchange_flag = 1;
+    a->sai.change_flag = 1;
+    return NCP_OK;
+}
+
+/* Remap r of the block's code at col: the call, the prolog, the sub, the
+ * epilog, and the line goes on. */
+static int remap_run(struct ncp_analyzer *a, const struct ncp_remap *r, uint16_t col)
+{
     if (a->remap_level >= NCP_REMAP_DEPTH)
         return ncp_an_error(a, col, "Too many nested remaps");
     struct remap_arg args[26];
@@ -173,9 +255,14 @@ int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran)
     const struct ncp_block *blk = a->blk;
     uint32_t line = a->line;
     unsigned tag = a->file_tag;
+    struct ncp_remap_frame *fr = &a->remap_frames[a->remap_level];
+    memset(fr, 0, sizeof *fr);
+    fr->r = r;
     rc = remap_call(a, r, col, args, n);
+    if (rc == NCP_OK)
+        rc = glue_prolog(a, fr, col);
     if (rc == NCP_OK) {
-        a->remap_running[a->remap_level++] = r;
+        a->remap_level++;
         rc = remap_body(a);
         a->remap_level--;
     }
@@ -185,7 +272,31 @@ int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran)
         a->line = line;
         a->file_tag = tag;
         ncp_an_reline(a);
+        if (r->epilog != NCP_GLUE_NONE)
+            rc = glue_epilog(a, fr, col, a->remap_builtin[a->remap_level]);
     }
     free(saved);
     return rc;
+}
+
+int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran)
+{
+    *ran = 0;
+    const struct ncp_remap *r = ncp_remap_of_m(a->remaps, a->w.m[slot]);
+    if (!r || !r->remappable || (builtin_in_own_remap(r->m) && remap_in_progress(a, r)))
+        return NCP_OK;
+    *ran = 1;
+    return remap_run(a, r, a->w.mcol[slot]);
+}
+
+int ncp_remap_t_step(struct ncp_analyzer *a)
+{
+    const struct ncp_remap *r = a->remaps->t >= 0 ? &a->remaps->r[a->remaps->t] : NULL;
+    if (!r)
+        return ncp_tools_select(a);
+    if (remap_in_progress(a, r)) {
+        ncp_remap_note_builtin(a);
+        return ncp_tools_select(a);
+    }
+    return remap_run(a, r, a->w.col[NCP_LETTER('T')]);
 }

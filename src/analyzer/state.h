@@ -179,7 +179,10 @@ struct ncp_analyzer {
      * innermost last (#<_remap_level> is their count) */
     struct ncp_remaps *remaps;
     int remap_level;
-    const struct ncp_remap *remap_running[NCP_REMAP_DEPTH];
+    struct ncp_remap_frame remap_frames[NCP_REMAP_DEPTH];
+    /* rs274's builtin_used of the line running at each remap level: a code
+     * ran built in (inside its own remap) for the remap that line started */
+    int remap_builtin[NCP_REMAP_DEPTH + 1];
     /* How a handler runs a line of its own as a block (M72's restore lines):
      * ncp_an_execute, handed down by the run loop so that no handler calls
      * back up into the file that calls it. */
@@ -302,6 +305,14 @@ void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op);
  * remap runs there (not in its own remap, for the codes rs274 then runs
  * built in): *ran = 1 and the remap's result. */
 int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran);
+/* T in its step: its remap, or the built-in select */
+int ncp_remap_t_step(struct ncp_analyzer *a);
+/* A built-in tool code ran: rs274 notes it on the line that controls the
+ * innermost remap (what stdglue's epilogs test) */
+static inline void ncp_remap_note_builtin(struct ncp_analyzer *a)
+{
+    a->remap_builtin[a->remap_level > 0 ? a->remap_level - 1 : 0] = 1;
+}
 
 /* stop.c */
 int ncp_stop_run(struct ncp_analyzer *a, int m);

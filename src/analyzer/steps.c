@@ -430,7 +430,7 @@ int ncp_an_steps(struct ncp_analyzer *a)
         ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->spindle_speed.speed = a->st.speed;
     }
     if (NCP_HAS(w, 'T'))
-        rc = ncp_tools_select(a);
+        rc = a->remaps ? ncp_remap_t_step(a) : ncp_tools_select(a);
     if (rc == NCP_OK && w->n_m != 0) /* most blocks have none: skip the group tests */
         rc = ncp_step_m_codes(a);
     if (a->block_consumed) { /* M72's restore lines ran in this block's place */

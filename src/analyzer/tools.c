@@ -273,6 +273,8 @@ static int ncp_tools_m61(struct ncp_analyzer *a)
 int ncp_tools_change(struct ncp_analyzer *a)
 {
     struct ncp_state *s = &a->st;
+    if (a->remaps) /* rs274 notes every built-in M6/M61 for the remap's epilog */
+        ncp_remap_note_builtin(a);
     if (a->w.m[NCP_MG_TOOL] == NCP_M61)
         return ncp_tools_m61(a);
     /* No "Txx missing" check: rs274 starts with tool 0 selected, so an M6
