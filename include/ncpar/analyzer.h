@@ -39,6 +39,12 @@ int ncp_tool_table_check(const char *path, FILE *warn, struct ncp_diag *d);
 
 #define NCP_DEFAULT_MAX_LOOPS 10000000u
 
+/* One key of a LinuxCNC INI, which a program reads as #<_ini[SECTION]KEY>
+ * (rs274 -i with [RS274NGC]INI_VARS, on by default). */
+struct ncp_ini_var {
+    const char *section, *key, *value;
+};
+
 /* One REMAP line of LinuxCNC's [RS274NGC] section ("M400 modalgroup=10
  * argspec=Pq ngc=m400"): its text after "REMAP =", and where it was read,
  * for the errors that name it. */
@@ -63,6 +69,9 @@ struct ncp_analyzer_cfg {
     int n_remaps;
     /* rs274 run with an INI (-i) closes with one ON_RESET, not two */
     int ini_given;
+    /* the INI's keys for #<_ini[SECTION]KEY> (read-only; none: undefined) */
+    const struct ncp_ini_var *ini_vars;
+    int n_ini_vars;
     /* The NCK's resident interpreter: modal state, parameters, offsets and
      * tool carry over from one run to the next (programs and MDI lines run one
      * after another, as on a controller), so a run emits no rs274 start-up

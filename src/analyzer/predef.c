@@ -2,7 +2,9 @@
  * from the analyzer state, installed as the params module's hook. */
 #include "state.h"
 
+#include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 enum ncp_predef {
     P_X, P_Y, P_Z, P_A, P_B, P_C, P_U, P_V, P_W,
@@ -88,11 +90,38 @@ static double ncp_predef_value(const struct ncp_analyzer *a, int k)
     }
 }
 
+/* #<_ini[section]key>: the INI's value, the names compared without case as
+ * LinuxCNC's INI reader does; a key that is not there, or not a number, is
+ * undefined. */
+static int ncp_predef_ini(const struct ncp_analyzer *a, const char *name, size_t len,
+                          double *out)
+{
+    const char *close = memchr(name, ']', len);
+    if (!close || a->cfg.n_ini_vars <= 0)
+        return 0;
+    size_t slen = (size_t)(close - (name + 5)), klen = len - (size_t)(close + 1 - name);
+    for (int k = 0; k < a->cfg.n_ini_vars; k++) {
+        const struct ncp_ini_var *v = &a->cfg.ini_vars[k];
+        if (strlen(v->section) != slen || strncasecmp(v->section, name + 5, slen) ||
+            strlen(v->key) != klen || strncasecmp(v->key, close + 1, klen))
+            continue;
+        char *end;
+        double d = strtod(v->value, &end);
+        if (end == v->value)
+            return 0;
+        *out = d;
+        return 1;
+    }
+    return 0;
+}
+
 int ncp_predef_lookup(void *ctx, const char *name, size_t len, double *out)
 {
     const struct ncp_analyzer *a = ctx;
     if (len < 2 || name[0] != '_')
         return 0;
+    if (len > 5 && strncasecmp(name, "_ini[", 5) == 0)
+        return ncp_predef_ini(a, name, len, out);
     for (int k = 0; k < P__N; k++) {
         const char *n = ncp_predef_names[k];
         if (strlen(n) == len && memcmp(n, name, len) == 0) {

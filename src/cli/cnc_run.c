@@ -234,6 +234,10 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
             o->acfg.subroutine_path = o->sub_path;
         }
         o->acfg.ini_given = 1;
+        if (o->ini.ini_vars) {
+            o->acfg.ini_vars = o->ini.vars;
+            o->acfg.n_ini_vars = o->ini.n_vars;
+        }
         o->acfg.remaps = o->ini.remaps;
         o->acfg.n_remaps = o->ini.n_remaps;
     }

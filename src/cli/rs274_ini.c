@@ -17,7 +17,8 @@
 
 static const char *const no_effect[] = {
     "PARAMETER_FILE", "USER_M_PATH", "FEATURES", "LOG_LEVEL", "LOG_FILE",
-    "ON_ABORT_COMMAND", "RS274NGC_STARTUP_CODE", "INI_VARS", "HAL_PIN_VARS",
+    "ON_ABORT_COMMAND", "RS274NGC_STARTUP_CODE", "HAL_PIN_VARS",
+    "DEBUG", /* rs274 reads [EMC]DEBUG, not this one */
 };
 
 enum section { SEC_OTHER, SEC_RS274NGC, SEC_EMCIO, SEC_TRAJ, SEC_AXIS_ABC };
@@ -131,7 +132,9 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
     }
     enum section sec = SEC_OTHER;
     char sec_name[32] = "";
-    int cap = 0;
+    const char *section = NULL;
+    int cap = 0, vcap = 0;
+    ini->ini_vars = 1;
     uint32_t line = 0;
     char *next = ini->text;
     while (next) {
@@ -151,10 +154,12 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
                       ? SEC_AXIS_ABC
                       : SEC_OTHER;
             snprintf(sec_name, sizeof sec_name, "%s", s);
+            char *close = strchr(s, ']');
+            if (close)
+                *close = '\0';
+            section = s + 1;
             continue;
         }
-        if (sec == SEC_OTHER)
-            continue;
         char *eq = strchr(s, '=');
         if (!eq && sec != SEC_RS274NGC)
             continue;
@@ -164,6 +169,18 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
         }
         *eq = '\0';
         char *key = trim(s), *value = trim(eq + 1);
+        if (section) {
+            if (ini->n_vars == vcap) {
+                vcap = vcap ? vcap * 2 : 32;
+                struct ncp_ini_var *more = realloc(ini->vars, (size_t)vcap * sizeof *more);
+                if (!more)
+                    return fprintf(stderr, "%s: error: out of memory\n", path), -1;
+                ini->vars = more;
+            }
+            ini->vars[ini->n_vars++] = (struct ncp_ini_var){ section, key, value };
+        }
+        if (sec == SEC_OTHER)
+            continue;
         if (sec != SEC_RS274NGC) {
             if (machine_key_changes(sec, key, value)) {
                 fprintf(stderr, "%s:%u: error: %s%s = %s changes what rs274 -i makes of a "
@@ -181,6 +198,8 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
                 ini->remaps = more;
             }
             ini->remaps[ini->n_remaps++] = (struct ncp_remap_line){ value, path, line };
+        } else if (!strcmp(key, "INI_VARS")) {
+            ini->ini_vars = ini_true(value);
         } else if (!strcmp(key, "SUBROUTINE_PATH")) {
             free(ini->sub_path);
             if (!(ini->sub_path = absolute_dirs(path, value)))
@@ -203,6 +222,7 @@ void rs274_ini_free(struct rs274_ini *ini)
 {
     free(ini->sub_path);
     free(ini->remaps);
+    free(ini->vars);
     free(ini->text);
     memset(ini, 0, sizeof *ini);
 }

@@ -11,6 +11,9 @@ struct rs274_ini {
                                       the INI's folder; NULL without one */
     struct ncp_remap_line *remaps;
     int n_remaps;
+    struct ncp_ini_var *vars;      /* every key, for #<_ini[SECTION]KEY> */
+    int n_vars;
+    int ini_vars;                  /* [RS274NGC]INI_VARS (default on) */
     char *text;                    /* the file: the REMAP texts point into it */
 };
 
