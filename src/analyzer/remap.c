@@ -91,6 +91,8 @@ static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
         return remap_error(d, l, "no code to remap");
     memset(r, 0, sizeof *r);
     r->group = -1;
+    if (strlen(code) >= sizeof r->code)
+        return remap_error(d, l, "code '%.20s...' is too long", code);
     snprintf(r->code, sizeof r->code, "%s", code);
     int has_ngc = 0;
     for (char *kw = strtok_r(NULL, " \t", &save); kw; kw = strtok_r(NULL, " \t", &save)) {
@@ -109,8 +111,14 @@ static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
                 return remap_error(d, l, "argspec: illegal word '%c'", arg[pos]);
             if (strchr(arg, 'N') || strchr(arg, 'n'))
                 return remap_error(d, l, "argspec: N (the line number) is not supported by ncpar");
+            if (strlen(arg) >= sizeof r->argspec)
+                return remap_error(d, l, "argspec: longer than %zu characters",
+                                   sizeof r->argspec - 1);
             snprintf(r->argspec, sizeof r->argspec, "%s", arg);
         } else if (!strncasecmp(kw, "ngc", kwlen)) {
+            if (strlen(arg) >= sizeof r->ngc)
+                return remap_error(d, l, "ngc=%.20s...: name longer than %zu characters", arg,
+                                   sizeof r->ngc - 1);
             if (!ngc_found(sub_path, arg))
                 return remap_error(d, l, "NGC file not found: ngc=%s", arg);
             snprintf(r->ngc, sizeof r->ngc, "%s", arg);

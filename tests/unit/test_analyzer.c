@@ -434,6 +434,37 @@ static void test_rotation_change_while_active(void **state)
 }
 
 /* The sequential bottleneck: a plain G1 block must stay well under 1 us. */
+/* A REMAP line the interpreter cannot honour stops it before the program,
+ * naming the INI and its line. */
+static void expect_remap_refused(const char *text, const char *words)
+{
+    struct ncp_remap_line line = { text, "cfg.ini", 7 };
+    struct ncp_analyzer_cfg cfg = { .remaps = &line, .n_remaps = 1 };
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    struct ncp_analyzer *a = ncp_analyzer_new(&cfg, &d);
+    assert_null(a);
+    assert_int_equal(d.line, 7);
+    assert_non_null(d.file);
+    assert_string_equal(d.file, "cfg.ini");
+    if (!strstr(d.msg, words))
+        fail_msg("'%s': message '%s' lacks '%s'", text, d.msg, words);
+}
+
+static void test_remap_refused(void **state)
+{
+    (void)state;
+    expect_remap_refused("M400 modalgroup=10 python=m400", "Python plugin");
+    expect_remap_refused("M400 modalgroup=10 prolog=mine ngc=x", "Python plugin");
+    expect_remap_refused("M400 modalgroup=10", "no remap function");
+    expect_remap_refused("M400 modalgroup=10 ngc=surely_not_a_file", "NGC file not found");
+    expect_remap_refused("M400 argspec=P% ngc=x", "illegal word '%'");
+    expect_remap_refused("M400 colour=red", "unrecognized option 'colour'");
+    expect_remap_refused("M400 modalgroup", "missing '=<value>'");
+    expect_remap_refused("G88.1 modalgroup=1 argspec=xyz", "no remap function");
+    expect_remap_refused("", "no code to remap");
+}
+
 static void test_speed(void **state)
 {
     (void)state;
@@ -514,6 +545,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_preamble_and_end),
+        cmocka_unit_test(test_remap_refused),
         cmocka_unit_test(test_print_calls),
         cmocka_unit_test(test_straight_feed),
         cmocka_unit_test(test_lathe_diameter_mode),
