@@ -72,6 +72,8 @@ static int glue_of(const char *name, int epilog, enum ncp_glue *out)
         *out = NCP_GLUE_PREPARE;
     else if (!strcmp(name, epilog ? "change_epilog" : "change_prolog"))
         *out = NCP_GLUE_CHANGE;
+    else if (!strcmp(name, epilog ? "settool_epilog" : "settool_prolog"))
+        *out = NCP_GLUE_SETTOOL;
     else
         return -1;
     return 0;
@@ -130,7 +132,7 @@ static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
                    !strncasecmp(kw, "epilog", kwlen)) {
             return remap_error(d, l, "%.*s=%s needs LinuxCNC's Python plugin, which ncpar does "
                                "not have (its built-in stdglue prologs and epilogs: "
-                               "prepare_*, change_*)", (int)kwlen, kw, arg);
+                               "prepare_*, change_*, settool_*)", (int)kwlen, kw, arg);
         } else {
             return remap_error(d, l, "unrecognized option '%.*s'", (int)kwlen, kw);
         }

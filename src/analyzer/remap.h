@@ -12,8 +12,9 @@
 #define NCP_REMAP_DEPTH 16   /* remaps running inside remaps (calls stop at 10) */
 
 /* The stdglue.py prologs and epilogs LinuxCNC ships for tool changes,
- * built in (their Python is not run): T with prepare_*, M6 with change_*. */
-enum ncp_glue { NCP_GLUE_NONE, NCP_GLUE_PREPARE, NCP_GLUE_CHANGE };
+ * built in (their Python is not run): T with prepare_*, M6 with change_*,
+ * M61 with settool_*. */
+enum ncp_glue { NCP_GLUE_NONE, NCP_GLUE_PREPARE, NCP_GLUE_CHANGE, NCP_GLUE_SETTOOL };
 
 struct ncp_remap {
     char code[16];      /* as written: "M400", "T" */
@@ -36,7 +37,7 @@ struct ncp_remaps {
  * its epilog reads back) */
 struct ncp_remap_frame {
     const struct ncp_remap *r;
-    double tool, pocket;          /* prepare_prolog */
+    double tool, pocket;          /* prepare_prolog, settool_prolog */
     double selected_pocket;       /* change_prolog */
 };
 

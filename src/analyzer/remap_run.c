@@ -175,6 +175,21 @@ static int glue_prolog(struct ncp_analyzer *a, struct ncp_remap_frame *fr, uint1
         fr->pocket = pocket;
         names[n] = "tool", values[n++] = tool;
         names[n] = "pocket", values[n++] = pocket;
+    } else if (fr->r->prolog == NCP_GLUE_SETTOOL) {
+        if (!NCP_HAS(&a->w, 'Q'))
+            return ncp_an_error(a, col, "M61 requires a Q parameter");
+        double q = a->w.v[NCP_LETTER('Q')];
+        int tool = (int)q; /* Python's int(): towards zero */
+        if (tool < -1e-6)
+            return ncp_an_error(a, col, "M61: Q value < 0");
+        int idx = ncp_tools_find(a, tool);
+        if (idx < 0)
+            return ncp_an_error(a, col, "M61 failed: requested tool %d not in table", tool);
+        fr->tool = tool;
+        /* find_tool_pocket: the P number (T0: the spindle entry's) */
+        fr->pocket = a->tools[idx].pocket;
+        names[n] = "tool", values[n++] = fr->tool;
+        names[n] = "pocket", values[n++] = fr->pocket;
     } else if (fr->r->prolog == NCP_GLUE_CHANGE) {
         if (s->selected_pocket < 0)
             return ncp_an_error(a, col, "M6: no tool prepared");
@@ -215,6 +230,20 @@ static int glue_epilog(struct ncp_analyzer *a, const struct ncp_remap_frame *fr,
         int idx = s->selected_pocket;
         s->selected_pocket_no = idx >= 0 && idx < a->n_tools ? a->tools[idx].pocket : -1;
         ncp_an_emit(a, NCP_C_SELECT_TOOL)->tool.tool = s->selected_tool;
+        return NCP_OK;
+    }
+    if (fr->r->epilog == NCP_GLUE_SETTOOL) {
+        if (value <= 0)
+            return ncp_an_error(a, col, "M61 aborted (return code %.1f)", value);
+        /* stdglue sets the spindle's tool number and current_pocket to the
+         * P number, and CHANGE_TOOL_NUMBER(P): the entry's offsets stay */
+        int pocket = (int)fr->pocket;
+        a->tool_no[0] = (int)fr->tool;
+        s->current_tool = (int)fr->tool;
+        s->current_pocket = pocket;
+        s->current_pocket_no = pocket >= 0 && pocket < a->n_tools ? a->tools[pocket].pocket : -1;
+        ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER)->tool.tool = pocket;
+        ncp_tools_sync_params(a, 1); /* set_tool_parameters() */
         return NCP_OK;
     }
     if (value <= 0)
