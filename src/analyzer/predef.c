@@ -102,8 +102,8 @@ static int ncp_predef_ini(const struct ncp_analyzer *a, const char *name, size_t
     size_t slen = (size_t)(close - (name + 5)), klen = len - (size_t)(close + 1 - name);
     for (int k = 0; k < a->cfg.n_ini_vars; k++) {
         const struct ncp_ini_var *v = &a->cfg.ini_vars[k];
-        if (strlen(v->section) != slen || strncasecmp(v->section, name + 5, slen) ||
-            strlen(v->key) != klen || strncasecmp(v->key, close + 1, klen))
+        if (strlen(v->section) != slen || strncasecmp(v->section, name + 5, slen) != 0 ||
+            strlen(v->key) != klen || strncasecmp(v->key, close + 1, klen) != 0)
             continue;
         char *end;
         double d = strtod(v->value, &end);

@@ -40,7 +40,8 @@ static int remap_args(struct ncp_analyzer *a, const struct ncp_remap *r, uint16_
                       struct remap_arg *args, int *n)
 {
     const struct ncp_words *w = &a->w;
-    char missing[64] = "", extra[32] = "";
+    char missing[64] = "";
+    const char *no_feed = "", *no_speed = "";
     size_t nm = 0;
     *n = 0;
     for (const char *s = r->argspec; *s && *n < 26; s++) {
@@ -67,7 +68,7 @@ static int remap_args(struct ncp_analyzer *a, const struct ncp_remap *r, uint16_
             args[*n].name = 'f';
             args[(*n)++].value = a->st.feed;
         } else {
-            strcat(extra, "F>0,");
+            no_feed = "F>0,";
         }
     }
     if (strchr(r->argspec, '^')) {
@@ -75,12 +76,12 @@ static int remap_args(struct ncp_analyzer *a, const struct ncp_remap *r, uint16_
             args[*n].name = 's';
             args[(*n)++].value = a->st.speed;
         } else {
-            strcat(extra, "S>0,");
+            no_speed = "S>0,";
         }
     }
-    if (nm || extra[0])
-        return ncp_an_error(a, col, "user-defined %s:%s%s%s", r->code, nm ? " missing: " : "",
-                            missing, extra);
+    if (nm || *no_feed || *no_speed)
+        return ncp_an_error(a, col, "user-defined %s:%s%s%s%s", r->code,
+                            nm ? " missing: " : "", missing, no_feed, no_speed);
     return NCP_OK;
 }
 

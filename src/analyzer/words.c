@@ -159,7 +159,7 @@ static int ncp_add_m(struct ncp_analyzer *a, double v, uint16_t col)
     int g;
     const struct ncp_remap *r = a->remaps ? ncp_remap_of_m(a->remaps, m) : NULL;
     if (r) { /* its group is the REMAP line's */
-        static const signed char slot[11] = {
+        static const int slot[11] = {
             -1, -1, -1, -1, NCP_MG_STOP, NCP_MG_IO, NCP_MG_TOOL, NCP_MG_SPINDLE,
             NCP_MG_COOLANT, NCP_MG_OVERRIDE, NCP_MG_USER,
         };

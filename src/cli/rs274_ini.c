@@ -206,7 +206,7 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
                 return fprintf(stderr, "%s: error: out of memory\n", path), -1;
         } else {
             size_t k = 0;
-            while (k < sizeof no_effect / sizeof no_effect[0] && strcmp(key, no_effect[k]))
+            while (k < sizeof no_effect / sizeof no_effect[0] && strcmp(key, no_effect[k]) != 0)
                 k++;
             if (k == sizeof no_effect / sizeof no_effect[0]) {
                 fprintf(stderr, "%s:%u: error: [RS274NGC]%s is not supported by ncpar\n", path,
