@@ -29,16 +29,17 @@ static int remap_error(struct ncp_diag *d, const struct ncp_remap_line *l, const
     return rc;
 }
 
-/* rs274's is_m_code_remappable: codes with no meaning of their own, and the
- * listed ones whose built-in step a remap may take over. */
+/* rs274 2.9's M_REMAPPABLE: codes with no meaning of their own, and the
+ * listed ones whose built-in step a remap may take over (M7 and M8 are not:
+ * a REMAP of them leaves the built-in code, as rs274 -i 2.9 shows). */
 static int remappable_m(int m)
 {
     switch (m) {
-    case 0: case 1: case 6: case 7: case 8: case 9: case 60: case 61: case 62: case 63:
+    case 0: case 1: case 6: case 9: case 60: case 61: case 62: case 63:
     case 64: case 65: case 66: case 67: case 68:
         return 1;
-    case 2: case 3: case 4: case 5: case 19: case 30: case 48: case 49: case 50: case 51:
-    case 52: case 53: case 70: case 71: case 72: case 73: case 98: case 99:
+    case 2: case 3: case 4: case 5: case 7: case 8: case 19: case 30: case 48: case 49:
+    case 50: case 51: case 52: case 53: case 70: case 71: case 72: case 73: case 98: case 99:
         return 0;
     default:
         return (m > 0 && m < 100) || (m > 199 && m < NCP_REMAP_M_MAX);

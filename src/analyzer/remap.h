@@ -9,7 +9,8 @@
 #include "ncpar/analyzer.h"
 
 #define NCP_REMAP_M_MAX 1000 /* rs274 remaps M0..M999 */
-#define NCP_REMAP_DEPTH 16   /* remaps running inside remaps (calls stop at 10) */
+#define NCP_REMAP_DEPTH 16   /* room for remaps running inside remaps */
+#define NCP_REMAP_MAX_NESTED 10 /* rs274's MAX_NESTED_REMAPS: the 10th is refused */
 
 /* The stdglue.py prologs and epilogs LinuxCNC ships for tool changes,
  * built in (their Python is not run): T with prepare_*, M6 with change_*,

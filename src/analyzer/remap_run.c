@@ -13,20 +13,32 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Codes whose built-in step runs when used inside their own remap (rs274's
- * find_remappings): the body may then call M6 to change the tool itself. */
-static int builtin_in_own_remap(int m)
-{
-    return m == 0 || m == 1 || m == 60 || m == 6 || m == 61 || m == 7 || m == 8 || m == 9 ||
-           (m >= 62 && m <= 68);
-}
-
 static int remap_in_progress(const struct ncp_analyzer *a, const struct ncp_remap *r)
 {
     for (int k = 0; k < a->remap_level; k++)
         if (a->remap_frames[k].r == r)
             return 1;
     return 0;
+}
+
+static int m_remap_in_progress(const struct ncp_analyzer *a, int m)
+{
+    const struct ncp_remap *r = ncp_remap_of_m(a->remaps, m);
+    return r && remap_in_progress(a, r);
+}
+
+/* The code runs built in rather than remapped (rs274 2.9's find_remappings):
+ * M6, M61 and M62-M68 inside their own remap, so that the body may change
+ * the tool itself; a stop code (group 4) inside any remap of M0, M1 or M60,
+ * which rs274 notes for the epilog. Others (M9, M400...) remap again. */
+static int runs_built_in(struct ncp_analyzer *a, const struct ncp_remap *r)
+{
+    if (r->group == 4 && (m_remap_in_progress(a, 0) || m_remap_in_progress(a, 1) ||
+                          m_remap_in_progress(a, 60))) {
+        ncp_remap_note_builtin(a);
+        return 1;
+    }
+    return (r->m == 6 || r->m == 61 || (r->m >= 62 && r->m <= 68)) && remap_in_progress(a, r);
 }
 
 struct remap_arg {
@@ -269,8 +281,8 @@ static int glue_epilog(struct ncp_analyzer *a, const struct ncp_remap_frame *fr,
  * epilog, and the line goes on. */
 static int remap_run(struct ncp_analyzer *a, const struct ncp_remap *r, uint16_t col)
 {
-    if (a->remap_level >= NCP_REMAP_DEPTH)
-        return ncp_an_error(a, col, "Too many nested remaps");
+    if (a->remap_level + 1 >= NCP_REMAP_MAX_NESTED)
+        return ncp_an_error(a, col, "maximum nesting of remapped blocks exceeded");
     struct remap_arg args[26];
     int n = 0;
     int rc = remap_args(a, r, col, args, &n);
@@ -313,7 +325,7 @@ int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran)
 {
     *ran = 0;
     const struct ncp_remap *r = ncp_remap_of_m(a->remaps, a->w.m[slot]);
-    if (!r || !r->remappable || (builtin_in_own_remap(r->m) && remap_in_progress(a, r)))
+    if (!r || !r->remappable || runs_built_in(a, r))
         return NCP_OK;
     *ran = 1;
     return remap_run(a, r, a->w.mcol[slot]);
