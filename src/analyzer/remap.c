@@ -1,8 +1,8 @@
 /* REMAP lines read as rs274 -i reads them (its parse_remap): the code, then
- * options kw=value. ncpar runs M codes and T remapped to ngc= subroutines,
- * with stdglue.py's prepare_* and change_* prologs and epilogs built in; what
- * needs LinuxCNC's Python plugin otherwise (python=, other prologs) and
- * remaps of S, F and G codes are refused here, naming the INI line, so that
+ * options kw=value. ncpar runs M codes, T, S and F remapped to ngc=
+ * subroutines, with stdglue.py's tool, speed and feed prologs and epilogs
+ * built in; what needs LinuxCNC's Python plugin otherwise (python=, other
+ * prologs) and remaps of G codes are refused here, naming the INI line, so that
  * nothing of the configuration is silently dropped. */
 #include "remap.h"
 
@@ -75,6 +75,10 @@ static int glue_of(const char *name, int epilog, enum ncp_glue *out)
         *out = NCP_GLUE_CHANGE;
     else if (!strcmp(name, epilog ? "settool_epilog" : "settool_prolog"))
         *out = NCP_GLUE_SETTOOL;
+    else if (!strcmp(name, epilog ? "setspeed_epilog" : "setspeed_prolog"))
+        *out = NCP_GLUE_SETSPEED;
+    else if (!strcmp(name, epilog ? "setfeed_epilog" : "setfeed_prolog"))
+        *out = NCP_GLUE_SETFEED;
     else
         return -1;
     return 0;
@@ -133,7 +137,7 @@ static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
                    !strncasecmp(kw, "epilog", kwlen)) {
             return remap_error(d, l, "%.*s=%s needs LinuxCNC's Python plugin, which ncpar does "
                                "not have (its built-in stdglue prologs and epilogs: "
-                               "prepare_*, change_*, settool_*)", (int)kwlen, kw, arg);
+                               "prepare_*, change_*, settool_*, setspeed_*, setfeed_*)", (int)kwlen, kw, arg);
         } else {
             return remap_error(d, l, "unrecognized option '%.*s'", (int)kwlen, kw);
         }
@@ -141,17 +145,19 @@ static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
     if (!has_ngc)
         return remap_error(d, l, "code '%s' - no remap function given, use 'ngc=<basename>'",
                            r->code);
-    if (toupper((unsigned char)code[0]) == 'T') {
+    int letter = toupper((unsigned char)code[0]);
+    if (letter == 'T' || letter == 'S' || letter == 'F') {
         if (code[1])
             return remap_error(d, l, "%s remap - only single letter code allowed", r->code);
         if (r->group != -1)
-            return remap_error(d, l, "T remap - modal group setting ignored - fixed sequencing");
+            return remap_error(d, l, "%c remap - modal group setting ignored - fixed sequencing",
+                               letter);
         r->m = -1;
         r->remappable = 1;
         return NCP_OK;
     }
-    if (toupper((unsigned char)code[0]) != 'M')
-        return remap_error(d, l, "code '%s': ncpar remaps M codes and T only", r->code);
+    if (letter != 'M')
+        return remap_error(d, l, "code '%s': ncpar remaps M codes, T, S and F only", r->code);
     char *end = NULL;
     long m = strtol(code + 1, &end, 10);
     if (end == code + 1 || *end || m < 0 || m >= NCP_REMAP_M_MAX)
@@ -181,20 +187,25 @@ int ncp_remaps_new(const struct ncp_analyzer_cfg *cfg, struct ncp_remaps **out,
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
     }
     memset(rs->by_m, 0xff, sizeof rs->by_m);
-    rs->t = -1;
+    rs->t = rs->s = rs->f = -1;
     for (int k = 0; k < cfg->n_remaps; k++) {
         struct ncp_remap *r = &rs->r[rs->n];
         int rc = remap_parse(&cfg->remaps[k], cfg->subroutine_path, r, d);
-        if (rc == NCP_OK && (r->m >= 0 ? rs->by_m[r->m] : rs->t) >= 0)
+        int *letter = NULL; /* T's, S's or F's slot */
+        if (rc == NCP_OK && r->m < 0)
+            letter = toupper((unsigned char)r->code[0]) == 'T'   ? &rs->t
+                     : toupper((unsigned char)r->code[0]) == 'S' ? &rs->s
+                                                                 : &rs->f;
+        if (rc == NCP_OK && (letter ? *letter : rs->by_m[r->m]) >= 0)
             rc = remap_error(d, &cfg->remaps[k], "code '%s' already remapped", r->code);
         if (rc != NCP_OK) {
             ncp_remaps_free(rs);
             return rc;
         }
-        if (r->m >= 0)
-            rs->by_m[r->m] = (int16_t)rs->n++;
+        if (letter)
+            *letter = rs->n++;
         else
-            rs->t = rs->n++;
+            rs->by_m[r->m] = (int16_t)rs->n++;
     }
     *out = rs;
     return NCP_OK;

@@ -14,12 +14,15 @@
 
 /* The stdglue.py prologs and epilogs LinuxCNC ships for tool changes,
  * built in (their Python is not run): T with prepare_*, M6 with change_*,
- * M61 with settool_*. */
-enum ncp_glue { NCP_GLUE_NONE, NCP_GLUE_PREPARE, NCP_GLUE_CHANGE, NCP_GLUE_SETTOOL };
+ * M61 with settool_*, S with setspeed_*, F with setfeed_*. */
+enum ncp_glue {
+    NCP_GLUE_NONE, NCP_GLUE_PREPARE, NCP_GLUE_CHANGE, NCP_GLUE_SETTOOL, NCP_GLUE_SETSPEED,
+    NCP_GLUE_SETFEED,
+};
 
 struct ncp_remap {
     char code[16];      /* as written: "M400", "T" */
-    int m;              /* -1 for T */
+    int m;              /* -1 for T, S, F */
     enum ncp_glue prolog, epilog;
     int group;          /* rs274's M modal group, 4..10 */
     int remappable;     /* rs274 runs it (else it only moves the code's group) */
@@ -31,7 +34,7 @@ struct ncp_remaps {
     struct ncp_remap *r;
     int n;
     int16_t by_m[NCP_REMAP_M_MAX]; /* index into r, -1 none */
-    int t;                         /* T's remap, -1 none */
+    int t, s, f;                   /* T's, S's, F's remap, -1 none */
 };
 
 /* A remap running: what its prolog gave the sub (stdglue's params, which
@@ -40,6 +43,7 @@ struct ncp_remap_frame {
     const struct ncp_remap *r;
     double tool, pocket;          /* prepare_prolog, settool_prolog */
     double selected_pocket;       /* change_prolog */
+    double value;                 /* setspeed_prolog, setfeed_prolog */
 };
 
 /* Reads cfg's REMAP lines; *out NULL when there are none. An error names the

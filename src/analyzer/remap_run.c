@@ -203,6 +203,13 @@ static int glue_prolog(struct ncp_analyzer *a, struct ncp_remap_frame *fr, uint1
         fr->pocket = a->tools[idx].pocket;
         names[n] = "tool", values[n++] = fr->tool;
         names[n] = "pocket", values[n++] = fr->pocket;
+    } else if (fr->r->prolog == NCP_GLUE_SETSPEED || fr->r->prolog == NCP_GLUE_SETFEED) {
+        int speed = fr->r->prolog == NCP_GLUE_SETSPEED;
+        char c = speed ? 'S' : 'F';
+        if (!NCP_HAS(&a->w, c))
+            return ncp_an_error(a, col, "%c requires a value", c);
+        fr->value = a->w.v[NCP_LETTER(c)];
+        names[n] = speed ? "speed" : "feed", values[n++] = fr->value;
     } else if (fr->r->prolog == NCP_GLUE_CHANGE) {
         if (s->selected_pocket < 0)
             return ncp_an_error(a, col, "M6: no tool prepared");
@@ -233,8 +240,20 @@ static int glue_epilog(struct ncp_analyzer *a, const struct ncp_remap_frame *fr,
     if (returned == 0.0)
         return ncp_an_error(a, col, "the %s remap procedure %s did not return a value",
                             fr->r->code, fr->r->ngc);
+    if (fr->r->epilog == NCP_GLUE_SETSPEED && value < -1e-6) /* TOLERANCE_EQUAL */
+        return ncp_an_error(a, col, "S: remap procedure returned %f", value);
     if (builtin)
         return NCP_OK;
+    if (fr->r->epilog == NCP_GLUE_SETSPEED) {
+        s->speed = fr->value;
+        ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->spindle_speed.speed = s->speed;
+        return NCP_OK;
+    }
+    if (fr->r->epilog == NCP_GLUE_SETFEED) {
+        s->feed = fr->value;
+        ncp_an_emit(a, NCP_C_SET_FEED_RATE)->feed_rate.rate = s->feed;
+        return NCP_OK;
+    }
     if (fr->r->epilog == NCP_GLUE_PREPARE) {
         if (value <= 0)
             return ncp_an_error(a, col, "T%d: aborted (return code %.1f)", (int)fr->tool, value);
@@ -331,14 +350,18 @@ int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran)
     return remap_run(a, r, a->w.mcol[slot]);
 }
 
-int ncp_remap_t_step(struct ncp_analyzer *a)
+int ncp_remap_letter_step(struct ncp_analyzer *a, char letter, int *ran)
 {
-    const struct ncp_remap *r = a->remaps->t >= 0 ? &a->remaps->r[a->remaps->t] : NULL;
-    if (!r)
-        return ncp_tools_select(a);
-    if (remap_in_progress(a, r)) {
+    const struct ncp_remaps *rs = a->remaps;
+    int k = letter == 'T' ? rs->t : letter == 'S' ? rs->s : rs->f;
+    *ran = 0;
+    if (k < 0)
+        return NCP_OK;
+    const struct ncp_remap *r = &rs->r[k];
+    if (remap_in_progress(a, r)) { /* the built-in code, noted for the epilog */
         ncp_remap_note_builtin(a);
-        return ncp_tools_select(a);
+        return NCP_OK;
     }
-    return remap_run(a, r, a->w.col[NCP_LETTER('T')]);
+    *ran = 1;
+    return remap_run(a, r, a->w.col[NCP_LETTER(letter)]);
 }

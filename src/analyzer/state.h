@@ -305,8 +305,9 @@ void ncp_sai_op(struct ncp_analyzer *a, const struct ncp_canon *op);
  * remap runs there (not in its own remap, for the codes rs274 then runs
  * built in): *ran = 1 and the remap's result. */
 int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran);
-/* T in its step: its remap, or the built-in select */
-int ncp_remap_t_step(struct ncp_analyzer *a);
+/* T, S or F in its step: *ran = 1 when its remap ran (else the built-in step
+ * is the caller's: no remap, or inside its own) */
+int ncp_remap_letter_step(struct ncp_analyzer *a, char letter, int *ran);
 /* A built-in tool code ran: rs274 notes it on the line that controls the
  * innermost remap (what stdglue's epilogs test) */
 static inline void ncp_remap_note_builtin(struct ncp_analyzer *a)

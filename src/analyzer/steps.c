@@ -421,16 +421,35 @@ int ncp_an_steps(struct ncp_analyzer *a)
         rc = ncp_step_feed_mode(a, w->g[NCP_GG_FEEDMODE]);
     if (rc != NCP_OK)
         return rc;
+    int ran = 0;
     if (NCP_HAS(w, 'F') && a->st.m.feed_mode != 1) {
-        a->st.feed = W(a, 'F');
-        ncp_an_emit(a, NCP_C_SET_FEED_RATE)->feed_rate.rate = a->st.feed;
+        if (a->remaps)
+            rc = ncp_remap_letter_step(a, 'F', &ran);
+        if (rc != NCP_OK)
+            return rc;
+        if (!ran) {
+            a->st.feed = W(a, 'F');
+            ncp_an_emit(a, NCP_C_SET_FEED_RATE)->feed_rate.rate = a->st.feed;
+        }
     }
     if (NCP_HAS(w, 'S')) {
-        a->st.speed = W(a, 'S');
-        ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->spindle_speed.speed = a->st.speed;
+        ran = 0;
+        if (a->remaps)
+            rc = ncp_remap_letter_step(a, 'S', &ran);
+        if (rc != NCP_OK)
+            return rc;
+        if (!ran) {
+            a->st.speed = W(a, 'S');
+            ncp_an_emit(a, NCP_C_SET_SPINDLE_SPEED)->spindle_speed.speed = a->st.speed;
+        }
     }
-    if (NCP_HAS(w, 'T'))
-        rc = a->remaps ? ncp_remap_t_step(a) : ncp_tools_select(a);
+    if (NCP_HAS(w, 'T')) {
+        ran = 0;
+        if (a->remaps)
+            rc = ncp_remap_letter_step(a, 'T', &ran);
+        if (rc == NCP_OK && !ran)
+            rc = ncp_tools_select(a);
+    }
     if (rc == NCP_OK && w->n_m != 0) /* most blocks have none: skip the group tests */
         rc = ncp_step_m_codes(a);
     if (a->block_consumed) { /* M72's restore lines ran in this block's place */

@@ -1,0 +1,2 @@
+# rs274 -i only
+from stdglue import *
