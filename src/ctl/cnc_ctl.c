@@ -29,6 +29,7 @@ enum {
 struct args {
     const char *url, *prefix, *key_file;
     double timeout;
+    int timeout_given;
     long channel;
     unsigned opts; /* OPT_* given */
     long from_line;
@@ -63,13 +64,15 @@ static const char global_usage[] =
     "                  ~/.config/ncpar/lcm.key): commands are sealed with it, and\n"
     "                  ACKs and statuses without its seal are ignored\n"
     "  --timeout S     seconds to wait for an answer (default 5; for wait and\n"
-    "                  status --watch 0 waits for ever). A command the NCK has not\n"
+    "                  status --watch 0 waits for ever; events follow until ^C\n"
+    "                  unless it is given). A command the NCK has not\n"
     "                  taken by then is never acted on (its deadline travels with it)\n"
     "  --channel N     NC channel (default 0)\n"
     "\n"
     "commands (cnc-ctl COMMAND --help for each):\n"
-    "  status [--json] [--watch]          load PROG           run [--from-line N]\n"
-    "  pause   resume   stop   abort      step on|off         mdi 'LINE'\n"
+    "  status [--json] [--watch]          events [--json]\n"
+    "  load PROG          run [--from-line N]                 mdi 'LINE'\n"
+    "  pause   resume   stop   abort      step on|off\n"
     "  home [AXES|all]                    override feed|rapid|spindle PCT\n"
     "  jog AXIS +|- [--speed MM_PER_MIN] [--distance MM]      jog AXIS stop\n"
     "  estop   reset   shutdown           wait STATE [--timeout S]\n"
@@ -145,6 +148,7 @@ static int parse_args(int argc, char **argv, struct args *a)
             v = opt_value(argc, argv, &i, "--timeout");
             if (v == NULL || ncp_num_double(v, 0, DBL_MAX, &a->timeout) != 0)
                 return usage_error("--timeout needs seconds (0 or more), not '%s'", v ? v : "");
+            a->timeout_given = 1;
         } else if (is_opt(s, "--channel")) {
             v = opt_value(argc, argv, &i, "--channel");
             if (v == NULL || ncp_num_long(v, 10, 0, 127, &a->channel) != 0)
@@ -393,6 +397,24 @@ static int run_status(struct ctl *c, const struct args *a)
     }
 }
 
+static void show_event(const ncp_event_t *e, void *ctx)
+{
+    if (*(const int *)ctx) {
+        char buf[2048];
+        if (ncp_msg_event_json(e, buf, sizeof buf) > 0)
+            printf("%s\n", buf);
+    } else {
+        ctl_print_event(e);
+    }
+    fflush(stdout);
+}
+
+static int run_events(struct ctl *c, const struct args *a)
+{
+    int json = (a->opts & OPT_JSON) != 0;
+    return ctl_follow_events(c, a->timeout_given ? c->timeout : 0, show_event, &json);
+}
+
 static int run_wait(struct ctl *c, const struct args *a)
 {
     int want = ncp_msg_state_parse(a->words[0]);
@@ -455,6 +477,12 @@ static const struct command commands[] = {
      "JSON object. --watch prints every status until interrupted (one JSON object a\n"
      "line with --json). Exit 3 when the NCK is in fault, 4 when no status comes.",
      OPT_JSON | OPT_WATCH, 0, 0, run_status},
+    {"events", "[--json]",
+     "Prints the NCK's events as they come (MSG, DEBUG and PRINT text from the\n"
+     "program, its errors as FILE:LINE:COL, faults, the NCK's notices), one a line\n"
+     "(one JSON object a line with --json), until interrupted, or for --timeout S\n"
+     "seconds when given. Only events from then on: none is kept for later.",
+     OPT_JSON, 0, 0, run_events},
     {"load", "PROG", "Loads a program (its path made absolute here).", 0, 1, 1, run_load},
     {"run", "[--from-line N]", "Runs the loaded program, from line N if given.",
      OPT_FROM_LINE, 0, 0, run_run},
@@ -543,8 +571,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: cnc-ctl [OPTIONS] %s %s\n", k->name, k->usage);
         return CTL_USAGE;
     }
-    if (a.timeout == 0 && k->run != run_wait && k->run != run_status)
-        return usage_error("--timeout 0 is only for wait and status --watch%s", "");
+    if (a.timeout == 0 && k->run != run_wait && k->run != run_status && k->run != run_events)
+        return usage_error("--timeout 0 is only for wait, status --watch and events%s", "");
 
     struct ctl c;
     memset(&c, 0, sizeof c);

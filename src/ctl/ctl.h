@@ -28,6 +28,7 @@ struct ctl {
     char ch_cmd[NCP_MSG_PREFIX_MAX + 8];
     char ch_ack[NCP_MSG_PREFIX_MAX + 8];
     char ch_status[NCP_MSG_PREFIX_MAX + 8];
+    char ch_event[NCP_MSG_PREFIX_MAX + 8];
     int8_t channel;  /* NC channel */
     double timeout;  /* seconds; 0: none (wait and status --watch only) */
     int32_t client_id;
@@ -39,6 +40,14 @@ struct ctl {
     uint64_t n_status; /* statuses of our NC channel received so far */
     ncp_status_t status;
     double status_at;  /* ctl_now() of the last one */
+    /* Statuses of other NC channels while none of ours came: enough of them,
+     * over long enough, say that ours is not served (no 5 s wait for it). */
+    uint32_t other_statuses;
+    double first_other_at;
+    uint8_t served[128];   /* NC channels seen in statuses */
+    /* events: the follower's printer */
+    void (*on_event)(const ncp_event_t *e, void *ctx);
+    void *event_ctx;
 };
 
 /* Set by SIGINT/SIGTERM (a second one ends the program). */
@@ -60,7 +69,8 @@ int ctl_command(struct ctl *c, ncp_command_t *cmd);
 int ctl_handle(struct ctl *c, double seconds);
 /* Waits for the next status (c->status), up to timeout seconds (0: for
  * ever): CTL_OK, CTL_NO_ANSWER, CTL_USAGE when LCM failed (said on stderr),
- * -1 when interrupted. */
+ * CTL_REJECTED when the NCK's statuses show it serves no such NC channel
+ * (said on stderr), -1 when interrupted. */
 int ctl_next_status(struct ctl *c, double timeout);
 /* "cnc-ctl: no WHAT from the NCK within S s (is ... running?)" */
 void ctl_no_answer(const char *what, double seconds);
@@ -68,6 +78,16 @@ void ctl_no_answer(const char *what, double seconds);
 /* jog AXIS +|-: incremental (distance > 0) or continuous (see cnc-ctl jog
  * --help); speed 0 is the NCK's default. */
 int ctl_jog(struct ctl *c, char axis, int dir, double speed, double distance);
+
+/* Calls show for every event of our NC channel that carries the key's seal,
+ * for up to seconds (0: until interrupted): CTL_OK, or CTL_USAGE when LCM
+ * failed. */
+int ctl_follow_events(struct ctl *c, double seconds,
+                      void (*show)(const ncp_event_t *e, void *ctx), void *ctx);
+
+/* cnc-ctl events: one line, "FILE:LINE:COL: error: TEXT" the way a compiler
+ * says it where the event names a place. */
+void ctl_print_event(const ncp_event_t *e);
 
 /* cnc-ctl status: the readable lines. */
 void ctl_print_status(const ncp_status_t *s);
