@@ -315,3 +315,37 @@ int ctl_follow_events(struct ctl *c, double seconds,
     }
     return CTL_OK;
 }
+
+int ctl_wait_done(struct ctl *c, int busy_state, const char *what)
+{
+    int64_t acked_utime = c->ack.utime;
+    double last = ctl_now();
+    for (;;) {
+        int rc = ctl_next_status(c, 0.25);
+        if (rc < 0)
+            return CTL_NO_ANSWER; /* interrupted: not seen to end */
+        double now = ctl_now();
+        if (rc == CTL_NO_ANSWER) {
+            if (c->timeout > 0 && now - last >= c->timeout) {
+                ctl_no_answer("status", c->timeout);
+                return CTL_NO_ANSWER;
+            }
+            continue;
+        }
+        if (rc != CTL_OK)
+            return rc;
+        last = now;
+        /* a status sent before the ACK may still show the state before the
+         * command: only later ones say how it ended */
+        if (c->status.utime < acked_utime || c->status.state == busy_state)
+            continue;
+        if (c->status.state == NCP_STATUS_T_FAULT || c->status.state == NCP_STATUS_T_ESTOP) {
+            const char *st = ncp_msg_state_name(c->status.state);
+            fprintf(stderr, "cnc-ctl: %s ended in %s: %.*s\n", what, st ? st : "?",
+                    (int)strnlen((const char *)c->status.error, sizeof c->status.error),
+                    (const char *)c->status.error);
+            return CTL_FAULT;
+        }
+        return CTL_OK;
+    }
+}
