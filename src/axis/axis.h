@@ -8,6 +8,7 @@
 #include <stdio.h>
 
 #include "ncpar/backend.h"
+#include "ncpar/config.h"
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
 #include "ncpar/rt.h"

@@ -11,9 +11,9 @@
 #include "signals.h"
 
 #include "ncpar/backend.h"
+#include "ncpar/config.h"
 #include "ncpar/dist.h"
 #include "ncpar/feeder.h"
-#include "ncpar/motion.h"
 #include "ncpar/msg.h"
 #include "ncpar/pipeline.h"
 #include "ncpar/nck.h"
