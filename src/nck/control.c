@@ -1,7 +1,7 @@
 /* The serving NCK's state machine: which command fits which state, what each
  * does, and how the NCK moves on between commands (ncp_nck_poll). Runs on the
  * caller's thread only (the service thread). */
-#include "nck_int.h"
+#include "control.h"
 #include "ncpar/clock.h"
 
 #include <ctype.h>

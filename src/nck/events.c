@@ -1,6 +1,6 @@
 /* The NCK's events, oldest first, for the service to publish. A full queue
  * drops the oldest: an operator needs the latest word more than the first. */
-#include "nck_int.h"
+#include "control.h"
 
 #include <stdarg.h>
 #include <stdio.h>

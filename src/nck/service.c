@@ -3,7 +3,7 @@
  * caller's) does all of it; the NCK's real-time threads never see a message.
  * Several NC channels share the transport: each message carries its
  * channel, a command goes to the NCK of its channel only. */
-#include "nck_int.h"
+#include "control.h"
 
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
