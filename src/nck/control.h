@@ -28,7 +28,7 @@ enum nck_drop {
 
 /* The service's NCK: the core plus the state machine (control.c). */
 struct ncp_nck {
-    struct nck n;
+    struct nck_core core;
     int state;                       /* enum ncp_nck_state */
     int resume_state;                /* what a resume returns to */
     struct ncp_analyzer *interp;     /* resident: modal state lives here */

@@ -10,7 +10,7 @@
 
 #define NCK_CONTOUR_HISTORY 64
 
-struct nck;
+struct nck_core;
 
 /* One servo cycle as the position loop saw it. */
 struct nck_fb {
@@ -60,7 +60,7 @@ struct nck_summary {
 /* stats.c */
 void nck_account(struct nck_summary *s, unsigned axis_mask, const struct nck_fb *fb, FILE *trace);
 /* Reads every cycle the loop has written: trace, summary, last cycle. */
-int nck_read_cycles(struct nck *n);
+int nck_read_cycles(struct nck_core *n);
 /* The trace's first row: the fixed columns, then cmd and act of each of
  * the machine's axes beyond X Y Z (axis_mask). */
 void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints, int rings);
@@ -68,7 +68,7 @@ void nck_trace_header(FILE *trace, const struct ncp_machine_cfg *cfg, int joints
 int nck_trace_flush(struct nck_summary *s, FILE *trace);
 
 /* pauses.c: the operator is told of a wait the loop began (stats.c) */
-void nck_wait_began(struct nck *n, const struct nck_fb *fb);
+void nck_wait_began(struct nck_core *n, const struct nck_fb *fb);
 const char *nck_wait_name(int wait);
 int nck_wait_operator(int wait);
 

@@ -5,7 +5,7 @@
 #include "ncpar/backend.h"
 #include "ncpar/nck.h"
 
-struct nck;
+struct nck_core;
 
 /* Homing (homing.c): the position loop drives each axis of the request on
  * its own, away from the planner, through LinuxCNC's phases; the trace's
@@ -41,21 +41,21 @@ struct nck_homing {
  * nck_home_cancel on an E-stop or fault (loop.c's drive() puts home.off
  * between the joints and the backend). The caller's thread: nck_home_request
  * (at rest, nothing queued), nck_home_finished once the loop is done. */
-int nck_home_take(struct nck *n);
-void nck_home_sense(struct nck *n, const double act[NCP_AXES]);
-void nck_home_cancel(struct nck *n);
-int nck_home_active(const struct nck *n);
-uint64_t nck_home_phases(const struct nck *n);
+int nck_home_take(struct nck_core *n);
+void nck_home_sense(struct nck_core *n, const double act[NCP_AXES]);
+void nck_home_cancel(struct nck_core *n);
+int nck_home_active(const struct nck_core *n);
+uint64_t nck_home_phases(const struct nck_core *n);
 /* The order of homing: HOME_SEQUENCE's absolute value; without any
  * HOME_SEQUENCE in the INI, Z first, then all the others together. */
 int nck_home_seq(const struct ncp_machine_cfg *c, int axis);
 /* The axes "home all" homes: all of them, or, once any axis has a
  * HOME_SEQUENCE, those that have one (LinuxCNC's rule). */
 unsigned nck_home_all_mask(const struct ncp_machine_cfg *c);
-void nck_home_request(struct nck *n, unsigned mask);
-int nck_home_finished(const struct nck *n);
+void nck_home_request(struct nck_core *n, unsigned mask);
+int nck_home_finished(const struct nck_core *n);
 /* One line per homed axis of the last request (where its switch latched),
  * or why homing failed; 0, or -1 when it failed. */
-int nck_home_report(const struct nck *n, char *buf, size_t len);
+int nck_home_report(const struct nck_core *n, char *buf, size_t len);
 
 #endif

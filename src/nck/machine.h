@@ -44,7 +44,6 @@ struct nck_mach {
     int64_t wait_since;
     uint64_t resume_used;
     int in_last;               /* M66 L1/L2: the input's previous value */
-    double m66_result;         /* #5399 as the machine found it */
     int spun;                  /* the spindle was stepped at spun_at */
     int64_t spun_at;
 };

@@ -4,7 +4,7 @@
 
 #include "ncpar/backend.h"
 
-struct nck;
+struct nck_core;
 
 /* The probe (probe.c): the position loop writes it; the job thread reads
  * the result once the probe move's stop was reached (ends_taken). */
@@ -20,8 +20,8 @@ struct nck_probe {
 };
 
 /* probe.c (real-time path) */
-void nck_probe_arm(struct nck *n, int flags);
-void nck_probe_cycle(struct nck *n, const double act[NCP_AXES]);
-int nck_probe_braking(const struct nck *n);
+void nck_probe_arm(struct nck_core *n, int flags);
+void nck_probe_cycle(struct nck_core *n, const double act[NCP_AXES]);
+int nck_probe_braking(const struct nck_core *n);
 
 #endif
