@@ -7,10 +7,7 @@
  * holds the axes where they stand: the planner brought them to a stop there.
  * Real-time rules: no allocation, locks or system calls here. */
 #include "nck_int.h"
-#include "job_state.h"
 #include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <math.h>
 #include <string.h>

@@ -3,8 +3,6 @@
  * after the program (or after --for's hold, or at a fault). */
 #include "nck_int.h"
 #include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
 #include "service_state.h"
 #include "ncpar/clock.h"
 
@@ -238,13 +236,14 @@ static void drain(struct nck_core *n, const struct ncp_nck_opts *o, struct batch
 
 /* "node 2: EMCY (0x082): ... (last completed block: line 7)", at the line
  * of the block in progress. */
-static void backend_diag(const struct nck_core *n, struct ncp_nck_result *res)
+static void backend_diag(const struct nck_core *n, const struct nck_loop_report *lr,
+                         struct ncp_nck_result *res)
 {
     char why[NCP_DIAG_MSG_MAX];
     n->cross.be.ops->describe_fault(&n->cross.be, why, sizeof why);
     char done[48] = "none";
-    if (n->loop->line_done)
-        snprintf(done, sizeof done, "line %u", n->loop->line_done);
+    if (lr->line_done)
+        snprintf(done, sizeof done, "line %u", lr->line_done);
     ncp_diag_set(&res->diag, NCP_ERR_IO, n->cross.fault_line, 0, "%.*s (last completed block: %s)",
                  (int)(sizeof res->diag.msg - 40), why, done);
     res->status = NCP_NCK_FAULT;
@@ -255,7 +254,9 @@ static void collect(const struct nck_core *n, struct ncp_nck_result *res)
     const struct nck_summary *s = &n->svc->sum;
     struct ncp_planner_stats ps;
     nck_plan_stats(n, &ps);
-    res->program_time = n->loop->ended ? (double)n->loop->end_ns * 1e-9 : s->t;
+    struct nck_loop_report lr;
+    nck_loop_report(n, &lr);
+    res->program_time = lr.ended ? (double)lr.end_ns * 1e-9 : s->t;
     res->path_length = s->path;
     res->segments = ps.segments;
     res->starved = ps.starved;
@@ -269,14 +270,14 @@ static void collect(const struct nck_core *n, struct ncp_nck_result *res)
     res->axis_mask = n->cfg->axis_mask;
     res->contour_max = s->contour_max;
     res->contour_avg = s->moving ? s->contour_sum / (double)s->moving : 0;
-    res->underruns = n->loop->underruns;
-    res->dry = n->loop->dry;
-    res->trace_dropped = n->loop->fb_dropped;
+    res->underruns = lr.underruns;
+    res->dry = lr.dry;
+    res->trace_dropped = lr.fb_dropped;
     res->fifo = n->cross.rt.fifo;
     memcpy(res->warning, n->cross.rt.warning, sizeof res->warning);
     res->lat = n->cross.rt.stats;
-    res->for_expired = n->loop->for_expired;
-    res->interrupted = atomic_load(&n->ctl->stop) && !n->loop->ended;
+    res->for_expired = lr.for_expired;
+    res->interrupted = atomic_load(&n->ctl->stop) && !lr.ended;
     res->trace_errno = n->svc->sum.trace_errno;
     res->spindle_rpm_max = s->rpm_max;
     nck_sched_summary(n, res->sched_summary, sizeof res->sched_summary);
@@ -292,7 +293,7 @@ static void collect(const struct nck_core *n, struct ncp_nck_result *res)
     const struct nck_job *j = n->job;
     int fault = atomic_load(&n->cross.loop_fault);
     if (fault == NCK_LF_BACKEND) {
-        backend_diag(n, res);
+        backend_diag(n, &lr, res);
     } else if (fault == NCK_LF_FERROR) {
         res->fault = 1;
         res->fault_axis = n->cross.fault_axis;
@@ -308,7 +309,7 @@ static void collect(const struct nck_core *n, struct ncp_nck_result *res)
     } else if (n->cross.inj_rep.trip) {
         /* a miss limit stopped the machine along the path */
         res->status = NCP_NCK_FAULT;
-    } else if (n->loop->for_expired || res->interrupted) {
+    } else if (lr.for_expired || res->interrupted) {
         /* the interpreter was cut short by us: its "stopped" is no program error */
     } else if (j->map_failed || j->rc != NCP_OK) {
         res->diag = j->map_failed ? j->map_diag : j->diag;

@@ -3,10 +3,6 @@
  * before anything moves. Nothing the interpreter says is dropped silently:
  * docs/operator.md's table of calls is this file in prose. */
 #include "nck_int.h"
-#include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <string.h>
 

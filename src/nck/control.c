@@ -3,8 +3,6 @@
  * caller's thread only (the service thread). */
 #include "control.h"
 #include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
 #include "service_state.h"
 #include "ncpar/clock.h"
 

@@ -143,6 +143,7 @@ int nck_start(struct nck_core *n, const struct ncp_nck_setup *s, int batch, stru
         return -1;
     }
     nck_inject_setup(n);
+    n->svc->sum.inject_col = n->cfg->inject.kinds != 0;
     n->trace_rings = s->trace_rings || n->cfg->sched.trace_rings;
     n->svc->sum.rings = n->trace_rings;
     n->svc->sum.seg_cap = (uint32_t)ncp_spsc_capacity(&n->cross.segs);

@@ -1,10 +1,6 @@
 /* The NCK's events, oldest first, for the service to publish. A full queue
  * drops the oldest: an operator needs the latest word more than the first. */
 #include "control.h"
-#include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <stdarg.h>
 #include <stdio.h>

@@ -12,10 +12,7 @@
  * The loop functions are on the real-time path: no allocation, locks or
  * system calls. */
 #include "nck_int.h"
-#include "job_state.h"
 #include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <math.h>
 #include <stdio.h>

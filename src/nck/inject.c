@@ -6,10 +6,7 @@
  * any of it the backend is stepped as it always was. Real-time path: no
  * allocation, locks or system calls. */
 #include "nck_int.h"
-#include "job_state.h"
 #include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -23,7 +20,6 @@ void nck_inject_setup(struct nck_core *n)
     const struct ncp_inject_cfg *c = &n->cfg->inject;
     n->loop->inj_on = c->kinds || c->max_consecutive > 0 || c->max_ratio > 0;
     n->loop->inj_timed = (c->kinds & TIMED_KINDS) != 0;
-    n->svc->sum.inject_col = c->kinds != 0;
     ncp_inject_init(&n->loop->inj, c, n->cfg->servo_period);
     ncp_inject_rx_init(&n->loop->rx, c->policy);
     for (int j = 0; j < NCP_AXES; j++)

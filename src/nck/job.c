@@ -4,9 +4,6 @@
  * message, after which the planner runs the rest to a stop. */
 #include "nck_int.h"
 #include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include "ncpar/executor.h"
 #include "ncpar/clock.h"

@@ -3,10 +3,7 @@
  * No allocation, locks or I/O: requests from other threads arrive as atomic
  * counters and are answered the same way. */
 #include "nck_int.h"
-#include "job_state.h"
 #include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 #include "ncpar/clock.h"
 
 #include <math.h>
@@ -384,4 +381,11 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
         idle_nap(n);
     }
     return NCP_RT_CONTINUE;
+}
+
+void nck_loop_report(const struct nck_core *n, struct nck_loop_report *r)
+{
+    const struct nck_loop *l = n->loop;
+    *r = (struct nck_loop_report){ l->underruns, l->dry, l->fb_dropped, l->ended,
+                                   l->for_expired, l->end_ns, l->line_done };
 }

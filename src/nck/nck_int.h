@@ -75,6 +75,15 @@ int nck_motion_done(const struct nck_core *n);
 
 /* loop.c: the position cycle (real-time path) */
 int nck_position_cycle(void *ctx, int64_t now_ns);
+/* What a batch run reports of the loop's own state: the caller's thread,
+ * only after nck_finish joined the loop. */
+struct nck_loop_report {
+    uint64_t underruns, dry, fb_dropped;
+    int ended, for_expired;
+    int64_t end_ns;
+    uint32_t line_done;
+};
+void nck_loop_report(const struct nck_core *n, struct nck_loop_report *r);
 
 /* inject.c: the servo's part of the position cycle under injected timing
  * faults and the miss limits (real-time path) */

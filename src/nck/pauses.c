@@ -3,9 +3,6 @@
  * batch run says on stderr how it will go on. Runs on the caller's thread,
  * from the cycles the position loop reports. */
 #include "nck_int.h"
-#include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
 #include "service_state.h"
 
 #include <unistd.h>

@@ -1,10 +1,7 @@
 /* The setpoint source of the planner thread: the ADCBI planner or the ADCAI
  * chain, chosen by [PLANNER] NCK, behind one set of calls. */
 #include "nck_int.h"
-#include "job_state.h"
-#include "loop_state.h"
 #include "planner_state.h"
-#include "service_state.h"
 #include "ncpar/adcai.h"
 
 int nck_plan_new(struct nck_core *n)

@@ -1,10 +1,7 @@
 /* The planner/interpolator thread: segments in, one setpoint per planning
  * period out. It lives as long as the NCK; between jobs it waits. */
 #include "nck_int.h"
-#include "job_state.h"
-#include "loop_state.h"
 #include "planner_state.h"
-#include "service_state.h"
 #include "ncpar/clock.h"
 
 #include <math.h>

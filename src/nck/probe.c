@@ -8,10 +8,7 @@
  * result once the move's stop is reached (queue buster, job.c).
  * No allocation, locks or system calls: real-time path. */
 #include "nck_int.h"
-#include "job_state.h"
 #include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <string.h>
 

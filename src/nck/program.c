@@ -1,10 +1,6 @@
 /* The loaded program's text as the NCK checked it and runs it: not the
  * file, which may have been written over since (the panel shows this). */
 #include "control.h"
-#include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 int ncp_nck_program_text(const struct ncp_nck *n, const char **text, size_t *len)
 {

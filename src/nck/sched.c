@@ -3,10 +3,6 @@
  * the planner), their priorities below the position loop, and what they ran
  * at for the summary. The position loop itself is never touched. */
 #include "nck_int.h"
-#include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <sched.h>
 #include <stdio.h>

@@ -4,10 +4,6 @@
  * Several NC channels share the transport: each message carries its
  * channel, a command goes to the NCK of its channel only. */
 #include "control.h"
-#include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"

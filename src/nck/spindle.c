@@ -6,10 +6,7 @@
  * neither of them.
  * Real-time rules: no allocation, locks or system calls here. */
 #include "nck_int.h"
-#include "job_state.h"
 #include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <math.h>
 

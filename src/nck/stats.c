@@ -2,9 +2,6 @@
  * contour error, the live progress line and the final summary. Runs on the
  * caller's thread, never on the real-time one. */
 #include "nck_int.h"
-#include "job_state.h"
-#include "loop_state.h"
-#include "planner_state.h"
 #include "service_state.h"
 
 #include <errno.h>

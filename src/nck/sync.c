@@ -16,10 +16,7 @@
  * tap's way again, moves back to where the tap started.
  * Real-time rules: no allocation, locks or system calls here. */
 #include "nck_int.h"
-#include "job_state.h"
 #include "loop_state.h"
-#include "planner_state.h"
-#include "service_state.h"
 
 #include <math.h>
 #include <string.h>
