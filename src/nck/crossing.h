@@ -74,10 +74,8 @@ struct nck_cross {
     /* #5399 as the loop found it at an M66: written before the AUX stop's
      * END counts in ends_taken, read by the job after that */
     double m66_result;
-    /* homing: the caller writes mask, then counts req; the loop counts done
-     * once that request is over (result, fail_axis, final, latched then
-     * hold for the caller); the phases and off are the loop's */
-    struct nck_homing home;
+    /* homing's request and result (homing.h) */
+    struct nck_home_req home;
 
     /* canonical calls the jobs took, acted on and refused, per kind: job
      * threads, in turn; the caller reads them after the job */

@@ -19,21 +19,25 @@ struct nck_home_axis {
     int stopping;          /* the phase's event came: braking to a stop */
     double pos, v;         /* commanded position (machine coordinates), velocity */
     double from;           /* where the phase began: a search's travel is bounded */
-    double latched;        /* where the switch latched, simulated machine's coordinates */
 };
-struct nck_homing {
-    /* the caller's thread writes mask, then counts req; the loop counts
-     * done once that request is over (result, final and latched then hold) */
+/* The request and its result (crossing.h): the caller's thread writes mask,
+ * then counts req; the loop counts done once that request is over (result,
+ * fail_axis, final and latched then hold for the caller). */
+struct nck_home_req {
     unsigned mask;
     _Atomic uint32_t req, done;
+    int result, fail_axis;
+    double final[NCP_AXES];
+    double latched[NCP_AXES];  /* where the switch latched, simulated machine's coordinates */
+};
+/* The run (loop_state.h): the loop's alone. */
+struct nck_homing {
     uint32_t taken;
     int active;
-    int result, fail_axis;
     struct nck_home_axis ax[NCP_AXES];
     /* the simulated machine's position minus the machine position: homing
      * sets the machine position where the switch latches */
     double off[NCP_AXES];
-    double final[NCP_AXES];
 };
 
 /* homing.c. The loop: nck_home_take instead of the planned setpoint (1 when

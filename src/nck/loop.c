@@ -61,14 +61,14 @@ static int drive(struct nck_core *n, double act[NCP_AXES], int with_faults)
     /* homing's offset between the joints and what the servos count from */
     double c[NCP_AXES], x[NCP_AXES], a[NCP_AXES];
     for (int j = 0; j < NCP_AXES; j++) {
-        c[j] = n->loop->jcmd[j] + n->cross.home.off[j];
-        x[j] = n->loop->jnext[j] + n->cross.home.off[j];
+        c[j] = n->loop->jcmd[j] + n->loop->home.off[j];
+        x[j] = n->loop->jnext[j] + n->loop->home.off[j];
         a[j] = c[j];  /* a backend reports only the machine's joints */
     }
     /* timing faults act on what the servos get: the joints */
     int rc = with_faults ? nck_servo_cycle(n, c, x, a) : n->cross.be.ops->cycle(&n->cross.be, c, x, a);
     for (int j = 0; j < NCP_AXES; j++)
-        n->loop->jact[j] = a[j] - n->cross.home.off[j];
+        n->loop->jact[j] = a[j] - n->loop->home.off[j];
     ncp_kins_forward(k, n->loop->cur.tool_z, n->loop->jact, act);
     return rc;
 }

@@ -4,11 +4,13 @@
 #ifndef NCPAR_NCK_LOOP_STATE_H
 #define NCPAR_NCK_LOOP_STATE_H
 
+#include "homing.h"
 #include "machine.h"
 
 struct nck_loop {
     struct nck_sync_state sync;      /* the synchronised run it moves (sync.c) */
     struct nck_mach mach;            /* the machine functions (aux.c) */
+    struct nck_homing home;          /* the axes homing (homing.c) */
     struct ncp_setpoint cur, next;
     double jcmd[NCP_AXES], jnext[NCP_AXES], jact[NCP_AXES];  /* cur, next, actual as joints */
     struct ncp_scaler scaler;
