@@ -90,7 +90,7 @@ static int init_motion(struct nck_core *n)
     const struct ncp_machine_cfg *c = n->cfg;
     ncp_canon_map_init(&n->job->map, c, n->start, n->plan_override);
     memcpy(n->loop->next.pos, n->start, sizeof n->loop->next.pos);
-    memcpy(n->cross.probe.last, n->start, sizeof n->cross.probe.last);
+    memcpy(n->loop->probe.last, n->start, sizeof n->loop->probe.last);
     n->loop->cur = n->loop->next;
     double a_min = INFINITY;
     for (int j = 0; j < NCP_AXES; j++)

@@ -68,9 +68,8 @@ struct nck_cross {
      * once the loop has ended, or after loop_fault */
     struct ncp_inject_report inj_rep;
 
-    /* the probe: the loop writes it; the job reads the result once the
-     * probe move's stop was reached (ends_taken); the caller arms nothing */
-    struct nck_probe probe;
+    /* the probe's result (probe.h) */
+    struct nck_probe_result probe;
     /* #5399 as the loop found it at an M66: written before the AUX stop's
      * END counts in ends_taken, read by the job after that */
     double m66_result;

@@ -60,7 +60,7 @@ static void set_position(struct nck_core *n, int j, double phys, double at)
     h->ax[j].pos += d;
     h->ax[j].from += d;
     n->loop->next.pos[j] += d;
-    n->cross.probe.last[j] += d;
+    n->loop->probe.last[j] += d;
 }
 
 static void begin_phase(struct nck_homing *h, int j, int phase)
@@ -77,13 +77,13 @@ static void begin_axis(struct nck_core *n, int j)
     h->ax[j].queued = 0;
     if (a->home_search_vel == 0) {
         /* no switch: the axis is homed where it stands */
-        double phys = n->cross.probe.last[j] + h->off[j];
+        double phys = n->loop->probe.last[j] + h->off[j];
         n->cross.home.latched[j] = phys;
         set_position(n, j, phys, a->home_offset);
         begin_phase(h, j, NCK_HP_FINAL);
         return;
     }
-    begin_phase(h, j, pressed(n, j, n->cross.probe.last[j]) ? NCK_HP_OFF_SWITCH : NCK_HP_SEARCH);
+    begin_phase(h, j, pressed(n, j, n->loop->probe.last[j]) ? NCK_HP_OFF_SWITCH : NCK_HP_SEARCH);
 }
 
 /* The velocity each phase runs at (0 once its event came). */

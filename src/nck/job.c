@@ -572,7 +572,7 @@ static int buster(struct nck_core *n, const struct ncp_cmd *cmd, const struct nc
         ms->input = n->cross.m66_result;
         return 0;
     }
-    const struct nck_probe *p = &n->cross.probe;
+    const struct nck_probe_result *p = &n->cross.probe;
     if (p->error != NCK_PROBE_OK) {
         ncp_diag_set(&j->map_diag, NCP_ERR_SEMANTIC, cmd->line, 0, "%s",
                      p->error == NCK_PROBE_TRIPPED_AT_START

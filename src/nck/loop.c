@@ -198,7 +198,7 @@ static void discard(struct nck_core *n, const double act[NCP_AXES])
            sizeof at);
     memcpy(n->cross.rest, at, sizeof n->cross.rest);
     nck_aux_discard(n);
-    n->cross.probe.state = NCK_PROBE_OFF;
+    n->loop->probe.state = NCK_PROBE_OFF;
     ncp_scaler_rebase(&n->loop->scaler, at);
     n->loop->scaler.decel = n->loop->decel_normal;
     memset(&n->loop->cur, 0, sizeof n->loop->cur);

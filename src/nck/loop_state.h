@@ -6,11 +6,13 @@
 
 #include "homing.h"
 #include "machine.h"
+#include "probe.h"
 
 struct nck_loop {
     struct nck_sync_state sync;      /* the synchronised run it moves (sync.c) */
     struct nck_mach mach;            /* the machine functions (aux.c) */
     struct nck_homing home;          /* the axes homing (homing.c) */
+    struct nck_probe probe;          /* the probe as armed and watched (probe.c) */
     struct ncp_setpoint cur, next;
     double jcmd[NCP_AXES], jnext[NCP_AXES], jact[NCP_AXES];  /* cur, next, actual as joints */
     struct ncp_scaler scaler;

@@ -45,16 +45,17 @@ static void crossing(const struct ncp_io_cfg *io, const double a[NCP_AXES],
 
 void nck_probe_arm(struct nck_core *n, int flags)
 {
-    struct nck_probe *p = &n->cross.probe;
+    struct nck_probe *p = &n->loop->probe;
+    struct nck_probe_result *r = &n->cross.probe;
     p->flags = flags;
-    p->tripped = 0;
-    p->error = NCK_PROBE_OK;
-    memcpy(p->trip, p->last, sizeof p->trip);
+    r->tripped = 0;
+    r->error = NCK_PROBE_OK;
+    memcpy(r->trip, p->last, sizeof r->trip);
     int contact = in_contact(&n->cfg->io, p->last);
     int away = (flags & NCP_PROBE_F_AWAY) != 0;
     if (contact != away) {
         /* LinuxCNC refuses to start: stop at once, nothing probed */
-        p->error = away ? NCK_PROBE_NOT_TRIPPED_AT_START : NCK_PROBE_TRIPPED_AT_START;
+        r->error = away ? NCK_PROBE_NOT_TRIPPED_AT_START : NCK_PROBE_TRIPPED_AT_START;
         p->state = NCK_PROBE_STOPPING;
         p->ends_at_trip = n->loop->scaler.ends;
         return;
@@ -87,13 +88,14 @@ static int drop_to_stop(struct nck_core *n, uint32_t *aux)
 
 void nck_probe_cycle(struct nck_core *n, const double act[NCP_AXES])
 {
-    struct nck_probe *p = &n->cross.probe;
+    struct nck_probe *p = &n->loop->probe;
+    struct nck_probe_result *r = &n->cross.probe;
     const struct ncp_io_cfg *io = &n->cfg->io;
     if (p->state == NCK_PROBE_ARMED) {
         int want = !(p->flags & NCP_PROBE_F_AWAY);
         if (in_contact(io, act) == want) {
-            crossing(io, p->last, act, want, p->trip);
-            p->tripped = 1;
+            crossing(io, p->last, act, want, r->trip);
+            r->tripped = 1;
             p->state = NCK_PROBE_STOPPING;
             p->ends_at_trip = n->loop->scaler.ends;
         }
@@ -103,7 +105,7 @@ void nck_probe_cycle(struct nck_core *n, const double act[NCP_AXES])
         n->loop->next.v == 0) {
         /* the move's own stop was reached while braking: nothing to drop */
         p->state = n->loop->scaler.ends != p->ends_at_trip ? NCK_PROBE_OFF : NCK_PROBE_DROPPING;
-        memcpy(p->rest, n->loop->cur.pos, sizeof p->rest);
+        memcpy(r->rest, n->loop->cur.pos, sizeof r->rest);
     }
     uint32_t aux = 0;
     if (p->state == NCK_PROBE_DROPPING && drop_to_stop(n, &aux)) {
@@ -121,5 +123,5 @@ void nck_probe_cycle(struct nck_core *n, const double act[NCP_AXES])
 
 int nck_probe_braking(const struct nck_core *n)
 {
-    return n->cross.probe.state >= NCK_PROBE_STOPPING;
+    return n->loop->probe.state >= NCK_PROBE_STOPPING;
 }
