@@ -93,12 +93,14 @@ struct nck_cross {
     struct nck_io io;
 
     /* the backend: opened and started by the caller before the loop starts,
-     * cycled by the loop; the caller asks it why it faulted only after
-     * loop_fault, and stops and closes it after the loop's join */
+     * cycled by the loop; the planner thread calls the plan taps and journal
+     * it set at open (hooks made for that thread); the caller asks it why it
+     * faulted only after loop_fault, and stops and closes it after the join */
     struct ncp_backend be;
-    /* the position loop's thread: the caller starts and joins it and asks
-     * it to stop (its atomics); its statistics are the loop's, read by the
-     * caller after the join (fifo and warning are set before the first cycle) */
+    /* the position loop's thread: the caller starts and joins it, asks it
+     * to stop and sees it running (its atomics); fifo and warning are set
+     * before it starts cycling; its statistics are the loop's, read by the
+     * caller after the join */
     struct ncp_rt_loop rt;
 
     /* [SCHED] (sched.c): set up by the caller before start; then each task
