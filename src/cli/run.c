@@ -501,7 +501,7 @@ static int draw_plot(const struct run_opts *o, struct plot_job *pj, const char *
 }
 
 /* SIGINT/SIGTERM: a controlled stop along the path, then the summary. */
-static volatile sig_atomic_t run_signal;
+static atomic_int run_signal; /* lock-free: the handler may store it */
 
 static void on_signal(int sig)
 {
