@@ -34,8 +34,10 @@ struct ncp_span {
 };
 
 /* Above this a program is mapped, not copied: a copy is anonymous memory the
- * kernel cannot drop and re-read as it can a mapped file's pages. */
-#define NCP_SOURCE_COPY_MAX ((size_t)256 << 20)
+ * process holds whole until the run ends, a mapped program only a window of
+ * it at a time (struct ncp_source_window), so that no program, however long,
+ * takes more than a few tens of MB of the process's own memory. */
+#define NCP_SOURCE_COPY_MAX ((size_t)32 << 20)
 
 /* Standard input or another pipe is read up to the program's end (a closing
  * '%', or an M2 or M30 the interpreter must reach), at most this much. */
