@@ -142,6 +142,7 @@ struct ncp_blocks_lines {
     const struct ncp_source *src;
     uint64_t off;
     uint32_t line;
+    struct ncp_source_window win; /* the mapped text this reader holds */
 };
 
 void ncp_blocks_lines_start(struct ncp_blocks_lines *it, const struct ncp_source *src);
