@@ -24,7 +24,7 @@ void ncp_source_window_move(struct ncp_source_window *w, uint64_t off)
     /* the mapping starts on a page: whole pages of it, from offset 0 */
     uint64_t keep = off > w->lag ? (off - w->lag) / page * page : 0;
     if (keep > w->dropped) {
-        (void)madvise((char *)(uintptr_t)w->text + w->dropped, keep - w->dropped,
+        (void)madvise((void *)(w->text + w->dropped), keep - w->dropped,
                       MADV_DONTNEED);
         w->dropped = keep;
     }
@@ -33,7 +33,7 @@ void ncp_source_window_move(struct ncp_source_window *w, uint64_t off)
     if (from < w->end) {
         uint64_t len = w->end - from < 2 * NCP_SOURCE_WINDOW_STEP ? w->end - from
                                                                     : 2 * NCP_SOURCE_WINDOW_STEP;
-        (void)madvise((char *)(uintptr_t)w->text + from, len, MADV_WILLNEED);
+        (void)madvise((void *)(w->text + from), len, MADV_WILLNEED);
     }
     w->next = off + NCP_SOURCE_WINDOW_STEP;
 }
