@@ -24,11 +24,10 @@
  * for), and the text more than STREAM_LAG behind is dropped from the page
  * cache (fadvise DONTNEED drops only what is already on the disk). Left to
  * the page cache, the canonical text of a long program takes as much fresh
- * memory, which costs per page and, in a virtual machine that hands free
- * memory back to its host, far more per page the more of it there is
- * (bench/RESULTS.md, "Scale"). Shorter outputs stay in the page cache as
- * before: they cost little there, and streaming them would put the disk's
- * work into their run. */
+ * memory, and in a virtual machine fresh memory can cost far more per page
+ * when hundreds of MB are taken at once (bench/RESULTS.md, "Scale").
+ * Shorter outputs stay in the page cache as before: they cost little there,
+ * and streaming them would put the disk's work into their run. */
 #define STREAM_FROM ((off_t)64 << 20)
 #define STREAM_LAG ((off_t)16 << 20)
 
