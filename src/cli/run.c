@@ -532,7 +532,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
         .feed_override = o->feed_override, .trace = trace,
-        .progress = isatty(2) && !o->virtual_clock ? stderr : NULL,
+        .progress = isatty(2) ? stderr : NULL,
         .total_lines = count_lines(src),
         .notes = stderr,
         .interrupt = &run_signal,
