@@ -28,3 +28,10 @@ $(BUILD)/bench/service-bench: bench/service-bench.c $(LIB) | $(GEN_STAMP)
 bench-service: all $(BUILD)/bench/service-bench
 	bench/bench-service $(BUILD)
 .PHONY: bench-service
+
+# Time and memory of `parse` at 10^6 and 10^7 blocks (SCALE_MAX=8: 10^8 too,
+# ~10 GB of disk for the program and its output, and minutes).
+SCALE_MAX ?= 7
+bench-scale: all
+	bench/scale $(BUILD) $(SCALE_MAX)
+.PHONY: bench-scale

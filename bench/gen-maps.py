@@ -112,7 +112,7 @@ def main():
                   (ids[0], [ids[0]], [ids[1 % len(ids)]]), fifo, how, inline=True)
         # ours, the default on two cores (-j 0 --executors 0): the analyzer lexing
         # on one CPU, the output thread executing and writing on the other, the
-        # feeder (it only prefaults the text) beside the output, as the ATT default
+        # feeder (idle without lexers) beside the output, as the ATT default
         write_map(o.outdir, "det2-j0%s.ini" % sfx, "det", 0, (-1, [], [-1, -1]), fifo, how)
         write_map(o.outdir, "att2-j0%s.ini" % sfx, "att", 0,
                   (ids[0], [], [ids[1 % len(ids)], ids[0]]), fifo, how)

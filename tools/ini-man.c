@@ -1,14 +1,13 @@
 /* tools/ini-man VERSION DATE > ncpar.ini.5: the machine INI's manual page,
  * printed from the table the reader checks keys against
- * (include/ncpar/ini_keys.h). Before it prints anything it loads, through
+ * (include/ncpar/config.h). Before it prints anything it loads, through
  * the reader itself, a probe INI for each row: every value the row allows
  * (both ends of its range, each word, its example) must be taken, a value
  * just outside the range must be refused as a bad value, and the default
  * the row states must leave the machine as the key left out does. Any
  * disagreement is printed and the exit status is 1, so the build stops
  * rather than ship a page that says what the reader does not do. */
-#include "ncpar/ini_keys.h"
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -378,7 +377,7 @@ int main(int argc, char **argv)
     }
     if (failures) {
         fprintf(stderr, "ini-man: %d disagreement%s between the table "
-                        "(src/motion/ini_keys.c) and the reader\n",
+                        "(src/config/ini_keys.c) and the reader\n",
                 failures, failures == 1 ? "" : "s");
         return 1;
     }

@@ -30,7 +30,7 @@ struct ncp_sim_axis {
  * following-error check, not thrown across the table.
  *
  * The caps are NCP_SIM_PEAK times the joint's MAX_VELOCITY and
- * MAX_ACCELERATION (ncpar.ini(5) states the factor: src/motion/ini_keys.c).
+ * MAX_ACCELERATION (ncpar.ini(5) states the factor: src/config/ini_keys.c).
  * Three, as an AC servo's peak torque is about three times its rated one;
  * and far enough above the limits that a run within them stays linear, as
  * Wan et al.'s plant is ("Performance analysis model for real-time

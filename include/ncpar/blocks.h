@@ -43,6 +43,7 @@ struct ncp_text_feed {
     uint64_t off;
     uint32_t line;
     uint64_t blocks;            /* blocks lexed so far */
+    struct ncp_source_window win; /* the mapped text this reader holds */
     struct ncp_block block;     /* the one the analyzer holds */
 };
 
@@ -52,6 +53,7 @@ static inline void ncp_text_feed_start(struct ncp_text_feed *f, const struct ncp
     f->off = src->begin;
     f->line = src->begin_line;
     f->blocks = 0;
+    ncp_source_window_start(&f->win, src, NCP_SOURCE_WINDOW_LAG);
 }
 
 /* struct ncp_block_feed's next(): the next line, or NULL at the end. Inline:
@@ -61,6 +63,7 @@ static inline const struct ncp_block *ncp_text_feed_next(void *ctx)
     struct ncp_text_feed *f = ctx;
     if (f->off >= f->src->end)
         return NULL;
+    ncp_source_window_at(&f->win, f->off);
     size_t next;
     ncp_lex_line(f->src->text + f->off, f->src->end - f->off, f->line, f->off, &f->block,
                  &next);
@@ -139,6 +142,7 @@ struct ncp_blocks_lines {
     const struct ncp_source *src;
     uint64_t off;
     uint32_t line;
+    struct ncp_source_window win; /* the mapped text this reader holds */
 };
 
 void ncp_blocks_lines_start(struct ncp_blocks_lines *it, const struct ncp_source *src);

@@ -34,8 +34,10 @@ struct ncp_span {
 };
 
 /* Above this a program is mapped, not copied: a copy is anonymous memory the
- * kernel cannot drop and re-read as it can a mapped file's pages. */
-#define NCP_SOURCE_COPY_MAX ((size_t)256 << 20)
+ * process holds whole until the run ends, a mapped program only a window of
+ * it at a time (struct ncp_source_window), so that no program, however long,
+ * takes more than a few tens of MB of the process's own memory. */
+#define NCP_SOURCE_COPY_MAX ((size_t)32 << 20)
 
 /* Standard input or another pipe is read up to the program's end (a closing
  * '%', or an M2 or M30 the interpreter must reach), at most this much. */
@@ -65,6 +67,37 @@ int ncp_source_percent_line(const char *s, size_t n);
  * block (a lone \r is left to the lexer, which treats it as a blank). */
 int ncp_source_span(const struct ncp_source *src, uint64_t off, uint32_t line,
                     struct ncp_span *out);
+
+/* How much of a mapped program the process holds: the pages its last reader
+ * in file order (the analyzer, or the feeder with lexer threads) has gone
+ * past are handed back (MADV_DONTNEED), `lag` bytes behind it, and the next
+ * stretch is asked for ahead (MADV_WILLNEED, read into the page cache
+ * without being mapped). The file stays in the page cache, the kernel's to
+ * keep or drop; the process maps a window of it, however long the program.
+ * A block read again later (a loop's, a call's) faults its page in again.
+ * Each reader keeps its own window; for a copy or a memory source it does
+ * nothing. */
+struct ncp_source_window {
+    const char *text;   /* the mapping, or NULL: nothing to do */
+    uint64_t end;       /* bytes of text mapped */
+    uint64_t next;      /* the reader's offset from which to act again */
+    uint64_t dropped;   /* text below this has been handed back */
+    uint64_t lag;
+};
+/* How far the reader goes between two calls of the kernel. */
+#define NCP_SOURCE_WINDOW_STEP ((uint64_t)4 << 20)
+/* What a reader keeps behind it unless it says otherwise. */
+#define NCP_SOURCE_WINDOW_LAG ((uint64_t)8 << 20)
+
+void ncp_source_window_start(struct ncp_source_window *w, const struct ncp_source *src,
+                             uint64_t lag);
+void ncp_source_window_move(struct ncp_source_window *w, uint64_t off);
+/* The reader is at off: every NCP_SOURCE_WINDOW_STEP bytes, move the window. */
+static inline void ncp_source_window_at(struct ncp_source_window *w, uint64_t off)
+{
+    if (off >= w->next)
+        ncp_source_window_move(w, off);
+}
 
 /* Chunks: where a piece of about `want` bytes from off ends, just after a
  * line end (or at src->end), and how many line ends text[off .. end) holds,

@@ -146,9 +146,16 @@ int ncp_msg_decode_command(const uint8_t *payload, size_t len, ncp_command_t *cm
  * anything else. */
 const char *ncp_msg_state_name(int state);
 int ncp_msg_state_parse(const char *name);
+/* event_t's kinds by name ("info", "msg", "debug", "print", "error",
+ * "fault"): NULL for anything else. */
+const char *ncp_msg_event_kind_name(int kind);
 /* A status as one JSON object (no newline), the keys of `cnc-ctl status
  * --json`. Returns its length, or -1 when size is too small (8192 is enough). */
 int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size);
+/* An event as one JSON object (no newline): kind, channel, seq, utime,
+ * file, line, col, text, what `cnc-ctl events --json` prints. Its length, or
+ * -1 when size is too small (2048 is enough). */
+int ncp_msg_event_json(const ncp_event_t *e, char *buf, size_t size);
 /* A modal code (code*10, as in the status's gcodes and mcodes: 911 -> "G91.1")
  * into buf: its length, or -1 for none (< 0) or no room. */
 int ncp_msg_code_name(char letter, int code10, char *buf, size_t size);

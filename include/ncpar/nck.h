@@ -80,9 +80,10 @@ struct ncp_nck_opts {
     uint32_t total_lines;    /* for the progress line */
     FILE *notes;             /* the check before motion says how far it is, or NULL */
     struct ncp_nck_ctl *ctl; /* live override / hold, or NULL */
-    /* polled while the run goes on: non-zero asks for a controlled stop
-     * (a signal handler's flag), or NULL */
-    volatile sig_atomic_t *interrupt;
+    /* polled while the run goes on: non-zero asks for a controlled stop, or
+     * NULL. Atomic: a signal handler (lock-free atomics are safe there) or
+     * another thread (an LLC leaving its DP 1 NCK) sets it */
+    atomic_int *interrupt;
     /* home every axis of the home-all list first (as cnc-ctl home all), then
      * run the program from HOME; 0: the machine starts homed where it is */
     int home;

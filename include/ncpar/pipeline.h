@@ -70,7 +70,7 @@ int ncp_thread_map_load(struct ncp_thread_map *m, const char *path, struct ncp_d
  * starts a run and again as it ends it, with what it is and a handle to read
  * its rings' fill without locks while it runs. */
 enum ncp_pipe_kind {
-    NCP_PIPE_FEEDER,     /* the feeder (or, without lexers, the text's prefaulter) */
+    NCP_PIPE_FEEDER,     /* the feeder (without lexers: a thread with nothing to do) */
     NCP_PIPE_LEXER,
     NCP_PIPE_ANALYZER,
     NCP_PIPE_EXECUTOR,

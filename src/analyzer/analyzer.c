@@ -1,7 +1,7 @@
 /* The analyzer's run loop and its output: one slot per block that produces
  * calls, consecutive cmd_ids, errors carried in program order. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <stdarg.h>
 #include <stdio.h>

@@ -2,7 +2,7 @@
  * R/Z/P/Q values, L repeats, G98/G99 retract, incremental positioning, all
  * expanded into traverses, feeds and dwells as rs274 does. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 #include <string.h>

@@ -3,7 +3,7 @@
  * PRINT is a call of its own that prints nothing in the canonical stream:
  * rs274 writes it to its stdout, cnc-run to stderr. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <ctype.h>
 #include <math.h>

@@ -3,7 +3,7 @@
  * geometry live in cutcomp.c; here we translate state and words into its
  * requests and keep the programmed/compensated points straight. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 #include <string.h>

@@ -2,6 +2,7 @@
  * of calls while cutter compensation holds a move, and the block's error.
  * Every handler emits through here; nothing here calls a handler. */
 #include "floor.h"
+#include "stages.h"
 
 #include <stdarg.h>
 #include <stdio.h>

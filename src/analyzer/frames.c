@@ -6,7 +6,7 @@
  * helper keeps rs274's order of floating-point operations, even with no
  * rotation, so that the results agree to the last bit. Also the unit
  * conversions between the program's unit and rs274's user unit (inch). */
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 

@@ -3,7 +3,7 @@
  * user unit (inch). L20 and L10/L11 measure from the current point, which goes
  * through the rotation of the systems involved (see frames.c). */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <stdio.h>
 #include <string.h>

@@ -5,7 +5,7 @@
  * arithmetic follows rs274's line for line (its compound angle is scaled
  * in long double) so that every coordinate prints the same. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 

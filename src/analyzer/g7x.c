@@ -15,7 +15,7 @@
  * on it) are lost and errors of the passes name that return line. */
 #include "floor.h"
 #include "offsets.h"
-#include "state.h"
+#include "stages.h"
 
 #include "ncpar/blocks.h"
 #include "g7x_path.h"

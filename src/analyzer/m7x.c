@@ -10,7 +10,7 @@
  * reads them into the block it is executing, so what that block had left to
  * do (its G codes, its motion) is dropped, and so it is here. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include "ncpar/blocks.h"
 

@@ -2,7 +2,7 @@
  * which motion the block performs, axis words without a user, words without a
  * G/M code that uses them (rs274's enhance_block and check_* rules). */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 

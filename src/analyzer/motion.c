@@ -1,7 +1,7 @@
 /* G0/G1 (and G53), G2/G3 arc requests, G80 and the dispatch to canned cycles.
  * End points are in program coordinates; arcs are resolved by the executor. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 #include <string.h>

@@ -11,7 +11,7 @@
  * rs274 -g prints NURBS_FEED(count, ...) only; the points follow the call
  * as NURBS_POINTS ops, which print nothing and carry the curve to the NCK. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <stdlib.h>
 #include <string.h>

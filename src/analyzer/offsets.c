@@ -4,7 +4,7 @@
  * program units. */
 #include "floor.h"
 #include "offsets.h"
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 #include <stdio.h>

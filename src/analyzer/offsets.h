@@ -5,7 +5,7 @@
 #ifndef NCP_ANALYZER_OFFSETS_H
 #define NCP_ANALYZER_OFFSETS_H
 
-#include "state.h"
+#include "stages.h"
 
 #include <string.h>
 

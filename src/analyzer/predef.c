@@ -1,6 +1,6 @@
 /* Read-only predefined named parameters (#<_x>, #<_metric>, ...) answered
  * from the analyzer state, installed as the params module's hook. */
-#include "state.h"
+#include "stages.h"
 
 #include <stdlib.h>
 #include <string.h>

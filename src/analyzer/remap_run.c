@@ -4,7 +4,7 @@
  * (#<p>, #<q>; with '@' positional #1, #2 instead), the sub's blocks run,
  * and at its return the line goes on with its next step. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include "ncpar/blocks.h"
 

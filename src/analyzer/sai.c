@@ -3,7 +3,7 @@
  * tool length offsets, backed off after a probe), and rs274 reloads its
  * current point from that copy at the block after a tool change or a probe.
  * We mirror it so that block matches (offsets.c reads it back). */
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 #include <string.h>

@@ -3,7 +3,7 @@
  * is a small function; the order lives in ncp_an_steps only. */
 #include "floor.h"
 #include "offsets.h"
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -3,7 +3,7 @@
  * coolant off, feed override on). */
 #include "floor.h"
 #include "offsets.h"
-#include "state.h"
+#include "stages.h"
 
 #include <string.h>
 

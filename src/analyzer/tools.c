@@ -2,7 +2,7 @@
  * rs274's indexing: 0 is the spindle, 1..n the table lines in file order, and
  * offsets stay in the table's unit (inch), converted when used. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <errno.h>
 #include <math.h>

@@ -1,7 +1,7 @@
 /* A block's words -> evaluated values, a letter bitmask and G/M codes sorted
  * into their modal groups; parameter assignments with pre-block values. */
 #include "floor.h"
-#include "state.h"
+#include "stages.h"
 
 #include <math.h>
 #include <pthread.h>

@@ -8,6 +8,7 @@
 #include <stdio.h>
 
 #include "ncpar/backend.h"
+#include "ncpar/config.h"
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
 #include "ncpar/rt.h"
@@ -152,6 +153,10 @@ void llc_ai_free(struct llc_ai *a);
 /* A DP2 (rough_ipo_t) or DP3 (accdec_ai_t) message: into the setpoint buffer. */
 void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len);
 void llc_ai_report(const struct llc *l);
+/* At DP2 and DP3: the records taken so far have come through the stages
+ * whole (the filters and the fine interpolator hold nothing more), so the
+ * last setpoint put is where the axis rests until the next record. */
+int llc_ai_at_rest(const struct llc_ai *a);
 /* The stages one by one (DP1): begin at mm (returned in nm) at point dp, one
  * rough record's sum in, one servo period's setpoint out (nm). */
 int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm);

@@ -36,7 +36,7 @@ struct llc_dp1 {
     pthread_t th;
     int started;
     _Atomic int done, quit;          /* done: 1 ok, -1 its run failed (why says) */
-    volatile sig_atomic_t stop;      /* its NCK brakes and ends: this LLC is leaving */
+    atomic_int stop;                 /* its NCK brakes and ends: this LLC is leaving */
     char why[200];
     char why_short[64];              /* as much as the status carries to the HLC */
     char label[32];

@@ -207,9 +207,12 @@ static double follow(struct llc *l, int64_t slot)
     double target = ncp_dist_nm_to_mm(ncp_dist_rx_play(&l->rx, slot));
     if (l->rx.held != l->held_seen) {
         /* a stream that stops with the axis at rest (the program's end, the
-         * HLC between jobs) is no loss: heartbeats watch the HLC then */
+         * HLC between jobs) is no loss: heartbeats watch the HLC then. At
+         * ADCAI's DP2 and DP3 the last setpoint of a stop is still a step
+         * (the filters' tail ends in one): there the stages say whether
+         * the motion they were given is over */
         if (l->run_held++ == 0)
-            l->held_moving = l->cmd != l->cmd_prev;
+            l->held_moving = l->cmd != l->cmd_prev && !(l->ai && llc_ai_at_rest(l->ai));
     } else {
         l->run_held = 0;
     }

@@ -100,6 +100,12 @@ int64_t llc_ai_step(struct llc_ai *a, int axis)
     return a->out_nm;
 }
 
+int llc_ai_at_rest(const struct llc_ai *a)
+{
+    return a->dp >= 2 && a->started && (a->dp == 3 || ncp_adcai_accdec_drained(a->acc)) &&
+           ncp_adcai_fine_drained(a->fine);
+}
+
 int llc_ai_ratio(const struct llc_ai *a)
 {
     return a->ratio;

@@ -33,6 +33,7 @@
 #include "lcm_clock.h"
 #include "lcm_tx.h"
 #include "ncpar/backend.h"
+#include "ncpar/config.h"
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
 

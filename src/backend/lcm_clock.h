@@ -9,9 +9,9 @@
 #include <stdatomic.h>
 #include <stdint.h>
 
+#include "ncpar/config.h"
 #include "ncpar/diag.h"
 #include "ncpar/dist.h"
-#include "ncpar/motion.h"
 #include "ncpar/msg.h"
 
 struct lcm_clock {

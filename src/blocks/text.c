@@ -14,11 +14,13 @@ void ncp_blocks_lines_start(struct ncp_blocks_lines *it, const struct ncp_source
     it->src = src;
     it->off = src->begin;
     it->line = src->begin_line;
+    ncp_source_window_start(&it->win, src, NCP_SOURCE_WINDOW_LAG);
 }
 
 int ncp_blocks_check_next(struct ncp_blocks_lines *it, struct ncp_span *sp,
                           struct ncp_block *b, int *bad)
 {
+    ncp_source_window_at(&it->win, it->off);
     if (ncp_source_span(it->src, it->off, it->line, sp) != 0)
         return 1;
     it->off = sp->next;

@@ -4,9 +4,7 @@
 all: $(BUILD)/cnc-drive-sim
 
 DRIVE_SIM_OBJS = $(patsubst %.c,$(BUILD)/%.o,$(wildcard src/can-drive-sim/*.c) \
-                   src/backend/sim.c src/backend/scale.c src/motion/config.c src/motion/ini_keys.c \
-                   src/motion/ini_num.c src/motion/config_io.c src/motion/config_kins.c \
-                   src/motion/config_home.c \
+                   src/backend/sim.c src/backend/scale.c $(wildcard src/config/*.c) \
                    src/adcai/windows.c $(wildcard src/inject/*.c) \
                    src/sched/config.c src/sched/policy.c src/http/policy.c) \
                  $(BUILD)/src/kins/trt.o

@@ -14,9 +14,22 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define WRITER_BUF (1u << 20)
+/* A long output to a regular file is streamed: past STREAM_FROM bytes each
+ * buffer written is sent to the disk at once (sync_file_range, not waited
+ * for), and the text more than STREAM_LAG behind is dropped from the page
+ * cache (fadvise DONTNEED drops only what is already on the disk). Left to
+ * the page cache, the canonical text of a long program takes as much fresh
+ * memory, and in a virtual machine fresh memory can cost far more per page
+ * when hundreds of MB are taken at once (bench/RESULTS.md, "Scale").
+ * Shorter outputs stay in the page cache as before: they cost little there,
+ * and streaming them would put the disk's work into their run. */
+#define STREAM_FROM ((off_t)64 << 20)
+#define STREAM_LAG ((off_t)16 << 20)
 
 /* Prefaulted before the run (ncpar/mem.h): touched page by page instead, the
  * buffer costs 256 page faults in the thread that emits, and in a virtual
@@ -28,6 +41,10 @@ struct canon_writer {
     struct ncp_mem mem;         /* where buf is */
     size_t used;
     int failed;                 /* errno of the first failed write */
+    int stream;                 /* a regular file: stream a long output */
+    off_t start;                /* the file offset of the first byte written */
+    off_t written;              /* bytes written so far */
+    off_t dropped;              /* bytes from start handed to fadvise DONTNEED */
 };
 
 /* 0, or the errno of the failed write. */
@@ -46,10 +63,28 @@ static int write_all(int fd, const char *p, size_t n)
 }
 
 /* The filled buffer goes out; the caller continues in it, empty. */
+static void stream_out(struct canon_writer *w, size_t just)
+{
+    w->written += (off_t)just;
+    if (!w->stream || w->written <= STREAM_FROM)
+        return;
+    (void)sync_file_range(w->fd, w->start + w->written - (off_t)just, (off_t)just,
+                          SYNC_FILE_RANGE_WRITE);
+    off_t upto = w->written - STREAM_LAG;
+    if (upto > w->dropped) {
+        (void)posix_fadvise(w->fd, w->start + w->dropped, upto - w->dropped,
+                            POSIX_FADV_DONTNEED);
+        w->dropped = upto;
+    }
+}
+
 static int hand_over(struct canon_writer *w)
 {
-    if (!w->failed)
+    if (!w->failed) {
         w->failed = write_all(w->fd, w->buf, w->used);
+        if (!w->failed)
+            stream_out(w, w->used);
+    }
     w->used = 0;
     return w->failed;
 }
@@ -117,6 +152,9 @@ struct canon_writer *canon_writer_open(const char *path, const struct ncp_file_i
         return NULL;
     }
     w->fd = w->out.fd;
+    struct stat st;
+    w->start = lseek(w->fd, 0, SEEK_CUR);
+    w->stream = w->start >= 0 && fstat(w->fd, &st) == 0 && S_ISREG(st.st_mode);
     return w;
 }
 

@@ -11,8 +11,8 @@
 #include "outfile.h"
 #include "signals.h"
 
+#include "ncpar/config.h"
 #include "ncpar/feeder.h"
-#include "ncpar/motion.h"
 #include "ncpar/nck.h"
 
 #include <errno.h>

@@ -19,7 +19,7 @@ struct ncp_cli_channel_common {
     const char *trace;           /* a name pattern (see ncp_cli_channel_trace_name) */
     struct ncp_analyzer_cfg interp;
     const char *backend, *inject, *seed;
-    volatile sig_atomic_t *interrupt; /* a stop signal: every channel stops */
+    atomic_int *interrupt; /* a stop signal: every channel stops */
     int trace_rings;             /* --trace-rings */
 };
 

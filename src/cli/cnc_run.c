@@ -55,7 +55,7 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
     if (serial)
         return;
     if (map->n_lexers == 0)
-        fprintf(stderr, "cnc-run: cpu ms: feeder %.1f (prefaults the text), lexers none "
+        fprintf(stderr, "cnc-run: cpu ms: feeder %.1f (idle), lexers none "
                 "(the analyzer lexes)", st->feeder.cpu_ms);
     else
         fprintf(stderr, "cnc-run: cpu ms: feeder %.1f, lexers", st->feeder.cpu_ms);

@@ -2,7 +2,7 @@
 #ifndef NCPAR_CLI_INJECT_OPTS_H
 #define NCPAR_CLI_INJECT_OPTS_H
 
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 
 /* spec and seed as given (NULL: not given). --inject replaces the INI's
  * specs (its policy and miss limits stay); --seed its SEED. Prints

@@ -3,7 +3,7 @@
 #ifndef NCPAR_CLI_KEY_OPTS_H
 #define NCPAR_CLI_KEY_OPTS_H
 
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 
 /* path NULL: the INI's stays. 0, or -1 after a message to stderr. */
 int ncp_cli_apply_key_file(const char *who, const char *path, struct ncp_machine_cfg *cfg);

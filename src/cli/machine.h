@@ -2,7 +2,7 @@
 #ifndef NCPAR_CLI_MACHINE_H
 #define NCPAR_CLI_MACHINE_H
 
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 
 /* The defaults, then path over them (NULL: the defaults alone). On an error
  * prints PATH:LINE: error: ... and returns -1. */

@@ -2,7 +2,7 @@
  * the thread mode of --mode, and the summary and error of its end. */
 #include "nck_run.h"
 
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 #include "ncpar/pipeline.h"
 
 #include <stdint.h>

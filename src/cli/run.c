@@ -11,9 +11,9 @@
 #include "signals.h"
 
 #include "ncpar/backend.h"
+#include "ncpar/config.h"
 #include "ncpar/dist.h"
 #include "ncpar/feeder.h"
-#include "ncpar/motion.h"
 #include "ncpar/msg.h"
 #include "ncpar/pipeline.h"
 #include "ncpar/nck.h"
@@ -215,12 +215,18 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     return 0;
 }
 
+/* Through a window (ncpar/feeder.h): counting must not leave a long mapped
+ * program held whole for the rest of the run. */
 static uint32_t count_lines(const struct ncp_source *src)
 {
+    struct ncp_source_window w;
+    ncp_source_window_start(&w, src, 0);
     uint32_t n = 1;
     for (const char *p = src->text, *e = src->text + src->len;
-         p < e && (p = memchr(p, '\n', (size_t)(e - p))) != NULL; p++)
+         p < e && (p = memchr(p, '\n', (size_t)(e - p))) != NULL; p++) {
+        ncp_source_window_at(&w, (uint64_t)(p - src->text));
         n++;
+    }
     return n;
 }
 
@@ -501,7 +507,7 @@ static int draw_plot(const struct run_opts *o, struct plot_job *pj, const char *
 }
 
 /* SIGINT/SIGTERM: a controlled stop along the path, then the summary. */
-static volatile sig_atomic_t run_signal;
+static atomic_int run_signal; /* lock-free: the handler may store it */
 
 static void on_signal(int sig)
 {
@@ -526,7 +532,7 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
         .feed_override = o->feed_override, .trace = trace,
-        .progress = isatty(2) && !o->virtual_clock ? stderr : NULL,
+        .progress = isatty(2) ? stderr : NULL,
         .total_lines = count_lines(src),
         .notes = stderr,
         .interrupt = &run_signal,

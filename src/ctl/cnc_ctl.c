@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "ctl.h"
 #include "ncp_version.h"
@@ -24,15 +25,19 @@ enum {
     OPT_FROM_LINE = 1 << 2,
     OPT_SPEED = 1 << 3,
     OPT_DISTANCE = 1 << 4,
+    OPT_WAIT = 1 << 5,
+    OPT_SYSTEM = 1 << 6,
 };
 
 struct args {
     const char *url, *prefix, *key_file;
     double timeout;
+    int timeout_given;
     long channel;
     unsigned opts; /* OPT_* given */
     long from_line;
     double speed, distance;
+    int system; /* --system: 1 = G54 ... 9 = G59.3 */
     int help;
     const char *name; /* the command */
     const char *words[MAX_WORDS];
@@ -63,15 +68,18 @@ static const char global_usage[] =
     "                  ~/.config/ncpar/lcm.key): commands are sealed with it, and\n"
     "                  ACKs and statuses without its seal are ignored\n"
     "  --timeout S     seconds to wait for an answer (default 5; for wait and\n"
-    "                  status --watch 0 waits for ever). A command the NCK has not\n"
+    "                  status --watch 0 waits for ever; events follow until ^C\n"
+    "                  unless it is given). A command the NCK has not\n"
     "                  taken by then is never acted on (its deadline travels with it)\n"
     "  --channel N     NC channel (default 0)\n"
     "\n"
     "commands (cnc-ctl COMMAND --help for each):\n"
-    "  status [--json] [--watch]          load PROG           run [--from-line N]\n"
-    "  pause   resume   stop   abort      step on|off         mdi 'LINE'\n"
+    "  status [--json] [--watch]          events [--json]\n"
+    "  load PROG          run [--from-line N]                 mdi 'LINE'\n"
+    "  pause   resume   stop   abort      step on|off\n"
     "  home [AXES|all]                    override feed|rapid|spindle PCT\n"
-    "  jog AXIS +|- [--speed MM_PER_MIN] [--distance MM]      jog AXIS stop\n"
+    "  jog AXIS +|- [--speed MM_PER_MIN] [--distance MM [--wait]]   jog AXIS stop\n"
+    "  touch-off AXIS VALUE [--system G54..G59.3]   touch-off-tool AXIS VALUE\n"
     "  estop   reset   shutdown           wait STATE [--timeout S]\n"
     "  tool-changed   optional-stop on|off   set-input N 0|1\n"
     "\n"
@@ -106,6 +114,17 @@ static int is_opt(const char *a, const char *name)
     return strncmp(a, name, n) == 0 && (a[n] == 0 || a[n] == '=');
 }
 
+/* G54..G59.3 (any case): 1..9, else 0. */
+static int coordinate_system(const char *s)
+{
+    static const char *const names[] = {"G54", "G55", "G56", "G57", "G58",
+                                        "G59", "G59.1", "G59.2", "G59.3"};
+    for (int i = 0; i < 9; i++)
+        if (strcasecmp(s, names[i]) == 0)
+            return i + 1;
+    return 0;
+}
+
 static int parse_args(int argc, char **argv, struct args *a)
 {
     memset(a, 0, sizeof *a);
@@ -115,7 +134,9 @@ static int parse_args(int argc, char **argv, struct args *a)
     for (int i = 1; i < argc; i++) {
         const char *s = argv[i];
         const char *v;
-        if (only_words || s[0] != '-' || strcmp(s, "-") == 0) {
+        /* a negative number is a word (touch-off Y -2.5), not an option */
+        int number = s[0] == '-' && (isdigit((unsigned char)s[1]) || s[1] == '.');
+        if (only_words || s[0] != '-' || strcmp(s, "-") == 0 || number) {
             if (a->name == NULL)
                 a->name = s;
             else if (a->n_words < MAX_WORDS)
@@ -132,6 +153,14 @@ static int parse_args(int argc, char **argv, struct args *a)
             a->opts |= OPT_JSON;
         } else if (strcmp(s, "--watch") == 0) {
             a->opts |= OPT_WATCH;
+        } else if (strcmp(s, "--wait") == 0) {
+            a->opts |= OPT_WAIT;
+        } else if (is_opt(s, "--system")) {
+            v = opt_value(argc, argv, &i, "--system");
+            if (v == NULL || (a->system = coordinate_system(v)) == 0)
+                return usage_error("--system needs a coordinate system G54 G55 G56 G57 G58 "
+                                   "G59 G59.1 G59.2 G59.3, not '%s'", v ? v : "");
+            a->opts |= OPT_SYSTEM;
         } else if (is_opt(s, "--lcm-url")) {
             if ((a->url = opt_value(argc, argv, &i, "--lcm-url")) == NULL)
                 return usage_error("%s needs a URL", s);
@@ -145,6 +174,7 @@ static int parse_args(int argc, char **argv, struct args *a)
             v = opt_value(argc, argv, &i, "--timeout");
             if (v == NULL || ncp_num_double(v, 0, DBL_MAX, &a->timeout) != 0)
                 return usage_error("--timeout needs seconds (0 or more), not '%s'", v ? v : "");
+            a->timeout_given = 1;
         } else if (is_opt(s, "--channel")) {
             v = opt_value(argc, argv, &i, "--channel");
             if (v == NULL || ncp_num_long(v, 10, 0, 127, &a->channel) != 0)
@@ -393,6 +423,24 @@ static int run_status(struct ctl *c, const struct args *a)
     }
 }
 
+static void show_event(const ncp_event_t *e, void *ctx)
+{
+    if (*(const int *)ctx) {
+        char buf[2048];
+        if (ncp_msg_event_json(e, buf, sizeof buf) > 0)
+            printf("%s\n", buf);
+    } else {
+        ctl_print_event(e);
+    }
+    fflush(stdout);
+}
+
+static int run_events(struct ctl *c, const struct args *a)
+{
+    int json = (a->opts & OPT_JSON) != 0;
+    return ctl_follow_events(c, a->timeout_given ? c->timeout : 0, show_event, &json);
+}
+
 static int run_wait(struct ctl *c, const struct args *a)
 {
     int want = ncp_msg_state_parse(a->words[0]);
@@ -445,8 +493,40 @@ static int run_jog(struct ctl *c, const struct args *a)
     }
     if (strcmp(d, "+") != 0 && strcmp(d, "-") != 0)
         return usage_error("jog: + or - or stop, not '%s'", d);
+    if ((a->opts & OPT_WAIT) && !(a->opts & OPT_DISTANCE))
+        return usage_error("jog: --wait is for a jog with --distance (a continuous jog "
+                           "stays until it ends)%s", "");
     return ctl_jog(c, axis, d[0] == '+' ? 1 : -1, a->opts & OPT_SPEED ? a->speed : 0,
-                   a->opts & OPT_DISTANCE ? a->distance : 0);
+                   a->opts & OPT_DISTANCE ? a->distance : 0, (a->opts & OPT_WAIT) != 0);
+}
+
+/* touch-off AXIS VALUE and touch-off-tool AXIS VALUE: the axis and the
+ * value the current position is to have. */
+static int touch_words(const struct args *a, const char *what, char *axis, double *value)
+{
+    if (!(*axis = axis_letter(a->words[0])))
+        return usage_error("an axis letter (XYZABCUVW), not '%s'", a->words[0]);
+    if (ncp_num_double(a->words[1], -DBL_MAX, DBL_MAX, value) != 0)
+        return usage_error(what, a->words[1]);
+    return CTL_OK;
+}
+
+static int run_touch_off(struct ctl *c, const struct args *a)
+{
+    char axis;
+    double v;
+    int rc = touch_words(a, "touch-off: the position the axis is to have, in mm (degrees), "
+                            "not '%s'", &axis, &v);
+    return rc != CTL_OK ? rc : ctl_touch_off(c, axis, v, a->opts & OPT_SYSTEM ? a->system : 0);
+}
+
+static int run_touch_off_tool(struct ctl *c, const struct args *a)
+{
+    char axis;
+    double v;
+    int rc = touch_words(a, "touch-off-tool: the position the tool tip is to have, in mm, "
+                            "not '%s'", &axis, &v);
+    return rc != CTL_OK ? rc : ctl_touch_off_tool(c, axis, v);
 }
 
 static const struct command commands[] = {
@@ -455,6 +535,12 @@ static const struct command commands[] = {
      "JSON object. --watch prints every status until interrupted (one JSON object a\n"
      "line with --json). Exit 3 when the NCK is in fault, 4 when no status comes.",
      OPT_JSON | OPT_WATCH, 0, 0, run_status},
+    {"events", "[--json]",
+     "Prints the NCK's events as they come (MSG, DEBUG and PRINT text from the\n"
+     "program, its errors as FILE:LINE:COL, faults, the NCK's notices), one a line\n"
+     "(one JSON object a line with --json), until interrupted, or for --timeout S\n"
+     "seconds when given. Only events from then on: none is kept for later.",
+     OPT_JSON, 0, 0, run_events},
     {"load", "PROG", "Loads a program (its path made absolute here).", 0, 1, 1, run_load},
     {"run", "[--from-line N]", "Runs the loaded program, from line N if given.",
      OPT_FROM_LINE, 0, 0, run_run},
@@ -475,12 +561,24 @@ static const struct command commands[] = {
      run_home},
     {"override", "feed|rapid|spindle PCT", "Sets an override, in percent.", 0, 2, 2,
      run_override},
-    {"jog", "AXIS +|-|stop [--speed MM_PER_MIN] [--distance MM]",
-     "With --distance, moves AXIS that far and returns on the answer. Without it, a\n"
+    {"touch-off", "AXIS VALUE [--system G54..G59.3]",
+     "Sets the work offset of the coordinate system (the active one when --system\n"
+     "is not given) so that the current position of AXIS reads VALUE there: MDI\n"
+     "G10 L20, run and waited for. Refused while a program runs, as MDI is.",
+     OPT_SYSTEM, 2, 2, run_touch_off},
+    {"touch-off-tool", "AXIS VALUE",
+     "Sets the offset of the tool in the spindle so that the tool tip's current\n"
+     "position on AXIS reads VALUE (MDI G10 L10, then G43 to put it in force), as\n"
+     "LinuxCNC's tool touch-off. Refused with no tool in the spindle.",
+     0, 2, 2, run_touch_off_tool},
+    {"jog", "AXIS +|-|stop [--speed MM_PER_MIN] [--distance MM [--wait]]",
+     "With --distance, moves AXIS that far and returns on the answer (with --wait,\n"
+     "when the move has ended: the next jog is not refused as one while jogging;\n"
+     "exit 3 if it ended in fault or estop). Without it, a\n"
      "continuous jog: cnc-ctl stays in the foreground keeping the jog alive until\n"
      "^C (or SIGTERM), then stops the axis; it also ends when the jog has been\n"
      "stopped otherwise (another client, a soft limit). `jog AXIS stop` stops a jog.",
-     OPT_SPEED | OPT_DISTANCE, 2, 2, run_jog},
+     OPT_SPEED | OPT_DISTANCE | OPT_WAIT, 2, 2, run_jog},
     {"estop", "", "Emergency stop.", 0, 0, 0, run_estop},
     {"reset", "", "Leaves estop or fault.", 0, 0, 0, run_reset},
     {"shutdown", "", "Ends the NCK service.", 0, 0, 0, run_shutdown},
@@ -543,8 +641,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: cnc-ctl [OPTIONS] %s %s\n", k->name, k->usage);
         return CTL_USAGE;
     }
-    if (a.timeout == 0 && k->run != run_wait && k->run != run_status)
-        return usage_error("--timeout 0 is only for wait and status --watch%s", "");
+    if (a.timeout == 0 && k->run != run_wait && k->run != run_status && k->run != run_events)
+        return usage_error("--timeout 0 is only for wait, status --watch and events%s", "");
 
     struct ctl c;
     memset(&c, 0, sizeof c);

@@ -28,6 +28,7 @@ struct ctl {
     char ch_cmd[NCP_MSG_PREFIX_MAX + 8];
     char ch_ack[NCP_MSG_PREFIX_MAX + 8];
     char ch_status[NCP_MSG_PREFIX_MAX + 8];
+    char ch_event[NCP_MSG_PREFIX_MAX + 8];
     int8_t channel;  /* NC channel */
     double timeout;  /* seconds; 0: none (wait and status --watch only) */
     int32_t client_id;
@@ -39,6 +40,14 @@ struct ctl {
     uint64_t n_status; /* statuses of our NC channel received so far */
     ncp_status_t status;
     double status_at;  /* ctl_now() of the last one */
+    /* Statuses of other NC channels while none of ours came: enough of them,
+     * over long enough, say that ours is not served (no 5 s wait for it). */
+    uint32_t other_statuses;
+    double first_other_at;
+    uint8_t served[128];   /* NC channels seen in statuses */
+    /* events: the follower's printer */
+    void (*on_event)(const ncp_event_t *e, void *ctx);
+    void *event_ctx;
 };
 
 /* Set by SIGINT/SIGTERM (a second one ends the program). */
@@ -56,18 +65,42 @@ void ctl_close(struct ctl *c);
  * CTL_NO_ANSWER, with the reason printed. */
 int ctl_send(struct ctl *c, ncp_command_t *cmd);
 int ctl_command(struct ctl *c, ncp_command_t *cmd);
+/* After an accepted command (c->ack): waits for a status sent after its ACK
+ * whose state is no longer busy_state (jogging for a jog, mdi for an MDI
+ * line): CTL_OK, CTL_FAULT when it ended in fault or estop (said on stderr),
+ * CTL_NO_ANSWER when no status came for --timeout seconds (the NCK is gone)
+ * or interrupted. what names the command in messages. */
+int ctl_wait_done(struct ctl *c, int busy_state, const char *what);
 /* Handles what arrives for up to seconds: 0, or -1 when LCM failed. */
 int ctl_handle(struct ctl *c, double seconds);
 /* Waits for the next status (c->status), up to timeout seconds (0: for
  * ever): CTL_OK, CTL_NO_ANSWER, CTL_USAGE when LCM failed (said on stderr),
- * -1 when interrupted. */
+ * CTL_REJECTED when the NCK's statuses show it serves no such NC channel
+ * (said on stderr), -1 when interrupted. */
 int ctl_next_status(struct ctl *c, double timeout);
 /* "cnc-ctl: no WHAT from the NCK within S s (is ... running?)" */
 void ctl_no_answer(const char *what, double seconds);
 
 /* jog AXIS +|-: incremental (distance > 0) or continuous (see cnc-ctl jog
- * --help); speed 0 is the NCK's default. */
-int ctl_jog(struct ctl *c, char axis, int dir, double speed, double distance);
+ * --help); speed 0 is the NCK's default. wait: an incremental jog returns
+ * when the move has ended, not when it is accepted. */
+int ctl_jog(struct ctl *c, char axis, int dir, double speed, double distance, int wait);
+
+/* Calls show for every event of our NC channel that carries the key's seal,
+ * for up to seconds (0: until interrupted): CTL_OK, or CTL_USAGE when LCM
+ * failed. */
+int ctl_follow_events(struct ctl *c, double seconds,
+                      void (*show)(const ncp_event_t *e, void *ctx), void *ctx);
+
+/* touch-off AXIS VALUE: G10 L20 in coordinate system `system` (1 = G54 ...
+ * 9 = G59.3, 0 the active one); touch-off-tool AXIS VALUE: G10 L10 for the
+ * tool in the spindle, then G43. Both wait until the NCK has run them. */
+int ctl_touch_off(struct ctl *c, char axis, double value, int system);
+int ctl_touch_off_tool(struct ctl *c, char axis, double value);
+
+/* cnc-ctl events: one line, "FILE:LINE:COL: error: TEXT" the way a compiler
+ * says it where the event names a place. */
+void ctl_print_event(const ncp_event_t *e);
 
 /* cnc-ctl status: the readable lines. */
 void ctl_print_status(const ncp_status_t *s);

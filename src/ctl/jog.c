@@ -32,11 +32,13 @@ static int stop_jog(struct ctl *c, char axis)
     return rc == CTL_REJECTED ? CTL_OK : rc;
 }
 
-int ctl_jog(struct ctl *c, char axis, int dir, double speed, double distance)
+int ctl_jog(struct ctl *c, char axis, int dir, double speed, double distance, int wait)
 {
     ncp_command_t cmd;
     jog_cmd(&cmd, NCP_COMMAND_T_JOG, axis, dir, speed, distance);
     int rc = ctl_command(c, &cmd);
+    if (rc == CTL_OK && distance > 0 && wait)
+        return ctl_wait_done(c, NCP_STATUS_T_JOGGING, "the jog");
     if (rc != CTL_OK || distance > 0)
         return rc;
 

@@ -91,11 +91,28 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     int n = sealed_body(c, rbuf, channel, buf, sizeof buf);
     if (n < 0 || ncp_status_t_decode(buf, 0, n, &s) != n)
         return;
-    if (s.channel != c->channel)
+    if (s.channel >= 0)
+        c->served[s.channel] = 1;
+    if (s.channel != c->channel) {
+        if (c->other_statuses++ == 0)
+            c->first_other_at = ctl_now();
         return;
+    }
     c->status = s;
     c->status_at = ctl_now();
     c->n_status++;
+}
+
+static void on_event(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    struct ctl *c = user;
+    ncp_event_t e;
+    uint8_t buf[4096];
+    int n = sealed_body(c, rbuf, channel, buf, sizeof buf);
+    if (n < 0 || ncp_event_t_decode(buf, 0, n, &e) != n)
+        return;
+    if (e.channel == c->channel && c->on_event)
+        c->on_event(&e, c->event_ctx);
 }
 
 static int32_t random_client_id(void)
@@ -124,6 +141,7 @@ int ctl_open(struct ctl *c, const char *url, const char *prefix, const char *key
     snprintf(c->ch_cmd, sizeof c->ch_cmd, "%sCMD", prefix);
     snprintf(c->ch_ack, sizeof c->ch_ack, "%sACK", prefix);
     snprintf(c->ch_status, sizeof c->ch_status, "%sSTATUS", prefix);
+    snprintf(c->ch_event, sizeof c->ch_event, "%sEVENT", prefix);
     c->url = url;
     c->client_id = random_client_id();
     c->lcm = lcm_create(url);
@@ -239,6 +257,25 @@ int ctl_command(struct ctl *c, ncp_command_t *cmd)
     return c->ack.state == NCP_STATUS_T_FAULT ? CTL_FAULT : CTL_REJECTED;
 }
 
+/* Three statuses of other channels over a second or more, and not one of
+ * ours: at any STATUS_HZ ours would have come by then, unless it is not
+ * served (a datagram lost on the way is one status, not three). */
+static int channel_not_served(const struct ctl *c)
+{
+    return c->n_status == 0 && c->other_statuses >= 3 && ctl_now() - c->first_other_at >= 1.0;
+}
+
+static void say_not_served(const struct ctl *c)
+{
+    char list[128 * 4] = "";
+    size_t len = 0;
+    for (int i = 0; i < 128 && len + 5 < sizeof list; i++)
+        if (c->served[i])
+            len += (size_t)snprintf(list + len, sizeof list - len, "%s%d", len ? ", " : "", i);
+    fprintf(stderr, "cnc-ctl: the NCK serves no NC channel %d (it serves %s)\n", c->channel,
+            list);
+}
+
 int ctl_next_status(struct ctl *c, double timeout)
 {
     uint64_t seen = c->n_status;
@@ -246,6 +283,10 @@ int ctl_next_status(struct ctl *c, double timeout)
     while (c->n_status == seen) {
         if (ctl_interrupted)
             return -1;
+        if (channel_not_served(c)) {
+            say_not_served(c);
+            return CTL_REJECTED;
+        }
         double left = timeout > 0 ? start + timeout - ctl_now() : 0.25;
         if (left <= 0)
             return CTL_NO_ANSWER;
@@ -253,4 +294,58 @@ int ctl_next_status(struct ctl *c, double timeout)
             return CTL_USAGE;
     }
     return CTL_OK;
+}
+
+int ctl_follow_events(struct ctl *c, double seconds,
+                      void (*show)(const ncp_event_t *e, void *ctx), void *ctx)
+{
+    c->on_event = show;
+    c->event_ctx = ctx;
+    if (lcm_subscribe(c->lcm, c->ch_event, on_event, c) == NULL) {
+        fprintf(stderr, "cnc-ctl: cannot subscribe to %s\n", c->ch_event);
+        return CTL_USAGE;
+    }
+    double end = ctl_now() + seconds;
+    while (!ctl_interrupted) {
+        double left = seconds > 0 ? end - ctl_now() : 0.25;
+        if (left <= 0)
+            break;
+        if (ctl_handle(c, left < 0.25 ? left : 0.25) != 0)
+            return CTL_USAGE;
+    }
+    return CTL_OK;
+}
+
+int ctl_wait_done(struct ctl *c, int busy_state, const char *what)
+{
+    int64_t acked_utime = c->ack.utime;
+    double last = ctl_now();
+    for (;;) {
+        int rc = ctl_next_status(c, 0.25);
+        if (rc < 0)
+            return CTL_NO_ANSWER; /* interrupted: not seen to end */
+        double now = ctl_now();
+        if (rc == CTL_NO_ANSWER) {
+            if (c->timeout > 0 && now - last >= c->timeout) {
+                ctl_no_answer("status", c->timeout);
+                return CTL_NO_ANSWER;
+            }
+            continue;
+        }
+        if (rc != CTL_OK)
+            return rc;
+        last = now;
+        /* a status sent before the ACK may still show the state before the
+         * command: only later ones say how it ended */
+        if (c->status.utime < acked_utime || c->status.state == busy_state)
+            continue;
+        if (c->status.state == NCP_STATUS_T_FAULT || c->status.state == NCP_STATUS_T_ESTOP) {
+            const char *st = ncp_msg_state_name(c->status.state);
+            fprintf(stderr, "cnc-ctl: %s ended in %s: %.*s\n", what, st ? st : "?",
+                    (int)strnlen((const char *)c->status.error, sizeof c->status.error),
+                    (const char *)c->status.error);
+            return CTL_FAULT;
+        }
+        return CTL_OK;
+    }
 }

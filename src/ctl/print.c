@@ -1,4 +1,5 @@
-/* cnc-ctl status without --json: a few lines a machinist reads at a glance. */
+/* cnc-ctl status and events without --json: what a machinist reads at a
+ * glance. */
 #include <stdio.h>
 #include <string.h>
 
@@ -17,7 +18,7 @@ static void print_axes(const char *label, const ncp_status_t *s, const double *v
     printf("\n");
 }
 
-static const char *text(const uint8_t *t, size_t size, char *buf, size_t bufsize)
+static const char *text_of(const uint8_t *t, size_t size, char *buf, size_t bufsize)
 {
     snprintf(buf, bufsize, "%.*s", (int)strnlen((const char *)t, size), (const char *)t);
     return buf;
@@ -30,7 +31,7 @@ void ctl_print_status(const ncp_status_t *s)
     char buf[260];
     const char *state = ncp_msg_state_name(s->state);
     printf("state     %s%s\n", state ? state : "unknown", s->step_mode ? " (single block)" : "");
-    text(s->program, sizeof s->program, buf, sizeof buf);
+    text_of(s->program, sizeof s->program, buf, sizeof buf);
     if (buf[0])
         printf("program   %s, line %d\n", buf, (int)s->line);
     else
@@ -54,7 +55,7 @@ void ctl_print_status(const ncp_status_t *s)
            s->g5x_index >= 1 && s->g5x_index <= 9 ? g5x[s->g5x_index - 1] : "G5x?");
     if (ncp_msg_active_codes_text(s, buf, sizeof buf) > 0)
         printf("modal     %s\n", buf);
-    text(s->error, sizeof s->error, buf, sizeof buf);
+    text_of(s->error, sizeof s->error, buf, sizeof buf);
     if (buf[0])
         printf("error     %s\n", buf);
     printf("messages  %lld commands, %lld garbage, %lld rejected; loop %lld cycles, %lld "
@@ -63,4 +64,21 @@ void ctl_print_status(const ncp_status_t *s)
            (long long)s->cycles, (long long)s->deadline_misses, s->latency_max_us);
     printf("dropped   %lld without the key's seal, %lld past their deadline, %lld replayed\n",
            (long long)s->auth_failed, (long long)s->stale, (long long)s->replayed);
+}
+
+void ctl_print_event(const ncp_event_t *e)
+{
+    char file[260], text[520];
+    const char *kind = ncp_msg_event_kind_name(e->kind);
+    kind = kind ? kind : "event";
+    text_of(e->text, sizeof e->text, text, sizeof text);
+    if (e->file[0] && e->line > 0)
+        printf("%s:%d:%d: %s: %s\n", text_of(e->file, sizeof e->file, file, sizeof file),
+               (int)e->line, (int)e->col, kind, text);
+    else if (e->file[0])
+        printf("%s: %s: %s\n", text_of(e->file, sizeof e->file, file, sizeof file), kind, text);
+    else if (e->line > 0)
+        printf("line %d: %s: %s\n", (int)e->line, kind, text);
+    else
+        printf("%s: %s\n", kind, text);
 }

@@ -251,7 +251,10 @@ int ncp_source_open(struct ncp_source *src, const char *path, struct ncp_diag *d
     }
     const char *text = "";
     if (size > 0) {
-        void *m = mmap(NULL, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+        /* not MAP_POPULATE: it maps the whole file before the first block
+         * (the process then holds all of it); the readers' windows
+         * (ncp_source_window) bring it in and hand it back as they go */
+        void *m = mmap(NULL, size, PROT_READ, MAP_PRIVATE, fd, 0);
         if (m == MAP_FAILED) {
             close(fd);
             return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot map program: %s",

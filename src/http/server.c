@@ -353,9 +353,9 @@ static void render_ack(struct ncp_http *h, const ncp_ack_t *a)
 
 static void render_event(struct ncp_http *h, const ncp_event_t *e)
 {
-    static const char *const kinds[] = { "info", "msg", "debug", "print", "error", "fault" };
     char msg[2048];
-    const char *kind = e->kind >= 0 && e->kind <= 5 ? kinds[e->kind] : "info";
+    const char *kind = ncp_msg_event_kind_name(e->kind);
+    kind = kind ? kind : "info";
     size_t n = (size_t)snprintf(msg, sizeof msg, "{\"type\": \"event\", \"kind\": \"%s\", "
                                 "\"line\": %d, \"col\": %d, \"file\": ", kind, (int)e->line,
                                 (int)e->col);

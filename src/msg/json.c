@@ -1,5 +1,6 @@
-/* status_t as one JSON object: what `cnc-ctl status --json` prints and what a
- * browser panel can take as it is. Written into the caller's buffer. */
+/* status_t and event_t as JSON objects: what `cnc-ctl status --json` and
+ * `events --json` print, and what a browser panel can take as it is. Written
+ * into the caller's buffer. */
 #include <ctype.h>
 #include <math.h>
 #include <stdarg.h>
@@ -158,6 +159,23 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
         (long long)s->auth_failed, (long long)s->stale, (long long)s->replayed,
         (long long)s->rejected, (long long)s->cycles, (long long)s->deadline_misses);
     put_num(&o, "%.3f", s->latency_max_us);
+    put(&o, "}");
+    return o.full ? -1 : (int)o.len;
+}
+
+int ncp_msg_event_json(const ncp_event_t *e, char *buf, size_t size)
+{
+    struct out o = {.buf = buf, .size = size};
+    if (size == 0)
+        return -1;
+    const char *kind = ncp_msg_event_kind_name(e->kind);
+    put(&o, "{\"kind\": ");
+    put(&o, kind ? "\"%s\"" : "null", kind ? kind : "");
+    put(&o, ", \"channel\": %d, \"seq\": %lld, \"utime\": %lld, \"file\": ", (int)e->channel,
+        (long long)e->seq, (long long)e->utime);
+    put_text(&o, e->file, sizeof e->file);
+    put(&o, ", \"line\": %d, \"col\": %d, \"text\": ", (int)e->line, (int)e->col);
+    put_text(&o, e->text, sizeof e->text);
     put(&o, "}");
     return o.full ? -1 : (int)o.len;
 }

@@ -1,5 +1,6 @@
-/* The NCK's states by name, as cnc-ctl, the status JSON and the INI speak of
- * them; the constants are status_t's. */
+/* The NCK's states and its events' kinds by name, as cnc-ctl, the status
+ * JSON, the panel and the INI speak of them; the constants are status_t's
+ * and event_t's. */
 #include <stddef.h>
 #include <string.h>
 
@@ -26,4 +27,15 @@ int ncp_msg_state_parse(const char *name)
         if (state_names[i] && strcmp(state_names[i], name) == 0)
             return i;
     return -1;
+}
+
+static const char *const event_kinds[] = {
+    [NCP_EVENT_T_INFO] = "info",   [NCP_EVENT_T_MSG] = "msg",     [NCP_EVENT_T_DEBUG] = "debug",
+    [NCP_EVENT_T_PRINT] = "print", [NCP_EVENT_T_ERROR] = "error", [NCP_EVENT_T_FAULT] = "fault",
+};
+
+const char *ncp_msg_event_kind_name(int kind)
+{
+    return kind >= 0 && kind < (int)(sizeof event_kinds / sizeof event_kinds[0])
+               ? event_kinds[kind] : NULL;
 }

@@ -7,6 +7,7 @@
  * holds the axes where they stand: the planner brought them to a stop there.
  * Real-time rules: no allocation, locks or system calls here. */
 #include "nck_int.h"
+#include "loop_state.h"
 
 #include <math.h>
 #include <string.h>
@@ -20,9 +21,9 @@ static double ramp(double from, double to, double step)
 
 /* M19: brake to a stop, then turn (P0 clockwise = as M3, P1 the other way,
  * P2 the shorter way) to the angle at ORIENT_RPM at most, braking into it. */
-static void orient_step(struct nck *n, double dt)
+static void orient_step(struct nck_core *n, double dt)
 {
-    struct nck_mach *m = &n->mach;
+    struct nck_mach *m = &n->loop->mach;
     const struct ncp_io_cfg *io = &n->cfg->io;
     double acc = io->spindle_acc;
     if (m->orienting == 1) {
@@ -52,9 +53,9 @@ static void orient_step(struct nck *n, double dt)
     m->rev += m->orient_sign * v * dt;
 }
 
-static void spindle_step(struct nck *n)
+static void spindle_step(struct nck_core *n)
 {
-    struct nck_mach *m = &n->mach;
+    struct nck_mach *m = &n->loop->mach;
     double dt = n->cfg->servo_period;
     if (m->orienting) {
         orient_step(n, dt);
@@ -67,32 +68,32 @@ static void spindle_step(struct nck *n)
 /* A pause for the operator: resume (tool: tool-changed) goes on; a batch run
  * goes on by itself after AUTO_RESUME_S unless that is negative (SIGUSR1,
  * which the batch turns into a resume). */
-static int operator_wait(struct nck *n, int kind, uint32_t line, _Atomic uint64_t *go)
+static int operator_wait(struct nck_core *n, int kind, uint32_t line, _Atomic uint64_t *go)
 {
-    struct nck_mach *m = &n->mach;
+    struct nck_mach *m = &n->loop->mach;
     if (m->wait != kind) {
         m->waits++;
         m->wait = kind;
         m->wait_line = line;
-        m->wait_since = n->now_ns;
+        m->wait_since = n->loop->now_ns;
         m->resume_used = atomic_load_explicit(go, memory_order_acquire);
     }
     /* a pause lasts one cycle at least: the trace and the operator see it */
-    if (n->now_ns == m->wait_since)
+    if (n->loop->now_ns == m->wait_since)
         return 1;
     if (atomic_load_explicit(go, memory_order_acquire) > m->resume_used)
         return 0;
     double after = n->cfg->io.auto_resume_s;
-    if (n->batch && after >= 0 && (double)(n->now_ns - m->wait_since) * 1e-9 >= after - 1e-12)
+    if (n->batch && after >= 0 && (double)(n->loop->now_ns - m->wait_since) * 1e-9 >= after - 1e-12)
         return 0;
     return 1;
 }
 
-static int input_wait(struct nck *n, const struct nck_aux *a)
+static int input_wait(struct nck_core *n, const struct nck_aux *a)
 {
-    struct nck_mach *m = &n->mach;
+    struct nck_mach *m = &n->loop->mach;
     if (a->a) {               /* analog: L0 only (the interpreter checks) */
-        m->m66_result = n->cfg->io.ain[a->idx];
+        n->cross.m66_result = n->cfg->io.ain[a->idx];
         return 0;
     }
     int v = (int)((atomic_load_explicit(&n->ctl->din, memory_order_acquire) >> a->idx) & 1u);
@@ -100,7 +101,7 @@ static int input_wait(struct nck *n, const struct nck_aux *a)
         m->waits++;
         m->wait = NCK_WAIT_INPUT;
         m->wait_line = a->line;
-        m->wait_since = n->now_ns;
+        m->wait_since = n->loop->now_ns;
         m->in_last = v;
     }
     int done;
@@ -113,20 +114,20 @@ static int input_wait(struct nck *n, const struct nck_aux *a)
     }
     m->in_last = v;
     if (done) {
-        m->m66_result = v;
+        n->cross.m66_result = v;
         return 0;
     }
-    if ((double)(n->now_ns - m->wait_since) * 1e-9 >= a->v) {
-        m->m66_result = -1;   /* timed out, as rs274 reports it */
+    if ((double)(n->loop->now_ns - m->wait_since) * 1e-9 >= a->v) {
+        n->cross.m66_result = -1;   /* timed out, as rs274 reports it */
         return 0;
     }
     return 1;
 }
 
 /* One action: 1 while it waits. */
-static int act(struct nck *n, const struct nck_aux *a)
+static int act(struct nck_core *n, const struct nck_aux *a)
 {
-    struct nck_mach *m = &n->mach;
+    struct nck_mach *m = &n->loop->mach;
     switch (a->kind) {
     case NCK_AUX_SPINDLE:
         m->rpm_cmd = a->v;
@@ -184,19 +185,19 @@ static int act(struct nck *n, const struct nck_aux *a)
     }
 }
 
-int nck_aux_cycle(struct nck *n)
+int nck_aux_cycle(struct nck_core *n)
 {
-    struct nck_mach *m = &n->mach;
+    struct nck_mach *m = &n->loop->mach;
     /* once per instant: a virtual clock's retry is the same period again */
-    if (!m->spun || m->spun_at != n->now_ns) {
+    if (!m->spun || m->spun_at != n->loop->now_ns) {
         spindle_step(n);
         m->spun = 1;
-        m->spun_at = n->now_ns;
+        m->spun_at = n->loop->now_ns;
     }
     for (;;) {
         if (!m->have_pack) {
             if (!m->have_ahead)
-                m->have_ahead = ncp_spsc_pop(&n->auxq, &m->ahead) == 0;
+                m->have_ahead = ncp_spsc_pop(&n->cross.auxq, &m->ahead) == 0;
             if (!m->have_ahead || m->ahead.seq > m->seq_reached)
                 return 0;
             m->pack = m->ahead;
@@ -219,10 +220,10 @@ int nck_aux_cycle(struct nck *n)
 
 /* A drop (stop, abort, E-stop, fault): what was queued is gone, and the
  * spindle and coolant go off, as LinuxCNC's abort turns them off. */
-void nck_aux_discard(struct nck *n)
+void nck_aux_discard(struct nck_core *n)
 {
-    struct nck_mach *m = &n->mach;
-    while (ncp_spsc_pop(&n->auxq, &m->ahead) == 0)
+    struct nck_mach *m = &n->loop->mach;
+    while (ncp_spsc_pop(&n->cross.auxq, &m->ahead) == 0)
         ;
     m->have_ahead = m->have_pack = 0;
     nck_sync_discard(n);

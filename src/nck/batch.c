@@ -2,6 +2,8 @@
  * program job; the position loop ends by itself once the plant has settled
  * after the program (or after --for's hold, or at a fault). */
 #include "nck_int.h"
+#include "job_state.h"
+#include "service_state.h"
 #include "ncpar/clock.h"
 
 #include <errno.h>
@@ -129,14 +131,14 @@ static enum precheck_end precheck(const struct ncp_nck_opts *o, const double sta
 
 /* ---- the run ------------------------------------------------------------------------- */
 
-static void progress(const struct nck *n, const struct ncp_nck_opts *o)
+static void progress(const struct nck_core *n, const struct ncp_nck_opts *o)
 {
-    const struct nck_summary *s = &n->sum;
+    const struct nck_summary *s = &n->svc->sum;
     uint32_t total = o->total_lines;
     fprintf(o->progress,
             "\r  line %u/%u (%3.0f%%)  t %.2f s  feed %.0f mm/min  max latency %.1f us  ",
             s->line, total, total ? 100.0 * s->line / total : 0.0, s->t, s->v * 60,
-            (double)atomic_load(&n->pub_lat_max_ns) / 1e3);
+            (double)atomic_load(&n->cross.pub_lat_max_ns) / 1e3);
     fflush(o->progress);
 }
 
@@ -166,7 +168,7 @@ struct batch_home {
     struct ncp_diag diag;
 };
 
-static void homing_done(struct nck *n, const struct ncp_nck_opts *o, struct batch_home *bh)
+static void homing_done(struct nck_core *n, const struct ncp_nck_opts *o, struct batch_home *bh)
 {
     char report[1024];
     bh->pending = 0;
@@ -174,42 +176,42 @@ static void homing_done(struct nck *n, const struct ncp_nck_opts *o, struct batc
         bh->failed = 1;
         ncp_diag_set(&bh->diag, NCP_ERR_IO, 0, 0, "%s", report);
         atomic_store(&n->ctl->stop, 1);
-        atomic_store(&n->job_pending, 0);
+        atomic_store(&n->cross.job_pending, 0);
         return;
     }
     if (o->notes)
         fprintf(o->notes, "%s\n", report);
-    memcpy(n->map.pos, n->home.final, sizeof n->map.pos);
+    memcpy(n->job->map.pos, n->cross.home.final, sizeof n->job->map.pos);
     if (nck_job_start(n)) {
         bh->failed = 1;
         ncp_diag_set(&bh->diag, NCP_ERR_IO, 0, 0, "cannot start the interpreter thread");
         atomic_store(&n->ctl->stop, 1);
     }
-    atomic_store(&n->job_pending, 0);
+    atomic_store(&n->cross.job_pending, 0);
 }
 
 /* Reads the loop's cycles until the loop has ended and its ring is empty. */
-static void drain(struct nck *n, const struct ncp_nck_opts *o, struct batch_home *bh)
+static void drain(struct nck_core *n, const struct ncp_nck_opts *o, struct batch_home *bh)
 {
     int64_t last_print = 0;
     sig_atomic_t usr1_seen = usr1;
     if (o->trace) {
         errno = 0;
-        n->sum.joints = ncp_kins_active(n->cfg);
-        nck_trace_header(o->trace, n->cfg, n->sum.joints, n->sum.rings);
+        n->svc->sum.joints = ncp_kins_active(n->cfg);
+        nck_trace_header(o->trace, n->cfg, n->svc->sum.joints, n->svc->sum.rings);
         if (ferror(o->trace))
-            n->sum.trace_errno = errno ? errno : EIO;
+            n->svc->sum.trace_errno = errno ? errno : EIO;
     }
     for (;;) {
         int got = nck_read_cycles(n);
-        if (!got && !atomic_load(&n->loop.running) && ncp_spsc_count(&n->fbs) == 0)
+        if (!got && !atomic_load(&n->cross.rt.running) && ncp_spsc_count(&n->cross.fbs) == 0)
             break;
         if (bh->pending && nck_home_finished(n))
             homing_done(n, o, bh);
         /* a trace that cannot be written (a full disk) stops the run as a
          * stop signal does: a run that was asked to be recorded is not
          * worth going on unrecorded */
-        if (((o->interrupt && *o->interrupt) || n->sum.trace_errno) &&
+        if (((o->interrupt && *o->interrupt) || n->svc->sum.trace_errno) &&
             !atomic_load(&n->ctl->stop))
             atomic_store(&n->ctl->stop, 1);
         if (usr1 != usr1_seen) {
@@ -229,29 +231,32 @@ static void drain(struct nck *n, const struct ncp_nck_opts *o, struct batch_home
     if (o->progress && last_print)
         fputc('\n', o->progress);
     if (o->trace)
-        nck_trace_flush(&n->sum, o->trace);
+        nck_trace_flush(&n->svc->sum, o->trace);
 }
 
 /* "node 2: EMCY (0x082): ... (last completed block: line 7)", at the line
  * of the block in progress. */
-static void backend_diag(const struct nck *n, struct ncp_nck_result *res)
+static void backend_diag(const struct nck_core *n, const struct nck_loop_report *lr,
+                         struct ncp_nck_result *res)
 {
     char why[NCP_DIAG_MSG_MAX];
-    n->be.ops->describe_fault(&n->be, why, sizeof why);
+    n->cross.be.ops->describe_fault(&n->cross.be, why, sizeof why);
     char done[48] = "none";
-    if (n->line_done)
-        snprintf(done, sizeof done, "line %u", n->line_done);
-    ncp_diag_set(&res->diag, NCP_ERR_IO, n->fault_line, 0, "%.*s (last completed block: %s)",
+    if (lr->line_done)
+        snprintf(done, sizeof done, "line %u", lr->line_done);
+    ncp_diag_set(&res->diag, NCP_ERR_IO, n->cross.fault_line, 0, "%.*s (last completed block: %s)",
                  (int)(sizeof res->diag.msg - 40), why, done);
     res->status = NCP_NCK_FAULT;
 }
 
-static void collect(const struct nck *n, struct ncp_nck_result *res)
+static void collect(const struct nck_core *n, struct ncp_nck_result *res)
 {
-    const struct nck_summary *s = &n->sum;
+    const struct nck_summary *s = &n->svc->sum;
     struct ncp_planner_stats ps;
     nck_plan_stats(n, &ps);
-    res->program_time = n->ended ? (double)n->end_ns * 1e-9 : s->t;
+    struct nck_loop_report lr;
+    nck_loop_report(n, &lr);
+    res->program_time = lr.ended ? (double)lr.end_ns * 1e-9 : s->t;
     res->path_length = s->path;
     res->segments = ps.segments;
     res->starved = ps.starved;
@@ -265,46 +270,46 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
     res->axis_mask = n->cfg->axis_mask;
     res->contour_max = s->contour_max;
     res->contour_avg = s->moving ? s->contour_sum / (double)s->moving : 0;
-    res->underruns = n->underruns;
-    res->dry = n->dry;
-    res->trace_dropped = n->fb_dropped;
-    res->fifo = n->loop.fifo;
-    memcpy(res->warning, n->loop.warning, sizeof res->warning);
-    res->lat = n->loop.stats;
-    res->for_expired = n->for_expired;
-    res->interrupted = atomic_load(&n->ctl->stop) && !n->ended;
-    res->trace_errno = n->sum.trace_errno;
+    res->underruns = lr.underruns;
+    res->dry = lr.dry;
+    res->trace_dropped = lr.fb_dropped;
+    res->fifo = n->cross.rt.fifo;
+    memcpy(res->warning, n->cross.rt.warning, sizeof res->warning);
+    res->lat = n->cross.rt.stats;
+    res->for_expired = lr.for_expired;
+    res->interrupted = atomic_load(&n->ctl->stop) && !lr.ended;
+    res->trace_errno = n->svc->sum.trace_errno;
     res->spindle_rpm_max = s->rpm_max;
     nck_sched_summary(n, res->sched_summary, sizeof res->sched_summary);
-    res->pauses = n->pauses;
+    res->pauses = n->svc->pauses;
     for (int k = 0; k < NCP_C__COUNT; k++) {
-        res->calls_in += n->calls_in[k];
-        res->calls_acted += n->calls_acted[k];
-        res->calls_refused += n->calls_refused[k];
+        res->calls_in += n->cross.calls_in[k];
+        res->calls_acted += n->cross.calls_acted[k];
+        res->calls_refused += n->cross.calls_refused[k];
     }
-    res->inject = n->inj_rep;
-    ncp_inject_summary(&n->cfg->inject, &n->inj_rep, res->inject_summary,
+    res->inject = n->cross.inj_rep;
+    ncp_inject_summary(&n->cfg->inject, &n->cross.inj_rep, res->inject_summary,
                        sizeof res->inject_summary);
-    const struct nck_job *j = &n->job;
-    int fault = atomic_load(&n->loop_fault);
+    const struct nck_job *j = n->job;
+    int fault = atomic_load(&n->cross.loop_fault);
     if (fault == NCK_LF_BACKEND) {
-        backend_diag(n, res);
+        backend_diag(n, &lr, res);
     } else if (fault == NCK_LF_FERROR) {
         res->fault = 1;
-        res->fault_axis = n->fault_axis;
-        res->fault_err = n->fault_err;
-        res->fault_line = n->fault_line;
+        res->fault_axis = n->cross.fault_axis;
+        res->fault_err = n->cross.fault_err;
+        res->fault_line = n->cross.fault_line;
         res->status = NCP_NCK_FAULT;
     } else if (fault == NCK_LF_JOINT) {
-        ncp_diag_set(&res->diag, NCP_ERR_LIMIT, n->fault_line, 0,
+        ncp_diag_set(&res->diag, NCP_ERR_LIMIT, n->cross.fault_line, 0,
                      "joint limit: the %c joint was commanded to %.4f, beyond [%.4f, %.4f]; "
-                     "servo stopped", NCP_AXIS_LETTERS[n->fault_axis], n->fault_err,
-                     n->cfg->joint[n->fault_axis].min_limit, n->cfg->joint[n->fault_axis].max_limit);
+                     "servo stopped", NCP_AXIS_LETTERS[n->cross.fault_axis], n->cross.fault_err,
+                     n->cfg->joint[n->cross.fault_axis].min_limit, n->cfg->joint[n->cross.fault_axis].max_limit);
         res->status = NCP_NCK_FAULT;
-    } else if (n->inj_rep.trip) {
+    } else if (n->cross.inj_rep.trip) {
         /* a miss limit stopped the machine along the path */
         res->status = NCP_NCK_FAULT;
-    } else if (n->for_expired || res->interrupted) {
+    } else if (lr.for_expired || res->interrupted) {
         /* the interpreter was cut short by us: its "stopped" is no program error */
     } else if (j->map_failed || j->rc != NCP_OK) {
         res->diag = j->map_failed ? j->map_diag : j->diag;
@@ -316,7 +321,7 @@ static void collect(const struct nck *n, struct ncp_nck_result *res)
 }
 
 /* Where the program starts: --home leaves the homed axes at HOME. */
-static const double *after_home(const struct nck *n, const struct ncp_nck_opts *o,
+static const double *after_home(const struct nck_core *n, const struct ncp_nck_opts *o,
                                 double at[NCP_AXES])
 {
     memcpy(at, n->start, sizeof n->start);
@@ -334,8 +339,9 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     memset(&bh, 0, sizeof bh);
     memset(res, 0, sizeof res[0]);
     ncp_rt_stats_reset(&res->lat);
-    struct nck *n = calloc(1, sizeof *n);
-    if (!n) {
+    struct nck_core *n = calloc(1, sizeof *n);
+    if (!n || nck_core_alloc(n)) {
+        free(n);
         snprintf(res->diag.msg, sizeof res->diag.msg, "cannot set up the runtime");
         return res->status = NCP_NCK_FAULT;
     }
@@ -364,20 +370,20 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     } else {
         if (o->cfg->io.auto_resume_s < 0)
             watch_usr1();
-        n->job.kind = NCK_JOB_PROGRAM;
-        n->job.interpret = o->interpret;
-        n->job.interp_ctx = o->interp_ctx;
+        n->job->kind = NCK_JOB_PROGRAM;
+        n->job->interpret = o->interpret;
+        n->job->interp_ctx = o->interp_ctx;
         if (o->home) {
             bh.pending = 1;
-            atomic_store(&n->job_pending, 1);
+            atomic_store(&n->cross.job_pending, 1);
             nck_home_request(n, nck_home_all_mask(o->cfg));
         }
         if ((!o->home && nck_job_start(n)) || nck_start_loop(n, &res->diag)) {
             snprintf(res->diag.msg, sizeof res->diag.msg, "cannot set up the runtime");
             res->status = NCP_NCK_FAULT;
         } else {
-            if (n->loop.warning[0] && o->progress)
-                fprintf(o->progress, "warning: %s\n", n->loop.warning);
+            if (n->cross.rt.warning[0] && o->progress)
+                fprintf(o->progress, "warning: %s\n", n->cross.rt.warning);
             drain(n, o, &bh);
         }
     }
@@ -391,6 +397,7 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
         res->status = NCP_NCK_FAULT;
     }
     nck_release(n);
+    nck_core_free(n);
     free(n);
     return res->status;
 }

@@ -1,7 +1,9 @@
 /* The serving NCK's state machine: which command fits which state, what each
  * does, and how the NCK moves on between commands (ncp_nck_poll). Runs on the
  * caller's thread only (the service thread). */
-#include "nck_int.h"
+#include "control.h"
+#include "job_state.h"
+#include "service_state.h"
 #include "ncpar/clock.h"
 
 #include <ctype.h>
@@ -63,22 +65,22 @@ static int axis_index(const char *text)
 static int all_homed(const struct ncp_nck *s)
 {
     for (int j = 0; j < NCP_AXES; j++)
-        if ((s->n.cfg->axis_mask & NCP_AXIS_BIT(j)) && !s->homed[j])
+        if ((s->core.cfg->axis_mask & NCP_AXIS_BIT(j)) && !s->homed[j])
             return 0;
     return 1;
 }
 
 static int need_homing(const struct ncp_nck *s)
 {
-    return !s->n.cfg->no_force_homing && !all_homed(s);
+    return !s->core.cfg->no_force_homing && !all_homed(s);
 }
 
 /* ---- the interpreter ---------------------------------------------------------------- */
 
 static int job_abort_asked(void *ctx)
 {
-    struct nck *n = ctx;
-    return atomic_load(&n->job.abort);
+    struct nck_core *n = ctx;
+    return atomic_load(&n->job->abort);
 }
 
 static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d)
@@ -86,10 +88,10 @@ static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d
     struct ncp_nck *s = ctx;
     struct ncp_run_stats st;
     memset(&st, 0, sizeof st);
-    if (s->n.setup.mode == NCP_MODE_SERIAL || s->run_src == &s->mdi_src)
+    if (s->core.setup.mode == NCP_MODE_SERIAL || s->run_src == &s->mdi_src)
         return ncp_serial_run(s->run_src, &s->acfg, out, &st, d);
     struct ncp_thread_map map;
-    ncp_thread_map_default(&map, s->n.setup.mode, 2, 1);
+    ncp_thread_map_default(&map, s->core.setup.mode, 2, 1);
     return ncp_pipeline_run(s->run_src, &map, &s->acfg, out, &st, d);
 }
 
@@ -97,7 +99,7 @@ static int interpret(void *ctx, const struct ncp_output *out, struct ncp_diag *d
 static void sync_interp(struct ncp_nck *s)
 {
     double prog[3];
-    ncp_canon_map_to_program(&s->n.map, s->n.map.pos, prog);
+    ncp_canon_map_to_program(&s->core.job->map, s->core.job->map.pos, prog);
     ncp_analyzer_set_position(s->interp, prog);
 }
 
@@ -107,10 +109,10 @@ static int emit_state_only(void *ctx, const struct ncp_cmd *cmd)
     struct ncp_seg seg;
     struct ncp_diag d;
     for (unsigned i = 0; i < cmd->n_ops; i++) {
-        nck_note_state(&s->n, &cmd->ops[i]);   /* the status shows the reset G5x too */
-        int rc = ncp_canon_map_op(&s->n.map, &cmd->ops[i], cmd->line, &seg, &d);
+        nck_note_state(&s->core, &cmd->ops[i]);   /* the status shows the reset G5x too */
+        int rc = ncp_canon_map_op(&s->core.job->map, &cmd->ops[i], cmd->line, &seg, &d);
         while (rc == 1)
-            rc = ncp_canon_map_more(&s->n.map, &seg, &d);
+            rc = ncp_canon_map_more(&s->core.job->map, &seg, &d);
     }
     return 0;
 }
@@ -129,11 +131,11 @@ static void reset_interp(struct ncp_nck *s)
     struct ncp_run_stats st;
     ncp_serial_run(&src, &s->acfg, &out, &st, &d);
     ncp_source_close(&src);
-    pthread_mutex_lock(&s->n.ev_lock);
-    s->n.io.dir = 0;
-    s->n.io.mist = 0;
-    s->n.io.flood = 0;
-    pthread_mutex_unlock(&s->n.ev_lock);
+    pthread_mutex_lock(&s->core.cross.ev_lock);
+    s->core.cross.io.dir = 0;
+    s->core.cross.io.mist = 0;
+    s->core.cross.io.flood = 0;
+    pthread_mutex_unlock(&s->core.cross.ev_lock);
     sync_interp(s);
 }
 
@@ -142,9 +144,9 @@ static void reset_interp(struct ncp_nck *s)
 static void begin_drop(struct ncp_nck *s, int hold, int full, int after, int reset)
 {
     s->machine_pause = 0;
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     if (hold) {
-        atomic_store(&n->full_decel, full);
+        atomic_store(&n->cross.full_decel, full);
         ncp_nck_feed_hold(n->ctl, 1);
         s->drop = NCK_DROP_HOLD;
     } else {
@@ -157,24 +159,24 @@ static void begin_drop(struct ncp_nck *s, int hold, int full, int after, int res
 
 static void drop_step(struct ncp_nck *s)
 {
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     switch (s->drop) {
     case NCK_DROP_HOLD:
-        if (!atomic_load(&n->at_rest))
+        if (!atomic_load(&n->cross.at_rest))
             return;
         s->drop = NCK_DROP_JOB;
         /* fall through */
     case NCK_DROP_JOB:
-        atomic_store(&n->job.abort, 1);
+        atomic_store(&n->job->abort, 1);
         nck_job_join(n);
-        n->job.kind = NCK_JOB_NONE;
+        n->job->kind = NCK_JOB_NONE;
         nck_park_planner(n);
         s->drop = NCK_DROP_PARK;
         /* fall through */
     case NCK_DROP_PARK:
         if (!nck_planner_parked(n))
             return;
-        nck_discard(n, atomic_load(&n->frozen));
+        nck_discard(n, atomic_load(&n->cross.frozen));
         s->drop = NCK_DROP_DISCARD;
         /* fall through */
     case NCK_DROP_DISCARD:
@@ -187,9 +189,9 @@ static void drop_step(struct ncp_nck *s)
         if (!nck_planner_unparked(n))
             return;
         s->drop = NCK_DROP_NONE;
-        atomic_store(&n->full_decel, 0);
+        atomic_store(&n->cross.full_decel, 0);
         if (s->drop_after == NCP_ST_IDLE)
-            atomic_store(&n->frozen, 0);
+            atomic_store(&n->cross.frozen, 0);
         ncp_nck_feed_hold(n->ctl, 0);
         if (s->drop_reset)
             reset_interp(s);
@@ -207,23 +209,23 @@ static void drop_step(struct ncp_nck *s)
 static int start_interp_job(struct ncp_nck *s, const struct ncp_source *src, uint32_t from,
                             int kind)
 {
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     sync_interp(s);
     s->run_src = src;
-    n->job.kind = kind;
-    n->job.interpret = interpret;
-    n->job.interp_ctx = s;
-    n->job.from_line = from;
+    n->job->kind = kind;
+    n->job->interpret = interpret;
+    n->job->interp_ctx = s;
+    n->job->from_line = from;
     s->error[0] = 0;
     return nck_job_start(n);
 }
 
 static int start_moves(struct ncp_nck *s, const struct ncp_seg *moves, int count)
 {
-    struct nck *n = &s->n;
-    n->job.kind = NCK_JOB_MOVE;
-    n->job.n_moves = count;
-    memcpy(n->job.moves, moves, (size_t)count * sizeof moves[0]);
+    struct nck_core *n = &s->core;
+    n->job->kind = NCK_JOB_MOVE;
+    n->job->n_moves = count;
+    memcpy(n->job->moves, moves, (size_t)count * sizeof moves[0]);
     return nck_job_start(n);
 }
 
@@ -318,7 +320,7 @@ static int check_answer(struct ncp_nck *s, char *why, size_t len)
     s->prog = s->load_src;
     s->have_prog = 1;
     snprintf(s->program, sizeof s->program, "%s", s->load_path);
-    nck_post(&s->n, NCP_EV_INFO, s->program, 0, 0, "loaded %s", s->program);
+    nck_post(&s->core, NCP_EV_INFO, s->program, 0, 0, "loaded %s", s->program);
     return 0;
 }
 
@@ -394,8 +396,8 @@ static int cmd_run(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
         return refuse(why, len, "run --from-line wants a line number of 1 or more");
     if (start_interp_job(s, &s->prog, (uint32_t)c->ivalue[0], NCK_JOB_PROGRAM))
         return refuse(why, len, "cannot start the interpreter thread");
-    set_state(s, atomic_load(&s->n.job.step) ? NCP_ST_STEPPING : NCP_ST_RUNNING);
-    nck_post(&s->n, NCP_EV_INFO, s->program, 0, 0, "running %s%s", s->program,
+    set_state(s, atomic_load(&s->core.job->step) ? NCP_ST_STEPPING : NCP_ST_RUNNING);
+    nck_post(&s->core, NCP_EV_INFO, s->program, 0, 0, "running %s%s", s->program,
              c->ivalue[0] > 0 ? " from a line" : "");
     return 0;
 }
@@ -425,7 +427,7 @@ static int cmd_mdi(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
  * at the soft limit. */
 static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
 {
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     if (s->state != NCP_ST_IDLE)
         return refuse(why, len, "cannot jog while %s", ncp_nck_state_name(s->state));
     int j = axis_index(c->text);
@@ -459,19 +461,19 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
         speed = a->max_vel;
     }
     double target[NCP_AXES];
-    memcpy(target, n->map.pos, sizeof target);
+    memcpy(target, n->job->map.pos, sizeof target);
     double limit = dir > 0 ? a->max_limit : a->min_limit;
     double dist = c->value[1];
     target[j] = dist > 0 ? target[j] + dir * dist : limit;
     target[j] = dir > 0 ? fmin(target[j], limit) : fmax(target[j], limit);
-    if (fabs(target[j] - n->map.pos[j]) < 1e-9)
+    if (fabs(target[j] - n->job->map.pos[j]) < 1e-9)
         return refuse(why, len, "%c is at its soft limit %.4f", NCP_AXIS_LETTERS[j], limit);
     struct ncp_seg seg;
-    n->job.step_line = 0;
-    nck_line(n, &seg, n->map.pos, target, speed, 0);
+    n->job->step_line = 0;
+    nck_line(n, &seg, n->job->map.pos, target, speed, 0);
     if (start_moves(s, &seg, 1))
         return refuse(why, len, "cannot start the jog");
-    memcpy(n->map.pos, target, sizeof n->map.pos);
+    memcpy(n->job->map.pos, target, sizeof n->job->map.pos);
     s->jog_continuous = dist <= 0;
     s->jog_last_ns = ncp_mono_ns();
     set_state(s, NCP_ST_JOGGING);
@@ -483,7 +485,7 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
  * loop driving the axes itself. */
 static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
 {
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     const struct ncp_machine_cfg *cfg = n->cfg;
     if (s->state != NCP_ST_IDLE)
         return refuse(why, len, "cannot home while %s", ncp_nck_state_name(s->state));
@@ -514,7 +516,7 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     for (int j = 0; j < NCP_AXES; j++)
         if (mask & NCP_AXIS_BIT(j))
             s->homed[j] = 0;
-    n->job.step_line = 0;
+    n->job->step_line = 0;
     nck_home_request(n, mask);
     s->homing_axes = (int)mask;
     set_state(s, NCP_ST_HOMING);
@@ -528,24 +530,24 @@ static int cmd_override(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *wh
         return refuse(why, len, "an override is a percentage of 0 or more");
     switch (c->ivalue[0]) {
     case 0:
-        if (pct > 100.0 * s->n.plan_override)
+        if (pct > 100.0 * s->core.plan_override)
             return refuse(why, len, "feed override above %.0f %% is not supported: motion is "
-                          "planned at %.0f %% of F", 100.0 * s->n.plan_override,
-                          100.0 * s->n.plan_override);
-        ncp_nck_set_feed_override(s->n.ctl, pct / 100.0);
+                          "planned at %.0f %% of F", 100.0 * s->core.plan_override,
+                          100.0 * s->core.plan_override);
+        ncp_nck_set_feed_override(s->core.ctl, pct / 100.0);
         return 0;
     case 1:
         if (pct > 100)
             return refuse(why, len, "rapid override is 0..100 %%: rapids already run at the "
                           "axes' maximum velocity");
-        atomic_store(&s->n.ctl->rapid_permille, (int)lround(pct * 10));
+        atomic_store(&s->core.ctl->rapid_permille, (int)lround(pct * 10));
         s->rapid_override = pct;
         return 0;
     case 2:
         if (pct > 200)
             return refuse(why, len, "spindle override is 0..200 %%");
         s->spindle_override = pct;
-        atomic_store(&s->n.ctl->spindle_permille, (int)lround(pct * 10));
+        atomic_store(&s->core.ctl->spindle_permille, (int)lround(pct * 10));
         return 0;
     default:
         return refuse(why, len, "override is feed, rapid or spindle");
@@ -557,7 +559,7 @@ static int cmd_pause(struct ncp_nck *s, char *why, size_t len)
     if (s->state != NCP_ST_RUNNING && s->state != NCP_ST_STEPPING && s->state != NCP_ST_MDI)
         return refuse(why, len, "nothing to pause while %s", ncp_nck_state_name(s->state));
     s->resume_state = s->state;
-    ncp_nck_feed_hold(s->n.ctl, 1);
+    ncp_nck_feed_hold(s->core.ctl, 1);
     set_state(s, NCP_ST_PAUSED);
     return 0;
 }
@@ -565,25 +567,25 @@ static int cmd_pause(struct ncp_nck *s, char *why, size_t len)
 /* The program paused the machine (M0 M1 M60 M6): what it waits for. */
 static int machine_wait(const struct ncp_nck *s)
 {
-    return s->machine_pause && s->n.have_fb ? s->n.last_fb.wait : NCK_WAIT_NONE;
+    return s->machine_pause && s->core.svc->have_fb ? s->core.svc->last_fb.wait : NCK_WAIT_NONE;
 }
 
 static int cmd_resume(struct ncp_nck *s, char *why, size_t len)
 {
     if (s->state == NCP_ST_PAUSED && machine_wait(s) == NCK_WAIT_TOOL)
         return refuse(why, len, "the M6 on line %u waits for the tool: cnc-ctl tool-changed "
-                      "once it is in the spindle", s->n.last_fb.wait_line);
+                      "once it is in the spindle", s->core.svc->last_fb.wait_line);
     if (s->state == NCP_ST_PAUSED && s->machine_pause) {
-        atomic_fetch_add(&s->n.ctl->resume_go, 1);
+        atomic_fetch_add(&s->core.ctl->resume_go, 1);
         s->machine_pause = 0;
     }
     if (s->state == NCP_ST_PAUSED) {
-        ncp_nck_feed_hold(s->n.ctl, 0);
+        ncp_nck_feed_hold(s->core.ctl, 0);
         set_state(s, s->resume_state);
         return 0;
     }
     if (s->state == NCP_ST_STEPPING) {
-        atomic_fetch_add(&s->n.job.step_go, 1);
+        atomic_fetch_add(&s->core.job->step_go, 1);
         return 0;
     }
     return refuse(why, len, "nothing to resume while %s", ncp_nck_state_name(s->state));
@@ -593,9 +595,9 @@ static int cmd_tool_changed(struct ncp_nck *s, char *why, size_t len)
 {
     if (s->state != NCP_ST_PAUSED || machine_wait(s) != NCK_WAIT_TOOL)
         return refuse(why, len, "no M6 waits for a tool (%s)", ncp_nck_state_name(s->state));
-    atomic_fetch_add(&s->n.ctl->tool_go, 1);
+    atomic_fetch_add(&s->core.ctl->tool_go, 1);
     s->machine_pause = 0;
-    ncp_nck_feed_hold(s->n.ctl, 0);
+    ncp_nck_feed_hold(s->core.ctl, 0);
     set_state(s, s->resume_state);
     return 0;
 }
@@ -606,9 +608,9 @@ static int cmd_set_input(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *w
     if (i < 0 || i >= NCP_DIO_MAX || (v != 0 && v != 1))
         return refuse(why, len, "set-input: digital input 0..%d, value 0 or 1", NCP_DIO_MAX - 1);
     if (v)
-        atomic_fetch_or(&s->n.ctl->din, 1ull << i);
+        atomic_fetch_or(&s->core.ctl->din, 1ull << i);
     else
-        atomic_fetch_and(&s->n.ctl->din, ~(1ull << i));
+        atomic_fetch_and(&s->core.ctl->din, ~(1ull << i));
     return 0;
 }
 
@@ -617,11 +619,11 @@ static int cmd_step(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     if (s->state == NCP_ST_ESTOP || s->state == NCP_ST_FAULT)
         return refuse(why, len, "not while %s", ncp_nck_state_name(s->state));
     int on = c->ivalue[0] != 0;
-    atomic_store(&s->n.job.step, on);
+    atomic_store(&s->core.job->step, on);
     if (on && s->state == NCP_ST_RUNNING)
         set_state(s, NCP_ST_STEPPING);
     else if (!on && s->state == NCP_ST_STEPPING) {
-        atomic_fetch_add(&s->n.job.step_go, 1);
+        atomic_fetch_add(&s->core.job->step_go, 1);
         set_state(s, NCP_ST_RUNNING);
     }
     if (s->state == NCP_ST_PAUSED && s->resume_state != NCP_ST_MDI)
@@ -635,18 +637,18 @@ static int cmd_stop(struct ncp_nck *s, int full, char *why, size_t len)
         return s->state == NCP_ST_IDLE || s->state == NCP_ST_STOPPING
                    ? 0
                    : refuse(why, len, "not while %s", ncp_nck_state_name(s->state));
-    int interp = s->n.job.kind == NCK_JOB_PROGRAM || s->n.job.kind == NCK_JOB_MDI;
+    int interp = s->core.job->kind == NCK_JOB_PROGRAM || s->core.job->kind == NCK_JOB_MDI;
     begin_drop(s, 1, full, NCP_ST_IDLE, interp);
     return 0;
 }
 
 static int cmd_estop(struct ncp_nck *s)
 {
-    struct nck *n = &s->n;
-    atomic_store(&n->frozen, 1);
+    struct nck_core *n = &s->core;
+    atomic_store(&n->cross.frozen, 1);
     if (s->state == NCP_ST_ESTOP)
         return 0;
-    int interp = n->job.kind == NCK_JOB_PROGRAM || n->job.kind == NCK_JOB_MDI;
+    int interp = n->job->kind == NCK_JOB_PROGRAM || n->job->kind == NCK_JOB_MDI;
     if (s->drop != NCK_DROP_NONE && s->drop != NCK_DROP_HOLD) {
         s->drop_after = NCP_ST_ESTOP;   /* already dropping: end there */
         s->drop_reset |= interp;
@@ -661,12 +663,12 @@ static int cmd_estop(struct ncp_nck *s)
  * (the axes coasted meanwhile), the drives come on again. */
 static int cmd_reset(struct ncp_nck *s, char *why, size_t len)
 {
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     if (s->state != NCP_ST_ESTOP && s->state != NCP_ST_FAULT)
         return s->state == NCP_ST_IDLE ? (s->error[0] = 0, 0)
                                        : refuse(why, len, "nothing to reset while %s",
                                                 ncp_nck_state_name(s->state));
-    atomic_store(&n->loop_fault, NCK_LF_NONE);
+    atomic_store(&n->cross.loop_fault, NCK_LF_NONE);
     s->error[0] = 0;
     /* rest at the actual position while still frozen, then let go */
     begin_drop(s, 0, 0, NCP_ST_IDLE, 0);
@@ -703,7 +705,7 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     case NCP_CMD_OVERRIDE: rc = cmd_override(s, c, why, len); break;
     case NCP_CMD_STEP: rc = cmd_step(s, c, why, len); break;
     case NCP_CMD_OPTIONAL_STOP:
-        atomic_store(&s->n.ctl->optional_stop, c->ivalue[0] != 0);
+        atomic_store(&s->core.ctl->optional_stop, c->ivalue[0] != 0);
         rc = 0;
         break;
     case NCP_CMD_SET_INPUT: rc = cmd_set_input(s, c, why, len); break;
@@ -751,8 +753,8 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
 
 static void job_ended(struct ncp_nck *s)
 {
-    struct nck *n = &s->n;
-    struct nck_job *j = &n->job;
+    struct nck_core *n = &s->core;
+    struct nck_job *j = n->job;
     nck_job_join(n);
     int kind = j->kind;
     j->kind = NCK_JOB_NONE;
@@ -773,7 +775,7 @@ static void job_ended(struct ncp_nck *s)
     }
     /* the whole job in the trace once it is over, not at the next 64 KiB */
     if (n->setup.trace)
-        nck_trace_flush(&n->sum, n->setup.trace);
+        nck_trace_flush(&n->svc->sum, n->setup.trace);
     set_state(s, NCP_ST_IDLE);
 }
 
@@ -782,7 +784,7 @@ static void job_ended(struct ncp_nck *s)
  * it has its own drop, which ends in the state it asked for). */
 static void homing_ended(struct ncp_nck *s)
 {
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     char report[1024];
     int rc = nck_home_report(n, report, sizeof report);
     for (int a = 0; a < NCP_AXES; a++)
@@ -801,46 +803,46 @@ static void homing_ended(struct ncp_nck *s)
         nck_post(n, NCP_EV_INFO, NULL, 0, 0, "homed");
     if (s->state != NCP_ST_HOMING)
         return;
-    memcpy(n->map.pos, n->home.final, sizeof n->map.pos);
+    memcpy(n->job->map.pos, n->cross.home.final, sizeof n->job->map.pos);
     sync_interp(s);
     if (n->setup.trace)
-        nck_trace_flush(&n->sum, n->setup.trace);
+        nck_trace_flush(&n->svc->sum, n->setup.trace);
     set_state(s, NCP_ST_IDLE);
 }
 
 static void check_fault(struct ncp_nck *s)
 {
-    struct nck *n = &s->n;
-    int f = atomic_load_explicit(&n->loop_fault, memory_order_acquire);
+    struct nck_core *n = &s->core;
+    int f = atomic_load_explicit(&n->cross.loop_fault, memory_order_acquire);
     if (f == NCK_LF_NONE || s->state == NCP_ST_FAULT ||
         (s->drop != NCK_DROP_NONE && s->drop_after == NCP_ST_FAULT))
         return;
     if (f == NCK_LF_FERROR)
         snprintf(s->error, sizeof s->error,
                  "following error on %c: %.4f mm exceeds FERROR %.4f mm (line %u); drives off",
-                 NCP_AXIS_LETTERS[n->fault_axis], n->fault_err, n->cfg->axis[n->fault_axis].ferror,
-                 n->fault_line);
+                 NCP_AXIS_LETTERS[n->cross.fault_axis], n->cross.fault_err, n->cfg->axis[n->cross.fault_axis].ferror,
+                 n->cross.fault_line);
     else if (f == NCK_LF_TIMING)
         nck_inject_describe(n, s->error, sizeof s->error);
     else if (f == NCK_LF_JOINT)
         snprintf(s->error, sizeof s->error,
                  "joint limit: the %c joint was commanded to %.4f, beyond [%.4f, %.4f] (line %u); "
-                 "drives off", NCP_AXIS_LETTERS[n->fault_axis], n->fault_err,
-                 n->cfg->joint[n->fault_axis].min_limit, n->cfg->joint[n->fault_axis].max_limit,
-                 n->fault_line);
+                 "drives off", NCP_AXIS_LETTERS[n->cross.fault_axis], n->cross.fault_err,
+                 n->cfg->joint[n->cross.fault_axis].min_limit, n->cfg->joint[n->cross.fault_axis].max_limit,
+                 n->cross.fault_line);
     else {
         char why[NCP_DIAG_MSG_MAX];
-        n->be.ops->describe_fault(&n->be, why, sizeof why);
+        n->cross.be.ops->describe_fault(&n->cross.be, why, sizeof why);
         snprintf(s->error, sizeof s->error, "drive fault: %s", why);
     }
-    nck_post(n, NCP_EV_FAULT, NULL, n->fault_line, 0, "%s", s->error);
-    int interp = n->job.kind == NCK_JOB_PROGRAM || n->job.kind == NCK_JOB_MDI;
+    nck_post(n, NCP_EV_FAULT, NULL, n->cross.fault_line, 0, "%s", s->error);
+    int interp = n->job->kind == NCK_JOB_PROGRAM || n->job->kind == NCK_JOB_MDI;
     begin_drop(s, 0, 0, NCP_ST_FAULT, interp);
 }
 
 int ncp_nck_poll(struct ncp_nck *s)
 {
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     nck_read_cycles(n);
     check_fault(s);
     if (s->drop != NCK_DROP_NONE)
@@ -848,20 +850,20 @@ int ncp_nck_poll(struct ncp_nck *s)
     int st = s->state;
     if ((st == NCP_ST_RUNNING || st == NCP_ST_STEPPING || st == NCP_ST_MDI ||
          st == NCP_ST_JOGGING) &&
-        atomic_load(&n->job.finished) && nck_motion_done(n))
+        atomic_load(&n->job->finished) && nck_motion_done(n))
         job_ended(s);
     if (s->homing_axes && nck_home_finished(n))
         homing_ended(s);
     /* the program paused the machine: PAUSED until resume (tool-changed) */
-    if (n->have_fb && n->last_fb.waits != s->waits_seen) {
+    if (n->svc->have_fb && n->svc->last_fb.waits != s->waits_seen) {
         st = s->state;
-        if (nck_wait_operator(n->last_fb.wait) && s->drop == NCK_DROP_NONE &&
+        if (nck_wait_operator(n->svc->last_fb.wait) && s->drop == NCK_DROP_NONE &&
             (st == NCP_ST_RUNNING || st == NCP_ST_STEPPING || st == NCP_ST_MDI)) {
             s->resume_state = st;
             s->machine_pause = 1;
             set_state(s, NCP_ST_PAUSED);
         }
-        s->waits_seen = n->last_fb.waits;
+        s->waits_seen = n->svc->last_fb.waits;
     }
     if (s->state == NCP_ST_JOGGING && s->jog_continuous && s->drop == NCK_DROP_NONE) {
         double limit = n->setup.jog_keepalive_s > 0 ? n->setup.jog_keepalive_s : 0.3;
@@ -871,12 +873,12 @@ int ncp_nck_poll(struct ncp_nck *s)
             begin_drop(s, 1, 0, NCP_ST_IDLE, 0);
         }
     }
-    if (n->sum.trace_errno && !s->trace_said) {
+    if (n->svc->sum.trace_errno && !s->trace_said) {
         /* the service goes on (an E-stop must not wait for a disk); the
          * operator learns that what follows is not recorded */
         s->trace_said = 1;
         nck_post(n, NCP_EV_ERROR, NULL, 0, 0, "the trace ended early at t %.3f s: %s (its rows "
-                 "so far are whole)", n->sum.t, strerror(n->sum.trace_errno));
+                 "so far are whole)", n->svc->sum.t, strerror(n->svc->sum.trace_errno));
     }
     if (s->shutdown_pending)
         end_check(s, NCK_CHECK_BY_SHUTDOWN);   /* answered by ncp_nck_pending */
@@ -893,13 +895,14 @@ int ncp_nck_poll(struct ncp_nck *s)
 struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *d)
 {
     struct ncp_nck *s = calloc(1, sizeof *s);
-    if (!s) {
+    if (!s || nck_core_alloc(&s->core)) {
+        free(s);
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
         return NULL;
     }
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     n->plan_override = 1.0;
-    n->post_prints = 1;
+    n->cross.post_prints = 1;
     s->rapid_override = 100;
     s->spindle_override = 100;
     s->acfg = setup->interp;
@@ -913,10 +916,10 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
     if (s->interp)   /* no run yet: the codes the first one starts in */
-        ncp_analyzer_active_codes(s->interp, &n->io.active);
-    n->sum.joints = ncp_kins_active(setup->cfg);
+        ncp_analyzer_active_codes(s->interp, &n->cross.io.active);
+    n->svc->sum.joints = ncp_kins_active(setup->cfg);
     if (setup->trace)
-        nck_trace_header(setup->trace, setup->cfg, n->sum.joints,
+        nck_trace_header(setup->trace, setup->cfg, n->svc->sum.joints,
                          setup->trace_rings || setup->cfg->sched.trace_rings);
     if (!s->interp || nck_start(n, setup, 0, d) || nck_start_loop(n, d)) {
         ncp_nck_free(s);
@@ -933,7 +936,7 @@ void ncp_nck_free(struct ncp_nck *s)
 {
     if (!s)
         return;
-    struct nck *n = &s->n;
+    struct nck_core *n = &s->core;
     if (s->loading) {
         end_check(s, NCK_CHECK_BY_FREE);
         pthread_join(s->load_th, NULL);
@@ -943,11 +946,12 @@ void ncp_nck_free(struct ncp_nck *s)
     nck_finish(n);
     nck_read_cycles(n);
     if (n->setup.trace)
-        nck_trace_flush(&n->sum, n->setup.trace);
+        nck_trace_flush(&n->svc->sum, n->setup.trace);
     nck_release(n);
     ncp_analyzer_free(s->interp);
     if (s->have_prog)
         ncp_source_close(&s->prog);
+    nck_core_free(n);
     free(s);
 }
 
@@ -967,7 +971,7 @@ int ncp_nck_shutdown_requested(const struct ncp_nck *s)
 
 void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
 {
-    const struct nck *n = &s->n;
+    const struct nck_core *n = &s->core;
     memset(st, 0, sizeof *st);
     st->state = s->state;
     snprintf(st->program, sizeof st->program, "%s", s->program);
@@ -979,33 +983,33 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
         int k = st->n_axes++;
         st->axes[k] = NCP_AXIS_LETTERS[j];
         st->homed[k] = s->homed[j];
-        st->pos_cmd[k] = n->have_fb ? n->last_fb.cmd[j] : n->start[j];
-        st->pos_act[k] = n->have_fb ? n->last_fb.act[j] : n->start[j];
+        st->pos_cmd[k] = n->svc->have_fb ? n->svc->last_fb.cmd[j] : n->start[j];
+        st->pos_act[k] = n->svc->have_fb ? n->svc->last_fb.act[j] : n->start[j];
     }
-    st->vel = n->have_fb ? n->last_fb.v * 60.0 : 0;
+    st->vel = n->svc->have_fb ? n->svc->last_fb.v * 60.0 : 0;
     st->feed_override = atomic_load(&n->ctl->override_permille) / 10.0;
     st->rapid_override = s->rapid_override;
     st->spindle_override = s->spindle_override;
-    pthread_mutex_t *lock = (pthread_mutex_t *)&n->ev_lock;
+    pthread_mutex_t *lock = (pthread_mutex_t *)&n->cross.ev_lock;
     pthread_mutex_lock(lock);
-    st->line = moving_state(s->state) && n->have_fb && n->last_fb.line ? n->last_fb.line
-                                                                       : n->io.interp_line;
+    st->line = moving_state(s->state) && n->svc->have_fb && n->svc->last_fb.line ? n->svc->last_fb.line
+                                                                       : n->cross.io.interp_line;
     /* the machine as it is (the interpreter runs ahead of it) */
-    const struct nck_fb *fb = &n->last_fb;
-    st->spindle_speed = n->have_fb ? fabs(fb->rpm) : 0;
+    const struct nck_fb *fb = &n->svc->last_fb;
+    st->spindle_speed = n->svc->have_fb ? fabs(fb->rpm) : 0;
     st->spindle_dir = fb->rpm > 0 ? 1 : fb->rpm < 0 ? -1 : 0;
     st->mist = fb->mist;
     st->flood = fb->flood;
     st->tool = fb->tool;
-    st->g5x_index = n->io.g5x_index ? n->io.g5x_index : 1;
-    st->active = n->io.active;
+    st->g5x_index = n->cross.io.g5x_index ? n->cross.io.g5x_index : 1;
+    st->active = n->cross.io.active;
     for (int k = 0; k < 6 && k < NCP_NCK_AXES_MAX; k++)
-        st->g5x_offset[k] = n->io.g5x[k];
+        st->g5x_offset[k] = n->cross.io.g5x[k];
     pthread_mutex_unlock(lock);
-    st->step_mode = atomic_load(&n->job.step);
+    st->step_mode = atomic_load(&n->job->step);
     snprintf(st->error, sizeof st->error, "%s", s->error);
     st->rejected = s->rejected;
-    st->cycles = n->sum.rows;
-    st->deadline_misses = atomic_load(&n->pub_misses);
-    st->latency_max_us = (double)atomic_load(&n->pub_lat_max_ns) / 1e3;
+    st->cycles = n->svc->sum.rows;
+    st->deadline_misses = atomic_load(&n->cross.pub_misses);
+    st->latency_max_us = (double)atomic_load(&n->cross.pub_lat_max_ns) / 1e3;
 }

@@ -12,6 +12,7 @@
  * The loop functions are on the real-time path: no allocation, locks or
  * system calls. */
 #include "nck_int.h"
+#include "loop_state.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -42,24 +43,24 @@ static double switch_at(const struct ncp_axis_cfg *a)
     return a->have_home_switch ? a->home_switch : a->home_offset;
 }
 
-static int pressed(const struct nck *n, int j, double act)
+static int pressed(const struct nck_core *n, int j, double act)
 {
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
-    double phys = act + n->home.off[j];
+    double phys = act + n->loop->home.off[j];
     return (phys - switch_at(a)) * (a->home_search_vel > 0 ? 1 : -1) >= 0;
 }
 
 /* The machine position of axis j becomes `at` where the simulated machine
  * stands at phys: what is commanded moves along, so nothing jumps. */
-static void set_position(struct nck *n, int j, double phys, double at)
+static void set_position(struct nck_core *n, int j, double phys, double at)
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     double d = h->off[j] - (phys - at);
     h->off[j] = phys - at;
     h->ax[j].pos += d;
     h->ax[j].from += d;
-    n->next.pos[j] += d;
-    n->probe.last[j] += d;
+    n->loop->next.pos[j] += d;
+    n->loop->probe.last[j] += d;
 }
 
 static void begin_phase(struct nck_homing *h, int j, int phase)
@@ -69,20 +70,20 @@ static void begin_phase(struct nck_homing *h, int j, int phase)
     h->ax[j].from = h->ax[j].pos;
 }
 
-static void begin_axis(struct nck *n, int j)
+static void begin_axis(struct nck_core *n, int j)
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
     h->ax[j].queued = 0;
     if (a->home_search_vel == 0) {
         /* no switch: the axis is homed where it stands */
-        double phys = n->probe.last[j] + h->off[j];
-        h->ax[j].latched = phys;
+        double phys = n->loop->probe.last[j] + h->off[j];
+        n->cross.home.latched[j] = phys;
         set_position(n, j, phys, a->home_offset);
         begin_phase(h, j, NCK_HP_FINAL);
         return;
     }
-    begin_phase(h, j, pressed(n, j, n->probe.last[j]) ? NCK_HP_OFF_SWITCH : NCK_HP_SEARCH);
+    begin_phase(h, j, pressed(n, j, n->loop->probe.last[j]) ? NCK_HP_OFF_SWITCH : NCK_HP_SEARCH);
 }
 
 /* The velocity each phase runs at (0 once its event came). */
@@ -121,23 +122,23 @@ static int approach(struct nck_home_axis *x, double to, double vmax, double a, d
 
 /* The group's synchronised axes (negative HOME_SEQUENCE) start their final
  * moves together, once every one of them has latched and stopped. */
-static int group_latched(const struct nck *n, int seq)
+static int group_latched(const struct nck_core *n, int seq)
 {
-    const struct nck_homing *h = &n->home;
+    const struct nck_homing *h = &n->loop->home;
     for (int j = 0; j < NCP_AXES; j++)
-        if ((h->mask & NCP_AXIS_BIT(j)) && n->cfg->axis[j].home_sequence < 0 &&
+        if ((n->cross.home.mask & NCP_AXIS_BIT(j)) && n->cfg->axis[j].home_sequence < 0 &&
             nck_home_seq(n->cfg, j) == seq &&
             (h->ax[j].phase != NCK_HP_LATCHED || h->ax[j].v != 0 || h->ax[j].queued))
             return 0;
     return 1;
 }
 
-static void next_phase(struct nck *n, int j)
+static void next_phase(struct nck_core *n, int j)
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
     struct nck_home_axis *x = &h->ax[j];
-    if (h->result != NCK_HOME_OK) {
+    if (n->cross.home.result != NCK_HOME_OK) {
         x->phase = NCK_HP_NONE;
         return;
     }
@@ -156,11 +157,13 @@ static void next_phase(struct nck *n, int j)
     }
 }
 
-static void stop_all(struct nck_homing *h, int result, int axis)
+static void stop_all(struct nck_core *n, int result, int axis)
 {
-    if (h->result == NCK_HOME_OK) {
-        h->result = result;
-        h->fail_axis = axis;
+    struct nck_homing *h = &n->loop->home;
+    struct nck_home_req *r = &n->cross.home;
+    if (r->result == NCK_HOME_OK) {
+        r->result = result;
+        r->fail_axis = axis;
     }
     for (int j = 0; j < NCP_AXES; j++) {
         h->ax[j].queued = 0;
@@ -169,22 +172,22 @@ static void stop_all(struct nck_homing *h, int result, int axis)
     }
 }
 
-static void finish(struct nck *n)
+static void finish(struct nck_core *n)
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     h->active = 0;
-    n->next.v = 0;
-    memcpy(h->final, n->next.pos, sizeof h->final);
-    ncp_scaler_rebase(&n->scaler, n->next.pos);
-    n->ends_seen = n->scaler.ends;
-    atomic_store_explicit(&h->done, h->taken, memory_order_release);
+    n->loop->next.v = 0;
+    memcpy(n->cross.home.final, n->loop->next.pos, sizeof n->cross.home.final);
+    ncp_scaler_rebase(&n->loop->scaler, n->loop->next.pos);
+    n->loop->ends_seen = n->loop->scaler.ends;
+    atomic_store_explicit(&n->cross.home.done, h->taken, memory_order_release);
 }
 
 /* Starts the next HOME_SEQUENCE when the last one is over: 1 while any
  * axis homes. */
-static int start_group(struct nck *n)
+static int start_group(struct nck_core *n)
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     int seq = -1;
     for (int j = 0; j < NCP_AXES; j++) {
         if (h->ax[j].phase != NCK_HP_NONE)
@@ -200,9 +203,9 @@ static int start_group(struct nck *n)
     return 1;
 }
 
-static void step_axis(struct nck *n, int j, double dt)
+static void step_axis(struct nck_core *n, int j, double dt)
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
     struct nck_home_axis *x = &h->ax[j];
     if (x->phase == NCK_HP_FINAL && !x->stopping) {
@@ -218,31 +221,32 @@ static void step_axis(struct nck *n, int j, double dt)
         next_phase(n, j);
     else if (!x->stopping && x->phase != NCK_HP_LATCHED &&
              fabs(x->pos - x->from) > SEARCH_TRAVEL * (a->max_limit - a->min_limit))
-        stop_all(h, NCK_HOME_NOT_FOUND, j);
+        stop_all(n, NCK_HOME_NOT_FOUND, j);
 }
 
-int nck_home_take(struct nck *n)
+int nck_home_take(struct nck_core *n)
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     if (!h->active) {
-        uint32_t req = atomic_load_explicit(&h->req, memory_order_acquire);
+        uint32_t req = atomic_load_explicit(&n->cross.home.req, memory_order_acquire);
         if (req == h->taken)
             return 0;
         h->taken = req;
         h->active = 1;
-        h->result = NCK_HOME_OK;
-        h->fail_axis = -1;
+        n->cross.home.result = NCK_HOME_OK;
+        n->cross.home.fail_axis = -1;
         for (int j = 0; j < NCP_AXES; j++) {
             struct nck_home_axis *x = &h->ax[j];
             memset(x, 0, sizeof *x);
-            x->pos = n->next.pos[j];
-            x->queued = (h->mask & n->cfg->axis_mask & NCP_AXIS_BIT(j)) != 0;
+            n->cross.home.latched[j] = 0;
+            x->pos = n->loop->next.pos[j];
+            x->queued = (n->cross.home.mask & n->cfg->axis_mask & NCP_AXIS_BIT(j)) != 0;
         }
     }
-    n->cur = n->next;
+    n->loop->cur = n->loop->next;
     if ((atomic_load_explicit(&n->ctl->hold, memory_order_relaxed) ||
          atomic_load_explicit(&n->ctl->stop, memory_order_relaxed)))
-        stop_all(h, NCK_HOME_STOPPED, -1);
+        stop_all(n, NCK_HOME_STOPPED, -1);
     if (!start_group(n)) {
         finish(n);
         return 1;
@@ -252,18 +256,18 @@ int nck_home_take(struct nck *n)
         if (h->ax[j].phase == NCK_HP_NONE)
             continue;
         step_axis(n, j, n->cfg->servo_period);
-        n->next.pos[j] = h->ax[j].pos;
+        n->loop->next.pos[j] = h->ax[j].pos;
         v2 += h->ax[j].v * h->ax[j].v;
     }
-    n->next.v = sqrt(v2);
-    n->next.flags = 0;
-    n->next.line = 0;
+    n->loop->next.v = sqrt(v2);
+    n->loop->next.flags = 0;
+    n->loop->next.line = 0;
     return 1;
 }
 
-void nck_home_sense(struct nck *n, const double act[NCP_AXES])
+void nck_home_sense(struct nck_core *n, const double act[NCP_AXES])
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     if (!h->active)
         return;
     for (int j = 0; j < NCP_AXES; j++) {
@@ -280,8 +284,8 @@ void nck_home_sense(struct nck *n, const double act[NCP_AXES])
         default:
             if (on == onto) {
                 /* the latch: here the machine position becomes HOME_OFFSET */
-                x->latched = act[j] + h->off[j];
-                set_position(n, j, x->latched, a->home_offset);
+                n->cross.home.latched[j] = act[j] + h->off[j];
+                set_position(n, j, n->cross.home.latched[j], a->home_offset);
                 x->phase = NCK_HP_LATCHED;
             }
             break;
@@ -289,12 +293,12 @@ void nck_home_sense(struct nck *n, const double act[NCP_AXES])
     }
 }
 
-void nck_home_cancel(struct nck *n)
+void nck_home_cancel(struct nck_core *n)
 {
-    struct nck_homing *h = &n->home;
+    struct nck_homing *h = &n->loop->home;
     if (!h->active)
         return;
-    stop_all(h, NCK_HOME_STOPPED, -1);
+    stop_all(n, NCK_HOME_STOPPED, -1);
     for (int j = 0; j < NCP_AXES; j++) {
         h->ax[j].phase = NCK_HP_NONE;
         h->ax[j].v = 0;
@@ -302,38 +306,38 @@ void nck_home_cancel(struct nck *n)
     finish(n);
 }
 
-int nck_home_active(const struct nck *n)
+int nck_home_active(const struct nck_core *n)
 {
-    return n->home.active;
+    return n->loop->home.active;
 }
 
-uint64_t nck_home_phases(const struct nck *n)
+uint64_t nck_home_phases(const struct nck_core *n)
 {
     uint64_t p = 0;
-    if (!n->home.active)
+    if (!n->loop->home.active)
         return 0;
     for (int j = 0; j < NCP_AXES; j++)
-        p |= (uint64_t)n->home.ax[j].phase << (4 * j);
+        p |= (uint64_t)n->loop->home.ax[j].phase << (4 * j);
     return p;
 }
 
 /* ---- the caller's thread ------------------------------------------------------------- */
 
-void nck_home_request(struct nck *n, unsigned mask)
+void nck_home_request(struct nck_core *n, unsigned mask)
 {
-    n->home.mask = mask;
-    atomic_fetch_add_explicit(&n->home.req, 1, memory_order_release);
+    n->cross.home.mask = mask;
+    atomic_fetch_add_explicit(&n->cross.home.req, 1, memory_order_release);
 }
 
-int nck_home_finished(const struct nck *n)
+int nck_home_finished(const struct nck_core *n)
 {
-    return atomic_load_explicit(&n->home.done, memory_order_acquire) ==
-           atomic_load_explicit(&n->home.req, memory_order_relaxed);
+    return atomic_load_explicit(&n->cross.home.done, memory_order_acquire) ==
+           atomic_load_explicit(&n->cross.home.req, memory_order_relaxed);
 }
 
-int nck_home_report(const struct nck *n, char *buf, size_t len)
+int nck_home_report(const struct nck_core *n, char *buf, size_t len)
 {
-    const struct nck_homing *h = &n->home;
+    const struct nck_home_req *h = &n->cross.home;
     size_t at = 0;
     buf[0] = 0;
     if (h->result == NCK_HOME_NOT_FOUND) {
@@ -359,7 +363,7 @@ int nck_home_report(const struct nck *n, char *buf, size_t len)
                     : snprintf(buf + at, len - at, "%shomed %c: switch at %.4f latched at %.4f "
                                "(%+.4f mm), position set to HOME_OFFSET %.4f there, then to "
                                "HOME %.4f", at ? "\n" : "", NCP_AXIS_LETTERS[j], switch_at(a),
-                               h->ax[j].latched, h->ax[j].latched - switch_at(a), a->home_offset,
+                               h->latched[j], h->latched[j] - switch_at(a), a->home_offset,
                                a->home);
         if (k < 0)
             break;

@@ -3,6 +3,7 @@
  * batch run says on stderr how it will go on. Runs on the caller's thread,
  * from the cycles the position loop reports. */
 #include "nck_int.h"
+#include "service_state.h"
 
 #include <unistd.h>
 
@@ -27,7 +28,7 @@ int nck_wait_operator(int wait)
            wait == NCK_WAIT_TOOL;
 }
 
-void nck_wait_began(struct nck *n, const struct nck_fb *fb)
+void nck_wait_began(struct nck_core *n, const struct nck_fb *fb)
 {
     if (!nck_wait_operator(fb->wait)) {
         if (!n->batch && fb->wait == NCK_WAIT_INPUT)
@@ -35,7 +36,7 @@ void nck_wait_began(struct nck *n, const struct nck_fb *fb)
                      nck_wait_name(fb->wait));
         return;
     }
-    n->pauses++;
+    n->svc->pauses++;
     const char *what = nck_wait_name(fb->wait);
     if (!n->batch) {
         nck_post(n, NCP_EV_INFO, NULL, fb->wait_line, 0, "paused: %s; cnc-ctl %s continues", what,

@@ -1,6 +1,7 @@
 /* The planner/interpolator thread: segments in, one setpoint per planning
  * period out. It lives as long as the NCK; between jobs it waits. */
 #include "nck_int.h"
+#include "planner_state.h"
 #include "ncpar/clock.h"
 
 #include <math.h>
@@ -18,11 +19,11 @@ static void nap_ns(long ns)
 
 /* END and SYNC both make the planner run what it has to a stop; after the
  * END setpoint the next job starts afresh (no blend with what went before). */
-static void pull_segments(struct nck *n, int *finishing, uint32_t *stop_aux, int *aux_stop,
+static void pull_segments(struct nck_core *n, int *finishing, uint32_t *stop_aux, int *aux_stop,
                           struct nck_seg_msg *jump)
 {
     struct nck_seg_msg m;
-    while (!*finishing && !nck_plan_full(n) && ncp_spsc_pop(&n->segs, &m) == 0) {
+    while (!*finishing && !nck_plan_full(n) && ncp_spsc_pop(&n->cross.segs, &m) == 0) {
         if (m.kind == NCK_MSG_SEG) {
             nck_plan_push(n, &m.seg);
         } else {
@@ -41,7 +42,7 @@ static void pull_segments(struct nck *n, int *finishing, uint32_t *stop_aux, int
  * (briefly) for the window; in motion the planner never holds the loop up.
  * Nothing queued and nothing due: no step (idle setpoints would only delay
  * the next job's motion by the ring's length). */
-static int may_step(struct nck *n, int finishing, int64_t *wait_since)
+static int may_step(struct nck_core *n, int finishing, int64_t *wait_since)
 {
     if (finishing || nck_plan_full(n)) {
         *wait_since = 0;
@@ -62,25 +63,25 @@ static int may_step(struct nck *n, int finishing, int64_t *wait_since)
 /* Parked (a drop in progress): the segment ring is emptied (its producer has
  * been stopped) and nothing is planned until the loop has rested and the
  * service thread says where. */
-static void parked(struct nck *n, int *finishing, int *aux_stop)
+static void parked(struct nck_core *n, int *finishing, int *aux_stop)
 {
     struct nck_seg_msg m;
-    while (ncp_spsc_pop(&n->segs, &m) == 0)
+    while (ncp_spsc_pop(&n->cross.segs, &m) == 0)
         ;
-    atomic_store_explicit(&n->park_ack, atomic_load(&n->park_req), memory_order_release);
-    while (!atomic_load(&n->quit) &&
-           atomic_load_explicit(&n->unpark_req, memory_order_acquire) ==
-               atomic_load_explicit(&n->unpark_ack, memory_order_relaxed))
+    atomic_store_explicit(&n->cross.park_ack, atomic_load(&n->cross.park_req), memory_order_release);
+    while (!atomic_load(&n->cross.quit) &&
+           atomic_load_explicit(&n->cross.unpark_req, memory_order_acquire) ==
+               atomic_load_explicit(&n->cross.unpark_ack, memory_order_relaxed))
         nap_ns(200000);
-    nck_plan_reset(n, n->rest);
+    nck_plan_reset(n, n->cross.rest);
     *finishing = 0;
     *aux_stop = 0;
-    atomic_store_explicit(&n->unpark_ack, atomic_load(&n->unpark_req), memory_order_release);
+    atomic_store_explicit(&n->cross.unpark_ack, atomic_load(&n->cross.unpark_req), memory_order_release);
 }
 
 void *nck_planner_main(void *arg)
 {
-    struct nck *n = arg;
+    struct nck_core *n = arg;
     int finishing = 0, aux_stop = 0;
     uint32_t stop_aux = 0;
     int64_t wait_since = 0;
@@ -89,15 +90,15 @@ void *nck_planner_main(void *arg)
     long nap = (long)(n->cfg->servo_period * nck_plan_stream_ratio(n->cfg) * 1e9 / 4) + 1000;
     int64_t last_step = 0;
     nck_sched_enter(n, 1);
-    while (!atomic_load(&n->quit)) {
-        if (atomic_load_explicit(&n->park_req, memory_order_acquire) !=
-            atomic_load_explicit(&n->park_ack, memory_order_relaxed)) {
+    while (!atomic_load(&n->cross.quit)) {
+        if (atomic_load_explicit(&n->cross.park_req, memory_order_acquire) !=
+            atomic_load_explicit(&n->cross.park_ack, memory_order_relaxed)) {
             parked(n, &finishing, &aux_stop);
             jump.jump = 0;
             continue;
         }
         pull_segments(n, &finishing, &stop_aux, &aux_stop, &jump);
-        if (ncp_spsc_count(&n->sps) >= ncp_spsc_capacity(&n->sps) ||
+        if (ncp_spsc_count(&n->cross.sps) >= ncp_spsc_capacity(&n->cross.sps) ||
             !may_step(n, finishing, &wait_since)) {
             int idle = nck_plan_idle(n) && nck_plan_queued(n) == 0;
             if (n->setup.virtual_clock && !idle)
@@ -117,18 +118,18 @@ void *nck_planner_main(void *arg)
             if (aux_stop)
                 sp.flags &= ~(uint32_t)NCP_SP_END;
         }
-        ncp_spsc_push(&n->sps, &sp);
+        ncp_spsc_push(&n->cross.sps, &sp);
         if (n->trace_rings) {
             /* response: one step's work; cycle: from one setpoint to the next */
             int64_t t1 = ncp_mono_ns();
-            atomic_store_explicit(&n->plan_resp_ns, t1 - t0, memory_order_relaxed);
+            atomic_store_explicit(&n->cross.plan_resp_ns, t1 - t0, memory_order_relaxed);
             if (last_step)
-                atomic_store_explicit(&n->plan_cycle_ns, t1 - last_step, memory_order_relaxed);
+                atomic_store_explicit(&n->cross.plan_cycle_ns, t1 - last_step, memory_order_relaxed);
             last_step = t1;
         }
         if (!more) {
             if (!aux_stop)
-                atomic_fetch_add_explicit(&n->ends_pushed, 1, memory_order_release);
+                atomic_fetch_add_explicit(&n->cross.ends_pushed, 1, memory_order_release);
             nck_plan_restart(n);
             /* a synchronised run the position loop moves starts here: the
              * next segment is planned from its end */

@@ -8,6 +8,7 @@
  * result once the move's stop is reached (queue buster, job.c).
  * No allocation, locks or system calls: real-time path. */
 #include "nck_int.h"
+#include "loop_state.h"
 
 #include <string.h>
 
@@ -42,20 +43,21 @@ static void crossing(const struct ncp_io_cfg *io, const double a[NCP_AXES],
         out[k] = a[k] + hi * (b[k] - a[k]);
 }
 
-void nck_probe_arm(struct nck *n, int flags)
+void nck_probe_arm(struct nck_core *n, int flags)
 {
-    struct nck_probe *p = &n->probe;
+    struct nck_probe *p = &n->loop->probe;
+    struct nck_probe_result *r = &n->cross.probe;
     p->flags = flags;
-    p->tripped = 0;
-    p->error = NCK_PROBE_OK;
-    memcpy(p->trip, p->last, sizeof p->trip);
+    r->tripped = 0;
+    r->error = NCK_PROBE_OK;
+    memcpy(r->trip, p->last, sizeof r->trip);
     int contact = in_contact(&n->cfg->io, p->last);
     int away = (flags & NCP_PROBE_F_AWAY) != 0;
     if (contact != away) {
         /* LinuxCNC refuses to start: stop at once, nothing probed */
-        p->error = away ? NCK_PROBE_NOT_TRIPPED_AT_START : NCK_PROBE_TRIPPED_AT_START;
+        r->error = away ? NCK_PROBE_NOT_TRIPPED_AT_START : NCK_PROBE_TRIPPED_AT_START;
         p->state = NCK_PROBE_STOPPING;
-        p->ends_at_trip = n->scaler.ends;
+        p->ends_at_trip = n->loop->scaler.ends;
         return;
     }
     p->state = NCK_PROBE_ARMED;
@@ -63,9 +65,9 @@ void nck_probe_arm(struct nck *n, int flags)
 
 /* The stop the planner made after the probe move: take it off the stream
  * (the scaler's samples first, then the ring). 1 once found. */
-static int drop_to_stop(struct nck *n, uint32_t *aux)
+static int drop_to_stop(struct nck_core *n, uint32_t *aux)
 {
-    struct ncp_scaler *s = &n->scaler;
+    struct ncp_scaler *s = &n->loop->scaler;
     if ((s->b.flags & NCP_SP_END) && !s->b_counted) {
         *aux = s->b.aux;
         return 1;
@@ -76,7 +78,7 @@ static int drop_to_stop(struct nck *n, uint32_t *aux)
     }
     s->have_c = 0;
     struct ncp_setpoint sp;
-    while (ncp_spsc_pop(&n->sps, &sp) == 0)
+    while (ncp_spsc_pop(&n->cross.sps, &sp) == 0)
         if (sp.flags & NCP_SP_END) {
             *aux = sp.aux;
             return 1;
@@ -84,41 +86,42 @@ static int drop_to_stop(struct nck *n, uint32_t *aux)
     return 0;
 }
 
-void nck_probe_cycle(struct nck *n, const double act[NCP_AXES])
+void nck_probe_cycle(struct nck_core *n, const double act[NCP_AXES])
 {
-    struct nck_probe *p = &n->probe;
+    struct nck_probe *p = &n->loop->probe;
+    struct nck_probe_result *r = &n->cross.probe;
     const struct ncp_io_cfg *io = &n->cfg->io;
     if (p->state == NCK_PROBE_ARMED) {
         int want = !(p->flags & NCP_PROBE_F_AWAY);
         if (in_contact(io, act) == want) {
-            crossing(io, p->last, act, want, p->trip);
-            p->tripped = 1;
+            crossing(io, p->last, act, want, r->trip);
+            r->tripped = 1;
             p->state = NCK_PROBE_STOPPING;
-            p->ends_at_trip = n->scaler.ends;
+            p->ends_at_trip = n->loop->scaler.ends;
         }
     }
     memcpy(p->last, act, sizeof p->last);
-    if (p->state == NCK_PROBE_STOPPING && n->scaler.r == 0 && n->cur.v == 0 &&
-        n->next.v == 0) {
+    if (p->state == NCK_PROBE_STOPPING && n->loop->scaler.r == 0 && n->loop->cur.v == 0 &&
+        n->loop->next.v == 0) {
         /* the move's own stop was reached while braking: nothing to drop */
-        p->state = n->scaler.ends != p->ends_at_trip ? NCK_PROBE_OFF : NCK_PROBE_DROPPING;
-        memcpy(p->rest, n->cur.pos, sizeof p->rest);
+        p->state = n->loop->scaler.ends != p->ends_at_trip ? NCK_PROBE_OFF : NCK_PROBE_DROPPING;
+        memcpy(r->rest, n->loop->cur.pos, sizeof r->rest);
     }
     uint32_t aux = 0;
     if (p->state == NCK_PROBE_DROPPING && drop_to_stop(n, &aux)) {
-        ncp_scaler_rebase(&n->scaler, n->cur.pos);
+        ncp_scaler_rebase(&n->loop->scaler, n->loop->cur.pos);
         /* the trace keeps the probe's line while the interpreter catches up */
-        n->scaler.a.line = n->scaler.b.line = n->cur.line;
-        n->next = n->cur;
-        n->ends_seen = n->scaler.ends;
-        if (aux > n->mach.seq_reached)
-            n->mach.seq_reached = aux;
+        n->loop->scaler.a.line = n->loop->scaler.b.line = n->loop->cur.line;
+        n->loop->next = n->loop->cur;
+        n->loop->ends_seen = n->loop->scaler.ends;
+        if (aux > n->loop->mach.seq_reached)
+            n->loop->mach.seq_reached = aux;
         p->state = NCK_PROBE_OFF;
-        atomic_fetch_add_explicit(&n->ends_taken, 1, memory_order_release);
+        atomic_fetch_add_explicit(&n->cross.ends_taken, 1, memory_order_release);
     }
 }
 
-int nck_probe_braking(const struct nck *n)
+int nck_probe_braking(const struct nck_core *n)
 {
-    return n->probe.state >= NCK_PROBE_STOPPING;
+    return n->loop->probe.state >= NCK_PROBE_STOPPING;
 }

@@ -30,27 +30,27 @@ static int pipe_slot(const struct ncp_pipe_thread *t)
 
 static size_t segs_fill(void *ctx)
 {
-    return ncp_spsc_count(&((struct nck *)ctx)->segs);
+    return ncp_spsc_count(&((struct nck_core *)ctx)->cross.segs);
 }
 
 static size_t sps_fill(void *ctx)
 {
-    return ncp_spsc_count(&((struct nck *)ctx)->sps);
+    return ncp_spsc_count(&((struct nck_core *)ctx)->cross.sps);
 }
 
 /* Where the strategy applies: a real-clock position loop on SCHED_FIFO
  * (the virtual clock's threads spin and never run SCHED_FIFO). */
-static int applies(const struct nck *n)
+static int applies(const struct nck_core *n)
 {
     return n->cfg->sched.strategy != NCP_SCHED_NONE && !n->setup.virtual_clock;
 }
 
 /* Static: by distance from the position loop along the whole chain, the
  * planner just below the loop. */
-static int static_prio(const struct nck *n, int rank)
+static int static_prio(const struct nck_core *n, int rank)
 {
     int prio[RANKS];
-    ncp_sched_static(RANKS, n->cfg->sched.floor, n->sched.ceiling, prio);
+    ncp_sched_static(RANKS, n->cfg->sched.floor, n->cross.sched.ceiling, prio);
     return prio[rank];
 }
 
@@ -61,42 +61,42 @@ static void pipe_gauge(void *ctx, struct ncp_sched_fill *f)
     *f = (struct ncp_sched_fill){ pf.in_fill, pf.in_cap, pf.out_fill, pf.out_cap };
 }
 
-void nck_sched_setup(struct nck *n)
+void nck_sched_setup(struct nck_core *n)
 {
     const struct ncp_machine_cfg *c = n->cfg;
-    n->job_place = c->interp;
-    n->planner_place = c->planner;
-    memset(&n->sched, 0, sizeof n->sched);
-    n->sched.cfg = c->sched;
+    n->cross.job_place = c->interp;
+    n->cross.planner_place = c->planner;
+    memset(&n->cross.sched, 0, sizeof n->cross.sched);
+    n->cross.sched.cfg = c->sched;
     int loop = n->setup.loop_priority_min > 0 && n->setup.loop_priority_min < c->position.priority
                    ? n->setup.loop_priority_min
                    : c->position.priority;
-    n->sched.ceiling = ncp_sched_ceiling(loop);
+    n->cross.sched.ceiling = ncp_sched_ceiling(loop);
     if (c->sched.strategy == NCP_SCHED_DATAFLOW) {
         /* the scheduler thread just below the loops, its band below it */
-        n->sched.thread_priority = n->sched.ceiling;
-        n->sched.ceiling--;
+        n->cross.sched.thread_priority = n->cross.sched.ceiling;
+        n->cross.sched.ceiling--;
     }
-    n->sched.n = NCP_SCHED_TASKS;
-    n->sched.task[TASK_JOB] = (struct ncp_sched_task){ .name = "job", .rank = RANK_JOB,
+    n->cross.sched.n = NCP_SCHED_TASKS;
+    n->cross.sched.task[TASK_JOB] = (struct ncp_sched_task){ .name = "job", .rank = RANK_JOB,
                                                        .out_fill = segs_fill,
-                                                       .out_cap = ncp_spsc_capacity(&n->segs),
+                                                       .out_cap = ncp_spsc_capacity(&n->cross.segs),
                                                        .ctx = n };
-    n->sched.task[TASK_PLANNER] = (struct ncp_sched_task){
+    n->cross.sched.task[TASK_PLANNER] = (struct ncp_sched_task){
         .name = "planner", .rank = RANK_PLANNER, .in_fill = segs_fill,
-        .in_cap = ncp_spsc_capacity(&n->segs), .out_fill = sps_fill,
-        .out_cap = ncp_spsc_capacity(&n->sps), .ctx = n
+        .in_cap = ncp_spsc_capacity(&n->cross.segs), .out_fill = sps_fill,
+        .out_cap = ncp_spsc_capacity(&n->cross.sps), .ctx = n
     };
     /* the pipeline's slots stay empty (tid 0, never ranked) until a thread
      * of that kind and index starts */
     for (int i = TASK_PIPE; i < NCP_SCHED_TASKS; i++)
-        n->sched.task[i] = (struct ncp_sched_task){ .name = "pipeline", .gauge = pipe_gauge,
-                                                    .ctx = &n->pipe_thread[i] };
+        n->cross.sched.task[i] = (struct ncp_sched_task){ .name = "pipeline", .gauge = pipe_gauge,
+                                                    .ctx = &n->cross.pipe_thread[i] };
     if (!applies(n))
         return;
     /* both strategies start from the static ranks; data flow moves them */
-    n->job_place = (struct ncp_rt_place){ c->interp.cpu, SCHED_FIFO, static_prio(n, RANK_JOB) };
-    n->planner_place = (struct ncp_rt_place){ c->planner.cpu, SCHED_FIFO,
+    n->cross.job_place = (struct ncp_rt_place){ c->interp.cpu, SCHED_FIFO, static_prio(n, RANK_JOB) };
+    n->cross.planner_place = (struct ncp_rt_place){ c->planner.cpu, SCHED_FIFO,
                                               static_prio(n, RANK_PLANNER) };
 }
 
@@ -105,75 +105,75 @@ void nck_sched_setup(struct nck *n)
  * it from there like the others. */
 static void pipe_started(void *ctx, const struct ncp_pipe_thread *t)
 {
-    struct nck *n = ctx;
+    struct nck_core *n = ctx;
     int slot = pipe_slot(t);
     if (slot < 0)
         return;
     static const int rank[NCP_PIPE_KINDS] = { RANK_FEEDER, RANK_LEXER, RANK_ANALYZER,
                                               RANK_EXECUTOR, RANK_OUTPUT };
-    struct ncp_sched_task *task = &n->sched.task[slot];
-    n->pipe_thread[slot] = *t;
+    struct ncp_sched_task *task = &n->cross.sched.task[slot];
+    n->cross.pipe_thread[slot] = *t;
     task->name = ncp_pipe_kind_name(t->kind);
     task->rank = rank[t->kind];
     struct sched_param sp = { .sched_priority = static_prio(n, task->rank) };
     if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0)
-        atomic_store(&n->prio_seen[slot], sp.sched_priority);
+        atomic_store(&n->cross.prio_seen[slot], sp.sched_priority);
     ncp_sched_enter(task);
 }
 
 static void pipe_ended(void *ctx, const struct ncp_pipe_thread *t)
 {
-    struct nck *n = ctx;
+    struct nck_core *n = ctx;
     int slot = pipe_slot(t);
     if (slot >= 0)
-        ncp_sched_leave_sync(&n->sched, &n->sched.task[slot]);
+        ncp_sched_leave_sync(&n->cross.sched, &n->cross.sched.task[slot]);
 }
 
-const struct ncp_pipe_hooks *nck_sched_pipe_hooks(struct nck *n)
+const struct ncp_pipe_hooks *nck_sched_pipe_hooks(struct nck_core *n)
 {
     if (!applies(n))
         return NULL;
-    n->pipe_hooks = (struct ncp_pipe_hooks){ n, pipe_started, pipe_ended };
-    return &n->pipe_hooks;
+    n->cross.pipe_hooks = (struct ncp_pipe_hooks){ n, pipe_started, pipe_ended };
+    return &n->cross.pipe_hooks;
 }
 
-int nck_sched_start(struct nck *n)
+int nck_sched_start(struct nck_core *n)
 {
-    return applies(n) ? ncp_sched_start(&n->sched) : 0;
+    return applies(n) ? ncp_sched_start(&n->cross.sched) : 0;
 }
 
 /* Called by the task's own thread as it starts: it registers with the
  * scheduler and notes the priority it really got. */
-void nck_sched_enter(struct nck *n, int task)
+void nck_sched_enter(struct nck_core *n, int task)
 {
-    ncp_sched_enter(&n->sched.task[task]);
+    ncp_sched_enter(&n->cross.sched.task[task]);
     if (!applies(n))
         return;
     int policy;
     struct sched_param sp;
     if (pthread_getschedparam(pthread_self(), &policy, &sp) == 0)
-        atomic_store(&n->prio_seen[task], policy == SCHED_FIFO ? sp.sched_priority : 0);
+        atomic_store(&n->cross.prio_seen[task], policy == SCHED_FIFO ? sp.sched_priority : 0);
 }
 
-void nck_sched_leave(struct nck *n, int task)
+void nck_sched_leave(struct nck_core *n, int task)
 {
-    ncp_sched_leave(&n->sched.task[task]);
+    ncp_sched_leave(&n->cross.sched.task[task]);
 }
 
 /* The pipeline's threads for the summary: " pipeline feeder 74, lexers
  * 75, ..." (static: what each kind got) or their data-flow range. */
-static void pipe_summary(const struct nck *n, int dataflow, char *buf, size_t len)
+static void pipe_summary(const struct nck_core *n, int dataflow, char *buf, size_t len)
 {
     size_t at = strlen(buf);
     int lo = 0, hi = 0, threads = 0, kind_prio[NCP_PIPE_KINDS] = { 0 };
     unsigned long long changes = 0;
     for (int i = TASK_PIPE; i < NCP_SCHED_TASKS; i++) {
-        const struct ncp_sched_task *t = &n->sched.task[i];
-        int seen = atomic_load(&n->prio_seen[i]);
+        const struct ncp_sched_task *t = &n->cross.sched.task[i];
+        int seen = atomic_load(&n->cross.prio_seen[i]);
         if (!seen)
             continue;
         threads++;
-        kind_prio[n->pipe_thread[i].kind] = seen;
+        kind_prio[n->cross.pipe_thread[i].kind] = seen;
         int a = t->changes ? (t->prio_min < seen ? t->prio_min : seen) : seen;
         int b = t->changes ? (t->prio_max > seen ? t->prio_max : seen) : seen;
         lo = threads == 1 || a < lo ? a : lo;
@@ -195,7 +195,7 @@ static void pipe_summary(const struct nck *n, int dataflow, char *buf, size_t le
     }
 }
 
-void nck_sched_summary(const struct nck *n, char *buf, size_t len)
+void nck_sched_summary(const struct nck_core *n, char *buf, size_t len)
 {
     buf[0] = '\0';
     const struct ncp_machine_cfg *c = n->cfg;
@@ -206,24 +206,24 @@ void nck_sched_summary(const struct nck *n, char *buf, size_t len)
         snprintf(buf, len, "%s: not applied on the virtual clock", name);
         return;
     }
-    if (!n->loop.fifo || n->sched.refused) {
+    if (!n->cross.rt.fifo || n->cross.sched.refused) {
         snprintf(buf, len, "%s: SCHED_FIFO not permitted, the tasks ran without priorities",
                  name);
         return;
     }
     if (c->sched.strategy == NCP_SCHED_STATIC) {
         snprintf(buf, len, "static: position loop %d, planner %d, job %d", c->position.priority,
-                 atomic_load(&n->prio_seen[TASK_PLANNER]), atomic_load(&n->prio_seen[TASK_JOB]));
+                 atomic_load(&n->cross.prio_seen[TASK_PLANNER]), atomic_load(&n->cross.prio_seen[TASK_JOB]));
         pipe_summary(n, 0, buf, len);
         return;
     }
-    const struct ncp_sched_task *p = &n->sched.task[TASK_PLANNER], *j = &n->sched.task[TASK_JOB];
+    const struct ncp_sched_task *p = &n->cross.sched.task[TASK_PLANNER], *j = &n->cross.sched.task[TASK_JOB];
     snprintf(buf, len,
              "dataflow every %d ms: position loop %d, planner %d..%d (%llu changes), "
              "job %d..%d (%llu changes), band %d..%d, scheduler %d",
              c->sched.period_ms, c->position.priority, p->prio_min, p->prio_max,
              (unsigned long long)p->changes, j->prio_min, j->prio_max,
-             (unsigned long long)j->changes, c->sched.floor, n->sched.ceiling,
-             n->sched.thread_priority);
+             (unsigned long long)j->changes, c->sched.floor, n->cross.sched.ceiling,
+             n->cross.sched.thread_priority);
     pipe_summary(n, 1, buf, len);
 }

@@ -3,7 +3,7 @@
  * caller's) does all of it; the NCK's real-time threads never see a message.
  * Several NC channels share the transport: each message carries its
  * channel, a command goes to the NCK of its channel only. */
-#include "nck_int.h"
+#include "control.h"
 
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
@@ -432,7 +432,7 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
     sv->n_ch = n;
     sv->hook = o->hook;
     /* the transport is one for all: the first channel's machine INI says where */
-    const struct ncp_machine_cfg *cfg = ncks[0]->n.cfg;
+    const struct ncp_machine_cfg *cfg = ncks[0]->core.cfg;
     const char *prefix = o->prefix && *o->prefix ? o->prefix : cfg->lcm.prefix;
     struct ncp_dist_msg_opts mo;
     if (ncp_dist_msg_opts(&cfg->lcm, &mo, d) != NCP_OK) {

@@ -6,12 +6,13 @@
  * neither of them.
  * Real-time rules: no allocation, locks or system calls here. */
 #include "nck_int.h"
+#include "loop_state.h"
 
 #include <math.h>
 
-double nck_spindle_target(const struct nck *n)
+double nck_spindle_target(const struct nck_core *n)
 {
-    const struct nck_mach *m = &n->mach;
+    const struct nck_mach *m = &n->loop->mach;
     double ov = m->en[NCK_EN_SPEED_OVERRIDE]
                     ? atomic_load_explicit(&n->ctl->spindle_permille, memory_order_relaxed) / 1000.0
                     : 1.0;
@@ -21,8 +22,8 @@ double nck_spindle_target(const struct nck *n)
     return t;
 }
 
-int nck_spindle_at_speed(const struct nck *n)
+int nck_spindle_at_speed(const struct nck_core *n)
 {
     double t = nck_spindle_target(n);
-    return fabs(n->mach.rpm - t) <= fmax(1e-6, n->cfg->io.at_speed_tol * fabs(t));
+    return fabs(n->loop->mach.rpm - t) <= fmax(1e-6, n->cfg->io.at_speed_tol * fabs(t));
 }

@@ -2,6 +2,7 @@
  * contour error, the live progress line and the final summary. Runs on the
  * caller's thread, never on the real-time one. */
 #include "nck_int.h"
+#include "service_state.h"
 
 #include <errno.h>
 #include <math.h>
@@ -259,16 +260,16 @@ int nck_trace_flush(struct nck_summary *s, FILE *trace)
     return 0;
 }
 
-int nck_read_cycles(struct nck *n)
+int nck_read_cycles(struct nck_core *n)
 {
     struct nck_fb fb;
     int got = 0;
-    while (ncp_spsc_pop(&n->fbs, &fb) == 0) {
-        nck_account(&n->sum, n->cfg->axis_mask, &fb, n->setup.trace);
-        if (fb.waits != n->last_fb.waits && fb.wait != NCK_WAIT_NONE)
+    while (ncp_spsc_pop(&n->cross.fbs, &fb) == 0) {
+        nck_account(&n->svc->sum, n->cfg->axis_mask, &fb, n->setup.trace);
+        if (fb.waits != n->svc->last_fb.waits && fb.wait != NCK_WAIT_NONE)
             nck_wait_began(n, &fb);
-        n->last_fb = fb;
-        n->have_fb = 1;
+        n->svc->last_fb = fb;
+        n->svc->have_fb = 1;
         got++;
     }
     return got;

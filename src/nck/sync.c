@@ -16,6 +16,7 @@
  * tap's way again, moves back to where the tap started.
  * Real-time rules: no allocation, locks or system calls here. */
 #include "nck_int.h"
+#include "loop_state.h"
 
 #include <math.h>
 #include <string.h>
@@ -25,9 +26,9 @@
 #define CATCH_UP_SHARE 0.5
 
 /* The path's acceleration and speed caps: every axis within its own. */
-static void run_limits(struct nck *n)
+static void run_limits(struct nck_core *n)
 {
-    struct nck_sync_state *st = &n->sync;
+    struct nck_sync_state *st = &n->loop->sync;
     const struct nck_sync_run *r = &st->run;
     const double *from = r->start;
     st->acc = INFINITY;
@@ -109,43 +110,43 @@ static double brake(const struct nck_sync_state *st, double v, double T)
     return fmin(v, fmin(sqrt(2 * CATCH_UP_SHARE * st->acc * left), left / T));
 }
 
-static void write_next(struct nck *n)
+static void write_next(struct nck_core *n)
 {
-    struct nck_sync_state *st = &n->sync;
-    run_point(&st->run, st->s, n->next.pos, n->next.dir, &n->next.line);
-    n->next.v = fabs(st->v);
-    n->next.flags = NCP_SP_SYNC;
-    n->next.rev_rpm = 0;
+    struct nck_sync_state *st = &n->loop->sync;
+    run_point(&st->run, st->s, n->loop->next.pos, n->loop->next.dir, &n->loop->next.line);
+    n->loop->next.v = fabs(st->v);
+    n->loop->next.flags = NCP_SP_SYNC;
+    n->loop->next.rev_rpm = 0;
     if (st->v < 0)
         for (int j = 0; j < NCP_AXES; j++)
-            n->next.dir[j] = -n->next.dir[j];
+            n->loop->next.dir[j] = -n->loop->next.dir[j];
 }
 
-static void begin_wait(struct nck *n, int kind)
+static void begin_wait(struct nck_core *n, int kind)
 {
-    struct nck_mach *m = &n->mach;
+    struct nck_mach *m = &n->loop->mach;
     if (m->wait != kind) {
         m->waits++;
         m->wait = kind;
-        m->wait_line = n->sync.run.l[0].line;
+        m->wait_line = n->loop->sync.run.l[0].line;
     }
 }
 
 /* The spindle's turns since the index, counted the way it turned at the
  * start, and their rate (turns per second), at the instant the setpoint
  * being made is commanded: one period on (the loop runs a setpoint ahead). */
-static double turns(const struct nck *n, double *rate)
+static double turns(const struct nck_core *n, double *rate)
 {
-    const struct nck_sync_state *st = &n->sync;
-    *rate = st->sgn * n->mach.rpm / 60.0;
-    return st->sgn * (n->mach.rev - st->index) + *rate * n->cfg->servo_period;
+    const struct nck_sync_state *st = &n->loop->sync;
+    *rate = st->sgn * n->loop->mach.rpm / 60.0;
+    return st->sgn * (n->loop->mach.rev - st->index) + *rate * n->cfg->servo_period;
 }
 
 /* The motion of one period once locked on to the index. */
-static void move(struct nck *n)
+static void move(struct nck_core *n)
 {
-    struct nck_sync_state *st = &n->sync;
-    struct nck_mach *m = &n->mach;
+    struct nck_sync_state *st = &n->loop->sync;
+    struct nck_mach *m = &n->loop->mach;
     double T = n->cfg->servo_period, rate, pitch = 0;
     double u = turns(n, &rate);
     double target = turns_to_dist(&st->run, u, &pitch), vt = pitch * rate;
@@ -196,49 +197,49 @@ static void move(struct nck *n)
 
 /* The run the loop is about to start: off the sync ring. 0, or -1 when
  * the ring has none (a dropped queue): nothing to do. */
-static int begin(struct nck *n)
+static int begin(struct nck_core *n)
 {
-    struct nck_sync_state *st = &n->sync;
-    if (ncp_spsc_pop(&n->syncq, &st->run) != 0 || st->run.n <= 0)
+    struct nck_sync_state *st = &n->loop->sync;
+    if (ncp_spsc_pop(&n->cross.syncq, &st->run) != 0 || st->run.n <= 0)
         return -1;
     run_limits(n);
     st->s = st->v = 0;
-    st->rpm_cmd = n->mach.rpm_cmd;
-    st->sgn = n->mach.rpm_cmd < 0 ? -1 : 1;
+    st->rpm_cmd = n->loop->mach.rpm_cmd;
+    st->sgn = n->loop->mach.rpm_cmd < 0 ? -1 : 1;
     st->phase = NCK_SYNC_ARRIVE;
     return 0;
 }
 
 /* The stream sits at the run's start: it is the stop the planner made for
  * it (a machine function due a sample early waits for the landing). */
-static int arrived(const struct nck *n)
+static int arrived(const struct nck_core *n)
 {
     for (int j = 0; j < NCP_AXES; j++)
-        if (fabs(n->next.pos[j] - n->sync.run.start[j]) > 1e-6)
+        if (fabs(n->loop->next.pos[j] - n->loop->sync.run.start[j]) > 1e-6)
             return 0;
-    return n->next.v == 0;
+    return n->loop->next.v == 0;
 }
 
 /* The run has ended away from where it started: the stream the planner made
  * after it starts there, so what the scaler holds of before moves too. */
-static void hand_back(struct nck *n)
+static void hand_back(struct nck_core *n)
 {
-    struct nck_sync_state *st = &n->sync;
+    struct nck_sync_state *st = &n->loop->sync;
     double end[NCP_AXES], dir[NCP_AXES], delta[NCP_AXES];
     uint32_t line;
     run_point(&st->run, st->s, end, dir, &line);
     for (int j = 0; j < NCP_AXES; j++)
         delta[j] = end[j] - st->run.start[j];
-    ncp_scaler_jump(&n->scaler, delta);
-    n->next.v = 0;
-    n->next.flags = 0;
-    memset(n->next.dir, 0, sizeof n->next.dir);
-    memcpy(n->next.pos, end, sizeof end);
+    ncp_scaler_jump(&n->loop->scaler, delta);
+    n->loop->next.v = 0;
+    n->loop->next.flags = 0;
+    memset(n->loop->next.dir, 0, sizeof n->loop->next.dir);
+    memcpy(n->loop->next.pos, end, sizeof end);
 }
 
-int nck_sync_cycle(struct nck *n)
+int nck_sync_cycle(struct nck_core *n)
 {
-    struct nck_sync_state *st = &n->sync;
+    struct nck_sync_state *st = &n->loop->sync;
     if (st->phase == NCK_SYNC_IDLE && begin(n) != 0)
         return 0;
     switch (st->phase) {
@@ -253,11 +254,11 @@ int nck_sync_cycle(struct nck *n)
             return 1;
         }
         st->phase = NCK_SYNC_INDEX;
-        st->rev_last = n->mach.rev;
+        st->rev_last = n->loop->mach.rev;
         begin_wait(n, NCK_WAIT_INDEX);
         return 1;
     case NCK_SYNC_INDEX: {
-        double now = n->mach.rev, last = st->rev_last;
+        double now = n->loop->mach.rev, last = st->rev_last;
         st->rev_last = now;
         if (floor(now) == floor(last)) {
             begin_wait(n, NCK_WAIT_INDEX);
@@ -265,7 +266,7 @@ int nck_sync_cycle(struct nck *n)
         }
         /* the whole turn crossed: the index, exactly where it lies */
         st->index = now > last ? floor(now) : floor(last);
-        n->mach.wait = NCK_WAIT_NONE;
+        n->loop->mach.wait = NCK_WAIT_NONE;
         st->phase = st->run.tap ? NCK_SYNC_TAP_IN : NCK_SYNC_FOLLOW;
         move(n);
         write_next(n);
@@ -282,10 +283,10 @@ int nck_sync_cycle(struct nck *n)
     }
 }
 
-void nck_sync_discard(struct nck *n)
+void nck_sync_discard(struct nck_core *n)
 {
     struct nck_sync_run r;
-    while (ncp_spsc_pop(&n->syncq, &r) == 0)
+    while (ncp_spsc_pop(&n->cross.syncq, &r) == 0)
         ;
-    n->sync.phase = NCK_SYNC_IDLE;
+    n->loop->sync.phase = NCK_SYNC_IDLE;
 }

@@ -191,6 +191,8 @@ static void enter_chunk(struct ncp_lex_ahead *la, uint64_t k)
     struct ncp_ahead_slot *s = &la->slot[k % NCP_AHEAD_SLOTS];
     la->chunk = k;
     la->chunk_end = chunk_start(la, k + 1);
+    /* the helper reads ahead of here, never behind */
+    ncp_source_window_at(&la->feed.win, chunk_start(la, k));
     atomic_store_explicit(&la->a_chunk, k, memory_order_relaxed);
     uint64_t tag = TAG(k, AHEAD_OPEN);
     if (atomic_compare_exchange_strong_explicit(&s->tag, &tag, TAG(k, AHEAD_ANALYZER),

@@ -102,7 +102,11 @@ void *ncp_pipe_feeder(void *arg)
     uint32_t line = src->begin_line;
     uint64_t k = 0;
     int col = 0;
+    /* the lexers read behind the feeder, at most a full string ring */
+    struct ncp_source_window win;
+    ncp_source_window_start(&win, src, p->string_fill * NCP_CHUNK_BYTES + NCP_SOURCE_WINDOW_LAG);
     while (off < src->end) {
+        ncp_source_window_at(&win, off);
         uint64_t end = ncp_source_chunk_end(src, off, NCP_CHUNK_BYTES);
         struct ncp_ring *r = &p->strings[col];
         struct ncp_chunk *slot = ncp_ring_reserve(r);
@@ -124,27 +128,14 @@ void *ncp_pipe_feeder(void *arg)
     return stage_done(arg);
 }
 
-#define NCP_PAGE_BYTES 4096u /* the smallest page: no page is stepped over */
-
-/* Without lexer threads (-j 0) the feeder only brings the text into memory
- * ahead of the analyzer: it reads one byte of every page. The first access to
- * a page of a fresh mapping is what costs (page tables; in a virtual machine a
- * shadow-page fault, even with MAP_POPULATE), and this thread pays it off the
- * analyzer's core, far faster than the analyzer reads. It is done long before
- * the analyzer is. */
+/* Without lexer threads (-j 0) this thread used to read one byte of every
+ * page of a mapped program ahead of the analyzer, when the first touch of a
+ * page cost microseconds in these guests. It now does nothing: touching the
+ * whole program ahead would make the process hold all of it, and the
+ * analyzer's window (ncp_source_window) brings the text in as it goes. It
+ * stays a stage so that the layouts keep their threads and statistics. */
 void *ncp_pipe_prefaulter(void *arg)
 {
-    struct ncp_pipe_worker *w = arg;
-    const struct ncp_source *src = w->p->src;
-    const volatile char *text = src->text; /* volatile: every read happens */
-    uint64_t pages = 0;
-    if (!src->mapped) /* a copy in memory (text_mem.h): its pages are in */
-        return stage_done(arg);
-    for (uint64_t off = src->begin; off < src->end; off += NCP_PAGE_BYTES, pages++)
-        (void)text[off];
-    if (src->end > src->begin)
-        (void)text[src->end - 1]; /* a last page the steps missed */
-    w->items = pages;
     return stage_done(arg);
 }
 

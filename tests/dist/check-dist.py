@@ -49,14 +49,24 @@ def path_dev(points, path):
     # a dwell or a pause repeats one point for many periods: as one point,
     # so that the search window ahead of the last match spans the path
     path = [p for i, p in enumerate(path) if i == 0 or p != path[i - 1]]
+    # A path that goes back over itself (Z up, then down the same line) puts
+    # a point at the same distance from both passes: the later one wins, so
+    # the match moves on with the motion instead of staying on the first
+    # pass until the window no longer reaches the rest of the path.
     worst, j = 0.0, 0
     n = len(path)
     for p in points:
+        # most points lie on the path a segment or two on (1 nm): the wide
+        # search only for the others
+        near = [k for k in range(j, min(n - 1, j + 6)) if seg_dist(p, path[k], path[k + 1]) <= 1e-6]
+        if near:
+            j = near[-1]
+            continue
         best, bj = math.inf, j
         for k in range(max(0, j - 50), min(n - 1, j + 300)):
             d = seg_dist(p, path[k], path[k + 1])
-            if d < best:
-                best, bj = d, k
+            if d < best - 1e-9 or (d <= best + 1e-9 and k > bj):
+                best, bj = min(d, best), k
         j = bj
         worst = max(worst, best)
     return worst

@@ -1,7 +1,7 @@
 /* The limits of rt-config/lcnc-compare.ini (LinuxCNC's comparison machine:
  * per axis 100 mm/s and 1000 mm/s^2) and the check of a trace against its
  * acceleration, shared by the motion tests that run against it. Include after
- * trace_rows.h and ncpar/motion.h. */
+ * trace_rows.h and ncpar/config.h. */
 #ifndef NCP_TEST_LCNC_LIMITS_H
 #define NCP_TEST_LCNC_LIMITS_H
 

@@ -20,7 +20,7 @@
 
 #include "ncpar/backend.h"
 #include "ncpar/can.h"
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 
 /* ---- INI ------------------------------------------------------------------ */
 

@@ -199,6 +199,80 @@ static void test_open_regular_file(void **state)
     unlink(path);
 }
 
+/* The process's share of a mapped file, from /proc/self/status. */
+static long rss_file_kb(void)
+{
+    char buf[4096];
+    int fd = open("/proc/self/status", O_RDONLY);
+    if (fd < 0)
+        return -1;
+    ssize_t n = read(fd, buf, sizeof buf - 1);
+    close(fd);
+    if (n <= 0)
+        return -1;
+    buf[n] = '\0';
+    const char *at = strstr(buf, "RssFile:");
+    return at ? strtol(at + 8, NULL, 10) : -1;
+}
+
+/* A sum of every line's bytes and length, read line by line as a reader in
+ * file order does, its window moved as it goes; the most file RSS seen. */
+static uint64_t read_through(const struct ncp_source *src, long *peak_kb)
+{
+    struct ncp_source_window w;
+    struct ncp_span sp;
+    uint64_t sum = 0, off = src->begin;
+    uint32_t line = src->begin_line;
+    ncp_source_window_start(&w, src, NCP_SOURCE_WINDOW_LAG);
+    while (ncp_source_span(src, off, line, &sp) == 0) {
+        ncp_source_window_at(&w, off);
+        sum = sum * 31 + sp.len;
+        for (uint32_t i = 0; i < sp.len; i++)
+            sum += (unsigned char)src->text[sp.off + i];
+        if (sp.line % 4096 == 0) {
+            long kb = rss_file_kb();
+            if (kb > *peak_kb)
+                *peak_kb = kb;
+        }
+        off = sp.next;
+        line++;
+    }
+    return sum;
+}
+
+/* A program over NCP_SOURCE_COPY_MAX is mapped, and a reader holds only a
+ * window of it: the pages behind are handed back as it goes. Read again from
+ * the start, the text is the same (the pages come back from the file). */
+static void test_mapped_window(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ncp-feeder-XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    size_t size = NCP_SOURCE_COPY_MAX + ((size_t)16 << 20) + 12345;
+    char *text = some_text(size, 7);
+    write_file(path, text, size);
+    struct ncp_source src, mem;
+    struct ncp_diag d;
+    assert_int_equal(ncp_source_open(&src, path, &d), NCP_OK);
+    assert_int_equal(src.mapped, 1);
+    assert_int_equal(ncp_source_from_memory(&mem, text, size, NULL, &d), NCP_OK);
+    long base = rss_file_kb(), peak = 0, ignored = 0;
+    assert_true(base >= 0);
+    uint64_t want = read_through(&mem, &ignored);
+    assert_true(read_through(&src, &peak) == want);
+    /* the lag, the step being read and the one asked for ahead, and slack
+     * for pages the kernel maps around a fault */
+    long bound = (long)((NCP_SOURCE_WINDOW_LAG + 4 * NCP_SOURCE_WINDOW_STEP) >> 10);
+    assert_true(peak - base <= bound);
+    peak = 0;
+    assert_true(read_through(&src, &peak) == want);
+    ncp_source_close(&src);
+    free(text);
+    unlink(path);
+}
+
 /* A pipe: read to its end through every growth of the copy (2, 4, 8 MB). */
 static void test_read_stream_grows(void **state)
 {
@@ -313,6 +387,7 @@ int main(void)
         cmocka_unit_test(test_read_stream_grows),
         cmocka_unit_test(test_read_file_shorter_than_said),
         cmocka_unit_test(test_stream_end),
+        cmocka_unit_test(test_mapped_window),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

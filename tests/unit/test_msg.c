@@ -376,6 +376,41 @@ static void test_status_json(void **state)
     assert_int_equal(ncp_msg_status_json(&s, buf, 40), -1);
 }
 
+/* An event as `cnc-ctl events --json` prints it: every kind by name, text
+ * escaped, an empty file null, a full buffer refused. */
+static void test_event_json(void **state)
+{
+    (void)state;
+    static const char *const kinds[] = {"info", "msg", "debug", "print", "error", "fault"};
+    for (int k = NCP_EVENT_T_INFO; k <= NCP_EVENT_T_FAULT; k++)
+        assert_string_equal(ncp_msg_event_kind_name(k), kinds[k]);
+    assert_null(ncp_msg_event_kind_name(6));
+    assert_null(ncp_msg_event_kind_name(-1));
+    ncp_event_t e;
+    memset(&e, 0, sizeof e);
+    e.kind = NCP_EVENT_T_ERROR;
+    e.channel = 3;
+    e.seq = 12;
+    e.utime = 1700000000000001;
+    snprintf((char *)e.file, sizeof e.file, "/parts/a.ngc");
+    e.line = 7;
+    e.col = 4;
+    snprintf((char *)e.text, sizeof e.text, "\"R\" word\tmissing");
+    char buf[2048];
+    int n = ncp_msg_event_json(&e, buf, sizeof buf);
+    assert_true(n > 0 && (size_t)n == strlen(buf));
+    assert_string_equal(buf, "{\"kind\": \"error\", \"channel\": 3, \"seq\": 12, "
+                             "\"utime\": 1700000000000001, \"file\": \"/parts/a.ngc\", "
+                             "\"line\": 7, \"col\": 4, \"text\": \"\\\"R\\\" word\\u0009missing\"}");
+    memset(&e, 0, sizeof e);
+    e.kind = 99;
+    n = ncp_msg_event_json(&e, buf, sizeof buf);
+    assert_true(n > 0);
+    assert_non_null(strstr(buf, "{\"kind\": null, "));
+    assert_non_null(strstr(buf, "\"file\": null, "));
+    assert_int_equal(ncp_msg_event_json(&e, buf, 30), -1);
+}
+
 /* The modal codes in force, spelt as written: code*10 with a decimal, G64's
  * P and Q in the text only when set, -1 slots left out. */
 static void test_active_codes(void **state)
@@ -620,7 +655,7 @@ int main(void)
         cmocka_unit_test(test_command_good),  cmocka_unit_test(test_command_garbage),
         cmocka_unit_test(test_round_trips),   cmocka_unit_test(test_url),
         cmocka_unit_test(test_state_names),   cmocka_unit_test(test_status_json),
-        cmocka_unit_test(test_active_codes),
+        cmocka_unit_test(test_active_codes),  cmocka_unit_test(test_event_json),
         cmocka_unit_test(test_open_errors),   cmocka_unit_test(test_loopback),
         cmocka_unit_test(test_loss_per_channel),
     };

@@ -1,9 +1,9 @@
 /* [KINS] and [JOINT_n] of the machine INI (config_kins.c), read by config.c's
  * loader. Not part of the public contract. */
-#ifndef NCPAR_MOTION_KINS_CFG_H
-#define NCPAR_MOTION_KINS_CFG_H
+#ifndef NCPAR_CONFIG_KINS_CFG_H
+#define NCPAR_CONFIG_KINS_CFG_H
 
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 
 #include <stddef.h>
 

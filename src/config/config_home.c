@@ -1,7 +1,7 @@
 /* The machine INI's homing keys, as LinuxCNC names them: per axis in
  * [AXIS_L], and the simulated home switch's place in [SIM]. What they do
  * is src/nck/homing.c's. */
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 
 #include "ini_num.h"
 

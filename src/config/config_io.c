@@ -2,7 +2,7 @@
  * spindle ([SPINDLE_0]), the tool changer ([EMCIO], LinuxCNC's keys) and the
  * simulated inputs and pause behaviour of a batch run ([SIM]). Every key is
  * optional: a machine file written before these existed keeps its meaning. */
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 #include "ini_num.h"
 
 #include <math.h>

@@ -1,7 +1,7 @@
 /* Numbers in the machine INI (ini_num.c), shared by its readers (config.c,
  * config_home.c, config_io.c, config_kins.c). */
-#ifndef NCPAR_MOTION_INI_NUM_H
-#define NCPAR_MOTION_INI_NUM_H
+#ifndef NCPAR_CONFIG_INI_NUM_H
+#define NCPAR_CONFIG_INI_NUM_H
 
 /* 1 if v is a plain decimal number (sign, digits, point, exponent, trailing
  * blanks): hex, inf, nan or a trailing unit are not what a machinist reading

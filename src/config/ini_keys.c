@@ -1,8 +1,8 @@
-/* The machine INI's keys (include/ncpar/ini_keys.h): what the reader takes
+/* The machine INI's keys (ncpar/config.h): what the reader takes
  * and what ncpar.ini(5) says. A key the reader learns is a row here, or the
  * reader refuses it as unknown; tools/ini-man checks the rows against the
  * reader at build time. */
-#include "ncpar/ini_keys.h"
+#include "ncpar/config.h"
 
 #include <ctype.h>
 #include <string.h>

@@ -1,9 +1,8 @@
 /* Machine INI (LinuxCNC style) read with libinih. Every key is known: a typo in a
  * machine file must not silently fall back to a default. */
-#include "ncpar/motion.h"
+#include "ncpar/config.h"
 #include "ncpar/adcai.h"
 #include "ncpar/http.h"
-#include "ncpar/ini_keys.h"
 #include "ini_num.h"
 #include "kins_cfg.h"
 #include "ncpar/num.h"
