@@ -239,6 +239,14 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
         if (a->stopped)
             break;
     }
+    /* A resident interpreter's last line may have been a queue buster (an
+     * MDI M6, M66 or probe): its answer is this run's, so it is read back
+     * now; the next run's job has none to give for it */
+    if (rc == NCP_END && a->cfg.resident && a->sai.sync) {
+        int synced = ncp_offsets_resync(a);
+        if (synced != NCP_OK)
+            rc = synced;
+    }
     if (rc == NCP_END) {
         ncp_an_finish(a, NCP_CMD_F_END);
         return NCP_END;
