@@ -460,7 +460,7 @@ int ncp_an_steps(struct ncp_analyzer *a)
     if (rc == NCP_OK)
         rc = ncp_step_g_codes(a);
     if (rc == NCP_OK && w->m[NCP_MG_STOP] != -1) {
-        int ran = 0;
+        ran = 0;
         if (a->remaps)
             rc = ncp_remap_step(a, NCP_MG_STOP, &ran);
         if (rc == NCP_OK && !ran)
