@@ -106,19 +106,7 @@ static int g7x_call(struct ncp_analyzer *a, const struct ncp_words *w)
         return rc;
     char text[32];
     int len = snprintf(text, sizeof text, "o%d call", n);
-    struct ncp_block *b = malloc(sizeof *b);
-    if (!b)
-        return ncp_an_error(a, col, "out of memory");
-    ncp_blocks_lex_text(text, (size_t)len, a->line, a->blk->offset, b);
-    b->length = 0; /* not text of the program: nothing to quote */
-    b->oword.col = col;
-    rc = b->err.code;
-    if (rc != NCP_OK)
-        a->err = b->err;
-    else
-        rc = ncp_flow_call_inline(a->flow, b, &a->err);
-    free(b);
-    return rc;
+    return ncp_an_call_text(a, text, (size_t)len, col);
 }
 
 struct g7x_rec {

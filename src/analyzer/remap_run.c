@@ -109,18 +109,7 @@ static int remap_call(struct ncp_analyzer *a, const struct ncp_remap *r, uint16_
         len += snprintf(text + len, sizeof text - (size_t)len, " [%.4f]", args[k].value);
     if (len <= 0 || (size_t)len >= sizeof text)
         return ncp_an_error(a, col, "user-defined %s: call too long", r->code);
-    struct ncp_block *b = malloc(sizeof *b);
-    if (!b)
-        return ncp_an_error(a, col, "out of memory");
-    ncp_blocks_lex_text(text, (size_t)len, a->line, a->blk->offset, b);
-    b->length = 0; /* not text of the program: nothing to quote */
-    b->oword.col = col;
-    int rc = b->err.code;
-    if (rc != NCP_OK)
-        a->err = b->err;
-    else
-        rc = ncp_flow_call_inline(a->flow, b, &a->err);
-    free(b);
+    int rc = ncp_an_call_text(a, text, (size_t)len, col);
     for (int k = 0; rc == NCP_OK && !positional && k < n; k++)
         rc = ncp_params_set_named(a->params, &args[k].name, 1, args[k].value, &a->err);
     return rc;
