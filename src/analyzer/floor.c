@@ -146,7 +146,7 @@ int ncp_an_error(struct ncp_analyzer *a, uint16_t col, const char *fmt, ...)
     a->err.col = col;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(a->err.msg, sizeof a->err.msg, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    vsnprintf(a->err.msg, sizeof a->err.msg, fmt, ap);
     va_end(ap);
     return NCP_ERR_SEMANTIC;
 }

@@ -22,8 +22,7 @@ static int remap_error(struct ncp_diag *d, const struct ncp_remap_line *l, const
     char msg[NCP_DIAG_MSG_MAX];
     va_list ap;
     va_start(ap, fmt);
-    /* the analyzer loses va_start when it analyses several files in one run */
-    vsnprintf(msg, sizeof msg, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     int rc = ncp_diag_set(d, NCP_ERR_SEMANTIC, l->line, 0, "REMAP: %s", msg);
     d->file = l->file ? ncp_diag_file_of_tag(ncp_diag_file_tag(l->file)) : NULL;

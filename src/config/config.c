@@ -114,7 +114,7 @@ static int fail_at(struct load_ctx *lc, unsigned line, const char *fmt, ...)
     char msg[NCP_DIAG_MSG_MAX];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     ncp_diag_set(lc->d, NCP_ERR_SEMANTIC, line, 0, "%s: %s", lc->path, msg);
     return 0;

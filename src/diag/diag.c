@@ -16,7 +16,7 @@ int ncp_diag_set(struct ncp_diag *d, enum ncp_status code, uint32_t line,
     d->file = NULL;
     va_start(ap, fmt);
     /* the analyzer loses va_start across the line above */
-    vsnprintf(d->msg, sizeof d->msg, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    vsnprintf(d->msg, sizeof d->msg, fmt, ap);
     va_end(ap);
     return (int)code;
 }

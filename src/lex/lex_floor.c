@@ -14,7 +14,7 @@ int ncp_lex_fail(struct ncp_lexer *lx, int pos, const char *fmt, ...)
     d->line = lx->b->line;
     d->col = lx->col[pos];
     va_start(ap, fmt);
-    vsnprintf(d->msg, sizeof d->msg, fmt, ap); /* NOLINT(clang-analyzer-valist.Uninitialized): false positive */
+    vsnprintf(d->msg, sizeof d->msg, fmt, ap);
     va_end(ap);
     return NCP_ERR_SYNTAX;
 }

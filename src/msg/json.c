@@ -21,8 +21,7 @@ __attribute__((format(printf, 2, 3))) static void put(struct out *o, const char 
         return;
     va_list ap;
     va_start(ap, fmt);
-    /* the analyzer loses va_start when it analyses several files in one run */
-    int n = vsnprintf(o->buf + o->len, o->size - o->len, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    int n = vsnprintf(o->buf + o->len, o->size - o->len, fmt, ap);
     va_end(ap);
     if (n < 0 || (size_t)n >= o->size - o->len)
         o->full = 1;

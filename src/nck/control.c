@@ -41,7 +41,7 @@ static int refuse(char *reason, size_t len, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(reason, len, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    vsnprintf(reason, len, fmt, ap);
     va_end(ap);
     return -1;
 }

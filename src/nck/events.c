@@ -23,7 +23,7 @@ void nck_post(struct nck_core *n, int kind, const char *file, uint32_t line, uin
     e->col = col;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(e->text, sizeof e->text, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    vsnprintf(e->text, sizeof e->text, fmt, ap);
     va_end(ap);
     pthread_mutex_unlock(&n->cross.ev_lock);
 }

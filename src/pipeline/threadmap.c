@@ -118,7 +118,7 @@ static int fail(struct map_loader *L, int line, const char *fmt, ...)
     va_start(ap, fmt);
     /* clang-analyzer loses track of va_start when it analyses several files in
      * one run and then calls ap uninitialised: a false positive. */
-    vsnprintf(msg, sizeof msg, fmt, ap); // NOLINT(clang-analyzer-valist.Uninitialized)
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     if (!L->failed) {
         L->failed = 1;
