@@ -9,12 +9,16 @@ DRIVE_SIM_OBJS = $(patsubst %.c,$(BUILD)/%.o,$(wildcard src/can-drive-sim/*.c) \
                    src/sched/config.c src/sched/policy.c src/http/policy.c) \
                  $(BUILD)/src/kins/trt.o
 
+# trt.o is C++ (Eigen): libstdc++ for what a sanitizer build of it needs
 $(BUILD)/cnc-drive-sim: $(DRIVE_SIM_OBJS) $(BUILD)/libncpar-can.a
-	$(Q)$(CC) $(ALL_CFLAGS) $(LDFLAGS) -o $@ $^ -lm -linih
+	$(Q)$(CC) $(ALL_CFLAGS) $(LDFLAGS) -o $@ $^ -lm -linih -lstdc++
 
 # The drive's guarding of its master, tested on the host over a socket pair
-# (no CAN needed): the drive's objects without its main.
+# (no CAN needed): the drive's objects without its main; only sources and
+# objects go to the compiler (its .d file adds headers to the prerequisites,
+# which clang would take for headers to precompile).
 $(BUILD)/tests/test_drive_guard: tests/unit/test_drive_guard.c \
         $(filter-out %/cnc_drive_sim.o,$(DRIVE_SIM_OBJS)) $(BUILD)/libncpar-can.a | $(GEN_STAMP)
 	@mkdir -p $(@D)
-	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -Isrc/can-drive-sim -o $@ $^ -lcmocka -lm -linih
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -Isrc/can-drive-sim -o $@ $(filter %.c %.o %.a,$^) \
+	    -lcmocka -lm -linih -lstdc++
