@@ -23,3 +23,15 @@ int ncp_an_call_text(struct ncp_analyzer *a, const char *text, size_t len, uint1
     free(b);
     return rc;
 }
+
+int ncp_an_sub_next(struct ncp_analyzer *a, const struct ncp_block **b)
+{
+    struct ncp_diag d = {0};
+    *b = NULL;
+    int rc = ncp_flow_next(a->flow, b, &d);
+    if (rc == NCP_END)
+        return ncp_an_error(a, 0, "File ended with no percent sign or program end");
+    if (rc != NCP_OK && rc != NCP_FLOW_RETURNED)
+        a->err = d;
+    return rc;
+}

@@ -212,20 +212,15 @@ static int g7x_record(struct ncp_analyzer *a, struct g7x_rec *r, struct ncp_g7x_
                       struct ncp_block *relex, uint32_t *ret_line, uint16_t *ret_col)
 {
     for (;;) {
-        const struct ncp_block *b = NULL;
-        struct ncp_diag d = {0};
-        int rc = ncp_flow_next(a->flow, &b, &d);
+        const struct ncp_block *b;
+        int rc = ncp_an_sub_next(a, &b);
         if (rc == NCP_FLOW_RETURNED) {
             *ret_line = b->line;
             *ret_col = b->oword.col;
             return NCP_OK;
         }
-        if (rc == NCP_END)
-            return ncp_an_error(a, 0, "File ended with no percent sign or program end");
-        if (rc != NCP_OK) {
-            a->err = d;
+        if (rc != NCP_OK)
             return rc;
-        }
         const struct ncp_source *src = ncp_flow_source(a->flow);
         /* it may be a U or W word, which rs274 takes here */
         if (b->err.code != NCP_OK && relex && ncp_blocks_relex_profile(src, b, relex) == 0 &&

@@ -119,17 +119,12 @@ static int remap_call(struct ncp_analyzer *a, const struct ncp_remap *r, uint16_
 static int remap_body(struct ncp_analyzer *a)
 {
     for (;;) {
-        const struct ncp_block *b = NULL;
-        struct ncp_diag d = {0};
-        int rc = ncp_flow_next(a->flow, &b, &d);
+        const struct ncp_block *b;
+        int rc = ncp_an_sub_next(a, &b);
         if (rc == NCP_FLOW_RETURNED)
             return NCP_OK;
-        if (rc == NCP_END)
-            return ncp_an_error(a, 0, "File ended with no percent sign or program end");
-        if (rc != NCP_OK) {
-            a->err = d;
+        if (rc != NCP_OK)
             return rc;
-        }
         a->blk = b;
         a->line = b->line;
         a->file_tag = ncp_flow_file_tag(a->flow);

@@ -46,6 +46,9 @@ int ncp_motion_probe(struct ncp_analyzer *a, int motion);
 /* call_text.c: a call rs274 makes in the block's place ("O<Q> call" for
  * G71, "o<sub> call" for a remap), run inline; col is where it points */
 int ncp_an_call_text(struct ncp_analyzer *a, const char *text, size_t len, uint16_t col);
+/* The next block of the sub such a call runs: NCP_OK, NCP_FLOW_RETURNED at
+ * its return (*b the return's block), else an error, set in a->err */
+int ncp_an_sub_next(struct ncp_analyzer *a, const struct ncp_block **b);
 /* g7x.c: G70, G71, G71.1, G71.2, G72, G72.1, G72.2 (motion x10) */
 int ncp_g7x_run(struct ncp_analyzer *a, int motion);
 int ncp_arc_run(struct ncp_analyzer *a, int motion, const double *end);
