@@ -65,6 +65,10 @@ void ncp_adcai_rough_reset(struct ncp_adcai_rough *r, const double pos[NCP_AXES]
 /* One rough period: 1 and *out filled while there is motion (or a dwell),
  * 0 with a zero record when there is nothing to interpolate. */
 int ncp_adcai_rough_step(struct ncp_adcai_rough *r, struct ncp_adcai_rough_rec *out);
+/* The queue had run out in the middle of a program (the interpreter behind
+ * the chain) and the block that came now makes a corner with the last that
+ * needs a stop: 1 once, so that the caller lets the filters drain first. */
+int ncp_adcai_rough_late_stop(struct ncp_adcai_rough *r);
 /* The path speed the stage gives s: its feed, capped so that no axis exceeds
  * its MAX_VELOCITY and an arc's centripetal acceleration stays within its
  * axes' MAX_ACCELERATION. */

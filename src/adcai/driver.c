@@ -168,6 +168,10 @@ static int next_record(struct ncp_adcai *a)
 {
     struct ncp_adcai_rough_rec rec;
     memset(&rec, 0, sizeof rec);
+    /* a block that came after the one before it had ended, while the
+     * filters still move it: the stop its corner needs is taken now */
+    if (!a->stop_pending && ncp_adcai_rough_late_stop(a->rough) && !drained(a))
+        a->stop_pending = 1;
     if (a->stop_pending && drained(a))
         a->stop_pending = 0;
     /* at rest the setpoint is where the rough stage is: a move that starts

@@ -24,6 +24,11 @@ struct ncp_adcai_rough {
     long dwell_left;        /* rough periods of the dwell at q[head] */
     int64_t pos[NCP_AXES];  /* the sum of the records so far */
     struct ncp_adcai_rough_rec tag;
+    /* The block that ended mid-program with nothing queued after it: the
+     * corner it makes with the next is decided when that one comes, so
+     * that a late interpreter cannot round a corner past its tolerance. */
+    int ran_out;
+    struct ncp_seg last;
 };
 
 /* The largest |d axis / d path| along s, per axis, and what of the axis's
@@ -137,7 +142,7 @@ void ncp_adcai_rough_restart(struct ncp_adcai_rough *r)
 void ncp_adcai_rough_reset(struct ncp_adcai_rough *r, const double pos[NCP_AXES])
 {
     r->head = r->count = 0;
-    r->active = r->finishing = 0;
+    r->active = r->finishing = r->ran_out = 0;
     r->s = r->v = 0;
     r->dwell_left = 0;
     for (int j = 0; j < NCP_AXES; j++)
@@ -267,6 +272,10 @@ static int advance(struct ncp_adcai_rough *r, double p[NCP_AXES])
         t -= left / r->v;
         ncp_seg_eval(s, s->length, p, NULL);
         stop = stops_after(r, s, at(r, 1));
+        if (!stop && r->count == 1) {
+            r->ran_out = 1;
+            r->last = *s;
+        }
         pop(r);
         /* a stop ends the record at the block's end point: the period's rest
          * waits while the ACC/DEC drains */
@@ -274,6 +283,14 @@ static int advance(struct ncp_adcai_rough *r, double p[NCP_AXES])
             return stop;
         start_head(r);
     }
+}
+
+int ncp_adcai_rough_late_stop(struct ncp_adcai_rough *r)
+{
+    if (!r->ran_out || r->active || r->count == 0)
+        return 0;
+    r->ran_out = 0;
+    return stops_after(r, &r->last, at(r, 0));
 }
 
 int ncp_adcai_rough_step(struct ncp_adcai_rough *r, struct ncp_adcai_rough_rec *out)

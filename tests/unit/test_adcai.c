@@ -249,11 +249,12 @@ struct run {
     size_t n, cap;
 };
 
-static void run_driver(struct ncp_adcai *a, struct run *out)
+/* The chain's output appended to out: periods of it, or (periods < 0)
+ * until it ends. */
+static void run_more(struct ncp_adcai *a, struct run *out, long periods)
 {
     struct ncp_setpoint sp;
-    out->n = 0;
-    for (;;) {
+    for (long k = 0; periods < 0 || k < periods; k++) {
         int more = ncp_adcai_step(a, &sp);
         if (out->n == out->cap) {
             out->cap = out->cap ? 2 * out->cap : 4096;
@@ -264,6 +265,12 @@ static void run_driver(struct ncp_adcai *a, struct run *out)
             break;
         assert_true(out->n < 50000000);
     }
+}
+
+static void run_driver(struct ncp_adcai *a, struct run *out)
+{
+    out->n = 0;
+    run_more(a, out, -1);
 }
 
 /* Velocity, acceleration and jerk from the servo output against the limits. */
@@ -341,7 +348,17 @@ static void test_chain_fine_ipo(void **state)
 
 /* The smallest distance of the output from the corner point, and whether
  * the axes stood still there. */
+static double corner_run_late(int term, double tolerance, long late, int *stopped);
+
 static double corner_run(int term, double tolerance, int *stopped)
+{
+    return corner_run_late(term, tolerance, 0, stopped);
+}
+
+/* corner_run with the second move queued only `late` periods after the
+ * chain started: the first has ended by then with nothing after it, as when
+ * the interpreter is behind the machine. */
+static double corner_run_late(int term, double tolerance, long late, int *stopped)
 {
     struct ncp_machine_cfg c;
     machine(&c, NCP_PROFILE_TRAPEZOID, 1);
@@ -350,11 +367,12 @@ static double corner_run(int term, double tolerance, int *stopped)
     const double p0[3] = { 0, 0, 0 }, p1[3] = { 50, 0, 0 }, p2[3] = { 50, 50, 0 };
     struct ncp_seg s1 = line_seg(p0, p1, 40, term), s2 = line_seg(p1, p2, 40, term);
     s1.tolerance = s2.tolerance = tolerance;
+    struct run r = { 0 };
     ncp_adcai_push(a, &s1);
+    run_more(a, &r, late);
     ncp_adcai_push(a, &s2);
     ncp_adcai_finish(a);
-    struct run r = { 0 };
-    run_driver(a, &r);
+    run_more(a, &r, -1);
     double best = INFINITY;
     size_t at = 0;
     for (size_t k = 0; k < r.n; k++) {
@@ -398,6 +416,30 @@ static void test_corner(void **state)
     assert_true(stopped);
     assert_true(corner_run(NCP_TERM_STOP, 0, &stopped) == 0.0);
     assert_true(stopped);
+}
+
+/* The corner a late second move makes with the first is the corner it
+ * makes queued in time: a stop where G64 P or G61 wants one (the first
+ * move's rough interpolation ended 40 periods before the second came,
+ * while its filters still moved), the same rounding where P allows it. */
+static void test_corner_late(void **state)
+{
+    (void)state;
+    int stopped;
+    struct ncp_machine_cfg c;
+    machine(&c, NCP_PROFILE_TRAPEZOID, 1);
+    int n[2];
+    ncp_adcai_windows(&c, c.servo_period, n);
+    long late = 1250 + 40;   /* 50 mm at 40 mm/s, and 40 periods more */
+    assert_true(40 < n[0] + n[1]);
+    double expect = 40 * sqrt(2) * n[0] * c.servo_period / 8;
+    assert_true(corner_run_late(NCP_TERM_CONTINUOUS, 0.9 * expect, late, &stopped) == 0.0);
+    assert_true(stopped);
+    assert_true(corner_run_late(NCP_TERM_EXACT_PATH, 0, late, &stopped) == 0.0);
+    assert_true(stopped);
+    double cut = corner_run_late(NCP_TERM_CONTINUOUS, 2 * expect, late, &stopped);
+    print_message("  late G64 corner cut %.4f mm (P %.4f mm)\n", cut, 2 * expect);
+    assert_true(cut > 0 && cut <= 2 * expect);
 }
 
 /* A dwell comes after a stop and lasts its time in rough periods at rest. */
@@ -508,6 +550,7 @@ int main(void)
         cmocka_unit_test(test_chain_scurve),
         cmocka_unit_test(test_chain_fine_ipo),
         cmocka_unit_test(test_corner),
+        cmocka_unit_test(test_corner_late),
         cmocka_unit_test(test_dwell),
         cmocka_unit_test(test_start_elsewhere),
         cmocka_unit_test(test_ini),
