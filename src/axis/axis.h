@@ -157,6 +157,9 @@ void llc_ai_report(const struct llc *l);
  * whole (the filters and the fine interpolator hold nothing more), so the
  * last setpoint put is where the axis rests until the next record. */
 int llc_ai_at_rest(const struct llc_ai *a);
+/* The stream held the axis in this period while it was moving: the HLC
+ * stamped the next record periods after the last one ended (a stall). */
+int llc_ai_held_in_motion(const struct llc_ai *a, int64_t slot);
 /* The stages one by one (DP1): begin at mm (returned in nm) at point dp, one
  * rough record's sum in, one servo period's setpoint out (nm). */
 int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm);

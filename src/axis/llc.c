@@ -205,6 +205,8 @@ static double follow(struct llc *l, int64_t slot)
 {
     const struct ncp_axis_cfg *a = &l->cfg->axis[l->axis];
     double target = ncp_dist_nm_to_mm(ncp_dist_rx_play(&l->rx, slot));
+    if (l->ai && llc_ai_held_in_motion(l->ai, slot))
+        l->rx.held++;
     if (l->rx.held != l->held_seen) {
         /* a stream that stops with the axis at rest (the program's end, the
          * HLC between jobs) is no loss: heartbeats watch the HLC then. At

@@ -12,7 +12,13 @@
  * sums on the straight line to the later one's, so the stages get a
  * plausible increment and the later sum puts the axis back on the path, no
  * drift. With nothing later yet, the buffer holds and the loop counts it,
- * as at DP5 (MAX_LOST_PERIODS). */
+ * as at DP5 (MAX_LOST_PERIODS).
+ *
+ * A record stamped later than the one before it ended while the axis was
+ * moving is the HLC's loop having skipped periods (a host stall): the
+ * periods between hold where the axis was, since no later setpoint may be
+ * guessed without leaving the other axes' path. That hold is a gap like a
+ * held period at DP5, and the loop counts and traces it as one. */
 #include "axis.h"
 
 #include "ncpar/adcai.h"
@@ -29,6 +35,8 @@ struct llc_ai {
     int32_t in_sum;                 /* this axis's input summed so far, nm (wraps) */
     int64_t out_nm;                 /* the fine interpolator's output, the setpoint */
     int64_t last_t;                 /* the period of the last setpoint put (0: none) */
+    int64_t moved_nm;               /* the last setpoint's step, nm */
+    int64_t hold_from, hold_to;     /* periods held in motion, [from, to] (to < from: none) */
     int32_t put_seq;
     int started;
     uint32_t records, lost, stale;
@@ -43,6 +51,7 @@ struct llc_ai *llc_ai_new(const struct ncp_machine_cfg *cfg)
     if (!a)
         return NULL;
     a->ratio = ratio;
+    a->hold_to = -1;
     a->acc = ncp_adcai_accdec_new(n[0], n[1]);
     a->fine = ncp_adcai_fine_new(ratio, cfg->profile == NCP_PROFILE_SCURVE ? 2 : 1);
     if (!a->acc || !a->fine) {
@@ -66,6 +75,11 @@ static void put(struct llc *l, int64_t t)
 {
     (void)ncp_dist_rx_put(&l->rx, l->ai->put_seq++, t, (int32_t)l->ai->out_nm);
     l->ai->last_t = t;
+}
+
+int llc_ai_held_in_motion(const struct llc_ai *a, int64_t slot)
+{
+    return slot >= a->hold_from && slot <= a->hold_to;
 }
 
 int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm)
@@ -123,11 +137,19 @@ static void stages(struct llc *l, int64_t t, int32_t sum)
         int64_t from = a->last_t + T;
         if (from < t - (NCP_DIST_RX_SLOTS - 8) * T)
             from = t - (NCP_DIST_RX_SLOTS - 8) * T;
+        if (from < t && a->moved_nm != 0) {
+            /* a range that may not have been played yet joins this one */
+            int recent = a->hold_to >= from - (a->ratio + NCP_DIST_PLAY_DELAY + 2) * T;
+            a->hold_from = recent && a->hold_from < from ? a->hold_from : from;
+            a->hold_to = t - T;
+        }
         for (int64_t s = from; s < t; s += T)
             put(l, s);
     }
     for (int k = 0; k < a->ratio; k++) {
+        int64_t before = a->out_nm;
         (void)llc_ai_step(a, l->axis);
+        a->moved_nm = a->out_nm - before;
         put(l, t + k * T);
     }
 }

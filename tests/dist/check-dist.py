@@ -18,8 +18,9 @@ Checks (each prints one line; exit 1 if one fails):
    measure on the central trace's cmd/act), or --contour-floor, whichever is
    larger, over the periods at least 50 periods after a bridged or held one,
    or one whose next setpoint was late for the servo's feed-forward (the LLC
-   trace's gap column: any but 0), and 150 after a left-out one (the
-   saturated drive's catch-up), which must be at least a quarter of them.
+   trace's gap column: any but 0), and 150 after a left-out one or a run of
+   3 or more held ones (the saturated drive's catch-up), which must be at
+   least a quarter of them.
 """
 import argparse
 import csv
@@ -147,8 +148,12 @@ def main():
     # stall of a dozen periods its catch-up takes up to 100 periods, then
     # SETTLE more.
     SETTLE_LEFT_OUT = 150
-    last_gap, last_late, clean, on_time = -10 ** 9, -10 ** 9, [], []
-    left_out = 0
+    # A run of held periods in motion (the HLC's loop stalled longer than
+    # the LLCs' buffer) stops the setpoints as a left-out run does: the
+    # same catch-up of the saturated drive follows it
+    LONG_HOLD = 3
+    last_gap, last_late, last_hold, clean, on_time = -10 ** 9, -10 ** 9, -10 ** 9, [], []
+    left_out = held_run = 0
     for i, s in enumerate(slots):
         gaps = [by[k][s].get("gap", "0") for k in range(3)]
         if any(g != "0" for g in gaps):
@@ -156,7 +161,11 @@ def main():
         if "3" in gaps:
             last_late = i
             left_out += 1
-        clean.append(i - last_gap >= SETTLE and i - last_late >= SETTLE_LEFT_OUT)
+        held_run = held_run + 1 if "2" in gaps else 0
+        if held_run >= LONG_HOLD:
+            last_hold = i
+        clean.append(i - last_gap >= SETTLE and i - last_late >= SETTLE_LEFT_OUT and
+                     i - last_hold >= SETTLE_LEFT_OUT)
         on_time.append(i - last_late >= SETTLE)
     dev = path_dev([p for p, c in zip(dcmd, on_time) if c], ccmd)
     ok = dev <= a.dev_max
