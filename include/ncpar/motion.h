@@ -277,6 +277,12 @@ struct ncp_accdec {
     struct ncp_trap trap;   /* the profile (zero for a dwell) */
     double dur;             /* s */
     uint8_t blend;          /* a G64 corner arc, not a programmed segment */
+    /* The planner's interpolator was told "no more" (a stop for an END,
+     * SYNC or machine function) before this one came: its stream rests one
+     * sample on the stop between them, which an LLC's interpolator, given
+     * the records back to back, must rest too (and leave at the HLC's mark:
+     * the HLC may have waited there, for the spindle say). */
+    uint8_t after_stop;
 };
 
 /* Where the interpolator gets its records. next: the record to run after one
@@ -317,6 +323,7 @@ struct ncp_la {
     double vmax, acc, acc_full, jerk, a_eff, kappa, a_cap;
     double v_end;
     uint8_t blend;
+    uint8_t after_stop;     /* as ncp_accdec's */
 };
 
 /* ADCBI's ACC/DEC stage on its own: the profile of la entered at v0 (the

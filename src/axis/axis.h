@@ -121,6 +121,7 @@ struct llc {
     int32_t start_k[LLC_STARTS];
     int32_t starts_done;
     int ex_on, ex_rest;
+    int stop_rested;              /* the head record is after_stop and the rest before it was taken */
     double ex_prev[NCP_AXES];
     int missing;
     int32_t missing_rec;

@@ -234,8 +234,16 @@ static double follow(struct llc *l, int64_t slot)
 static int rec_next(void *ctx, double v0, struct ncp_accdec *rec)
 {
     struct llc *l = ctx;
-    if (llc_exec_head(l, v0, rec))
+    if (llc_exec_head(l, v0, rec)) {
+        /* the HLC's stream rested a sample on the stop before this record
+         * (its planner's "no more"): so does this one, and it leaves the
+         * stop at the HLC's mark, as from any standstill */
+        if (rec->after_stop && v0 == 0 && !l->stop_rested) {
+            l->stop_rested = 1;
+            return 0;
+        }
         return 1;
+    }
     if (v0 > 0) {
         l->missing = 1;
         l->missing_rec = llc_exec_ring(l)->next;
@@ -245,6 +253,7 @@ static int rec_next(void *ctx, double v0, struct ncp_accdec *rec)
 
 static void rec_done(void *ctx)
 {
+    ((struct llc *)ctx)->stop_rested = 0;
     ncp_dist_recs_pop(llc_exec_ring(ctx));
 }
 
@@ -268,6 +277,7 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
     }
     int64_t due = llc_start_at(l, l->starts_done);
     struct ncp_exec before = l->ex;
+    int stop_rested = l->stop_rested;
     struct ncp_dist_recs *q = llc_exec_ring(l);
     int32_t next = q->next;
     const struct ncp_exec_source src = { rec_next, rec_done, l };
@@ -285,6 +295,7 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
     }
     if (hold || !commit) {
         l->ex = before;
+        l->stop_rested = stop_rested;
         q->next = next;
         if (hold)
             l->missing = 0;

@@ -44,7 +44,8 @@ void ncp_dist_la_encode(const struct ncp_la *la, ncp_la_rec_t *r)
     const double v[8] = { la->vmax,  la->acc,   la->acc_full, la->jerk,
                           la->a_eff, la->kappa, la->a_cap,    la->v_end };
     memcpy(r->la, v, sizeof v);
-    r->blend = (int8_t)la->blend;
+    r->flags = (int8_t)((la->blend ? NCP_LA_REC_T_FLAG_BLEND : 0) |
+                        (la->after_stop ? NCP_LA_REC_T_FLAG_AFTER_STOP : 0));
 }
 
 void ncp_dist_la_decode(const ncp_la_rec_t *r, struct ncp_la *la)
@@ -59,7 +60,8 @@ void ncp_dist_la_decode(const ncp_la_rec_t *r, struct ncp_la *la)
     la->kappa = r->la[5];
     la->a_cap = r->la[6];
     la->v_end = r->la[7];
-    la->blend = (uint8_t)r->blend;
+    la->blend = (r->flags & NCP_LA_REC_T_FLAG_BLEND) != 0;
+    la->after_stop = (r->flags & NCP_LA_REC_T_FLAG_AFTER_STOP) != 0;
 }
 
 void ncp_dist_op_encode(const struct ncp_dist_op *o, ncp_int_rec_t *r)

@@ -14,7 +14,8 @@ void ncp_dist_rec_encode(const struct ncp_accdec *a, ncp_accdec_rec_t *r)
     const struct ncp_seg *s = &a->s;
     memset(r, 0, sizeof *r);
     NCP_DIST_SEG_ENCODE(s, r);
-    r->blend = (int8_t)a->blend;
+    r->flags = (int8_t)((a->blend ? NCP_ACCDEC_REC_T_FLAG_BLEND : 0) |
+                        (a->after_stop ? NCP_ACCDEC_REC_T_FLAG_AFTER_STOP : 0));
     const struct ncp_trap *t = &a->trap;
     const double tr[12] = { t->v0, t->vp, t->v1, t->a,      t->t1, t->t2,
                             t->t3, t->d1, t->d2, t->length, t->j,  a->dur };
@@ -26,7 +27,8 @@ void ncp_dist_rec_decode(const ncp_accdec_rec_t *r, struct ncp_accdec *a)
     struct ncp_seg *s = &a->s;
     memset(a, 0, sizeof *a);
     NCP_DIST_SEG_DECODE(r, s);
-    a->blend = (uint8_t)r->blend;
+    a->blend = (r->flags & NCP_ACCDEC_REC_T_FLAG_BLEND) != 0;
+    a->after_stop = (r->flags & NCP_ACCDEC_REC_T_FLAG_AFTER_STOP) != 0;
     struct ncp_trap *t = &a->trap;
     t->v0 = r->trap[0];
     t->vp = r->trap[1];

@@ -25,6 +25,7 @@ void ncp_la_profile(enum ncp_profile profile, const struct ncp_la *la, double v0
     memset(rec, 0, sizeof *rec);
     rec->s = la->s;
     rec->blend = la->blend;
+    rec->after_stop = la->after_stop;
     if (la->s.kind == NCP_SEG_DWELL) {
         rec->dur = la->s.dwell;
         return;
@@ -52,14 +53,18 @@ void ncp_la_profile(enum ncp_profile profile, const struct ncp_la *la, double v0
 static int head_record(void *ctx, double v0, struct ncp_accdec *rec)
 {
     struct ncp_planner *p = ctx;
-    if (p->count == 0)
+    if (p->count == 0) {
+        p->ended |= p->finished;
         return p->finished ? -1 : 0;
+    }
     const struct plan_seg *ps = plan_at(p, 0);
     struct ncp_la la = {
         .s = ps->s, .vmax = ps->vmax, .acc = ps->acc, .acc_full = ps->acc_full,
         .jerk = ps->jerk, .a_eff = ps->a_eff, .kappa = ps->kappa, .a_cap = ps->a_cap,
         .v_end = p->count > 1 ? plan_at(p, 1)->v_in : 0, .blend = (uint8_t)ps->blend,
+        .after_stop = (uint8_t)p->ended,
     };
+    p->ended = 0;
     ncp_la_profile(p->cfg.profile, &la, v0, rec);
     if (p->tap)
         p->tap(p->tap_ctx, &la, rec);

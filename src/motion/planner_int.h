@@ -32,6 +32,7 @@ struct ncp_planner {
     size_t head, count;
     size_t programmed;       /* queued segments that are not blend arcs */
     int finished;
+    int ended;               /* the interpolator got "no more": the next record is after_stop */
     /* the interpolator: ex.active = q[head] is executing with a frozen profile */
     struct ncp_exec ex;
     void (*tap)(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec);
