@@ -227,19 +227,9 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
     if (o->ini_path) {
         if (rs274_ini_load(o->ini_path, &o->ini) != 0)
             return -1;
-        if (o->ini.sub_path) {
-            o->sub_path = rs274_ini_join_paths(o->acfg.subroutine_path, o->ini.sub_path);
-            if (!o->sub_path)
-                return fprintf(stderr, "cnc-run: out of memory\n"), -1;
-            o->acfg.subroutine_path = o->sub_path;
-        }
+        if (rs274_ini_apply(&o->ini, &o->acfg, &o->sub_path) != 0)
+            return -1;
         o->acfg.ini_given = 1;
-        if (o->ini.ini_vars) {
-            o->acfg.ini_vars = o->ini.vars;
-            o->acfg.n_ini_vars = o->ini.n_vars;
-        }
-        o->acfg.remaps = o->ini.remaps;
-        o->acfg.n_remaps = o->ini.n_remaps;
     }
     return 0;
 }

@@ -8,6 +8,7 @@
 #include "key_opts.h"
 #include "machine.h"
 #include "outfile.h"
+#include "rs274_ini.h"
 #include "signals.h"
 
 #include "ncpar/backend.h"
@@ -521,13 +522,10 @@ static int run_stop_asked(void *ctx)
 }
 
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
-                       const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
+                       const struct ncp_analyzer_cfg *acfg, const struct ncp_source *src,
+                       FILE *trace, struct ncp_rt_stats *lat)
 {
-    struct ncp_cli_interp ic = { src,
-                             { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path,
-                               .max_loop_iterations = o->max_loops, .m66_on_machine = 1,
-                               .cancel = run_stop_asked },
-                             o->mode };
+    struct ncp_cli_interp ic = { src, *acfg, o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
@@ -572,32 +570,11 @@ static int drop_outputs(struct ncp_outfile *trace_of, struct plot_job *pj, struc
     return RUN_USAGE;
 }
 
-int ncp_cli_run(int argc, char **argv)
+/* The run of a loaded machine and interpreter: the program, the outputs. */
+static int run_loaded(const struct run_opts *op, const struct ncp_machine_cfg *cfg,
+                      const struct ncp_analyzer_cfg *acfg)
 {
-    struct run_opts o = { 0 };
-    o.feed_override = 1.0;
-    o.mode = NCP_MODE_SERIAL;
-    if (parse_opts(argc, argv, &o))
-        return usage(stderr), RUN_USAGE;
-    ncp_cli_catch_stop_signals(on_signal);
-    if (o.n_channels) {
-        if (o.plot || o.home)
-            return fprintf(stderr, "cnc-run run: --%s is for one program, not --channel\n",
-                           o.plot ? "plot" : "home"), RUN_USAGE;
-        struct ncp_cli_channel_common cc = {
-            .virtual_clock = o.virtual_clock, .for_s = o.for_s,
-            .feed_override = o.feed_override, .mode = o.mode, .trace = o.trace,
-            .interp = { .tool_table_path = o.tool_table, .subroutine_path = o.sub_path,
-                        .max_loop_iterations = o.max_loops, .m66_on_machine = 1,
-                        .cancel = run_stop_asked },
-            .backend = o.backend, .inject = o.inject, .seed = o.seed,
-            .interrupt = &run_signal, .trace_rings = o.trace_rings,
-        };
-        return ncp_cli_run_channels(o.channel, o.n_channels, &cc);
-    }
-    struct ncp_machine_cfg cfg;
-    if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
-        return RUN_USAGE;
+    const struct run_opts o = *op;
     struct ncp_source src;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
@@ -642,7 +619,7 @@ int ncp_cli_run(int argc, char **argv)
         return drop_outputs(&trace_of, pj, &src);
     }
     struct ncp_rt_stats *lat = calloc(1, sizeof *lat);
-    int rc = lat ? run_program(&o, &cfg, &src, trace, lat) : RUN_FAULT;
+    int rc = lat ? run_program(&o, cfg, acfg, &src, trace, lat) : RUN_FAULT;
     if (trace && fclose(trace) != 0) {
         fprintf(stderr, "cnc-run run: error writing %s: %s\n", trace_path, strerror(errno));
         rc = rc ? rc : RUN_FAULT;
@@ -661,5 +638,49 @@ int ncp_cli_run(int argc, char **argv)
     free(pj);
     free(lat);
     ncp_source_close(&src);
+    return rc;
+}
+
+int ncp_cli_run(int argc, char **argv)
+{
+    struct run_opts o = { 0 };
+    o.feed_override = 1.0;
+    o.mode = NCP_MODE_SERIAL;
+    if (parse_opts(argc, argv, &o))
+        return usage(stderr), RUN_USAGE;
+    ncp_cli_catch_stop_signals(on_signal);
+    if (o.n_channels) {
+        if (o.plot || o.home)
+            return fprintf(stderr, "cnc-run run: --%s is for one program, not --channel\n",
+                           o.plot ? "plot" : "home"), RUN_USAGE;
+        struct ncp_cli_channel_common cc = {
+            .virtual_clock = o.virtual_clock, .for_s = o.for_s,
+            .feed_override = o.feed_override, .mode = o.mode, .trace = o.trace,
+            .interp = { .tool_table_path = o.tool_table, .subroutine_path = o.sub_path,
+                        .max_loop_iterations = o.max_loops, .m66_on_machine = 1,
+                        .cancel = run_stop_asked },
+            .backend = o.backend, .inject = o.inject, .seed = o.seed,
+            .interrupt = &run_signal, .trace_rings = o.trace_rings,
+        };
+        return ncp_cli_run_channels(o.channel, o.n_channels, &cc);
+    }
+    struct ncp_machine_cfg cfg;
+    if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
+        return RUN_USAGE;
+    /* the interpreter of the same INI: its [RS274NGC] (REMAP, folders) */
+    struct ncp_analyzer_cfg acfg = { .tool_table_path = o.tool_table,
+                                     .subroutine_path = o.sub_path,
+                                     .max_loop_iterations = o.max_loops, .m66_on_machine = 1,
+                                     .cancel = run_stop_asked };
+    struct rs274_ini ini;
+    char *joined = NULL;
+    if (rs274_ini_machine(o.config, cfg.rs274.user_m_dirs, &ini, &acfg, &joined)) {
+        rs274_ini_free(&ini);
+        free(joined);
+        return RUN_USAGE;
+    }
+    int rc = run_loaded(&o, &cfg, &acfg);
+    rs274_ini_free(&ini);
+    free(joined);
     return rc;
 }
