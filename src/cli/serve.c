@@ -7,6 +7,7 @@
 #include "inject_opts.h"
 #include "key_opts.h"
 #include "outfile.h"
+#include "rs274_ini.h"
 #include "machine.h"
 #include "signals.h"
 
@@ -187,15 +188,32 @@ struct serve_channel {
     char trace_path[PATH_MAX];
     struct ncp_outfile trace_of;
     FILE *trace;
+    /* its interpreter: the INI's [RS274NGC] over the command line's */
+    struct rs274_ini ini;
+    char *sub_path;
+    struct ncp_analyzer_cfg acfg;
 };
 
 static int load_channel(struct serve_channel *ch, const struct serve_args *a)
 {
+    ch->acfg = (struct ncp_analyzer_cfg){ .tool_table_path = a->tool_table,
+                                          .subroutine_path = a->sub_path };
     return ncp_cli_load_machine(ch->config, &ch->cfg) ||
                    ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
-                   ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg)
+                   ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg) ||
+                   rs274_ini_machine(ch->config, ch->cfg.rs274.user_m_dirs, &ch->ini, &ch->acfg,
+                                     &ch->sub_path)
                ? -1
                : 0;
+}
+
+static void free_channels(struct serve_channel *chs, int n)
+{
+    for (int k = 0; chs && k < n; k++) {
+        rs274_ini_free(&chs[k].ini);
+        free(chs[k].sub_path);
+    }
+    free(chs);
 }
 
 /* the trace is a live record (outfile.h), never over an input */
@@ -261,13 +279,13 @@ static struct serve_channel *load_channels(const struct serve_args *a, int *n)
     for (int k = 0; k < *n; k++) {
         chs[k].trace_of.fd = -1;
         if (load_channel(&chs[k], a))
-            return free(chs), NULL;
+            return free_channels(chs, k + 1), NULL;
     }
     for (int k = 0; k < *n; k++) {
         if (open_trace(&chs[k], a, several)) {
             for (int i = 0; i < k; i++)
                 close_trace(&chs[i]);
-            return free(chs), NULL;
+            return free_channels(chs, *n), NULL;
         }
     }
     return chs;
@@ -290,7 +308,7 @@ int ncp_cli_serve(int argc, char **argv)
     if (ncp_cli_check_key("cnc-run serve", &chs[0].cfg)) {
         for (int k = 0; k < n; k++)
             close_trace(&chs[k]);
-        free(chs);
+        free_channels(chs, n);
         return SERVE_USAGE;
     }
     struct ncp_diag d;
@@ -299,7 +317,7 @@ int ncp_cli_serve(int argc, char **argv)
     if (a.http && start_http(&a, &chs[0].cfg, &http)) {
         for (int k = 0; k < n; k++)
             close_trace(&chs[k]);
-        free(chs);
+        free_channels(chs, n);
         return SERVE_USAGE;
     }
     ncp_cli_catch_stop_signals(on_signal);
@@ -316,7 +334,7 @@ int ncp_cli_serve(int argc, char **argv)
         struct ncp_nck_setup setup = {
             .cfg = &chs[made].cfg, .virtual_clock = a.virtual_clock, .trace = chs[made].trace,
             .mode = a.mode,
-            .interp = { .tool_table_path = a.tool_table, .subroutine_path = a.sub_path },
+            .interp = chs[made].acfg,
             .loop_priority_min = loop_min,
         };
         ncks[made] = ncp_nck_new(&setup, &d);
@@ -358,7 +376,7 @@ int ncp_cli_serve(int argc, char **argv)
     for (int k = 0; k < n; k++)
         if (close_trace(&chs[k]) != 0 && rc == 0)
             rc = 1;
-    free(chs);
+    free_channels(chs, n);
     if (rc == -2)
         return SERVE_FAULT;
     if (rc < 0) {
