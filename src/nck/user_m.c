@@ -57,6 +57,14 @@ static int spawn(pid_t *pid, char *const argv[])
     return rc;
 }
 
+/* The job is aborted (stop, E-stop, shutdown), or a batch run was asked
+ * to stop (a signal): its loop, frozen at rest on a virtual clock while
+ * the program runs, would not get to end the job itself. */
+static int aborted(struct nck_core *n)
+{
+    return atomic_load(&n->job->abort) || (n->batch && atomic_load(&n->ctl->stop));
+}
+
 /* Waits for pid; an abort (stop, E-stop) interrupts the program as
  * LinuxCNC's abort does (SIGINT), and kills it when it does not end within
  * a second. 0 with *status, -1 aborted (reaped all the same). */
@@ -69,7 +77,7 @@ static int wait_child(struct nck_core *n, pid_t pid, int *status)
             return since_abort >= 0 ? -1 : 0;
         if (r < 0 && errno != EINTR)
             return -1;
-        if (since_abort < 0 && atomic_load(&n->job->abort)) {
+        if (since_abort < 0 && aborted(n)) {
             kill(pid, SIGINT);
             since_abort = 0;
         } else if (since_abort >= 0 && (since_abort += 1) == 1000) {
