@@ -26,16 +26,16 @@ static int absolute_dirs(const char *ini_path, const char *value, char *out, siz
         size_t n = strcspn(p, ":");
         int w;
         const char *sep = len ? ":" : "";
+        /* a relative folder is taken from the INI's ("/" included); an INI
+         * named without a folder is in the current one */
+        int rel = n && p[0] != '/' && slash;
         if (n == 0)
             w = 0;
-        else if (p[0] == '/')
-            w = snprintf(out + len, cap - len, "%s%.*s", sep, (int)n, p);
         else if (p[0] == '~' && (n == 1 || p[1] == '/') && home && *home)
             w = snprintf(out + len, cap - len, "%s%s%.*s", sep, home, (int)n - 1, p + 1);
-        else if (slash)
-            w = snprintf(out + len, cap - len, "%s%.*s/%.*s", sep, base, ini_path, (int)n, p);
         else
-            w = snprintf(out + len, cap - len, "%s%.*s", sep, (int)n, p);
+            w = snprintf(out + len, cap - len, "%s%.*s%s%.*s", sep, rel ? base : 0, ini_path,
+                         rel ? "/" : "", (int)n, p);
         if (w < 0 || (size_t)w >= cap - len)
             return -1;
         len += (size_t)w;

@@ -90,6 +90,13 @@ static void test_ini_folders(void **state)
                                        why, sizeof why), 1);
     ncp_rs274_cfg_finish(&r);
     assert_string_equal(r.user_m_dirs, "nc_files:/etc/ncpar/mcodes:/opt/m:/home/op/m");
+    /* an INI in the root folder, and one named without a folder */
+    assert_int_equal(ncp_rs274_cfg_key(&r, "/m.ini", "RS274NGC", "USER_M_PATH", "mc", why,
+                                       sizeof why), 1);
+    assert_string_equal(r.user_m_path, "/mc");
+    assert_int_equal(ncp_rs274_cfg_key(&r, "m.ini", "RS274NGC", "USER_M_PATH", "mc:/a", why,
+                                       sizeof why), 1);
+    assert_string_equal(r.user_m_path, "mc:/a");
     char big[2000];
     memset(big, 'x', sizeof big - 1);
     big[sizeof big - 1] = '\0';
