@@ -65,6 +65,7 @@ static void usage(FILE *f)
           "                      (REMAP, SUBROUTINE_PATH, USER_M_PATH: M100-M199 run their\n"
           "                      executables, the machine at rest) configures the\n"
           "                      interpreter, as in LinuxCNC (docs/remap.md)\n"
+          "  --ini INI           the same as --config (parse's name for it)\n"
           "  --trace CSV         per-cycle trace: t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n"
           "                      (motion: 0 rapid, 1 feed, 2 arc); an existing CSV (the\n"
           "                      last run's) is kept as CSV.1\n"
@@ -128,6 +129,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
 {
     static const struct option longopts[] = {
         { "config", required_argument, 0, 'c' },
+        { "ini", required_argument, 0, 'N' },
         { "trace", required_argument, 0, 't' },
         { "plot", required_argument, 0, 'p' },
         { "for", required_argument, 0, 'f' },
@@ -154,7 +156,14 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     optind = 1;
     while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:I:R:HD:U:", longopts, NULL)) != -1) {
         switch (c) {
-        case 'c': o->config = optarg; break;
+        case 'c': case 'N':
+            /* --ini as parse's: the one INI, the machine's and its interpreter's */
+            if (o->config && strcmp(o->config, optarg) != 0)
+                return fprintf(stderr, "cnc-run run: --config and --ini name one INI, the "
+                                       "machine's with its [RS274NGC]: not '%s' and '%s'\n",
+                               o->config, optarg), -1;
+            o->config = optarg;
+            break;
         case 't': o->trace = optarg; break;
         case 'p': o->plot = optarg; break;
         case 'T': o->tool_table = optarg; break;

@@ -56,7 +56,8 @@ static void usage(FILE *f)
           "are and waits for commands on LCM (cnc-ctl is its command-line client).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill); [LCM] URL,\n"
           "                      CHANNEL_PREFIX (NCP_) and STATUS_HZ (50) are read from it,\n"
-          "                      [RS274NGC] (REMAP, USER_M_PATH...) as run's.\n"
+          "                      [RS274NGC] (REMAP, USER_M_PATH...) as run's. --ini INI\n"
+          "                      is the same as --config.\n"
           "                      An INI of [CHANNEL_n] sections (n 0..15, CONFIG = machine\n"
           "                      INI, relative to its folder) serves one NCK per NC channel;\n"
           "                      LCM messages carry the channel (cnc-ctl --channel N), [LCM]\n"
@@ -99,7 +100,8 @@ struct serve_args {
 static int parse(int argc, char **argv, struct serve_args *a)
 {
     static const struct option longopts[] = {
-        { "config", required_argument, 0, 'c' }, { "lcm-url", required_argument, 0, 'u' },
+        { "config", required_argument, 0, 'c' }, { "ini", required_argument, 0, 'N' },
+        { "lcm-url", required_argument, 0, 'u' },
         { "prefix", required_argument, 0, 'P' }, { "clock", required_argument, 0, 'k' },
         { "trace", required_argument, 0, 't' }, { "mode", required_argument, 0, 'm' },
         { "tool-table", required_argument, 0, 'T' },
@@ -113,7 +115,13 @@ static int parse(int argc, char **argv, struct serve_args *a)
     optind = 1;
     while ((c = getopt_long(argc, argv, "c:u:P:k:t:m:T:S:hI:R:", longopts, NULL)) != -1) {
         switch (c) {
-        case 'c': a->config = optarg; break;
+        case 'c': case 'N':
+            if (a->config && strcmp(a->config, optarg) != 0)
+                return fprintf(stderr, "cnc-run serve: --config and --ini name one INI, the "
+                                       "machine's with its [RS274NGC]: not '%s' and '%s'\n",
+                               a->config, optarg), -1;
+            a->config = optarg;
+            break;
         case 'u': a->url = optarg; break;
         case 'P': a->prefix = optarg; break;
         case 't': a->trace = optarg; break;
