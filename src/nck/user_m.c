@@ -67,7 +67,8 @@ static int aborted(struct nck_core *n)
 
 /* Waits for pid; an abort (stop, E-stop) interrupts the program as
  * LinuxCNC's abort does (SIGINT), and kills it when it does not end within
- * a second. 0 with *status, -1 aborted (reaped all the same). */
+ * a second. 0 with *status, -1 aborted (reaped all the same), or an errno
+ * of waitpid (the child lost: someone else reaped it). */
 static int wait_child(struct nck_core *n, pid_t pid, int *status)
 {
     long since_abort = -1;
@@ -76,7 +77,7 @@ static int wait_child(struct nck_core *n, pid_t pid, int *status)
         if (r == pid)
             return since_abort >= 0 ? -1 : 0;
         if (r < 0 && errno != EINTR)
-            return -1;
+            return errno > 0 ? errno : EIO;
         if (since_abort < 0 && aborted(n)) {
             kill(pid, SIGINT);
             since_abort = 0;
@@ -116,7 +117,13 @@ int nck_user_m_run(struct nck_core *n, const struct ncp_cmd *cmd, const struct n
         return -1;
     }
     int st = 0;
-    if (wait_child(n, pid, &st))
+    int w = wait_child(n, pid, &st);
+    if (w > 0) {
+        ncp_diag_set(&j->map_diag, NCP_ERR_IO, cmd->line, col, "M%d: lost %s while it ran: %s",
+                     code, path, strerror(w));
+        j->map_diag.file = file;
+    }
+    if (w)
         return -1;
     if (WIFEXITED(st) && WEXITSTATUS(st) == 0)
         return 0;
