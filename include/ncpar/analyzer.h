@@ -85,6 +85,13 @@ struct ncp_analyzer_cfg {
      * (#5399) the interpreter reads back at a queue buster (see
      * ncp_machine_sync). 0 (parse, check): no call, rs274 -g's stand-in. */
     int m66_on_machine;
+    /* The machine's M100..M199 (LinuxCNC's user M codes): folders, ':'
+     * between them, searched in order for an executable file M1nn when the
+     * interpreter is made. A code found there becomes a USER_M call, which
+     * the NCK runs with the machine at rest; one not found is refused as
+     * rs274 refuses it ("Unknown m code used"). NULL (parse, check: rs274 -g
+     * runs none): every one is refused. */
+    const char *user_m_dirs;
     /* A stop request (a signal, an operator's abort), asked every 64
      * blocks the interpreter reads, laps of loops and skipped lines
      * included (well under a millisecond): nonzero ends the run there with
@@ -116,6 +123,12 @@ struct ncp_machine_sync {
 };
 /* Returns 0 with ms filled, or non-zero when the run is being stopped. */
 typedef int (*ncp_machine_sync_fn)(void *ctx, struct ncp_machine_sync *ms);
+
+/* The executable file M<code> (100..199) in the first of dirs (':' between
+ * folders) that has one, as LinuxCNC's task finds it: its path in out, 0;
+ * -1 when none has it (or it does not fit out). A file that is not
+ * executable is passed over. */
+int ncp_user_m_find(const char *dirs, int code, char *out, size_t len);
 
 struct ncp_analyzer;
 

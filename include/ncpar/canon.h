@@ -78,6 +78,7 @@ enum ncp_canon_kind {
     NCP_C_RIGID_TAP,             /* rigid_tap (G33.1): back at the start after */
     NCP_C_RAW_TEXT,              /* text printed verbatim (for calls not modelled above) */
     NCP_C_WAIT_INPUT,            /* wait_input: M66 for the NCK only, rs274 -g prints nothing */
+    NCP_C_USER_M,                /* user_m: M100..M199 for the NCK only (rs274 -g has none) */
     NCP_C__COUNT
 };
 
@@ -183,6 +184,10 @@ struct ncp_canon {
         struct { NCP_CANON_IPAD(0); double bottom[3]; } rigid_tap; /* x y z of the hole's bottom */
         /* M66: P (digital, analog 0) or E (analog 1), L the wait mode, Q the timeout */
         struct { int32_t index, mode, analog; NCP_CANON_IPAD(3); double timeout; } wait_input;
+        /* M100..M199: the machine's program M<code> runs with P and Q as its
+         * arguments (-1 when the block has none, as LinuxCNC passes them);
+         * col: the M word's, for the error of a program that fails */
+        struct { int32_t code, col; NCP_CANON_IPAD(2); double p, q; } user_m;
     };
 };
 
@@ -221,7 +226,8 @@ _Static_assert(offsetof(struct ncp_canon, offset.v) == NCP_CANON_D0 &&
                offsetof(struct ncp_canon, nurbs.ctrl) == NCP_CANON_D0 + 5 * 8 &&
                offsetof(struct ncp_canon, nurbs.follow) == NCP_CANON_I0 + 2 * 4 &&
                offsetof(struct ncp_canon, nurbs_points.pt) == NCP_CANON_D0 &&
-               offsetof(struct ncp_canon, rigid_tap.bottom) == NCP_CANON_D0,
+               offsetof(struct ncp_canon, rigid_tap.bottom) == NCP_CANON_D0 &&
+               offsetof(struct ncp_canon, user_m.p) == NCP_CANON_D0,
                "every kind's fields stand where raw's do");
 
 #define NCP_CMD_MAX_OPS 8       /* more calls for one block continue in the next slot */

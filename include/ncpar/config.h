@@ -205,6 +205,18 @@ struct ncp_machine_cfg {
     struct ncp_inject_cfg inject;
     struct ncp_kins kins;         /* [KINS] KINEMATICS and the pivot offsets */
     struct ncp_joint_cfg joint[NCP_AXES];
+    /* The interpreter's keys of a LinuxCNC INI ([RS274NGC], [DISPLAY]
+     * PROGRAM_PREFIX). REMAP, SUBROUTINE_PATH and INI_VARS are the
+     * interpreter's own: cnc-run reads them from the same file (rs274_ini.c);
+     * the NCK needs only where the user M codes' programs are. Folders are
+     * absolute here, relative ones taken from the INI's folder. */
+    struct ncp_rs274_cfg {
+        char program_prefix[512]; /* [DISPLAY] PROGRAM_PREFIX ("" none) */
+        char user_m_path[1024];   /* [RS274NGC] USER_M_PATH, ':' between folders */
+        /* both, in LinuxCNC's order of search for M100..M199: PROGRAM_PREFIX,
+         * then USER_M_PATH's folders; "" none */
+        char user_m_dirs[1540];
+    } rs274;
 };
 
 void ncp_machine_cfg_default(struct ncp_machine_cfg *c);
@@ -217,6 +229,13 @@ int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp
 void ncp_io_cfg_default(struct ncp_io_cfg *io);
 int ncp_io_cfg_key(struct ncp_io_cfg *io, const char *sec, const char *k, const char *v,
                    char *why, size_t len);
+/* config_rs274.c: one key of [RS274NGC] or [DISPLAY] (1 taken, 0 unknown,
+ * -1 bad value, -2 not one of those sections); ini_path is the INI's, for
+ * its relative folders. ncp_rs274_cfg_finish joins the folders once the
+ * file is read. */
+int ncp_rs274_cfg_key(struct ncp_rs274_cfg *r, const char *ini_path, const char *sec,
+                      const char *k, const char *v, char *why, size_t len);
+void ncp_rs274_cfg_finish(struct ncp_rs274_cfg *r);
 /* config_home.c: one [AXIS_L] homing key (1 taken, 0 unknown, -1 bad
  * value), one [SIM] HOME_SWITCH_<L> key (same, -2 not such a key), and the
  * checks across an axis's homing keys once the file is read (0, or -1 with

@@ -135,6 +135,15 @@ static inline void ncp_remap_note_builtin(struct ncp_analyzer *a)
     a->remap_builtin[a->remap_level > 0 ? a->remap_level - 1 : 0] = 1;
 }
 
+/* user_m.c: which of M100..M199 the machine has a program for (made once,
+ * from cfg.user_m_dirs) */
+void ncp_user_m_scan(struct ncp_analyzer *a);
+static inline int ncp_user_m_has(const struct ncp_analyzer *a, int m)
+{
+    unsigned k = (unsigned)(m - 100);
+    return k < 100 && ((a->user_m[k / 64] >> (k % 64)) & 1u);
+}
+
 /* stop.c */
 int ncp_stop_run(struct ncp_analyzer *a, int m);
 void ncp_state_init(struct ncp_analyzer *a);

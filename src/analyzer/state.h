@@ -178,6 +178,8 @@ struct ncp_analyzer {
     /* REMAP (remap_run.c): NULL without REMAP lines; the remaps running,
      * innermost last (#<_remap_level> is their count) */
     struct ncp_remaps *remaps;
+    /* M100+k has an executable on the machine (cfg.user_m_dirs): bit k */
+    uint64_t user_m[2];
     int remap_level;
     struct ncp_remap_frame remap_frames[NCP_REMAP_DEPTH];
     /* rs274's builtin_used of the line running at each remap level: a code

@@ -279,8 +279,15 @@ static int ncp_m_group_run(struct ncp_analyzer *a, int slot)
     default:
         /* M100-M199 run the machine's programs of that name; rs274 -g has
          * none (its canon knows no user function), so it refuses them here,
-         * after the block's other M codes */
-        return ncp_an_error(a, w->mcol[slot], "Unknown m code used: M%d", m);
+         * after the block's other M codes, as does a machine without one */
+        if (!ncp_user_m_has(a, m))
+            return ncp_an_error(a, w->mcol[slot], "Unknown m code used: M%d", m);
+        struct ncp_canon *op = ncp_an_emit(a, NCP_C_USER_M);
+        op->user_m.code = m;
+        op->user_m.col = w->mcol[slot];
+        op->user_m.p = NCP_HAS(w, 'P') ? w->v[NCP_LETTER('P')] : -1.0;
+        op->user_m.q = NCP_HAS(w, 'Q') ? w->v[NCP_LETTER('Q')] : -1.0;
+        return NCP_OK;
     }
 }
 

@@ -5,6 +5,7 @@
  * signal stops them all. Everything is loaded and every output opened (or
  * refused) before any channel moves. */
 #include "channels.h"
+#include "rs274_ini.h"
 #include "inject_opts.h"
 #include "machine.h"
 #include "nck_run.h"
@@ -36,6 +37,8 @@ struct channel {
     struct ncp_outfile trace_of;
     FILE *trace;
     struct ncp_cli_interp ic;
+    struct rs274_ini rs274;         /* the INI's [RS274NGC]: ic's REMAP, folders */
+    char *sub_path;
     struct ncp_nck_opts no;
     struct ncp_nck_result res;
     pthread_t thread;
@@ -98,8 +101,11 @@ static int parse_spec(struct channel *ch, const char *spec)
 
 static int load_channel(struct channel *ch, const struct ncp_cli_channel_common *c)
 {
+    ch->ic = (struct ncp_cli_interp){ &ch->src, c->interp, c->mode };
     if (ncp_cli_load_machine(ch->ini, &ch->cfg) ||
-        ncp_cli_apply_inject("cnc-run run", c->inject, c->seed, &ch->cfg))
+        ncp_cli_apply_inject("cnc-run run", c->inject, c->seed, &ch->cfg) ||
+        rs274_ini_machine(ch->ini, ch->cfg.rs274.user_m_dirs, &ch->rs274, &ch->ic.acfg,
+                          &ch->sub_path))
         return CH_USAGE;
     ch->cfg.backend = NCP_BACKEND_SIM;
     struct ncp_diag d;
@@ -150,7 +156,6 @@ static void *channel_main(void *arg)
 static void start_channel(struct channel *ch, const struct ncp_cli_channel_common *c,
                           int loop_priority_min)
 {
-    ch->ic = (struct ncp_cli_interp){ &ch->src, c->interp, c->mode };
     ch->no = (struct ncp_nck_opts){
         .cfg = &ch->cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ch->ic,
         .virtual_clock = c->virtual_clock, .for_s = c->for_s,
@@ -226,6 +231,10 @@ static void drop_channel(struct channel *ch)
         ncp_outfile_discard(&ch->trace_of);
     if (ch->src_open)
         ncp_source_close(&ch->src);
+    ch->src_open = 0;
+    rs274_ini_free(&ch->rs274);
+    free(ch->sub_path);
+    ch->sub_path = NULL;
 }
 
 /* Before anything moves: every spec, INI, program and trace, and no channel
@@ -294,6 +303,9 @@ int ncp_cli_run_channels(const char *const *specs, int n, const struct ncp_cli_c
         worst = r > worst ? r : worst;
         if (chs[i].src_open)
             ncp_source_close(&chs[i].src);
+        chs[i].src_open = 0;
+        rs274_ini_free(&chs[i].rs274);
+        free(chs[i].sub_path);
     }
     free(chs);
     return worst;

@@ -138,7 +138,8 @@ static void usage(FILE *f)
           "       `o<name> call` of a sub not defined yet reads name.ngc from the\n"
           "       current folder, then from the --subroutine-path folders (as rs274).\n"
           "       --ini: LinuxCNC's [RS274NGC] as rs274 -i reads it: SUBROUTINE_PATH\n"
-          "       (after --subroutine-path) and REMAP lines of M codes to ngc= subs.\n"
+          "       (after --subroutine-path) and REMAP lines of M codes to ngc= subs;\n"
+          "       run and serve read the same keys from their --config INI.\n"
           "check  report every error in PROG as PROG:LINE:COL: error: message.\n"
           "run    run PROG on the machine: planner, interpolator, position loop, backend\n"
           "       (the simulated servo by default); `cnc-run run --help` for details.\n"
@@ -227,19 +228,9 @@ static int parse_args(int argc, char **argv, struct parse_opts *o)
     if (o->ini_path) {
         if (rs274_ini_load(o->ini_path, &o->ini) != 0)
             return -1;
-        if (o->ini.sub_path) {
-            o->sub_path = rs274_ini_join_paths(o->acfg.subroutine_path, o->ini.sub_path);
-            if (!o->sub_path)
-                return fprintf(stderr, "cnc-run: out of memory\n"), -1;
-            o->acfg.subroutine_path = o->sub_path;
-        }
+        if (rs274_ini_apply(&o->ini, &o->acfg, &o->sub_path) != 0)
+            return -1;
         o->acfg.ini_given = 1;
-        if (o->ini.ini_vars) {
-            o->acfg.ini_vars = o->ini.vars;
-            o->acfg.n_ini_vars = o->ini.n_vars;
-        }
-        o->acfg.remaps = o->ini.remaps;
-        o->acfg.n_remaps = o->ini.n_remaps;
     }
     return 0;
 }

@@ -122,7 +122,10 @@ static char *absolute_dirs(const char *ini_path, const char *value)
     return out;
 }
 
-int rs274_ini_load(const char *path, struct rs274_ini *ini)
+/* machine: the machine INI of run and serve, whose reader took every key
+ * already (ncpar.ini(5)); its machine sections are the NCK's, not keys that
+ * change what rs274 -g would print. */
+static int load(const char *path, struct rs274_ini *ini, int machine)
 {
     memset(ini, 0, sizeof *ini);
     ini->text = read_file(path);
@@ -182,7 +185,7 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
         if (sec == SEC_OTHER)
             continue;
         if (sec != SEC_RS274NGC) {
-            if (machine_key_changes(sec, key, value)) {
+            if (!machine && machine_key_changes(sec, key, value)) {
                 fprintf(stderr, "%s:%u: error: %s%s = %s changes what rs274 -i makes of a "
                         "program; ncpar does not follow it\n", path, line, sec_name, key, value);
                 return -1;
@@ -208,7 +211,7 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
             size_t k = 0;
             while (k < sizeof no_effect / sizeof no_effect[0] && strcmp(key, no_effect[k]) != 0)
                 k++;
-            if (k == sizeof no_effect / sizeof no_effect[0]) {
+            if (k == sizeof no_effect / sizeof no_effect[0] && !machine) {
                 fprintf(stderr, "%s:%u: error: [RS274NGC]%s is not supported by ncpar\n", path,
                         line, key);
                 return -1;
@@ -216,6 +219,16 @@ int rs274_ini_load(const char *path, struct rs274_ini *ini)
         }
     }
     return 0;
+}
+
+int rs274_ini_load(const char *path, struct rs274_ini *ini)
+{
+    return load(path, ini, 0);
+}
+
+int rs274_ini_load_machine(const char *path, struct rs274_ini *ini)
+{
+    return load(path, ini, 1);
 }
 
 void rs274_ini_free(struct rs274_ini *ini)
@@ -236,4 +249,50 @@ char *rs274_ini_join_paths(const char *cli, const char *ini)
     if (out)
         snprintf(out, n, "%s%s%s", cli ? cli : "", cli && ini ? ":" : "", ini ? ini : "");
     return out;
+}
+
+int rs274_ini_apply(const struct rs274_ini *ini, struct ncp_analyzer_cfg *acfg, char **joined)
+{
+    *joined = NULL;
+    if (ini->sub_path) {
+        *joined = rs274_ini_join_paths(acfg->subroutine_path, ini->sub_path);
+        if (!*joined)
+            return fprintf(stderr, "cnc-run: out of memory\n"), -1;
+        acfg->subroutine_path = *joined;
+    }
+    if (ini->ini_vars) {
+        acfg->ini_vars = ini->vars;
+        acfg->n_ini_vars = ini->n_vars;
+    }
+    acfg->remaps = ini->remaps;
+    acfg->n_remaps = ini->n_remaps;
+    return 0;
+}
+
+int rs274_ini_machine(const char *path, const char *user_m_dirs, struct rs274_ini *ini,
+                      struct ncp_analyzer_cfg *acfg, char **joined)
+{
+    memset(ini, 0, sizeof *ini);
+    *joined = NULL;
+    if (user_m_dirs && *user_m_dirs)
+        acfg->user_m_dirs = user_m_dirs;
+    if (!path)
+        return 0;
+    if (rs274_ini_load_machine(path, ini) != 0 || rs274_ini_apply(ini, acfg, joined) != 0)
+        return -1;
+    if (!ini->n_remaps)
+        return 0;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    struct ncp_analyzer *a = ncp_analyzer_new(acfg, &d);
+    if (a) {
+        ncp_analyzer_free(a);
+        return 0;
+    }
+    if (d.line)
+        fprintf(stderr, "%s:%u:%u: error: %s\n", d.file ? d.file : path, d.line,
+                d.col ? (unsigned)d.col : 1u, d.msg);
+    else
+        fprintf(stderr, "%s: error: %s\n", d.file ? d.file : path, d.msg);
+    return -1;
 }

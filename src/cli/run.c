@@ -8,6 +8,7 @@
 #include "key_opts.h"
 #include "machine.h"
 #include "outfile.h"
+#include "rs274_ini.h"
 #include "signals.h"
 
 #include "ncpar/backend.h"
@@ -60,7 +61,11 @@ static void usage(FILE *f)
           "       cnc-run run --channel N:PROG[:INI] [--channel M:PROG2[:INI2] ...] [options]\n"
           "Runs PROG on the simulated machine (or CiA 402 drives over CAN): interpreter ->\n"
           "look-ahead planner -> interpolator -> position loop (SCHED_FIFO when permitted).\n"
-          "  --config INI        machine INI (default: built-in 3-axis mill)\n"
+          "  --config INI        machine INI (default: built-in 3-axis mill); its [RS274NGC]\n"
+          "                      (REMAP, SUBROUTINE_PATH, USER_M_PATH: M100-M199 run their\n"
+          "                      executables, the machine at rest) configures the\n"
+          "                      interpreter, as in LinuxCNC (docs/remap.md)\n"
+          "  --ini INI           the same as --config (parse's name for it)\n"
           "  --trace CSV         per-cycle trace: t,line,x_cmd,y_cmd,z_cmd,x_act,y_act,z_act,v,motion\n"
           "                      (motion: 0 rapid, 1 feed, 2 arc); an existing CSV (the\n"
           "                      last run's) is kept as CSV.1\n"
@@ -124,6 +129,7 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
 {
     static const struct option longopts[] = {
         { "config", required_argument, 0, 'c' },
+        { "ini", required_argument, 0, 'N' },
         { "trace", required_argument, 0, 't' },
         { "plot", required_argument, 0, 'p' },
         { "for", required_argument, 0, 'f' },
@@ -150,7 +156,14 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     optind = 1;
     while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:I:R:HD:U:", longopts, NULL)) != -1) {
         switch (c) {
-        case 'c': o->config = optarg; break;
+        case 'c': case 'N':
+            /* --ini as parse's: the one INI, the machine's and its interpreter's */
+            if (o->config && strcmp(o->config, optarg) != 0)
+                return fprintf(stderr, "cnc-run run: --config and --ini name one INI, the "
+                                       "machine's with its [RS274NGC]: not '%s' and '%s'\n",
+                               o->config, optarg), -1;
+            o->config = optarg;
+            break;
         case 't': o->trace = optarg; break;
         case 'p': o->plot = optarg; break;
         case 'T': o->tool_table = optarg; break;
@@ -521,13 +534,10 @@ static int run_stop_asked(void *ctx)
 }
 
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
-                       const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
+                       const struct ncp_analyzer_cfg *acfg, const struct ncp_source *src,
+                       FILE *trace, struct ncp_rt_stats *lat)
 {
-    struct ncp_cli_interp ic = { src,
-                             { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path,
-                               .max_loop_iterations = o->max_loops, .m66_on_machine = 1,
-                               .cancel = run_stop_asked },
-                             o->mode };
+    struct ncp_cli_interp ic = { src, *acfg, o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
@@ -572,32 +582,11 @@ static int drop_outputs(struct ncp_outfile *trace_of, struct plot_job *pj, struc
     return RUN_USAGE;
 }
 
-int ncp_cli_run(int argc, char **argv)
+/* The run of a loaded machine and interpreter: the program, the outputs. */
+static int run_loaded(const struct run_opts *op, const struct ncp_machine_cfg *cfg,
+                      const struct ncp_analyzer_cfg *acfg)
 {
-    struct run_opts o = { 0 };
-    o.feed_override = 1.0;
-    o.mode = NCP_MODE_SERIAL;
-    if (parse_opts(argc, argv, &o))
-        return usage(stderr), RUN_USAGE;
-    ncp_cli_catch_stop_signals(on_signal);
-    if (o.n_channels) {
-        if (o.plot || o.home)
-            return fprintf(stderr, "cnc-run run: --%s is for one program, not --channel\n",
-                           o.plot ? "plot" : "home"), RUN_USAGE;
-        struct ncp_cli_channel_common cc = {
-            .virtual_clock = o.virtual_clock, .for_s = o.for_s,
-            .feed_override = o.feed_override, .mode = o.mode, .trace = o.trace,
-            .interp = { .tool_table_path = o.tool_table, .subroutine_path = o.sub_path,
-                        .max_loop_iterations = o.max_loops, .m66_on_machine = 1,
-                        .cancel = run_stop_asked },
-            .backend = o.backend, .inject = o.inject, .seed = o.seed,
-            .interrupt = &run_signal, .trace_rings = o.trace_rings,
-        };
-        return ncp_cli_run_channels(o.channel, o.n_channels, &cc);
-    }
-    struct ncp_machine_cfg cfg;
-    if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
-        return RUN_USAGE;
+    const struct run_opts o = *op;
     struct ncp_source src;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
@@ -642,7 +631,7 @@ int ncp_cli_run(int argc, char **argv)
         return drop_outputs(&trace_of, pj, &src);
     }
     struct ncp_rt_stats *lat = calloc(1, sizeof *lat);
-    int rc = lat ? run_program(&o, &cfg, &src, trace, lat) : RUN_FAULT;
+    int rc = lat ? run_program(&o, cfg, acfg, &src, trace, lat) : RUN_FAULT;
     if (trace && fclose(trace) != 0) {
         fprintf(stderr, "cnc-run run: error writing %s: %s\n", trace_path, strerror(errno));
         rc = rc ? rc : RUN_FAULT;
@@ -661,5 +650,49 @@ int ncp_cli_run(int argc, char **argv)
     free(pj);
     free(lat);
     ncp_source_close(&src);
+    return rc;
+}
+
+int ncp_cli_run(int argc, char **argv)
+{
+    struct run_opts o = { 0 };
+    o.feed_override = 1.0;
+    o.mode = NCP_MODE_SERIAL;
+    if (parse_opts(argc, argv, &o))
+        return usage(stderr), RUN_USAGE;
+    ncp_cli_catch_stop_signals(on_signal);
+    if (o.n_channels) {
+        if (o.plot || o.home)
+            return fprintf(stderr, "cnc-run run: --%s is for one program, not --channel\n",
+                           o.plot ? "plot" : "home"), RUN_USAGE;
+        struct ncp_cli_channel_common cc = {
+            .virtual_clock = o.virtual_clock, .for_s = o.for_s,
+            .feed_override = o.feed_override, .mode = o.mode, .trace = o.trace,
+            .interp = { .tool_table_path = o.tool_table, .subroutine_path = o.sub_path,
+                        .max_loop_iterations = o.max_loops, .m66_on_machine = 1,
+                        .cancel = run_stop_asked },
+            .backend = o.backend, .inject = o.inject, .seed = o.seed,
+            .interrupt = &run_signal, .trace_rings = o.trace_rings,
+        };
+        return ncp_cli_run_channels(o.channel, o.n_channels, &cc);
+    }
+    struct ncp_machine_cfg cfg;
+    if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
+        return RUN_USAGE;
+    /* the interpreter of the same INI: its [RS274NGC] (REMAP, folders) */
+    struct ncp_analyzer_cfg acfg = { .tool_table_path = o.tool_table,
+                                     .subroutine_path = o.sub_path,
+                                     .max_loop_iterations = o.max_loops, .m66_on_machine = 1,
+                                     .cancel = run_stop_asked };
+    struct rs274_ini ini;
+    char *joined = NULL;
+    if (rs274_ini_machine(o.config, cfg.rs274.user_m_dirs, &ini, &acfg, &joined)) {
+        rs274_ini_free(&ini);
+        free(joined);
+        return RUN_USAGE;
+    }
+    int rc = run_loaded(&o, &cfg, &acfg);
+    rs274_ini_free(&ini);
+    free(joined);
     return rc;
 }

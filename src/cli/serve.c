@@ -7,6 +7,7 @@
 #include "inject_opts.h"
 #include "key_opts.h"
 #include "outfile.h"
+#include "rs274_ini.h"
 #include "machine.h"
 #include "signals.h"
 
@@ -54,7 +55,9 @@ static void usage(FILE *f)
           "Runs the NCK as a service on the simulated machine: it holds the axes where they\n"
           "are and waits for commands on LCM (cnc-ctl is its command-line client).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill); [LCM] URL,\n"
-          "                      CHANNEL_PREFIX (NCP_) and STATUS_HZ (50) are read from it.\n"
+          "                      CHANNEL_PREFIX (NCP_) and STATUS_HZ (50) are read from it,\n"
+          "                      [RS274NGC] (REMAP, USER_M_PATH...) as run's. --ini INI\n"
+          "                      is the same as --config.\n"
           "                      An INI of [CHANNEL_n] sections (n 0..15, CONFIG = machine\n"
           "                      INI, relative to its folder) serves one NCK per NC channel;\n"
           "                      LCM messages carry the channel (cnc-ctl --channel N), [LCM]\n"
@@ -97,7 +100,8 @@ struct serve_args {
 static int parse(int argc, char **argv, struct serve_args *a)
 {
     static const struct option longopts[] = {
-        { "config", required_argument, 0, 'c' }, { "lcm-url", required_argument, 0, 'u' },
+        { "config", required_argument, 0, 'c' }, { "ini", required_argument, 0, 'N' },
+        { "lcm-url", required_argument, 0, 'u' },
         { "prefix", required_argument, 0, 'P' }, { "clock", required_argument, 0, 'k' },
         { "trace", required_argument, 0, 't' }, { "mode", required_argument, 0, 'm' },
         { "tool-table", required_argument, 0, 'T' },
@@ -111,7 +115,13 @@ static int parse(int argc, char **argv, struct serve_args *a)
     optind = 1;
     while ((c = getopt_long(argc, argv, "c:u:P:k:t:m:T:S:hI:R:", longopts, NULL)) != -1) {
         switch (c) {
-        case 'c': a->config = optarg; break;
+        case 'c': case 'N':
+            if (a->config && strcmp(a->config, optarg) != 0)
+                return fprintf(stderr, "cnc-run serve: --config and --ini name one INI, the "
+                                       "machine's with its [RS274NGC]: not '%s' and '%s'\n",
+                               a->config, optarg), -1;
+            a->config = optarg;
+            break;
         case 'u': a->url = optarg; break;
         case 'P': a->prefix = optarg; break;
         case 't': a->trace = optarg; break;
@@ -187,15 +197,32 @@ struct serve_channel {
     char trace_path[PATH_MAX];
     struct ncp_outfile trace_of;
     FILE *trace;
+    /* its interpreter: the INI's [RS274NGC] over the command line's */
+    struct rs274_ini ini;
+    char *sub_path;
+    struct ncp_analyzer_cfg acfg;
 };
 
 static int load_channel(struct serve_channel *ch, const struct serve_args *a)
 {
+    ch->acfg = (struct ncp_analyzer_cfg){ .tool_table_path = a->tool_table,
+                                          .subroutine_path = a->sub_path };
     return ncp_cli_load_machine(ch->config, &ch->cfg) ||
                    ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
-                   ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg)
+                   ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg) ||
+                   rs274_ini_machine(ch->config, ch->cfg.rs274.user_m_dirs, &ch->ini, &ch->acfg,
+                                     &ch->sub_path)
                ? -1
                : 0;
+}
+
+static void free_channels(struct serve_channel *chs, int n)
+{
+    for (int k = 0; chs && k < n; k++) {
+        rs274_ini_free(&chs[k].ini);
+        free(chs[k].sub_path);
+    }
+    free(chs);
 }
 
 /* the trace is a live record (outfile.h), never over an input */
@@ -261,13 +288,13 @@ static struct serve_channel *load_channels(const struct serve_args *a, int *n)
     for (int k = 0; k < *n; k++) {
         chs[k].trace_of.fd = -1;
         if (load_channel(&chs[k], a))
-            return free(chs), NULL;
+            return free_channels(chs, k + 1), NULL;
     }
     for (int k = 0; k < *n; k++) {
         if (open_trace(&chs[k], a, several)) {
             for (int i = 0; i < k; i++)
                 close_trace(&chs[i]);
-            return free(chs), NULL;
+            return free_channels(chs, *n), NULL;
         }
     }
     return chs;
@@ -290,7 +317,7 @@ int ncp_cli_serve(int argc, char **argv)
     if (ncp_cli_check_key("cnc-run serve", &chs[0].cfg)) {
         for (int k = 0; k < n; k++)
             close_trace(&chs[k]);
-        free(chs);
+        free_channels(chs, n);
         return SERVE_USAGE;
     }
     struct ncp_diag d;
@@ -299,7 +326,7 @@ int ncp_cli_serve(int argc, char **argv)
     if (a.http && start_http(&a, &chs[0].cfg, &http)) {
         for (int k = 0; k < n; k++)
             close_trace(&chs[k]);
-        free(chs);
+        free_channels(chs, n);
         return SERVE_USAGE;
     }
     ncp_cli_catch_stop_signals(on_signal);
@@ -316,7 +343,7 @@ int ncp_cli_serve(int argc, char **argv)
         struct ncp_nck_setup setup = {
             .cfg = &chs[made].cfg, .virtual_clock = a.virtual_clock, .trace = chs[made].trace,
             .mode = a.mode,
-            .interp = { .tool_table_path = a.tool_table, .subroutine_path = a.sub_path },
+            .interp = chs[made].acfg,
             .loop_priority_min = loop_min,
         };
         ncks[made] = ncp_nck_new(&setup, &d);
@@ -358,7 +385,7 @@ int ncp_cli_serve(int argc, char **argv)
     for (int k = 0; k < n; k++)
         if (close_trace(&chs[k]) != 0 && rc == 0)
             rc = 1;
-    free(chs);
+    free_channels(chs, n);
     if (rc == -2)
         return SERVE_FAULT;
     if (rc < 0) {

@@ -467,7 +467,8 @@ static int known_section(const char *sec)
 {
     static const char *const names[] = { "EMCMOT", "TRAJ",   "LCM",   "PLANNER",
                                          "SIM",    "RT",     "CAN",   "SPINDLE_0",
-                                         "EMCIO",  "INJECT", "SCHED", "HTTP" };
+                                         "EMCIO",  "INJECT", "SCHED", "HTTP",
+                                         "RS274NGC", "DISPLAY" };
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
         if (!strcasecmp(sec, names[i]))
             return 1;
@@ -529,6 +530,9 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
         return ncp_sched_ini_key(&c->sched, k, v, why, len);
     if (!strcasecmp(sec, "CAN"))
         return can_key(&c->can, k, v, why, len);
+    int rr = ncp_rs274_cfg_key(&c->rs274, lc->path, sec, k, v, why, len);
+    if (rr != -2)
+        return rr;
     int r = ncp_kins_cfg_key(&lc->kl, c, sec, k, v, lc->line, why, len);
     if (r != -2)
         return r;
@@ -562,6 +566,9 @@ static int on_key(void *user, const char *sec, const char *k, const char *v)
     char why[112] = "";
     /* a key ncpar.ini(5) does not list is unknown, whatever dispatch knows */
     int r = ncp_ini_key_find(sec, k) ? dispatch(lc, sec, k, v, why, sizeof why) : 0;
+    /* REMAP is LinuxCNC's one key given once per remapped code */
+    if (r == 1 && !strcasecmp(sec, "RS274NGC") && !strcasecmp(k, "REMAP"))
+        return 1;
     if (r == 1)
         return duplicate(lc, sec, k) ? 0 : 1;
     if (r == -2)
@@ -833,6 +840,7 @@ int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp
             fail_at(lc, (unsigned)r, "expected 'KEY = VALUE' or '[SECTION]'");
         else if (r < 0 || (!lc->failed && ferror(lc->f)))
             fail_at(lc, 0, "cannot read: %s", strerror(errno));
+        ncp_rs274_cfg_finish(&c->rs274);
         if (!lc->failed && check_axes(lc) == 0 && check_cfg(lc) == 0)
             if (check_kins(lc) == 0 && check_adcai(lc) == 0)
                 check_sched(lc);

@@ -39,6 +39,11 @@ const struct ncp_ini_section ncp_ini_sections[] = {
              "(cnc-run run --backend lcm, cnc-axis)." },
     { "INJECT", "Timing faults injected into the real position loop (tests and experiments)." },
     { "SCHED", "Priorities of the soft real-time tasks below the position loop." },
+    { "RS274NGC", "The interpreter's keys of a LinuxCNC INI, so that one file configures "
+                  "the machine and its interpreter (docs/remap.md). cnc-run parse and check "
+                  "read the same keys with --ini INI." },
+    { "DISPLAY", "LinuxCNC's display section: of its keys, the machine INI takes the one "
+                 "that says where user M codes are." },
     { "HTTP", "The operator's panel in a browser (cnc-run serve --http): who may reach it "
               "besides its own origin and address (docs/panel-security.md)." },
 };
@@ -233,6 +238,26 @@ const struct ncp_ini_key ncp_ini_keys[] = {
          "spaces or commas", NULL, "cnc1.shop.example",
          "Host headers accepted besides the bound address and localhost; any other gets 421 "
          "(DNS rebinding). A panel bound to 0.0.0.0 lists the machine's own names here."),
+
+    TEXT("RS274NGC", "REMAP", "CODE [modalgroup=N] [argspec=WORDS] [prolog=NAME] ngc=NAME "
+         "[epilog=NAME], as LinuxCNC's", NULL, "M6 modalgroup=6 prolog=change_prolog ngc=change "
+         "epilog=change_epilog",
+         "The code runs the O-word subroutine NAME.ngc; given once per remapped code. "
+         "stdglue's prologs and epilogs are built in; python= is refused."),
+    TEXT("RS274NGC", "SUBROUTINE_PATH", "folders separated by ':', relative to the INI's folder",
+         NULL, "subs:/usr/share/ncpar/subs",
+         "Where o<name> call and the REMAP subs find name.ngc, after the current folder and "
+         "--subroutine-path."),
+    TEXT("RS274NGC", "USER_M_PATH", "folders separated by ':', relative to the INI's folder",
+         NULL, "mcodes",
+         "Where the executables M100 .. M199 are, after PROGRAM_PREFIX; each runs with P "
+         "and Q as two arguments once the machine is at rest."),
+    WORD("RS274NGC", "INI_VARS", "0|1|NO|YES|FALSE|TRUE|OFF|ON", "1",
+         "The program reads the INI's keys as #<_ini[SECTION]KEY>."),
+    TEXT("RS274NGC", "PARAMETER_FILE", "LinuxCNC's", NULL, "sim.var",
+         "Taken and ignored: the NCK keeps the parameters as long as it runs."),
+    TEXT("DISPLAY", "PROGRAM_PREFIX", "a folder, relative to the INI's folder", NULL,
+         "nc_files", "The first folder searched for the executables M100 .. M199."),
 
     TEXT("INJECT", "SPEC", "specs separated by commas, as cnc-run run --inject", NULL,
          "miss=0.01", "The faults."),

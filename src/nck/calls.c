@@ -50,6 +50,7 @@ int nck_call_class(const struct ncp_canon *op, const char *text)
     case NCP_C_SET_AUX_OUTPUT_BIT: case NCP_C_CLEAR_AUX_OUTPUT_BIT:
     case NCP_C_SET_MOTION_OUTPUT_BIT: case NCP_C_CLEAR_MOTION_OUTPUT_BIT:
     case NCP_C_SET_AUX_OUTPUT_VALUE: case NCP_C_SET_MOTION_OUTPUT_VALUE: case NCP_C_WAIT_INPUT:
+    case NCP_C_USER_M:           /* the machine at rest, its program runs (user_m.c) */
         return NCK_CALL_AUX;
     case NCP_C_COMMENT: case NCP_C_MESSAGE: case NCP_C_LOGOPEN: case NCP_C_LOGAPPEND:
     case NCP_C_LOGCLOSE: case NCP_C_LOG: case NCP_C_PRINT:

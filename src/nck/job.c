@@ -548,7 +548,9 @@ static int take_seg(struct nck_core *n, const struct ncp_seg *s)
  * until the machine is there, and answer the interpreter with what the
  * machine found. The interpreter makes no command after the buster until
  * it has the answer, so this thread waits for nothing it has yet to send. */
-static int buster(struct nck_core *n, const struct ncp_cmd *cmd, const struct ncp_canon *op)
+/* The motion sent so far runs to a stop and the machine stands there: -1
+ * when the job is aborted meanwhile. */
+static int drain(struct nck_core *n)
 {
     struct nck_job *j = n->job;
     if (push_mark(n, NCK_MSG_SYNC))
@@ -559,6 +561,14 @@ static int buster(struct nck_core *n, const struct ncp_cmd *cmd, const struct nc
             return -1;
         nap_us(200);
     }
+    return 0;
+}
+
+static int buster(struct nck_core *n, const struct ncp_cmd *cmd, const struct ncp_canon *op)
+{
+    struct nck_job *j = n->job;
+    if (drain(n))
+        return -1;
     struct ncp_machine_sync *ms = &j->answer;
     if (op->kind == NCP_C_CHANGE_TOOL) {
         /* where the change left the axes (the change position, or where
@@ -690,6 +700,14 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
         int after_pallet = i > 0 && cmd->ops[i - 1].kind == NCP_C_PALLET_SHUTTLE;
         if ((!j->from_line || j->reached) && take_aux(n, cmd, op, after_pallet))
             return 1;
+        /* M100..M199: in order with motion, as LinuxCNC's task runs them */
+        if (op->kind == NCP_C_USER_M && !skipping && (drain(n) || nck_user_m_run(n, cmd, op))) {
+            if (j->map_diag.code != NCP_OK) {
+                n->cross.calls_refused[kind]++;
+                j->map_failed = 1;
+            }
+            return 1;
+        }
         if (is_buster(op)) {
             /* skipped lines (run from line) get the stand-in's answer */
             if (!skipping && buster(n, cmd, op)) {

@@ -26,4 +26,9 @@ const char *nck_call_what(int kind);
  * take it: the batch run's pass before motion asks the same. */
 int nck_check_call(const struct ncp_cmd *cmd, const struct ncp_canon *op, struct ncp_diag *d);
 
+/* user_m.c: M100..M199's program, run once the machine is at rest; 0
+ * when it exited 0, else -1 (the job's map_diag says why, unless the job
+ * was aborted meanwhile) */
+int nck_user_m_run(struct nck_core *n, const struct ncp_cmd *cmd, const struct ncp_canon *op);
+
 #endif
