@@ -266,11 +266,12 @@ static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 {
     const struct ncp_cli_backend_opts bo = { "cnc-run run", o->config, o->backend, o->dp,
                                              o->lcm_url, o->key_file, o->virtual_clock };
+    int lcm = o->backend ? !strcmp(o->backend, "lcm") : cfg->backend == NCP_BACKEND_LCM;
+    if (!lcm && (o->dp || o->lcm_url || o->key_file))
+        return fprintf(stderr, "cnc-run run: --dp, --lcm-url and --key-file go with --backend "
+                               "lcm\n"), -1;
     if (ncp_cli_apply_backend(&bo, cfg))
         return -1;
-    if (cfg->backend != NCP_BACKEND_LCM && (o->lcm_url || o->key_file))
-        return fprintf(stderr, "cnc-run run: --lcm-url and --key-file go with --backend lcm\n"),
-               -1;
     return cfg->backend == NCP_BACKEND_LCM && cfg->lcm.dp == 1 ? apply_dp1(o, cfg) : 0;
 }
 
