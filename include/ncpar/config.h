@@ -153,7 +153,7 @@ struct ncp_machine_cfg {
      * an integer multiple of servo_period; the position loop fine-interpolates
      * between its points. 0 = servo_period (no fine interpolation). */
     double planning_period;
-    enum ncp_backend_kind backend; /* not from the INI: cnc-run run --backend */
+    enum ncp_backend_kind backend; /* [EMCMOT] BACKEND, over which --backend goes */
     struct ncp_can_cfg can;
     /* [TRAJ] NO_FORCE_HOMING = 1: programs, MDI and jogs may run before the
      * axes are homed (LinuxCNC's key; 0, the default, refuses them) */

@@ -100,6 +100,8 @@ struct llc {
     double fault_ferr;    /* the following error LLC_END_FERROR saw */
     int32_t seq;
     int done_req;
+    int hold;             /* the HLC's heartbeat says hold (fine setpoints only) */
+    int64_t hold_until;   /* after a hold: the HLC's period of its RUN, played from */
     int64_t done_at;      /* the HLC's last period, as its done said */
     _Atomic int signal;   /* set by the signal handler */
     struct ncp_spsc trace_ring;

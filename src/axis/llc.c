@@ -48,6 +48,13 @@ static void on_hlc_heartbeat(struct llc *l, const uint8_t *p, size_t len, int64_
     if (ncp_heartbeat_t_decode(p, 0, (int)len, &h) != (int)len || h.sender != NCP_DIST_HLC_ID)
         return;
     l->last_hlc_ns = now;
+    /* the setpoints played next are a play delay old: from before the HLC
+     * rested its command on the actual position; the hold lasts until the
+     * period the HLC let go in comes to be played */
+    int hold = h.command == NCP_HEARTBEAT_T_COMMAND_HOLD;
+    if (l->hold && !hold)
+        l->hold_until = h.t_ns;
+    l->hold = hold;
     if (!l->dp && h.dp >= 1 && h.dp <= 4)
         l->dp = (unsigned char)h.dp;
     if (h.command == NCP_HEARTBEAT_T_COMMAND_DONE && !l->done_req) {
@@ -402,6 +409,12 @@ static void trace(struct llc *l, int64_t now, int64_t slot, int gap)
         l->trace_dropped++;
 }
 
+static int hold_now(const struct llc *l, int64_t slot)
+{
+    return (l->hold || slot < l->hold_until) && !l->dp4 && !l->dp1ai &&
+           l->state == NCP_AX_STATUS_T_RUNNING;
+}
+
 /* One period of the axis, slot being the HLC's period it plays. */
 static void period(struct llc *l, int64_t now, int64_t slot, int latest)
 {
@@ -415,6 +428,12 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     if (l->end == LLC_END_NONE && (!l->done_req || play_on)) {
         l->state = NCP_AX_STATUS_T_RUNNING;
         next_cmd = l->dp1ai ? play_ai(l, slot) : l->dp4 ? interpolate(l, slot) : follow(l, slot);
+        /* the HLC's E-stop, heard at once rather than a play delay later
+         * in its frozen setpoints: they are still taken (no loss), the
+         * command stays; a block-level point computes its own and has no
+         * hold (serve does not run there) */
+        if (hold_now(l, slot))
+            next_cmd = l->cmd;
         if (l->dp4 || l->dp1ai)
             l->rx.played_t = slot;   /* where a late loop catches up from */
     } else {
@@ -434,7 +453,9 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     int32_t ahead;
     int guessed = 0;
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
-    if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp1ai)
+    if (hold_now(l, slot))
+        cmd_ahead = l->cmd;
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp1ai)
         cmd_ahead = llc_dp1_ai_ahead(l, slot + T);
     else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
         cmd_ahead = interpolate_ahead(l, slot + T);

@@ -83,6 +83,8 @@ struct lcm_be {
     struct lcm_dp1 *dp1;     /* DP1: the program the LLCs run */
     struct lcm_ai *ai;       /* ADCAI's DP2, DP3 */
     int rest;                /* the path stood still last period */
+    int hold;                /* drives off (serve's E-stop, a fault): HOLD every period */
+    int release;             /* periods left that say RUN after a hold (one may be lost) */
     double prev_cmd[NCP_AXES];
     struct lcm_clock clk;    /* answers the LLCs' clock probes; the HLC's clock */
     uint64_t ends_sent;      /* heartbeats saying done (or stop) at the end */
@@ -458,9 +460,10 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
     } else {
         send_fine(s, t, cmd);
     }
-    if (now - s->last_hb >= s->hb_period) {
+    if (s->hold || s->release > 0 || now - s->last_hb >= s->hb_period) {
+        s->release -= s->release > 0;
         s->last_hb = now;
-        heartbeat(s, NCP_HEARTBEAT_T_COMMAND_RUN, 0);
+        heartbeat(s, s->hold ? NCP_HEARTBEAT_T_COMMAND_HOLD : NCP_HEARTBEAT_T_COMMAND_RUN, 0);
     }
     uint64_t before[NCP_AXES];
     for (int i = 0; i < s->n; i++)
@@ -488,6 +491,18 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
             act[j] = cmd[j] - ncp_dist_nm_to_mm(p->st.ferr_nm);
     }
     return s->faulted ? -1 : 0;
+}
+
+/* Real-time, from the position loop: off is a serving NCK's E-stop or
+ * fault. The LLCs hear HOLD every period from the next cycle() on and keep
+ * their command where it is then, rather than play the frozen setpoints a
+ * play delay later; on, RUN goes out for the next 10 periods to let them
+ * follow again. */
+static void lcm_enable(struct ncp_backend *b, int on)
+{
+    struct lcm_be *s = b->impl;
+    s->release = on && s->hold ? 10 : 0;
+    s->hold = !on;
 }
 
 static void lcm_stop(struct ncp_backend *b)
@@ -611,7 +626,7 @@ static void lcm_close(struct ncp_backend *b)
 }
 
 static const struct ncp_backend_ops lcm_ops = {
-    "lcm", lcm_start, lcm_cycle, lcm_stop, lcm_describe, lcm_close, NULL, lcm_live,
+    "lcm", lcm_start, lcm_cycle, lcm_stop, lcm_describe, lcm_close, lcm_enable, lcm_live,
 };
 
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,

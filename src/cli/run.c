@@ -2,6 +2,7 @@
  * loop) on the simulated machine. Option parsing, loading and reporting; the
  * runtime itself is ncp_nck_run (src/rt/). */
 #include "run.h"
+#include "backend_opts.h"
 #include "channels.h"
 #include "nck_run.h"
 #include "inject_opts.h"
@@ -86,7 +87,8 @@ static void usage(FILE *f)
           "                      folder (colon-separated, as rs274's SUBROUTINE_PATH)\n"
           "  --max-loops N       a loop (while/do/repeat, M98 L, G76 passes) may repeat N\n"
           "                      times before it counts as runaway (default 10000000)\n"
-          "  --backend sim       the simulated machine (default)\n"
+          "  --backend sim       the simulated machine (default: the INI's [EMCMOT]\n"
+          "                      BACKEND, else sim)\n"
           "  --backend socketcan[:IFACE]  CiA 402 drives in CSP mode over SocketCAN on\n"
           "                      IFACE (default: the INI's [CAN] INTERFACE); each axis\n"
           "                      needs [AXIS_n] NODE_ID and COUNTS_PER_MM; real clock only.\n"
@@ -271,69 +273,19 @@ static int apply_dp1(const struct run_opts *o, struct ncp_machine_cfg *cfg)
     return 0;
 }
 
-/* --backend lcm: the distributed NCK at the INI's or --dp's point. A point
- * the variant does not have is refused here, before anything is opened. */
-static int apply_lcm(const struct run_opts *o, struct ncp_machine_cfg *cfg)
-{
-    cfg->backend = NCP_BACKEND_LCM;
-    if (o->dp)
-        cfg->lcm.dp = o->dp;
-    if (o->lcm_url) {
-        struct ncp_msg_url u;
-        struct ncp_diag d;
-        memset(&d, 0, sizeof d);
-        if (strlen(o->lcm_url) >= sizeof cfg->lcm.url || ncp_msg_parse_url(o->lcm_url, &u, &d))
-            return fprintf(stderr, "cnc-run run: --lcm-url: %s\n",
-                           d.msg[0] ? d.msg : "too long"), -1;
-        snprintf(cfg->lcm.url, sizeof cfg->lcm.url, "%s", o->lcm_url);
-    }
-    if (o->virtual_clock)
-        return fprintf(stderr, "cnc-run run: --backend lcm runs with its axes in real time: it "
-                               "needs --clock real\n"), -1;
-    if (cfg->nck == NCP_NCK_ADCAI && cfg->lcm.dp == 5)
-        return fprintf(stderr, "cnc-run run: --backend lcm: [PLANNER] NCK = adcai has no DP 5: "
-                               "its fine setpoints (fineIPObuf) are DP 4; choose --dp 1, 2, 3 "
-                               "or 4 (the INI's [LCM] DP defaults to 5)\n"), -1;
-    if (cfg->lcm.dp == 1)
-        return apply_dp1(o, cfg);
-    if (cfg->nck == NCP_NCK_ADCAI ? !ncp_dist_adcai_dp(cfg->lcm.dp)
-                                  : cfg->lcm.dp < 1 || cfg->lcm.dp > 5)
-        return fprintf(stderr, "cnc-run run: --backend lcm: [PLANNER] NCK = %s has no DP %d "
-                               "(ADCBI: DP 1-5; ADCAI: DP 1-4)\n",
-                       cfg->nck == NCP_NCK_ADCAI ? "adcai" : "adcbi", cfg->lcm.dp), -1;
-    return 0;
-}
-
-/* --backend sim | socketcan | socketcan:IFACE, over what the INI said. */
+/* --backend, over the INI's [EMCMOT] BACKEND (backend_opts.c, as serve's);
+ * DP 1's program is this command's own. */
 static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
 {
-    const char *b = o->backend;
-    int lcm = b && !strcmp(b, "lcm");
+    const struct ncp_cli_backend_opts bo = { "cnc-run run", o->config, o->backend, o->dp,
+                                             o->lcm_url, o->key_file, o->virtual_clock };
+    int lcm = o->backend ? !strcmp(o->backend, "lcm") : cfg->backend == NCP_BACKEND_LCM;
     if (!lcm && (o->dp || o->lcm_url || o->key_file))
         return fprintf(stderr, "cnc-run run: --dp, --lcm-url and --key-file go with --backend "
                                "lcm\n"), -1;
-    if (lcm)
-        return ncp_cli_apply_key_file("cnc-run run", o->key_file, cfg) || apply_lcm(o, cfg) ||
-                       ncp_cli_check_key("cnc-run run", cfg)
-                   ? -1
-                   : 0;
-    struct ncp_diag d;
-    memset(&d, 0, sizeof d);
-    int spec = ncp_backend_spec(b, cfg, &d);
-    if (spec > 0)
-        return fprintf(stderr, "cnc-run run: --backend is sim, socketcan[:IFACE] or lcm, not '%s'\n",
-                       b), -1;
-    if (spec < 0)
-        return fprintf(stderr, "cnc-run run: %s\n", d.msg), -1;
-    if (cfg->backend == NCP_BACKEND_SIM)
-        return 0;
-    if (o->virtual_clock)
-        return fprintf(stderr, "cnc-run run: --backend socketcan drives real hardware: it "
-                               "needs --clock real\n"), -1;
-    if (ncp_socketcan_check_cfg(cfg, &d) != NCP_OK)
-        return fprintf(stderr, "%s: error: %s\n", o->config ? o->config : "cnc-run run", d.msg),
-               -1;
-    return 0;
+    if (ncp_cli_apply_backend(&bo, cfg))
+        return -1;
+    return cfg->backend == NCP_BACKEND_LCM && cfg->lcm.dp == 1 ? apply_dp1(o, cfg) : 0;
 }
 
 static int load_config(const struct run_opts *o, struct ncp_machine_cfg *cfg)

@@ -1,6 +1,7 @@
 /* cnc-run serve: the NCK as a long-running service on LCM. Options, the
  * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
 #include "serve.h"
+#include "backend_opts.h"
 #include "cell.h"
 #include "datadir.h"
 #include "channels.h"
@@ -14,11 +15,14 @@
 #include "ncpar/http.h"
 #include "ncpar/nck.h"
 
+#include "ncpar/num.h"
+
 #include <getopt.h>
 #include <unistd.h>
 #include <signal.h>
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,12 +52,14 @@ static void ready(void *ctx, const char *prefix)
 static void usage(FILE *f)
 {
     fputs("usage: cnc-run serve [--config INI] [--lcm-url URL] [--prefix P] [--key-file F]\n"
+          "                     [--backend sim|lcm] [--dp N]\n"
           "                     [--clock real|virtual] [--trace CSV] [--mode serial|det|att]\n"
           "                     [--tool-table FILE] [--subroutine-path DIR[:DIR...]]\n"
           "                     [--inject SPEC[,SPEC...]] [--seed N]\n"
           "                     [--http [ADDR:]PORT [--http-readonly] [--web DIR]]\n"
-          "Runs the NCK as a service on the simulated machine: it holds the axes where they\n"
-          "are and waits for commands on LCM (cnc-ctl is its command-line client).\n"
+          "Runs the NCK as a service on the simulated machine or on distributed axes: it\n"
+          "holds the axes where they are and waits for commands on LCM (cnc-ctl is its\n"
+          "command-line client).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill); [LCM] URL,\n"
           "                      CHANNEL_PREFIX (NCP_) and STATUS_HZ (50) are read from it,\n"
           "                      [RS274NGC] (REMAP, USER_M_PATH...) as run's. --ini INI\n"
@@ -66,6 +72,16 @@ static void usage(FILE *f)
           "  --lcm-url URL       LCM URL (default: the INI's, else $LCM_DEFAULT_URL, else\n"
           "                      udpm://239.255.76.67:7667?ttl=0)\n"
           "  --prefix P          channel prefix (channels PCMD, PACK, PSTATUS, PEVENT)\n"
+          "  --backend sim       the simulated machine (default: the INI's [EMCMOT] BACKEND,\n"
+          "                      else sim)\n"
+          "  --backend lcm       the distributed NCK: one `cnc-axis` per axis of the INI on\n"
+          "                      the same LCM URL and key (docs/distributed.md); real clock\n"
+          "                      only, one machine INI (no [CHANNEL_n]). Served at the\n"
+          "                      fine-setpoint point only: ADCBI DP 5, ADCAI DP 4. An LLC\n"
+          "                      lost or stopped on its own is state fault naming its axis,\n"
+          "                      the others held; E-stop holds every LLC's command where\n"
+          "                      it is (their heartbeat watch stops them if serve dies)\n"
+          "  --dp N              distribution point (default: the INI's [LCM] DP, 5)\n"
           "  --key-file F        the key every command must be sealed with (default: [LCM]\n"
           "                      KEY_FILE, else ~/.config/ncpar/lcm.key); made (32 random\n"
           "                      bytes, mode 0600) when missing; refused when group or\n"
@@ -92,8 +108,8 @@ static void usage(FILE *f)
 
 struct serve_args {
     const char *config, *url, *prefix, *trace, *tool_table, *sub_path, *inject, *seed;
-    const char *http, *web, *key_file;
-    int virtual_clock, http_readonly;
+    const char *http, *web, *key_file, *backend;
+    int virtual_clock, http_readonly, dp;
     enum ncp_thread_mode mode;
 };
 
@@ -109,6 +125,7 @@ static int parse(int argc, char **argv, struct serve_args *a)
         { "inject", required_argument, 0, 'I' }, { "seed", required_argument, 0, 'R' },
         { "http", required_argument, 0, 'H' }, { "http-readonly", no_argument, 0, 'O' },
         { "web", required_argument, 0, 'W' }, { "key-file", required_argument, 0, 'K' },
+        { "backend", required_argument, 0, 'b' }, { "dp", required_argument, 0, 'D' },
         { 0, 0, 0, 0 },
     };
     int c;
@@ -133,6 +150,15 @@ static int parse(int argc, char **argv, struct serve_args *a)
         case 'O': a->http_readonly = 1; break;
         case 'W': a->web = optarg; break;
         case 'K': a->key_file = optarg; break;
+        case 'b': a->backend = optarg; break;
+        case 'D': {
+            double dp;
+            if (ncp_num_double(optarg, 1, 5, &dp) || dp != floor(dp) || strpbrk(optarg, ".eE"))
+                return fprintf(stderr, "cnc-run serve: --dp is a distribution point 1..5, not "
+                                       "'%s'\n", optarg), -1;
+            a->dp = (int)dp;
+            break;
+        }
         case 'k':
             if (strcmp(optarg, "real") != 0 && strcmp(optarg, "virtual") != 0)
                 return fprintf(stderr, "cnc-run serve: --clock is real or virtual\n"), -1;
@@ -203,13 +229,57 @@ struct serve_channel {
     struct ncp_analyzer_cfg acfg;
 };
 
-static int load_channel(struct serve_channel *ch, const struct serve_args *a)
+/* What serve drives beyond the simulated machine is what every command of
+ * the seat can stop along the path and hold: 0, or -1 after saying what is
+ * missing for the rest. */
+static int no_socketcan(const struct serve_channel *ch, const char *backend)
+{
+    const char *ini = ch->config ? ch->config : "the built-in mill";
+    /* before the CAN keys are checked: what is missing is not in the INI */
+    if (backend ? !strncmp(backend, "socketcan", 9) : ch->cfg.backend == NCP_BACKEND_SOCKETCAN)
+        return fprintf(stderr, "cnc-run serve: %s: the socketcan backend is not served yet: it "
+                               "has no hook to disable the drives, so an E-stop would hold them "
+                               "at a frozen setpoint instead of Quick Stop and Disable Voltage, "
+                               "and homing cannot read a drive's inputs; CAN drives run under "
+                               "cnc-run run --backend socketcan\n", ini), -1;
+    return 0;
+}
+
+static int servable(const struct serve_channel *ch, int several)
+{
+    const struct ncp_machine_cfg *c = &ch->cfg;
+    const char *ini = ch->config ? ch->config : "the built-in mill";
+    if (c->backend != NCP_BACKEND_LCM)
+        return 0;
+    if (several)
+        return fprintf(stderr, "cnc-run serve: %s: --backend lcm serves one machine INI, not "
+                               "channels of [CHANNEL_n]: the LLCs' LCM channels are one set\n",
+                       ini), -1;
+    int adcai = c->nck == NCP_NCK_ADCAI, fine = adcai ? 4 : 5;
+    if (c->lcm.dp != fine)
+        return fprintf(stderr, "cnc-run serve: --backend lcm --dp %d ([PLANNER] NCK = %s) is not "
+                               "served: at this point each LLC computes its own command from "
+                               "what it was sent ahead, and no message takes that back, so a "
+                               "feed hold, stop or E-stop from the seat could not stop its axis "
+                               "along the path, nor homing or a jog move it; serve runs the "
+                               "distributed NCK at %s's fine setpoints, --dp %d (cnc-run run "
+                               "--backend lcm runs a program at DP %d)\n",
+                       c->lcm.dp, adcai ? "adcai" : "adcbi", adcai ? "ADCAI" : "ADCBI", fine,
+                       c->lcm.dp), -1;
+    return 0;
+}
+
+static int load_channel(struct serve_channel *ch, const struct serve_args *a, int several)
 {
     ch->acfg = (struct ncp_analyzer_cfg){ .tool_table_path = a->tool_table,
                                           .subroutine_path = a->sub_path };
+    const struct ncp_cli_backend_opts bo = { "cnc-run serve", ch->config, a->backend, a->dp,
+                                             a->url, a->key_file, a->virtual_clock };
     return ncp_cli_load_machine(ch->config, &ch->cfg) ||
                    ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
                    ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg) ||
+                   no_socketcan(ch, a->backend) || ncp_cli_apply_backend(&bo, &ch->cfg) ||
+                   servable(ch, several) ||
                    rs274_ini_machine(ch->config, ch->cfg.rs274.user_m_dirs, &ch->ini, &ch->acfg,
                                      &ch->sub_path)
                ? -1
@@ -287,7 +357,7 @@ static struct serve_channel *load_channels(const struct serve_args *a, int *n)
     free(cell);
     for (int k = 0; k < *n; k++) {
         chs[k].trace_of.fd = -1;
-        if (load_channel(&chs[k], a))
+        if (load_channel(&chs[k], a, several))
             return free_channels(chs, k + 1), NULL;
     }
     for (int k = 0; k < *n; k++) {

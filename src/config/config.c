@@ -246,6 +246,21 @@ static int either(const char *v, const char *first, const char *other, int *seco
     return -1;
 }
 
+/* What cnc-run run and serve drive when no --backend says; an LLC
+ * (cnc-axis) takes its own drive from its --backend, never from here. */
+static int backend_key(struct ncp_machine_cfg *c, const char *v, char *why, size_t len)
+{
+    static const char *const names[] = { "sim", "socketcan", "lcm" };
+    static const enum ncp_backend_kind kinds[] = { NCP_BACKEND_SIM, NCP_BACKEND_SOCKETCAN,
+                                                   NCP_BACKEND_LCM };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (!strcasecmp(v, names[i])) {
+            c->backend = kinds[i];
+            return 1;
+        }
+    return snprintf(why, len, "sim, socketcan or lcm"), -1;
+}
+
 static int planner_key(struct ncp_machine_cfg *c, const char *k, const char *v, char *why,
                        size_t len)
 {
@@ -480,6 +495,8 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
 {
     struct ncp_machine_cfg *c = lc->c;
     if (!strcasecmp(sec, "EMCMOT")) {
+        if (!strcasecmp(k, "BACKEND"))
+            return backend_key(c, v, why, len);
         if (strcasecmp(k, "SERVO_PERIOD") != 0)
             return 0;
         /* 125 us .. 10 ms: outside that the plant model and the loop make no sense */

@@ -52,6 +52,11 @@ const size_t ncp_ini_n_sections = sizeof ncp_ini_sections / sizeof ncp_ini_secti
 const struct ncp_ini_key ncp_ini_keys[] = {
     REAL("EMCMOT", "SERVO_PERIOD", 125000, 10000000, "ns", "1000000",
          "Period of the position loop."),
+    WORD("EMCMOT", "BACKEND", "sim|socketcan|lcm", "sim",
+         "What cnc-run run and serve drive when no --backend is given: the simulated "
+         "machine, CiA 402 drives over [CAN] INTERFACE, or one cnc-axis per axis over LCM "
+         "at [LCM] DP (docs/distributed.md). cnc-axis takes its own drive from its "
+         "--backend, never from this key."),
 
     TEXT("TRAJ", "COORDINATES", "axis letters of XYZABCUVW, each once", "XYZ", "XYZ",
          "The machine's axes; each needs its [AXIS_L] section."),

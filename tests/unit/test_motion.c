@@ -208,6 +208,29 @@ static void test_config_errors(void **state)
     unlink(p);
 }
 
+/* [EMCMOT] BACKEND: what run and serve drive without --backend */
+static void test_config_backend(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg c;
+    struct ncp_diag d;
+    ncp_machine_cfg_default(&c);
+    assert_int_equal(c.backend, NCP_BACKEND_SIM);
+    char *p = write_tmp("[EMCMOT]\nBACKEND = lcm\n" AXES);
+    assert_int_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_int_equal(c.backend, NCP_BACKEND_LCM);
+    ncp_machine_cfg_default(&c);
+    p = write_tmp("[EMCMOT]\nBACKEND = SocketCAN\n" AXES);
+    assert_int_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_int_equal(c.backend, NCP_BACKEND_SOCKETCAN);
+    ncp_machine_cfg_default(&c);
+    p = write_tmp("[EMCMOT]\nBACKEND = ethercat\n" AXES);
+    assert_int_not_equal(ncp_machine_cfg_load(&c, p, &d), NCP_OK);
+    assert_int_equal(d.line, 2);
+    assert_non_null(strstr(d.msg, "sim, socketcan or lcm"));
+    unlink(p);
+}
+
 /* ---- trapezoid ------------------------------------------------------------ */
 
 static void test_trap_long_line_time(void **state)
@@ -884,6 +907,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_config_shipped),
         cmocka_unit_test(test_config_errors),
+        cmocka_unit_test(test_config_backend),
         cmocka_unit_test(test_trap_long_line_time),
         cmocka_unit_test(test_trap_short_triangle),
         cmocka_unit_test(test_g61_exact_stop_ends),
