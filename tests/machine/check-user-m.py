@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""check-user-m.py TRACE LOG: user-codes.d/userm.ngc's run (--clock real).
+"""check-user-m.py TRACE LOG: user-codes-files/userm.ngc's run (--clock real).
 
-M101 (user-codes.d/mcodes/M101) appends "P Q start end" to LOG and takes
+M101 (user-codes-files/mcodes/M101) appends "P Q start end" to LOG and takes
 0.3 s. Checked: it ran twice, with P1.5 Q2 and then the -1 -1 LinuxCNC
 passes for absent words; the machine stood still at X10 and at X20 for at
 least the 0.3 s each run took (the queue drained first, motion waited for
