@@ -274,3 +274,16 @@ void ncp_analyzer_set_sync(struct ncp_analyzer *a, ncp_machine_sync_fn fn, void 
     a->sai.sync = fn;
     a->sai.sync_ctx = ctx;
 }
+
+double ncp_analyzer_param(const struct ncp_analyzer *a, int index)
+{
+    if (index < 1 || index >= NCP_PARAMS_MAX)
+        return 0.0;
+    return *ncp_params_slot(a->params, index);
+}
+
+void ncp_analyzer_set_param(struct ncp_analyzer *a, int index, double v)
+{
+    if (index >= 1 && index < NCP_PARAMS_MAX)
+        *ncp_params_slot(a->params, index) = v;
+}

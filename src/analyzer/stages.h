@@ -98,6 +98,11 @@ int ncp_g10_run(struct ncp_analyzer *a);
 
 /* tools.c */
 int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d);
+/* One line of a tool table as the loader reads it (tools.c): 1 and the
+ * entry (Y A B C U V W offsets in more[7]) for a tool line the loader
+ * keeps, 0 for any other (blank, comment, skipped). */
+int ncp_tools_read_line(const char *s, const char *end, struct ncp_tool_entry *t, double *more,
+                        int *toolno);
 int ncp_tools_find(const struct ncp_analyzer *a, int tool);
 int ncp_tools_select(struct ncp_analyzer *a);
 int ncp_tools_change(struct ncp_analyzer *a);

@@ -22,7 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { SERVE_OK = 0, SERVE_USAGE = 1, SERVE_FAULT = 3 };
+enum { SERVE_OK = 0, SERVE_USAGE = 1, SERVE_BAD_INPUT = 2, SERVE_FAULT = 3 };
 
 static volatile sig_atomic_t stop_signal;
 
@@ -81,7 +81,8 @@ static void usage(FILE *f)
           "  --web DIR           the panel's files (default: web/ beside cnc-run, else\n"
           "                      share/ncpar/web/ of its install prefix)\n"
           "SIGINT/SIGTERM: a controlled stop along the path, then shutdown.\n"
-          "exit status: 0 ok, 1 usage or set-up, 3 a fault happened while serving\n",
+          "exit status: 0 ok, 1 usage or set-up, 2 a malformed [RS274NGC] PARAMETER_FILE,\n"
+          "3 a fault happened while serving\n",
           f);
     if (!ncp_http_available())
         fputs("(--http is missing: this cnc-run was built without libwebsockets)\n", f);
@@ -187,15 +188,31 @@ struct serve_channel {
     char trace_path[PATH_MAX];
     struct ncp_outfile trace_of;
     FILE *trace;
+    struct ncp_var_file *vars;      /* [RS274NGC] PARAMETER_FILE read, or NULL */
+    const char *tool_table;         /* --tool-table, else [EMCIO] TOOL_TABLE, or NULL */
 };
 
+/* 0, -1 (set-up: exit 1), or -2 (a malformed parameter file or tool
+ * table: exit 2) */
 static int load_channel(struct serve_channel *ch, const struct serve_args *a)
 {
-    return ncp_cli_load_machine(ch->config, &ch->cfg) ||
-                   ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
-                   ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg)
-               ? -1
-               : 0;
+    if (ncp_cli_load_machine(ch->config, &ch->cfg) ||
+        ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
+        ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg))
+        return -1;
+    ch->tool_table = a->tool_table ? a->tool_table
+                     : ch->cfg.op.tool_table[0] ? ch->cfg.op.tool_table : NULL;
+    if (!a->tool_table && ncp_cli_check_tool_table(ch->tool_table))
+        return -1;
+    int rc = ncp_cli_load_vars("cnc-run serve", &ch->cfg, &ch->vars);
+    return rc == 2 ? -2 : rc ? -1 : 0;
+}
+
+static void free_channels(struct serve_channel *chs, int n)
+{
+    for (int k = 0; chs && k < n; k++)
+        free(chs[k].vars);
+    free(chs);
 }
 
 /* the trace is a live record (outfile.h), never over an input */
@@ -211,7 +228,7 @@ static int open_trace(struct serve_channel *ch, const struct serve_args *a, int 
         return fprintf(stderr, "cnc-run serve: --trace '%s': name too long\n", a->trace), -1;
     struct ncp_file_id ids[2];
     int n_ids = ncp_file_id_add(ids, 0, ch->config, "the machine INI");
-    n_ids = ncp_file_id_add(ids, n_ids, a->tool_table, "the tool table");
+    n_ids = ncp_file_id_add(ids, n_ids, ch->tool_table, "the tool table");
     if (ncp_outfile_open(&ch->trace_of, ch->trace_path, ids, n_ids, NCP_OUT_LIVE) != 0)
         return -1;
     if (!(ch->trace = fdopen(ch->trace_of.fd, "w"))) {
@@ -238,8 +255,9 @@ static int close_trace(struct serve_channel *ch)
     return rc;
 }
 
-/* The channels from a channels INI, or the one machine INI as channel 0. */
-static struct serve_channel *load_channels(const struct serve_args *a, int *n)
+/* The channels from a channels INI, or the one machine INI as channel 0;
+ * NULL with *bad_input set when a channel's files are malformed. */
+static struct serve_channel *load_channels(const struct serve_args *a, int *n, int *bad_input)
 {
     struct ncp_cli_cell *cell = calloc(1, sizeof *cell);
     int several = !cell ? -1 : a->config ? ncp_cli_cell_load(a->config, cell) : 0;
@@ -260,14 +278,17 @@ static struct serve_channel *load_channels(const struct serve_args *a, int *n)
     free(cell);
     for (int k = 0; k < *n; k++) {
         chs[k].trace_of.fd = -1;
-        if (load_channel(&chs[k], a))
-            return free(chs), NULL;
+        int rc = load_channel(&chs[k], a);
+        if (rc) {
+            *bad_input = rc == -2;
+            return free_channels(chs, *n), NULL;
+        }
     }
     for (int k = 0; k < *n; k++) {
         if (open_trace(&chs[k], a, several)) {
             for (int i = 0; i < k; i++)
                 close_trace(&chs[i]);
-            return free(chs), NULL;
+            return free_channels(chs, *n), NULL;
         }
     }
     return chs;
@@ -281,16 +302,16 @@ int ncp_cli_serve(int argc, char **argv)
         return usage(stderr), SERVE_USAGE;
     if (ncp_cli_check_tool_table(a.tool_table))
         return SERVE_USAGE;
-    int n = 0;
-    struct serve_channel *chs = load_channels(&a, &n);
+    int n = 0, bad_input = 0;
+    struct serve_channel *chs = load_channels(&a, &n, &bad_input);
     if (!chs)
-        return SERVE_USAGE;
+        return bad_input ? SERVE_BAD_INPUT : SERVE_USAGE;
     /* the key before anything is powered: made when missing, refused when
      * others may read it (the service opens it again with the transport) */
     if (ncp_cli_check_key("cnc-run serve", &chs[0].cfg)) {
         for (int k = 0; k < n; k++)
             close_trace(&chs[k]);
-        free(chs);
+        free_channels(chs, n);
         return SERVE_USAGE;
     }
     struct ncp_diag d;
@@ -299,7 +320,7 @@ int ncp_cli_serve(int argc, char **argv)
     if (a.http && start_http(&a, &chs[0].cfg, &http)) {
         for (int k = 0; k < n; k++)
             close_trace(&chs[k]);
-        free(chs);
+        free_channels(chs, n);
         return SERVE_USAGE;
     }
     ncp_cli_catch_stop_signals(on_signal);
@@ -316,7 +337,9 @@ int ncp_cli_serve(int argc, char **argv)
         struct ncp_nck_setup setup = {
             .cfg = &chs[made].cfg, .virtual_clock = a.virtual_clock, .trace = chs[made].trace,
             .mode = a.mode,
-            .interp = { .tool_table_path = a.tool_table, .subroutine_path = a.sub_path },
+            .interp = { .tool_table_path = chs[made].tool_table,
+                        .subroutine_path = a.sub_path },
+            .vars = chs[made].vars,
             .loop_priority_min = loop_min,
         };
         ncks[made] = ncp_nck_new(&setup, &d);
@@ -358,7 +381,7 @@ int ncp_cli_serve(int argc, char **argv)
     for (int k = 0; k < n; k++)
         if (close_trace(&chs[k]) != 0 && rc == 0)
             rc = 1;
-    free(chs);
+    free_channels(chs, n);
     if (rc == -2)
         return SERVE_FAULT;
     if (rc < 0) {

@@ -117,20 +117,42 @@ static int emit_state_only(void *ctx, const struct ncp_cmd *cmd)
     return 0;
 }
 
-/* After a stop, an error or an E-stop: the interpreter's end-of-program reset
- * (G54, G17, G90, G94, spindle and coolant off, ...), as M2 would. */
-static void reset_interp(struct ncp_nck *s)
+/* Lines run through the interpreter that change its state only (what the
+ * status and the canon map follow), never the machine. */
+static void run_state_text(struct ncp_nck *s, const char *text, const char *name)
 {
-    static const char m2[] = "M2\n";
     struct ncp_source src;
     struct ncp_diag d;
-    if (ncp_source_from_memory(&src, m2, sizeof m2 - 1, "reset", &d) != NCP_OK)
+    if (!text[0] || ncp_source_from_memory(&src, text, strlen(text), name, &d) != NCP_OK)
         return;
     sync_interp(s);
     struct ncp_output out = { .ctx = s, .emit = emit_state_only };
     struct ncp_run_stats st;
     ncp_serial_run(&src, &s->acfg, &out, &st, &d);
     ncp_source_close(&src);
+}
+
+/* What a job, a stop or the shutdown changed of the offsets and tools, on
+ * the disk before the next command: a failure is the operator's to know. */
+static void persist(struct ncp_nck *s)
+{
+    char why[NCP_DIAG_MSG_MAX];
+    int w = nck_persist_save(&s->persist, s->interp, why, sizeof why);
+    if (w < 0)
+        nck_post(&s->core, NCP_EV_ERROR, NULL, 0, 0, "%s", why);
+    if (w > 0 && (w & 1))
+        nck_post(&s->core, NCP_EV_INFO, NULL, 0, 0, "offsets saved to %s",
+                 s->persist.var_path);
+    if (w > 0 && (w & 2))
+        nck_post(&s->core, NCP_EV_INFO, NULL, 0, 0, "tool table %s written",
+                 s->persist.tool_path);
+}
+
+/* After a stop, an error or an E-stop: the interpreter's end-of-program reset
+ * (G54, G17, G90, G94, spindle and coolant off, ...), as M2 would. */
+static void reset_interp(struct ncp_nck *s)
+{
+    run_state_text(s, "M2\n", "reset");
     pthread_mutex_lock(&s->core.cross.ev_lock);
     s->core.cross.io.dir = 0;
     s->core.cross.io.mist = 0;
@@ -197,6 +219,7 @@ static void drop_step(struct ncp_nck *s)
             reset_interp(s);
         else
             sync_interp(s);
+        persist(s);
         set_state(s, s->drop_after);
         break;
     case NCK_DROP_NONE:
@@ -773,6 +796,7 @@ static void job_ended(struct ncp_nck *s)
     } else if (kind == NCK_JOB_PROGRAM) {
         nck_post(n, NCP_EV_INFO, s->program, 0, 0, "program finished");
     }
+    persist(s);
     /* the whole job in the trace once it is over, not at the next 64 KiB */
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
@@ -915,6 +939,12 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->acfg.cancel_ctx = n;
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
+    if (s->interp && nck_persist_init(&s->persist, setup->vars, setup->cfg->op.parameter_file,
+                                      s->acfg.tool_table_path, s->interp)) {
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
+        ncp_nck_free(s);
+        return NULL;
+    }
     if (s->interp)   /* no run yet: the codes the first one starts in */
         ncp_analyzer_active_codes(s->interp, &n->cross.io.active);
     n->svc->sum.joints = ncp_kins_active(setup->cfg);
@@ -928,6 +958,9 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     for (int j = 0; j < NCP_AXES; j++)
         s->homed[j] = 0;
     s->state = NCP_ST_IDLE;
+    char restore[64];
+    nck_persist_restore_text(&s->persist, restore, sizeof restore);
+    run_state_text(s, restore, "parameter file");
     sync_interp(s);
     return s;
 }
@@ -947,6 +980,12 @@ void ncp_nck_free(struct ncp_nck *s)
     nck_read_cycles(n);
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
+    if (s->interp) {   /* at shutdown: what the last job changed is saved already */
+        char why[NCP_DIAG_MSG_MAX];
+        if (nck_persist_save(&s->persist, s->interp, why, sizeof why) < 0)
+            fprintf(stderr, "cnc-run serve: error: %s\n", why);
+    }
+    nck_persist_free(&s->persist);
     nck_release(n);
     ncp_analyzer_free(s->interp);
     if (s->have_prog)
