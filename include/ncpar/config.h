@@ -205,7 +205,7 @@ struct ncp_machine_cfg {
          * from the INI's folder as LinuxCNC reads them ("": not given) */
         char parameter_file[512], tool_table[512];
         /* [DISPLAY] MAX_FEED_OVERRIDE (1.0), MIN_SPINDLE_OVERRIDE (0.0) and
-         * MAX_SPINDLE_OVERRIDE (1.0): ratios, 1.0 = 100 % */
+         * MAX_SPINDLE_OVERRIDE (2.0): ratios, 1.0 = 100 % */
         double max_feed_override, min_spindle_override, max_spindle_override;
     } op;
     struct ncp_io_cfg io;

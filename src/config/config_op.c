@@ -1,7 +1,9 @@
 /* The INI keys of what an operator sets and may set: where the offsets and
  * tool data persist ([RS274NGC] PARAMETER_FILE, [EMCIO] TOOL_TABLE) and how
  * far the overrides go ([DISPLAY] MAX_FEED_OVERRIDE, MIN_SPINDLE_OVERRIDE,
- * MAX_SPINDLE_OVERRIDE), under LinuxCNC's names and meanings. */
+ * MAX_SPINDLE_OVERRIDE), under LinuxCNC's names and meanings. Without
+ * them the feed override stops at 100 % (AXIS's default), so motion at 100 %
+ * is as fast as the limits allow (see MAX_FEED_OVERRIDE in ini_keys.c). */
 #include "ncpar/config.h"
 #include "ini_num.h"
 
@@ -14,7 +16,7 @@ void ncp_op_cfg_default(struct ncp_op_cfg *op)
     memset(op, 0, sizeof *op);
     op->max_feed_override = 1.0;
     op->min_spindle_override = 0.0;
-    op->max_spindle_override = 1.0;
+    op->max_spindle_override = 2.0;   /* the 0..200 % cnc-ctl always took */
 }
 
 /* LinuxCNC opens a relative file from the configuration's folder (it runs

@@ -186,8 +186,8 @@ const struct ncp_ini_key ncp_ini_keys[] = {
          "Highest feed override, a ratio (1.2 = 120 %). Motion is planned at this override "
          "and slowed in time below it, so no axis exceeds its limits at any override; above "
          "1.0, moves that the limits cap run that much slower at 100 %."),
-    REAL("DISPLAY", "MAX_SPINDLE_OVERRIDE", 0.0, 2.0, "", "1.0",
-         "Highest spindle override, a ratio."),
+    REAL("DISPLAY", "MAX_SPINDLE_OVERRIDE", 0.0, 2.0, "", "2.0",
+         "Highest spindle override, a ratio (the spindle stays under [SPINDLE_0] MAX_RPM)."),
     REAL("DISPLAY", "MIN_SPINDLE_OVERRIDE", 0.0, 2.0, "", "0.0",
          "Lowest spindle override, a ratio, not above MAX_SPINDLE_OVERRIDE."),
     TEXT("EMCIO", "CYCLE_TIME", "LinuxCNC's", NULL, "0.1", "Taken and ignored."),

@@ -551,12 +551,14 @@ static int cmd_override(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *wh
     double pct = c->value[0];
     if (!isfinite(pct) || pct < 0)
         return refuse(why, len, "an override is a percentage of 0 or more");
+    const struct ncp_op_cfg *op = &s->core.cfg->op;
     switch (c->ivalue[0]) {
     case 0:
-        if (pct > 100.0 * s->core.plan_override)
-            return refuse(why, len, "feed override above %.0f %% is not supported: motion is "
-                          "planned at %.0f %% of F", 100.0 * s->core.plan_override,
-                          100.0 * s->core.plan_override);
+        /* 1e-9: "override feed 120" against 1.2 */
+        if (pct > 100.0 * s->core.plan_override + 1e-9)
+            return refuse(why, len, "feed override %g %% is above this machine's %g %% "
+                          "([DISPLAY] MAX_FEED_OVERRIDE = %g in its INI, at most 2.0)", pct,
+                          100.0 * s->core.plan_override, s->core.plan_override);
         ncp_nck_set_feed_override(s->core.ctl, pct / 100.0);
         return 0;
     case 1:
@@ -567,8 +569,14 @@ static int cmd_override(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *wh
         s->rapid_override = pct;
         return 0;
     case 2:
-        if (pct > 200)
-            return refuse(why, len, "spindle override is 0..200 %%");
+        if (pct > 100.0 * op->max_spindle_override + 1e-9)
+            return refuse(why, len, "spindle override %g %% is above this machine's %g %% "
+                          "([DISPLAY] MAX_SPINDLE_OVERRIDE = %g in its INI)", pct,
+                          100.0 * op->max_spindle_override, op->max_spindle_override);
+        if (pct < 100.0 * op->min_spindle_override - 1e-9)
+            return refuse(why, len, "spindle override %g %% is below this machine's %g %% "
+                          "([DISPLAY] MIN_SPINDLE_OVERRIDE = %g in its INI)", pct,
+                          100.0 * op->min_spindle_override, op->min_spindle_override);
         s->spindle_override = pct;
         atomic_store(&s->core.ctl->spindle_permille, (int)lround(pct * 10));
         return 0;
@@ -925,7 +933,10 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
         return NULL;
     }
     struct nck_core *n = &s->core;
-    n->plan_override = 1.0;
+    /* planned at the highest override the operator may choose and slowed
+     * in time below it (loop.c), so none can take an axis past its limits */
+    n->plan_override = setup->cfg->op.max_feed_override >= 1.0 ? setup->cfg->op.max_feed_override
+                                                               : 1.0;
     n->cross.post_prints = 1;
     s->rapid_override = 100;
     s->spindle_override = 100;
@@ -951,7 +962,10 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     if (setup->trace)
         nck_trace_header(setup->trace, setup->cfg, n->svc->sum.joints,
                          setup->trace_rings || setup->cfg->sched.trace_rings);
-    if (!s->interp || nck_start(n, setup, 0, d) || nck_start_loop(n, d)) {
+    int started = s->interp && nck_start(n, setup, 0, d) == 0;
+    if (started)   /* the service starts at 100 %, whatever the plan is made for */
+        ncp_nck_set_feed_override(n->ctl, 1.0);
+    if (!started || nck_start_loop(n, d)) {
         ncp_nck_free(s);
         return NULL;
     }
