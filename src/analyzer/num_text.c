@@ -7,8 +7,7 @@
 
 int ncp_num_text(char *out, size_t len, double v, int plus)
 {
-    if (v == 0)
-        v = 0;   /* no "-0.000000" */
+    v += 0.0;   /* -0 becomes 0: no "-0.000000" */
     for (int prec = 6; prec <= 20; prec++) {
         int n = snprintf(out, len, plus ? "%+.*f" : "%.*f", prec, v);
         if (n > 0 && (size_t)n < len && fabs(strtod(out, NULL) - v) <= 1e-12 * fmax(1, fabs(v)))

@@ -127,7 +127,10 @@ char *ncp_var_file_text(const struct ncp_var_file *vf, size_t *len)
 {
     size_t cap = 4096, n = 0;
     char *text = malloc(cap);
-    for (int k = 1; text && k < NCP_VAR_PARAMS; k++) {
+    if (!text)
+        return NULL;
+    text[0] = '\0';
+    for (int k = 1; k < NCP_VAR_PARAMS; k++) {
         if (!vf->listed[k])
             continue;
         if (cap - n < 400) {

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "ncpar/analyzer.h"
+#include "ncpar/config.h"
 #include "ncpar/pipeline.h"
 
 static char dir[64];
@@ -248,6 +249,54 @@ static void test_tool_table_unwritable(void **state)
     ncp_analyzer_free(a);
 }
 
+/* sim-3axis.ini with more lines: the machine INI's load of them */
+static int load_ini(const char *more, struct ncp_machine_cfg *c, struct ncp_diag *d)
+{
+    char *base = malloc(16384);
+    FILE *f = fopen("rt-config/sim-3axis.ini", "r");
+    assert_non_null(f);
+    size_t n = fread(base, 1, 16383, f);
+    fclose(f);
+    base[n] = '\0';
+    char *text = malloc(n + strlen(more) + 2);
+    sprintf(text, "%s\n%s", base, more);
+    put(path_of("m.ini"), text);
+    free(text);
+    free(base);
+    ncp_machine_cfg_default(c);
+    memset(d, 0, sizeof *d);
+    return ncp_machine_cfg_load(c, path_of("m.ini"), d);
+}
+
+static void test_ini_keys(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg *c = malloc(sizeof *c);
+    struct ncp_diag d;
+    assert_int_equal(load_ini("", c, &d), NCP_OK);
+    assert_string_equal(c->op.parameter_file, "");
+    assert_true(c->op.max_feed_override == 1.0 && c->op.max_spindle_override == 2.0);
+    /* relative to the INI's folder, as LinuxCNC opens them */
+    assert_int_equal(load_ini("[RS274NGC]\nPARAMETER_FILE = mill.var\n[EMCIO]\n"
+                              "TOOL_TABLE = /abs/t.tbl\n[DISPLAY]\nMAX_FEED_OVERRIDE = 1.2\n"
+                              "MIN_SPINDLE_OVERRIDE = 0.5\nMAX_SPINDLE_OVERRIDE = 1.5\n", c, &d),
+                     NCP_OK);
+    char want[160];
+    snprintf(want, sizeof want, "%s/mill.var", dir);
+    assert_string_equal(c->op.parameter_file, want);
+    assert_string_equal(c->op.tool_table, "/abs/t.tbl");
+    assert_true(c->op.max_feed_override == 1.2 && c->op.min_spindle_override == 0.5 &&
+                c->op.max_spindle_override == 1.5);
+    assert_int_not_equal(load_ini("[DISPLAY]\nMAX_FEED_OVERRIDE = 2.5\n", c, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "MAX_FEED_OVERRIDE"));
+    assert_int_not_equal(load_ini("[DISPLAY]\nMIN_SPINDLE_OVERRIDE = 1.5\n"
+                                  "MAX_SPINDLE_OVERRIDE = 1.2\n", c, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "MIN_SPINDLE_OVERRIDE 1.5 is above"));
+    assert_int_not_equal(load_ini("[RS274NGC]\nREMAP = M400 ngc=x\n", c, &d), NCP_OK);
+    assert_non_null(strstr(d.msg, "REMAP"));
+    free(c);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -257,6 +306,7 @@ int main(void)
         cmocka_unit_test(test_malformed_names_line),
         cmocka_unit_test(test_tool_table_write_back),
         cmocka_unit_test(test_tool_table_unwritable),
+        cmocka_unit_test(test_ini_keys),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
