@@ -170,14 +170,18 @@ void ncp_analyzer_set_param(struct ncp_analyzer *a, int index, double v);
 /* The tool table file's text with the interpreter's entries (after G10 L1,
  * L10, L11): a line whose tool changed is written anew in LinuxCNC's form
  * ("T1 P1 Z+0.511000 D0.125000 ;its comment"), every other line (comments,
- * blank, skipped, unchanged tools) byte for byte. *changed: 0 when the text
- * is the old one. malloc'd; NULL out of memory. */
-char *ncp_analyzer_tool_table_text(const struct ncp_analyzer *a, const char *old, size_t len,
-                                   size_t *out_len, int *changed);
+ * blank, skipped, unchanged tools) byte for byte. Changed: against base's
+ * entry (an analyzer holding the table as last loaded or written), or
+ * with base NULL against the line itself. *changed: 0 when the text is the
+ * old one. malloc'd; NULL out of memory. */
+char *ncp_analyzer_tool_table_text(const struct ncp_analyzer *a, const struct ncp_analyzer *base,
+                                   const char *old, size_t len, size_t *out_len, int *changed);
 /* Reads path, and writes it whole (temporary file, fsync, rename) when the
  * interpreter's entries changed it; *written says so. NCP_OK or NCP_ERR_IO. */
-int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const char *path, int *written,
-                                 struct ncp_diag *d);
+int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const struct ncp_analyzer *base,
+                                 const char *path, int *written, struct ncp_diag *d);
+/* dst's tool table becomes src's (the baseline after a write). */
+void ncp_analyzer_copy_tools(struct ncp_analyzer *dst, const struct ncp_analyzer *src);
 
 /* The modal codes in force (what every slot is stamped with when handed on);
  * for a resident analyzer between runs, the state the next run starts in. */

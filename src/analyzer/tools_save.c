@@ -2,7 +2,10 @@
  * LinuxCNC does, but line by line: what the operator wrote (comments, the
  * order, the lines of tools nobody changed) stays as written. Entry k of
  * the interpreter is the k-th line the loader kept (tools.c), so the file
- * must be the one the interpreter loaded. */
+ * must have the lines the interpreter loaded; against a baseline (the
+ * entries as last loaded or written), only the tools this interpreter
+ * changed are written, so another writer's changes to other tools (a
+ * second NC channel on the same table) are kept. */
 #include "num_text.h"
 #include "save_whole.h"
 #include "stages.h"
@@ -19,6 +22,7 @@ static int same(double a, double b)
     return fabs(a - b) <= 1e-12 * fmax(1, fabs(b));
 }
 
+/* Entry k of a against t, more, no (a line's, or another analyzer's). */
 static int same_entry(const struct ncp_analyzer *a, int k, const struct ncp_tool_entry *t,
                       const double *more, int no)
 {
@@ -64,8 +68,8 @@ static size_t format_entry(const struct ncp_analyzer *a, int k, const char *comm
     return n < cap ? n : cap - 1;
 }
 
-char *ncp_analyzer_tool_table_text(const struct ncp_analyzer *a, const char *old, size_t len,
-                                   size_t *out_len, int *changed)
+char *ncp_analyzer_tool_table_text(const struct ncp_analyzer *a, const struct ncp_analyzer *base,
+                                   const char *old, size_t len, size_t *out_len, int *changed)
 {
     /* a rewritten line is at most 9 offsets, D I J Q of 40 characters each
      * and its comment */
@@ -83,7 +87,11 @@ char *ncp_analyzer_tool_table_text(const struct ncp_analyzer *a, const char *old
         double more[7];
         int no;
         if (k < a->n_tools && ncp_tools_read_line(p, le, &t, more, &no)) {
-            if (!same_entry(a, k, &t, more, no)) {
+            int same = base && k < base->n_tools
+                           ? same_entry(a, k, &base->tools[k], base->tool_more[k],
+                                        base->tool_no[k])
+                           : same_entry(a, k, &t, more, no);
+            if (!same) {
                 const char *semi = memchr(p, ';', (size_t)(le - p));
                 size_t clen = semi ? (size_t)(le - semi) : 0;
                 while (clen && (semi[clen - 1] == '\r' || semi[clen - 1] == ' '))
@@ -104,8 +112,8 @@ char *ncp_analyzer_tool_table_text(const struct ncp_analyzer *a, const char *old
     return out;
 }
 
-int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const char *path, int *written,
-                                 struct ncp_diag *d)
+int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const struct ncp_analyzer *base,
+                                 const char *path, int *written, struct ncp_diag *d)
 {
     *written = 0;
     FILE *f = fopen(path, "rb");
@@ -132,7 +140,7 @@ int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const char *path,
     }
     size_t n;
     int changed;
-    char *text = ncp_analyzer_tool_table_text(a, old, len, &n, &changed);
+    char *text = ncp_analyzer_tool_table_text(a, base, old, len, &n, &changed);
     free(old);
     if (!text)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "tool table %s: out of memory", path);
@@ -140,4 +148,12 @@ int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const char *path,
     *written = changed && rc == NCP_OK;
     free(text);
     return rc;
+}
+
+void ncp_analyzer_copy_tools(struct ncp_analyzer *dst, const struct ncp_analyzer *src)
+{
+    dst->n_tools = src->n_tools;
+    memcpy(dst->tool_no, src->tool_no, (size_t)src->n_tools * sizeof src->tool_no[0]);
+    memcpy(dst->tools, src->tools, (size_t)src->n_tools * sizeof src->tools[0]);
+    memcpy(dst->tool_more, src->tool_more, (size_t)src->n_tools * sizeof src->tool_more[0]);
 }

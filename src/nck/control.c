@@ -951,8 +951,7 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
     if (s->interp && nck_persist_init(&s->persist, setup->vars, setup->cfg->op.parameter_file,
-                                      s->acfg.tool_table_path, s->interp)) {
-        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
+                                      s->acfg.tool_table_path, s->interp, d)) {
         ncp_nck_free(s);
         return NULL;
     }

@@ -9,14 +9,21 @@
 #include <string.h>
 
 int nck_persist_init(struct nck_persist *p, const struct ncp_var_file *vars,
-                     const char *var_path, const char *tool_path, struct ncp_analyzer *interp)
+                     const char *var_path, const char *tool_path, struct ncp_analyzer *interp,
+                     struct ncp_diag *d)
 {
     memset(p, 0, sizeof *p);
     p->tool_path = tool_path;
+    if (tool_path) {
+        /* the interpreter's table is taken below: no second read */
+        if (!(p->tools_base = ncp_analyzer_new(NULL, d)))
+            return -1;
+        ncp_analyzer_copy_tools(p->tools_base, interp);
+    }
     if (!vars)
         return 0;
     if (!(p->vf = malloc(sizeof *p->vf)))
-        return -1;
+        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory"), -1;
     *p->vf = *vars;
     snprintf(p->var_path, sizeof p->var_path, "%s", var_path);
     for (int k = 1; k < NCP_VAR_PARAMS; k++)
@@ -29,6 +36,8 @@ void nck_persist_free(struct nck_persist *p)
 {
     free(p->vf);
     p->vf = NULL;
+    ncp_analyzer_free(p->tools_base);
+    p->tools_base = NULL;
 }
 
 void nck_persist_restore_text(const struct nck_persist *p, char *buf, size_t len)
@@ -72,8 +81,10 @@ int nck_persist_save(struct nck_persist *p, const struct ncp_analyzer *interp, c
     }
     if (p->tool_path) {
         int w = 0;
-        if (ncp_analyzer_save_tool_table(interp, p->tool_path, &w, &d) != NCP_OK)
+        if (ncp_analyzer_save_tool_table(interp, p->tools_base, p->tool_path, &w, &d) != NCP_OK)
             return snprintf(why, len, "%s", d.msg), -1;
+        if (w)
+            ncp_analyzer_copy_tools(p->tools_base, interp);
         written |= w ? 2 : 0;
     }
     return written;

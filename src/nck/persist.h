@@ -14,11 +14,14 @@ struct nck_persist {
     struct ncp_var_file *vf;        /* as last written; NULL: no parameter file */
     char var_path[512];
     const char *tool_path;          /* the tool table, or NULL */
+    struct ncp_analyzer *tools_base;/* its entries as last loaded or written */
 };
 
-/* Takes the file's values into the interpreter. 0, or -1 out of memory. */
+/* Takes the file's values into the interpreter, and keeps the tool table
+ * as loaded. 0, or -1 with d->msg. */
 int nck_persist_init(struct nck_persist *p, const struct ncp_var_file *vars,
-                     const char *var_path, const char *tool_path, struct ncp_analyzer *interp);
+                     const char *var_path, const char *tool_path, struct ncp_analyzer *interp,
+                     struct ncp_diag *d);
 void nck_persist_free(struct nck_persist *p);
 
 /* The lines that make the interpreter take the file's frames, as rs274's

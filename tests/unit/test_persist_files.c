@@ -201,7 +201,7 @@ static void test_tool_table_write_back(void **state)
     struct ncp_analyzer *a = run_on_table(p, "G20\nG10 L1 P2 Z0.5 R0.25\nG10 L1 P3 X0\n");
     struct ncp_diag d;
     int written = 0;
-    assert_int_equal(ncp_analyzer_save_tool_table(a, p, &written, &d), NCP_OK);
+    assert_int_equal(ncp_analyzer_save_tool_table(a, NULL, p, &written, &d), NCP_OK);
     assert_int_equal(written, 1);
     assert_string_equal(get(p),
                         "; shop tools, inches\n"
@@ -212,7 +212,7 @@ static void test_tool_table_write_back(void **state)
                         "junk line\n"
                         "T4 P4 Z0.3100 ; slot drill\n");
     /* nothing changed since: the file is left alone */
-    assert_int_equal(ncp_analyzer_save_tool_table(a, p, &written, &d), NCP_OK);
+    assert_int_equal(ncp_analyzer_save_tool_table(a, NULL, p, &written, &d), NCP_OK);
     assert_int_equal(written, 0);
     ncp_analyzer_free(a);
 
@@ -221,12 +221,44 @@ static void test_tool_table_write_back(void **state)
     size_t n;
     int changed = 1;
     const char *text = get(p);
-    char *again = ncp_analyzer_tool_table_text(a, text, strlen(text), &n, &changed);
+    char *again = ncp_analyzer_tool_table_text(a, NULL, text, strlen(text), &n, &changed);
     assert_non_null(again);
     assert_int_equal(changed, 0);
     assert_string_equal(again, text);
     free(again);
     ncp_analyzer_free(a);
+}
+
+/* Two interpreters on one table (two NC channels), each against the table
+ * as it loaded it: each writes only the tool it changed, the other's
+ * change stays. */
+static void test_tool_table_two_writers(void **state)
+{
+    (void)state;
+    const char *p = path_of("shared.tbl");
+    put(p, table);
+    struct ncp_analyzer *a = run_on_table(p, "G20 G10 L1 P1 Z0.75\n");
+    struct ncp_analyzer *b = run_on_table(p, "G20 G10 L1 P4 Z0.5\n");
+    struct ncp_diag d;
+    struct ncp_analyzer *base_a = ncp_analyzer_new(NULL, &d), *base_b = ncp_analyzer_new(NULL, &d);
+    struct ncp_analyzer *fresh = run_on_table(p, "G20\n");
+    ncp_analyzer_copy_tools(base_a, fresh);
+    ncp_analyzer_copy_tools(base_b, fresh);
+    int written = 0;
+    assert_int_equal(ncp_analyzer_save_tool_table(a, base_a, p, &written, &d), NCP_OK);
+    assert_int_equal(written, 1);
+    assert_int_equal(ncp_analyzer_save_tool_table(b, base_b, p, &written, &d), NCP_OK);
+    assert_int_equal(written, 1);
+    const char *text = get(p);
+    assert_non_null(strstr(text, "T1 P1 Z+0.750000 D0.393700 ;10 mm flat end mill\n"));
+    assert_non_null(strstr(text, "T4 P4 Z+0.500000 ; slot drill\n"));
+    assert_non_null(strstr(text, "T2 P2 Z0.1200 D0.2362 ;6 mm flat end mill\n"));
+    /* against the line itself, b would have put T1 back */
+    ncp_analyzer_free(fresh);
+    ncp_analyzer_free(base_a);
+    ncp_analyzer_free(base_b);
+    ncp_analyzer_free(a);
+    ncp_analyzer_free(b);
 }
 
 /* A table that can be read but not replaced (its temporary file's name
@@ -242,7 +274,7 @@ static void test_tool_table_unwritable(void **state)
     struct ncp_analyzer *a = run_on_table(p, "G20 G10 L1 P1 Z1\n");
     struct ncp_diag d;
     int written = 1;
-    assert_int_equal(ncp_analyzer_save_tool_table(a, p, &written, &d), NCP_ERR_IO);
+    assert_int_equal(ncp_analyzer_save_tool_table(a, NULL, p, &written, &d), NCP_ERR_IO);
     assert_int_equal(written, 0);
     assert_non_null(strstr(d.msg, "cannot write tool table"));
     assert_string_equal(get(p), table);
@@ -305,6 +337,7 @@ int main(void)
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_malformed_names_line),
         cmocka_unit_test(test_tool_table_write_back),
+        cmocka_unit_test(test_tool_table_two_writers),
         cmocka_unit_test(test_tool_table_unwritable),
         cmocka_unit_test(test_ini_keys),
     };
