@@ -119,6 +119,14 @@ struct ncp_analyzer_cfg {
      * asked. */
     int (*cancel)(void *ctx);
     void *cancel_ctx;
+    /* LinuxCNC's parameter file (cnc-run run): the interpreter starts from
+     * these values as rs274 does from its .var file (the coordinate system
+     * of #5220 with its offsets and rotation, G92 when #5210 says it is
+     * applied, the machine's zero as the current point), and on its free
+     * copies the persistent parameters' last values to params_out. NULL:
+     * rs274's defaults, nothing copied. */
+    const struct ncp_var_file *params_in;
+    struct ncp_var_file *params_out;
 };
 
 /* Queue busters. The interpreter runs far ahead of motion; after a G38.x

@@ -93,6 +93,9 @@ void ncp_frame_relative(const struct ncp_analyzer *a, const double *abs, double 
 void ncp_frame_absolute(const struct ncp_analyzer *a, double *out);
 void ncp_frame_g53(const struct ncp_analyzer *a, const double *word, uint32_t given, double *end);
 
+/* analyzer.c: rs274's start-up from a parameter file */
+void ncp_an_take_params(struct ncp_analyzer *a, const struct ncp_var_file *vf);
+
 /* g10.c: G10 L1/L10/L11 (tool table) and L2/L20 (coordinate systems) */
 int ncp_g10_run(struct ncp_analyzer *a);
 

@@ -87,11 +87,11 @@ char *ncp_analyzer_tool_table_text(const struct ncp_analyzer *a, const struct nc
         double more[7];
         int no;
         if (k < a->n_tools && ncp_tools_read_line(p, le, &t, more, &no)) {
-            int same = base && k < base->n_tools
+            int kept = base && k < base->n_tools
                            ? same_entry(a, k, &base->tools[k], base->tool_more[k],
                                         base->tool_no[k])
                            : same_entry(a, k, &t, more, no);
-            if (!same) {
+            if (!kept) {
                 const char *semi = memchr(p, ';', (size_t)(le - p));
                 size_t clen = semi ? (size_t)(le - semi) : 0;
                 while (clen && (semi[clen - 1] == '\r' || semi[clen - 1] == ' '))

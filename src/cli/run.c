@@ -520,13 +520,35 @@ static int run_stop_asked(void *ctx)
     return run_signal != 0;
 }
 
-static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
-                       const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat)
+/* The parameter file again when the run changed it (vars: as read). */
+static int save_vars(const struct ncp_machine_cfg *cfg, const struct ncp_var_file *vars,
+                     const struct ncp_var_file *out)
 {
+    int changed = 0;
+    for (int k = 1; k < NCP_VAR_PARAMS && !changed; k++)
+        changed = vars->listed[k] && vars->value[k] != out->value[k];
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (!changed || ncp_var_file_write(cfg->op.parameter_file, out, &d) == NCP_OK)
+        return 0;
+    fprintf(stderr, "cnc-run run: error: %s ([RS274NGC] PARAMETER_FILE)\n", d.msg);
+    return -1;
+}
+
+static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
+                       const struct ncp_source *src, FILE *trace, struct ncp_rt_stats *lat,
+                       const struct ncp_var_file *vars)
+{
+    struct ncp_var_file *vars_out = vars ? malloc(sizeof *vars_out) : NULL;
+    if (vars && !vars_out)
+        return RUN_FAULT;
+    if (vars_out)
+        *vars_out = *vars;
     struct ncp_cli_interp ic = { src,
                              { .tool_table_path = o->tool_table, .subroutine_path = o->sub_path,
                                .max_loop_iterations = o->max_loops, .m66_on_machine = 1,
-                               .cancel = run_stop_asked },
+                               .cancel = run_stop_asked, .params_in = vars,
+                               .params_out = vars_out },
                              o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
@@ -540,9 +562,14 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .trace_rings = o->trace_rings,
     };
     struct ncp_nck_result *res = malloc(sizeof *res);
-    if (!res)
+    if (!res) {
+        free(vars_out);
         return RUN_FAULT;
+    }
     ncp_nck_run(&no, res);
+    /* the interpreter's last values, as LinuxCNC writes them at its exit */
+    int vars_failed = vars_out && save_vars(cfg, vars, vars_out) != 0;
+    free(vars_out);
     if (res->warning[0] && !no.progress)
         fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
     int rc = ncp_cli_run_report(o->prog, cfg, res, stderr);
@@ -555,6 +582,8 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
     }
     if (rc == RUN_OK && res->interrupted)
         rc = 128 + (int)run_signal;   /* as a shell reports a signal: 130, 143 */
+    if (rc == RUN_OK && vars_failed)
+        rc = RUN_FAULT;
     *lat = res->lat;
     free(res);
     return rc;
@@ -596,8 +625,16 @@ int ncp_cli_run(int argc, char **argv)
         return ncp_cli_run_channels(o.channel, o.n_channels, &cc);
     }
     struct ncp_machine_cfg cfg;
-    if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
+    if (load_config(&o, &cfg))
         return RUN_USAGE;
+    if (!o.tool_table && cfg.op.tool_table[0])
+        o.tool_table = cfg.op.tool_table;
+    if (ncp_cli_check_tool_table(o.tool_table))
+        return RUN_USAGE;
+    struct ncp_var_file *vars = NULL;
+    int vrc = ncp_cli_load_vars("cnc-run run", &cfg, &vars);
+    if (vrc)
+        return vrc == 2 ? RUN_PROGRAM : RUN_USAGE;
     struct ncp_source src;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
@@ -607,6 +644,7 @@ int ncp_cli_run(int argc, char **argv)
                     d.msg);
         else
             fprintf(stderr, "%s: error: %s\n", o.prog, d.msg);
+        free(vars);
         return RUN_PROGRAM;
     }
     ncp_cli_catch_input_faults(o.prog, 0);
@@ -624,12 +662,13 @@ int ncp_cli_run(int argc, char **argv)
     if (o.trace && !strcmp(o.trace, "-")) {
         fprintf(stderr, "cnc-run run: --trace wants a file (standard output is the summary's)\n");
         free(pj);
+        free(vars);
         ncp_source_close(&src);
         return RUN_USAGE;
     }
     if ((o.trace && ncp_outfile_open(&trace_of, o.trace, ids, n_ids, NCP_OUT_LIVE) != 0) ||
         (o.plot && (!pj || plot_prepare(pj, o.plot, ids, n_ids) != 0)))
-        return drop_outputs(&trace_of, pj, &src);
+        return free(vars), drop_outputs(&trace_of, pj, &src);
     /* --plot alone still needs a trace: one in the plot's private folder */
     const char *trace_path = o.trace ? o.trace : pj ? pj->trace : NULL;
     FILE *trace = NULL;
@@ -639,10 +678,11 @@ int ncp_cli_run(int argc, char **argv)
         trace = fopen(pj->trace, "w");
     if (trace_path && !trace) {
         fprintf(stderr, "cnc-run run: cannot write %s: %s\n", trace_path, strerror(errno));
-        return drop_outputs(&trace_of, pj, &src);
+        return free(vars), drop_outputs(&trace_of, pj, &src);
     }
     struct ncp_rt_stats *lat = calloc(1, sizeof *lat);
-    int rc = lat ? run_program(&o, &cfg, &src, trace, lat) : RUN_FAULT;
+    int rc = lat ? run_program(&o, &cfg, &src, trace, lat, vars) : RUN_FAULT;
+    free(vars);
     if (trace && fclose(trace) != 0) {
         fprintf(stderr, "cnc-run run: error writing %s: %s\n", trace_path, strerror(errno));
         rc = rc ? rc : RUN_FAULT;

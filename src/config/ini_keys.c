@@ -170,14 +170,15 @@ const struct ncp_ini_key ncp_ini_keys[] = {
          "Where a tool change happens; not given: where the machine is."),
     TEXT("EMCIO", "TOOL_TABLE", "a path, relative to the INI's folder", NULL, "tool.tbl",
          "The tool table (LinuxCNC's format) of cnc-run run and serve when --tool-table is "
-         "not given; G10 L1, L10 and L11 write their changes back to it (temporary file, "
-         "fsync, rename), its comments and other lines kept."),
+         "not given; under serve, G10 L1, L10 and L11 write their changes back to it "
+         "(temporary file, fsync, rename), its comments and other lines kept."),
 
     TEXT("RS274NGC", "PARAMETER_FILE", "a path, relative to the INI's folder", NULL,
          "linuxcnc.var",
          "LinuxCNC's parameter file: cnc-run serve reads it at start (missing: G54, all "
          "offsets 0) and writes it whole (temporary file, fsync, rename) after each program, "
-         "MDI line or stop that changed a persistent parameter, and at shutdown: G28 and G30 "
+         "MDI line or stop that changed a persistent parameter, and at shutdown (cnc-run run: "
+         "read at start, written at its end): G28 and G30 "
          "positions (#5161-#5169, #5181-#5189), G92 (#5210-#5219), the coordinate system "
          "(#5220) and G54..G59.3 (#5221-#5390, R included). Values in the interpreter's "
          "user unit (inch), as the tool table's. Not given: nothing persists."),
