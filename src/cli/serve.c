@@ -16,6 +16,7 @@
 #include <getopt.h>
 #include <unistd.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <errno.h>
 #include <limits.h>
 #include <stdio.h>
@@ -255,6 +256,27 @@ static int close_trace(struct serve_channel *ch)
     return rc;
 }
 
+/* Two NC channels on one parameter file would each write their own
+ * offsets over the other's: refused (the files exist by now). */
+static int shared_parameter_file(const struct serve_channel *chs, int n)
+{
+    for (int i = 0; i < n; i++) {
+        struct stat a;
+        if (!chs[i].vars || stat(chs[i].cfg.op.parameter_file, &a) != 0)
+            continue;
+        for (int j = i + 1; j < n; j++) {
+            struct stat b;
+            if (chs[j].vars && stat(chs[j].cfg.op.parameter_file, &b) == 0 &&
+                a.st_dev == b.st_dev && a.st_ino == b.st_ino)
+                return fprintf(stderr, "cnc-run serve: error: channels %d (%s) and %d (%s) "
+                               "name one [RS274NGC] PARAMETER_FILE %s: each channel keeps "
+                               "its own offsets\n", chs[i].num, chs[i].config, chs[j].num,
+                               chs[j].config, chs[i].cfg.op.parameter_file), 1;
+        }
+    }
+    return 0;
+}
+
 /* The channels from a channels INI, or the one machine INI as channel 0;
  * NULL with *bad_input set when a channel's files are malformed. */
 static struct serve_channel *load_channels(const struct serve_args *a, int *n, int *bad_input)
@@ -284,6 +306,8 @@ static struct serve_channel *load_channels(const struct serve_args *a, int *n, i
             return free_channels(chs, *n), NULL;
         }
     }
+    if (shared_parameter_file(chs, *n))
+        return free_channels(chs, *n), NULL;
     for (int k = 0; k < *n; k++) {
         if (open_trace(&chs[k], a, several)) {
             for (int i = 0; i < k; i++)
