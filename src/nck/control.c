@@ -493,7 +493,9 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
         return refuse(why, len, "%c is at its soft limit %.4f", NCP_AXIS_LETTERS[j], limit);
     struct ncp_seg seg;
     n->job->step_line = 0;
-    nck_line(n, &seg, n->job->map.pos, target, speed, 0);
+    /* the loop plays feed moves at override / plan override: at 100 % the
+     * jog runs at its speed (capped by the planner at the axis's limit) */
+    nck_line(n, &seg, n->job->map.pos, target, speed * n->plan_override, 0);
     if (start_moves(s, &seg, 1))
         return refuse(why, len, "cannot start the jog");
     memcpy(n->job->map.pos, target, sizeof n->job->map.pos);
