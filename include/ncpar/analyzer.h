@@ -37,6 +37,31 @@ struct ncp_tool_entry {
  * be read (missing, a directory) is an error in d. */
 int ncp_tool_table_check(const char *path, FILE *warn, struct ncp_diag *d);
 
+/* LinuxCNC's parameter file ([RS274NGC] PARAMETER_FILE, the ".var" file):
+ * one "NUMBER<TAB>VALUE" line per parameter, numbers ascending. The
+ * persistent ones are always in it (ncp_var_persistent: #5161-#5169 and
+ * #5181-#5189, G28/G30; #5210-#5219, G92 applied and its offsets; #5220, the
+ * coordinate system; #5221-#5230 .. #5381-#5390, G54..G59.3 with R); any
+ * other number a file lists is kept too, as LinuxCNC does. Values are in
+ * the interpreter's user unit (inch, as the tool table's). */
+#define NCP_VAR_PARAMS 5602      /* #1..#5601, as rs274 */
+struct ncp_var_file {
+    double value[NCP_VAR_PARAMS];
+    unsigned char listed[NCP_VAR_PARAMS]; /* written back */
+};
+int ncp_var_persistent(int index);
+/* No file yet: the persistent numbers listed, G54 (#5220 = 1), the rest 0. */
+void ncp_var_file_init(struct ncp_var_file *vf);
+/* A missing file is the defaults (*existed = 0); a line that is not
+ * "NUMBER VALUE" (a number 1..5601, ascending, a finite value; #5220 one of
+ * 1..9) is NCP_ERR_SEMANTIC with its line in d->line and why in d->msg. */
+int ncp_var_file_read(const char *path, struct ncp_var_file *vf, int *existed,
+                      struct ncp_diag *d);
+/* The text of the file (malloc'd, *len its length), and the whole file
+ * written by temporary file, fsync and rename (never torn). */
+char *ncp_var_file_text(const struct ncp_var_file *vf, size_t *len);
+int ncp_var_file_write(const char *path, const struct ncp_var_file *vf, struct ncp_diag *d);
+
 #define NCP_DEFAULT_MAX_LOOPS 10000000u
 
 /* One key of a LinuxCNC INI, which a program reads as #<_ini[SECTION]KEY>
@@ -101,6 +126,14 @@ struct ncp_analyzer_cfg {
      * asked. */
     int (*cancel)(void *ctx);
     void *cancel_ctx;
+    /* LinuxCNC's parameter file (cnc-run run): the interpreter starts from
+     * these values as rs274 does from its .var file (the coordinate system
+     * of #5220 with its offsets and rotation, G92 when #5210 says it is
+     * applied, the machine's zero as the current point), and on its free
+     * copies the persistent parameters' last values to params_out. NULL:
+     * rs274's defaults, nothing copied. */
+    const struct ncp_var_file *params_in;
+    struct ncp_var_file *params_out;
 };
 
 /* Queue busters. The interpreter runs far ahead of motion; after a G38.x
@@ -146,6 +179,30 @@ int ncp_analyzer_run(struct ncp_analyzer *a, const struct ncp_block_feed *feed,
  * stopped program, a jog, homing), so its current point becomes pos (X Y Z in
  * program coordinates and units: see ncp_canon_map_to_program). */
 void ncp_analyzer_set_position(struct ncp_analyzer *a, const double pos[3]);
+
+/* Between runs of a resident analyzer: numbered parameter #index (1..5601;
+ * 0 outside), and setting one as the parameter file gives it. After
+ * setting the frame parameters (#5210-#5390), the analyzer takes them into
+ * its state only when a block selects a system or restores G92 (the NCK
+ * runs "G92.3" and "G5x" lines to do so, as rs274's start-up would). */
+double ncp_analyzer_param(const struct ncp_analyzer *a, int index);
+void ncp_analyzer_set_param(struct ncp_analyzer *a, int index, double v);
+
+/* The tool table file's text with the interpreter's entries (after G10 L1,
+ * L10, L11): a line whose tool changed is written anew in LinuxCNC's form
+ * ("T1 P1 Z+0.511000 D0.125000 ;its comment"), every other line (comments,
+ * blank, skipped, unchanged tools) byte for byte. Changed: against base's
+ * entry (an analyzer holding the table as last loaded or written), or
+ * with base NULL against the line itself. *changed: 0 when the text is the
+ * old one. malloc'd; NULL out of memory. */
+char *ncp_analyzer_tool_table_text(const struct ncp_analyzer *a, const struct ncp_analyzer *base,
+                                   const char *old, size_t len, size_t *out_len, int *changed);
+/* Reads path, and writes it whole (temporary file, fsync, rename) when the
+ * interpreter's entries changed it; *written says so. NCP_OK or NCP_ERR_IO. */
+int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const struct ncp_analyzer *base,
+                                 const char *path, int *written, struct ncp_diag *d);
+/* dst's tool table becomes src's (the baseline after a write). */
+void ncp_analyzer_copy_tools(struct ncp_analyzer *dst, const struct ncp_analyzer *src);
 
 /* The modal codes in force (what every slot is stamped with when handed on);
  * for a resident analyzer between runs, the state the next run starts in. */

@@ -200,6 +200,14 @@ struct ncp_machine_cfg {
          * space- or comma-separated lists, "" for none (both default) */
         char allow_origin[512], allow_host[512];
     } http;
+    struct ncp_op_cfg {           /* what the operator sets, and its bounds */
+        /* [RS274NGC] PARAMETER_FILE and [EMCIO] TOOL_TABLE, made absolute
+         * from the INI's folder as LinuxCNC reads them ("": not given) */
+        char parameter_file[512], tool_table[512];
+        /* [DISPLAY] MAX_FEED_OVERRIDE (1.0), MIN_SPINDLE_OVERRIDE (0.0) and
+         * MAX_SPINDLE_OVERRIDE (2.0): ratios, 1.0 = 100 % */
+        double max_feed_override, min_spindle_override, max_spindle_override;
+    } op;
     struct ncp_io_cfg io;
     /* [INJECT] and [RT]'s miss keys: timing faults, setpoint policy, miss limits */
     struct ncp_inject_cfg inject;
@@ -226,6 +234,14 @@ int ncp_machine_cfg_load(struct ncp_machine_cfg *c, const char *path, struct ncp
 /* config_io.c: the defaults of ncp_io_cfg, and one key of the sections it
  * reads ([SPINDLE_0], [EMCIO], [SIM]'s input and pause keys): 1 taken, 0
  * unknown key, -1 bad value (why says more), -2 not one of its sections. */
+/* config_op.c: the defaults of ncp_op_cfg, and one key of its sections
+ * ([RS274NGC], [DISPLAY], [EMCIO] TOOL_TABLE), a path made absolute from
+ * ini_path's folder: 1 taken, 0 unknown, -1 bad value, -2 not its key. */
+void ncp_op_cfg_default(struct ncp_op_cfg *op);
+int ncp_op_cfg_key(struct ncp_op_cfg *op, const char *ini_path, const char *sec, const char *k,
+                   const char *v, char *why, size_t len);
+/* after the load: the overrides' bounds against each other */
+int ncp_op_cfg_check(const struct ncp_op_cfg *op, char *why, size_t len);
 void ncp_io_cfg_default(struct ncp_io_cfg *io);
 int ncp_io_cfg_key(struct ncp_io_cfg *io, const char *sec, const char *k, const char *v,
                    char *why, size_t len);

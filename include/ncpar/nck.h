@@ -202,7 +202,13 @@ struct ncp_nck_setup {
     const struct ncp_machine_cfg *cfg;
     int virtual_clock;
     FILE *trace;                     /* per-cycle CSV, or NULL */
-    struct ncp_analyzer_cfg interp;  /* tool table, subroutine path of the interpreter */
+    struct ncp_analyzer_cfg interp;  /* tool table, subroutine path of the interpreter; a
+                                        tool table G10 L1/L10/L11 change is written back */
+    /* [RS274NGC] PARAMETER_FILE's contents (cfg->op.parameter_file), read by
+     * the caller: the interpreter starts from them, and the NCK writes the
+     * file again whenever a job, a stop or the shutdown changed them. NULL:
+     * no parameter file. */
+    const struct ncp_var_file *vars;
     enum ncp_thread_mode mode;       /* how programs are interpreted */
     double jog_keepalive_s;          /* a continuous jog stops this long after the last
                                         keep-alive (0: 0.3 s, three of

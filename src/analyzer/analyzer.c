@@ -37,6 +37,8 @@ struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
     }
     ncp_user_m_scan(a);
     ncp_state_init(a);
+    if (a->cfg.params_in)
+        ncp_an_take_params(a, a->cfg.params_in);
     a->execute = ncp_an_execute;
     a->active_codes = ncp_analyzer_active_codes;
     ncp_cutcomp_init(&a->comp, NULL);
@@ -48,6 +50,10 @@ void ncp_analyzer_free(struct ncp_analyzer *a)
 {
     if (!a)
         return;
+    if (a->cfg.params_out)
+        for (int k = 1; k < NCP_VAR_PARAMS; k++)
+            if (a->cfg.params_out->listed[k])
+                a->cfg.params_out->value[k] = *ncp_params_slot(a->params, k);
     if (a->flow)
         ncp_flow_free(a->flow);
     ncp_m7x_free(a);
@@ -57,14 +63,25 @@ void ncp_analyzer_free(struct ncp_analyzer *a)
     free(a);
 }
 
+/* rs274's start-up calls: the frames of its parameters (G54 and zeros
+ * without a parameter file), after which its canon's position, and so the
+ * current point, is the machine's zero in program coordinates. */
 static void ncp_an_preamble(struct ncp_analyzer *a)
 {
-    static const double zero[6];
+    struct ncp_state *s = &a->st;
     ncp_an_emit(a, NCP_C_USE_LENGTH_UNITS)->units.mm = 1;
     struct ncp_canon *op = ncp_an_emit(a, NCP_C_SET_G5X_OFFSET);
-    op->offset.index = 1;
-    ncp_an_emit6(a, NCP_C_SET_G92_OFFSET, zero);
-    ncp_an_emit(a, NCP_C_SET_XY_ROTATION);
+    op->offset.index = s->m.origin;
+    memcpy(op->offset.v, s->g5x, sizeof op->offset.v);
+    if (a->cfg.params_in)
+        ncp_sai_g5x(a, s->g5x);
+    ncp_an_emit6(a, NCP_C_SET_G92_OFFSET, s->g92);
+    ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->rotation.degrees = s->rotation;
+    if (a->cfg.params_in) {
+        static const double zero[NCP_NAX];
+        ncp_frame_relative(a, zero, s->pos);
+        memcpy(a->sai.pos, s->pos, sizeof a->sai.pos);
+    }
     ncp_an_emit(a, NCP_C_SET_FEED_REFERENCE)->feed_reference.xyz = 1;
     ncp_an_emit(a, NCP_C_ON_RESET);
 }
@@ -274,4 +291,34 @@ void ncp_analyzer_set_sync(struct ncp_analyzer *a, ncp_machine_sync_fn fn, void 
 {
     a->sai.sync = fn;
     a->sai.sync_ctx = ctx;
+}
+
+/* rs274's init from its parameter file: the values, then the frames they
+ * hold (the preamble emits them). */
+void ncp_an_take_params(struct ncp_analyzer *a, const struct ncp_var_file *vf)
+{
+    struct ncp_state *s = &a->st;
+    for (int k = 1; k < NCP_VAR_PARAMS; k++)
+        if (vf->listed[k])
+            *ncp_params_slot(a->params, k) = vf->value[k];
+    int origin = (int)ncp_frame_param(a, 5220);
+    s->m.origin = origin >= 1 && origin <= 9 ? origin : 1;
+    for (int ax = 0; ax < NCP_NAX; ax++) {
+        s->g5x[ax] = ncp_frame_user(a, ax, 5201 + 20 * s->m.origin + ax);
+        s->g92[ax] = ncp_frame_param(a, 5210) != 0.0 ? ncp_frame_user(a, ax, 5211 + ax) : 0.0;
+    }
+    s->rotation = ncp_frame_param(a, 5210 + 20 * s->m.origin);
+}
+
+double ncp_analyzer_param(const struct ncp_analyzer *a, int index)
+{
+    if (index < 1 || index >= NCP_PARAMS_MAX)
+        return 0.0;
+    return *ncp_params_slot(a->params, index);
+}
+
+void ncp_analyzer_set_param(struct ncp_analyzer *a, int index, double v)
+{
+    if (index >= 1 && index < NCP_PARAMS_MAX)
+        *ncp_params_slot(a->params, index) = v;
 }

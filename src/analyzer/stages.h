@@ -93,11 +93,19 @@ void ncp_frame_relative(const struct ncp_analyzer *a, const double *abs, double 
 void ncp_frame_absolute(const struct ncp_analyzer *a, double *out);
 void ncp_frame_g53(const struct ncp_analyzer *a, const double *word, uint32_t given, double *end);
 
+/* analyzer.c: rs274's start-up from a parameter file */
+void ncp_an_take_params(struct ncp_analyzer *a, const struct ncp_var_file *vf);
+
 /* g10.c: G10 L1/L10/L11 (tool table) and L2/L20 (coordinate systems) */
 int ncp_g10_run(struct ncp_analyzer *a);
 
 /* tools.c */
 int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d);
+/* One line of a tool table as the loader reads it (tools.c): 1 and the
+ * entry (Y A B C U V W offsets in more[7]) for a tool line the loader
+ * keeps, 0 for any other (blank, comment, skipped). */
+int ncp_tools_read_line(const char *s, const char *end, struct ncp_tool_entry *t, double *more,
+                        int *toolno);
 int ncp_tools_find(const struct ncp_analyzer *a, int tool);
 int ncp_tools_select(struct ncp_analyzer *a);
 int ncp_tools_change(struct ncp_analyzer *a);

@@ -169,6 +169,13 @@ int ncp_tool_table_check(const char *path, FILE *warn, struct ncp_diag *d)
     return NCP_OK;
 }
 
+int ncp_tools_read_line(const char *s, const char *end, struct ncp_tool_entry *t, double *more,
+                        int *toolno)
+{
+    char why[64];
+    return ncp_tool_line_check(s, end, why, sizeof why) > 0 && ncp_tool_line(s, end, t, more, toolno);
+}
+
 static void ncp_tools_parse(struct ncp_analyzer *a, const char *text, size_t len)
 {
     const char *p = text, *end = text + len;
@@ -181,9 +188,7 @@ static void ncp_tools_parse(struct ncp_analyzer *a, const char *text, size_t len
         const char *nl = memchr(p, '\n', (size_t)(end - p));
         const char *le = nl ? nl : end;
         int no;
-        char why[64];
-        if (ncp_tool_line_check(p, le, why, sizeof why) > 0 &&
-            ncp_tool_line(p, le, &a->tools[a->n_tools], a->tool_more[a->n_tools], &no))
+        if (ncp_tools_read_line(p, le, &a->tools[a->n_tools], a->tool_more[a->n_tools], &no))
             a->tool_no[a->n_tools++] = no;
         p = nl ? nl + 1 : end;
     }

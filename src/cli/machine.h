@@ -2,6 +2,7 @@
 #ifndef NCPAR_CLI_MACHINE_H
 #define NCPAR_CLI_MACHINE_H
 
+#include "ncpar/analyzer.h"
 #include "ncpar/config.h"
 
 /* The defaults, then path over them (NULL: the defaults alone). On an error
@@ -11,5 +12,12 @@ int ncp_cli_load_machine(const char *path, struct ncp_machine_cfg *cfg);
 /* A tool table given (NULL: none): a warning per line the interpreter will
  * skip; -1 after printing the error when it cannot be read. */
 int ncp_cli_check_tool_table(const char *path);
+
+/* cfg's [RS274NGC] PARAMETER_FILE read (*out malloc'd; NULL when the INI
+ * names none), and made with the defaults when it does not exist. Returns
+ * 0; 2 for a malformed file (PATH:LINE: error: ... printed), 1 when it
+ * cannot be read or made. */
+int ncp_cli_load_vars(const char *who, const struct ncp_machine_cfg *cfg,
+                      struct ncp_var_file **out);
 
 #endif

@@ -485,11 +485,34 @@ static int run_stop_asked(void *ctx)
     return run_signal != 0;
 }
 
+/* The parameter file again when the run changed it (vars: as read). */
+static int save_vars(const struct ncp_machine_cfg *cfg, const struct ncp_var_file *vars,
+                     const struct ncp_var_file *out)
+{
+    int changed = 0;
+    for (int k = 1; k < NCP_VAR_PARAMS && !changed; k++)
+        changed = vars->listed[k] && vars->value[k] != out->value[k];
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (!changed || ncp_var_file_write(cfg->op.parameter_file, out, &d) == NCP_OK)
+        return 0;
+    fprintf(stderr, "cnc-run run: error: %s ([RS274NGC] PARAMETER_FILE)\n", d.msg);
+    return -1;
+}
+
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_analyzer_cfg *acfg, const struct ncp_source *src,
-                       FILE *trace, struct ncp_rt_stats *lat)
+                       FILE *trace, struct ncp_rt_stats *lat, const struct ncp_var_file *vars)
 {
-    struct ncp_cli_interp ic = { src, *acfg, o->mode };
+    struct ncp_var_file *vars_out = vars ? malloc(sizeof *vars_out) : NULL;
+    if (vars && !vars_out)
+        return RUN_FAULT;
+    if (vars_out)
+        *vars_out = *vars;
+    struct ncp_analyzer_cfg with_vars = *acfg;
+    with_vars.params_in = vars;
+    with_vars.params_out = vars_out;
+    struct ncp_cli_interp ic = { src, with_vars, o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
@@ -502,9 +525,14 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         .trace_rings = o->trace_rings,
     };
     struct ncp_nck_result *res = malloc(sizeof *res);
-    if (!res)
+    if (!res) {
+        free(vars_out);
         return RUN_FAULT;
+    }
     ncp_nck_run(&no, res);
+    /* the interpreter's last values, as LinuxCNC writes them at its exit */
+    int vars_failed = vars_out && save_vars(cfg, vars, vars_out) != 0;
+    free(vars_out);
     if (res->warning[0] && !no.progress)
         fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
     int rc = ncp_cli_run_report(o->prog, cfg, res, stderr);
@@ -517,6 +545,8 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
     }
     if (rc == RUN_OK && res->interrupted)
         rc = 128 + (int)run_signal;   /* as a shell reports a signal: 130, 143 */
+    if (rc == RUN_OK && vars_failed)
+        rc = RUN_FAULT;
     *lat = res->lat;
     free(res);
     return rc;
@@ -536,7 +566,7 @@ static int drop_outputs(struct ncp_outfile *trace_of, struct plot_job *pj, struc
 
 /* The run of a loaded machine and interpreter: the program, the outputs. */
 static int run_loaded(const struct run_opts *op, const struct ncp_machine_cfg *cfg,
-                      const struct ncp_analyzer_cfg *acfg)
+                      const struct ncp_analyzer_cfg *acfg, const struct ncp_var_file *vars)
 {
     const struct run_opts o = *op;
     struct ncp_source src;
@@ -583,7 +613,7 @@ static int run_loaded(const struct run_opts *op, const struct ncp_machine_cfg *c
         return drop_outputs(&trace_of, pj, &src);
     }
     struct ncp_rt_stats *lat = calloc(1, sizeof *lat);
-    int rc = lat ? run_program(&o, cfg, acfg, &src, trace, lat) : RUN_FAULT;
+    int rc = lat ? run_program(&o, cfg, acfg, &src, trace, lat, vars) : RUN_FAULT;
     if (trace && fclose(trace) != 0) {
         fprintf(stderr, "cnc-run run: error writing %s: %s\n", trace_path, strerror(errno));
         rc = rc ? rc : RUN_FAULT;
@@ -629,7 +659,11 @@ int ncp_cli_run(int argc, char **argv)
         return ncp_cli_run_channels(o.channel, o.n_channels, &cc);
     }
     struct ncp_machine_cfg cfg;
-    if (load_config(&o, &cfg) || ncp_cli_check_tool_table(o.tool_table))
+    if (load_config(&o, &cfg))
+        return RUN_USAGE;
+    if (!o.tool_table && cfg.op.tool_table[0])
+        o.tool_table = cfg.op.tool_table;
+    if (ncp_cli_check_tool_table(o.tool_table))
         return RUN_USAGE;
     /* the interpreter of the same INI: its [RS274NGC] (REMAP, folders) */
     struct ncp_analyzer_cfg acfg = { .tool_table_path = o.tool_table,
@@ -643,7 +677,13 @@ int ncp_cli_run(int argc, char **argv)
         free(joined);
         return RUN_USAGE;
     }
-    int rc = run_loaded(&o, &cfg, &acfg);
+    struct ncp_var_file *vars = NULL;
+    int rc = ncp_cli_load_vars("cnc-run run", &cfg, &vars);
+    if (rc)
+        rc = rc == 2 ? RUN_PROGRAM : RUN_USAGE;
+    else
+        rc = run_loaded(&o, &cfg, &acfg, vars);
+    free(vars);
     rs274_ini_free(&ini);
     free(joined);
     return rc;

@@ -20,6 +20,7 @@
 #include <getopt.h>
 #include <unistd.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -27,7 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { SERVE_OK = 0, SERVE_USAGE = 1, SERVE_FAULT = 3 };
+enum { SERVE_OK = 0, SERVE_USAGE = 1, SERVE_BAD_INPUT = 2, SERVE_FAULT = 3 };
 
 static volatile sig_atomic_t stop_signal;
 
@@ -100,7 +101,8 @@ static void usage(FILE *f)
           "  --web DIR           the panel's files (default: web/ beside cnc-run, else\n"
           "                      share/ncpar/web/ of its install prefix)\n"
           "SIGINT/SIGTERM: a controlled stop along the path, then shutdown.\n"
-          "exit status: 0 ok, 1 usage or set-up, 3 a fault happened while serving\n",
+          "exit status: 0 ok, 1 usage or set-up, 2 a malformed [RS274NGC] PARAMETER_FILE,\n"
+          "3 a fault happened while serving\n",
           f);
     if (!ncp_http_available())
         fputs("(--http is missing: this cnc-run was built without libwebsockets)\n", f);
@@ -227,6 +229,8 @@ struct serve_channel {
     struct rs274_ini ini;
     char *sub_path;
     struct ncp_analyzer_cfg acfg;
+    struct ncp_var_file *vars;      /* [RS274NGC] PARAMETER_FILE read, or NULL */
+    const char *tool_table;         /* --tool-table, else [EMCIO] TOOL_TABLE, or NULL */
 };
 
 /* What serve drives beyond the simulated machine is what every command of
@@ -269,21 +273,29 @@ static int servable(const struct serve_channel *ch, int several)
     return 0;
 }
 
+/* 0, -1 (set-up: exit 1), or -2 (a malformed parameter file or tool
+ * table: exit 2) */
 static int load_channel(struct serve_channel *ch, const struct serve_args *a, int several)
 {
-    ch->acfg = (struct ncp_analyzer_cfg){ .tool_table_path = a->tool_table,
-                                          .subroutine_path = a->sub_path };
     const struct ncp_cli_backend_opts bo = { "cnc-run serve", ch->config, a->backend, a->dp,
                                              a->url, a->key_file, a->virtual_clock };
-    return ncp_cli_load_machine(ch->config, &ch->cfg) ||
-                   ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
-                   ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg) ||
-                   no_socketcan(ch, a->backend) || ncp_cli_apply_backend(&bo, &ch->cfg) ||
-                   servable(ch, several) ||
-                   rs274_ini_machine(ch->config, ch->cfg.rs274.user_m_dirs, &ch->ini, &ch->acfg,
-                                     &ch->sub_path)
-               ? -1
-               : 0;
+    if (ncp_cli_load_machine(ch->config, &ch->cfg) ||
+        ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
+        ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg) ||
+        no_socketcan(ch, a->backend) || ncp_cli_apply_backend(&bo, &ch->cfg) ||
+        servable(ch, several))
+        return -1;
+    ch->tool_table = a->tool_table ? a->tool_table
+                     : ch->cfg.op.tool_table[0] ? ch->cfg.op.tool_table : NULL;
+    if (!a->tool_table && ncp_cli_check_tool_table(ch->tool_table))
+        return -1;
+    ch->acfg = (struct ncp_analyzer_cfg){ .tool_table_path = ch->tool_table,
+                                          .subroutine_path = a->sub_path };
+    if (rs274_ini_machine(ch->config, ch->cfg.rs274.user_m_dirs, &ch->ini, &ch->acfg,
+                          &ch->sub_path))
+        return -1;
+    int rc = ncp_cli_load_vars("cnc-run serve", &ch->cfg, &ch->vars);
+    return rc == 2 ? -2 : rc ? -1 : 0;
 }
 
 static void free_channels(struct serve_channel *chs, int n)
@@ -291,6 +303,7 @@ static void free_channels(struct serve_channel *chs, int n)
     for (int k = 0; chs && k < n; k++) {
         rs274_ini_free(&chs[k].ini);
         free(chs[k].sub_path);
+        free(chs[k].vars);
     }
     free(chs);
 }
@@ -308,7 +321,7 @@ static int open_trace(struct serve_channel *ch, const struct serve_args *a, int 
         return fprintf(stderr, "cnc-run serve: --trace '%s': name too long\n", a->trace), -1;
     struct ncp_file_id ids[2];
     int n_ids = ncp_file_id_add(ids, 0, ch->config, "the machine INI");
-    n_ids = ncp_file_id_add(ids, n_ids, a->tool_table, "the tool table");
+    n_ids = ncp_file_id_add(ids, n_ids, ch->tool_table, "the tool table");
     if (ncp_outfile_open(&ch->trace_of, ch->trace_path, ids, n_ids, NCP_OUT_LIVE) != 0)
         return -1;
     if (!(ch->trace = fdopen(ch->trace_of.fd, "w"))) {
@@ -335,8 +348,30 @@ static int close_trace(struct serve_channel *ch)
     return rc;
 }
 
-/* The channels from a channels INI, or the one machine INI as channel 0. */
-static struct serve_channel *load_channels(const struct serve_args *a, int *n)
+/* Two NC channels on one parameter file would each write their own
+ * offsets over the other's: refused (the files exist by now). */
+static int shared_parameter_file(const struct serve_channel *chs, int n)
+{
+    for (int i = 0; i < n; i++) {
+        struct stat a;
+        if (!chs[i].vars || stat(chs[i].cfg.op.parameter_file, &a) != 0)
+            continue;
+        for (int j = i + 1; j < n; j++) {
+            struct stat b;
+            if (chs[j].vars && stat(chs[j].cfg.op.parameter_file, &b) == 0 &&
+                a.st_dev == b.st_dev && a.st_ino == b.st_ino)
+                return fprintf(stderr, "cnc-run serve: error: channels %d (%s) and %d (%s) "
+                               "name one [RS274NGC] PARAMETER_FILE %s: each channel keeps "
+                               "its own offsets\n", chs[i].num, chs[i].config, chs[j].num,
+                               chs[j].config, chs[i].cfg.op.parameter_file), 1;
+        }
+    }
+    return 0;
+}
+
+/* The channels from a channels INI, or the one machine INI as channel 0;
+ * NULL with *bad_input set when a channel's files are malformed. */
+static struct serve_channel *load_channels(const struct serve_args *a, int *n, int *bad_input)
 {
     struct ncp_cli_cell *cell = calloc(1, sizeof *cell);
     int several = !cell ? -1 : a->config ? ncp_cli_cell_load(a->config, cell) : 0;
@@ -357,9 +392,14 @@ static struct serve_channel *load_channels(const struct serve_args *a, int *n)
     free(cell);
     for (int k = 0; k < *n; k++) {
         chs[k].trace_of.fd = -1;
-        if (load_channel(&chs[k], a, several))
-            return free_channels(chs, k + 1), NULL;
+        int rc = load_channel(&chs[k], a, several);
+        if (rc) {
+            *bad_input = rc == -2;
+            return free_channels(chs, *n), NULL;
+        }
     }
+    if (shared_parameter_file(chs, *n))
+        return free_channels(chs, *n), NULL;
     for (int k = 0; k < *n; k++) {
         if (open_trace(&chs[k], a, several)) {
             for (int i = 0; i < k; i++)
@@ -378,10 +418,10 @@ int ncp_cli_serve(int argc, char **argv)
         return usage(stderr), SERVE_USAGE;
     if (ncp_cli_check_tool_table(a.tool_table))
         return SERVE_USAGE;
-    int n = 0;
-    struct serve_channel *chs = load_channels(&a, &n);
+    int n = 0, bad_input = 0;
+    struct serve_channel *chs = load_channels(&a, &n, &bad_input);
     if (!chs)
-        return SERVE_USAGE;
+        return bad_input ? SERVE_BAD_INPUT : SERVE_USAGE;
     /* the key before anything is powered: made when missing, refused when
      * others may read it (the service opens it again with the transport) */
     if (ncp_cli_check_key("cnc-run serve", &chs[0].cfg)) {
@@ -414,6 +454,7 @@ int ncp_cli_serve(int argc, char **argv)
             .cfg = &chs[made].cfg, .virtual_clock = a.virtual_clock, .trace = chs[made].trace,
             .mode = a.mode,
             .interp = chs[made].acfg,
+            .vars = chs[made].vars,
             .loop_priority_min = loop_min,
         };
         ncks[made] = ncp_nck_new(&setup, &d);

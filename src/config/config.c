@@ -47,6 +47,7 @@ void ncp_machine_cfg_default(struct ncp_machine_cfg *c)
     c->planner = (struct ncp_rt_place){ -1, SCHED_OTHER, 0 };
     c->interp = (struct ncp_rt_place){ -1, SCHED_OTHER, 0 };
     c->backend = NCP_BACKEND_SIM;
+    ncp_op_cfg_default(&c->op);
     /* 10 heartbeats may go missing before the drive counts as lost; SDO
      * answers come within a few ms from any drive that is there at all */
     c->can.heartbeat_period_ms = 50;
@@ -547,10 +548,17 @@ static int dispatch(struct load_ctx *lc, const char *sec, const char *k, const c
         return ncp_sched_ini_key(&c->sched, k, v, why, len);
     if (!strcasecmp(sec, "CAN"))
         return can_key(&c->can, k, v, why, len);
+    /* [RS274NGC] and [DISPLAY] are shared: the operator's keys (the
+     * parameter file, the overrides) first, then the interpreter's */
+    int r = ncp_op_cfg_key(&c->op, lc->path, sec, k, v, why, len);
+    if (r == 1 || r == -1)
+        return r;
     int rr = ncp_rs274_cfg_key(&c->rs274, lc->path, sec, k, v, why, len);
     if (rr != -2)
         return rr;
-    int r = ncp_kins_cfg_key(&lc->kl, c, sec, k, v, lc->line, why, len);
+    if (r == 0)
+        return 0;
+    r = ncp_kins_cfg_key(&lc->kl, c, sec, k, v, lc->line, why, len);
     if (r != -2)
         return r;
     return ncp_io_cfg_key(&c->io, sec, k, v, why, len);
@@ -741,6 +749,9 @@ static int check_cfg(struct load_ctx *lc)
         return fail_at(lc, key_line(lc, "SIM", key), "[SIM] %s: the machine has no axis %c "
                        "([TRAJ] COORDINATES)", key, NCP_AXIS_LETTERS[i]), -1;
     }
+    char op_why[160];
+    if (ncp_op_cfg_check(&c->op, op_why, sizeof op_why))
+        return fail_at(lc, key_line(lc, "DISPLAY", "MIN_SPINDLE_OVERRIDE"), "%s", op_why), -1;
     if (c->lcm.heartbeat_timeout_ms <= c->lcm.heartbeat_period_ms)
         return fail_at(lc, key_line(lc, "LCM", "HEARTBEAT_TIMEOUT_MS"),
                        "[LCM] HEARTBEAT_TIMEOUT_MS %d must be longer than HEARTBEAT_PERIOD_MS %d",

@@ -76,9 +76,9 @@ static int emcio_key(struct ncp_io_cfg *io, const char *k, const char *v, char *
         io->have_tc_pos = 1;
         return 1;
     }
-    /* LinuxCNC's other [EMCIO] keys (cycle time, tool table, random
+    /* LinuxCNC's other [EMCIO] keys (cycle time, random
      * changer) are the interpreter's or the tool table's business */
-    if (!strcasecmp(k, "TOOL_TABLE") || !strcasecmp(k, "CYCLE_TIME") ||
+    if (!strcasecmp(k, "CYCLE_TIME") ||
         !strcasecmp(k, "EMCIO") || !strcasecmp(k, "RANDOM_TOOLCHANGER") ||
         !strcasecmp(k, "TOOL_CHANGE_WITH_SPINDLE_ON") || !strcasecmp(k, "TOOL_CHANGE_AT_G30"))
         return 1;

@@ -76,8 +76,6 @@ int ncp_rs274_cfg_key(struct ncp_rs274_cfg *r, const char *ini_path, const char 
                 return 1;
         return snprintf(why, len, "0 or 1"), -1;
     }
-    if (!strcasecmp(k, "PARAMETER_FILE"))
-        return 1;
     return 0;
 }
 

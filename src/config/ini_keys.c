@@ -39,11 +39,11 @@ const struct ncp_ini_section ncp_ini_sections[] = {
              "(cnc-run run --backend lcm, cnc-axis)." },
     { "INJECT", "Timing faults injected into the real position loop (tests and experiments)." },
     { "SCHED", "Priorities of the soft real-time tasks below the position loop." },
-    { "RS274NGC", "The interpreter's keys of a LinuxCNC INI, so that one file configures "
-                  "the machine and its interpreter (docs/remap.md). cnc-run parse and check "
-                  "read the same keys with --ini INI." },
-    { "DISPLAY", "LinuxCNC's display section: of its keys, the machine INI takes the one "
-                 "that says where user M codes are." },
+    { "RS274NGC", "The interpreter's keys and files of a LinuxCNC INI, so that one file "
+                  "configures the machine and its interpreter (docs/remap.md); cnc-run parse "
+                  "and check read the same keys with --ini INI." },
+    { "DISPLAY", "LinuxCNC's display section: how far an operator may turn the overrides "
+                 "(cnc-ctl override, the panel), and where user M codes are." },
     { "HTTP", "The operator's panel in a browser (cnc-run serve --http): who may reach it "
               "besides its own origin and address (docs/panel-security.md)." },
 };
@@ -174,8 +174,29 @@ const struct ncp_ini_key ncp_ini_keys[] = {
         "1: Z goes to machine 0 before a tool change."),
     TEXT("EMCIO", "TOOL_CHANGE_POSITION", "X Y Z, machine coordinates, mm", NULL, "0 0 0",
          "Where a tool change happens; not given: where the machine is."),
-    TEXT("EMCIO", "TOOL_TABLE", "LinuxCNC's", NULL, "tool.tbl",
-         "Taken and ignored: the tool table is cnc-run's --tool-table."),
+    TEXT("EMCIO", "TOOL_TABLE", "a path, relative to the INI's folder", NULL, "tool.tbl",
+         "The tool table (LinuxCNC's format) of cnc-run run and serve when --tool-table is "
+         "not given; under serve, G10 L1, L10 and L11 write their changes back to it "
+         "(temporary file, fsync, rename), its comments and other lines kept."),
+
+    TEXT("RS274NGC", "PARAMETER_FILE", "a path, relative to the INI's folder", NULL,
+         "linuxcnc.var",
+         "LinuxCNC's parameter file: cnc-run serve reads it at start (missing: G54, all "
+         "offsets 0) and writes it whole (temporary file, fsync, rename) after each program, "
+         "MDI line or stop that changed a persistent parameter, and at shutdown (cnc-run run: "
+         "read at start, written at its end): G28 and G30 "
+         "positions (#5161-#5169, #5181-#5189), G92 (#5210-#5219), the coordinate system "
+         "(#5220) and G54..G59.3 (#5221-#5390, R included). Values in the interpreter's "
+         "user unit (inch), as the tool table's. Not given: nothing persists."),
+
+    REAL("DISPLAY", "MAX_FEED_OVERRIDE", 1.0, 2.0, "", "1.0",
+         "Highest feed override, a ratio (1.2 = 120 %). Motion is planned at this override "
+         "and slowed in time below it, so no axis exceeds its limits at any override; above "
+         "1.0, moves that the limits cap run that much slower at 100 %."),
+    REAL("DISPLAY", "MAX_SPINDLE_OVERRIDE", 0.0, 2.0, "", "2.0",
+         "Highest spindle override, a ratio (the spindle stays under [SPINDLE_0] MAX_RPM)."),
+    REAL("DISPLAY", "MIN_SPINDLE_OVERRIDE", 0.0, 2.0, "", "0.0",
+         "Lowest spindle override, a ratio, not above MAX_SPINDLE_OVERRIDE."),
     TEXT("EMCIO", "CYCLE_TIME", "LinuxCNC's", NULL, "0.1", "Taken and ignored."),
     TEXT("EMCIO", "EMCIO", "LinuxCNC's", NULL, "io", "Taken and ignored."),
     TEXT("EMCIO", "RANDOM_TOOLCHANGER", "LinuxCNC's", NULL, "0", "Taken and ignored."),
@@ -259,8 +280,6 @@ const struct ncp_ini_key ncp_ini_keys[] = {
          "and Q as two arguments once the machine is at rest."),
     WORD("RS274NGC", "INI_VARS", "0|1|NO|YES|FALSE|TRUE|OFF|ON", "1",
          "The program reads the INI's keys as #<_ini[SECTION]KEY>."),
-    TEXT("RS274NGC", "PARAMETER_FILE", "LinuxCNC's", NULL, "sim.var",
-         "Taken and ignored: the NCK keeps the parameters as long as it runs."),
     TEXT("DISPLAY", "PROGRAM_PREFIX", "a folder, relative to the INI's folder", NULL,
          "nc_files", "The first folder searched for the executables M100 .. M199."),
 

@@ -117,20 +117,42 @@ static int emit_state_only(void *ctx, const struct ncp_cmd *cmd)
     return 0;
 }
 
-/* After a stop, an error or an E-stop: the interpreter's end-of-program reset
- * (G54, G17, G90, G94, spindle and coolant off, ...), as M2 would. */
-static void reset_interp(struct ncp_nck *s)
+/* Lines run through the interpreter that change its state only (what the
+ * status and the canon map follow), never the machine. */
+static void run_state_text(struct ncp_nck *s, const char *text, const char *name)
 {
-    static const char m2[] = "M2\n";
     struct ncp_source src;
     struct ncp_diag d;
-    if (ncp_source_from_memory(&src, m2, sizeof m2 - 1, "reset", &d) != NCP_OK)
+    if (!text[0] || ncp_source_from_memory(&src, text, strlen(text), name, &d) != NCP_OK)
         return;
     sync_interp(s);
     struct ncp_output out = { .ctx = s, .emit = emit_state_only };
     struct ncp_run_stats st;
     ncp_serial_run(&src, &s->acfg, &out, &st, &d);
     ncp_source_close(&src);
+}
+
+/* What a job, a stop or the shutdown changed of the offsets and tools, on
+ * the disk before the next command: a failure is the operator's to know. */
+static void persist(struct ncp_nck *s)
+{
+    char why[NCP_DIAG_MSG_MAX];
+    int w = nck_persist_save(&s->persist, s->interp, why, sizeof why);
+    if (w < 0)
+        nck_post(&s->core, NCP_EV_ERROR, NULL, 0, 0, "%s", why);
+    if (w > 0 && (w & 1))
+        nck_post(&s->core, NCP_EV_INFO, NULL, 0, 0, "offsets saved to %s",
+                 s->persist.var_path);
+    if (w > 0 && (w & 2))
+        nck_post(&s->core, NCP_EV_INFO, NULL, 0, 0, "tool table %s written",
+                 s->persist.tool_path);
+}
+
+/* After a stop, an error or an E-stop: the interpreter's end-of-program reset
+ * (G54, G17, G90, G94, spindle and coolant off, ...), as M2 would. */
+static void reset_interp(struct ncp_nck *s)
+{
+    run_state_text(s, "M2\n", "reset");
     pthread_mutex_lock(&s->core.cross.ev_lock);
     s->core.cross.io.dir = 0;
     s->core.cross.io.mist = 0;
@@ -197,6 +219,7 @@ static void drop_step(struct ncp_nck *s)
             reset_interp(s);
         else
             sync_interp(s);
+        persist(s);
         set_state(s, s->drop_after);
         break;
     case NCK_DROP_NONE:
@@ -470,7 +493,9 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
         return refuse(why, len, "%c is at its soft limit %.4f", NCP_AXIS_LETTERS[j], limit);
     struct ncp_seg seg;
     n->job->step_line = 0;
-    nck_line(n, &seg, n->job->map.pos, target, speed, 0);
+    /* the loop plays feed moves at override / plan override: at 100 % the
+     * jog runs at its speed (capped by the planner at the axis's limit) */
+    nck_line(n, &seg, n->job->map.pos, target, speed * n->plan_override, 0);
     if (start_moves(s, &seg, 1))
         return refuse(why, len, "cannot start the jog");
     memcpy(n->job->map.pos, target, sizeof n->job->map.pos);
@@ -528,12 +553,14 @@ static int cmd_override(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *wh
     double pct = c->value[0];
     if (!isfinite(pct) || pct < 0)
         return refuse(why, len, "an override is a percentage of 0 or more");
+    const struct ncp_op_cfg *op = &s->core.cfg->op;
     switch (c->ivalue[0]) {
     case 0:
-        if (pct > 100.0 * s->core.plan_override)
-            return refuse(why, len, "feed override above %.0f %% is not supported: motion is "
-                          "planned at %.0f %% of F", 100.0 * s->core.plan_override,
-                          100.0 * s->core.plan_override);
+        /* 1e-9: "override feed 120" against 1.2 */
+        if (pct > 100.0 * s->core.plan_override + 1e-9)
+            return refuse(why, len, "feed override %g %% is above this machine's %g %% "
+                          "([DISPLAY] MAX_FEED_OVERRIDE = %g in its INI, at most 2.0)", pct,
+                          100.0 * s->core.plan_override, s->core.plan_override);
         ncp_nck_set_feed_override(s->core.ctl, pct / 100.0);
         return 0;
     case 1:
@@ -544,8 +571,14 @@ static int cmd_override(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *wh
         s->rapid_override = pct;
         return 0;
     case 2:
-        if (pct > 200)
-            return refuse(why, len, "spindle override is 0..200 %%");
+        if (pct > 100.0 * op->max_spindle_override + 1e-9)
+            return refuse(why, len, "spindle override %g %% is above this machine's %g %% "
+                          "([DISPLAY] MAX_SPINDLE_OVERRIDE = %g in its INI)", pct,
+                          100.0 * op->max_spindle_override, op->max_spindle_override);
+        if (pct < 100.0 * op->min_spindle_override - 1e-9)
+            return refuse(why, len, "spindle override %g %% is below this machine's %g %% "
+                          "([DISPLAY] MIN_SPINDLE_OVERRIDE = %g in its INI)", pct,
+                          100.0 * op->min_spindle_override, op->min_spindle_override);
         s->spindle_override = pct;
         atomic_store(&s->core.ctl->spindle_permille, (int)lround(pct * 10));
         return 0;
@@ -773,6 +806,7 @@ static void job_ended(struct ncp_nck *s)
     } else if (kind == NCK_JOB_PROGRAM) {
         nck_post(n, NCP_EV_INFO, s->program, 0, 0, "program finished");
     }
+    persist(s);
     /* the whole job in the trace once it is over, not at the next 64 KiB */
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
@@ -901,7 +935,10 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
         return NULL;
     }
     struct nck_core *n = &s->core;
-    n->plan_override = 1.0;
+    /* planned at the highest override the operator may choose and slowed
+     * in time below it (loop.c), so none can take an axis past its limits */
+    n->plan_override = setup->cfg->op.max_feed_override >= 1.0 ? setup->cfg->op.max_feed_override
+                                                               : 1.0;
     n->cross.post_prints = 1;
     s->rapid_override = 100;
     s->spindle_override = 100;
@@ -915,19 +952,30 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->acfg.cancel_ctx = n;
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
+    if (s->interp && nck_persist_init(&s->persist, setup->vars, setup->cfg->op.parameter_file,
+                                      s->acfg.tool_table_path, s->interp, d)) {
+        ncp_nck_free(s);
+        return NULL;
+    }
     if (s->interp)   /* no run yet: the codes the first one starts in */
         ncp_analyzer_active_codes(s->interp, &n->cross.io.active);
     n->svc->sum.joints = ncp_kins_active(setup->cfg);
     if (setup->trace)
         nck_trace_header(setup->trace, setup->cfg, n->svc->sum.joints,
                          setup->trace_rings || setup->cfg->sched.trace_rings);
-    if (!s->interp || nck_start(n, setup, 0, d) || nck_start_loop(n, d)) {
+    int started = s->interp && nck_start(n, setup, 0, d) == 0;
+    if (started)   /* the service starts at 100 %, whatever the plan is made for */
+        ncp_nck_set_feed_override(n->ctl, 1.0);
+    if (!started || nck_start_loop(n, d)) {
         ncp_nck_free(s);
         return NULL;
     }
     for (int j = 0; j < NCP_AXES; j++)
         s->homed[j] = 0;
     s->state = NCP_ST_IDLE;
+    char restore[64];
+    nck_persist_restore_text(&s->persist, restore, sizeof restore);
+    run_state_text(s, restore, "parameter file");
     sync_interp(s);
     return s;
 }
@@ -947,6 +995,12 @@ void ncp_nck_free(struct ncp_nck *s)
     nck_read_cycles(n);
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
+    if (s->interp) {   /* at shutdown: what the last job changed is saved already */
+        char why[NCP_DIAG_MSG_MAX];
+        if (nck_persist_save(&s->persist, s->interp, why, sizeof why) < 0)
+            fprintf(stderr, "cnc-run serve: error: %s\n", why);
+    }
+    nck_persist_free(&s->persist);
     nck_release(n);
     ncp_analyzer_free(s->interp);
     if (s->have_prog)

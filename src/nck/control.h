@@ -3,6 +3,7 @@
 #define NCPAR_NCK_CONTROL_H
 
 #include "nck_int.h"
+#include "persist.h"
 
 /* What ended a load's check before its end (control.c): the ACK names it. */
 enum nck_check_end {
@@ -70,6 +71,7 @@ struct ncp_nck {
     uint32_t waits_seen;             /* the loop's wait count the state machine has seen */
     int machine_pause;               /* PAUSED by the program (M0 M1 M60 M6), not by pause */
     int changed;
+    struct nck_persist persist;      /* the parameter file, the tool table */
 };
 
 #endif

@@ -148,3 +148,38 @@ def controlled_stop(rows, end, accel_step=3.0, vmax=200.0):
     if ramp < 5:
         return "no ramp down at the end (%d rows)" % ramp
     return None
+
+
+def axis_peaks(rows, t0=-math.inf, t1=math.inf):
+    """Largest |velocity| and |acceleration| of each commanded axis (x, y,
+    z) between t0 and t1, from the rows' differences: ([vx, vy, vz], [ax,
+    ay, az]). Positions are printed to 1e-6 mm: at 1 ms rows that is
+    1e-3 mm/s of velocity and 2 mm/s^2 of acceleration."""
+    rows = [r for r in rows if t0 <= r[0] <= t1]
+    vmax, amax = [0.0] * 3, [0.0] * 3
+    prev_v = None
+    for i in range(1, len(rows)):
+        dt = rows[i][0] - rows[i - 1][0]
+        if dt <= 0:
+            continue
+        v = [(rows[i][2][k] - rows[i - 1][2][k]) / dt for k in range(3)]
+        for k in range(3):
+            vmax[k] = max(vmax[k], abs(v[k]))
+            if prev_v is not None:
+                amax[k] = max(amax[k], abs(v[k] - prev_v[k]) / dt)
+        prev_v = v
+    return vmax, amax
+
+
+def motions(rows, gap):
+    """[(t_start, t_end)] of the stretches in motion (v > 0) that rest
+    for at least gap seconds between them."""
+    out = []
+    for r in rows:
+        if r[3] <= 0:
+            continue
+        if out and r[0] - out[-1][1] < gap:
+            out[-1][1] = r[0]
+        else:
+            out.append([r[0], r[0]])
+    return [tuple(x) for x in out]
