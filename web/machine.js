@@ -30,7 +30,7 @@ export function initMachine({ $, send, log }) {
   // touch-off: G10 L20 sets the chosen system's offset so that the axis
   // reads VALUE there now; P0 is the system in force
   const sys = $('touch-system');
-  sys.innerHTML = '<option value="0">active</option>' +
+  sys.innerHTML = '<option value="0" title="the system in force (P0)">in use</option>' +
     SYSTEMS.map((n, i) => `<option value="${i + 1}">${n}</option>`).join('');
   $('touch-form').addEventListener('submit', (e) => {
     e.preventDefault();

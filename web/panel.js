@@ -115,6 +115,36 @@ function send(obj) {
   return obj.seq || 0;
 }
 
+// The slow queries (list, program, preview): the server answers a socket's
+// first QUERIES_IN_FLIGHT and refuses more until they are answered, so the
+// rest wait here. A panel opened while a program is loaded asks for all
+// three at once, and a refused preview would leave it without a drawing.
+const QUERIES_IN_FLIGHT = 2;
+const queries = { inFlight: [], waiting: [] };
+function ask(cmd) {
+  if (!queries.waiting.includes(cmd)) queries.waiting.push(cmd);
+  pumpQueries();
+}
+function pumpQueries() {
+  while (queries.inFlight.length < QUERIES_IN_FLIGHT && queries.waiting.length) {
+    const cmd = queries.waiting.shift();
+    queries.inFlight.push(cmd);
+    send({ cmd });
+  }
+}
+function answered(cmd) {
+  const i = queries.inFlight.indexOf(cmd);
+  if (i >= 0) queries.inFlight.splice(i, 1);
+  pumpQueries();
+}
+// the server's worker was busy with other sockets' queries: the one sent
+// last is asked again in a moment
+function retryQuery() {
+  const cmd = queries.inFlight.pop();
+  if (cmd && !queries.waiting.includes(cmd)) queries.waiting.unshift(cmd);
+  setTimeout(pumpQueries, 500);
+}
+
 function onMessage(text) {
   ui.lastRecv = performance.now();
   let m;
@@ -132,30 +162,37 @@ function onMessage(text) {
     }
     case 'hello':
       ui.authed = m.authed; ui.readonly = m.readonly; ui.loadedPath = null; ui.parts = {};
+      queries.inFlight = []; queries.waiting = [];
       setOverrideLimits(m.limits);
       setOnline(true);
       log('info', m.authed ? (m.readonly ? 'connected, read-only' : 'connected') : 'connected without a valid token: watching only');
-      if (m.authed) send({ cmd: 'list' });
+      if (m.authed) ask('list');
       break;
     case 'status': onStatus(m); break;
     case 'ack':
       if (m.result !== 'accepted') log('rejected', `#${m.seq}: ${m.reason}`);
       break;
-    case 'refused': log('refused', (m.seq ? `#${m.seq}: ` : '') + m.reason); break;
+    case 'refused':
+      // seq 0: a query's answer (the worker could not answer it), or its
+      // refusal for now
+      if (!m.seq && /earlier queries/.test(m.reason)) { retryQuery(); break; }
+      if (!m.seq && queries.inFlight.length) answered(queries.inFlight[0]);
+      log('refused', (m.seq ? `#${m.seq}: ` : '') + m.reason);
+      break;
     case 'event': {
       const where = m.file ? `${m.file}${m.line ? ':' + m.line : ''}${m.col ? ':' + m.col : ''}: ` : '';
       log(m.kind, where + m.text);
       break;
     }
-    case 'list': fillFiles(m.files); break;
+    case 'list': answered('list'); fillFiles(m.files); break;
     case 'loaded':
       // a load was checked: its text and preview are the NCK's copy, anew
       // even when the path is the same one
       ui.loadedPath = m.path;
-      if (ui.authed) { send({ cmd: 'program' }); send({ cmd: 'preview' }); }
+      if (ui.authed) { ask('program'); ask('preview'); }
       break;
-    case 'program': showProgram(m.path, m.text); break;
-    case 'preview': setCanon(m.canon); break;
+    case 'program': answered('program'); showProgram(m.path, m.text); break;
+    case 'preview': answered('preview'); setCanon(m.canon); break;
   }
 }
 
@@ -229,7 +266,7 @@ function onStatus(m) {
     $('ov-' + w + '-v').textContent = `${Math.round(s[w + '_override'])} %`;
   }
   if (!prev || prev.program !== s.program) {
-    if (s.program && ui.authed && s.program !== ui.loadedPath) { send({ cmd: 'program' }); send({ cmd: 'preview' }); }
+    if (s.program && ui.authed && s.program !== ui.loadedPath) { ask('program'); ask('preview'); }
     else if (!s.program) { showProgram('', ''); setCanon(''); }
   }
   if (s.line !== ui.currentLine) highlight(s.line);
@@ -318,7 +355,7 @@ $('upload-file').addEventListener('change', async () => {
   if (!answer.ok) { log('refused', `upload of ${file.name}: ${answer.reason}`); return; }
   log('info', `uploaded ${answer.name}`);
   ui.pendingSelect = answer.name;
-  send({ cmd: 'list' });
+  ask('list');
   send({ cmd: 'load', path: answer.name });
 });
 $('run-from').addEventListener('click', () => { if (ui.selectedLine) send({ cmd: 'run', line: ui.selectedLine }); });
