@@ -10,6 +10,12 @@
 const WINDOW = 400;     // segments looked at ahead of the last match per status
 const ON_PATH = 0.5;    // mm: farther from every segment, the tool is off the path
                         // (a tool change, a jog in a pause): no distance to go
+// Until the tool is first found on the path after a reset (a run from a
+// line far into the program starts beyond any window), the search covers
+// this many segments, at every FIRST_EVERY-th status: a long CAM program's
+// whole path 50 times a second would take the page's time.
+const FIRST_SPAN = 200000;
+const FIRST_EVERY = 10;
 
 function distToSeg(p, a, b) {
   const d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
@@ -20,18 +26,19 @@ function distToSeg(p, a, b) {
 }
 
 export function createProgress() {
-  let path = null, at = 0, onPath = false;
+  let path = null, at = 0, onPath = false, found = false, tries = 0;
   const ends = (s) => {
     const arr = s.feed ? path.feed : path.rapid, k = 6 * s.i;
     return [[arr[k], arr[k + 1], arr[k + 2]], [arr[k + 3], arr[k + 4], arr[k + 5]]];
   };
   return {
     // a new program, or a new run of it: back to its start
-    reset(p) { if (p !== undefined) path = p; at = 0; onPath = false; },
+    reset(p) { if (p !== undefined) path = p; at = 0; onPath = false; found = false; tries = 0; },
     // the tool's point (canon.js's toolPoint) while the program runs
     follow(xyz) {
       if (!path || !path.segs.length) return;
-      const n = Math.min(path.segs.length, at + WINDOW);
+      const wide = !found && tries++ % FIRST_EVERY === 0;
+      const n = Math.min(path.segs.length, at + (wide ? FIRST_SPAN : WINDOW));
       let best = Infinity, bestAt = at;
       for (let i = at; i < n; i++) {
         const [a, b] = ends(path.segs[i]);
@@ -41,7 +48,7 @@ export function createProgress() {
         if (d < best - 1e-4) { best = d; bestAt = i; }
       }
       onPath = best <= ON_PATH;
-      if (onPath) at = bestAt;
+      if (onPath) { at = bestAt; found = true; }
     },
     // per axis x, y, z: the end of the move the tool is on minus the tool;
     // null while the tool is not on the program's path
