@@ -10,7 +10,8 @@
 // and coolant, jog, touch-off, upload; the layout
 // on a 10-inch touch panel; then what others on the network might send: no
 // token, malformed JSON, unknown commands, an oversized message and a flood.
-// Then the core of the session again in Firefox (WebDriver BiDi). Each case
+// Then the core of the session again in Firefox (WebDriver BiDi), and its
+// preview views. Each case
 // prints PASS/FAIL/SKIP; every wait is bounded; screenshots of each step land
 // in WORKDIR.
 import { spawn, spawnSync } from 'node:child_process';
@@ -20,7 +21,7 @@ import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
 
-const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "spindle-coolant", "jog", "touch-off", "tool-table", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi"];
+const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "spindle-coolant", "jog", "touch-off", "tool-table", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
 
 const [BUILD, WORK, CHROMIUM, FIREFOX] = process.argv.slice(2);
 const ROOT = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..', '..');
@@ -507,7 +508,8 @@ async function session(browser) {
       await tp.setViewport(TOUCH_VIEWPORT);
       await tp.goto(`${srv.base}?token=${srv.token}`, { waitUntil: 'load', timeout: 15000 });
       await tp.waitForFunction(() => window.ncpPanel && window.ncpPanel.status && window.ncpPanel.authed &&
-        document.querySelectorAll('#program div').length > 0, { timeout: 20000 });
+        document.querySelectorAll('#program div').length > 0 && window.ncpPanel.path && window.ncpPanel.path.segs.length > 0,
+        { timeout: 20000 });
       await sleep(1000);   // the preview drawn
       await tp.screenshot({ path: path.join(WORK, 'panel-1024x600.png') });
       const bad = await checkTouchLayout(tp);
@@ -868,6 +870,15 @@ async function firefox() {
       await click(page, '#mdi-send');
       await page.waitForFunction(() => /\bG20\b.*\bG91\b|\bG91\b.*\bG20\b/.test(document.querySelector('#gcodes').textContent), { timeout: 5000 });
       await page.screenshot({ path: path.join(WORK, 'firefox-mdi.png') });
+    });
+    await run('firefox-views', async () => {
+      const m = {};
+      for (const name of ['top', 'front']) {
+        await page.click(`#preview [data-view="${name}"]`);
+        await page.waitForFunction((n) => { const v = window.ncpPanel.preview.view(); return v && v.name === n; }, { timeout: 3000 }, name);
+        m[name] = (await page.evaluate(() => window.ncpPanel.preview.view())).matrix;
+      }
+      check(m.top.some((x, k) => Math.abs(x - m.front[k]) > 1e-3), 'top and front have the same view matrix');
     });
     await page.close();
   } catch (e) {
