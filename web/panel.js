@@ -19,6 +19,9 @@ const ui = {
   canCommand: false,
 };
 window.ncpPanel = ui;  // for tests and the curious: read-only use
+// what the server would send, for the test of what the panel does with a
+// message this server does not send yet (a hello with limits)
+ui.receive = (text) => onMessage(text);
 
 const preview = createPreview($('preview'), $('preview-2d'));
 ui.preview = preview;
@@ -164,6 +167,8 @@ function onMessage(text) {
       ui.authed = m.authed; ui.readonly = m.readonly; ui.loadedPath = null; ui.parts = {};
       queries.inFlight = []; queries.waiting = [];
       setOverrideLimits(m.limits);
+      ui.travel = m.travel || null;
+      if (ui.travelShown) { ui.travelShown = null; preview.setTravel(null); }
       setOnline(true);
       log('info', m.authed ? (m.readonly ? 'connected, read-only' : 'connected') : 'connected without a valid token: watching only');
       if (m.authed) ask('list');
@@ -249,6 +254,7 @@ function onStatus(m) {
     c[5].textContent = fmt(s.pos_cmd[a] - s.pos_act[a], 4);
   });
   machine.show(s);
+  showTravel(s, axes, off);
   $('line').textContent = s.line || '—';
   $('vel').textContent = `${fmt(s.vel, 0)} mm/min`;
   $('spindle').textContent = `${fmt(s.spindle.speed, 0)} rpm ${s.spindle.dir > 0 ? 'CW' : s.spindle.dir < 0 ? 'CCW' : 'stopped'}`;
@@ -272,6 +278,21 @@ function onStatus(m) {
   if (s.line !== ui.currentLine) highlight(s.line);
   preview.setTool(xyz, ['running', 'stepping', 'paused', 'mdi', 'jogging', 'homing', 'stopping'].includes(s.state));
   if (prev && prev.error !== s.error && s.error) log('error', s.error);
+}
+
+// The machine's travel (soft limits, machine coordinates) when the server's
+// hello carries it as {"travel": {"min": {"x": ..}, "max": {..}}}: drawn as
+// the box in the drawing's coordinates, so it moves with the work offset and
+// the tool's length. Without it the box is the program's extents.
+function showTravel(s, axes, off) {
+  if (!ui.travel || !ui.travel.min || !ui.travel.max) return;
+  const corner = (lim) => toolPoint(ui.path, axes.map((a) => (lim[a] ?? NaN) - (off[a] || 0)), axes, s.tool);
+  const box = [corner(ui.travel.min), corner(ui.travel.max)];
+  if (box.flat().some((v) => !isFinite(v))) return;
+  const key = JSON.stringify(box);
+  if (key === ui.travelShown) return;
+  ui.travelShown = key;
+  preview.setTravel(box);
 }
 
 // ---- program ------------------------------------------------------------------------------

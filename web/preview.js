@@ -45,6 +45,8 @@ export function createPreview(box, canvas2d) {
     // for the test and the curious: the view's name, the camera's view
     // matrix (16 numbers, column-major) and its distance to what it looks at
     view() { return state.impl ? state.impl.view() : null; },
+    // the box drawn: [min, max] in the drawing's coordinates, or null
+    box() { return travelBox(state.path, state.travel); },
   };
   for (const b of box.querySelectorAll('[data-view]'))
     b.addEventListener('click', () => api.setView(b.dataset.view));

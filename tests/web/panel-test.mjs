@@ -21,7 +21,7 @@ import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
 
-const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "spindle-coolant", "jog", "touch-off", "tool-table", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
+const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "spindle-coolant", "jog", "touch-off", "tool-table", "server-limits", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
 
 const [BUILD, WORK, CHROMIUM, FIREFOX] = process.argv.slice(2);
 const ROOT = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..', '..');
@@ -617,6 +617,30 @@ async function session(browser) {
     // the service has no tool table command: the control says so, disabled
     const t = await page.$eval('#tools', (b) => ({ disabled: b.disabled, title: b.title }));
     check(t.disabled && /no command/.test(t.title), `tool table control ${JSON.stringify(t)}`);
+  });
+  // This server sends no limits yet; a hello that carries them (override
+  // ranges, soft limits in machine coordinates) sets the sliders and the
+  // preview's box, and one without them brings the defaults back.
+  await run('server-limits', async () => {
+    const st = await status(page);
+    const hello = (extra) => page.evaluate((m) => window.ncpPanel.receive(JSON.stringify(m)),
+      { type: 'hello', authed: true, readonly: false, ...extra });
+    await hello({ limits: { feed: [0, 120], spindle: [60, 140] },
+                  travel: { min: { x: -10, y: -20, z: -100 }, max: { x: 300, y: 200, z: 0 } } });
+    await page.waitForFunction(() => window.ncpPanel.travelShown, { timeout: 3000 });
+    const ov = await page.$$eval('#ov-feed, #ov-spindle', (e) => e.map((x) => [Number(x.min), Number(x.max)]));
+    check(JSON.stringify(ov) === '[[0,120],[60,140]]', `override ranges ${JSON.stringify(ov)}`);
+    const box = await page.evaluate(() => window.ncpPanel.preview.box());
+    const off = st.g5x.offset;
+    check(Math.abs(box[0][0] - (-10 - off.x)) < 1e-6 && Math.abs(box[1][1] - (200 - off.y)) < 1e-6,
+      `the box ${JSON.stringify(box)} is not the travel less ${st.g5x.name}'s offset`);
+    await shot(page, '07c-travel');
+    await hello({});
+    await page.waitForFunction(() => !window.ncpPanel.travelShown, { timeout: 3000 });
+    const back = await page.evaluate(() => window.ncpPanel.preview.box());
+    check(!back || back[1][0] < 200, `the box stayed the travel: ${JSON.stringify(back)}`);
+    const ov2 = await page.$$eval('#ov-feed, #ov-spindle', (e) => e.map((x) => [Number(x.min), Number(x.max)]));
+    check(JSON.stringify(ov2) === '[[0,200],[50,150]]', `override ranges after a plain hello ${JSON.stringify(ov2)}`);
   });
   const srcDir = path.join(WORK, 'upload-src');
   fs.mkdirSync(srcDir, { recursive: true });
