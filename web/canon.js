@@ -3,7 +3,11 @@
 // Coordinates are the program's work coordinates in mm (inch programs scaled).
 // Only the linear axes are drawn; rotary words are ignored. tlo says the tool
 // length offset the program uses with each tool, so that the machine's
-// position can be put on the drawing.
+// position can be put on the drawing. The canonical text carries no line
+// numbers, so order is what ties the drawing to the machine: segs lists every
+// segment in the order the program runs them (kind, index into its array,
+// the move it belongs to), and moveEnd where each move ends; an arc is one
+// move of many chords. progress.js follows the tool along them.
 
 const ARC_SEG_DEG = 5;   // one chord per 5 degrees: smooth at any zoom the panel offers
 
@@ -19,7 +23,9 @@ export function parseCanon(text) {
   const tlo = {};
   const min = [Infinity, Infinity, Infinity], max = [-Infinity, -Infinity, -Infinity];
   const errors = [];
+  const segs = [], moveEnd = [];
   const push = (arr, a, b) => {
+    segs.push({ feed: arr === feed, i: arr.length / 6, move: moveEnd.length });
     arr.push(a[0], a[1], a[2], b[0], b[1], b[2]);
     for (const p of [a, b]) for (let i = 0; i < 3; i++) { min[i] = Math.min(min[i], p[i]); max[i] = Math.max(max[i], p[i]); }
   };
@@ -34,13 +40,22 @@ export function parseCanon(text) {
     } else if (name === 'SELECT_PLANE') plane = line.includes('_YZ') ? 'YZ' : line.includes('_XZ') ? 'XZ' : 'XY';
     else if (name === 'STRAIGHT_TRAVERSE' || name === 'STRAIGHT_FEED' || name === 'STRAIGHT_PROBE') {
       const v = nums(line).slice(0, 3).map((x) => x * scale);
-      if (pos) push(name === 'STRAIGHT_TRAVERSE' ? rapid : feed, pos, v);
+      if (pos) { push(name === 'STRAIGHT_TRAVERSE' ? rapid : feed, pos, v); moveEnd.push(v); }
       pos = v;
     } else if (name === 'ARC_FEED' && pos) {
       pos = arc(nums(line).map((x, i) => (i === 4 ? x : x * scale)), plane, pos, (a, b) => push(feed, a, b));
+      moveEnd.push(pos);
     }
   }
-  return { feed, rapid, min, max, errors, tlo };
+  return { feed, rapid, min, max, errors, tlo, segs, moveEnd };
+}
+
+// The machine's work position (per axis, in the status's order) as a point
+// of the drawing: the program's tool length offset of toolNo taken off, so
+// that the tool's tip meets the path it cuts.
+export function toolPoint(path, p, axes, toolNo) {
+  const tlo = (path && path.tlo[toolNo]) || [0, 0, 0];
+  return [0, 1, 2].map((i) => (axes[i] ? p[i] - tlo[i] : 0));
 }
 
 // rs274's ARC_FEED(first_end, second_end, first_axis, second_axis, rotation,

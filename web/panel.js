@@ -2,6 +2,9 @@
 // commands out), the DRO, program view, controls and the log. Everything the
 // NCK decides (states, refusals) comes back from it: the panel never guesses.
 import { createPreview } from './preview.js';
+import { toolPoint } from './canon.js';
+import { createProgress } from './progress.js';
+import { initMachine, allowed } from './machine.js';
 
 const $ = (id) => document.getElementById(id);
 const params = new URLSearchParams(location.search);
@@ -12,10 +15,21 @@ const ui = {
   program: '', programLines: [], currentLine: 0, selectedLine: 0,
   mdiHistory: [], mdiIndex: -1, jogTimer: null, jogAxis: null,
   lag: [],           // [seq, NCK utime (us), receive time (us)] for the test and the title
+  link: 'connecting', // connecting (never opened yet), up, lost (was up, dropped)
+  canCommand: false,
 };
 window.ncpPanel = ui;  // for tests and the curious: read-only use
+// what the server would send, for the test of what the panel does with a
+// message this server does not send yet (a hello with limits)
+ui.receive = (text) => onMessage(text);
 
 const preview = createPreview($('preview'), $('preview-2d'));
+ui.preview = preview;
+const progress = createProgress();
+ui.progress = progress;
+// The override sliders' ranges: the limits the server reports in its hello,
+// else LinuxCNC's (feed 0-200 %, spindle 50-150 %).
+const OVERRIDE_DEFAULTS = { feed: [0, 200], rapid: [0, 100], spindle: [50, 150] };
 
 // ---- log ------------------------------------------------------------------------------
 function log(kind, text) {
@@ -30,13 +44,30 @@ function log(kind, text) {
 }
 
 // ---- connection ---------------------------------------------------------------------------
+// Before its socket first opens the page is connecting, not lost: "lost"
+// (and the banner) is for a link that was up and dropped. It then tries
+// again every second.
 function setOnline(up) {
+  if (up) ui.link = 'up';
+  else if (ui.link === 'up') ui.link = 'lost';
   document.body.classList.toggle('offline', !up);
-  $('conn').textContent = up ? (ui.authed ? (ui.readonly ? 'read-only' : 'connected') : 'watching (no token)') : 'disconnected';
+  document.body.classList.toggle('connecting', ui.link === 'connecting');
+  document.body.classList.toggle('lost', ui.link === 'lost');
+  $('banner').hidden = ui.link !== 'lost';
+  $('conn').textContent = up ? (ui.authed ? (ui.readonly ? 'read-only' : 'connected') : 'watching (no token)')
+    : ui.link === 'lost' ? 'lost: reconnecting…' : 'connecting…';
   $('conn').classList.toggle('up', up);
-  const canCommand = up && ui.authed && !ui.readonly;
-  for (const el of document.querySelectorAll('button, input, select')) el.disabled = !canCommand;
+  ui.canCommand = up && ui.authed && !ui.readonly;
+  refreshEnabled();
   if (!up) stopJog();
+}
+
+// Every control: enabled while this panel may command and, for those marked
+// so, while the machine's state allows their use (machine.js).
+function refreshEnabled() {
+  const state = ui.status && ui.status.state;
+  for (const el of document.querySelectorAll('button, input, select'))
+    el.disabled = !('view' in el.dataset) && !allowed(el, ui.canCommand, state);
 }
 
 // Once a link is dropped, nothing it still delivers counts; a stalled link's
@@ -44,7 +75,7 @@ function setOnline(up) {
 function dropLink(ws) {
   if (ui.ws !== ws) return;
   ui.ws = null;
-  if (!document.body.classList.contains('offline')) log('fault', 'connection to the NCK lost');
+  if (ui.link === 'up') log('fault', 'connection to the NCK lost');
   setOnline(false);
   // without the token the server closes the socket after a moment: asking
   // again and again would only fill the log
@@ -87,6 +118,36 @@ function send(obj) {
   return obj.seq || 0;
 }
 
+// The slow queries (list, program, preview): the server answers a socket's
+// first QUERIES_IN_FLIGHT and refuses more until they are answered, so the
+// rest wait here. A panel opened while a program is loaded asks for all
+// three at once, and a refused preview would leave it without a drawing.
+const QUERIES_IN_FLIGHT = 2;
+const queries = { inFlight: [], waiting: [] };
+function ask(cmd) {
+  if (!queries.waiting.includes(cmd)) queries.waiting.push(cmd);
+  pumpQueries();
+}
+function pumpQueries() {
+  while (queries.inFlight.length < QUERIES_IN_FLIGHT && queries.waiting.length) {
+    const cmd = queries.waiting.shift();
+    queries.inFlight.push(cmd);
+    send({ cmd });
+  }
+}
+function answered(cmd) {
+  const i = queries.inFlight.indexOf(cmd);
+  if (i >= 0) queries.inFlight.splice(i, 1);
+  pumpQueries();
+}
+// the server's worker was busy with other sockets' queries: the one sent
+// last is asked again in a moment
+function retryQuery() {
+  const cmd = queries.inFlight.pop();
+  if (cmd && !queries.waiting.includes(cmd)) queries.waiting.unshift(cmd);
+  setTimeout(pumpQueries, 500);
+}
+
 function onMessage(text) {
   ui.lastRecv = performance.now();
   let m;
@@ -104,30 +165,47 @@ function onMessage(text) {
     }
     case 'hello':
       ui.authed = m.authed; ui.readonly = m.readonly; ui.loadedPath = null; ui.parts = {};
+      queries.inFlight = []; queries.waiting = [];
+      setOverrideLimits(m.limits);
+      ui.travel = m.travel || null;
+      if (ui.travelShown) { ui.travelShown = null; preview.setTravel(null); }
       setOnline(true);
       log('info', m.authed ? (m.readonly ? 'connected, read-only' : 'connected') : 'connected without a valid token: watching only');
-      if (m.authed) send({ cmd: 'list' });
+      if (m.authed) ask('list');
       break;
     case 'status': onStatus(m); break;
     case 'ack':
       if (m.result !== 'accepted') log('rejected', `#${m.seq}: ${m.reason}`);
       break;
-    case 'refused': log('refused', (m.seq ? `#${m.seq}: ` : '') + m.reason); break;
+    case 'refused':
+      // seq 0: a query's answer (the worker could not answer it), or its
+      // refusal for now
+      if (!m.seq && /earlier queries/.test(m.reason)) { retryQuery(); break; }
+      if (!m.seq && queries.inFlight.length) answered(queries.inFlight[0]);
+      log('refused', (m.seq ? `#${m.seq}: ` : '') + m.reason);
+      break;
     case 'event': {
       const where = m.file ? `${m.file}${m.line ? ':' + m.line : ''}${m.col ? ':' + m.col : ''}: ` : '';
       log(m.kind, where + m.text);
       break;
     }
-    case 'list': fillFiles(m.files); break;
+    case 'list': answered('list'); fillFiles(m.files); break;
     case 'loaded':
       // a load was checked: its text and preview are the NCK's copy, anew
       // even when the path is the same one
       ui.loadedPath = m.path;
-      if (ui.authed) { send({ cmd: 'program' }); send({ cmd: 'preview' }); }
+      if (ui.authed) { ask('program'); ask('preview'); }
       break;
-    case 'program': showProgram(m.path, m.text); break;
-    case 'preview': preview.setCanon(m.canon); break;
+    case 'program': answered('program'); showProgram(m.path, m.text); break;
+    case 'preview': answered('preview'); setCanon(m.canon); break;
   }
+}
+
+// The loaded program's drawing: the preview shows it, the DRO's distance to
+// go and the cut colour follow the tool along it.
+function setCanon(text) {
+  ui.path = preview.setCanon(text);
+  progress.reset(ui.path);
 }
 
 // ---- status -> DRO, program line, preview ---------------------------------------------
@@ -150,20 +228,33 @@ function onStatus(m) {
     body.innerHTML = '';
     for (const a of axes) {
       const r = body.insertRow();
-      r.innerHTML = `<td class="axis">${a.toUpperCase()}</td><td class="work"></td><td></td><td></td><td></td>`;
+      r.innerHTML = `<td class="axis">${a.toUpperCase()}</td><td class="work"></td><td class="togo"></td><td></td><td></td><td></td>`;
     }
     buildJog(axes);
   }
+  machine.axes(axes, refreshEnabled);
+  if (!prev || prev.state !== s.state) refreshEnabled();
   const off = (s.g5x && s.g5x.offset) || {};
+  const xyz = toolPoint(ui.path, axes.map((a) => s.pos_act[a] - (off[a] || 0)), axes, s.tool);
+  // a new run starts at the program's start; the tool is followed while it runs
+  const inProgram = ['running', 'stepping', 'paused'].includes(s.state);
+  if (inProgram && !(prev && ['running', 'stepping', 'paused', 'stopping'].includes(prev.state))) progress.reset();
+  if (inProgram) progress.follow(xyz);
+  const toGo = inProgram ? progress.toGo(xyz) : null;
+  ui.toGo = toGo;
+  preview.setDone(progress.done);
   axes.forEach((a, i) => {
     const c = body.rows[i].cells;
     c[0].classList.toggle('unhomed', !s.homed[a]);
     c[0].title = s.homed[a] ? 'homed' : 'not homed';
     c[1].textContent = fmt(s.pos_act[a] - (off[a] || 0));
-    c[2].textContent = fmt(s.pos_cmd[a]);
-    c[3].textContent = fmt(s.pos_act[a]);
-    c[4].textContent = fmt(s.pos_cmd[a] - s.pos_act[a], 4);
+    c[2].textContent = toGo && i < 3 ? fmt(toGo[i]) : '';
+    c[3].textContent = fmt(s.pos_cmd[a]);
+    c[4].textContent = fmt(s.pos_act[a]);
+    c[5].textContent = fmt(s.pos_cmd[a] - s.pos_act[a], 4);
   });
+  machine.show(s);
+  showTravel(s, axes, off);
   $('line').textContent = s.line || '—';
   $('vel').textContent = `${fmt(s.vel, 0)} mm/min`;
   $('spindle').textContent = `${fmt(s.spindle.speed, 0)} rpm ${s.spindle.dir > 0 ? 'CW' : s.spindle.dir < 0 ? 'CCW' : 'stopped'}`;
@@ -181,13 +272,27 @@ function onStatus(m) {
     $('ov-' + w + '-v').textContent = `${Math.round(s[w + '_override'])} %`;
   }
   if (!prev || prev.program !== s.program) {
-    if (s.program && ui.authed && s.program !== ui.loadedPath) { send({ cmd: 'program' }); send({ cmd: 'preview' }); }
-    else if (!s.program) { showProgram('', ''); preview.setCanon(''); }
+    if (s.program && ui.authed && s.program !== ui.loadedPath) { ask('program'); ask('preview'); }
+    else if (!s.program) { showProgram('', ''); setCanon(''); }
   }
   if (s.line !== ui.currentLine) highlight(s.line);
-  preview.setTool(axes.map((a) => s.pos_act[a] - (off[a] || 0)), axes,
-                  ['running', 'stepping', 'paused', 'mdi', 'jogging', 'homing', 'stopping'].includes(s.state), s.tool);
+  preview.setTool(xyz, ['running', 'stepping', 'paused', 'mdi', 'jogging', 'homing', 'stopping'].includes(s.state));
   if (prev && prev.error !== s.error && s.error) log('error', s.error);
+}
+
+// The machine's travel (soft limits, machine coordinates) when the server's
+// hello carries it as {"travel": {"min": {"x": ..}, "max": {..}}}: drawn as
+// the box in the drawing's coordinates, so it moves with the work offset and
+// the tool's length. Without it the box is the program's extents.
+function showTravel(s, axes, off) {
+  if (!ui.travel || !ui.travel.min || !ui.travel.max) return;
+  const corner = (lim) => toolPoint(ui.path, axes.map((a) => (lim[a] ?? NaN) - (off[a] || 0)), axes, s.tool);
+  const box = [corner(ui.travel.min), corner(ui.travel.max)];
+  if (box.flat().some((v) => !isFinite(v))) return;
+  const key = JSON.stringify(box);
+  if (key === ui.travelShown) return;
+  ui.travelShown = key;
+  preview.setTravel(box);
 }
 
 // ---- program ------------------------------------------------------------------------------
@@ -271,11 +376,21 @@ $('upload-file').addEventListener('change', async () => {
   if (!answer.ok) { log('refused', `upload of ${file.name}: ${answer.reason}`); return; }
   log('info', `uploaded ${answer.name}`);
   ui.pendingSelect = answer.name;
-  send({ cmd: 'list' });
+  ask('list');
   send({ cmd: 'load', path: answer.name });
 });
 $('run-from').addEventListener('click', () => { if (ui.selectedLine) send({ cmd: 'run', line: ui.selectedLine }); });
 $('step').addEventListener('change', () => send({ cmd: 'step', on: $('step').checked ? 1 : 0 }));
+
+function setOverrideLimits(limits) {
+  for (const w of ['feed', 'rapid', 'spindle']) {
+    const l = (limits && limits[w]) || OVERRIDE_DEFAULTS[w];
+    const el = $('ov-' + w);
+    el.min = l[0];
+    el.max = l[1];
+  }
+}
+setOverrideLimits(null);
 
 for (const w of ['feed', 'rapid', 'spindle']) {
   const el = $('ov-' + w);
@@ -342,7 +457,7 @@ function buildJog(axes) {
       box.appendChild(b);
     }
   }
-  setOnline(!document.body.classList.contains('offline'));
+  refreshEnabled();
 }
 
 const jogKeys = { ArrowLeft: ['X', -1], ArrowRight: ['X', 1], ArrowDown: ['Y', -1], ArrowUp: ['Y', 1], PageDown: ['Z', -1], PageUp: ['Z', 1] };
@@ -356,5 +471,6 @@ document.addEventListener('keydown', (e) => {
 document.addEventListener('keyup', (e) => { if (jogKeys[e.key]) stopJog(); });
 window.addEventListener('blur', stopJog);
 
+const machine = initMachine({ $, send, log });
 setOnline(false);
 connect();

@@ -1,27 +1,33 @@
 // The toolpath preview: the whole program from its canonical commands (feeds
-// solid, rapids dashed), the tool where the machine is, and the way the tool
-// has gone while the program ran drawn over it in another colour. three.js
-// (vendored at build time) where WebGL works; a 2D top view where it does not.
+// solid, rapids dashed), the part already cut in another colour than what
+// remains (progress.js says how far), the tool where the machine is, a grid
+// and the travel box, seen from the top, front, side or at an angle, zoomed
+// with the wheel and panned by dragging. three.js (vendored at build time)
+// where WebGL works; preview-2d.js where it does not.
 import { parseCanon } from './canon.js';
+import { twoDView } from './preview-2d.js';
+import { COLORS, VIEWS, travelBox } from './preview-common.js';
 
-const COLORS = { feed: 0x4fb3ff, rapid: 0xe0a040, cut: 0x5cff8a, tool: 0xff4060 };
-const css = (c) => '#' + c.toString(16).padStart(6, '0');
 const TRAIL_MAX = 200000;
 
 export function createPreview(box, canvas2d) {
-  const state = { path: null, trail: [], tool: null, impl: null, errorsShown: false };
+  const state = { path: null, trail: [], tool: null, impl: null, done: 0, view: 'iso', travel: null };
   const api = {
     kind: 'none',
+    // returns the parsed path: the panel follows the tool along it
     setCanon(text) {
       state.path = parseCanon(text || '');
       state.trail = [];
+      state.done = 0;
       if (state.impl) state.impl.setPath(state.path);
+      return state.path;
     },
-    // p: work position (machine minus G5x) per axis; the tool's length
-    // offset as the program gives it, so that the tip meets the path
-    setTool(p, axes, moving, toolNo) {
-      const tlo = (state.path && state.path.tlo[toolNo]) || [0, 0, 0];
-      const xyz = [0, 1, 2].map((i) => (axes[i] ? p[i] - tlo[i] : 0));
+    // the machine's travel in work coordinates, [min, max] (null: none
+    // known, the box is the program's extents)
+    setTravel(t) { state.travel = t; if (state.impl && state.path) state.impl.setPath(state.path); },
+    // xyz: the tool's point on the drawing (canon.js's toolPoint); moving:
+    // whether its way so far is drawn
+    setTool(xyz, moving) {
       const last = state.trail[state.trail.length - 1];
       if (moving && (!last || Math.hypot(xyz[0] - last[0], xyz[1] - last[1], xyz[2] - last[2]) > 0.02)) {
         if (state.trail.length < TRAIL_MAX) state.trail.push(xyz);
@@ -29,7 +35,21 @@ export function createPreview(box, canvas2d) {
       state.tool = xyz;
       if (state.impl) state.impl.setTool(xyz, state.trail);
     },
+    // segments before done (in the program's order) are drawn as cut
+    setDone(done) {
+      if (done === state.done) return;
+      state.done = done;
+      if (state.impl) state.impl.setDone(done);
+    },
+    setView(name) { state.view = name; if (state.impl) state.impl.setView(name); },
+    // for the test and the curious: the view's name, the camera's view
+    // matrix (16 numbers, column-major) and its distance to what it looks at
+    view() { return state.impl ? state.impl.view() : null; },
+    // the box drawn: [min, max] in the drawing's coordinates, or null
+    box() { return travelBox(state.path, state.travel); },
   };
+  for (const b of box.querySelectorAll('[data-view]'))
+    b.addEventListener('click', () => api.setView(b.dataset.view));
   import('three')
     .then((THREE) => import('./vendor/OrbitControls.js').then((oc) => threeView(THREE, oc.OrbitControls, box, canvas2d, state)))
     .catch(() => twoDView(canvas2d, state))
@@ -50,13 +70,18 @@ function threeView(THREE, OrbitControls, box, canvas2d, state) {
     return twoDView(canvas2d, state);
   }
   canvas2d.remove();
-  box.appendChild(renderer.domElement);
+  box.prepend(renderer.domElement);
   const scene = new THREE.Scene();
-  scene.background = new THREE.Color(0x0b0d10);
+  scene.background = new THREE.Color(COLORS.bg);
   const camera = new THREE.PerspectiveCamera(40, 1, 0.1, 100000);
   camera.up.set(0, 0, 1);
   const controls = new OrbitControls(camera, renderer.domElement);
-  const group = new THREE.Group();
+  // A machinist drags the drawing to move it, as in LinuxCNC's AXIS; turning
+  // it is the right button (or two fingers), and the view buttons.
+  controls.mouseButtons = { LEFT: THREE.MOUSE.PAN, MIDDLE: THREE.MOUSE.DOLLY, RIGHT: THREE.MOUSE.ROTATE };
+  controls.touches = { ONE: THREE.TOUCH.PAN, TWO: THREE.TOUCH.DOLLY_ROTATE };
+  controls.screenSpacePanning = true;
+  const group = new THREE.Group();      // the program: path, grid, travel box
   scene.add(group);
   scene.add(new THREE.AxesHelper(10));
   const tool = new THREE.Mesh(new THREE.ConeGeometry(1.5, 6, 16), new THREE.MeshBasicMaterial({ color: COLORS.tool }));
@@ -71,6 +96,7 @@ function threeView(THREE, OrbitControls, box, canvas2d, state) {
   trail.renderOrder = 2;
   scene.add(trail);
   let trailDrawn = 0;
+  let feedColors = null, coloured = 0, size = 10, centre = [0, 0, 0], viewName = state.view;
 
   let dirty = true, viewMoved = false, last = 0;
   function resize() {
@@ -107,21 +133,73 @@ function threeView(THREE, OrbitControls, box, canvas2d, state) {
   controls.addEventListener('change', () => { viewMoved = true; });
   requestAnimationFrame(draw);
 
+  // Feed segments before done in the cut colour, the rest in the feed colour:
+  // only the range that changed is written.
+  function colourDone(done) {
+    if (!feedColors || !state.path) return;
+    const segs = state.path.segs;
+    const from = Math.min(coloured, done), to = Math.min(Math.max(coloured, done), segs.length);
+    const cut = new THREE.Color(COLORS.cut), todo = new THREE.Color(COLORS.feed);
+    for (let k = from; k < to; k++) {
+      const s = segs[k];
+      if (!s.feed) continue;
+      const c = k < done ? cut : todo;
+      feedColors.setXYZ(2 * s.i, c.r, c.g, c.b);
+      feedColors.setXYZ(2 * s.i + 1, c.r, c.g, c.b);
+    }
+    feedColors.needsUpdate = true;
+    coloured = done;
+    dirty = true;
+  }
+
+  function setView(name) {
+    const v = VIEWS[name] || VIEWS.iso;
+    viewName = VIEWS[name] ? name : 'iso';
+    const d = size * 1.5;
+    controls.target.set(...centre);
+    // a view straight down Z is kept a hair off the axis: OrbitControls
+    // cannot tell which way is up when looking along camera.up
+    camera.position.set(centre[0] + d * v[0], centre[1] + d * v[1] - (v[0] === 0 && v[1] === 0 ? 1e-3 * d : 0), centre[2] + d * v[2]);
+    controls.update();
+    viewMoved = true;
+  }
+
   return {
     kind: 'webgl',
     setPath(p) {
       group.clear();
-      if (p.feed.length) group.add(lines(p.feed, new THREE.LineBasicMaterial({ color: COLORS.feed })));
+      feedColors = null;
+      coloured = 0;
+      if (p.feed.length) {
+        const l = lines(p.feed, new THREE.LineBasicMaterial({ vertexColors: true }));
+        const n = p.feed.length / 3, col = new Float32Array(3 * n);
+        const c = new THREE.Color(COLORS.feed);
+        for (let i = 0; i < n; i++) col.set([c.r, c.g, c.b], 3 * i);
+        feedColors = new THREE.BufferAttribute(col, 3);
+        l.geometry.setAttribute('color', feedColors);
+        group.add(l);
+      }
       if (p.rapid.length) group.add(lines(p.rapid, new THREE.LineDashedMaterial({ color: COLORS.rapid, dashSize: 1.5, gapSize: 1.2 })));
+      const tb = travelBox(p, state.travel);
+      if (tb) {
+        const [lo, hi] = tb;
+        const bx = new THREE.Box3(new THREE.Vector3(...lo), new THREE.Vector3(...hi));
+        group.add(new THREE.Box3Helper(bx, new THREE.Color(COLORS.box)));
+        // a 10 mm grid on the work's Z0 plane, over the box and the origin
+        const span = Math.max(hi[0], hi[1], 0) - Math.min(lo[0], lo[1], 0);
+        const cells = Math.max(2, Math.ceil(span / 10) + 2);
+        const grid = new THREE.GridHelper(cells * 10, cells, COLORS.gridMajor, COLORS.grid);
+        grid.rotation.x = Math.PI / 2;   // GridHelper lies in XZ; the table is XY
+        const mid = (a, b) => Math.round(((Math.min(a, 0) + Math.max(b, 0)) / 2) / 10) * 10;
+        grid.position.set(mid(lo[0], hi[0]), mid(lo[1], hi[1]), 0);
+        group.add(grid);
+        centre = lo.map((v, i) => (v + hi[i]) / 2);
+        size = Math.max(...hi.map((v, i) => v - lo[i]), 10);
+        setView(viewName);
+      }
       trailDrawn = 0;
       trailGeo.setDrawRange(0, 0);
-      if (isFinite(p.min[0])) {
-        const c = p.min.map((v, i) => (v + p.max[i]) / 2);
-        const size = Math.max(...p.max.map((v, i) => v - p.min[i]), 10);
-        controls.target.set(c[0], c[1], c[2]);
-        camera.position.set(c[0] - size * 0.6, c[1] - size * 1.3, c[2] + size * 1.1);
-        controls.update();
-      }
+      colourDone(state.done);
       dirty = true;
     },
     setTool(xyz, trailPts) {
@@ -136,57 +214,13 @@ function threeView(THREE, OrbitControls, box, canvas2d, state) {
       }
       dirty = true;
     },
-  };
-}
-
-// A top view (XY) on a 2D canvas: the same colours and dashes.
-function twoDView(canvas, state) {
-  const ctx = canvas.getContext('2d');
-  let view = null;
-  function fit() {
-    const p = state.path;
-    const w = canvas.clientWidth, h = canvas.clientHeight;
-    canvas.width = w * devicePixelRatio;
-    canvas.height = h * devicePixelRatio;
-    if (!p || !isFinite(p.min[0])) { view = null; return; }
-    const sx = p.max[0] - p.min[0] || 10, sy = p.max[1] - p.min[1] || 10;
-    const s = 0.9 * Math.min(w / sx, h / sy) * devicePixelRatio;
-    view = { s, ox: canvas.width / 2 - s * (p.min[0] + sx / 2), oy: canvas.height / 2 + s * (p.min[1] + sy / 2) };
-  }
-  const X = (x) => view.ox + view.s * x, Y = (y) => view.oy - view.s * y;
-  function segs(arr, color, dash) {
-    ctx.strokeStyle = css(color);
-    ctx.setLineDash(dash);
-    ctx.beginPath();
-    for (let i = 0; i < arr.length; i += 6) { ctx.moveTo(X(arr[i]), Y(arr[i + 1])); ctx.lineTo(X(arr[i + 3]), Y(arr[i + 4])); }
-    ctx.stroke();
-  }
-  function draw() {
-    ctx.fillStyle = '#0b0d10';
-    ctx.fillRect(0, 0, canvas.width, canvas.height);
-    if (!view) return;
-    ctx.lineWidth = devicePixelRatio;
-    segs(state.path.feed, COLORS.feed, []);
-    segs(state.path.rapid, COLORS.rapid, [6, 5]);
-    if (state.trail.length > 1) {
-      ctx.strokeStyle = css(COLORS.cut);
-      ctx.lineWidth = 2 * devicePixelRatio;
-      ctx.setLineDash([]);
-      ctx.beginPath();
-      state.trail.forEach((p, i) => (i ? ctx.lineTo(X(p[0]), Y(p[1])) : ctx.moveTo(X(p[0]), Y(p[1]))));
-      ctx.stroke();
-    }
-    if (state.tool) {
-      ctx.fillStyle = css(COLORS.tool);
-      ctx.beginPath();
-      ctx.arc(X(state.tool[0]), Y(state.tool[1]), 5 * devicePixelRatio, 0, 2 * Math.PI);
-      ctx.fill();
-    }
-  }
-  new ResizeObserver(() => { fit(); draw(); }).observe(canvas);
-  return {
-    kind: '2d',
-    setPath() { fit(); draw(); },
-    setTool() { draw(); },
+    setDone: colourDone,
+    setView,
+    view() {
+      camera.updateMatrixWorld();
+      return { name: viewName, matrix: [...camera.matrixWorldInverse.elements],
+               distance: camera.position.distanceTo(controls.target),
+               target: controls.target.toArray() };
+    },
   };
 }

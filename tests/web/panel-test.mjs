@@ -3,11 +3,15 @@
 // `cnc-run serve --http` on the simulated machine (real clock, loopback, a
 // private LCM group and prefix, a copy of ncprograms/ as its program folder),
 // the panel opened in headless chromium with the printed token, and an
-// operator's session through the panel's own buttons: load, cycle start, feed
-// hold, resume, MDI (and the modal codes it leaves), jog, upload; the layout
+// operator's session through the panel's own buttons: the first "connecting",
+// per-axis home, load, the preview's views, zoom and pan, cycle start (with
+// the distance to go, the cut part in its own colour and the manual controls
+// disabled), feed hold, resume, MDI (and the modal codes it leaves), spindle
+// and coolant, jog, touch-off, upload; the layout
 // on a 10-inch touch panel; then what others on the network might send: no
 // token, malformed JSON, unknown commands, an oversized message and a flood.
-// Then the core of the session again in Firefox (WebDriver BiDi). Each case
+// Then the core of the session again in Firefox (WebDriver BiDi), and its
+// preview views. Each case
 // prints PASS/FAIL/SKIP; every wait is bounded; screenshots of each step land
 // in WORKDIR.
 import { spawn, spawnSync } from 'node:child_process';
@@ -17,7 +21,7 @@ import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
 
-const CASES = ["static", "connect", "page-stall", "load", "cycle-start", "feed-hold", "resume", "status-lag", "status-lag-p99", "touch-layout", "mdi", "modal-codes", "jog", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi"];
+const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "spindle-coolant", "jog", "touch-off", "tool-table", "server-limits", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
 
 const [BUILD, WORK, CHROMIUM, FIREFOX] = process.argv.slice(2);
 const ROOT = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..', '..');
@@ -101,6 +105,34 @@ async function waitFor(page, what, fn, ms = 10000) {
 async function shot(page, name) {
   await page.screenshot({ path: path.join(WORK, `${name}.png`) });
 }
+
+// What the panel shows and may be pressed, read in one go with its status:
+// the DOM is updated in the same task as ui.status.
+const panelState = (page, ids) => page.evaluate((ids) => ({
+  s: window.ncpPanel.status,
+  disabled: Object.fromEntries(ids.map((id) => [id, document.getElementById(id).disabled])),
+}), ids);
+
+// The preview's pixels: how many are near each colour (r, g, b), and a hash
+// of the whole, from its canvas (WebGL's is kept: preserveDrawingBuffer).
+async function canvasPixels(page, colors) {
+  return page.evaluate((colors) => {
+    const src = document.querySelector('#preview canvas');
+    const c = document.createElement('canvas');
+    c.width = src.width; c.height = src.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(src, 0, 0);
+    const d = ctx.getImageData(0, 0, c.width, c.height).data;
+    const counts = colors.map(() => 0);
+    let hash = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      hash = (hash * 31 + d[i] + 7 * d[i + 1] + 13 * d[i + 2]) >>> 0;
+      colors.forEach(([r, g, b], k) => { if (Math.abs(d[i] - r) + Math.abs(d[i + 1] - g) + Math.abs(d[i + 2] - b) < 60) counts[k]++; });
+    }
+    return { counts, hash };
+  }, colors);
+}
+const CUT_RGB = [0x5c, 0xff, 0x8a], FEED_RGB = [0x4f, 0xb3, 0xff];
 
 // The jog step radio: clicked, and checked before the jog that depends on it.
 async function setStep(page, v) {
@@ -229,6 +261,19 @@ async function session(browser) {
     const three = await fetch(srv.base + 'vendor/three.module.js');
     previewKind = three.status === 200 ? '3d' : '2d';
   });
+  // Every text the connection badge shows from the page's first moment, and
+  // whether the lost banner showed: before the socket first opens the page
+  // is connecting, never lost.
+  await page.evaluateOnNewDocument(() => {
+    window.connSeen = [];
+    const note = () => {
+      const c = document.getElementById('conn'), b = document.getElementById('banner');
+      if (!c) return;
+      const t = c.textContent + (b && getComputedStyle(b).display !== 'none' ? ' [banner]' : '');
+      if (window.connSeen[window.connSeen.length - 1] !== t) window.connSeen.push(t);
+    };
+    new MutationObserver(note).observe(document, { subtree: true, childList: true, characterData: true, attributes: true });
+  });
   await run('connect', async () => {
     await openPanel(page, srv, 15000);
     const s = await status(page);
@@ -236,7 +281,17 @@ async function session(browser) {
     const dro = await page.$$eval('#dro tbody tr', (rows) => rows.length);
     check(dro === 3, `DRO rows ${dro}`);
     check(!(await page.$eval('#run', (b) => b.disabled)), 'cycle start disabled while connected');
+    // no limits from the server: LinuxCNC's defaults
+    const ov = await page.$$eval('#ov-feed, #ov-spindle', (e) => e.map((x) => [Number(x.min), Number(x.max)]));
+    check(JSON.stringify(ov) === '[[0,200],[50,150]]', `override ranges ${JSON.stringify(ov)}, not feed 0-200, spindle 50-150`);
     await shot(page, '01-connected');
+  });
+  await run('connecting', async () => {
+    const seen = await page.evaluate(() => window.connSeen);
+    const first = seen.findIndex((t) => t.startsWith('connected'));
+    check(first > 0, `the badge showed ${JSON.stringify(seen)}`);
+    const before = seen.slice(0, first);
+    check(before.every((t) => t === 'connecting…'), `before the socket opened the badge showed ${JSON.stringify(before)}`);
   });
   // A page busy for longer than the panel's 2 s watchdog (a slow first WebGL
   // set-up, a starved browser) has statuses queued behind the watchdog's own
@@ -250,6 +305,19 @@ async function session(browser) {
     check(lost.length === 0, `the panel called the link lost after a 2.6 s stall of its own: ${lost.join(' | ')}`);
     check(!(await page.$eval('#run', (b) => b.disabled)), 'cycle start disabled after the page stalled');
   });
+  // one axis homed by its own button, and only that one (the simulated
+  // machine has no switches: its homing is over within a status period, so
+  // the buttons' state while busy is checked while the program runs)
+  await run('home-axis', async () => {
+    const ids = ['home-x', 'home-y', 'home', 'spindle-cw', 'touch-apply'];
+    const a = await panelState(page, ids);
+    check(!Object.values(a.disabled).some(Boolean), `disabled while idle: ${JSON.stringify(a.disabled)}`);
+    check(Object.values(a.s.homed).every((h) => !h), `homed before any home: ${JSON.stringify(a.s.homed)}`);
+    await click(page, '#home-x');
+    const s = await waitFor(page, 'X homed', (s) => s.state === 'idle' && s.homed.x, 10000);
+    check(Object.keys(s.homed).every((k) => k === 'x' || !s.homed[k]), `Home X homed ${JSON.stringify(s.homed)}`);
+    await page.waitForFunction(() => !document.querySelector('#dro tbody td.axis').classList.contains('unhomed'), { timeout: 2000 });
+  });
   await run('load', async () => {
     await loadDemo(page);
     const src = fs.readFileSync(path.join(ROOT, 'ncprograms', 'demo.ngc'), 'utf8').split('\n');
@@ -260,7 +328,45 @@ async function session(browser) {
     await sleep(1500);
     await shot(page, '02-loaded');
   });
+  // the view buttons change the camera (its view matrix) and the drawing;
+  // the wheel zooms, a drag pans
+  await run('preview-views', async () => {
+    const v = {}, px = {};
+    for (const name of ['top', 'front', 'side', 'iso']) {
+      await page.click(`#preview [data-view="${name}"]`);
+      await sleep(300);
+      v[name] = await page.evaluate(() => window.ncpPanel.preview.view());
+      check(v[name] && v[name].name === name, `after ${name}: view ${JSON.stringify(v[name] && v[name].name)}`);
+      px[name] = (await canvasPixels(page, [])).hash;
+      if (name === 'top') await shot(page, '02b-view-top');
+    }
+    const names = Object.keys(v);
+    for (let i = 0; i < names.length; i++)
+      for (let j = i + 1; j < names.length; j++) {
+        const a = v[names[i]].matrix, b = v[names[j]].matrix;
+        check(a.some((x, k) => Math.abs(x - b[k]) > 1e-3), `${names[i]} and ${names[j]} have the same view matrix`);
+        check(px[names[i]] !== px[names[j]], `${names[i]} and ${names[j]} draw the same pixels`);
+      }
+    // top: looking down Z, X to the right (the matrix's first row is screen right)
+    const t = v.top.matrix;
+    check(Math.abs(t[0] - 1) < 1e-3 && Math.abs(t[10] - 1) < 1e-2, `top view matrix ${t.map((x) => x.toFixed(2)).join(' ')}`);
+    const box = await (await page.$('#preview canvas')).boundingBox();
+    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.wheel({ deltaY: -400 });
+    await sleep(300);
+    const z = await page.evaluate(() => window.ncpPanel.preview.view());
+    check(z.distance < v.iso.distance * 0.95, `the wheel did not zoom in: distance ${v.iso.distance.toFixed(1)} -> ${z.distance.toFixed(1)}`);
+    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.down();
+    await page.mouse.move(box.x + box.width / 2 + 80, box.y + box.height / 2 + 40, { steps: 5 });
+    await page.mouse.up();
+    await sleep(300);
+    const p = await page.evaluate(() => window.ncpPanel.preview.view());
+    check(p.target.some((x, k) => Math.abs(x - z.target[k]) > 0.1), `a drag did not pan: target ${JSON.stringify(z.target)} -> ${JSON.stringify(p.target)}`);
+    await page.click('#preview [data-view="iso"]');
+  });
   let runStart;
+  let runSeen = { toGo: [], disabled: null };
   await run('cycle-start', async () => {
     await click(page, '#run');
     // the demo starts with T1 M6: the NCK pauses until the operator says the tool is in
@@ -276,6 +382,16 @@ async function session(browser) {
       const s = await status(page);
       const hl = await page.$eval('#program', (p) => { const c = p.querySelector('div.current'); return c ? Number(c.dataset.line) : 0; });
       if (hl && hl !== lastLine) { advanced++; lastLine = hl; lines.add(hl); }
+      const seen = await page.evaluate(() => ({
+        s: window.ncpPanel.status, toGo: window.ncpPanel.toGo,
+        cells: [...document.querySelectorAll('#dro tbody td.togo')].map((td) => td.textContent),
+        disabled: Object.fromEntries(['home-x', 'home', 'spindle-cw', 'spindle-stop', 'coolant-flood', 'touch-apply']
+          .map((id) => [id, document.getElementById(id).disabled])),
+      }));
+      if (seen.s.state === 'running') {
+        runSeen.disabled = seen.disabled;
+        if (seen.toGo) runSeen.toGo.push({ cells: seen.cells, toGo: seen.toGo, pos: seen.s.pos_act, line: seen.s.line });
+      }
       if (Math.abs(s.pos_act.x - runStart.pos_act.x) + Math.abs(s.pos_act.y - runStart.pos_act.y) + Math.abs(s.pos_act.z - runStart.pos_act.z) > 1) moved = true;
       await sleep(50);
     }
@@ -283,9 +399,39 @@ async function session(browser) {
     check(advanced >= 3 && lines.size >= 3, `the highlighted line moved ${advanced} times (lines seen ${[...lines].join(' ')})`);
     const dro = await page.$eval('#dro tbody tr td:nth-child(4)', (td) => td.textContent);
     check(dro !== '0.000' || moved, 'DRO cell unchanged');
-    await sleep(1500);
+    // 1.5 s of the run read in the page at each status: the distance to go
+    runSeen.toGo.push(...await page.evaluate(() => new Promise((done) => {
+      const got = [], t0 = performance.now();
+      let last = null;
+      const tick = setInterval(() => {
+        const u = window.ncpPanel;
+        if (u.status !== last && u.status.state === 'running' && u.toGo)
+          got.push({ cells: [...document.querySelectorAll('#dro tbody td.togo')].map((td) => td.textContent), toGo: u.toGo });
+        last = u.status;
+        if (performance.now() - t0 > 1500) { clearInterval(tick); done(got); }
+      }, 10);
+    })));
     await shot(page, '03-running');
     await page.screenshot({ path: path.join(WORK, 'panel-1280x800.png') });
+  });
+  // the distance to go while the program runs: shown in the DRO, and it
+  // shrinks along a move (the program's moves are millimetres long)
+  await run('to-go', async () => {
+    check(results.get('cycle-start') === 'PASS', 'needs cycle-start');
+    const t = runSeen.toGo;
+    check(t.length >= 5, `distance to go shown in ${t.length} of the statuses read while running`);
+    check(t.every((e) => e.cells.slice(0, 3).every((c) => /^-?\d+\.\d{3}$/.test(c))), `DRO to-go cells ${JSON.stringify(t[0].cells)}`);
+    const len = (e) => Math.hypot(...e.toGo);
+    let shrinking = 0;
+    for (let i = 1; i < t.length; i++) if (len(t[i]) < len(t[i - 1]) - 1e-3) shrinking++;
+    check(shrinking >= 2, `the distance to go never shrank: ${t.map((e) => len(e).toFixed(2)).join(' ')}`);
+    check(t.every((e) => len(e) < 200), `a distance to go beyond the part: ${t.map((e) => len(e).toFixed(1)).join(' ')}`);
+  });
+  await run('busy-disabled', async () => {
+    const d = runSeen.disabled;
+    check(d, 'never read the controls while running');
+    const on = Object.keys(d).filter((k) => !d[k]);
+    check(on.length === 0, `enabled while running: ${on.join(' ')}`);
   });
   await run('feed-hold', async () => {
     check(results.get('cycle-start') === 'PASS', 'needs cycle-start');
@@ -345,6 +491,16 @@ async function session(browser) {
     check(gaps <= lag.length / 20, `${gaps} gaps in ${lag.length} statuses`);
     check(pct(0.5) <= 2 * PERIOD_MS, `median lag ${pct(0.5).toFixed(2)} ms over 2 periods`);
   });
+  // after a while of the run, the part already cut and what remains are both
+  // drawn, in their own colours
+  await run('preview-cut', async () => {
+    check(results.get('resume') === 'PASS', 'needs the program running (resume)');
+    const done = await page.evaluate(() => window.ncpPanel.progress.done);
+    check(done > 3, `only ${done} segments followed as cut`);
+    const { counts } = await canvasPixels(page, [CUT_RGB, FEED_RGB]);
+    check(counts[0] > 30 && counts[1] > 30, `cut-colour pixels ${counts[0]}, still-to-cut pixels ${counts[1]}`);
+    await shot(page, '05b-cut');
+  });
   await run('touch-layout', async () => {
     // a 10-inch panel (1024x600, touch, no mobile viewport) on the running program
     const tp = await browser.newPage();
@@ -352,7 +508,8 @@ async function session(browser) {
       await tp.setViewport(TOUCH_VIEWPORT);
       await tp.goto(`${srv.base}?token=${srv.token}`, { waitUntil: 'load', timeout: 15000 });
       await tp.waitForFunction(() => window.ncpPanel && window.ncpPanel.status && window.ncpPanel.authed &&
-        document.querySelectorAll('#program div').length > 0, { timeout: 20000 });
+        document.querySelectorAll('#program div').length > 0 && window.ncpPanel.path && window.ncpPanel.path.segs.length > 0,
+        { timeout: 20000 });
       await sleep(1000);   // the preview drawn
       await tp.screenshot({ path: path.join(WORK, 'panel-1024x600.png') });
       const bad = await checkTouchLayout(tp);
@@ -390,6 +547,24 @@ async function session(browser) {
     await click(page, '#mdi-send');
     await waitFor(page, 'G21 G90 back', (s) => s.state === 'idle' && s.gcodes.includes('G21') && s.gcodes.includes('G90'), 5000);
   });
+  await run('spindle-coolant', async () => {
+    await page.$eval('#spindle-rpm', (e) => { e.value = '1200'; });
+    await click(page, '#spindle-cw');
+    await waitFor(page, 'spindle CW 1200', (s) => s.state === 'idle' && s.spindle.dir === 1 && Math.abs(s.spindle.speed - 1200) < 1e-6, 5000);
+    await page.waitForFunction(() => document.querySelector('#spindle-cw').classList.contains('on'), { timeout: 2000 });
+    await click(page, '#spindle-ccw');
+    await waitFor(page, 'spindle CCW', (s) => s.state === 'idle' && s.spindle.dir === -1, 5000);
+    await click(page, '#coolant-flood');
+    await waitFor(page, 'flood on', (s) => s.state === 'idle' && s.coolant.flood, 5000);
+    await click(page, '#coolant-mist');
+    await waitFor(page, 'mist on', (s) => s.state === 'idle' && s.coolant.mist, 5000);
+    await page.waitForFunction(() => document.querySelector('#coolant-mist').classList.contains('on'), { timeout: 2000 });
+    await shot(page, '06c-spindle-coolant');
+    await click(page, '#coolant-off');
+    await waitFor(page, 'coolant off', (s) => s.state === 'idle' && !s.coolant.mist && !s.coolant.flood, 5000);
+    await click(page, '#spindle-stop');
+    await waitFor(page, 'spindle stopped', (s) => s.state === 'idle' && s.spindle.dir === 0, 5000);
+  });
   await run('jog', async () => {
     const a = await status(page);
     await setStep(page, '1');
@@ -416,6 +591,56 @@ async function session(browser) {
     const d = await waitFor(page, 'jog stopped', (s) => s.state === 'idle', 5000);
     check(d.pos_cmd.y > c.pos_cmd.y + 0.5, `Y moved ${(d.pos_cmd.y - c.pos_cmd.y).toFixed(3)} mm in a 600 ms jog`);
     await shot(page, '07-jogged');
+  });
+  // touch-off X to 5 in G55 (not the system in force): G55's offset, seen
+  // in the status once G55 is in force, puts the tool at X5 there
+  await run('touch-off', async () => {
+    const a = await waitFor(page, 'idle in G54', (s) => s.state === 'idle' && s.g5x.name === 'G54', 5000);
+    await page.select('#touch-axis', 'X');
+    await page.$eval('#touch-value', (e) => { e.value = '5'; });
+    await page.select('#touch-system', '2');
+    await click(page, '#touch-apply');
+    await sleep(300);
+    await waitFor(page, 'idle after the touch-off', (s) => s.state === 'idle', 5000);
+    check((await status(page)).g5x.name === 'G54', 'the touch-off changed the system in force');
+    await page.type('#mdi', 'G55');
+    await click(page, '#mdi-send');
+    const s = await waitFor(page, 'G55 in force', (s) => s.state === 'idle' && s.g5x.name === 'G55', 5000);
+    check(Math.abs(s.g5x.offset.x - (a.pos_cmd.x - 5)) < 1e-6, `G55 X offset ${s.g5x.offset.x}, not ${a.pos_cmd.x - 5}`);
+    await page.waitForFunction(() => document.querySelector('#dro tbody td.work').textContent === '5.000', { timeout: 2000 });
+    await shot(page, '07a-touch-off');
+    await page.type('#mdi', 'G54');
+    await click(page, '#mdi-send');
+    await waitFor(page, 'G54 back', (s) => s.state === 'idle' && s.g5x.name === 'G54', 5000);
+  });
+  await run('tool-table', async () => {
+    // the service has no tool table command: the control says so, disabled
+    const t = await page.$eval('#tools', (b) => ({ disabled: b.disabled, title: b.title }));
+    check(t.disabled && /no command/.test(t.title), `tool table control ${JSON.stringify(t)}`);
+  });
+  // This server sends no limits yet; a hello that carries them (override
+  // ranges, soft limits in machine coordinates) sets the sliders and the
+  // preview's box, and one without them brings the defaults back.
+  await run('server-limits', async () => {
+    const st = await status(page);
+    const hello = (extra) => page.evaluate((m) => window.ncpPanel.receive(JSON.stringify(m)),
+      { type: 'hello', authed: true, readonly: false, ...extra });
+    await hello({ limits: { feed: [0, 120], spindle: [60, 140] },
+                  travel: { min: { x: -10, y: -20, z: -100 }, max: { x: 300, y: 200, z: 0 } } });
+    await page.waitForFunction(() => window.ncpPanel.travelShown, { timeout: 3000 });
+    const ov = await page.$$eval('#ov-feed, #ov-spindle', (e) => e.map((x) => [Number(x.min), Number(x.max)]));
+    check(JSON.stringify(ov) === '[[0,120],[60,140]]', `override ranges ${JSON.stringify(ov)}`);
+    const box = await page.evaluate(() => window.ncpPanel.preview.box());
+    const off = st.g5x.offset;
+    check(Math.abs(box[0][0] - (-10 - off.x)) < 1e-6 && Math.abs(box[1][1] - (200 - off.y)) < 1e-6,
+      `the box ${JSON.stringify(box)} is not the travel less ${st.g5x.name}'s offset`);
+    await shot(page, '07c-travel');
+    await hello({});
+    await page.waitForFunction(() => !window.ncpPanel.travelShown, { timeout: 3000 });
+    const back = await page.evaluate(() => window.ncpPanel.preview.box());
+    check(!back || back[1][0] < 200, `the box stayed the travel: ${JSON.stringify(back)}`);
+    const ov2 = await page.$$eval('#ov-feed, #ov-spindle', (e) => e.map((x) => [Number(x.min), Number(x.max)]));
+    check(JSON.stringify(ov2) === '[[0,200],[50,150]]', `override ranges after a plain hello ${JSON.stringify(ov2)}`);
   });
   const srcDir = path.join(WORK, 'upload-src');
   fs.mkdirSync(srcDir, { recursive: true });
@@ -557,6 +782,8 @@ async function session(browser) {
     check(disabled, 'controls still enabled after the NCK went away');
     const banner = await page.$eval('#banner', (e) => getComputedStyle(e).display);
     check(banner !== 'none', 'no lost-connection banner');
+    const conn = await page.$eval('#conn', (e) => e.textContent);
+    check(/^lost/.test(conn), `the badge says "${conn}" after the link dropped`);
     await shot(page, '09-connection-lost');
   });
   const log = fs.readFileSync(srv.log, 'utf8');
@@ -667,6 +894,15 @@ async function firefox() {
       await click(page, '#mdi-send');
       await page.waitForFunction(() => /\bG20\b.*\bG91\b|\bG91\b.*\bG20\b/.test(document.querySelector('#gcodes').textContent), { timeout: 5000 });
       await page.screenshot({ path: path.join(WORK, 'firefox-mdi.png') });
+    });
+    await run('firefox-views', async () => {
+      const m = {};
+      for (const name of ['top', 'front']) {
+        await page.click(`#preview [data-view="${name}"]`);
+        await page.waitForFunction((n) => { const v = window.ncpPanel.preview.view(); return v && v.name === n; }, { timeout: 3000 }, name);
+        m[name] = (await page.evaluate(() => window.ncpPanel.preview.view())).matrix;
+      }
+      check(m.top.some((x, k) => Math.abs(x - m.front[k]) > 1e-3), 'top and front have the same view matrix');
     });
     await page.close();
   } catch (e) {
