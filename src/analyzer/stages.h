@@ -101,6 +101,8 @@ int ncp_g10_run(struct ncp_analyzer *a);
 
 /* tools.c */
 int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d);
+/* A tool table file's whole text (malloc'd; NULL with d set: it cannot be read). */
+char *ncp_tools_read_file(const char *path, size_t *len, struct ncp_diag *d);
 /* One line of a tool table as the loader reads it (tools.c): 1 and the
  * entry (Y A B C U V W offsets in more[7]) for a tool line the loader
  * keeps, 0 for any other (blank, comment, skipped). */

@@ -194,29 +194,23 @@ static void ncp_tools_parse(struct ncp_analyzer *a, const char *text, size_t len
     }
 }
 
-int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d)
+char *ncp_tools_read_file(const char *path, size_t *len, struct ncp_diag *d)
 {
-    if (!path) {
-        ncp_tools_parse(a, ncp_default_table, sizeof ncp_default_table - 1);
-        return NCP_OK;
-    }
     FILE *f = fopen(path, "rb");
-    if (!f)
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot open tool table %s: %s", path,
-                            strerror(errno));
-    size_t cap = 1 << 16, len = 0;
+    if (!f) {
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot open tool table %s: %s", path, strerror(errno));
+        return NULL;
+    }
+    size_t cap = 1 << 16;
+    *len = 0;
     char *buf = malloc(cap);
     while (buf) {
-        size_t n = fread(buf + len, 1, cap - len, f);
-        len += n;
-        if (len < cap)
+        *len += fread(buf + *len, 1, cap - *len, f);
+        if (*len < cap)
             break;
         char *nb = realloc(buf, cap * 2);
-        if (!nb) {
+        if (!nb)
             free(buf);
-            buf = NULL;
-            break;
-        }
         buf = nb;
         cap *= 2;
     }
@@ -224,8 +218,22 @@ int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d)
     fclose(f);
     if (!buf || bad) {
         free(buf);
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read tool table %s", path);
+        ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read tool table %s", path);
+        return NULL;
     }
+    return buf;
+}
+
+int ncp_tools_load(struct ncp_analyzer *a, const char *path, struct ncp_diag *d)
+{
+    if (!path) {
+        ncp_tools_parse(a, ncp_default_table, sizeof ncp_default_table - 1);
+        return NCP_OK;
+    }
+    size_t len;
+    char *buf = ncp_tools_read_file(path, &len, d);
+    if (!buf)
+        return d->code;
     ncp_tools_parse(a, buf, len);
     free(buf);
     return NCP_OK;

@@ -116,28 +116,10 @@ int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const struct ncp_
                                  const char *path, int *written, struct ncp_diag *d)
 {
     *written = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read tool table %s: %s", path,
-                            strerror(errno));
-    size_t cap = 1 << 16, len = 0;
-    char *old = malloc(cap);
-    while (old) {
-        len += fread(old + len, 1, cap - len, f);
-        if (len < cap)
-            break;
-        char *more = realloc(old, cap * 2);
-        if (!more)
-            free(old);
-        old = more;
-        cap *= 2;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (!old || bad) {
-        free(old);
-        return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "cannot read tool table %s", path);
-    }
+    size_t len;
+    char *old = ncp_tools_read_file(path, &len, d);
+    if (!old)
+        return d->code;
     size_t n;
     int changed;
     char *text = ncp_analyzer_tool_table_text(a, base, old, len, &n, &changed);

@@ -17,29 +17,7 @@
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
 
-struct mem_feed {
-    struct ncp_source src;
-    uint64_t off;
-    uint32_t line;
-    struct ncp_block block;
-};
-
-static const struct ncp_block *mf_next(void *ctx)
-{
-    struct mem_feed *f = ctx;
-    struct ncp_span sp;
-    if (ncp_source_span(&f->src, f->off, f->line, &sp) != 0)
-        return NULL;
-    ncp_lex_block(f->src.text + sp.off, sp.len, sp.line, sp.off, &f->block);
-    f->off = sp.next;
-    f->line++;
-    return &f->block;
-}
-
-static void mf_release(void *ctx)
-{
-    (void)ctx;
-}
+#include "mem_feed.h"
 
 #define MAX_SLOTS 4096
 

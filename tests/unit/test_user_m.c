@@ -19,6 +19,8 @@
 #include "ncpar/feeder.h"
 #include "ncpar/lex.h"
 
+#include "mem_feed.h"
+
 static char dir_a[64], dir_b[64];
 
 static void touch(const char *dir, const char *name, mode_t mode)
@@ -114,30 +116,6 @@ static void test_ini_folders(void **state)
 }
 
 /* ---- the interpreter's call ---- */
-
-struct mem_feed {
-    struct ncp_source src;
-    uint64_t off;
-    uint32_t line;
-    struct ncp_block block;
-};
-
-static const struct ncp_block *mf_next(void *ctx)
-{
-    struct mem_feed *f = ctx;
-    struct ncp_span sp;
-    if (ncp_source_span(&f->src, f->off, f->line, &sp) != 0)
-        return NULL;
-    ncp_lex_block(f->src.text + sp.off, sp.len, sp.line, sp.off, &f->block);
-    f->off = sp.next;
-    f->line++;
-    return &f->block;
-}
-
-static void mf_release(void *ctx)
-{
-    (void)ctx;
-}
 
 struct calls {
     struct ncp_cmd cur;
