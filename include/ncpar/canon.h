@@ -160,7 +160,9 @@ struct ncp_canon {
         struct { int32_t spindle; NCP_CANON_IPAD(1); double css_max; } spindle_mode;
         struct { int32_t spindle; } spindle;
         struct { int32_t spindle, direction; NCP_CANON_IPAD(2); double angle; } orient;
-        struct { int32_t tool; } tool;
+        /* tool: what rs274 prints (SELECT_TOOL's number, CHANGE_TOOL's table
+         * entry); number: the tool's number, what the machine shows */
+        struct { int32_t tool, number; } tool;
         struct { NCP_CANON_IPAD(0); double v[9]; } tool_length; /* x y z a b c u v w */
         struct { NCP_CANON_IPAD(0); double radius; } comp_radius;
         struct { int32_t side; } comp_start;                /* 1 LEFT, 2 RIGHT */

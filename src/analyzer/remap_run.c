@@ -245,7 +245,8 @@ static int glue_epilog(struct ncp_analyzer *a, const struct ncp_remap_frame *fr,
         s->selected_pocket = (int)fr->pocket;
         int idx = s->selected_pocket;
         s->selected_pocket_no = idx >= 0 && idx < a->n_tools ? a->tools[idx].pocket : -1;
-        ncp_an_emit(a, NCP_C_SELECT_TOOL)->tool.tool = s->selected_tool;
+        struct ncp_canon *c = ncp_an_emit(a, NCP_C_SELECT_TOOL);
+        c->tool.tool = c->tool.number = s->selected_tool;
         return NCP_OK;
     }
     if (fr->r->epilog == NCP_GLUE_SETTOOL) {
@@ -258,14 +259,18 @@ static int glue_epilog(struct ncp_analyzer *a, const struct ncp_remap_frame *fr,
         s->current_tool = (int)fr->tool;
         s->current_pocket = pocket;
         s->current_pocket_no = pocket >= 0 && pocket < a->n_tools ? a->tools[pocket].pocket : -1;
-        ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER)->tool.tool = pocket;
+        struct ncp_canon *c = ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER);
+        c->tool.tool = pocket;
+        c->tool.number = (int)fr->tool;
         ncp_tools_sync_params(a, 1); /* set_tool_parameters() */
         return NCP_OK;
     }
     if (value <= 0)
         return ncp_an_error(a, col, "M6 aborted (return code %.1f)", value);
     int pocket = (int)fr->selected_pocket;
-    ncp_an_emit(a, NCP_C_CHANGE_TOOL)->tool.tool = pocket;
+    struct ncp_canon *c = ncp_an_emit(a, NCP_C_CHANGE_TOOL);
+    c->tool.tool = pocket;
+    c->tool.number = pocket > 0 && pocket < a->n_tools ? a->tool_no[pocket] : a->tool_no[0];
     if (pocket > 0 && pocket < a->n_tools)
         ncp_tools_copy(a, 0, pocket);
     s->current_pocket = pocket;

@@ -258,7 +258,8 @@ int ncp_tools_select(struct ncp_analyzer *a)
     if (idx < 0)
         return ncp_an_error(a, w->col[NCP_LETTER('T')],
                             "Requested tool %d not found in the tool table", t);
-    ncp_an_emit(a, NCP_C_SELECT_TOOL)->tool.tool = t;
+    struct ncp_canon *c = ncp_an_emit(a, NCP_C_SELECT_TOOL);
+    c->tool.tool = c->tool.number = t;
     a->st.selected_pocket = idx;
     a->st.selected_pocket_no = a->tools[idx].pocket; /* T0: the spindle's */
     a->st.selected_tool = t;
@@ -279,7 +280,9 @@ static int ncp_tools_m61(struct ncp_analyzer *a)
     a->st.current_pocket_no = a->tools[idx].pocket;
     a->st.current_tool = t;
     a->st.toolchange_flag = 1;
-    ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER)->tool.tool = idx;
+    struct ncp_canon *c = ncp_an_emit(a, NCP_C_CHANGE_TOOL_NUMBER);
+    c->tool.tool = idx;
+    c->tool.number = t;
     return NCP_OK;
 }
 
@@ -298,7 +301,9 @@ int ncp_tools_change(struct ncp_analyzer *a)
     ncp_an_emit(a, NCP_C_START_CHANGE);
     ncp_an_emit(a, NCP_C_STOP_SPINDLE_TURNING);
     s->m.spindle_dir = 0;
-    ncp_an_emit(a, NCP_C_CHANGE_TOOL)->tool.tool = s->selected_pocket;
+    struct ncp_canon *c = ncp_an_emit(a, NCP_C_CHANGE_TOOL);
+    c->tool.tool = s->selected_pocket;
+    c->tool.number = s->selected_tool;
     if (s->selected_pocket > 0)
         ncp_tools_copy(a, 0, s->selected_pocket);
     s->current_pocket = s->selected_pocket;

@@ -163,7 +163,7 @@ static int act(struct nck_core *n, const struct nck_aux *a)
     case NCK_AUX_AOUT: m->aout[a->idx] = a->v; return 0;
     case NCK_AUX_PREPARE:
         m->prepared = a->i;
-        if (a->a)           /* M61 */
+        if (a->idx)         /* M61: job.c marks it in idx */
             m->tool = a->i;
         return 0;
     case NCK_AUX_ENABLE: m->en[a->i & 3] = a->v != 0; return 0;

@@ -292,7 +292,7 @@ void nck_note_state(struct nck_core *n, const struct ncp_canon *op)
     case NCP_C_FLOOD_ON: io->flood = 1; break;
     case NCP_C_FLOOD_OFF: io->flood = 0; break;
     case NCP_C_CHANGE_TOOL:
-    case NCP_C_CHANGE_TOOL_NUMBER: io->tool = op->tool.tool; break;
+    case NCP_C_CHANGE_TOOL_NUMBER: io->tool = op->tool.number; break;
     case NCP_C_SET_G5X_OFFSET:
         io->g5x_index = op->offset.index;
         for (int k = 0; k < 6; k++)
@@ -348,7 +348,7 @@ static int tool_change(struct nck_core *n, const struct ncp_canon *op, uint32_t 
         memcpy(n->job->map.pos, pts[k - 1], sizeof n->job->map.pos);
     /* the change itself with the spindle at rest (rs274 stopped it) */
     return aux_add(n, NCK_AUX_AT_SPEED, 0, 0, 0, line, 1) ||
-           aux_add(n, NCK_AUX_TOOL, 0, op->tool.tool, 0, line, 1);
+           aux_add(n, NCK_AUX_TOOL, 0, op->tool.number, 0, line, 1);
 }
 
 /* An S above the spindle's top speed runs at the top, as LinuxCNC's
@@ -404,11 +404,11 @@ static int take_aux(struct nck_core *n, const struct ncp_cmd *cmd, const struct 
     case NCP_C_MIST_ON: case NCP_C_MIST_OFF:
         return aux_add(n, NCK_AUX_MIST, 0, op->kind == NCP_C_MIST_ON, 0, line, 1);
     case NCP_C_SELECT_TOOL:
-        return aux_add(n, NCK_AUX_PREPARE, 0, op->tool.tool, 0, line, 0);
+        return aux_add(n, NCK_AUX_PREPARE, 0, op->tool.number, 0, line, 0);
     case NCP_C_CHANGE_TOOL:
         return tool_change(n, op, line);
     case NCP_C_CHANGE_TOOL_NUMBER:  /* M61: the tool is in the spindle already */
-        return aux_add(n, NCK_AUX_PREPARE, 1, op->tool.tool, 0, line, 1);
+        return aux_add(n, NCK_AUX_PREPARE, 1, op->tool.number, 0, line, 1);
     case NCP_C_ENABLE_FEED_OVERRIDE: case NCP_C_DISABLE_FEED_OVERRIDE:
         return aux_add(n, NCK_AUX_ENABLE, 0, NCK_EN_FEED_OVERRIDE,
                        op->kind == NCP_C_ENABLE_FEED_OVERRIDE, line, 1);
