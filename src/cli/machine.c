@@ -27,6 +27,15 @@ int ncp_cli_load_machine(const char *path, struct ncp_machine_cfg *cfg)
     return -1;
 }
 
+int ncp_cli_set_config(const char *who, const char **config, const char *arg)
+{
+    if (*config && strcmp(*config, arg) != 0)
+        return fprintf(stderr, "%s: --config and --ini name one INI, the machine's with its "
+                               "[RS274NGC]: not '%s' and '%s'\n", who, *config, arg), -1;
+    *config = arg;
+    return 0;
+}
+
 int ncp_cli_check_tool_table(const char *path)
 {
     struct ncp_diag d;

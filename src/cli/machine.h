@@ -9,6 +9,11 @@
  * prints PATH:LINE: error: ... and returns -1. */
 int ncp_cli_load_machine(const char *path, struct ncp_machine_cfg *cfg);
 
+/* --config or --ini (parse's name for it) given as arg: one INI, the
+ * machine's with its [RS274NGC], so a second different one is refused
+ * (-1 after saying so, who naming the command). */
+int ncp_cli_set_config(const char *who, const char **config, const char *arg);
+
 /* A tool table given (NULL: none): a warning per line the interpreter will
  * skip; -1 after printing the error when it cannot be read. */
 int ncp_cli_check_tool_table(const char *path);

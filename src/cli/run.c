@@ -159,12 +159,8 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     while ((c = getopt_long(argc, argv, "c:t:p:f:o:k:m:hT:b:S:L:I:R:HD:U:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': case 'N':
-            /* --ini as parse's: the one INI, the machine's and its interpreter's */
-            if (o->config && strcmp(o->config, optarg) != 0)
-                return fprintf(stderr, "cnc-run run: --config and --ini name one INI, the "
-                                       "machine's with its [RS274NGC]: not '%s' and '%s'\n",
-                               o->config, optarg), -1;
-            o->config = optarg;
+            if (ncp_cli_set_config("cnc-run run", &o->config, optarg))
+                return -1;
             break;
         case 't': o->trace = optarg; break;
         case 'p': o->plot = optarg; break;

@@ -135,11 +135,8 @@ static int parse(int argc, char **argv, struct serve_args *a)
     while ((c = getopt_long(argc, argv, "c:u:P:k:t:m:T:S:hI:R:", longopts, NULL)) != -1) {
         switch (c) {
         case 'c': case 'N':
-            if (a->config && strcmp(a->config, optarg) != 0)
-                return fprintf(stderr, "cnc-run serve: --config and --ini name one INI, the "
-                                       "machine's with its [RS274NGC]: not '%s' and '%s'\n",
-                               a->config, optarg), -1;
-            a->config = optarg;
+            if (ncp_cli_set_config("cnc-run serve", &a->config, optarg))
+                return -1;
             break;
         case 'u': a->url = optarg; break;
         case 'P': a->prefix = optarg; break;
