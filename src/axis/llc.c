@@ -212,8 +212,6 @@ static double follow(struct llc *l, int64_t slot)
 {
     const struct ncp_axis_cfg *a = &l->cfg->axis[l->axis];
     double target = ncp_dist_nm_to_mm(ncp_dist_rx_play(&l->rx, slot));
-    if (l->ai && llc_ai_held_in_motion(l->ai, slot))
-        l->rx.held++;
     if (l->rx.held != l->held_seen) {
         /* a stream that stops with the axis at rest (the program's end, the
          * HLC between jobs) is no loss: heartbeats watch the HLC then. At
@@ -225,6 +223,11 @@ static double follow(struct llc *l, int64_t slot)
     } else {
         l->run_held = 0;
     }
+    /* a hold the HLC's stall put in the stream is counted and traced as
+     * held, but it is the HLC's time, not a loss: MAX_LOST_PERIODS is not
+     * run down by it (the HLC's heartbeat watches a stalled HLC) */
+    if (l->ai && llc_ai_held_in_motion(l->ai, slot))
+        l->rx.held++;
     l->held_seen = l->rx.held;
     /* a setpoint at MAX_VELOCITY is no jump: 1 nm of rounding allowed */
     double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9 + 1e-6;
