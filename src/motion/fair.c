@@ -101,11 +101,11 @@ static void relax(struct ncp_planner *p, int n)
     }
 }
 
-/* Sends the first m of the n held lines, each through its moved ends with
- * what is left of P for the blends at them. */
+/* Hands the first m of the n held lines to the planner (fair_out), each
+ * through its moved ends with what is left of P for the blends at them. */
 static void emit(struct ncp_planner *p, int n, int m)
 {
-    double moved[PLAN_FAIR_MAX + 1];
+    double moved[PLAN_FAIR_MAX + 1] = { 0 };
     for (int i = 0; i <= n; i++)
         moved[i] = dist3(p->fair_pt[i], p->fair_orig[i]);
     for (int k = 0; k < m; k++) {
@@ -117,7 +117,7 @@ static void emit(struct ncp_planner *p, int n, int m)
         memcpy(s.end, p->fair_pt[k + 1], sizeof p->fair_pt[k + 1]);
         ncp_seg_set_length(&s);
         s.tolerance -= e;
-        ncp_planner_push_line(p, &s);
+        p->fair_out[p->fair_out_n++] = s;
     }
 }
 

@@ -54,6 +54,9 @@ struct ncp_planner {
     int fair_n, fair_max;
     struct ncp_seg fair_seg[PLAN_FAIR_MAX];
     double fair_orig[PLAN_FAIR_MAX + 1][3], fair_pt[PLAN_FAIR_MAX + 1][3];
+    /* faired lines for the planner to queue, in order */
+    int fair_out_n;
+    struct ncp_seg fair_out[PLAN_FAIR_MAX];
     struct ncp_planner_stats st;
 };
 
@@ -64,14 +67,12 @@ static inline struct plan_seg *plan_at(struct ncp_planner *p, size_t k)
 
 void ncp_planner_pop(struct ncp_planner *p);
 
-/* planner.c: blends s with the queued tail and queues it. */
-void ncp_planner_push_line(struct ncp_planner *p, const struct ncp_seg *s);
-
 /* fair.c: may s join the CAM chain held back (or start one)? */
 int ncp_fair_takes(const struct ncp_planner *p, const struct ncp_seg *s);
-/* fair.c: holds s back; a full window sends its first lines, faired. */
+/* fair.c: holds s back; a full window hands its first lines on, faired
+ * (fair_out). */
 void ncp_fair_add(struct ncp_planner *p, const struct ncp_seg *s);
-/* fair.c: fairs and sends every line held back. */
+/* fair.c: fairs every line held back and hands it on (fair_out). */
 void ncp_fair_flush(struct ncp_planner *p);
 
 /* scurve.c: evaluation of a jerk-limited profile (ncp_trap with j > 0). */

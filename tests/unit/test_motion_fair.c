@@ -40,7 +40,7 @@ static double next_unit(uint64_t *s)
 /* The program, its points rounded as written (4 decimals). */
 static char *cam_chain(void)
 {
-    char *prog = malloc(64 * (CHORDS + 4));
+    char *prog = malloc((size_t)64 * (CHORDS + 4));
     assert_non_null(prog);
     int len = sprintf(prog, "G21 G90 G17 G94 G64 P%.2f Q0\nG1 F3000\n", P_TOL);
     uint64_t seed = 44;
