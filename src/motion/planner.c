@@ -64,6 +64,8 @@ struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
     fine_ipo_margins(&p->cfg);
     /* room for a blend arc per programmed segment: the window is LOOKAHEAD blocks */
     p->cap = 2 * (size_t)(cfg->lookahead > 1 ? cfg->lookahead : 1) + 2;
+    /* a CAM chain held back for fairing takes at most a quarter of the window */
+    p->fair_max = cfg->lookahead / 4 < PLAN_FAIR_MAX ? cfg->lookahead / 4 : PLAN_FAIR_MAX;
     p->q = calloc(p->cap, sizeof *p->q);
     if (!p->q) {
         free(p);
@@ -86,7 +88,8 @@ int ncp_planner_full(const struct ncp_planner *p)
 {
     /* a push may add a blend arc too; blends do not count against the window,
      * a chain of lines held back for G64 Q counts as the one it will become */
-    return p->programmed + (p->chain_n > 0) >= (size_t)p->cfg.lookahead || p->count + 2 > p->cap;
+    return p->programmed + (p->chain_n > 0) + (size_t)p->fair_n >= (size_t)p->cfg.lookahead ||
+           p->count + 2 > p->cap;
 }
 
 size_t ncp_planner_queued(const struct ncp_planner *p)
@@ -100,10 +103,12 @@ int ncp_planner_idle(const struct ncp_planner *p)
 }
 
 static void chain_flush(struct ncp_planner *p);
+static void fair_flush(struct ncp_planner *p);
 
 void ncp_planner_finish(struct ncp_planner *p)
 {
     chain_flush(p);
+    fair_flush(p);
     p->finished = 1;
 }
 
@@ -121,6 +126,8 @@ void ncp_planner_reset(struct ncp_planner *p, const double pos[NCP_AXES])
     p->finished = 0;
     p->have_last = 0;
     p->chain_n = 0;
+    p->fair_n = 0;
+    p->fair_out_n = 0;
     /* the last block's line, machine functions and tool stay what the held
      * samples report */
     struct ncp_exec was = p->ex;
@@ -931,11 +938,40 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     return 1;
 }
 
-static void push_blended(struct ncp_planner *p, const struct ncp_seg *s)
+static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
 {
     struct ncp_seg cur = *s;
     try_blend(p, &cur);
     push_one(p, &cur, 0);
+}
+
+/* Queues what fairing handed on. */
+static void fair_drain(struct ncp_planner *p)
+{
+    for (int i = 0; i < p->fair_out_n; i++)
+        push_line(p, &p->fair_out[i]);
+    p->fair_out_n = 0;
+}
+
+static void fair_flush(struct ncp_planner *p)
+{
+    ncp_fair_flush(p);
+    fair_drain(p);
+}
+
+/* After G64 Q's joining: a short line of a CAM chain is held back to be
+ * faired with its neighbours (fair.c), anything else ends the chain. */
+static void push_blended(struct ncp_planner *p, const struct ncp_seg *s)
+{
+    if (!ncp_fair_takes(p, s)) {
+        fair_flush(p);
+        if (!ncp_fair_takes(p, s)) {
+            push_line(p, s);
+            return;
+        }
+    }
+    ncp_fair_add(p, s);
+    fair_drain(p);
 }
 
 static int chain_may_start(const struct ncp_seg *s)

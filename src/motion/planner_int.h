@@ -24,6 +24,8 @@ struct plan_seg {
 
 /* At most this many programmed lines are joined into one (LinuxCNC's bound). */
 #define PLAN_CHAIN_MAX 100
+/* At most this many short lines are held back to be faired (fair.c). */
+#define PLAN_FAIR_MAX 32
 
 struct ncp_planner {
     struct ncp_machine_cfg cfg;
@@ -47,6 +49,14 @@ struct ncp_planner {
     int chain_n;                        /* programmed points in the chain, 0 = none */
     struct ncp_seg chain;               /* the joined line so far */
     double chain_pt[PLAN_CHAIN_MAX][NCP_AXES];
+    /* CAM chains held back to be faired (fair.c): the lines as programmed,
+     * their programmed vertices and the moved ones (fair_n + 1 each) */
+    int fair_n, fair_max;
+    struct ncp_seg fair_seg[PLAN_FAIR_MAX];
+    double fair_orig[PLAN_FAIR_MAX + 1][3], fair_pt[PLAN_FAIR_MAX + 1][3];
+    /* faired lines for the planner to queue, in order */
+    int fair_out_n;
+    struct ncp_seg fair_out[PLAN_FAIR_MAX];
     struct ncp_planner_stats st;
 };
 
@@ -56,6 +66,14 @@ static inline struct plan_seg *plan_at(struct ncp_planner *p, size_t k)
 }
 
 void ncp_planner_pop(struct ncp_planner *p);
+
+/* fair.c: may s join the CAM chain held back (or start one)? */
+int ncp_fair_takes(const struct ncp_planner *p, const struct ncp_seg *s);
+/* fair.c: holds s back; a full window hands its first lines on, faired
+ * (fair_out). */
+void ncp_fair_add(struct ncp_planner *p, const struct ncp_seg *s);
+/* fair.c: fairs every line held back and hands it on (fair_out). */
+void ncp_fair_flush(struct ncp_planner *p);
 
 /* scurve.c: evaluation of a jerk-limited profile (ncp_trap with j > 0). */
 double ncp_scurve_eval(const struct ncp_trap *tp, double t, double *v);
