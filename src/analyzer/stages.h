@@ -17,6 +17,8 @@ int ncp_comp_stop(struct ncp_analyzer *a, int reset);
  * the G code table) */
 void ncp_words_init(void);
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
+/* 1 when G code (x10) is one of rs274's own (a remap of it never runs) */
+int ncp_g_code_known(int code);
 int ncp_words_fault_before(struct ncp_analyzer *a, const struct ncp_block *b, uint16_t col);
 /* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);
@@ -138,6 +140,10 @@ int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran);
 /* T, S or F in its step: *ran = 1 when its remap ran (else the built-in step
  * is the caller's: no remap, or inside its own) */
 int ncp_remap_letter_step(struct ncp_analyzer *a, char letter, int *ran);
+/* The block's motion G code (x10) when it is remapped: *ran = 1 and the
+ * remap's result for a code of its own; rs274's "Bug unknown motion code" for
+ * one of rs274's other groups moved to the motion's by its REMAP line. */
+int ncp_remap_g_step(struct ncp_analyzer *a, int motion, int *ran);
 /* A built-in tool code ran: rs274 notes it on the line that controls the
  * innermost remap (what stdglue's epilogs test) */
 static inline void ncp_remap_note_builtin(struct ncp_analyzer *a)

@@ -364,6 +364,12 @@ static int ncp_step_motion(struct ncp_analyzer *a, int motion)
         return ncp_canned_run(a, motion);
     default: {
         uint16_t col = NCP_MOTION_COL(&a->w);
+        if (a->remaps) {
+            int ran = 0;
+            int rc = ncp_remap_g_step(a, motion, &ran);
+            if (ran || rc != NCP_OK)
+                return rc;
+        }
         if (motion % 10)
             return ncp_an_error(a, col, "G%d.%d is not supported", motion / 10, motion % 10);
         return ncp_an_error(a, col, "G%d is not supported", motion / 10);

@@ -74,6 +74,24 @@ void ncp_words_init(void)
     pthread_once(&ncp_g_group_once, ncp_g_table_init);
 }
 
+int ncp_g_code_known(int code)
+{
+    ncp_words_init();
+    return code >= 0 && code < 1000 && ncp_g_group[code] >= 0;
+}
+
+/* A remapped G code goes to the motion group whatever rs274 has it in, and
+ * without G80's leave to share it (rs274's read_g asks its remaps first). */
+static int ncp_add_remapped_g(struct ncp_analyzer *a, int code, uint16_t col)
+{
+    struct ncp_words *w = &a->w;
+    if (w->g[NCP_GG_MOTION] != -1)
+        return ncp_an_error(a, col, "Two g codes used from same modal group");
+    w->g[NCP_GG_MOTION] = (int16_t)code;
+    w->gcol[NCP_GG_MOTION] = col;
+    return NCP_OK;
+}
+
 static int ncp_m_group(int m)
 {
     switch (m) {
@@ -121,6 +139,8 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
         return ncp_an_error(a, col, "G-code out of range");
     if (code < 0)
         return ncp_an_error(a, col, "Negative g code used");
+    if (a->remaps && ncp_remap_of_g(a->remaps, code))
+        return ncp_add_remapped_g(a, code, col);
     int g = (int)ncp_g_group[code]; /* -1: no such code */
     if (g < 0)
         return ncp_an_error(a, col, "Unknown g code used");
