@@ -244,6 +244,13 @@ int ncp_remaps_new(const struct ncp_analyzer_cfg *cfg, struct ncp_remaps **out,
             *letter = rs->n++;
         else
             *slot = (int16_t)rs->n++;
+        rs->n_g += r->g >= 0;
+    }
+    if (rs->n_g) {
+        memcpy(rs->g_group, ncp_g_groups(), sizeof rs->g_group);
+        for (int g = 0; g < NCP_REMAP_G_MAX; g++)
+            if (rs->by_g[g] >= 0)
+                rs->g_group[g] = NCP_G_REMAPPED;
     }
     *out = rs;
     return NCP_OK;

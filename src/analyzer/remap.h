@@ -13,6 +13,7 @@
 #define NCP_REMAP_G_MAX 1000 /* and G0..G99.9 (code x10) */
 #define NCP_REMAP_DEPTH 16   /* room for remaps running inside remaps */
 #define NCP_REMAP_MAX_NESTED 10 /* rs274's MAX_NESTED_REMAPS: the 10th is refused */
+#define NCP_G_REMAPPED (-2)     /* in ncp_remaps.g_group: the code has a REMAP line */
 
 /* The stdglue.py prologs and epilogs LinuxCNC ships for tool changes,
  * built in (their Python is not run): T with prepare_*, M6 with change_*,
@@ -39,6 +40,8 @@ struct ncp_remaps {
     int n;
     int16_t by_m[NCP_REMAP_M_MAX]; /* index into r, -1 none */
     int16_t by_g[NCP_REMAP_G_MAX]; /* the same for G codes x10 */
+    int n_g;                       /* how many G codes are remapped */
+    int8_t g_group[NCP_REMAP_G_MAX]; /* with n_g: the G code table the words read */
     int t, s, f;                   /* T's, S's, F's remap, -1 none */
 };
 

@@ -19,6 +19,8 @@ void ncp_words_init(void);
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
 /* 1 when G code (x10) is one of rs274's own (a remap of it never runs) */
 int ncp_g_code_known(int code);
+/* The G code table (x10 -> modal group, -1 unknown), 1000 entries */
+const int8_t *ncp_g_groups(void);
 int ncp_words_fault_before(struct ncp_analyzer *a, const struct ncp_block *b, uint16_t col);
 /* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);
@@ -144,6 +146,12 @@ int ncp_remap_letter_step(struct ncp_analyzer *a, char letter, int *ran);
  * remap's result for a code of its own; rs274's "Bug unknown motion code" for
  * one of rs274's other groups moved to the motion's by its REMAP line. */
 int ncp_remap_g_step(struct ncp_analyzer *a, int motion, int *ran);
+/* 1 when G code g (x10) runs a remap (a code of rs274's own never does). */
+static inline int ncp_remapped_g(const struct ncp_analyzer *a, int g)
+{
+    const struct ncp_remap *r = ncp_remap_of_g(a->remaps, g);
+    return r && r->remappable;
+}
 /* A built-in tool code ran: rs274 notes it on the line that controls the
  * innermost remap (what stdglue's epilogs test) */
 static inline void ncp_remap_note_builtin(struct ncp_analyzer *a)

@@ -74,6 +74,12 @@ void ncp_words_init(void)
     pthread_once(&ncp_g_group_once, ncp_g_table_init);
 }
 
+const int8_t *ncp_g_groups(void)
+{
+    ncp_words_init();
+    return ncp_g_group;
+}
+
 int ncp_g_code_known(int code)
 {
     ncp_words_init();
@@ -82,13 +88,17 @@ int ncp_g_code_known(int code)
 
 /* A remapped G code goes to the motion group whatever rs274 has it in, and
  * without G80's leave to share it (rs274's read_g asks its remaps first). */
-static int ncp_add_remapped_g(struct ncp_analyzer *a, int code, uint16_t col)
+static int ncp_add_remapped_g(struct ncp_analyzer *a, const struct ncp_remap *r, int code,
+                              uint16_t col)
 {
     struct ncp_words *w = &a->w;
     if (w->g[NCP_GG_MOTION] != -1)
         return ncp_an_error(a, col, "Two g codes used from same modal group");
     w->g[NCP_GG_MOTION] = (int16_t)code;
     w->gcol[NCP_GG_MOTION] = col;
+    /* a code of its own takes no word but its argspec's, which its remap
+     * checks: rs274 skips the checks of the block's other words */
+    w->remapped |= r->remappable;
     return NCP_OK;
 }
 
@@ -139,11 +149,12 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
         return ncp_an_error(a, col, "G-code out of range");
     if (code < 0)
         return ncp_an_error(a, col, "Negative g code used");
-    if (a->remaps && ncp_remap_of_g(a->remaps, code))
-        return ncp_add_remapped_g(a, code, col);
-    int g = (int)ncp_g_group[code]; /* -1: no such code */
-    if (g < 0)
+    int g = (int)a->g_group[code]; /* -1: no such code */
+    if (g < 0) {
+        if (g == NCP_G_REMAPPED) /* rs274 asks its remaps first */
+            return ncp_add_remapped_g(a, ncp_remap_of_g(a->remaps, code), code, col);
         return ncp_an_error(a, col, "Unknown g code used");
+    }
     if (code == NCP_G80 && w->g[g] != -1)
         return NCP_OK;
     if (w->g[g] != -1 && w->g[g] != NCP_G80)
