@@ -283,8 +283,8 @@ static int dp1_interpreter_refused(const struct ncp_machine_cfg *cfg,
                                                                    "PROGRAM_PREFIX)"
                        : acfg->oword_nargs || acfg->orient_offset != 0.0 || acfg->no_fanuc_subs
                            ? "OWORD_NARGS, ORIENT_OFFSET or DISABLE_FANUC_STYLE_SUB"
-                       : acfg->subroutine_path && strcmp(acfg->subroutine_path,
-                                                         cfg->lcm.sub_path)
+                       : acfg->subroutine_path &&
+                               strcmp(acfg->subroutine_path, cfg->lcm.sub_path) != 0
                            ? "SUBROUTINE_PATH"
                            : NULL;
     if (!what)
