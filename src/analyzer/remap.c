@@ -5,7 +5,6 @@
  * prologs) is refused here, naming the INI line, so that nothing of the
  * configuration is silently dropped. */
 #include "remap.h"
-#include "stages.h"
 
 #include <ctype.h>
 #include <stdarg.h>
@@ -108,7 +107,7 @@ static int remap_parse_g(const struct ncp_remap_line *l, struct ncp_remap *r,
     if (r->group != 1)
         return remap_error(d, l, "code '%s' : invalid modalgroup=<int> given (currently "
                            "valid: 1)", r->code);
-    r->remappable = !ncp_g_code_known(code);
+    r->remappable = 1; /* until words.c finds it is one of rs274's own */
     return NCP_OK;
 }
 
@@ -245,12 +244,6 @@ int ncp_remaps_new(const struct ncp_analyzer_cfg *cfg, struct ncp_remaps **out,
         else
             *slot = (int16_t)rs->n++;
         rs->n_g += r->g >= 0;
-    }
-    if (rs->n_g) {
-        memcpy(rs->g_group, ncp_g_groups(), sizeof rs->g_group);
-        for (int g = 0; g < NCP_REMAP_G_MAX; g++)
-            if (rs->by_g[g] >= 0)
-                rs->g_group[g] = NCP_G_REMAPPED;
     }
     *out = rs;
     return NCP_OK;

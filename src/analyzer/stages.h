@@ -17,10 +17,10 @@ int ncp_comp_stop(struct ncp_analyzer *a, int reset);
  * the G code table) */
 void ncp_words_init(void);
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
-/* 1 when G code (x10) is one of rs274's own (a remap of it never runs) */
-int ncp_g_code_known(int code);
-/* The G code table (x10 -> modal group, -1 unknown), 1000 entries */
-const int8_t *ncp_g_groups(void);
+/* The G code table a's words read (a->g_group): the built-in one, or with
+ * G remaps the remaps' copy with those codes marked, and each G remap of
+ * one of rs274's own codes marked as never running. */
+void ncp_words_use_remaps(struct ncp_analyzer *a);
 int ncp_words_fault_before(struct ncp_analyzer *a, const struct ncp_block *b, uint16_t col);
 /* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);

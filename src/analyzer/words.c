@@ -74,16 +74,22 @@ void ncp_words_init(void)
     pthread_once(&ncp_g_group_once, ncp_g_table_init);
 }
 
-const int8_t *ncp_g_groups(void)
+void ncp_words_use_remaps(struct ncp_analyzer *a)
 {
+    struct ncp_remaps *rs = a->remaps;
     ncp_words_init();
-    return ncp_g_group;
-}
-
-int ncp_g_code_known(int code)
-{
-    ncp_words_init();
-    return code >= 0 && code < 1000 && ncp_g_group[code] >= 0;
+    a->g_group = ncp_g_group;
+    if (!rs || !rs->n_g)
+        return;
+    memcpy(rs->g_group, ncp_g_group, sizeof rs->g_group);
+    for (int k = 0; k < rs->n; k++) {
+        struct ncp_remap *r = &rs->r[k];
+        if (r->g < 0)
+            continue;
+        r->remappable = ncp_g_group[r->g] < 0; /* rs274's own G codes run built in */
+        rs->g_group[r->g] = NCP_G_REMAPPED;
+    }
+    a->g_group = rs->g_group;
 }
 
 /* A remapped G code goes to the motion group whatever rs274 has it in, and
