@@ -92,6 +92,15 @@ struct ncp_analyzer_cfg {
      * O-word subroutine. None (0): no remapping, and no cost for it. */
     const struct ncp_remap_line *remaps;
     int n_remaps;
+    /* [RS274NGC]OWORD_NARGS: a called sub has #<n_args>, the number of
+     * its arguments (read-only), as rs274 -i gives it */
+    int oword_nargs;
+    /* [RS274NGC]ORIENT_OFFSET: degrees added to M19's R (or M19 P's angle
+     * without R), as rs274 -i adds them */
+    double orient_offset;
+    /* [RS274NGC]DISABLE_FANUC_STYLE_SUB: M98, M99 and bare O-word lines
+     * are refused, as rs274 -i refuses them */
+    int no_fanuc_subs;
     /* rs274 run with an INI (-i) closes with one ON_RESET, not two */
     int ini_given;
     /* the INI's keys for #<_ini[SECTION]KEY> (read-only; none: undefined) */

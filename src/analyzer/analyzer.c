@@ -35,6 +35,7 @@ struct ncp_analyzer *ncp_analyzer_new(const struct ncp_analyzer_cfg *cfg,
         ncp_analyzer_free(a);
         return NULL;
     }
+    ncp_words_use_remaps(a);
     ncp_user_m_scan(a);
     ncp_state_init(a);
     if (a->cfg.params_in)

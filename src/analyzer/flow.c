@@ -103,6 +103,8 @@ struct ncp_flow {
     struct ncp_flow_frames hooks;
     struct ncp_flow_m98_reader m98_reader;
     uint32_t max_loops, max_depth;
+    int oword_nargs;                  /* [RS274NGC]OWORD_NARGS: each call's #<n_args> */
+    int no_fanuc;                     /* [RS274NGC]DISABLE_FANUC_STYLE_SUB */
     int (*cancel)(void *ctx);
     void *cancel_ctx;
     uint32_t ticks;                   /* blocks seen, for the stop request */
@@ -361,6 +363,20 @@ static int ncp_flow_oword_error(const struct ncp_block *b, const char *what,
                        struct ncp_diag *d)
 {
     return ncp_diag_set(d, NCP_ERR_SEMANTIC, b->line, b->oword.col, "%s", what);
+}
+
+/* [RS274NGC]DISABLE_FANUC_STYLE_SUB: rs274 refuses M98, M99 and a bare
+ * O-word line as it reads them, skipped or not, in its words. */
+static int ncp_flow_no_fanuc(const struct ncp_block *b, int kind, struct ncp_diag *d)
+{
+    if (kind == NCP_O_M98)
+        return ncp_flow_oword_error(b, "DISABLE_FANUC_STYLE_SUB set in INI file, but found m98", d);
+    if (kind == NCP_O_M99)
+        return ncp_flow_oword_error(b, "DISABLE_FANUC_STYLE_SUB set in INI file, but found m99", d);
+    if (kind == NCP_O_FANUC)
+        return ncp_flow_oword_error(
+            b, "DISABLE_FANUC_STYLE_SUB disabled in INI file, but found bare O-word", d);
+    return NCP_OK;
 }
 
 static int ncp_flow_err_undefined(struct ncp_flow *f, const struct ncp_block *b,
@@ -812,6 +828,8 @@ static int ncp_flow_enter_call(struct ncp_flow *f, const struct ncp_block *b, in
         return ncp_diag_set(d, NCP_ERR_IO, b->line, 0, "out of memory");
     int rc = ct == FLOW_CT_M98 ? ncp_params_push_shared(f->params, d)
                                : ncp_params_push_call(f->params, f->args, f->nargs, d);
+    if (rc == NCP_OK && f->oword_nargs)
+        rc = ncp_params_set_nargs(f->params, ct == FLOW_CT_M98 ? 0 : f->nargs, d);
     if (rc != NCP_OK)
         return rc;
     struct flow_frame *fr = &f->frames[++f->level];
@@ -1407,6 +1425,8 @@ static int ncp_flow_step(struct ncp_flow *f, const struct ncp_block **out,
              * is an M code like M2 */
             if (kind == NCP_O_M99 && f->level == 0)
                 kind = NCP_O_NONE;
+            if (f->no_fanuc && (rc = ncp_flow_no_fanuc(b, kind, d)) != NCP_OK)
+                return rc;
         }
         if (b->err.code != NCP_OK) {
             /* rs274 does not parse the lines it skips, but for M98 lines;
@@ -1484,6 +1504,8 @@ struct ncp_flow *ncp_flow_new(const struct ncp_block_feed *feed, struct ncp_para
     f->max_loops = cfg && cfg->max_loop_iterations ? cfg->max_loop_iterations
                                                    : NCP_DEFAULT_MAX_LOOPS;
     f->max_depth = cfg && cfg->max_call_depth ? cfg->max_call_depth : FLOW_DEFAULT_MAX_DEPTH;
+    f->oword_nargs = cfg ? cfg->oword_nargs : 0;
+    f->no_fanuc = cfg ? cfg->no_fanuc_subs : 0;
     f->cancel = cfg ? cfg->cancel : NULL;
     f->cancel_ctx = cfg ? cfg->cancel_ctx : NULL;
     f->cur.off = f->src->begin;

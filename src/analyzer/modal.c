@@ -45,8 +45,10 @@ static int ncp_motion_to_be(struct ncp_analyzer *a)
             if (covets)
                 return ncp_an_error(a, w->gcol[NCP_GG_NONMODAL],
                                     "Cannot use two g codes that both use axis values");
+            /* a remapped code of its own takes no word but its argspec's,
+             * which its remap checks (words.c marked the block remapped) */
             if (!axis && m1 != NCP_G0 && m1 != NCP_G1 && m1 != NCP_G2 && m1 != NCP_G3 &&
-                m1 != NCP_G5_2 && !ncp_is_g7x(m1))
+                m1 != NCP_G5_2 && !ncp_is_g7x(m1) && !ncp_remapped_g(a, m1))
                 return ncp_an_error(a, col, "All axes missing with motion code");
         }
         w->motion_to_be = m1;

@@ -44,6 +44,7 @@ struct ncp_params {
     ncp_predef_fn predef;
     void *predef_ctx;
     double scratch;            /* where ncp_params_slot points for a bad index */
+    int nargs;                 /* [RS274NGC]OWORD_NARGS: subs have a read-only #<n_args> */
 };
 
 static uint32_t name_hash(const char *s, size_t n)
@@ -310,11 +311,23 @@ int ncp_params_set_named(struct ncp_params *p, const char *name, size_t len,
                                 "Cannot assign to read-only parameter #<%.*s>", n, name);
         t = &p->globals;
     } else {
+        if (p->nargs && p->level > 0 && name_is(name, len, "n_args"))
+            return ncp_diag_set(d, NCP_ERR_SEMANTIC, 0, 0,
+                                "Cannot assign to read-only parameter #<n_args>");
         t = local_tab_for_write(p);
     }
     if (!t || tab_set(t, name, len, v) != 0)
         return ncp_diag_set(d, NCP_ERR_LIMIT, 0, 0,
                             "out of memory storing parameter #<%.*s>", n, name);
+    return NCP_OK;
+}
+
+int ncp_params_set_nargs(struct ncp_params *p, int nargs, struct ncp_diag *d)
+{
+    struct nametab *t = local_tab_for_write(p);
+    p->nargs = 1;
+    if (!t || tab_set(t, "n_args", 6, nargs) != 0)
+        return ncp_diag_set(d, NCP_ERR_LIMIT, 0, 0, "out of memory storing parameter #<n_args>");
     return NCP_OK;
 }
 

@@ -56,6 +56,9 @@ int ncp_params_push_call(struct ncp_params *p, const double *args, int nargs,
  * neither saves nor sets them); its pop restores only the scope. */
 int ncp_params_push_shared(struct ncp_params *p, struct ncp_diag *d);
 void ncp_params_pop_call(struct ncp_params *p);
+/* [RS274NGC]OWORD_NARGS: the new call level's #<n_args>, the count of its
+ * arguments, which the sub may not assign. */
+int ncp_params_set_nargs(struct ncp_params *p, int nargs, struct ncp_diag *d);
 int ncp_params_call_level(const struct ncp_params *p);
 
 /* Adapter for ncp_expr_eval(). */

@@ -1,9 +1,9 @@
 /* REMAP lines read as rs274 -i reads them (its parse_remap): the code, then
- * options kw=value. ncpar runs M codes, T, S and F remapped to ngc=
+ * options kw=value. ncpar runs M and G codes, T, S and F remapped to ngc=
  * subroutines, with stdglue.py's tool, speed and feed prologs and epilogs
  * built in; what needs LinuxCNC's Python plugin otherwise (python=, other
- * prologs) and remaps of G codes are refused here, naming the INI line, so that
- * nothing of the configuration is silently dropped. */
+ * prologs) is refused here, naming the INI line, so that nothing of the
+ * configuration is silently dropped. */
 #include "remap.h"
 
 #include <ctype.h>
@@ -84,6 +84,33 @@ static int glue_of(const char *name, int epilog, enum ncp_glue *out)
     return 0;
 }
 
+/* G88.1 is code 881, G88 880, as rs274 numbers them (its "%d.%d", then "%d"
+ * times ten). Only modal group 1 (the motion's, its default) is rs274's; a
+ * code of its own (G88.1) runs the sub, one rs274 has (G1, G17) only moves
+ * to group 1 and runs built in, as there. */
+static int remap_parse_g(const struct ncp_remap_line *l, struct ncp_remap *r,
+                         struct ncp_diag *d)
+{
+    int g1 = 0, g2 = 0, code = -1;
+    if (sscanf(r->code + 1, "%d.%d", &g1, &g2) == 2)
+        code = g1 * 10 + g2;
+    else if (sscanf(r->code + 1, "%d", &g1) == 1)
+        code = g1 * 10;
+    else
+        return remap_error(d, l, "code '%s' : can't parse G-code", r->code);
+    if (code < 0 || code >= NCP_REMAP_G_MAX)
+        return remap_error(d, l, "code '%s' : G-code out of range (G0 .. G99.9)", r->code);
+    r->m = -1;
+    r->g = code;
+    if (r->group == -1)
+        r->group = 1; /* rs274's default, with a warning */
+    if (r->group != 1)
+        return remap_error(d, l, "code '%s' : invalid modalgroup=<int> given (currently "
+                           "valid: 1)", r->code);
+    r->remappable = 1; /* until words.c finds it is one of rs274's own */
+    return NCP_OK;
+}
+
 static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
                        struct ncp_remap *r, struct ncp_diag *d)
 {
@@ -152,12 +179,16 @@ static int remap_parse(const struct ncp_remap_line *l, const char *sub_path,
         if (r->group != -1)
             return remap_error(d, l, "%c remap - modal group setting ignored - fixed sequencing",
                                letter);
-        r->m = -1;
+        r->m = r->g = -1;
         r->remappable = 1;
         return NCP_OK;
     }
+    if (letter == 'G')
+        return remap_parse_g(l, r, d);
+    r->g = -1;
     if (letter != 'M')
-        return remap_error(d, l, "code '%s': ncpar remaps M codes, T, S and F only", r->code);
+        return remap_error(d, l, "code '%s': ncpar remaps M and G codes, T, S and F only",
+                           r->code);
     char *end = NULL;
     long m = strtol(code + 1, &end, 10);
     if (end == code + 1 || *end || m < 0 || m >= NCP_REMAP_M_MAX)
@@ -187,16 +218,22 @@ int ncp_remaps_new(const struct ncp_analyzer_cfg *cfg, struct ncp_remaps **out,
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory");
     }
     memset(rs->by_m, 0xff, sizeof rs->by_m);
+    memset(rs->by_g, 0xff, sizeof rs->by_g);
     rs->t = rs->s = rs->f = -1;
     for (int k = 0; k < cfg->n_remaps; k++) {
         struct ncp_remap *r = &rs->r[rs->n];
         int rc = remap_parse(&cfg->remaps[k], cfg->subroutine_path, r, d);
         int *letter = NULL; /* T's, S's or F's slot */
-        if (rc == NCP_OK && r->m < 0)
+        int16_t *slot = NULL; /* an M or G code's */
+        if (rc == NCP_OK && r->m >= 0)
+            slot = &rs->by_m[r->m];
+        else if (rc == NCP_OK && r->g >= 0)
+            slot = &rs->by_g[r->g];
+        else if (rc == NCP_OK)
             letter = toupper((unsigned char)r->code[0]) == 'T'   ? &rs->t
                      : toupper((unsigned char)r->code[0]) == 'S' ? &rs->s
                                                                  : &rs->f;
-        if (rc == NCP_OK && (letter ? *letter : rs->by_m[r->m]) >= 0)
+        if (rc == NCP_OK && (letter ? *letter : *slot) >= 0)
             rc = remap_error(d, &cfg->remaps[k], "code '%s' already remapped", r->code);
         if (rc != NCP_OK) {
             ncp_remaps_free(rs);
@@ -205,7 +242,8 @@ int ncp_remaps_new(const struct ncp_analyzer_cfg *cfg, struct ncp_remaps **out,
         if (letter)
             *letter = rs->n++;
         else
-            rs->by_m[r->m] = (int16_t)rs->n++;
+            *slot = (int16_t)rs->n++;
+        rs->n_g += r->g >= 0;
     }
     *out = rs;
     return NCP_OK;

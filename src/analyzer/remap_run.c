@@ -1,4 +1,4 @@
-/* Running a remapped M code as rs274 -i does (convert_remapped_code and
+/* Running a remapped M or G code, T, S or F as rs274 -i does (convert_remapped_code and
  * add_parameters): in the code's step of the line, "O<ngc> call" is run as
  * if read there, the argspec's words become the sub's local parameters
  * (#<p>, #<q>; with '@' positional #1, #2 instead), the sub's blocks run,
@@ -353,4 +353,16 @@ int ncp_remap_letter_step(struct ncp_analyzer *a, char letter, int *ran)
     }
     *ran = 1;
     return remap_run(a, r, a->w.col[NCP_LETTER(letter)]);
+}
+
+int ncp_remap_g_step(struct ncp_analyzer *a, int motion, int *ran)
+{
+    const struct ncp_remap *r = ncp_remap_of_g(a->remaps, motion);
+    *ran = 0;
+    if (!r)
+        return NCP_OK;
+    *ran = 1;
+    if (!r->remappable)
+        return ncp_an_error(a, NCP_MOTION_COL(&a->w), "Bug unknown motion code");
+    return remap_run(a, r, NCP_MOTION_COL(&a->w));
 }

@@ -17,6 +17,10 @@ int ncp_comp_stop(struct ncp_analyzer *a, int reset);
  * the G code table) */
 void ncp_words_init(void);
 int ncp_words_collect(struct ncp_analyzer *a, const struct ncp_block *b);
+/* The G code table a's words read (a->g_group): the built-in one, or with
+ * G remaps the remaps' copy with those codes marked, and each G remap of
+ * one of rs274's own codes marked as never running. */
+void ncp_words_use_remaps(struct ncp_analyzer *a);
 int ncp_words_fault_before(struct ncp_analyzer *a, const struct ncp_block *b, uint16_t col);
 /* v as rs274 reads an integer word, or 'Non integer value for integer' at col. */
 int ncp_integer_word(struct ncp_analyzer *a, double v, uint16_t col, int *out);
@@ -138,6 +142,16 @@ int ncp_remap_step(struct ncp_analyzer *a, int slot, int *ran);
 /* T, S or F in its step: *ran = 1 when its remap ran (else the built-in step
  * is the caller's: no remap, or inside its own) */
 int ncp_remap_letter_step(struct ncp_analyzer *a, char letter, int *ran);
+/* The block's motion G code (x10) when it is remapped: *ran = 1 and the
+ * remap's result for a code of its own; rs274's "Bug unknown motion code" for
+ * one of rs274's other groups moved to the motion's by its REMAP line. */
+int ncp_remap_g_step(struct ncp_analyzer *a, int motion, int *ran);
+/* 1 when G code g (x10) runs a remap (a code of rs274's own never does). */
+static inline int ncp_remapped_g(const struct ncp_analyzer *a, int g)
+{
+    const struct ncp_remap *r = ncp_remap_of_g(a->remaps, g);
+    return r && r->remappable;
+}
 /* A built-in tool code ran: rs274 notes it on the line that controls the
  * innermost remap (what stdglue's epilogs test) */
 static inline void ncp_remap_note_builtin(struct ncp_analyzer *a)

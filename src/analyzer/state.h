@@ -178,6 +178,10 @@ struct ncp_analyzer {
     /* REMAP (remap_run.c): NULL without REMAP lines; the remaps running,
      * innermost last (#<_remap_level> is their count) */
     struct ncp_remaps *remaps;
+    /* G code (x10) -> modal group, -1 unknown: words.c's table, or the
+     * remaps' copy where a remapped code is NCP_G_REMAPPED (so that a
+     * program without G remaps pays nothing for them) */
+    const int8_t *g_group;
     /* M100+k has an executable on the machine (cfg.user_m_dirs): bit k */
     uint64_t user_m[2];
     int remap_level;

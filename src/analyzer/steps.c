@@ -59,7 +59,7 @@ static int ncp_step_spindle(struct ncp_analyzer *a, int m)
         a->st.m.spindle_dir = 0;
         if (NCP_HAS(&a->w, 'R') || NCP_HAS(&a->w, 'P')) {
             struct ncp_canon *op = ncp_an_emit(a, NCP_C_ORIENT_SPINDLE);
-            op->orient.angle = NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0;
+            op->orient.angle = (NCP_HAS(&a->w, 'R') ? W(a, 'R') : 0.0) + a->cfg.orient_offset;
             op->orient.direction = NCP_HAS(&a->w, 'P') ? ncp_trunc_int_round(W(a, 'P')) : 0;
         }
         if (NCP_HAS(&a->w, 'Q')) { /* wait for the orientation, Q seconds at most */
@@ -364,6 +364,12 @@ static int ncp_step_motion(struct ncp_analyzer *a, int motion)
         return ncp_canned_run(a, motion);
     default: {
         uint16_t col = NCP_MOTION_COL(&a->w);
+        if (a->remaps) {
+            int ran = 0;
+            int rc = ncp_remap_g_step(a, motion, &ran);
+            if (ran || rc != NCP_OK)
+                return rc;
+        }
         if (motion % 10)
             return ncp_an_error(a, col, "G%d.%d is not supported", motion / 10, motion % 10);
         return ncp_an_error(a, col, "G%d is not supported", motion / 10);

@@ -74,6 +74,40 @@ void ncp_words_init(void)
     pthread_once(&ncp_g_group_once, ncp_g_table_init);
 }
 
+void ncp_words_use_remaps(struct ncp_analyzer *a)
+{
+    struct ncp_remaps *rs = a->remaps;
+    ncp_words_init();
+    a->g_group = ncp_g_group;
+    if (!rs || !rs->n_g)
+        return;
+    memcpy(rs->g_group, ncp_g_group, sizeof rs->g_group);
+    for (int k = 0; k < rs->n; k++) {
+        struct ncp_remap *r = &rs->r[k];
+        if (r->g < 0)
+            continue;
+        r->remappable = ncp_g_group[r->g] < 0; /* rs274's own G codes run built in */
+        rs->g_group[r->g] = NCP_G_REMAPPED;
+    }
+    a->g_group = rs->g_group;
+}
+
+/* A remapped G code goes to the motion group whatever rs274 has it in, and
+ * without G80's leave to share it (rs274's read_g asks its remaps first). */
+static int ncp_add_remapped_g(struct ncp_analyzer *a, const struct ncp_remap *r, int code,
+                              uint16_t col)
+{
+    struct ncp_words *w = &a->w;
+    if (w->g[NCP_GG_MOTION] != -1)
+        return ncp_an_error(a, col, "Two g codes used from same modal group");
+    w->g[NCP_GG_MOTION] = (int16_t)code;
+    w->gcol[NCP_GG_MOTION] = col;
+    /* a code of its own takes no word but its argspec's, which its remap
+     * checks: rs274 skips the checks of the block's other words */
+    w->remapped |= r->remappable;
+    return NCP_OK;
+}
+
 static int ncp_m_group(int m)
 {
     switch (m) {
@@ -121,9 +155,12 @@ static int ncp_add_g(struct ncp_analyzer *a, double v, uint16_t col)
         return ncp_an_error(a, col, "G-code out of range");
     if (code < 0)
         return ncp_an_error(a, col, "Negative g code used");
-    int g = (int)ncp_g_group[code]; /* -1: no such code */
-    if (g < 0)
+    int g = (int)a->g_group[code]; /* -1: no such code */
+    if (g < 0) {
+        if (g == NCP_G_REMAPPED) /* rs274 asks its remaps first */
+            return ncp_add_remapped_g(a, ncp_remap_of_g(a->remaps, code), code, col);
         return ncp_an_error(a, col, "Unknown g code used");
+    }
     if (code == NCP_G80 && w->g[g] != -1)
         return NCP_OK;
     if (w->g[g] != -1 && w->g[g] != NCP_G80)

@@ -1,5 +1,6 @@
 /* [RS274NGC] of a LinuxCNC INI, read as rs274 -i reads it. rs274 -i itself
- * reads SUBROUTINE_PATH and REMAP; PARAMETER_FILE, USER_M_PATH and the
+ * reads SUBROUTINE_PATH, REMAP, INI_VARS, OWORD_NARGS, ORIENT_OFFSET and
+ * DISABLE_FANUC_STYLE_SUB; PARAMETER_FILE, USER_M_PATH and the
  * logging keys are its task's or GUI's, so they change nothing in rs274 -g
  * and are taken without effect here; any other key would change what rs274
  * prints in a way ncpar does not follow, so it is refused. rs274 -i also
@@ -10,6 +11,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -203,6 +205,18 @@ static int load(const char *path, struct rs274_ini *ini, int machine)
             ini->remaps[ini->n_remaps++] = (struct ncp_remap_line){ value, path, line };
         } else if (!strcmp(key, "INI_VARS")) {
             ini->ini_vars = ini_true(value);
+        } else if (!strcmp(key, "DISABLE_FANUC_STYLE_SUB")) {
+            ini->no_fanuc_subs = ini_true(value);
+        } else if (!strcmp(key, "OWORD_NARGS")) {
+            ini->oword_nargs = ini_true(value);
+        } else if (!strcmp(key, "ORIENT_OFFSET")) {
+            char *end = NULL;
+            ini->orient_offset = strtod(value, &end);
+            if (end == value || *trim(end) || !isfinite(ini->orient_offset)) {
+                fprintf(stderr, "%s:%u: error: [RS274NGC]ORIENT_OFFSET = %s: a number of "
+                        "degrees expected\n", path, line, value);
+                return -1;
+            }
         } else if (!strcmp(key, "SUBROUTINE_PATH")) {
             free(ini->sub_path);
             if (!(ini->sub_path = absolute_dirs(path, value)))
@@ -266,6 +280,9 @@ int rs274_ini_apply(const struct rs274_ini *ini, struct ncp_analyzer_cfg *acfg, 
     }
     acfg->remaps = ini->remaps;
     acfg->n_remaps = ini->n_remaps;
+    acfg->oword_nargs = ini->oword_nargs;
+    acfg->orient_offset = ini->orient_offset;
+    acfg->no_fanuc_subs = ini->no_fanuc_subs;
     return 0;
 }
 

@@ -15,6 +15,9 @@ struct rs274_ini {
     struct ncp_ini_var *vars;      /* every key, for #<_ini[SECTION]KEY> */
     int n_vars;
     int ini_vars;                  /* [RS274NGC]INI_VARS (default on) */
+    int oword_nargs;               /* [RS274NGC]OWORD_NARGS (default off) */
+    double orient_offset;          /* [RS274NGC]ORIENT_OFFSET (default 0) */
+    int no_fanuc_subs;             /* [RS274NGC]DISABLE_FANUC_STYLE_SUB (default off) */
     char *text;                    /* the file: the REMAP texts point into it */
 };
 

@@ -269,6 +269,31 @@ static int apply_dp1(const struct run_opts *o, struct ncp_machine_cfg *cfg)
     return 0;
 }
 
+/* DP 1's LLCs interpret the program with the command line's folders and
+ * tool table only: an INI whose [RS274NGC] changes what the program does
+ * there (REMAP, user M codes, its keys) would have the HLC and the LLCs
+ * run different programs, so it is refused before anything moves. */
+static int dp1_interpreter_refused(const struct ncp_machine_cfg *cfg,
+                                   const struct ncp_analyzer_cfg *acfg)
+{
+    if (cfg->backend != NCP_BACKEND_LCM || cfg->lcm.dp != 1)
+        return 0;
+    const char *what = acfg->n_remaps                             ? "REMAP lines"
+                       : acfg->user_m_dirs && *acfg->user_m_dirs ? "user M codes (USER_M_PATH, "
+                                                                   "PROGRAM_PREFIX)"
+                       : acfg->oword_nargs || acfg->orient_offset != 0.0 || acfg->no_fanuc_subs
+                           ? "OWORD_NARGS, ORIENT_OFFSET or DISABLE_FANUC_STYLE_SUB"
+                       : acfg->subroutine_path &&
+                               strcmp(acfg->subroutine_path, cfg->lcm.sub_path) != 0
+                           ? "SUBROUTINE_PATH"
+                           : NULL;
+    if (!what)
+        return 0;
+    fprintf(stderr, "cnc-run run: --backend lcm --dp 1: each LLC interprets the program "
+                    "without the INI's [RS274NGC] %s; use DP 2-5 with this INI\n", what);
+    return -1;
+}
+
 /* --backend, over the INI's [EMCMOT] BACKEND (backend_opts.c, as serve's);
  * DP 1's program is this command's own. */
 static int apply_backend(const struct run_opts *o, struct ncp_machine_cfg *cfg)
@@ -668,7 +693,8 @@ int ncp_cli_run(int argc, char **argv)
                                      .cancel = run_stop_asked };
     struct rs274_ini ini;
     char *joined = NULL;
-    if (rs274_ini_machine(o.config, cfg.rs274.user_m_dirs, &ini, &acfg, &joined)) {
+    if (rs274_ini_machine(o.config, cfg.rs274.user_m_dirs, &ini, &acfg, &joined) ||
+        dp1_interpreter_refused(&cfg, &acfg)) {
         rs274_ini_free(&ini);
         free(joined);
         return RUN_USAGE;

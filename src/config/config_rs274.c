@@ -69,7 +69,15 @@ int ncp_rs274_cfg_key(struct ncp_rs274_cfg *r, const char *ini_path, const char 
     /* the interpreter's: checked when cnc-run reads them */
     if (!strcasecmp(k, "REMAP") || !strcasecmp(k, "SUBROUTINE_PATH"))
         return *v ? 1 : (snprintf(why, len, "not empty"), -1);
-    if (!strcasecmp(k, "INI_VARS")) {
+    if (!strcasecmp(k, "ORIENT_OFFSET")) {
+        char *end = NULL;
+        double d = strtod(v, &end);
+        return end != v && !*end && d >= -1e9 && d <= 1e9
+                   ? 1
+                   : (snprintf(why, len, "a number of degrees"), -1);
+    }
+    if (!strcasecmp(k, "INI_VARS") || !strcasecmp(k, "OWORD_NARGS") ||
+        !strcasecmp(k, "DISABLE_FANUC_STYLE_SUB")) {
         static const char *const words[] = { "0", "1", "NO", "YES", "FALSE", "TRUE", "OFF", "ON" };
         for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
             if (!strcasecmp(v, words[i]))

@@ -280,6 +280,12 @@ const struct ncp_ini_key ncp_ini_keys[] = {
          "and Q as two arguments once the machine is at rest."),
     WORD("RS274NGC", "INI_VARS", "0|1|NO|YES|FALSE|TRUE|OFF|ON", "1",
          "The program reads the INI's keys as #<_ini[SECTION]KEY>."),
+    WORD("RS274NGC", "OWORD_NARGS", "0|1|NO|YES|FALSE|TRUE|OFF|ON", "0",
+         "A called subroutine has #<n_args>, the number of its arguments (read-only)."),
+    WORD("RS274NGC", "DISABLE_FANUC_STYLE_SUB", "0|1|NO|YES|FALSE|TRUE|OFF|ON", "0",
+         "M98, M99 and bare O-word lines (Fanuc-style subroutines) are refused."),
+    REAL("RS274NGC", "ORIENT_OFFSET", -1e9, 1e9, "degrees", "0",
+         "Added to the angle of M19 (its R word, 0 without one)."),
     TEXT("DISPLAY", "PROGRAM_PREFIX", "a folder, relative to the INI's folder", NULL,
          "nc_files", "The first folder searched for the executables M100 .. M199."),
 

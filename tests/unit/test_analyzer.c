@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "ncpar/analyzer.h"
 #include "ncpar/feeder.h"
@@ -414,10 +415,10 @@ static void test_rotation_change_while_active(void **state)
 /* The sequential bottleneck: a plain G1 block must stay well under 1 us. */
 /* A REMAP line the interpreter cannot honour stops it before the program,
  * naming the INI and its line. */
-static void expect_remap_refused(const char *text, const char *words)
+static void expect_remap_refused_in(const char *text, const char *sub_path, const char *words)
 {
     struct ncp_remap_line line = { text, "cfg.ini", 7 };
-    struct ncp_analyzer_cfg cfg = { .remaps = &line, .n_remaps = 1 };
+    struct ncp_analyzer_cfg cfg = { .remaps = &line, .n_remaps = 1, .subroutine_path = sub_path };
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     struct ncp_analyzer *a = ncp_analyzer_new(&cfg, &d);
@@ -427,6 +428,11 @@ static void expect_remap_refused(const char *text, const char *words)
     assert_string_equal(d.file, "cfg.ini");
     if (!strstr(d.msg, words))
         fail_msg("'%s': message '%s' lacks '%s'", text, d.msg, words);
+}
+
+static void expect_remap_refused(const char *text, const char *words)
+{
+    expect_remap_refused_in(text, NULL, words);
 }
 
 static void test_remap_refused(void **state)
@@ -441,6 +447,34 @@ static void test_remap_refused(void **state)
     expect_remap_refused("M400 modalgroup", "missing '=<value>'");
     expect_remap_refused("G88.1 modalgroup=1 argspec=xyz", "no remap function");
     expect_remap_refused("", "no code to remap");
+}
+
+/* A G code's REMAP line: rs274's modal group 1 only, G0 .. G99.9. */
+static void test_remap_g_refused(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/test_remap_g.XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[64];
+    snprintf(path, sizeof path, "%s/g881.ngc", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("o<g881> sub\no<g881> endsub\nM2\n", f);
+    fclose(f);
+    expect_remap_refused_in("G88.1 modalgroup=2 ngc=g881", dir, "invalid modalgroup");
+    expect_remap_refused_in("G88.1 modalgroup=10 argspec=x ngc=g881", dir, "invalid modalgroup");
+    expect_remap_refused_in("Gx ngc=g881", dir, "can't parse G-code");
+    expect_remap_refused_in("G100 ngc=g881", dir, "out of range");
+    /* and taken in group 1 when it names none */
+    struct ncp_remap_line line = { "G88.1 argspec=Xy ngc=g881", "cfg.ini", 7 };
+    struct ncp_analyzer_cfg cfg = { .remaps = &line, .n_remaps = 1, .subroutine_path = dir };
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    struct ncp_analyzer *a = ncp_analyzer_new(&cfg, &d);
+    assert_non_null(a);
+    ncp_analyzer_free(a);
+    remove(path);
+    rmdir(dir);
 }
 
 static void test_speed(void **state)
@@ -524,6 +558,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_preamble_and_end),
         cmocka_unit_test(test_remap_refused),
+        cmocka_unit_test(test_remap_g_refused),
         cmocka_unit_test(test_print_calls),
         cmocka_unit_test(test_straight_feed),
         cmocka_unit_test(test_lathe_diameter_mode),
