@@ -147,6 +147,10 @@ struct ncp_machine_cfg {
     /* [SIM]: PID of the simulated plant plus feed-forward (LinuxCNC pid naming):
      * u = KP e + KI int(e) + KD de/dt + FF1 v_cmd + FF2 a_cmd */
     double kp, ki, kd, ff1, ff2;
+    /* where the simulated machine's joints stand when it starts: not an INI
+     * key (0, the machine's zero); serve's estimate starts where its machine
+     * stands */
+    double sim_start[NCP_AXES];
     struct ncp_rt_place position, planner, interp; /* [RT] */
     struct ncp_sched_cfg sched;   /* [SCHED]: the soft-RT tasks' priorities, trace columns */
     /* [TRAJ] PLANNING_PERIOD (ns in the INI): the rough interpolator's period,

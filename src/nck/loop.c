@@ -168,6 +168,8 @@ static int take_setpoint(struct nck_core *n)
     /* a batch run ends with the period that commands its END sample (a
      * queue buster's stop is one too, but more motion is expected after it) */
     n->loop->end_seen = (n->loop->cur.flags & NCP_SP_END) != 0;
+    if (n->loop->end_seen)
+        atomic_store_explicit(&n->cross.end_ns, n->loop->now_ns, memory_order_relaxed);
     if (n->batch && n->loop->end_seen && !n->loop->ended &&
         atomic_load_explicit(&n->cross.ends_taken, memory_order_relaxed) >=
             atomic_load_explicit(&n->cross.marks_sent, memory_order_acquire)) {

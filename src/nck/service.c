@@ -142,6 +142,12 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.cycles = (int64_t)st.cycles;
     m.deadline_misses = (int64_t)st.deadline_misses;
     m.latency_max_us = st.latency_max_us;
+    m.estimate_state = (int8_t)st.estimate_state;
+    m.estimate_s = st.estimate_s;
+    m.estimate_path_mm = st.estimate_path_mm;
+    m.estimate_ferr_mm = st.estimate_ferr_mm;
+    m.estimate_compute_s = st.estimate_compute_s;
+    m.program_time_s = st.program_time_s;
     ncp_msg_send_status(sv->msg, &m);
     if (sv->hook && sv->hook->status)
         sv->hook->status(sv->hook->ctx, &m);
