@@ -208,6 +208,8 @@ struct ncp_machine_cfg {
         /* [RS274NGC] PARAMETER_FILE and [EMCIO] TOOL_TABLE, made absolute
          * from the INI's folder as LinuxCNC reads them ("": not given) */
         char parameter_file[512], tool_table[512];
+        /* [DISPLAY] HISTORY_FILE: serve's job history, absolute ("": none) */
+        char history_file[512];
         /* [DISPLAY] MAX_FEED_OVERRIDE (1.0), MIN_SPINDLE_OVERRIDE (0.0) and
          * MAX_SPINDLE_OVERRIDE (2.0): ratios, 1.0 = 100 % */
         double max_feed_override, min_spindle_override, max_spindle_override;

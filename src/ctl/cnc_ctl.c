@@ -27,6 +27,7 @@ enum {
     OPT_DISTANCE = 1 << 4,
     OPT_WAIT = 1 << 5,
     OPT_SYSTEM = 1 << 6,
+    OPT_COUNT = 1 << 7,
 };
 
 struct args {
@@ -36,6 +37,7 @@ struct args {
     long channel;
     unsigned opts; /* OPT_* given */
     long from_line;
+    long count;     /* -n N */
     double speed, distance;
     int system; /* --system: 1 = G54 ... 9 = G59.3 */
     int help;
@@ -75,6 +77,7 @@ static const char global_usage[] =
     "\n"
     "commands (cnc-ctl COMMAND --help for each):\n"
     "  status [--json] [--watch]          events [--json]\n"
+    "  history [--json] [-n N]\n"
     "  load PROG          run [--from-line N]                 mdi 'LINE'\n"
     "  pause   resume   stop   abort      step on|off\n"
     "  home [AXES|all]                    override feed|rapid|spindle PCT\n"
@@ -179,6 +182,12 @@ static int parse_args(int argc, char **argv, struct args *a)
             v = opt_value(argc, argv, &i, "--channel");
             if (v == NULL || ncp_num_long(v, 10, 0, 127, &a->channel) != 0)
                 return usage_error("--channel needs an NC channel 0..127, not '%s'", v ? v : "");
+        } else if (is_opt(s, "-n")) {
+            v = opt_value(argc, argv, &i, "-n");
+            if (v == NULL || ncp_num_long(v, 10, 1, 1000000, &a->count) != 0)
+                return usage_error("-n needs a number of jobs (1 or more), not '%s'",
+                                   v ? v : "");
+            a->opts |= OPT_COUNT;
         } else if (is_opt(s, "--from-line")) {
             v = opt_value(argc, argv, &i, "--from-line");
             if (v == NULL || ncp_num_long(v, 10, 0, INT32_MAX, &a->from_line) != 0)
@@ -441,6 +450,11 @@ static int run_events(struct ctl *c, const struct args *a)
     return ctl_follow_events(c, a->timeout_given ? c->timeout : 0, show_event, &json);
 }
 
+static int run_history(struct ctl *c, const struct args *a)
+{
+    return ctl_history(c, (a->opts & OPT_JSON) != 0, a->opts & OPT_COUNT ? a->count : 20);
+}
+
 static int run_wait(struct ctl *c, const struct args *a)
 {
     int want = ncp_msg_state_parse(a->words[0]);
@@ -541,6 +555,13 @@ static const struct command commands[] = {
      "(one JSON object a line with --json), until interrupted, or for --timeout S\n"
      "seconds when given. Only events from then on: none is kept for later.",
      OPT_JSON, 0, 0, run_events},
+    {"history", "[--json] [-n N]",
+     "The last N jobs (20 by default) of the NCK's job history, newest last: start,\n"
+     "result (done error stopped estop fault), program time and the estimate made\n"
+     "at the load, program, reason; with --json the lines as the NCK wrote them\n"
+     "(start, end, program, result, reason, program_time_s, estimate_s). The file\n"
+     "is the INI's [DISPLAY] HISTORY_FILE, named in the status, read on this host.",
+     OPT_JSON | OPT_COUNT, 0, 0, run_history},
     {"load", "PROG", "Loads a program (its path made absolute here).", 0, 1, 1, run_load},
     {"run", "[--from-line N]", "Runs the loaded program, from line N if given.",
      OPT_FROM_LINE, 0, 0, run_run},

@@ -80,6 +80,9 @@ int ctl_handle(struct ctl *c, double seconds);
 int ctl_next_status(struct ctl *c, double timeout);
 /* "cnc-ctl: no WHAT from the NCK within S s (is ... running?)" */
 void ctl_no_answer(const char *what, double seconds);
+/* history.c: the last `last` jobs of the NCK's job history (its status
+ * names the file; read on this host), as text or JSON lines. */
+int ctl_history(struct ctl *c, int json, long last);
 
 /* jog AXIS +|-: incremental (distance > 0) or continuous (see cnc-ctl jog
  * --help); speed 0 is the NCK's default. wait: an incremental jog returns

@@ -148,6 +148,17 @@ static void persist(struct ncp_nck *s)
                  s->persist.tool_path);
 }
 
+/* A program run's line in the job history; a failure to write it is the
+ * operator's to know, the service goes on. */
+static void history_end(struct ncp_nck *s, const char *result, double program_time)
+{
+    char why[NCP_DIAG_MSG_MAX];
+    int fault = !strcmp(result, "error") || !strcmp(result, "fault");
+    if (nck_history_end(&s->hist, result, fault ? s->error : "", program_time, why,
+                        sizeof why) != 0)
+        nck_post(&s->core, NCP_EV_ERROR, NULL, 0, 0, "%s", why);
+}
+
 /* After a stop, an error or an E-stop: the interpreter's end-of-program reset
  * (G54, G17, G90, G94, spindle and coolant off, ...), as M2 would. */
 static void reset_interp(struct ncp_nck *s)
@@ -220,6 +231,13 @@ static void drop_step(struct ncp_nck *s)
         else
             sync_interp(s);
         persist(s);
+        if (s->hist.open) {   /* a program run ended by the drop */
+            int64_t now = atomic_load_explicit(&n->ctl->now_ns, memory_order_acquire);
+            history_end(s, s->drop_after == NCP_ST_ESTOP   ? "estop"
+                           : s->drop_after == NCP_ST_FAULT ? "fault"
+                                                           : "stopped",
+                        now > s->run_t0_ns ? (double)(now - s->run_t0_ns) * 1e-9 : 0);
+        }
         set_state(s, s->drop_after);
         break;
     case NCK_DROP_NONE:
@@ -454,6 +472,8 @@ static int cmd_run(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
     s->run_t0_ns = atomic_load_explicit(&s->core.ctl->now_ns, memory_order_acquire);
     if (start_interp_job(s, &s->prog, (uint32_t)c->ivalue[0], NCK_JOB_PROGRAM))
         return refuse(why, len, "cannot start the interpreter thread");
+    nck_history_begin(&s->hist, s->program,
+                      s->est.state == NCP_EST_DONE ? s->est.program_time : -1);
     set_state(s, atomic_load(&s->core.job->step) ? NCP_ST_STEPPING : NCP_ST_RUNNING);
     nck_post(&s->core, NCP_EV_INFO, s->program, 0, 0, "running %s%s", s->program,
              c->ivalue[0] > 0 ? " from a line" : "");
@@ -838,9 +858,13 @@ static void job_ended(struct ncp_nck *s)
             reset_interp(s);
         else
             sync_interp(s);
-    } else if (kind == NCK_JOB_PROGRAM) {
+    }
+    if (kind == NCK_JOB_PROGRAM) {
         int64_t end = atomic_load_explicit(&n->cross.end_ns, memory_order_relaxed);
         s->program_time = end > s->run_t0_ns ? (double)(end - s->run_t0_ns) * 1e-9 : 0;
+        history_end(s, d ? "error" : "done", s->program_time);
+    }
+    if (kind == NCK_JOB_PROGRAM && !d) {
         char est[64] = "";
         if (s->est.state == NCP_EST_DONE)
             snprintf(est, sizeof est, " (estimate %.3f s)", s->est.program_time);
@@ -987,6 +1011,7 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     n->cross.post_prints = 1;
     s->rapid_override = 100;
     s->spindle_override = 100;
+    s->hist.path = setup->cfg->op.history_file;
     s->acfg = setup->interp;
     s->acfg.resident = 1;
     s->acfg.m66_on_machine = 1;   /* M66 waits on the machine's inputs */
@@ -1118,5 +1143,6 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     st->estimate_ferr_mm = s->est.ferr_max;
     st->estimate_compute_s = s->est.seconds;
     st->program_time_s = s->program_time;
+    snprintf(st->history_file, sizeof st->history_file, "%s", s->hist.path ? s->hist.path : "");
 }
 

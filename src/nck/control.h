@@ -4,6 +4,7 @@
 
 #include "nck_int.h"
 #include "estimate.h"
+#include "history.h"
 #include "persist.h"
 
 /* What ended a load's check before its end (control.c): the ACK names it. */
@@ -78,6 +79,7 @@ struct ncp_nck {
     struct nck_estimate est;
     int64_t run_t0_ns;               /* the loop's time when the program run began */
     double program_time;             /* the last program run's, s (0: none yet) */
+    struct nck_history hist;         /* [DISPLAY] HISTORY_FILE */
 };
 
 #endif
