@@ -291,6 +291,7 @@ struct ncp_nck_snapshot {
     double estimate_s, estimate_path_mm, estimate_ferr_mm, estimate_compute_s;
     double program_time_s;           /* the last program run's, start to end (0: none) */
     char history_file[256];          /* [DISPLAY] HISTORY_FILE, "" none */
+    char tool_table[256];            /* the tool table written back, "" none */
 };
 
 /* A load's estimate (cnc-run serve): running in the background, done,

@@ -77,7 +77,7 @@ static const char global_usage[] =
     "\n"
     "commands (cnc-ctl COMMAND --help for each):\n"
     "  status [--json] [--watch]          events [--json]\n"
-    "  history [--json] [-n N]\n"
+    "  history [--json] [-n N]            tool list [--json] | tool set T Z MM D MM ...\n"
     "  load PROG          run [--from-line N]                 mdi 'LINE'\n"
     "  pause   resume   stop   abort      step on|off\n"
     "  home [AXES|all]                    override feed|rapid|spindle PCT\n"
@@ -450,6 +450,15 @@ static int run_events(struct ctl *c, const struct args *a)
     return ctl_follow_events(c, a->timeout_given ? c->timeout : 0, show_event, &json);
 }
 
+static int run_tool(struct ctl *c, const struct args *a)
+{
+    if (!strcmp(a->words[0], "list") && a->n_words == 1)
+        return ctl_tool_list(c, (a->opts & OPT_JSON) != 0);
+    if (!strcmp(a->words[0], "set") && a->n_words >= 3 && !(a->opts & OPT_JSON))
+        return ctl_tool_set(c, a->words + 1, a->n_words - 1);
+    return usage_error("tool list [--json] | tool set T LETTER VALUE ...%s", "");
+}
+
 static int run_history(struct ctl *c, const struct args *a)
 {
     return ctl_history(c, (a->opts & OPT_JSON) != 0, a->opts & OPT_COUNT ? a->count : 20);
@@ -555,6 +564,12 @@ static const struct command commands[] = {
      "(one JSON object a line with --json), until interrupted, or for --timeout S\n"
      "seconds when given. Only events from then on: none is kept for later.",
      OPT_JSON, 0, 0, run_events},
+    {"tool", "list [--json] | set T [Z MM] [X MM] [D MM] [Q N] ...",
+     "list: the NCK's tool table (the file it writes back, read on this host;\n"
+     "lengths in mm). set: changes tool T's offsets (X Y Z ... in mm), diameter D\n"
+     "(mm), orientation Q, angles I J, as MDI G10 L1 does, waited for; the NCK\n"
+     "rewrites the tool table whole. Refused while a program runs, as MDI is.",
+     OPT_JSON, 1, MAX_WORDS, run_tool},
     {"history", "[--json] [-n N]",
      "The last N jobs (20 by default) of the NCK's job history, newest last: start,\n"
      "result (done error stopped estop fault), program time and the estimate made\n"

@@ -83,6 +83,11 @@ void ctl_no_answer(const char *what, double seconds);
 /* history.c: the last `last` jobs of the NCK's job history (its status
  * names the file; read on this host), as text or JSON lines. */
 int ctl_history(struct ctl *c, int json, long last);
+/* tools.c: the tool table the NCK writes back, read on this host (lengths
+ * in mm); a change of tool words[0] by MDI G10 L1 from LETTER VALUE pairs,
+ * waited for. */
+int ctl_tool_list(struct ctl *c, int json);
+int ctl_tool_set(struct ctl *c, const char *const *words, int n);
 
 /* jog AXIS +|-: incremental (distance > 0) or continuous (see cnc-ctl jog
  * --help); speed 0 is the NCK's default. wait: an incremental jog returns

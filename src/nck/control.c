@@ -1144,5 +1144,7 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     st->estimate_compute_s = s->est.seconds;
     st->program_time_s = s->program_time;
     snprintf(st->history_file, sizeof st->history_file, "%s", s->hist.path ? s->hist.path : "");
+    snprintf(st->tool_table, sizeof st->tool_table, "%s",
+             s->persist.tool_path ? s->persist.tool_path : "");
 }
 

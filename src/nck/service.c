@@ -149,6 +149,7 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.estimate_compute_s = st.estimate_compute_s;
     m.program_time_s = st.program_time_s;
     snprintf((char *)m.history_file, sizeof m.history_file, "%s", st.history_file);
+    snprintf((char *)m.tool_table, sizeof m.tool_table, "%s", st.tool_table);
     ncp_msg_send_status(sv->msg, &m);
     if (sv->hook && sv->hook->status)
         sv->hook->status(sv->hook->ctx, &m);
