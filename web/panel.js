@@ -19,8 +19,8 @@ const ui = {
   canCommand: false,
 };
 window.ncpPanel = ui;  // for tests and the curious: read-only use
-// what the server would send, for the test of what the panel does with a
-// message this server does not send yet (a hello with limits)
+// a message as if from the server, for the tests of what the panel does
+// with one (a hello with other limits)
 ui.receive = (text) => onMessage(text);
 
 const preview = createPreview($('preview'), $('preview-2d'));

@@ -121,6 +121,7 @@ int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *
     r->acfg.cancel = run_stopped;
     r->acfg.cancel_ctx = r;
     r->acfg.params_out = NULL;
+    r->acfg.tools_out = NULL;
     ncp_var_file_init(&r->vars);
     for (int k = 1; k < NCP_VAR_PARAMS; k++)
         if (r->vars.listed[k])
