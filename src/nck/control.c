@@ -1061,7 +1061,7 @@ void ncp_nck_free(struct ncp_nck *s)
         ncp_source_close(&s->load_src);
         s->loading = 0;
     }
-    nck_estimate_cancel(&s->est, "the shutdown");
+    nck_estimate_free(&s->est);
     nck_finish(n);
     nck_read_cycles(n);
     if (n->setup.trace)

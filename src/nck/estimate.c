@@ -93,9 +93,21 @@ static void estimate_machine(struct ncp_machine_cfg *c, const double *joints)
         memcpy(c->sim_start, joints, sizeof c->sim_start);
 }
 
+static void release(struct nck_estimate_run *r, pthread_t th);
+
+/* The cancelled one, once it has ended (wait: however long that takes). */
+static void reap(struct nck_estimate *e, int wait)
+{
+    if (e->dying && (wait || atomic_load_explicit(&e->dying->done, memory_order_acquire))) {
+        release(e->dying, e->dying_th);
+        e->dying = NULL;
+    }
+}
+
 int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *in)
 {
     nck_estimate_cancel(e, "a new load");
+    reap(e, 1);   /* between jobs: the one a run cancelled has long ended */
     memset(e, 0, sizeof *e);
     struct nck_estimate_run *r = calloc(1, sizeof *r);
     char *text = r ? malloc(in->len + 1) : NULL;
@@ -148,15 +160,12 @@ int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *
     return 0;
 }
 
-static void release(struct nck_estimate *e)
+static void release(struct nck_estimate_run *r, pthread_t th)
 {
-    struct nck_estimate_run *r = e->run;
-    pthread_join(e->th, NULL);
-    e->seconds = (double)(r->t1_ns - r->t0_ns) * 1e-9;
+    pthread_join(th, NULL);
     ncp_source_close(&r->src);
     free(r->text);
     free(r);
-    e->run = NULL;
 }
 
 /* "line 12: soft limit: ..." as the run would have refused it */
@@ -173,6 +182,7 @@ static void failed(struct nck_estimate *e, const struct ncp_nck_result *res)
 
 int nck_estimate_poll(struct nck_estimate *e)
 {
+    reap(e, 0);
     struct nck_estimate_run *r = e->run;
     if (!r || !atomic_load_explicit(&r->done, memory_order_acquire))
         return 0;
@@ -188,7 +198,9 @@ int nck_estimate_poll(struct nck_estimate *e)
         e->path_length = res->path_length;
         e->ferr_max = res->ferr_max;
     }
-    release(e);
+    e->seconds = (double)(r->t1_ns - r->t0_ns) * 1e-9;
+    release(r, e->th);
+    e->run = NULL;
     return 1;
 }
 
@@ -200,7 +212,16 @@ void nck_estimate_cancel(struct nck_estimate *e, const char *why)
     if (nck_estimate_poll(e))   /* it ended meanwhile: its result stands */
         return;
     atomic_store_explicit(&r->stop, 1, memory_order_relaxed);
-    release(e);
+    reap(e, 1);   /* one slot: an older one still ending is waited for (rare) */
+    e->dying = r;
+    e->dying_th = e->th;
+    e->run = NULL;
     e->state = NCP_EST_CANCELLED;
     snprintf(e->why, sizeof e->why, "cancelled by %s", why);
+}
+
+void nck_estimate_free(struct nck_estimate *e)
+{
+    nck_estimate_cancel(e, "the NCK's end");
+    reap(e, 1);
 }

@@ -18,6 +18,10 @@ struct nck_estimate_run;
 struct nck_estimate {
     struct nck_estimate_run *run;    /* the thread's, while state is RUNNING */
     pthread_t th;
+    /* one cancelled and not yet ended: joined once it has (never waited
+     * for on a run's way: its threads run below the service's) */
+    struct nck_estimate_run *dying;
+    pthread_t dying_th;
     int state;                       /* enum ncp_nck_estimate_state */
     double program_time, path_length, ferr_max;  /* s, mm, mm (state DONE) */
     double seconds;                  /* how long it took to find (host time) */
@@ -41,8 +45,12 @@ struct nck_estimate_input {
 int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *in);
 /* 1 when a running estimate has just ended (its result is in e), else 0. */
 int nck_estimate_poll(struct nck_estimate *e);
-/* Ends a running estimate within a few blocks of its program and joins it:
- * state CANCELLED with why. Nothing when none runs. */
+/* Asks a running estimate to end within a few blocks of its program, and
+ * returns without waiting for it (nck_estimate_poll joins it later): state
+ * CANCELLED with why. Nothing when none runs; the result when it had
+ * ended already. */
 void nck_estimate_cancel(struct nck_estimate *e, const char *why);
+/* Ends and joins whatever still runs (the NCK's end). */
+void nck_estimate_free(struct nck_estimate *e);
 
 #endif
