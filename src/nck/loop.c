@@ -161,6 +161,11 @@ static int take_setpoint(struct nck_core *n)
     if (n->loop->next.aux > n->loop->mach.seq_reached)
         n->loop->mach.seq_reached = n->loop->next.aux;
     if (n->loop->scaler.ends != n->loop->ends_seen) {
+        /* the END is commanded next period (the servo runs one late): a
+         * serving NCK's program time ends there, as a batch run's does. Set
+         * before the count the service reads it by (release) */
+        atomic_store_explicit(&n->cross.end_ns, n->loop->now_ns + n->cross.rt.cfg.period_ns,
+                              memory_order_relaxed);
         atomic_fetch_add_explicit(&n->cross.ends_taken, n->loop->scaler.ends - n->loop->ends_seen,
                                   memory_order_release);
         n->loop->ends_seen = n->loop->scaler.ends;
@@ -168,8 +173,6 @@ static int take_setpoint(struct nck_core *n)
     /* a batch run ends with the period that commands its END sample (a
      * queue buster's stop is one too, but more motion is expected after it) */
     n->loop->end_seen = (n->loop->cur.flags & NCP_SP_END) != 0;
-    if (n->loop->end_seen)
-        atomic_store_explicit(&n->cross.end_ns, n->loop->now_ns, memory_order_relaxed);
     if (n->batch && n->loop->end_seen && !n->loop->ended &&
         atomic_load_explicit(&n->cross.ends_taken, memory_order_relaxed) >=
             atomic_load_explicit(&n->cross.marks_sent, memory_order_acquire)) {
