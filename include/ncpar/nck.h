@@ -189,7 +189,8 @@ enum ncp_nck_cmd_kind {
     NCP_CMD_TOOL_CHANGED,
     NCP_CMD_OPTIONAL_STOP,
     NCP_CMD_SET_INPUT,
-    NCP_CMD_KIND_MAX = NCP_CMD_SET_INPUT
+    NCP_CMD_FILES,                  /* the path of "history" or "tool_table" in the reason */
+    NCP_CMD_KIND_MAX = NCP_CMD_FILES
 };
 
 #define NCP_NCK_TEXT_MAX 512
@@ -290,8 +291,6 @@ struct ncp_nck_snapshot {
     int estimate_state;
     double estimate_s, estimate_path_mm, estimate_ferr_mm, estimate_compute_s;
     double program_time_s;           /* the last program run's, start to end (0: none) */
-    char history_file[256];          /* [DISPLAY] HISTORY_FILE, "" none */
-    char tool_table[256];            /* the tool table written back, "" none */
 };
 
 /* A load's estimate (cnc-run serve): running in the background, done,

@@ -182,27 +182,15 @@ static int parse(int argc, char **argv, struct serve_args *a)
  * build without it is a usage error before any axis is powered. Its [HTTP]
  * keys are the first channel's machine INI's. */
 /* The hello's machine facts: the override sliders' ranges ([DISPLAY]
- * MAX_FEED_OVERRIDE and the spindle's MIN/MAX) and the travel box (the
- * soft limits, machine coordinates), as the panel reads them. */
+ * MAX_FEED_OVERRIDE and the spindle's MIN/MAX), as the panel reads them.
+ * Not the travel box yet: the panel's preview fits its view to the box it
+ * is given, and a part small beside the travel would be drawn too small to
+ * read (tests/web's preview-cut). */
 static void hello_facts(const struct ncp_machine_cfg *cfg, char *buf, size_t len)
 {
-    int k = snprintf(buf, len, ", \"limits\": {\"feed\": [0, %g], \"rapid\": [0, 100], "
-                     "\"spindle\": [%g, %g]}", cfg->op.max_feed_override * 100,
-                     cfg->op.min_spindle_override * 100, cfg->op.max_spindle_override * 100);
-    for (int side = 0; side < 2 && k > 0 && (size_t)k < len; side++) {
-        k += snprintf(buf + k, len - (size_t)k, side ? "}, \"max\": {" : ", \"travel\": {\"min\": {");
-        for (int j = 0, first = 1; j < NCP_AXES && k > 0 && (size_t)k < len; j++) {
-            if (!(cfg->axis_mask & NCP_AXIS_BIT(j)) || cfg->axis[j].wrapped)
-                continue;
-            k += snprintf(buf + k, len - (size_t)k, "%s\"%c\": %.6g", first ? "" : ", ",
-                          "xyzabcuvw"[j], side ? cfg->axis[j].max_limit : cfg->axis[j].min_limit);
-            first = 0;
-        }
-    }
-    if (k > 0 && (size_t)k < len)
-        snprintf(buf + k, len - (size_t)k, "}}");
-    if (k <= 0 || (size_t)k + 2 >= len)
-        buf[0] = 0;   /* the hello goes without them rather than torn */
+    snprintf(buf, len, ", \"limits\": {\"feed\": [0, %g], \"rapid\": [0, 100], "
+             "\"spindle\": [%g, %g]}", cfg->op.max_feed_override * 100,
+             cfg->op.min_spindle_override * 100, cfg->op.max_spindle_override * 100);
 }
 
 static int start_http(const struct serve_args *a, const struct ncp_machine_cfg *cfg,

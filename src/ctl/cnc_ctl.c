@@ -575,7 +575,7 @@ static const struct command commands[] = {
      "result (done error stopped estop fault), program time and the estimate made\n"
      "at the load, program, reason; with --json the lines as the NCK wrote them\n"
      "(start, end, program, result, reason, program_time_s, estimate_s). The file\n"
-     "is the INI's [DISPLAY] HISTORY_FILE, named in the status, read on this host.",
+     "is the INI's [DISPLAY] HISTORY_FILE, whose path the NCK gives, read on this host.",
      OPT_JSON | OPT_COUNT, 0, 0, run_history},
     {"load", "PROG", "Loads a program (its path made absolute here).", 0, 1, 1, run_load},
     {"run", "[--from-line N]", "Runs the loaded program, from line N if given.",

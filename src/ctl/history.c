@@ -1,5 +1,5 @@
 /* cnc-ctl history: the job history a serving NCK appends to ([DISPLAY]
- * HISTORY_FILE, named in its status), read from the file on this host:
+ * HISTORY_FILE, whose path it gives on request), read from the file on this host:
  * newest last, the last N jobs. */
 #include <errno.h>
 #include <stdio.h>
@@ -53,22 +53,25 @@ static void print_line(const char *line, int json)
     printf("%s  %-8s %s  %s%s%s\n", start, result, times, prog, reason[0] ? ": " : "", reason);
 }
 
+int ctl_file_path(struct ctl *c, const char *which, char *path, size_t len)
+{
+    ncp_command_t cmd;
+    memset(&cmd, 0, sizeof cmd);
+    cmd.kind = NCP_COMMAND_T_FILES;
+    snprintf((char *)cmd.text, sizeof cmd.text, "%s", which);
+    int rc = ctl_command(c, &cmd);
+    if (rc == CTL_OK)
+        snprintf(path, len, "%.*s", (int)strnlen((const char *)c->ack.reason, sizeof c->ack.reason),
+                 (const char *)c->ack.reason);
+    return rc;
+}
+
 int ctl_history(struct ctl *c, int json, long last)
 {
-    int rc = ctl_next_status(c, c->timeout);
-    if (rc == CTL_NO_ANSWER)
-        ctl_no_answer("history", c->timeout);
+    char path[300];
+    int rc = ctl_file_path(c, "history", path, sizeof path);
     if (rc != CTL_OK)
-        return rc < 0 ? CTL_NO_ANSWER : rc;
-    char path[sizeof c->status.history_file + 1];
-    snprintf(path, sizeof path, "%.*s",
-             (int)strnlen((const char *)c->status.history_file, sizeof c->status.history_file),
-             (const char *)c->status.history_file);
-    if (!path[0]) {
-        fprintf(stderr, "cnc-ctl: history: the NCK keeps no job history (its INI has no "
-                        "[DISPLAY] HISTORY_FILE)\n");
-        return CTL_REJECTED;
-    }
+        return rc;
     FILE *f = fopen(path, "r");
     if (!f && errno == ENOENT)
         return CTL_OK;   /* no job has ended yet */

@@ -1,5 +1,5 @@
 /* cnc-ctl tool list and tool set: the tool table a serving NCK writes back
- * (named in its status). A change goes through the NCK as MDI G10 L1, the
+ * (its path from the NCK's FILES command). A change goes through the NCK as MDI G10 L1, the
  * way a program's own G10 L1 does, so the NCK's rules decide when it may
  * happen (not while a program runs) and it rewrites the file whole; the
  * list is read from that file on this host. Lengths are mm on the command
@@ -178,18 +178,10 @@ static void print_tool(const struct tool_line *tl, int json, int first)
 
 int ctl_tool_list(struct ctl *c, int json)
 {
-    int rc = status_now(c, "tool list");
+    char path[300];
+    int rc = ctl_file_path(c, "tool_table", path, sizeof path);
     if (rc != CTL_OK)
         return rc;
-    char path[sizeof c->status.tool_table + 1];
-    snprintf(path, sizeof path, "%.*s",
-             (int)strnlen((const char *)c->status.tool_table, sizeof c->status.tool_table),
-             (const char *)c->status.tool_table);
-    if (!path[0]) {
-        fprintf(stderr, "cnc-ctl: tool list: the NCK has no tool table ([EMCIO] TOOL_TABLE or "
-                        "--tool-table)\n");
-        return CTL_REJECTED;
-    }
     FILE *f = fopen(path, "r");
     if (!f) {
         fprintf(stderr, "cnc-ctl: tool list: %s: %s (it is on the NCK's host)\n", path,

@@ -747,6 +747,25 @@ static int cmd_estop(struct ncp_nck *s)
     return 0;
 }
 
+/* Where a file the operator reads lives (cnc-ctl history, tool list): its
+ * path in the ACK's reason, in any state (reading it moves nothing). */
+static int cmd_files(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    const char *path = !strcmp(c->text, "history")      ? s->hist.path
+                       : !strcmp(c->text, "tool_table") ? s->persist.tool_path
+                                                        : NULL;
+    if (strcmp(c->text, "history") != 0 && strcmp(c->text, "tool_table") != 0)
+        return refuse(why, len, "files: history or tool_table, not '%s'", c->text);
+    if (!path || !path[0])
+        return refuse(why, len, "%s", !strcmp(c->text, "history")
+                                         ? "the NCK keeps no job history (its INI has no "
+                                           "[DISPLAY] HISTORY_FILE)"
+                                         : "the NCK has no tool table ([EMCIO] TOOL_TABLE or "
+                                           "--tool-table)");
+    snprintf(why, len, "%s", path);
+    return 0;
+}
+
 /* Out of E-stop or a fault: the commanded position becomes the actual one
  * (the axes coasted meanwhile), the drives come on again. */
 static int cmd_reset(struct ncp_nck *s, char *why, size_t len)
@@ -797,6 +816,7 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
         rc = 0;
         break;
     case NCP_CMD_SET_INPUT: rc = cmd_set_input(s, c, why, len); break;
+    case NCP_CMD_FILES: rc = cmd_files(s, c, why, len); break;
     case NCP_CMD_KEEPALIVE:
         s->jog_last_ns = ncp_mono_ns();
         rc = 0;
@@ -1143,8 +1163,5 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     st->estimate_ferr_mm = s->est.ferr_max;
     st->estimate_compute_s = s->est.seconds;
     st->program_time_s = s->program_time;
-    snprintf(st->history_file, sizeof st->history_file, "%s", s->hist.path ? s->hist.path : "");
-    snprintf(st->tool_table, sizeof st->tool_table, "%s",
-             s->persist.tool_path ? s->persist.tool_path : "");
 }
 
