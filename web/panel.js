@@ -19,8 +19,8 @@ const ui = {
   canCommand: false,
 };
 window.ncpPanel = ui;  // for tests and the curious: read-only use
-// what the server would send, for the test of what the panel does with a
-// message this server does not send yet (a hello with limits)
+// a message as if from the server, for the tests of what the panel does
+// with one (a hello with other limits)
 ui.receive = (text) => onMessage(text);
 
 const preview = createPreview($('preview'), $('preview-2d'));
@@ -211,6 +211,24 @@ function setCanon(text) {
 // ---- status -> DRO, program line, preview ---------------------------------------------
 const fmt = (v, d = 3) => (v === null || v === undefined ? '—' : Number(v).toFixed(d));
 
+// "12.3 s" or "1 min 41.6 s"
+function duration(t) {
+  if (t < 60) return `${t.toFixed(1)} s`;
+  const m = Math.floor(t / 60);
+  return `${m} min ${(t - 60 * m).toFixed(1)} s`;
+}
+
+// The loaded program's estimate (serve finds it after the load), and the
+// last run's own time beside it
+function cycleTime(s) {
+  const e = s.estimate || {};
+  const est = e.state === 'done' ? `${duration(e.program_time_s)} (estimate)`
+    : e.state === 'running' ? 'estimating…'
+    : e.state === 'failed' ? 'no estimate (see the log)' : '';
+  const last = s.program_time_s > 0 ? `last run ${duration(s.program_time_s)}` : '';
+  return [est, last].filter(Boolean).join(', ') || '—';
+}
+
 function onStatus(m) {
   const recvUs = (performance.timeOrigin + performance.now()) * 1000;
   ui.lag.push([m.status.seq, m.utime, recvUs]);
@@ -262,6 +280,7 @@ function onStatus(m) {
   $('g5x').textContent = (s.g5x && s.g5x.name) || '—';
   $('coolant').textContent = [s.coolant.mist && 'mist', s.coolant.flood && 'flood'].filter(Boolean).join(', ') || 'off';
   $('stepmode').textContent = s.step ? 'on' : 'off';
+  $('estimate').textContent = cycleTime(s);
   const g = (s.gcodes || []).map((c) => (c === 'G64' && s.g64 && (s.g64.p > 0 || s.g64.q > 0)) ? `G64 P${s.g64.p} Q${s.g64.q}` : c);
   $('gcodes').textContent = g.join(' ') || '—';
   $('mcodes').textContent = (s.mcodes || []).join(' ') || '—';

@@ -143,6 +143,9 @@ struct ncp_analyzer_cfg {
      * rs274's defaults, nothing copied. */
     const struct ncp_var_file *params_in;
     struct ncp_var_file *params_out;
+    /* cnc-run run: on its free the tool table (after G10 L1, L10, L11)
+     * becomes tools_out's, to be written back as serve does (NULL: none) */
+    struct ncp_analyzer *tools_out;
 };
 
 /* Queue busters. The interpreter runs far ahead of motion; after a G38.x

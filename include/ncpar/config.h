@@ -147,6 +147,10 @@ struct ncp_machine_cfg {
     /* [SIM]: PID of the simulated plant plus feed-forward (LinuxCNC pid naming):
      * u = KP e + KI int(e) + KD de/dt + FF1 v_cmd + FF2 a_cmd */
     double kp, ki, kd, ff1, ff2;
+    /* where the simulated machine's joints stand when it starts: not an INI
+     * key (0, the machine's zero); serve's estimate starts where its machine
+     * stands */
+    double sim_start[NCP_AXES];
     struct ncp_rt_place position, planner, interp; /* [RT] */
     struct ncp_sched_cfg sched;   /* [SCHED]: the soft-RT tasks' priorities, trace columns */
     /* [TRAJ] PLANNING_PERIOD (ns in the INI): the rough interpolator's period,
@@ -204,6 +208,8 @@ struct ncp_machine_cfg {
         /* [RS274NGC] PARAMETER_FILE and [EMCIO] TOOL_TABLE, made absolute
          * from the INI's folder as LinuxCNC reads them ("": not given) */
         char parameter_file[512], tool_table[512];
+        /* [DISPLAY] HISTORY_FILE: serve's job history, absolute ("": none) */
+        char history_file[512];
         /* [DISPLAY] MAX_FEED_OVERRIDE (1.0), MIN_SPINDLE_OVERRIDE (0.0) and
          * MAX_SPINDLE_OVERRIDE (2.0): ratios, 1.0 = 100 % */
         double max_feed_override, min_spindle_override, max_spindle_override;

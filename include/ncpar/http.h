@@ -37,6 +37,9 @@ struct ncp_http_opts {
     const char *self_exe;           /* cnc-run, for the preview's `parse --canon` */
     /* the machine INI's [HTTP] ALLOW_ORIGIN and ALLOW_HOST (NULL: none) */
     const char *allow_origin, *allow_host;
+    /* put into every hello after its own fields (", \"limits\": ..."): the
+     * machine's override limits and travel for the panel; NULL: none */
+    const char *hello_extra;
 };
 
 /* Counters of the socket's input (all since start). */

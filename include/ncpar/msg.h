@@ -146,6 +146,9 @@ int ncp_msg_decode_command(const uint8_t *payload, size_t len, ncp_command_t *cm
  * anything else. */
 const char *ncp_msg_state_name(int state);
 int ncp_msg_state_parse(const char *name);
+/* status_t's estimate states (EST_ constants) by name: "none", "running",
+ * "done", "failed", "cancelled"; NULL for anything else. */
+const char *ncp_msg_estimate_name(int state);
 /* event_t's kinds by name ("info", "msg", "debug", "print", "error",
  * "fault"): NULL for anything else. */
 const char *ncp_msg_event_kind_name(int kind);

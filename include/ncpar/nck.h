@@ -92,6 +92,9 @@ struct ncp_nck_opts {
     const char *label;
     int trace_rings;         /* as ncp_nck_setup's */
     int loop_priority_min;
+    /* a what-if run (serve's estimate, estimate.c): nothing said on stderr,
+     * no user M program run */
+    int quiet;
     /* every segment the ADCBI planner starts (ncp_planner_set_tap; planner
      * thread), or NULL: an LLC at DP 1 runs its own NCK for these */
     void (*plan_tap)(void *ctx, const struct ncp_la *la, const struct ncp_accdec *rec);
@@ -186,7 +189,8 @@ enum ncp_nck_cmd_kind {
     NCP_CMD_TOOL_CHANGED,
     NCP_CMD_OPTIONAL_STOP,
     NCP_CMD_SET_INPUT,
-    NCP_CMD_KIND_MAX = NCP_CMD_SET_INPUT
+    NCP_CMD_FILES,                  /* the path of "history" or "tool_table" in the reason */
+    NCP_CMD_KIND_MAX = NCP_CMD_FILES
 };
 
 #define NCP_NCK_TEXT_MAX 512
@@ -281,7 +285,21 @@ struct ncp_nck_snapshot {
     char error[256];                 /* the last error, "" = none */
     uint64_t rejected, cycles, deadline_misses;
     double latency_max_us;
+    /* the loaded program's estimate (enum ncp_nck_estimate_state): its
+     * program time, path and largest following error on the simulated
+     * machine at 100 %, and how long finding them took */
+    int estimate_state;
+    double estimate_s, estimate_path_mm, estimate_ferr_mm, estimate_compute_s;
+    double program_time_s;           /* the last program run's, start to end (0: none) */
 };
+
+/* A load's estimate (cnc-run serve): running in the background, done,
+ * failed (the simulated run refused the program or faulted) or cancelled
+ * (a run, a new load or the shutdown came first). */
+enum ncp_nck_estimate_state {
+    NCP_EST_NONE = 0, NCP_EST_RUNNING, NCP_EST_DONE, NCP_EST_FAILED, NCP_EST_CANCELLED
+};
+_Static_assert(NCP_EST_CANCELLED == NCP_STATUS_T_EST_CANCELLED, "the status's estimate states");
 void ncp_nck_get_status(const struct ncp_nck *n, struct ncp_nck_snapshot *st);
 
 enum ncp_nck_event_kind {

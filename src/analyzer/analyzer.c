@@ -55,6 +55,8 @@ void ncp_analyzer_free(struct ncp_analyzer *a)
         for (int k = 1; k < NCP_VAR_PARAMS; k++)
             if (a->cfg.params_out->listed[k])
                 a->cfg.params_out->value[k] = *ncp_params_slot(a->params, k);
+    if (a->cfg.tools_out)
+        ncp_analyzer_copy_tools(a->cfg.tools_out, a);
     if (a->flow)
         ncp_flow_free(a->flow);
     ncp_m7x_free(a);

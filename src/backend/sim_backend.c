@@ -60,11 +60,10 @@ static const struct ncp_backend_ops sim_ops = {
 int ncp_backend_open_sim(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                          struct ncp_diag *d)
 {
-    static const double origin[NCP_AXES];
     struct sim_be *sb = calloc(1, sizeof *sb);
     if (!sb)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "out of memory for the simulated machine");
-    ncp_sim_init(&sb->s, cfg, origin);
+    ncp_sim_init(&sb->s, cfg, cfg->sim_start);
     memset(b, 0, sizeof *b);
     b->ops = &sim_ops;
     b->impl = sb;

@@ -521,6 +521,43 @@ static int save_vars(const struct ncp_machine_cfg *cfg, const struct ncp_var_fil
     return -1;
 }
 
+/* The tool table after the run, written back whole when its G10 L1, L10 or
+ * L11 changed it (as serve does after each job): 0, or -1 said on stderr. */
+static int save_tools(const char *path, const struct ncp_analyzer *base,
+                      const struct ncp_analyzer *out)
+{
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    int written = 0;
+    if (ncp_analyzer_save_tool_table(out, base, path, &written, &d) != NCP_OK) {
+        fprintf(stderr, "cnc-run run: error: %s ([EMCIO] TOOL_TABLE)\n", d.msg);
+        return -1;
+    }
+    if (written)
+        fprintf(stderr, "cnc-run run: tool table %s written (G10 L1/L10/L11)\n", path);
+    return 0;
+}
+
+/* The table as loaded (base) and the one the run's interpreter leaves
+ * (out); both NULL without a tool table. -1 out of memory or unreadable. */
+static int tools_open(const char *path, struct ncp_analyzer **base, struct ncp_analyzer **out)
+{
+    *base = *out = NULL;
+    if (!path)
+        return 0;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    const struct ncp_analyzer_cfg tc = { .tool_table_path = path };
+    if (!(*base = ncp_analyzer_new(&tc, &d)) || !(*out = ncp_analyzer_new(NULL, &d))) {
+        fprintf(stderr, "cnc-run run: error: %s: %s\n", path, d.msg);
+        ncp_analyzer_free(*base);
+        *base = NULL;
+        return -1;
+    }
+    ncp_analyzer_copy_tools(*out, *base);
+    return 0;
+}
+
 static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *cfg,
                        const struct ncp_analyzer_cfg *acfg, const struct ncp_source *src,
                        FILE *trace, struct ncp_rt_stats *lat, const struct ncp_var_file *vars)
@@ -530,9 +567,15 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
         return RUN_FAULT;
     if (vars_out)
         *vars_out = *vars;
+    struct ncp_analyzer *tools_base, *tools_out;
+    if (tools_open(acfg->tool_table_path, &tools_base, &tools_out)) {
+        free(vars_out);
+        return RUN_USAGE;
+    }
     struct ncp_analyzer_cfg with_vars = *acfg;
     with_vars.params_in = vars;
     with_vars.params_out = vars_out;
+    with_vars.tools_out = tools_out;
     struct ncp_cli_interp ic = { src, with_vars, o->mode };
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
@@ -548,12 +591,18 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
     struct ncp_nck_result *res = malloc(sizeof *res);
     if (!res) {
         free(vars_out);
+        ncp_analyzer_free(tools_base);
+        ncp_analyzer_free(tools_out);
         return RUN_FAULT;
     }
     ncp_nck_run(&no, res);
     /* the interpreter's last values, as LinuxCNC writes them at its exit */
     int vars_failed = vars_out && save_vars(cfg, vars, vars_out) != 0;
     free(vars_out);
+    if (tools_out && save_tools(acfg->tool_table_path, tools_base, tools_out) != 0)
+        vars_failed = 1;
+    ncp_analyzer_free(tools_base);
+    ncp_analyzer_free(tools_out);
     if (res->warning[0] && !no.progress)
         fprintf(stderr, "cnc-run run: warning: %s\n", res->warning);
     int rc = ncp_cli_run_report(o->prog, cfg, res, stderr);

@@ -181,13 +181,26 @@ static int parse(int argc, char **argv, struct serve_args *a)
 /* The panel's server, started before the NCK so that a port in use or a
  * build without it is a usage error before any axis is powered. Its [HTTP]
  * keys are the first channel's machine INI's. */
+/* The hello's machine facts: the override sliders' ranges ([DISPLAY]
+ * MAX_FEED_OVERRIDE and the spindle's MIN/MAX), as the panel reads them.
+ * Not the travel box yet: the panel's preview fits its view to the box it
+ * is given, and a part small beside the travel would be drawn too small to
+ * read (tests/web's preview-cut). */
+static void hello_facts(const struct ncp_machine_cfg *cfg, char *buf, size_t len)
+{
+    snprintf(buf, len, ", \"limits\": {\"feed\": [0, %g], \"rapid\": [0, 100], "
+             "\"spindle\": [%g, %g]}", cfg->op.max_feed_override * 100,
+             cfg->op.min_spindle_override * 100, cfg->op.max_spindle_override * 100);
+}
+
 static int start_http(const struct serve_args *a, const struct ncp_machine_cfg *cfg,
                       struct ncp_http **out)
 {
-    static char exe[PATH_MAX], web[PATH_MAX];
+    static char exe[PATH_MAX], web[PATH_MAX], facts[1024];
+    hello_facts(cfg, facts, sizeof facts);
     struct ncp_http_opts ho = { .readonly = a->http_readonly,
                                 .allow_origin = cfg->http.allow_origin,
-                                .allow_host = cfg->http.allow_host };
+                                .allow_host = cfg->http.allow_host, .hello_extra = facts };
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);

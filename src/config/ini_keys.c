@@ -197,6 +197,12 @@ const struct ncp_ini_key ncp_ini_keys[] = {
          "Highest spindle override, a ratio (the spindle stays under [SPINDLE_0] MAX_RPM)."),
     REAL("DISPLAY", "MIN_SPINDLE_OVERRIDE", 0.0, 2.0, "", "0.0",
          "Lowest spindle override, a ratio, not above MAX_SPINDLE_OVERRIDE."),
+    TEXT("DISPLAY", "HISTORY_FILE", "a path, relative to the INI's folder", NULL,
+         "history.jsonl",
+         "cnc-run serve's job history: one JSON line appended (whole, then fsync) at the "
+         "end of each program run: start, end, program, result (done, error, stopped, "
+         "estop, fault), reason, program time and the estimate made at its load; cnc-ctl "
+         "history shows it. Not given: no history."),
     TEXT("EMCIO", "CYCLE_TIME", "LinuxCNC's", NULL, "0.1", "Taken and ignored."),
     TEXT("EMCIO", "EMCIO", "LinuxCNC's", NULL, "io", "Taken and ignored."),
     TEXT("EMCIO", "RANDOM_TOOLCHANGER", "LinuxCNC's", NULL, "0", "Taken and ignored."),

@@ -27,6 +27,7 @@ enum {
     OPT_DISTANCE = 1 << 4,
     OPT_WAIT = 1 << 5,
     OPT_SYSTEM = 1 << 6,
+    OPT_COUNT = 1 << 7,
 };
 
 struct args {
@@ -36,6 +37,7 @@ struct args {
     long channel;
     unsigned opts; /* OPT_* given */
     long from_line;
+    long count;     /* -n N */
     double speed, distance;
     int system; /* --system: 1 = G54 ... 9 = G59.3 */
     int help;
@@ -75,6 +77,7 @@ static const char global_usage[] =
     "\n"
     "commands (cnc-ctl COMMAND --help for each):\n"
     "  status [--json] [--watch]          events [--json]\n"
+    "  history [--json] [-n N]            tool list [--json] | tool set T Z MM D MM ...\n"
     "  load PROG          run [--from-line N]                 mdi 'LINE'\n"
     "  pause   resume   stop   abort      step on|off\n"
     "  home [AXES|all]                    override feed|rapid|spindle PCT\n"
@@ -179,6 +182,12 @@ static int parse_args(int argc, char **argv, struct args *a)
             v = opt_value(argc, argv, &i, "--channel");
             if (v == NULL || ncp_num_long(v, 10, 0, 127, &a->channel) != 0)
                 return usage_error("--channel needs an NC channel 0..127, not '%s'", v ? v : "");
+        } else if (is_opt(s, "-n")) {
+            v = opt_value(argc, argv, &i, "-n");
+            if (v == NULL || ncp_num_long(v, 10, 1, 1000000, &a->count) != 0)
+                return usage_error("-n needs a number of jobs (1 or more), not '%s'",
+                                   v ? v : "");
+            a->opts |= OPT_COUNT;
         } else if (is_opt(s, "--from-line")) {
             v = opt_value(argc, argv, &i, "--from-line");
             if (v == NULL || ncp_num_long(v, 10, 0, INT32_MAX, &a->from_line) != 0)
@@ -441,6 +450,20 @@ static int run_events(struct ctl *c, const struct args *a)
     return ctl_follow_events(c, a->timeout_given ? c->timeout : 0, show_event, &json);
 }
 
+static int run_tool(struct ctl *c, const struct args *a)
+{
+    if (!strcmp(a->words[0], "list") && a->n_words == 1)
+        return ctl_tool_list(c, (a->opts & OPT_JSON) != 0);
+    if (!strcmp(a->words[0], "set") && a->n_words >= 3 && !(a->opts & OPT_JSON))
+        return ctl_tool_set(c, a->words + 1, a->n_words - 1);
+    return usage_error("tool list [--json] | tool set T LETTER VALUE ...%s", "");
+}
+
+static int run_history(struct ctl *c, const struct args *a)
+{
+    return ctl_history(c, (a->opts & OPT_JSON) != 0, a->opts & OPT_COUNT ? a->count : 20);
+}
+
 static int run_wait(struct ctl *c, const struct args *a)
 {
     int want = ncp_msg_state_parse(a->words[0]);
@@ -541,6 +564,19 @@ static const struct command commands[] = {
      "(one JSON object a line with --json), until interrupted, or for --timeout S\n"
      "seconds when given. Only events from then on: none is kept for later.",
      OPT_JSON, 0, 0, run_events},
+    {"tool", "list [--json] | set T [Z MM] [X MM] [D MM] [Q N] ...",
+     "list: the NCK's tool table (the file it writes back, read on this host;\n"
+     "lengths in mm). set: changes tool T's offsets (X Y Z ... in mm), diameter D\n"
+     "(mm), orientation Q, angles I J, as MDI G10 L1 does, waited for; the NCK\n"
+     "rewrites the tool table whole. Refused while a program runs, as MDI is.",
+     OPT_JSON, 1, MAX_WORDS, run_tool},
+    {"history", "[--json] [-n N]",
+     "The last N jobs (20 by default) of the NCK's job history, newest last: start,\n"
+     "result (done error stopped estop fault), program time and the estimate made\n"
+     "at the load, program, reason; with --json the lines as the NCK wrote them\n"
+     "(start, end, program, result, reason, program_time_s, estimate_s). The file\n"
+     "is the INI's [DISPLAY] HISTORY_FILE, whose path the NCK gives, read on this host.",
+     OPT_JSON | OPT_COUNT, 0, 0, run_history},
     {"load", "PROG", "Loads a program (its path made absolute here).", 0, 1, 1, run_load},
     {"run", "[--from-line N]", "Runs the loaded program, from line N if given.",
      OPT_FROM_LINE, 0, 0, run_run},

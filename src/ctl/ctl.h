@@ -80,6 +80,17 @@ int ctl_handle(struct ctl *c, double seconds);
 int ctl_next_status(struct ctl *c, double timeout);
 /* "cnc-ctl: no WHAT from the NCK within S s (is ... running?)" */
 void ctl_no_answer(const char *what, double seconds);
+/* history.c: the last `last` jobs of the NCK's job history (the NCK
+ * names the file; read on this host), as text or JSON lines. */
+int ctl_history(struct ctl *c, int json, long last);
+/* The path of the NCK's "history" or "tool_table" file (its FILES
+ * command): CTL_OK with path, or the command's refusal (said). */
+int ctl_file_path(struct ctl *c, const char *which, char *path, size_t len);
+/* tools.c: the tool table the NCK writes back, read on this host (lengths
+ * in mm); a change of tool words[0] by MDI G10 L1 from LETTER VALUE pairs,
+ * waited for. */
+int ctl_tool_list(struct ctl *c, int json);
+int ctl_tool_set(struct ctl *c, const char *const *words, int n);
 
 /* jog AXIS +|-: incremental (distance > 0) or continuous (see cnc-ctl jog
  * --help); speed 0 is the NCK's default. wait: an incremental jog returns

@@ -24,6 +24,20 @@ static const char *text_of(const uint8_t *t, size_t size, char *buf, size_t bufs
     return buf;
 }
 
+/* The loaded program's time before it runs (and the last run's beside it,
+ * the two a machinist compares). */
+static void print_estimate(const ncp_status_t *s)
+{
+    const char *name = ncp_msg_estimate_name(s->estimate_state);
+    if (s->estimate_state == NCP_STATUS_T_EST_DONE)
+        printf("estimate  program time %.3f s, path %.3f mm, max following error %.4f mm\n",
+               s->estimate_s, s->estimate_path_mm, s->estimate_ferr_mm);
+    else if (s->estimate_state != NCP_STATUS_T_EST_NONE)
+        printf("estimate  %s\n", name ? name : "unknown");
+    if (s->program_time_s > 0)
+        printf("last run  program time %.3f s\n", s->program_time_s);
+}
+
 void ctl_print_status(const ncp_status_t *s)
 {
     static const char *const g5x[] = {"G54", "G55", "G56", "G57", "G58",
@@ -55,6 +69,7 @@ void ctl_print_status(const ncp_status_t *s)
            s->g5x_index >= 1 && s->g5x_index <= 9 ? g5x[s->g5x_index - 1] : "G5x?");
     if (ncp_msg_active_codes_text(s, buf, sizeof buf) > 0)
         printf("modal     %s\n", buf);
+    print_estimate(s);
     text_of(s->error, sizeof s->error, buf, sizeof buf);
     if (buf[0])
         printf("error     %s\n", buf);

@@ -725,12 +725,14 @@ static int on_ws(struct lws *wsi, enum lws_callback_reasons reason, void *user, 
             admit_unauth(h, c);
         count(h, &h->stats.connections);
         {
-            char hello[200];
+            char hello[2048];
             int n = snprintf(hello, sizeof hello,
-                             "{\"type\": \"hello\", \"authed\": %s, \"readonly\": %s%s}",
+                             "{\"type\": \"hello\", \"authed\": %s, \"readonly\": %s%s%s}",
                              c->authed ? "true" : "false", h->o.readonly ? "true" : "false",
-                             c->authed ? "" : ", \"closes_in_ms\": " NCP_HTTP_STR(UNAUTH_MS));
-            send_copy(h, c, hello, (size_t)n);
+                             c->authed ? "" : ", \"closes_in_ms\": " NCP_HTTP_STR(UNAUTH_MS),
+                             h->o.hello_extra ? h->o.hello_extra : "");
+            if (n > 0 && (size_t)n < sizeof hello)
+                send_copy(h, c, hello, (size_t)n);
         }
         break;
     case LWS_CALLBACK_CLOSED:

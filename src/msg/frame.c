@@ -83,7 +83,7 @@ int ncp_msg_decode_command(const uint8_t *payload, size_t len, ncp_command_t *cm
         return -1;
     if (memchr(cmd->text, 0, sizeof cmd->text) == NULL)
         return -1;
-    if (cmd->kind < NCP_COMMAND_T_LOAD || cmd->kind > NCP_COMMAND_T_SET_INPUT)
+    if (cmd->kind < NCP_COMMAND_T_LOAD || cmd->kind > NCP_COMMAND_T_FILES)
         return -1;
     if (cmd->client_id == 0)
         return -1;

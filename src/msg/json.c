@@ -158,6 +158,19 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
         (long long)s->auth_failed, (long long)s->stale, (long long)s->replayed,
         (long long)s->rejected, (long long)s->cycles, (long long)s->deadline_misses);
     put_num(&o, "%.3f", s->latency_max_us);
+    const char *est = ncp_msg_estimate_name(s->estimate_state);
+    put(&o, ", \"estimate\": {\"state\": ");
+    put(&o, est ? "\"%s\"" : "null", est ? est : "");
+    put(&o, ", \"program_time_s\": ");
+    put_num(&o, "%.6f", s->estimate_s);
+    put(&o, ", \"path_length_mm\": ");
+    put_num(&o, "%.6f", s->estimate_path_mm);
+    put(&o, ", \"max_following_error_mm\": ");
+    put_num(&o, "%.6f", s->estimate_ferr_mm);
+    put(&o, ", \"compute_s\": ");
+    put_num(&o, "%.3f", s->estimate_compute_s);
+    put(&o, "}, \"program_time_s\": ");
+    put_num(&o, "%.6f", s->program_time_s);
     put(&o, "}");
     return o.full ? -1 : (int)o.len;
 }

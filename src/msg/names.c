@@ -29,6 +29,18 @@ int ncp_msg_state_parse(const char *name)
     return -1;
 }
 
+static const char *const estimate_names[] = {
+    [NCP_STATUS_T_EST_NONE] = "none",     [NCP_STATUS_T_EST_RUNNING] = "running",
+    [NCP_STATUS_T_EST_DONE] = "done",     [NCP_STATUS_T_EST_FAILED] = "failed",
+    [NCP_STATUS_T_EST_CANCELLED] = "cancelled",
+};
+
+const char *ncp_msg_estimate_name(int state)
+{
+    return state >= 0 && state < (int)(sizeof estimate_names / sizeof estimate_names[0])
+               ? estimate_names[state] : NULL;
+}
+
 static const char *const event_kinds[] = {
     [NCP_EVENT_T_INFO] = "info",   [NCP_EVENT_T_MSG] = "msg",     [NCP_EVENT_T_DEBUG] = "debug",
     [NCP_EVENT_T_PRINT] = "print", [NCP_EVENT_T_ERROR] = "error", [NCP_EVENT_T_FAULT] = "fault",

@@ -349,6 +349,7 @@ int ncp_nck_run(const struct ncp_nck_opts *o, struct ncp_nck_result *res)
     n->for_s = o->for_s;
     n->ctl = o->ctl;
     n->label = o->label ? o->label : "";
+    n->quiet = o->quiet;
     enum precheck_end pre = PC_OK;
     struct ncp_nck_setup setup = { .cfg = o->cfg, .virtual_clock = o->virtual_clock,
                                    .trace = o->trace, .trace_rings = o->trace_rings,

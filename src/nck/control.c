@@ -148,6 +148,17 @@ static void persist(struct ncp_nck *s)
                  s->persist.tool_path);
 }
 
+/* A program run's line in the job history; a failure to write it is the
+ * operator's to know, the service goes on. */
+static void history_end(struct ncp_nck *s, const char *result, double program_time)
+{
+    char why[NCP_DIAG_MSG_MAX];
+    int fault = !strcmp(result, "error") || !strcmp(result, "fault");
+    if (nck_history_end(&s->hist, result, fault ? s->error : "", program_time, why,
+                        sizeof why) != 0)
+        nck_post(&s->core, NCP_EV_ERROR, NULL, 0, 0, "%s", why);
+}
+
 /* After a stop, an error or an E-stop: the interpreter's end-of-program reset
  * (G54, G17, G90, G94, spindle and coolant off, ...), as M2 would. */
 static void reset_interp(struct ncp_nck *s)
@@ -220,6 +231,13 @@ static void drop_step(struct ncp_nck *s)
         else
             sync_interp(s);
         persist(s);
+        if (s->hist.open) {   /* a program run ended by the drop */
+            int64_t now = atomic_load_explicit(&n->ctl->now_ns, memory_order_acquire);
+            history_end(s, s->drop_after == NCP_ST_ESTOP   ? "estop"
+                           : s->drop_after == NCP_ST_FAULT ? "fault"
+                                                           : "stopped",
+                        now > s->run_t0_ns ? (double)(now - s->run_t0_ns) * 1e-9 : 0);
+        }
         set_state(s, s->drop_after);
         break;
     case NCK_DROP_NONE:
@@ -319,6 +337,33 @@ static void end_check(struct ncp_nck *s, int why)
         s->cancel_ns = ncp_mono_ns();
 }
 
+/* The cycle time of the program just loaded, from where the machine stands
+ * and the offsets in force now. */
+static void start_estimate(struct ncp_nck *s)
+{
+    const struct nck_core *n = &s->core;
+    const struct nck_estimate_input in = {
+        .name = s->program, .text = s->prog.text, .len = s->prog.len, .cfg = n->cfg,
+        .acfg = &s->acfg, .interp = s->interp,
+        .joints = n->svc->have_fb ? n->svc->last_fb.jcmd : NULL,
+    };
+    if (nck_estimate_start(&s->est, &in))
+        nck_post(&s->core, NCP_EV_ERROR, s->program, 0, 0, "estimate: %s", s->est.why);
+}
+
+/* What the estimate found, once: an event the operator and the panel see. */
+static void estimate_ended(struct ncp_nck *s)
+{
+    const struct nck_estimate *e = &s->est;
+    if (e->state == NCP_EST_DONE)
+        nck_post(&s->core, NCP_EV_INFO, s->program, 0, 0,
+                 "estimate: program time %.3f s, path %.3f mm, max following error %.4f mm "
+                 "(simulated at 100 %% in %.2f s)", e->program_time, e->path_length, e->ferr_max,
+                 e->seconds);
+    else if (e->state == NCP_EST_FAILED)
+        nck_post(&s->core, NCP_EV_ERROR, s->program, 0, 0, "estimate failed: %s", e->why);
+}
+
 /* The answer of a check that has ended: 0 with the program taken, or -1
  * with the reason (a program error, or what ended it). Joins its thread. */
 static int check_answer(struct ncp_nck *s, char *why, size_t len)
@@ -344,6 +389,7 @@ static int check_answer(struct ncp_nck *s, char *why, size_t len)
     s->have_prog = 1;
     snprintf(s->program, sizeof s->program, "%s", s->load_path);
     nck_post(&s->core, NCP_EV_INFO, s->program, 0, 0, "loaded %s", s->program);
+    start_estimate(s);
     return 0;
 }
 
@@ -368,6 +414,7 @@ static int cmd_load(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     struct ncp_source src;
     if (ncp_source_open(&src, c->text, &d) != NCP_OK)
         return refuse(why, len, "%s: %s", c->text, d.msg);
+    nck_estimate_cancel(&s->est, "a new load");
     if (s->loading) {   /* the newer load wins: the older one's answer comes first */
         end_check(s, NCK_CHECK_BY_LOAD);
         finish_ended_check(s);
@@ -417,8 +464,16 @@ static int cmd_run(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
         return refuse(why, len, "the machine is not homed (cnc-ctl home all)");
     if (c->ivalue[0] < 0)
         return refuse(why, len, "run --from-line wants a line number of 1 or more");
+    /* the job has the machine to itself: an estimate still running ends
+     * here (it said so if it ended just before) */
+    if (nck_estimate_poll(&s->est))
+        estimate_ended(s);
+    nck_estimate_cancel(&s->est, "the program's run");
+    s->run_t0_ns = atomic_load_explicit(&s->core.ctl->now_ns, memory_order_acquire);
     if (start_interp_job(s, &s->prog, (uint32_t)c->ivalue[0], NCK_JOB_PROGRAM))
         return refuse(why, len, "cannot start the interpreter thread");
+    nck_history_begin(&s->hist, s->program,
+                      s->est.state == NCP_EST_DONE ? s->est.program_time : -1);
     set_state(s, atomic_load(&s->core.job->step) ? NCP_ST_STEPPING : NCP_ST_RUNNING);
     nck_post(&s->core, NCP_EV_INFO, s->program, 0, 0, "running %s%s", s->program,
              c->ivalue[0] > 0 ? " from a line" : "");
@@ -692,6 +747,25 @@ static int cmd_estop(struct ncp_nck *s)
     return 0;
 }
 
+/* Where a file the operator reads lives (cnc-ctl history, tool list): its
+ * path in the ACK's reason, in any state (reading it moves nothing). */
+static int cmd_files(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    const char *path = !strcmp(c->text, "history")      ? s->hist.path
+                       : !strcmp(c->text, "tool_table") ? s->persist.tool_path
+                                                        : NULL;
+    if (strcmp(c->text, "history") != 0 && strcmp(c->text, "tool_table") != 0)
+        return refuse(why, len, "files: history or tool_table, not '%s'", c->text);
+    if (!path || !path[0])
+        return refuse(why, len, "%s", !strcmp(c->text, "history")
+                                         ? "the NCK keeps no job history (its INI has no "
+                                           "[DISPLAY] HISTORY_FILE)"
+                                         : "the NCK has no tool table ([EMCIO] TOOL_TABLE or "
+                                           "--tool-table)");
+    snprintf(why, len, "%s", path);
+    return 0;
+}
+
 /* Out of E-stop or a fault: the commanded position becomes the actual one
  * (the axes coasted meanwhile), the drives come on again. */
 static int cmd_reset(struct ncp_nck *s, char *why, size_t len)
@@ -742,6 +816,7 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
         rc = 0;
         break;
     case NCP_CMD_SET_INPUT: rc = cmd_set_input(s, c, why, len); break;
+    case NCP_CMD_FILES: rc = cmd_files(s, c, why, len); break;
     case NCP_CMD_KEEPALIVE:
         s->jog_last_ns = ncp_mono_ns();
         rc = 0;
@@ -803,8 +878,18 @@ static void job_ended(struct ncp_nck *s)
             reset_interp(s);
         else
             sync_interp(s);
-    } else if (kind == NCK_JOB_PROGRAM) {
-        nck_post(n, NCP_EV_INFO, s->program, 0, 0, "program finished");
+    }
+    if (kind == NCK_JOB_PROGRAM) {
+        int64_t end = atomic_load_explicit(&n->cross.end_ns, memory_order_relaxed);
+        s->program_time = end > s->run_t0_ns ? (double)(end - s->run_t0_ns) * 1e-9 : 0;
+        history_end(s, d ? "error" : "done", s->program_time);
+    }
+    if (kind == NCK_JOB_PROGRAM && !d) {
+        char est[64] = "";
+        if (s->est.state == NCP_EST_DONE)
+            snprintf(est, sizeof est, " (estimate %.3f s)", s->est.program_time);
+        nck_post(n, NCP_EV_INFO, s->program, 0, 0, "program finished: program time %.3f s%s",
+                 s->program_time, est);
     }
     persist(s);
     /* the whole job in the trace once it is over, not at the next 64 KiB */
@@ -888,6 +973,10 @@ int ncp_nck_poll(struct ncp_nck *s)
         job_ended(s);
     if (s->homing_axes && nck_home_finished(n))
         homing_ended(s);
+    if (nck_estimate_poll(&s->est)) {
+        estimate_ended(s);
+        s->changed = 1;   /* a status now: the panel shows it at once */
+    }
     /* the program paused the machine: PAUSED until resume (tool-changed) */
     if (n->svc->have_fb && n->svc->last_fb.waits != s->waits_seen) {
         st = s->state;
@@ -942,6 +1031,7 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     n->cross.post_prints = 1;
     s->rapid_override = 100;
     s->spindle_override = 100;
+    s->hist.path = setup->cfg->op.history_file;
     s->acfg = setup->interp;
     s->acfg.resident = 1;
     s->acfg.m66_on_machine = 1;   /* M66 waits on the machine's inputs */
@@ -991,6 +1081,7 @@ void ncp_nck_free(struct ncp_nck *s)
         ncp_source_close(&s->load_src);
         s->loading = 0;
     }
+    nck_estimate_free(&s->est);
     nck_finish(n);
     nck_read_cycles(n);
     if (n->setup.trace)
@@ -1066,4 +1157,11 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     st->cycles = n->svc->sum.rows;
     st->deadline_misses = atomic_load(&n->cross.pub_misses);
     st->latency_max_us = (double)atomic_load(&n->cross.pub_lat_max_ns) / 1e3;
+    st->estimate_state = s->est.state;
+    st->estimate_s = s->est.program_time;
+    st->estimate_path_mm = s->est.path_length;
+    st->estimate_ferr_mm = s->est.ferr_max;
+    st->estimate_compute_s = s->est.seconds;
+    st->program_time_s = s->program_time;
 }
+

@@ -3,6 +3,8 @@
 #define NCPAR_NCK_CONTROL_H
 
 #include "nck_int.h"
+#include "estimate.h"
+#include "history.h"
 #include "persist.h"
 
 /* What ended a load's check before its end (control.c): the ACK names it. */
@@ -72,6 +74,12 @@ struct ncp_nck {
     int machine_pause;               /* PAUSED by the program (M0 M1 M60 M6), not by pause */
     int changed;
     struct nck_persist persist;      /* the parameter file, the tool table */
+    /* the loaded program's cycle time, found in the background; a run
+     * cancels it (the estimate's threads stay off a running job's CPUs) */
+    struct nck_estimate est;
+    int64_t run_t0_ns;               /* the loop's time when the program run began */
+    double program_time;             /* the last program run's, s (0: none yet) */
+    struct nck_history hist;         /* [DISPLAY] HISTORY_FILE */
 };
 
 #endif

@@ -39,6 +39,8 @@ struct nck_cross {
      * ends_taken reaches the marks it sent. The caller resets marks_sent at
      * an unpark, while the job is ended and the planner parked. */
     _Atomic uint64_t marks_sent, ends_pushed, ends_taken;
+    _Atomic int64_t end_ns;          /* loop -> caller: machine time of the last END commanded
+                                        (a serving NCK's program time ends there) */
 
     /* The steps of dropping what is queued (stop, abort, E-stop, fault),
      * each a req the caller counts and an ack the other side counts: park

@@ -360,7 +360,7 @@ static double spindle_capped(struct nck_core *n, double s, uint32_t line)
         return s;
     if (s != n->job->capped_said) {
         n->job->capped_said = s;
-        if (n->batch)
+        if (n->batch && !n->quiet)
             fprintf(stderr, "%sline %u: S%g is above the spindle's top speed ([SPINDLE_0] "
                             "MAX_RPM): it turns at %.0f rpm\n", n->label ? n->label : "", line,
                     s, top);
@@ -514,8 +514,9 @@ static void log_text(struct nck_core *n, const struct ncp_cmd *cmd, const struct
     if (off > NCP_CMD_TEXT_POOL || len > NCP_CMD_TEXT_POOL - off)
         return;
     static const char *const what[] = { "LOGOPEN", "LOGAPPEND", "LOGCLOSE", "LOG" };
-    fprintf(stderr, "%sline %u: %s: %.*s\n", n->label ? n->label : "", cmd->line,
-            what[op->kind - NCP_C_LOGOPEN], (int)len, cmd->text + off);
+    if (!n->quiet)
+        fprintf(stderr, "%sline %u: %s: %.*s\n", n->label ? n->label : "", cmd->line,
+                what[op->kind - NCP_C_LOGOPEN], (int)len, cmd->text + off);
 }
 
 /* Run from line: the spindle and coolant the skipped part left on come on
@@ -649,7 +650,7 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd)
     struct nck_job *j = n->job;
     if (atomic_load(&j->abort))
         return 1;
-    if (cmd->text_used && !n->cross.post_prints)
+    if (cmd->text_used && !n->cross.post_prints && !n->quiet)
         (void)ncp_exec_write_prints(cmd, stderr);
     if (j->from_line && !j->reached && cmd->line >= j->from_line) {
         /* the map's position is where the skipped part left the tool */

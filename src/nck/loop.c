@@ -161,6 +161,11 @@ static int take_setpoint(struct nck_core *n)
     if (n->loop->next.aux > n->loop->mach.seq_reached)
         n->loop->mach.seq_reached = n->loop->next.aux;
     if (n->loop->scaler.ends != n->loop->ends_seen) {
+        /* the END is commanded next period (the servo runs one late): a
+         * serving NCK's program time ends there, as a batch run's does. Set
+         * before the count the service reads it by (release) */
+        atomic_store_explicit(&n->cross.end_ns, n->loop->now_ns + n->cross.rt.cfg.period_ns,
+                              memory_order_relaxed);
         atomic_fetch_add_explicit(&n->cross.ends_taken, n->loop->scaler.ends - n->loop->ends_seen,
                                   memory_order_release);
         n->loop->ends_seen = n->loop->scaler.ends;

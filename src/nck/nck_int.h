@@ -36,6 +36,10 @@ struct nck_core {
     /* batch (ncp_nck_run): one program, then the loop ends by itself */
     int batch;
     const char *label;           /* batch: before its own lines on stderr ("ch2: "), or "" */
+    /* batch: a what-if run (serve's estimate): nothing said on stderr, no
+     * user M program run (its side effects are the machine's, not the
+     * estimate's) */
+    int quiet;
     double plan_override;        /* feed override the plan is made at (1.0 = 100 %) */
     double for_s;                /* batch: feed hold after this much machine time */
     struct ncp_nck_ctl own_ctl;

@@ -44,6 +44,8 @@ void nck_wait_began(struct nck_core *n, const struct nck_fb *fb)
         return;
     }
     double after = n->cfg->io.auto_resume_s;
+    if (n->quiet)
+        return;
     if (after < 0)
         fprintf(stderr, "%sline %u: paused: %s; continues on SIGUSR1 (kill -USR1 %ld)\n",
                 n->label, fb->wait_line, what, (long)getpid());

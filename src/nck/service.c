@@ -142,6 +142,12 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.cycles = (int64_t)st.cycles;
     m.deadline_misses = (int64_t)st.deadline_misses;
     m.latency_max_us = st.latency_max_us;
+    m.estimate_state = (int8_t)st.estimate_state;
+    m.estimate_s = st.estimate_s;
+    m.estimate_path_mm = st.estimate_path_mm;
+    m.estimate_ferr_mm = st.estimate_ferr_mm;
+    m.estimate_compute_s = st.estimate_compute_s;
+    m.program_time_s = st.program_time_s;
     ncp_msg_send_status(sv->msg, &m);
     if (sv->hook && sv->hook->status)
         sv->hook->status(sv->hook->ctx, &m);
@@ -213,7 +219,7 @@ static void refuse_channel(struct serve *sv, const ncp_command_t *c, ncp_ack_t *
 }
 
 static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int32_t client,
-                   int32_t seq, int rc, const char *why);
+                   int32_t seq, int rc, const char *why, int said);
 static void answer_pending(struct serve *sv, struct serve_channel *ch);
 
 /* Why a command cannot act now (NULL: it may): its deadline passed, or it
@@ -350,13 +356,13 @@ static void act(struct serve *sv, struct serve_channel *ch, struct client *cl,
     cl->pending = 0;
     if (rc == 0 && c->kind == NCP_CMD_JOG && !(c->value[1] > 0))
         ch->jog_client = c->client_id;
-    answer(sv, ch, a, c->client_id, c->seq, rc, why);
+    answer(sv, ch, a, c->client_id, c->seq, rc, why, c->kind == NCP_CMD_FILES);
 }
 
 /* The ACK of a command, with the state it leaves (it may change it at
  * once), and the status after it. */
 static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int32_t client,
-                   int32_t seq, int rc, const char *why)
+                   int32_t seq, int rc, const char *why, int said)
 {
     ncp_nck_poll(ch->nck);
     struct ncp_nck_snapshot st;
@@ -367,7 +373,8 @@ static void answer(struct serve *sv, struct serve_channel *ch, ncp_ack_t *a, int
     a->channel = (int8_t)ch->num;
     a->result = rc == 0 ? NCP_ACK_T_ACCEPTED : NCP_ACK_T_REJECTED;
     a->state = (int8_t)st.state;
-    snprintf((char *)a->reason, sizeof a->reason, "%s", rc == 0 ? "" : why);
+    /* an accepted FILES command answers with its path */
+    snprintf((char *)a->reason, sizeof a->reason, "%s", rc == 0 && !said ? "" : why);
     send_ack(sv, a);
     send_status(sv, ch);
 }
@@ -392,7 +399,7 @@ static void answer_pending(struct serve *sv, struct serve_channel *ch)
     }
     ncp_ack_t a;
     memset(&a, 0, sizeof a);
-    answer(sv, ch, &a, ch->pending_client, ch->pending_seq, rc, why);
+    answer(sv, ch, &a, ch->pending_client, ch->pending_seq, rc, why, 0);
     if (cl != NULL && cl->seq == ch->pending_seq) {
         cl->ack = a;
         cl->pending = 0;

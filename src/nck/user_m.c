@@ -95,6 +95,8 @@ int nck_user_m_run(struct nck_core *n, const struct ncp_cmd *cmd, const struct n
     uint16_t col = (uint16_t)op->user_m.col;
     const char *file = NCP_CMD_FILE(cmd) ? ncp_diag_file_of_tag(NCP_CMD_FILE(cmd)) : NULL;
     char path[1600], p[64], q[64];
+    if (n->quiet)   /* the estimate: the program's time, not its side effects */
+        return 0;
     if (ncp_user_m_find(n->cfg->rs274.user_m_dirs, code, path, sizeof path) != 0) {
         ncp_diag_set(&j->map_diag, NCP_ERR_SEMANTIC, cmd->line, col,
                      "M%d: its program is gone from [RS274NGC] USER_M_PATH (%s) since the "

@@ -170,14 +170,14 @@ static void test_command_garbage(void **state)
     n = encode_command(&c, buf, sizeof buf);
     assert_int_equal(ncp_msg_decode_command(buf, (size_t)n, &d), -1);
 
-    static const int16_t bad_kinds[] = {0, 20, -1, 1000};
+    static const int16_t bad_kinds[] = {0, 21, -1, 1000};
     for (size_t i = 0; i < sizeof bad_kinds / sizeof bad_kinds[0]; i++) {
         c = good_command();
         c.kind = bad_kinds[i];
         n = encode_command(&c, buf, sizeof buf);
         assert_int_equal(ncp_msg_decode_command(buf, (size_t)n, &d), -1);
     }
-    for (int16_t k = NCP_COMMAND_T_LOAD; k <= NCP_COMMAND_T_SET_INPUT; k++) {
+    for (int16_t k = NCP_COMMAND_T_LOAD; k <= NCP_COMMAND_T_FILES; k++) {
         c = good_command();
         c.kind = k;
         n = encode_command(&c, buf, sizeof buf);
@@ -336,6 +336,10 @@ static void test_state_names(void **state)
         assert_int_equal(ncp_msg_state_parse(ncp_msg_state_name(i)), i);
     assert_int_equal(ncp_msg_state_parse("Idle"), -1);
     assert_int_equal(ncp_msg_state_parse(""), -1);
+    assert_string_equal(ncp_msg_estimate_name(NCP_STATUS_T_EST_RUNNING), "running");
+    assert_string_equal(ncp_msg_estimate_name(NCP_STATUS_T_EST_CANCELLED), "cancelled");
+    assert_null(ncp_msg_estimate_name(5));
+    assert_null(ncp_msg_estimate_name(-1));
 }
 
 static void test_status_json(void **state)
@@ -353,6 +357,10 @@ static void test_status_json(void **state)
     s.pos_act[1] = NAN;
     s.g5x_index = 8;
     s.seq = 99;
+    s.estimate_state = NCP_STATUS_T_EST_DONE;
+    s.estimate_s = 101.557;
+    s.estimate_path_mm = 1444.142;
+    s.program_time_s = 4.5;
     snprintf((char *)s.error, sizeof s.error, "line\nbreak");
     char buf[4096];
     int n = ncp_msg_status_json(&s, buf, sizeof buf);
@@ -365,7 +373,11 @@ static void test_status_json(void **state)
     assert_non_null(strstr(buf, "\"name\": \"G59.2\""));
     assert_non_null(strstr(buf, "\"error\": \"line\\u000abreak\""));
     assert_non_null(strstr(buf, "\"seq\": 99"));
-    assert_non_null(strstr(buf, "\"latency_max_us\": 0.000}"));
+    assert_non_null(strstr(buf, "\"latency_max_us\": 0.000, "));
+    /* the load's estimate and the last run's time */
+    assert_non_null(strstr(buf, "\"estimate\": {\"state\": \"done\", \"program_time_s\": "
+                                "101.557000, \"path_length_mm\": 1444.142000"));
+    assert_non_null(strstr(buf, "}, \"program_time_s\": 4.500000}"));
     /* nothing and no state: nulls */
     memset(&s, 0, sizeof s);
     s.state = 42;
@@ -373,6 +385,10 @@ static void test_status_json(void **state)
     assert_true(n > 0);
     assert_non_null(strstr(buf, "\"state\": null, \"program\": null"));
     assert_non_null(strstr(buf, "\"g5x\": {\"index\": 0, \"name\": null"));
+    assert_non_null(strstr(buf, "\"estimate\": {\"state\": \"none\""));
+    s.estimate_state = 9;
+    assert_true(ncp_msg_status_json(&s, buf, sizeof buf) > 0);
+    assert_non_null(strstr(buf, "\"estimate\": {\"state\": null"));
     assert_int_equal(ncp_msg_status_json(&s, buf, 40), -1);
 }
 

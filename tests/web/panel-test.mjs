@@ -281,9 +281,10 @@ async function session(browser) {
     const dro = await page.$$eval('#dro tbody tr', (rows) => rows.length);
     check(dro === 3, `DRO rows ${dro}`);
     check(!(await page.$eval('#run', (b) => b.disabled)), 'cycle start disabled while connected');
-    // no limits from the server: LinuxCNC's defaults
+    // the server's limits in its hello: the built-in mill's MAX_FEED_OVERRIDE 1.0,
+    // spindle 0-200 %
     const ov = await page.$$eval('#ov-feed, #ov-spindle', (e) => e.map((x) => [Number(x.min), Number(x.max)]));
-    check(JSON.stringify(ov) === '[[0,200],[50,150]]', `override ranges ${JSON.stringify(ov)}, not feed 0-200, spindle 50-150`);
+    check(JSON.stringify(ov) === '[[0,100],[0,200]]', `override ranges ${JSON.stringify(ov)}, not feed 0-100, spindle 0-200`);
     await shot(page, '01-connected');
   });
   await run('connecting', async () => {
@@ -323,6 +324,9 @@ async function session(browser) {
     const src = fs.readFileSync(path.join(ROOT, 'ncprograms', 'demo.ngc'), 'utf8').split('\n');
     const shown = await page.$$eval('#program div', (d) => d.map((e) => e.textContent));
     check(shown.length === src.length && shown[5].trim() === src[5].trim(), 'the program text differs from demo.ngc');
+    // serve's estimate of the demo's cycle time (101.557 s on the built-in mill)
+    await page.waitForFunction(() => /^1 min 41\.6 s \(estimate\)/.test(document.querySelector('#estimate').textContent), { timeout: 5000 })
+      .catch(async () => { throw new Fail(`cycle time shows '${await page.$eval('#estimate', (e) => e.textContent)}'`); });
     // the preview's segments come from `cnc-run parse --canon`
     await page.waitForFunction(() => document.querySelector('#preview canvas'), { timeout: 8000 });
     await sleep(1500);
