@@ -281,6 +281,11 @@ struct ncp_nck_snapshot {
     char error[256];                 /* the last error, "" = none */
     uint64_t rejected, cycles, deadline_misses;
     double latency_max_us;
+    /* CiA 402 drives (socketcan backend), as their last frames said */
+    int n_drives;
+    char drive_axis[NCP_NCK_AXES_MAX];
+    unsigned drive_node[NCP_NCK_AXES_MAX];
+    uint16_t drive_statusword[NCP_NCK_AXES_MAX], drive_error[NCP_NCK_AXES_MAX];
 };
 void ncp_nck_get_status(const struct ncp_nck *n, struct ncp_nck_snapshot *st);
 

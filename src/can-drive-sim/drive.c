@@ -26,8 +26,16 @@ void drive_set_state(struct drive *dv, enum ncp_cia402_state s)
     if (s != dv->st && dv->o.verbose)
         fprintf(stderr, "cnc-drive-sim node %u: %s -> %s\n", dv->o.node,
                 ncp_cia402_state_name(dv->st), ncp_cia402_state_name(s));
+    if (s != dv->st)
+        dv->halted = 0;
     dv->st = s;
-    od_set(&dv->od, 0x6041, 0, ncp_cia402_statusword(s));
+    od_set(&dv->od, 0x6041, 0, drive_statusword(dv));
+}
+
+uint16_t drive_statusword(const struct drive *dv)
+{
+    uint16_t sw = ncp_cia402_statusword(dv->st);
+    return dv->halted && dv->st == NCP_402_QUICK_STOP_ACTIVE ? sw | NCP_402_SW_TARGET_REACHED : sw;
 }
 
 void drive_boot(struct drive *dv)
@@ -52,7 +60,7 @@ void drive_boot(struct drive *dv)
 int drive_send_tpdo(struct drive *dv)
 {
     struct ncp_can_frame f;
-    ncp_tpdo1_frame(&f, dv->o.node, ncp_cia402_statusword(dv->st), dv->actual);
+    ncp_tpdo1_frame(&f, dv->o.node, drive_statusword(dv), dv->actual);
     return drive_send(dv, &f);
 }
 
@@ -65,7 +73,7 @@ int drive_send_heartbeat(struct drive *dv)
     return drive_send(dv, &f);
 }
 
-static void apply_controlword(struct drive *dv, uint16_t cw)
+static int apply_controlword(struct drive *dv, uint16_t cw)
 {
     dv->prev_cw = dv->cw;
     dv->cw = cw;
@@ -78,7 +86,10 @@ static void apply_controlword(struct drive *dv, uint16_t cw)
         dv->prev_actual = dv->actual;
         drive_servo_enable(dv);
     }
+    if (next == NCP_402_QUICK_STOP_ACTIVE && dv->st == NCP_402_OPERATION_ENABLED)
+        return drive_quick_stop(dv, dv->now_ms);
     drive_set_state(dv, next);
+    return 0;
 }
 
 int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy)
@@ -163,7 +174,7 @@ static void after_write(struct drive *dv, struct od_entry *e, uint32_t v)
     if (e->index == 0x6060)
         od_set(&dv->od, 0x6061, 0, v);
     else if (e->index == 0x6040)
-        apply_controlword(dv, (uint16_t)v);
+        (void)apply_controlword(dv, (uint16_t)v);
     else if (e->index == 0x607A)
         dv->target = (int32_t)v;
 }
@@ -210,6 +221,7 @@ int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f, long long no
 {
     uint8_t n = dv->o.node;
     unsigned master = drive_master_node(dv);
+    dv->now_ms = now_ms;
     if (f->id == NCP_COB_NMT)
         return on_nmt(dv, f);
     if (master && f->id == NCP_COB_HEARTBEAT + master) {
@@ -227,8 +239,8 @@ int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f, long long no
         int32_t target;
         dv->last_rpdo = now_ms;
         if (ncp_rpdo1_decode(f, &cw, &target) == 0) {
-            if (cw != dv->cw)
-                apply_controlword(dv, cw);
+            if (cw != dv->cw && apply_controlword(dv, cw) < 0)
+                return -1;
             if (dv->st == NCP_402_OPERATION_ENABLED)
                 dv->target = target;
         }

@@ -60,7 +60,13 @@ static int start_ramp(struct drive *dv, enum ncp_cia402_state during, enum ncp_c
     dv->after_stop = after;
     dv->next_step = now;
     drive_set_state(dv, during);
+    dv->halted = 0;
     return drive_send_tpdo(dv);
+}
+
+int drive_quick_stop(struct drive *dv, long long now_ms)
+{
+    return start_ramp(dv, NCP_402_QUICK_STOP_ACTIVE, NCP_402_QUICK_STOP_ACTIVE, now_ms);
 }
 
 static int react(struct drive *dv, uint16_t code, long long now)
@@ -106,14 +112,18 @@ static int ramp_step(struct drive *dv)
     dv->actual += (int32_t)lround(dv->stop_vel);
     dv->target = dv->actual;
     od_set(&dv->od, 0x6064, 0, (uint32_t)dv->actual);
-    if (dv->stop_vel == 0)
+    if (dv->stop_vel == 0) {
         drive_set_state(dv, dv->after_stop);
+        dv->halted = 1;
+        od_set(&dv->od, 0x6041, 0, drive_statusword(dv));
+    }
     return drive_send_tpdo(dv);
 }
 
 static int ramping(const struct drive *dv)
 {
-    return dv->st == NCP_402_QUICK_STOP_ACTIVE || dv->st == NCP_402_FAULT_REACTION_ACTIVE;
+    return (dv->st == NCP_402_QUICK_STOP_ACTIVE || dv->st == NCP_402_FAULT_REACTION_ACTIVE) &&
+           !dv->halted;
 }
 
 int drive_guard_tick(struct drive *dv, long long now)

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "ncpar/can.h"
 #include "ncpar/msg.h"
 
 struct out {
@@ -158,7 +159,16 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
         (long long)s->auth_failed, (long long)s->stale, (long long)s->replayed,
         (long long)s->rejected, (long long)s->cycles, (long long)s->deadline_misses);
     put_num(&o, "%.3f", s->latency_max_us);
-    put(&o, "}");
+    put(&o, ", \"drives\": [");
+    for (int k = 0; k < s->n_drives && k < 9; k++) {
+        uint16_t sw = (uint16_t)s->drive_statusword[k], err = (uint16_t)s->drive_error[k];
+        char axis = isalpha(s->drive_axis[k]) ? (char)s->drive_axis[k] : '?';
+        put(&o, "%s{\"axis\": \"%c\", \"node\": %d, \"state\": \"%s\", \"statusword\": "
+            "\"0x%04X\", \"error\": \"0x%04X\", \"error_text\": \"%s\"}",
+            k ? ", " : "", axis, (int)s->drive_node[k],
+            ncp_cia402_state_name(ncp_cia402_state(sw)), sw, err, err ? ncp_emcy_code_text(err) : "");
+    }
+    put(&o, "]}");
     return o.full ? -1 : (int)o.len;
 }
 

@@ -538,6 +538,16 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
                                   cfg->axis[j].home_sequence);
         }
     }
+    /* the search's switch is the simulated machine's: a CAN drive's own
+     * inputs (0x60FD) are not read, so a search there would latch nothing real */
+    for (int j = 0; j < NCP_AXES; j++)
+        if ((mask & NCP_AXIS_BIT(j)) && cfg->backend == NCP_BACKEND_SOCKETCAN &&
+            cfg->axis[j].home_search_vel != 0)
+            return refuse(why, len, "homing %c: the socketcan backend does not read the "
+                          "drive's home switch (0x60FD digital inputs) yet, so a search "
+                          "(HOME_SEARCH_VEL %g) would latch no real switch; HOME_SEARCH_VEL "
+                          "= 0 homes the axis where it stands", NCP_AXIS_LETTERS[j],
+                          cfg->axis[j].home_search_vel);
     for (int j = 0; j < NCP_AXES; j++)
         if (mask & NCP_AXIS_BIT(j))
             s->homed[j] = 0;
@@ -1066,4 +1076,14 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     st->cycles = n->svc->sum.rows;
     st->deadline_misses = atomic_load(&n->cross.pub_misses);
     st->latency_max_us = (double)atomic_load(&n->cross.pub_lat_max_ns) / 1e3;
+    if (n->cross.be.ops && n->cross.be.ops->drives) {
+        struct ncp_drive_info d[NCP_NCK_AXES_MAX];
+        st->n_drives = n->cross.be.ops->drives(&n->cross.be, d, NCP_NCK_AXES_MAX);
+        for (int k = 0; k < st->n_drives; k++) {
+            st->drive_axis[k] = NCP_AXIS_LETTERS[d[k].axis];
+            st->drive_node[k] = d[k].node;
+            st->drive_statusword[k] = d[k].statusword;
+            st->drive_error[k] = d[k].error;
+        }
+    }
 }

@@ -142,6 +142,13 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.cycles = (int64_t)st.cycles;
     m.deadline_misses = (int64_t)st.deadline_misses;
     m.latency_max_us = st.latency_max_us;
+    m.n_drives = (int8_t)(st.n_drives < 9 ? st.n_drives : 9);
+    for (int k = 0; k < m.n_drives; k++) {
+        m.drive_axis[k] = (uint8_t)st.drive_axis[k];
+        m.drive_node[k] = (int8_t)st.drive_node[k];
+        m.drive_statusword[k] = (int16_t)st.drive_statusword[k];
+        m.drive_error[k] = (int16_t)st.drive_error[k];
+    }
     ncp_msg_send_status(sv->msg, &m);
     if (sv->hook && sv->hook->status)
         sv->hook->status(sv->hook->ctx, &m);

@@ -365,7 +365,22 @@ static void test_status_json(void **state)
     assert_non_null(strstr(buf, "\"name\": \"G59.2\""));
     assert_non_null(strstr(buf, "\"error\": \"line\\u000abreak\""));
     assert_non_null(strstr(buf, "\"seq\": 99"));
-    assert_non_null(strstr(buf, "\"latency_max_us\": 0.000}"));
+    assert_non_null(strstr(buf, "\"latency_max_us\": 0.000, \"drives\": []}"));
+    /* CiA 402 drives: state by name, statusword and last EMCY code with its meaning */
+    s.n_drives = 2;
+    memcpy(s.drive_axis, "XY", 2);
+    s.drive_node[0] = 1;
+    s.drive_node[1] = 2;
+    s.drive_statusword[0] = 0x0237;
+    s.drive_statusword[1] = 0x0218;
+    s.drive_error[1] = (int16_t)0x8611;
+    n = ncp_msg_status_json(&s, buf, sizeof buf);
+    assert_true(n > 0);
+    assert_non_null(strstr(buf, "\"drives\": [{\"axis\": \"X\", \"node\": 1, \"state\": "
+                                "\"Operation enabled\", \"statusword\": \"0x0237\", \"error\": "
+                                "\"0x0000\", \"error_text\": \"\"}, {\"axis\": \"Y\", \"node\": 2, "
+                                "\"state\": \"Fault\", \"statusword\": \"0x0218\", \"error\": "
+                                "\"0x8611\", \"error_text\": \"following error\"}]}"));
     /* nothing and no state: nulls */
     memset(&s, 0, sizeof s);
     s.state = 42;
