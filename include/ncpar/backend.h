@@ -118,6 +118,10 @@ struct ncp_backend_ops {
     /* Not real-time (the serving thread): the drives as their last frames
      * said, one per row up to max; the count. NULL: no drives to show. */
     int (*drives)(const struct ncp_backend *b, struct ncp_drive_info *out, int max);
+    /* Real-time, after cycle(): the home switch of the axis's drive as its
+     * last frame said, 1 pressed or 0; -1 when the backend has none to read
+     * (NULL: the same). Homing then uses the simulated switch. */
+    int (*home_switch)(const struct ncp_backend *b, int axis);
 };
 
 /* The ADCBI planner's calls, as plan_journal sees them. */

@@ -16,6 +16,7 @@
 #define NCP_COB_EMCY      0x080u
 #define NCP_COB_TPDO1     0x180u
 #define NCP_COB_RPDO1     0x200u
+#define NCP_COB_TPDO2     0x280u /* digital inputs 0x60FD, when mapped */
 #define NCP_COB_SDO_TX    0x580u /* server (drive) -> client (master) */
 #define NCP_COB_SDO_RX    0x600u /* client -> server */
 #define NCP_COB_HEARTBEAT 0x700u
@@ -174,11 +175,15 @@ struct ncp_co_node {
     uint8_t hb_state;     /* enum ncp_nmt_state */
     uint32_t emcys;       /* EMCY frames received; the last one in emcy */
     struct ncp_emcy emcy;
+    uint32_t din;         /* digital inputs 0x60FD from TPDO2 (bit 2: home switch) */
+    uint32_t dins;        /* TPDO2 frames received */
 };
-enum ncp_co_event { NCP_CO_NONE, NCP_CO_TPDO, NCP_CO_HEARTBEAT, NCP_CO_EMCY };
+enum ncp_co_event { NCP_CO_NONE, NCP_CO_TPDO, NCP_CO_HEARTBEAT, NCP_CO_EMCY, NCP_CO_DIN };
+/* 0x60FD bit 2 (CiA 402): the home switch. */
+#define NCP_402_DIN_HOME_SWITCH 0x4u
 
 void ncp_co_node_init(struct ncp_co_node *node, uint8_t id);
-/* The COB-IDs a master listens to for these nodes (4 per node); returns count. */
+/* The COB-IDs a master listens to for these nodes (5 per node); returns count. */
 size_t ncp_co_filter_ids(const struct ncp_co_node *nodes, size_t n, uint32_t *ids,
                          size_t max);
 /* Updates the node the frame comes from; returns what the frame was. */
@@ -211,6 +216,9 @@ struct ncp_co_master_cfg {
     int rpdo_timeout_ms;
     int abort_option;
     int fault_reaction;
+    /* TPDO2 = digital inputs 0x60FD at every SYNC (a homing search reads
+     * the home switch there); 0: not mapped */
+    int map_din;
 };
 
 enum ncp_co_fault_kind {

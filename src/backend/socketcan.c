@@ -155,8 +155,20 @@ static void sc_close(struct ncp_backend *b)
     b->impl = NULL;
 }
 
+static int sc_home_switch(const struct ncp_backend *b, int axis)
+{
+    const struct sc *s = b->impl;
+    for (int k = 0; k < s->n; k++)
+        if (s->ax[k] == axis)
+            return !s->m.cfg.map_din || s->m.node[k].dins == 0
+                       ? -1
+                       : (s->m.node[k].din & NCP_402_DIN_HOME_SWITCH) != 0;
+    return -1;
+}
+
 static const struct ncp_backend_ops sc_ops = {
     "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, sc_enable, sc_live, sc_drives,
+    sc_home_switch,
 };
 
 int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
@@ -186,6 +198,9 @@ int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_c
         .abort_option = cfg->can.abort_option,
         .fault_reaction = cfg->can.fault_reaction,
     };
+    /* a homing search reads the drive's home switch (0x60FD in TPDO2) */
+    for (int k = 0; k < s->n; k++)
+        mc.map_din |= cfg->axis[s->ax[k]].home_search_vel != 0;
     if (ncp_co_master_open(&s->m, cfg->can.interface, nodes, s->n, &mc, d) != NCP_OK) {
         free(s);
         return d->code;

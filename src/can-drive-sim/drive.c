@@ -115,6 +115,23 @@ static int32_t plant_step(int32_t actual, int32_t target, int32_t max_step)
     return (int32_t)(actual + err);
 }
 
+/* TPDO2 with the digital inputs 0x60FD, where the master mapped it and
+ * asked for it at every SYNC. */
+static int send_inputs(struct drive *dv)
+{
+    uint32_t din = dv->o.have_home_switch && dv->actual >= dv->o.home_switch
+                       ? NCP_402_DIN_HOME_SWITCH : 0;
+    od_set(&dv->od, 0x60FD, 0, din);
+    uint32_t tt = od_get(&dv->od, 0x1801, 2);
+    if (od_get(&dv->od, 0x1A01, 0) != 1 || od_get(&dv->od, 0x1A01, 1) != 0x60FD0020u ||
+        tt < 1 || tt > 240)
+        return 0;
+    struct ncp_can_frame f = {.id = NCP_COB_TPDO2 + dv->o.node, .len = 4,
+                              .data = {(uint8_t)din, (uint8_t)(din >> 8), (uint8_t)(din >> 16),
+                                       (uint8_t)(din >> 24)}};
+    return drive_send(dv, &f);
+}
+
 static int on_sync(struct drive *dv)
 {
     if (dv->nmt != NCP_NMT_OPERATIONAL)
@@ -138,7 +155,7 @@ static int on_sync(struct drive *dv)
     dv->tpdos++;
     if (dv->o.drop_every > 0 && dv->tpdos % dv->o.drop_every == 0)
         return 0;
-    return drive_send_tpdo(dv);
+    return drive_send_tpdo(dv) < 0 ? -1 : send_inputs(dv);
 }
 
 static int on_nmt(struct drive *dv, const struct ncp_can_frame *f)

@@ -28,6 +28,10 @@ struct drive_opts {
      * SYNCs from the first target that differs from the one at enabling, so
      * a fault lands at a point of the program however long start-up took */
     int count_from_motion;
+    /* --home-switch COUNTS: 0x60FD bit 2 while the actual position is at
+     * or above it */
+    int have_home_switch;
+    int32_t home_switch;
 };
 
 struct drive {

@@ -538,16 +538,6 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
                                   cfg->axis[j].home_sequence);
         }
     }
-    /* the search's switch is the simulated machine's: a CAN drive's own
-     * inputs (0x60FD) are not read, so a search there would latch nothing real */
-    for (int j = 0; j < NCP_AXES; j++)
-        if ((mask & NCP_AXIS_BIT(j)) && cfg->backend == NCP_BACKEND_SOCKETCAN &&
-            cfg->axis[j].home_search_vel != 0)
-            return refuse(why, len, "homing %c: the socketcan backend does not read the "
-                          "drive's home switch (0x60FD digital inputs) yet, so a search "
-                          "(HOME_SEARCH_VEL %g) would latch no real switch; HOME_SEARCH_VEL "
-                          "= 0 homes the axis where it stands", NCP_AXIS_LETTERS[j],
-                          cfg->axis[j].home_search_vel);
     for (int j = 0; j < NCP_AXES; j++)
         if (mask & NCP_AXIS_BIT(j))
             s->homed[j] = 0;
