@@ -73,6 +73,17 @@ int drive_send_heartbeat(struct drive *dv)
     return drive_send(dv, &f);
 }
 
+int drive_start_ramp(struct drive *dv, enum ncp_cia402_state during,
+                     enum ncp_cia402_state after, long long now_ms)
+{
+    dv->stop_vel = (double)dv->actual - dv->prev_actual;
+    dv->after_stop = after;
+    dv->next_step = now_ms;
+    drive_set_state(dv, during);
+    dv->halted = 0;
+    return drive_send_tpdo(dv);
+}
+
 static int apply_controlword(struct drive *dv, uint16_t cw)
 {
     dv->prev_cw = dv->cw;
@@ -87,7 +98,7 @@ static int apply_controlword(struct drive *dv, uint16_t cw)
         drive_servo_enable(dv);
     }
     if (next == NCP_402_QUICK_STOP_ACTIVE && dv->st == NCP_402_OPERATION_ENABLED)
-        return drive_quick_stop(dv, dv->now_ms);
+        return drive_start_ramp(dv, next, next, dv->now_ms);
     drive_set_state(dv, next);
     return 0;
 }

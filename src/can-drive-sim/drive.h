@@ -85,9 +85,11 @@ int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy);
 /* The statusword of the drive's state; in Quick stop active with bit 10
  * (target reached) once the ramp has ended. */
 uint16_t drive_statusword(const struct drive *dv);
-/* The master's Quick Stop (controlword 0x0002 in Operation enabled): brake
- * at 0x6085 on the drive's own clock and stay in Quick stop active. */
-int drive_quick_stop(struct drive *dv, long long now_ms);
+/* A ramp at 0x6085 on the drive's own clock (guard.c steps it): in state
+ * during, then after. The master's Quick Stop (controlword 0x0002 in
+ * Operation enabled) is one that stays in Quick stop active. */
+int drive_start_ramp(struct drive *dv, enum ncp_cia402_state during,
+                     enum ncp_cia402_state after, long long now_ms);
 
 /* guard.c: the deadlines of the master's heartbeat, SYNC and RPDO1, and the
  * drive's own reaction (0x6007, 0x605E) when one passes: called whenever the
