@@ -80,6 +80,14 @@ void ncp_sim_step_timed(struct ncp_sim *s, struct ncp_sim_timed *tm,
 struct ncp_backend;
 struct ncp_adcai_tap;
 
+/* A drive as the operator's status shows it (CiA 402 drives). */
+struct ncp_drive_info {
+    int axis;             /* 0..8 = X..W */
+    unsigned node;        /* CANopen node-ID */
+    uint16_t statusword;  /* 0x6041: the CiA 402 state is in it */
+    uint16_t error;       /* the last EMCY error code, 0 none */
+};
+
 struct ncp_backend_ops {
     const char *name;
     /* Before the real-time loop (may block, allocate, talk SDO): brings the
@@ -107,6 +115,13 @@ struct ncp_backend_ops {
      * all the time (they guard the master), also while the program is
      * checked before motion. NULL: nothing to hand over. */
     void (*live)(struct ncp_backend *b);
+    /* Not real-time (the serving thread): the drives as their last frames
+     * said, one per row up to max; the count. NULL: no drives to show. */
+    int (*drives)(const struct ncp_backend *b, struct ncp_drive_info *out, int max);
+    /* Real-time, after cycle(): the home switch of the axis's drive as its
+     * last frame said, 1 pressed or 0; -1 when the backend has none to read
+     * (NULL: the same). Homing then uses the simulated switch. */
+    int (*home_switch)(const struct ncp_backend *b, int axis);
 };
 
 /* The ADCBI planner's calls, as plan_journal sees them. */

@@ -16,6 +16,7 @@
 #define NCP_COB_EMCY      0x080u
 #define NCP_COB_TPDO1     0x180u
 #define NCP_COB_RPDO1     0x200u
+#define NCP_COB_TPDO2     0x280u /* digital inputs 0x60FD, when mapped */
 #define NCP_COB_SDO_TX    0x580u /* server (drive) -> client (master) */
 #define NCP_COB_SDO_RX    0x600u /* client -> server */
 #define NCP_COB_HEARTBEAT 0x700u
@@ -117,6 +118,9 @@ struct ncp_emcy {
 };
 void ncp_emcy_frame(struct ncp_can_frame *f, uint8_t node, const struct ncp_emcy *e);
 int ncp_emcy_decode(const struct ncp_can_frame *f, struct ncp_emcy *e);
+/* The meaning of an EMCY error code: the codes CiA 402 servos commonly
+ * send, the rest by their CiA 301 class ("monitoring error"). */
+const char *ncp_emcy_code_text(uint16_t code);
 /* "0x8611 following error; register 0x21: generic, device profile" */
 void ncp_emcy_describe(const struct ncp_emcy *e, char *buf, size_t len);
 
@@ -148,6 +152,18 @@ uint16_t ncp_cia402_statusword(enum ncp_cia402_state s);
 /* Next state of a drive in state s receiving controlword cw. */
 enum ncp_cia402_state ncp_cia402_apply(enum ncp_cia402_state s, uint16_t cw,
                                        uint16_t prev_cw);
+/* Statusword bit 10: in Quick stop active, the drive has come to rest. */
+#define NCP_402_SW_TARGET_REACHED 0x0400u
+/* TPDOs in a row with the same actual position that count as at rest for
+ * a drive that does not set bit 10 in Quick stop active. */
+#define NCP_402_STILL_TPDOS 3
+/* An E-stop from the seat, for one drive: at rest after its quick stop
+ * (bit 10, or still for NCP_402_STILL_TPDOS TPDOs)? */
+int ncp_cia402_at_rest(uint16_t statusword, int still_tpdos);
+/* The controlword of a drive being E-stopped: Quick Stop while it is
+ * enabled or still braking, Disable Voltage once at rest, and at once in
+ * any other state (Fault included: a reset is the operator's). */
+uint16_t ncp_cia402_estop_cw(uint16_t statusword, int still_tpdos);
 
 /* ---- what the master knows of each drive --------------------------- */
 struct ncp_co_node {
@@ -159,11 +175,15 @@ struct ncp_co_node {
     uint8_t hb_state;     /* enum ncp_nmt_state */
     uint32_t emcys;       /* EMCY frames received; the last one in emcy */
     struct ncp_emcy emcy;
+    uint32_t din;         /* digital inputs 0x60FD from TPDO2 (bit 2: home switch) */
+    uint32_t dins;        /* TPDO2 frames received */
 };
-enum ncp_co_event { NCP_CO_NONE, NCP_CO_TPDO, NCP_CO_HEARTBEAT, NCP_CO_EMCY };
+enum ncp_co_event { NCP_CO_NONE, NCP_CO_TPDO, NCP_CO_HEARTBEAT, NCP_CO_EMCY, NCP_CO_DIN };
+/* 0x60FD bit 2 (CiA 402): the home switch. */
+#define NCP_402_DIN_HOME_SWITCH 0x4u
 
 void ncp_co_node_init(struct ncp_co_node *node, uint8_t id);
-/* The COB-IDs a master listens to for these nodes (4 per node); returns count. */
+/* The COB-IDs a master listens to for these nodes (5 per node); returns count. */
 size_t ncp_co_filter_ids(const struct ncp_co_node *nodes, size_t n, uint32_t *ids,
                          size_t max);
 /* Updates the node the frame comes from; returns what the frame was. */
@@ -196,6 +216,9 @@ struct ncp_co_master_cfg {
     int rpdo_timeout_ms;
     int abort_option;
     int fault_reaction;
+    /* TPDO2 = digital inputs 0x60FD at every SYNC (a homing search reads
+     * the home switch there); 0: not mapped */
+    int map_din;
 };
 
 enum ncp_co_fault_kind {
@@ -244,6 +267,15 @@ struct ncp_co_master {
     int64_t next_hb_ms;                 /* the master's next own heartbeat */
     unsigned tx_full;                   /* consecutive periods with a full queue */
     struct ncp_co_fault fault;
+    /* The seat's E-stop and reset (cnc-run serve): RUN follows the targets;
+     * ESTOP brakes every drive (Quick Stop, then Disable Voltage at rest);
+     * ENABLING walks each back to Operation enabled holding its actual
+     * position. still[]/seen[]: TPDOs in a row with an unchanged actual. */
+    int mode;                           /* enum ncp_co_mode */
+    uint8_t still[NCP_CO_MAX_NODES];
+    uint32_t seen[NCP_CO_MAX_NODES];    /* node tpdos at the last look */
+    int32_t last_act[NCP_CO_MAX_NODES];
+    long mode_cycles;                   /* periods since the mode began */
     /* blocking cycles call this for every TPDO taken in (tests judge them) */
     void (*on_tpdo)(void *ctx, size_t i);
     void *on_tpdo_ctx;
@@ -285,5 +317,19 @@ int ncp_co_master_check(struct ncp_co_master *m, int64_t now_ms);
  * once on a socket error. */
 int ncp_co_master_send(struct ncp_co_master *m);
 int64_t ncp_co_now_ms(void);
+
+/* ---- the seat: E-stop and reset of the drives (real-time, seat.c) ---- */
+enum ncp_co_mode { NCP_CO_RUN, NCP_CO_ESTOP, NCP_CO_ENABLING };
+/* Periods a reset may take to bring every drive to Operation enabled. */
+#define NCP_CO_ENABLE_PERIODS 400
+/* on = 0: E-stop every drive; 1 after an E-stop: walk them back to
+ * Operation enabled (fault reset where in Fault), the fault and EMCY codes
+ * forgotten (1 while running: nothing). */
+void ncp_co_master_seat(struct ncp_co_master *m, int on);
+/* Outside RUN, one period's controlwords, and targets at the actual
+ * positions. ENABLING turns into RUN once every drive is enabled (then 0);
+ * 1 while the mode holds the drives; -1 with a STATE fault when a reset
+ * found a drive that would not enable within NCP_CO_ENABLE_PERIODS. */
+int ncp_co_master_seat_step(struct ncp_co_master *m);
 
 #endif

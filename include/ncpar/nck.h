@@ -291,6 +291,11 @@ struct ncp_nck_snapshot {
     int estimate_state;
     double estimate_s, estimate_path_mm, estimate_ferr_mm, estimate_compute_s;
     double program_time_s;           /* the last program run's, start to end (0: none) */
+    /* CiA 402 drives (socketcan backend), as their last frames said */
+    int n_drives;
+    char drive_axis[NCP_NCK_AXES_MAX];
+    unsigned drive_node[NCP_NCK_AXES_MAX];
+    uint16_t drive_statusword[NCP_NCK_AXES_MAX], drive_error[NCP_NCK_AXES_MAX];
 };
 
 /* A load's estimate (cnc-run serve): running in the background, done,

@@ -626,7 +626,7 @@ static void lcm_close(struct ncp_backend *b)
 }
 
 static const struct ncp_backend_ops lcm_ops = {
-    "lcm", lcm_start, lcm_cycle, lcm_stop, lcm_describe, lcm_close, lcm_enable, lcm_live,
+    "lcm", lcm_start, lcm_cycle, lcm_stop, lcm_describe, lcm_close, lcm_enable, lcm_live, NULL, NULL,
 };
 
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,

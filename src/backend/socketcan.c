@@ -10,7 +10,10 @@
  * are those send()/recv() with MSG_DONTWAIT and the clock_gettime of the
  * vDSO. A drive's TPDO answers the previous period's SYNC: the actual
  * position is one servo period old.
- * stop() (after the loop): hold, shutdown, NMT pre-operational. */
+ * stop() (after the loop): hold, shutdown, NMT pre-operational.
+ * enable() (a serving NCK's E-stop, fault and reset, real-time): Quick Stop
+ * on every drive then Disable Voltage at rest, or the walk back to
+ * Operation enabled at the actual positions (src/can/seat.c). */
 #include "ncpar/backend.h"
 #include "ncpar/can.h"
 
@@ -34,6 +37,8 @@ struct sc {
     int idle_started;
     atomic_int idle_run;
     atomic_int idle_failed;
+    /* for the seat's status: statusword | last EMCY code << 16, per node */
+    atomic_uint pub[NCP_CO_MAX_NODES];
 };
 
 static void *idle_main(void *arg)
@@ -93,14 +98,40 @@ static int sc_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const dou
     /* a fault while the drives were held before the loop (fault recorded) */
     int bad = atomic_load(&s->idle_failed) || ncp_co_master_poll(m, now, POLL_MAX) ||
               ncp_co_master_check(m, now);
-    for (int k = 0; k < s->n; k++)
-        act[s->ax[k]] = ncp_counts_to_mm(m->node[k].actual, s->cpm[k]);
-    if (bad)
+    for (int k = 0; k < s->n; k++) {
+        const struct ncp_co_node *nd = &m->node[k];
+        act[s->ax[k]] = ncp_counts_to_mm(nd->actual, s->cpm[k]);
+        atomic_store_explicit(&s->pub[k], (unsigned)nd->statusword | (unsigned)nd->emcy.code << 16,
+                              memory_order_relaxed);
+    }
+    if (m->mode == NCP_CO_RUN && bad)
         return -1;
-    for (int k = 0; k < s->n; k++)
+    /* E-stopped or being reset: the drives hear their controlwords every
+     * period, faults or not, and the NCK's frozen setpoints are not theirs */
+    int seat = ncp_co_master_seat_step(m);
+    for (int k = 0; seat == 0 && k < s->n; k++)
         if (ncp_mm_to_counts(next[s->ax[k]], s->cpm[k], &m->target[k]))
             return -1; /* cannot happen within the checked soft limits */
-    return ncp_co_master_send(m);
+    int rc = ncp_co_master_send(m);
+    return bad || seat < 0 || rc ? -1 : 0;
+}
+
+static void sc_enable(struct ncp_backend *b, int on)
+{
+    struct sc *s = b->impl;
+    ncp_co_master_seat(&s->m, on);
+}
+
+static int sc_drives(const struct ncp_backend *b, struct ncp_drive_info *out, int max)
+{
+    struct sc *s = b->impl;
+    int n = 0;
+    for (; n < s->n && n < max; n++) {
+        unsigned v = atomic_load_explicit(&s->pub[n], memory_order_relaxed);
+        out[n] = (struct ncp_drive_info){ s->ax[n], s->m.node[n].id, (uint16_t)(v & 0xFFFFu),
+                                          (uint16_t)(v >> 16) };
+    }
+    return n;
 }
 
 static void sc_stop(struct ncp_backend *b)
@@ -124,8 +155,20 @@ static void sc_close(struct ncp_backend *b)
     b->impl = NULL;
 }
 
+static int sc_home_switch(const struct ncp_backend *b, int axis)
+{
+    const struct sc *s = b->impl;
+    for (int k = 0; k < s->n; k++)
+        if (s->ax[k] == axis)
+            return !s->m.cfg.map_din || s->m.node[k].dins == 0
+                       ? -1
+                       : (s->m.node[k].din & NCP_402_DIN_HOME_SWITCH) != 0;
+    return -1;
+}
+
 static const struct ncp_backend_ops sc_ops = {
-    "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, NULL, sc_live,
+    "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, sc_enable, sc_live, sc_drives,
+    sc_home_switch,
 };
 
 int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
@@ -155,6 +198,9 @@ int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_c
         .abort_option = cfg->can.abort_option,
         .fault_reaction = cfg->can.fault_reaction,
     };
+    /* a homing search reads the drive's home switch (0x60FD in TPDO2) */
+    for (int k = 0; k < s->n; k++)
+        mc.map_din |= cfg->axis[s->ax[k]].home_search_vel != 0;
     if (ncp_co_master_open(&s->m, cfg->can.interface, nodes, s->n, &mc, d) != NCP_OK) {
         free(s);
         return d->code;

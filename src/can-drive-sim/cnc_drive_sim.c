@@ -39,6 +39,8 @@ static void usage(FILE *f)
           "                            instead of the slew-limited plant\n"
           "  --sync-loss-ms MS         no SYNC for MS ms while enabled: EMCY 0x8700 and\n"
           "                            the stop of 0x6007 (default 100, 0 = never)\n"
+          "  --home-switch COUNTS      home switch (0x60FD bit 2, in TPDO2 where the master\n"
+          "                            maps it) pressed at and above this actual position\n"
           "  --verbose                 log state changes on stderr\n"
           "Answers NMT, SDO (expedited), SYNC and RPDO1/TPDO1 (controlword+target,\n"
           "statusword+actual); heartbeat period from object 0x1017 (default 100 ms).\n"
@@ -70,6 +72,7 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         {"verbose", no_argument, 0, 'v'},            {"help", no_argument, 0, 'h'},
         {"config", required_argument, 0, 'c'},       {"axis", required_argument, 0, 'x'},
         {"sync-loss-ms", required_argument, 0, 'L'}, {"count-from-motion", no_argument, 0, 'M'},
+        {"home-switch", required_argument, 0, 'S'},
         {0, 0, 0, 0}};
     *o = (struct drive_opts){.node = 0, .fault_after = -1, .emcy_after = -1,
                              .hb_stop_after = -1, .abort_index = -1, .max_step = 1000000,
@@ -90,6 +93,10 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         case 'M': o->count_from_motion = 1; break;
         case 'L': o->sync_loss_ms = num(optarg, "--sync-loss-ms", 0, 600000); break;
         case 'c': o->config = optarg; break;
+        case 'S':
+            o->have_home_switch = 1;
+            o->home_switch = (int32_t)num(optarg, "--home-switch", -(1L << 30), 1L << 30);
+            break;
         case 'x':
             if (!optarg[0] || optarg[1] || !strchr("XYZxyz", optarg[0])) {
                 fprintf(stderr, "cnc-drive-sim: --axis is X, Y or Z\n");

@@ -26,8 +26,16 @@ void drive_set_state(struct drive *dv, enum ncp_cia402_state s)
     if (s != dv->st && dv->o.verbose)
         fprintf(stderr, "cnc-drive-sim node %u: %s -> %s\n", dv->o.node,
                 ncp_cia402_state_name(dv->st), ncp_cia402_state_name(s));
+    if (s != dv->st)
+        dv->halted = 0;
     dv->st = s;
-    od_set(&dv->od, 0x6041, 0, ncp_cia402_statusword(s));
+    od_set(&dv->od, 0x6041, 0, drive_statusword(dv));
+}
+
+uint16_t drive_statusword(const struct drive *dv)
+{
+    uint16_t sw = ncp_cia402_statusword(dv->st);
+    return dv->halted && dv->st == NCP_402_QUICK_STOP_ACTIVE ? sw | NCP_402_SW_TARGET_REACHED : sw;
 }
 
 void drive_boot(struct drive *dv)
@@ -52,7 +60,7 @@ void drive_boot(struct drive *dv)
 int drive_send_tpdo(struct drive *dv)
 {
     struct ncp_can_frame f;
-    ncp_tpdo1_frame(&f, dv->o.node, ncp_cia402_statusword(dv->st), dv->actual);
+    ncp_tpdo1_frame(&f, dv->o.node, drive_statusword(dv), dv->actual);
     return drive_send(dv, &f);
 }
 
@@ -65,7 +73,18 @@ int drive_send_heartbeat(struct drive *dv)
     return drive_send(dv, &f);
 }
 
-static void apply_controlword(struct drive *dv, uint16_t cw)
+int drive_start_ramp(struct drive *dv, enum ncp_cia402_state during,
+                     enum ncp_cia402_state after, long long now_ms)
+{
+    dv->stop_vel = (double)dv->actual - dv->prev_actual;
+    dv->after_stop = after;
+    dv->next_step = now_ms;
+    drive_set_state(dv, during);
+    dv->halted = 0;
+    return drive_send_tpdo(dv);
+}
+
+static int apply_controlword(struct drive *dv, uint16_t cw)
 {
     dv->prev_cw = dv->cw;
     dv->cw = cw;
@@ -78,7 +97,10 @@ static void apply_controlword(struct drive *dv, uint16_t cw)
         dv->prev_actual = dv->actual;
         drive_servo_enable(dv);
     }
+    if (next == NCP_402_QUICK_STOP_ACTIVE && dv->st == NCP_402_OPERATION_ENABLED)
+        return drive_start_ramp(dv, next, next, dv->now_ms);
     drive_set_state(dv, next);
+    return 0;
 }
 
 int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy)
@@ -104,6 +126,23 @@ static int32_t plant_step(int32_t actual, int32_t target, int32_t max_step)
     return (int32_t)(actual + err);
 }
 
+/* TPDO2 with the digital inputs 0x60FD, where the master mapped it and
+ * asked for it at every SYNC. */
+static int send_inputs(struct drive *dv)
+{
+    uint32_t din = dv->o.have_home_switch && dv->actual >= dv->o.home_switch
+                       ? NCP_402_DIN_HOME_SWITCH : 0;
+    od_set(&dv->od, 0x60FD, 0, din);
+    uint32_t tt = od_get(&dv->od, 0x1801, 2);
+    if (od_get(&dv->od, 0x1A01, 0) != 1 || od_get(&dv->od, 0x1A01, 1) != 0x60FD0020u ||
+        tt < 1 || tt > 240)
+        return 0;
+    struct ncp_can_frame f = {.id = NCP_COB_TPDO2 + dv->o.node, .len = 4,
+                              .data = {(uint8_t)din, (uint8_t)(din >> 8), (uint8_t)(din >> 16),
+                                       (uint8_t)(din >> 24)}};
+    return drive_send(dv, &f);
+}
+
 static int on_sync(struct drive *dv)
 {
     if (dv->nmt != NCP_NMT_OPERATIONAL)
@@ -127,7 +166,7 @@ static int on_sync(struct drive *dv)
     dv->tpdos++;
     if (dv->o.drop_every > 0 && dv->tpdos % dv->o.drop_every == 0)
         return 0;
-    return drive_send_tpdo(dv);
+    return drive_send_tpdo(dv) < 0 ? -1 : send_inputs(dv);
 }
 
 static int on_nmt(struct drive *dv, const struct ncp_can_frame *f)
@@ -163,7 +202,7 @@ static void after_write(struct drive *dv, struct od_entry *e, uint32_t v)
     if (e->index == 0x6060)
         od_set(&dv->od, 0x6061, 0, v);
     else if (e->index == 0x6040)
-        apply_controlword(dv, (uint16_t)v);
+        (void)apply_controlword(dv, (uint16_t)v);
     else if (e->index == 0x607A)
         dv->target = (int32_t)v;
 }
@@ -210,6 +249,7 @@ int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f, long long no
 {
     uint8_t n = dv->o.node;
     unsigned master = drive_master_node(dv);
+    dv->now_ms = now_ms;
     if (f->id == NCP_COB_NMT)
         return on_nmt(dv, f);
     if (master && f->id == NCP_COB_HEARTBEAT + master) {
@@ -227,8 +267,8 @@ int drive_on_frame(struct drive *dv, const struct ncp_can_frame *f, long long no
         int32_t target;
         dv->last_rpdo = now_ms;
         if (ncp_rpdo1_decode(f, &cw, &target) == 0) {
-            if (cw != dv->cw)
-                apply_controlword(dv, cw);
+            if (cw != dv->cw && apply_controlword(dv, cw) < 0)
+                return -1;
             if (dv->st == NCP_402_OPERATION_ENABLED)
                 dv->target = target;
         }

@@ -28,6 +28,10 @@ struct drive_opts {
      * SYNCs from the first target that differs from the one at enabling, so
      * a fault lands at a point of the program however long start-up took */
     int count_from_motion;
+    /* --home-switch COUNTS: 0x60FD bit 2 while the actual position is at
+     * or above it */
+    int have_home_switch;
+    int32_t home_switch;
 };
 
 struct drive {
@@ -56,6 +60,8 @@ struct drive {
     double stop_vel;      /* counts per period while ramping down on its own */
     long long next_step;  /* the ramp's next step, ms */
     enum ncp_cia402_state after_stop; /* where the ramp ends */
+    int halted;           /* a quick stop's ramp ended (statusword bit 10) */
+    long long now_ms;     /* the drive's clock at the frame being handled */
 };
 
 /* 0x60C2: value * 10^index s, the period the master runs SYNC at. */
@@ -76,6 +82,14 @@ unsigned drive_master_node(struct drive *dv);
 void drive_set_state(struct drive *dv, enum ncp_cia402_state s);
 int drive_send(struct drive *dv, const struct ncp_can_frame *f);
 int drive_go_fault(struct drive *dv, uint16_t code, int with_emcy);
+/* The statusword of the drive's state; in Quick stop active with bit 10
+ * (target reached) once the ramp has ended. */
+uint16_t drive_statusword(const struct drive *dv);
+/* A ramp at 0x6085 on the drive's own clock (guard.c steps it): in state
+ * during, then after. The master's Quick Stop (controlword 0x0002 in
+ * Operation enabled) is one that stays in Quick stop active. */
+int drive_start_ramp(struct drive *dv, enum ncp_cia402_state during,
+                     enum ncp_cia402_state after, long long now_ms);
 
 /* guard.c: the deadlines of the master's heartbeat, SYNC and RPDO1, and the
  * drive's own reaction (0x6007, 0x605E) when one passes: called whenever the

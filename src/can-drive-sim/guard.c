@@ -53,16 +53,6 @@ static int period_ms(struct drive *dv)
     return ms > 0 ? ms : 1;
 }
 
-static int start_ramp(struct drive *dv, enum ncp_cia402_state during, enum ncp_cia402_state after,
-                      long long now)
-{
-    dv->stop_vel = (double)dv->actual - dv->prev_actual;
-    dv->after_stop = after;
-    dv->next_step = now;
-    drive_set_state(dv, during);
-    return drive_send_tpdo(dv);
-}
-
 static int react(struct drive *dv, uint16_t code, long long now)
 {
     dv->lost = code;
@@ -81,7 +71,7 @@ static int react(struct drive *dv, uint16_t code, long long now)
         drive_set_state(dv, NCP_402_SWITCH_ON_DISABLED);
         return drive_send_tpdo(dv);
     case 3:
-        return start_ramp(dv, NCP_402_QUICK_STOP_ACTIVE, NCP_402_SWITCH_ON_DISABLED, now);
+        return drive_start_ramp(dv, NCP_402_QUICK_STOP_ACTIVE, NCP_402_SWITCH_ON_DISABLED, now);
     default:
         od_set(&dv->od, 0x603F, 0, code);
         od_set(&dv->od, 0x1001, 0, 0x11);
@@ -90,7 +80,7 @@ static int react(struct drive *dv, uint16_t code, long long now)
             drive_set_state(dv, NCP_402_FAULT);
             return drive_send_tpdo(dv);
         }
-        return start_ramp(dv, NCP_402_FAULT_REACTION_ACTIVE, NCP_402_FAULT, now);
+        return drive_start_ramp(dv, NCP_402_FAULT_REACTION_ACTIVE, NCP_402_FAULT, now);
     }
 }
 
@@ -106,14 +96,18 @@ static int ramp_step(struct drive *dv)
     dv->actual += (int32_t)lround(dv->stop_vel);
     dv->target = dv->actual;
     od_set(&dv->od, 0x6064, 0, (uint32_t)dv->actual);
-    if (dv->stop_vel == 0)
+    if (dv->stop_vel == 0) {
         drive_set_state(dv, dv->after_stop);
+        dv->halted = 1;
+        od_set(&dv->od, 0x6041, 0, drive_statusword(dv));
+    }
     return drive_send_tpdo(dv);
 }
 
 static int ramping(const struct drive *dv)
 {
-    return dv->st == NCP_402_QUICK_STOP_ACTIVE || dv->st == NCP_402_FAULT_REACTION_ACTIVE;
+    return (dv->st == NCP_402_QUICK_STOP_ACTIVE || dv->st == NCP_402_FAULT_REACTION_ACTIVE) &&
+           !dv->halted;
 }
 
 int drive_guard_tick(struct drive *dv, long long now)

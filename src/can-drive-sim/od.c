@@ -26,6 +26,10 @@ void od_init(struct od *od)
     add(od, 0x1600, 2, 4, OD_RW, 0x607A0020);
     add(od, 0x1800, 1, 4, OD_RW, 0x180);
     add(od, 0x1800, 2, 1, OD_RW, 1);
+    add(od, 0x1801, 1, 4, OD_RW, 0x280);      /* TPDO2 COB-ID (+ node) */
+    add(od, 0x1801, 2, 1, OD_RW, 255);        /* event-driven until set to every SYNC */
+    add(od, 0x1A01, 0, 1, OD_RW, 0);          /* TPDO2 unmapped until the master maps it */
+    add(od, 0x1A01, 1, 4, OD_RW, 0);
     add(od, 0x1A00, 0, 1, OD_RW, 2);
     add(od, 0x1A00, 1, 4, OD_RW, 0x60410010);
     add(od, 0x1A00, 2, 4, OD_RW, 0x60640020);
@@ -40,6 +44,7 @@ void od_init(struct od *od)
     add(od, 0x6064, 0, 4, OD_RO, 0);
     add(od, 0x607A, 0, 4, OD_RW, 0);
     add(od, 0x6085, 0, 4, OD_RW, 2000000);    /* quick stop deceleration, counts/s^2 */
+    add(od, 0x60FD, 0, 4, OD_RO, 0);          /* digital inputs: bit 2 home switch */
     add(od, 0x60C2, 1, 1, OD_RW, 1);          /* interpolation period value */
     add(od, 0x60C2, 2, 1, OD_RW, 0xFD);       /* ... index: 10^-3 s */
 }

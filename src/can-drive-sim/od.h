@@ -15,7 +15,7 @@ struct od_entry {
 };
 
 struct od {
-    struct od_entry e[48];
+    struct od_entry e[64];
     int n;
 };
 

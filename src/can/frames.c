@@ -97,22 +97,26 @@ int ncp_emcy_decode(const struct ncp_can_frame *f, struct ncp_emcy *e)
 }
 
 /* Codes a CiA 402 servo commonly sends; the rest by their CiA 301 class. */
-static const char *emcy_code_text(uint16_t code)
+const char *ncp_emcy_code_text(uint16_t code)
 {
     static const struct { uint16_t code; const char *text; } known[] = {
         {0x0000, "error reset / no error"},
         {0x2310, "continuous over-current"},
+        {0x2320, "short circuit at the outputs"},
         {0x3210, "DC link over-voltage"},
         {0x3220, "DC link under-voltage"},
         {0x4310, "drive over-temperature"},
         {0x5530, "EEPROM / data storage fault"},
+        {0x7121, "motor blocked"},
         {0x7305, "incremental encoder fault"},
         {0x8110, "CAN overrun (frames lost)"},
         {0x8120, "CAN in error passive mode"},
         {0x8130, "life guard or heartbeat error"},
         {0x8140, "recovered from bus off"},
         {0x8611, "following error"},
+        {0x8250, "RPDO timeout"},
         {0x8612, "reference limit"},
+        {0x8700, "sync controller: SYNC lost"},
     };
     for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
         if (known[i].code == code)
@@ -138,7 +142,7 @@ void ncp_emcy_describe(const struct ncp_emcy *e, char *buf, size_t len)
                                         "communication", "device profile", "reserved",
                                         "manufacturer"};
     int n = snprintf(buf, len, "error code 0x%04X %s; error register 0x%02X", e->code,
-                     emcy_code_text(e->code), e->reg);
+                     ncp_emcy_code_text(e->code), e->reg);
     const char *sep = ": ";
     for (int b = 0; b < 8 && n >= 0 && (size_t)n < len; b++) {
         if (!(e->reg & (1u << b)))

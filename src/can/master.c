@@ -28,7 +28,7 @@ int ncp_co_master_open(struct ncp_co_master *m, const char *ifname, const uint8_
     for (size_t i = 0; i < n; i++)
         ncp_co_node_init(&m->node[i], nodes[i]);
     m->n = n;
-    uint32_t ids[4 * NCP_CO_MAX_NODES];
+    uint32_t ids[5 * NCP_CO_MAX_NODES];
     size_t nids = ncp_co_filter_ids(m->node, n, ids, sizeof ids / sizeof ids[0]);
     if (ncp_can_open(&m->bus, ifname, d) != NCP_OK)
         return d->code;
@@ -99,6 +99,12 @@ int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *
     size_t n_guard = !m->cfg.master_node       ? 0
                      : m->quick_stop_dec[i] != 0 ? sizeof guard / sizeof guard[0]
                                                : sizeof guard / sizeof guard[0] - 1;
+    /* TPDO2 = the digital inputs, at every SYNC (only where homing needs
+     * the switch: a start-up without it stays as it was) */
+    const struct sdo_step din[] = {
+        {0x1801, 2, 1, 1},
+        {0x1A01, 0, 0, 1}, {0x1A01, 1, 0x60FD0020, 4}, {0x1A01, 0, 1, 1},
+    };
     uint32_t v;
     int to = m->cfg.sdo_timeout_ms;
     if (ncp_sdo_read(&m->bus, node, 0x1000, 0, &v, to, NULL, d) != NCP_OK)
@@ -110,6 +116,7 @@ int ncp_co_master_configure(struct ncp_co_master *m, size_t i, struct ncp_diag *
         return start_fault(m, node, d);
     }
     if (write_steps(m, node, steps, sizeof steps / sizeof steps[0], d) ||
+        (m->cfg.map_din && write_steps(m, node, din, sizeof din / sizeof din[0], d)) ||
         write_steps(m, node, guard, n_guard, d))
         return start_fault(m, node, d);
     if (ncp_sdo_read(&m->bus, node, 0x6061, 0, &v, to, NULL, d) != NCP_OK)

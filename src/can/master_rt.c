@@ -29,9 +29,13 @@ static int emcy_fault(struct ncp_co_master *m, const struct ncp_can_frame *f)
         const struct ncp_co_node *nd = &m->node[i];
         /* code 0x0000 is "error reset / no error": the drive recovered */
         if (nd->id == (f->id & 0x7Fu) && nd->emcy.code != 0) {
-            m->fault.kind = NCP_CO_FAULT_EMCY;
-            m->fault.node = nd->id;
-            m->fault.emcy = nd->emcy;
+            /* the first fault is the one the operator is told of: a drive
+             * stopping on its own after it says nothing new */
+            if (m->fault.kind == NCP_CO_FAULT_NONE) {
+                m->fault.kind = NCP_CO_FAULT_EMCY;
+                m->fault.node = nd->id;
+                m->fault.emcy = nd->emcy;
+            }
             return -1;
         }
     }

@@ -10,9 +10,10 @@ size_t ncp_co_filter_ids(const struct ncp_co_node *nodes, size_t n, uint32_t *id
                          size_t max)
 {
     size_t k = 0;
-    for (size_t i = 0; i < n && k + 4 <= max; i++) {
+    for (size_t i = 0; i < n && k + 5 <= max; i++) {
         ids[k++] = NCP_COB_SDO_TX + nodes[i].id;
         ids[k++] = NCP_COB_TPDO1 + nodes[i].id;
+        ids[k++] = NCP_COB_TPDO2 + nodes[i].id;
         ids[k++] = NCP_COB_EMCY + nodes[i].id;
         ids[k++] = NCP_COB_HEARTBEAT + nodes[i].id;
     }
@@ -30,6 +31,12 @@ enum ncp_co_event ncp_co_track(struct ncp_co_node *nodes, size_t n,
         if (fn == NCP_COB_TPDO1 && ncp_tpdo1_decode(f, &nd->statusword, &nd->actual) == 0) {
             nd->tpdos++;
             return NCP_CO_TPDO;
+        }
+        if (fn == NCP_COB_TPDO2 && f->len >= 4) {
+            nd->din = (uint32_t)f->data[0] | (uint32_t)f->data[1] << 8 |
+                      (uint32_t)f->data[2] << 16 | (uint32_t)f->data[3] << 24;
+            nd->dins++;
+            return NCP_CO_DIN;
         }
         if (fn == NCP_COB_HEARTBEAT && f->len >= 1) {
             nd->last_hb_ms = now_ms;

@@ -53,12 +53,13 @@ static void ready(void *ctx, const char *prefix)
 static void usage(FILE *f)
 {
     fputs("usage: cnc-run serve [--config INI] [--lcm-url URL] [--prefix P] [--key-file F]\n"
-          "                     [--backend sim|lcm] [--dp N]\n"
+          "                     [--backend sim|socketcan[:IFACE]|lcm] [--dp N]\n"
           "                     [--clock real|virtual] [--trace CSV] [--mode serial|det|att]\n"
           "                     [--tool-table FILE] [--subroutine-path DIR[:DIR...]]\n"
           "                     [--inject SPEC[,SPEC...]] [--seed N]\n"
           "                     [--http [ADDR:]PORT [--http-readonly] [--web DIR]]\n"
-          "Runs the NCK as a service on the simulated machine or on distributed axes: it\n"
+          "Runs the NCK as a service on the simulated machine, CiA 402 drives or\n"
+          "distributed axes: it\n"
           "holds the axes where they are and waits for commands on LCM (cnc-ctl is its\n"
           "command-line client).\n"
           "  --config INI        machine INI (default: built-in 3-axis mill); [LCM] URL,\n"
@@ -75,6 +76,12 @@ static void usage(FILE *f)
           "  --prefix P          channel prefix (channels PCMD, PACK, PSTATUS, PEVENT)\n"
           "  --backend sim       the simulated machine (default: the INI's [EMCMOT] BACKEND,\n"
           "                      else sim)\n"
+          "  --backend socketcan[:IFACE]  CiA 402 drives in CSP mode over SocketCAN\n"
+          "                      ([CAN] INTERFACE; docs/integrator.md); real clock only,\n"
+          "                      one machine INI. E-stop: Quick Stop on every drive, then\n"
+          "                      Disable Voltage once at rest; reset: fault reset, back\n"
+          "                      to Operation enabled where the axes stand; a drive's\n"
+          "                      fault or EMCY is state fault with its code and meaning\n"
           "  --backend lcm       the distributed NCK: one `cnc-axis` per axis of the INI on\n"
           "                      the same LCM URL and key (docs/distributed.md); real clock\n"
           "                      only, one machine INI (no [CHANNEL_n]). Served at the\n"
@@ -243,26 +250,14 @@ struct serve_channel {
     const char *tool_table;         /* --tool-table, else [EMCIO] TOOL_TABLE, or NULL */
 };
 
-/* What serve drives beyond the simulated machine is what every command of
- * the seat can stop along the path and hold: 0, or -1 after saying what is
- * missing for the rest. */
-static int no_socketcan(const struct serve_channel *ch, const char *backend)
-{
-    const char *ini = ch->config ? ch->config : "the built-in mill";
-    /* before the CAN keys are checked: what is missing is not in the INI */
-    if (backend ? !strncmp(backend, "socketcan", 9) : ch->cfg.backend == NCP_BACKEND_SOCKETCAN)
-        return fprintf(stderr, "cnc-run serve: %s: the socketcan backend is not served yet: it "
-                               "has no hook to disable the drives, so an E-stop would hold them "
-                               "at a frozen setpoint instead of Quick Stop and Disable Voltage, "
-                               "and homing cannot read a drive's inputs; CAN drives run under "
-                               "cnc-run run --backend socketcan\n", ini), -1;
-    return 0;
-}
-
 static int servable(const struct serve_channel *ch, int several)
 {
     const struct ncp_machine_cfg *c = &ch->cfg;
     const char *ini = ch->config ? ch->config : "the built-in mill";
+    if (c->backend == NCP_BACKEND_SOCKETCAN && several)
+        return fprintf(stderr, "cnc-run serve: %s: --backend socketcan serves one machine INI, "
+                               "not channels of [CHANNEL_n]: one master sends SYNC on a bus, "
+                               "and each channel would send its own\n", ini), -1;
     if (c->backend != NCP_BACKEND_LCM)
         return 0;
     if (several)
@@ -292,7 +287,7 @@ static int load_channel(struct serve_channel *ch, const struct serve_args *a, in
     if (ncp_cli_load_machine(ch->config, &ch->cfg) ||
         ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
         ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg) ||
-        no_socketcan(ch, a->backend) || ncp_cli_apply_backend(&bo, &ch->cfg) ||
+        ncp_cli_apply_backend(&bo, &ch->cfg) ||
         servable(ch, several))
         return -1;
     ch->tool_table = a->tool_table ? a->tool_table

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "ctl.h"
+#include "ncpar/can.h"
 
 static int n_axes(const ncp_status_t *s)
 {
@@ -79,6 +80,14 @@ void ctl_print_status(const ncp_status_t *s)
            (long long)s->cycles, (long long)s->deadline_misses, s->latency_max_us);
     printf("dropped   %lld without the key's seal, %lld past their deadline, %lld replayed\n",
            (long long)s->auth_failed, (long long)s->stale, (long long)s->replayed);
+    for (int k = 0; k < s->n_drives && k < 9; k++) {
+        uint16_t sw = (uint16_t)s->drive_statusword[k], err = (uint16_t)s->drive_error[k];
+        printf("drive %c   node %d: %s, statusword 0x%04X", s->drive_axis[k], (int)s->drive_node[k],
+               ncp_cia402_state_name(ncp_cia402_state(sw)), sw);
+        if (err)
+            printf(", last EMCY 0x%04X %s", err, ncp_emcy_code_text(err));
+        printf("\n");
+    }
 }
 
 void ctl_print_event(const ncp_event_t *e)

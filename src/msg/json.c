@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "ncpar/can.h"
 #include "ncpar/msg.h"
 
 struct out {
@@ -171,7 +172,16 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
     put_num(&o, "%.3f", s->estimate_compute_s);
     put(&o, "}, \"program_time_s\": ");
     put_num(&o, "%.6f", s->program_time_s);
-    put(&o, "}");
+    put(&o, ", \"drives\": [");
+    for (int k = 0; k < s->n_drives && k < 9; k++) {
+        uint16_t sw = (uint16_t)s->drive_statusword[k], err = (uint16_t)s->drive_error[k];
+        char axis = isalpha(s->drive_axis[k]) ? (char)s->drive_axis[k] : '?';
+        put(&o, "%s{\"axis\": \"%c\", \"node\": %d, \"state\": \"%s\", \"statusword\": "
+            "\"0x%04X\", \"error\": \"0x%04X\", \"error_text\": \"%s\"}",
+            k ? ", " : "", axis, (int)s->drive_node[k],
+            ncp_cia402_state_name(ncp_cia402_state(sw)), sw, err, err ? ncp_emcy_code_text(err) : "");
+    }
+    put(&o, "]}");
     return o.full ? -1 : (int)o.len;
 }
 

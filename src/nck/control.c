@@ -1163,5 +1163,15 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     st->estimate_ferr_mm = s->est.ferr_max;
     st->estimate_compute_s = s->est.seconds;
     st->program_time_s = s->program_time;
+    if (n->cross.be.ops && n->cross.be.ops->drives) {
+        struct ncp_drive_info d[NCP_NCK_AXES_MAX];
+        st->n_drives = n->cross.be.ops->drives(&n->cross.be, d, NCP_NCK_AXES_MAX);
+        for (int k = 0; k < st->n_drives; k++) {
+            st->drive_axis[k] = NCP_AXIS_LETTERS[d[k].axis];
+            st->drive_node[k] = d[k].node;
+            st->drive_statusword[k] = d[k].statusword;
+            st->drive_error[k] = d[k].error;
+        }
+    }
 }
 

@@ -7,8 +7,10 @@
  * for the opposite sign), where the machine position becomes HOME_OFFSET,
  * then to HOME at HOME_FINAL_VEL. Every event is seen on the actual
  * position, once per servo period, and each phase ends in a stop at the
- * axis's MAX_ACCELERATION. The simulated switch is pressed on the search's
- * side of [SIM] HOME_SWITCH_<axis> (HOME_OFFSET without it).
+ * axis's MAX_ACCELERATION. The switch is the drive's input where the
+ * backend reads one (CiA 402 drives: 0x60FD bit 2); the simulated switch is
+ * pressed on the search's side of [SIM] HOME_SWITCH_<axis> (HOME_OFFSET
+ * without it).
  * The loop functions are on the real-time path: no allocation, locks or
  * system calls. */
 #include "nck_int.h"
@@ -45,6 +47,11 @@ static double switch_at(const struct ncp_axis_cfg *a)
 
 static int pressed(const struct nck_core *n, int j, double act)
 {
+    /* a drive's own switch input (CAN: 0x60FD) where the backend reads one */
+    const struct ncp_backend *be = &n->cross.be;
+    int sw = be->ops->home_switch ? be->ops->home_switch(be, j) : -1;
+    if (sw >= 0)
+        return sw;
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
     double phys = act + n->loop->home.off[j];
     return (phys - switch_at(a)) * (a->home_search_vel > 0 ? 1 : -1) >= 0;

@@ -148,6 +148,13 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.estimate_ferr_mm = st.estimate_ferr_mm;
     m.estimate_compute_s = st.estimate_compute_s;
     m.program_time_s = st.program_time_s;
+    m.n_drives = (int8_t)(st.n_drives < 9 ? st.n_drives : 9);
+    for (int k = 0; k < m.n_drives; k++) {
+        m.drive_axis[k] = (uint8_t)st.drive_axis[k];
+        m.drive_node[k] = (int8_t)st.drive_node[k];
+        m.drive_statusword[k] = (int16_t)st.drive_statusword[k];
+        m.drive_error[k] = (int16_t)st.drive_error[k];
+    }
     ncp_msg_send_status(sv->msg, &m);
     if (sv->hook && sv->hook->status)
         sv->hook->status(sv->hook->ctx, &m);

@@ -377,7 +377,22 @@ static void test_status_json(void **state)
     /* the load's estimate and the last run's time */
     assert_non_null(strstr(buf, "\"estimate\": {\"state\": \"done\", \"program_time_s\": "
                                 "101.557000, \"path_length_mm\": 1444.142000"));
-    assert_non_null(strstr(buf, "}, \"program_time_s\": 4.500000}"));
+    assert_non_null(strstr(buf, "}, \"program_time_s\": 4.500000, \"drives\": []}"));
+    /* CiA 402 drives: state by name, statusword and last EMCY code with its meaning */
+    s.n_drives = 2;
+    memcpy(s.drive_axis, "XY", 2);
+    s.drive_node[0] = 1;
+    s.drive_node[1] = 2;
+    s.drive_statusword[0] = 0x0237;
+    s.drive_statusword[1] = 0x0218;
+    s.drive_error[1] = (int16_t)0x8611;
+    n = ncp_msg_status_json(&s, buf, sizeof buf);
+    assert_true(n > 0);
+    assert_non_null(strstr(buf, "\"drives\": [{\"axis\": \"X\", \"node\": 1, \"state\": "
+                                "\"Operation enabled\", \"statusword\": \"0x0237\", \"error\": "
+                                "\"0x0000\", \"error_text\": \"\"}, {\"axis\": \"Y\", \"node\": 2, "
+                                "\"state\": \"Fault\", \"statusword\": \"0x0218\", \"error\": "
+                                "\"0x8611\", \"error_text\": \"following error\"}]}"));
     /* nothing and no state: nulls */
     memset(&s, 0, sizeof s);
     s.state = 42;

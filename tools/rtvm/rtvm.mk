@@ -5,7 +5,7 @@
 # RTVM_FLAGS passes options to tools/rtvm/run, e.g. RTVM_FLAGS="--tcg --timeout 600".
 
 RTVM_FLAGS ?=
-RTVM_TIMEOUT ?= 1500
+RTVM_TIMEOUT ?= 2100
 
 .PHONY: rtvm-deps test-rt test-can-host
 
