@@ -78,10 +78,14 @@ $(GEN_STAMP): $(LCM_TYPES)
 	$(Q)touch $@
 $(GEN_SRCS): $(GEN_STAMP) ;
 
-# lcm-gen's code has unused parameters (its decode_cleanup functions).
+# lcm-gen's code has unused parameters (its decode_cleanup functions). Its
+# decoders store a double's bytes through an int64_t pointer (lcm_coretypes.h),
+# which strict aliasing lets the compiler ignore: inlined by LTO into a caller
+# that had zeroed the message, the doubles came back 0. So these objects are
+# compiled without strict aliasing and kept out of LTO (nothing inlines them).
 $(GEN_DIR)/%.o: $(GEN_DIR)/%.c | $(GEN_STAMP)
 	@$(if $(Q),echo "  CC   $<")
-	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -Wno-unused-parameter -c -o $@ $<
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -fno-strict-aliasing -fno-lto -Wno-unused-parameter -c -o $@ $<
 
 $(BUILD)/%.o: %.c | $(GEN_STAMP)
 	@mkdir -p $(@D)
