@@ -133,3 +133,11 @@ void lcm_tx_resend(struct lcm_tx *x, struct ncp_msg *m, const uint8_t *b, size_t
     send_burst(x, m, from, count);
     x->resent++;
 }
+
+int32_t lcm_tx_void(struct lcm_tx *x)
+{
+    /* popped into the place of the next number, which stays unnumbered */
+    while (ncp_spsc_pop(&x->tapped, slot(x, x->next)) == 0)
+        ;
+    return x->next;
+}

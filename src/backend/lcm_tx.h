@@ -56,6 +56,10 @@ const void *lcm_tx_rec(const struct lcm_tx *x, int32_t n);
  * taken the fewest records any LLC has taken (flow control). */
 void lcm_tx_cycle(struct lcm_tx *x, struct ncp_msg *m, int64_t t, int64_t period, int moving,
                   int32_t taken);
+/* Position loop, after an abort parked the planner: the records tapped and
+ * not numbered yet are dropped; returns the number below which every record
+ * is the aborted job's. */
+int32_t lcm_tx_void(struct lcm_tx *x);
 /* An LLC's resend request (rec_mark_t) for records from its number on. */
 void lcm_tx_resend(struct lcm_tx *x, struct ncp_msg *m, const uint8_t *b, size_t len);
 
