@@ -274,7 +274,6 @@ static int servable(const struct serve_channel *ch, int several)
                                   : "its own look-ahead planner",
                    adcai ? "ADCAI's fine setpoints, --dp 4" : "ADCBI's --dp 5, 4 or 3",
                    c->lcm.dp), -1;
-    return 0;
 }
 
 /* 0, -1 (set-up: exit 1), or -2 (a malformed parameter file or tool
