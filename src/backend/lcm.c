@@ -426,15 +426,16 @@ static void scale_put(struct lcm_be *s, double adv)
 
 /* Block-level points: the LLCs' interpolators advance as this loop read its
  * stream (ncp_backend.adv), period by period (llc_scale.c). A period the
- * loop skipped (it woke late) goes on at 1 for them: standing still for it
- * would jolt every axis in motion, so they run a period ahead of this
- * stream until a standstill's mark (as before the scaling). An abort (the loop dropped its stream) makes
+ * loop skipped (it woke late) goes on at the advance of the period after
+ * it: standing still for it would jolt every axis in motion (they then run
+ * a period ahead of this stream until a standstill's mark, as before the
+ * scaling), and in a hold (0) they must not move. An abort (the loop dropped its stream) makes
  * every record numbered so far void: the planner was parked before, so
  * every record of the aborted job is among them. */
 static void scale_cycle(struct lcm_be *s, const struct ncp_backend *b, int64_t t, int64_t skipped)
 {
     for (int64_t k = 0; k < skipped && k < SCALE_WINDOW; k++)
-        scale_put(s, 1.0);
+        scale_put(s, b->adv);
     scale_put(s, b->adv);
     if (b->discards != s->discards_seen) {
         s->discards_seen = b->discards;
