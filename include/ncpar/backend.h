@@ -135,6 +135,13 @@ struct ncp_backend {
     /* Injected timing of the coming cycle (set by the position loop, NULL =
      * none): the simulated plant models it; real drives have their own. */
     const struct ncp_inject_ev *timing;
+    /* Set by the position loop before each cycle: how far its scaler read
+     * the setpoint stream to make this cycle's cmd (samples; 1 the stream's
+     * own pace, 0 standing: a feed hold, homing, an E-stop), and how many
+     * times it dropped the stream (an abort). An HLC at a block-level point
+     * has its LLCs follow both (lcm.c). */
+    double adv;
+    uint32_t discards;
     /* An HLC at a block-level point sends on what the ADCBI planner starts:
      * the NCK hands it to the planner's tap (planner thread; NULL: none). */
     void (*plan_tap)(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec);

@@ -25,6 +25,7 @@
 #include "ncp_ax_status_t.h"
 #include "ncp_fine_ipo_t.h"
 #include "ncp_heartbeat_t.h"
+#include "ncp_time_scale_t.h"
 #include "ncp_int_burst_t.h"
 #include "ncp_la_burst_t.h"
 #include "ncp_plan_mark_t.h"
@@ -45,6 +46,7 @@
 #define NCP_DIST_CH_INT "NCP_HLC_INT"       /* ADCBI DP2 */
 #define NCP_DIST_CH_STEPS "NCP_HLC_STEPS"   /* ADCBI DP2 */
 #define NCP_DIST_CH_PROGRAM "NCP_HLC_PROGRAM" /* ADCBI DP1 */
+#define NCP_DIST_CH_SCALE "NCP_HLC_SCALE"   /* block-level points: time_scale_t */
 #define NCP_DIST_CH_CLOCK "NCP_HLC_CLOCK"   /* answers to the LLCs' clock probes */
 enum ncp_dist_ax_ch { NCP_DIST_AX_ADVERT, NCP_DIST_AX_STATUS, NCP_DIST_AX_HEARTBEAT,
                       NCP_DIST_AX_RESEND, NCP_DIST_AX_CLOCK };
@@ -178,6 +180,9 @@ void ncp_dist_recs_put(struct ncp_dist_recs *q, int32_t num, const union ncp_dis
 int ncp_dist_recs_peek(const struct ncp_dist_recs *q, union ncp_dist_rec *r);
 /* The interpolator is done with the next record. */
 void ncp_dist_recs_pop(struct ncp_dist_recs *q);
+/* Every record below num is void (the HLC's abort dropped them): neither
+ * run nor asked for again. */
+void ncp_dist_recs_skip(struct ncp_dist_recs *q, int32_t num);
 static inline int ncp_dist_recs_level(const struct ncp_dist_recs *q) { return q->have - q->next; }
 
 /* ---- ADCAI's period-level points DP2 and DP3 (ai.c) -------------------

@@ -349,6 +349,8 @@ struct ncp_scaler {
     int have_c, have_z;
     double f;                  /* read position between a (0) and b (1) */
     double r;                  /* rate: setpoints per period, 0..1 */
+    double adv;                /* how far the last step read on, in samples (r, but for a
+                                * stop landed on): the LLCs of a block-level point follow it */
     double rd;                 /* its rate of change, 1/s (jerk-limited rate changes) */
     double decel, period;
     /* Jerk budget of a rate change along the path, mm/s^3: > 0 makes rate

@@ -143,6 +143,17 @@ struct llc {
     ncp_int_burst_t int_burst;
     struct llc_dp1 *dp1;          /* DP1: its own NCK (dp1.c) */
     struct llc_dp1_ai *dp1ai;     /* ADCAI's DP1: its NCK's samples (dp1_ai.c) */
+    /* The HLC's time scaling (llc_scale.c): its stream advance by period,
+     * the newest heard, and the records an abort of its made void */
+#define LLC_SCALE_HIST 64
+    int64_t scale_t[LLC_SCALE_HIST];
+    double scale_adv[LLC_SCALE_HIST];
+    int64_t scale_newest_t;
+    double scale_newest;
+    int32_t void_below;
+    int64_t void_t;
+    int void_due;
+    uint32_t voided;
     char fault[200];              /* LLC_END_PROGRAM, LLC_END_DRIVE: why */
     char fault_short[64];         /* the same in what its status carries ("": fault) */
     struct llc_clock clk;
@@ -181,6 +192,15 @@ void llc_plan_advance(struct llc *l);
  * after one that ended at speed v0 (1), or none here (0). */
 struct ncp_dist_recs *llc_exec_ring(struct llc *l);
 int llc_exec_head(struct llc *l, double v0, struct ncp_accdec *a);
+
+/* llc_scale.c: the HLC's time scaling at the block-level points */
+void llc_on_scale(struct llc *l, const uint8_t *p, size_t len);
+/* The stream advance of the HLC's period slot (samples; 1 its own pace). */
+double llc_scale_at(const struct llc *l, int64_t slot);
+/* Drops the records an abort of the HLC's made void, once slot reaches
+ * the period it dropped them in; the interpolator starts again from the
+ * next record's start. */
+void llc_scale_void(struct llc *l, int64_t slot);
 
 /* dp1.c: DP1 at the LLC (its own NCK on the HLC's program) */
 struct llc_dp1;

@@ -98,7 +98,7 @@ static void on_sync(struct llc *l, const uint8_t *p, size_t len)
 
 /* Subscriptions, in the order cnc_axis.c makes them. */
 enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC, SUB_ROUGH, SUB_ACCDEC_AI, SUB_LA,
-       SUB_INT, SUB_STEPS, SUB_PROGRAM };
+       SUB_INT, SUB_STEPS, SUB_PROGRAM, SUB_SCALE };
 
 void llc_take(struct llc *l, int64_t now)
 {
@@ -124,6 +124,8 @@ void llc_take(struct llc *l, int64_t now)
             llc_on_steps(l, p, len);
         else if (sub == SUB_PROGRAM)
             llc_on_program(l, p, len);
+        else if (sub == SUB_SCALE)
+            llc_on_scale(l, p, len);
     }
 }
 
@@ -285,8 +287,17 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
         memcpy(l->ex_prev, first.s.start, sizeof l->ex_prev);
         l->ex_on = l->ex_rest = 1;
     }
+    /* the HLC's loop read nothing of its stream in that period (a hold,
+     * a period it skipped): nor does this interpolator, and it is no
+     * standstill of the path's, as it is none at the HLC (lcm.c) */
+    double adv = llc_scale_at(l, slot);
+    if (adv <= 0) {
+        *pos = l->ex_prev[l->axis];
+        return 1;
+    }
     int64_t due = llc_start_at(l, l->starts_done);
     struct ncp_exec before = l->ex;
+    l->ex.period = adv * (double)l->period_ns * 1e-9;
     int stop_rested = l->stop_rested;
     struct ncp_dist_recs *q = llc_exec_ring(l);
     int32_t next = q->next;
@@ -314,7 +325,9 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
     }
     if (moving && l->ex_rest)
         l->starts_done++;
-    l->ex_rest = !moving;
+    /* a standstill begins only at the stream's own pace, as at the HLC */
+    if (adv == 1.0 || moving)
+        l->ex_rest = !moving;
     memcpy(l->ex_prev, sp.pos, sizeof l->ex_prev);
     *pos = sp.pos[l->axis];
     return 1;
@@ -323,6 +336,12 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
 static double interpolate(struct llc *l, int64_t slot)
 {
     if (slot < l->t_start)
+        return l->cmd;
+    llc_scale_void(l, slot);
+    /* after an abort: where the command stands until the next job's first
+     * record (it starts where the HLC rested on this axis's command) */
+    struct ncp_accdec first;
+    if (l->voided && !l->ex_on && !llc_exec_head(l, 0, &first))
         return l->cmd;
     double pos;
     (void)exec_try(l, slot, 1, &pos);
@@ -339,7 +358,8 @@ static double interpolate(struct llc *l, int64_t slot)
 static double interpolate_ahead(struct llc *l, int64_t slot)
 {
     double pos;
-    if (slot < l->t_start)
+    struct ncp_accdec first;
+    if (slot < l->t_start || (l->voided && !l->ex_on && !llc_exec_head(l, 0, &first)))
         return l->cmd;
     (void)exec_try(l, slot, 0, &pos);
     if (l->missing) {
@@ -414,7 +434,7 @@ static void trace(struct llc *l, int64_t now, int64_t slot, int gap)
 
 static int hold_now(const struct llc *l, int64_t slot)
 {
-    return (l->hold || slot < l->hold_until) && !l->dp4 && !l->dp1ai &&
+    return (l->hold || slot < l->hold_until) && !l->dp1ai &&
            l->state == NCP_AX_STATUS_T_RUNNING;
 }
 
@@ -433,8 +453,9 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
         next_cmd = l->dp1ai ? play_ai(l, slot) : l->dp4 ? interpolate(l, slot) : follow(l, slot);
         /* the HLC's E-stop, heard at once rather than a play delay later
          * in its frozen setpoints: they are still taken (no loss), the
-         * command stays; a block-level point computes its own and has no
-         * hold (serve does not run there) */
+         * command stays; at a block-level point the interpolator runs on
+         * behind it until the HLC's stream stood still (its advance 0)
+         * and its abort's records are dropped (llc_scale.c) */
         if (hold_now(l, slot))
             next_cmd = l->cmd;
         if (l->dp4 || l->dp1ai)

@@ -47,6 +47,8 @@
 
 #define HIST 64   /* setpoints remembered, periods: more than any status lags */
 #define STOP_WAIT_NS 3000000000LL
+#define SCALE_WINDOW 16   /* periods each time_scale_t carries */
+#define SCALE_AFTER 32    /* periods an advance of 1 is still said after one that was not */
 
 struct peer {
     int axis;
@@ -89,6 +91,16 @@ struct lcm_be {
     struct lcm_clock clk;    /* answers the LLCs' clock probes; the HLC's clock */
     uint64_t ends_sent;      /* heartbeats saying done (or stop) at the end */
     int64_t last_cycle_ns, end_gap_ns;   /* the loop's last period; from it to the end said */
+    /* block-level points: the loop's stream advance of the last SCALE_WINDOW
+     * periods (oldest first) and the periods still to say it, the abort
+     * whose records are void (time_scale_t) */
+    double scale_adv[SCALE_WINDOW];
+    int scale_left;
+    int32_t scale_seq;
+    uint32_t discards_seen;
+    int32_t void_below;
+    int64_t void_t;
+    uint64_t scale_sent;
 };
 
 /* Every time the HLC sends is on this clock ([LCM] CLOCK), its grid too. */
@@ -404,6 +416,51 @@ static void send_fine(struct lcm_be *s, int64_t t, const double cmd[NCP_AXES])
     }
 }
 
+static void scale_put(struct lcm_be *s, double adv)
+{
+    memmove(s->scale_adv, s->scale_adv + 1, (SCALE_WINDOW - 1) * sizeof s->scale_adv[0]);
+    s->scale_adv[SCALE_WINDOW - 1] = adv;
+    if (adv != 1.0)
+        s->scale_left = SCALE_AFTER;
+}
+
+/* Block-level points: the LLCs' interpolators advance as this loop read its
+ * stream (ncp_backend.adv), period by period (llc_scale.c). A period the
+ * loop skipped (it woke late) goes on at the advance of the period after
+ * it: standing still for it would jolt every axis in motion (they then run
+ * a period ahead of this stream until a standstill's mark, as before the
+ * scaling), and in a hold (0) they must not move. An abort (the loop dropped its stream) makes
+ * every record numbered so far void: the planner was parked before, so
+ * every record of the aborted job is among them. */
+static void scale_cycle(struct lcm_be *s, const struct ncp_backend *b, int64_t t, int64_t skipped)
+{
+    for (int64_t k = 0; k < skipped && k < SCALE_WINDOW; k++)
+        scale_put(s, b->adv);
+    scale_put(s, b->adv);
+    if (b->discards != s->discards_seen) {
+        s->discards_seen = b->discards;
+        s->void_below = lcm_tx_void(s->tx);
+        s->void_t = t;
+        s->scale_left = SCALE_AFTER;
+    }
+    if (s->scale_left <= 0)
+        return;
+    s->scale_left--;
+    ncp_time_scale_t m;
+    memset(&m, 0, sizeof m);
+    m.seq = s->scale_seq++;
+    m.sender = NCP_DIST_HLC_ID;
+    m.t_ns = t;
+    m.count = SCALE_WINDOW;
+    memcpy(m.adv, s->scale_adv, sizeof m.adv);
+    m.void_below = s->void_below;
+    m.void_t_ns = s->void_t;
+    uint8_t buf[256];
+    int n = ncp_time_scale_t_encode(buf, 0, sizeof buf, &m);
+    if (n > 0 && ncp_msg_publish(s->msg, NCP_DIST_CH_SCALE, buf, (size_t)n) == 0)
+        s->scale_sent++;
+}
+
 static void tap(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec)
 {
     struct lcm_tx *x = ((struct lcm_be *)impl)->tx;
@@ -434,23 +491,38 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
      * grid only jumps for periods the loop skipped */
     if (s->cycles > 0 && t <= s->last_t + s->T)
         t = s->last_t + s->T;
+    int64_t skipped = s->cycles > 0 ? (t - s->last_t) / s->T - 1 : 0;
     s->last_t = t;
     unsigned h = (unsigned)((uint64_t)(t / s->T) % HIST);
     s->hist_t[h] = t;
     memcpy(s->hist_cmd[h], cmd, sizeof s->hist_cmd[h]);
     if (s->tx) {
-        /* the LLCs' interpolators leave each standstill when this does */
+        /* the LLCs' interpolators leave each standstill when this does. A
+         * standstill begins only in a period that read the stream at its
+         * own pace: there this command is the stream's samples, as the
+         * LLCs' is; in a scaled period (a hold, a landing, an underrun)
+         * the two round differently near 0, and a standstill one side
+         * counted and the other not would shift every mark after it */
         int moving = 0;
         for (int j = 0; j < NCP_AXES && s->cycles > 0; j++)
             moving |= cmd[j] != s->prev_cmd[j];
+        /* after an abort the next job starts from a standstill, as the
+         * LLCs' interpolators do once they dropped its records (the
+         * command's jump onto the actual position is no start) */
+        if (b->discards != s->discards_seen) {
+            s->rest = 1;
+            moving = 0;
+        }
         int start = moving && s->rest;
-        s->rest = !moving;
+        if (b->adv == 1.0 || moving || s->cycles == 0)
+            s->rest = !moving;
         memcpy(s->prev_cmd, cmd, sizeof s->prev_cmd);
+        scale_cycle(s, b, t, skipped);
         int32_t taken = INT32_MAX;
         for (int i = 0; i < s->n; i++)
             taken = s->p[i].st.rec_next < taken ? s->p[i].st.rec_next : taken;
         int32_t steps = atomic_load_explicit(&s->dp2.steps, memory_order_acquire);
-        lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken);
+        lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken, s->rest);
         if (s->tx->kind == &lcm_kind_int)
             lcm_dp2_mark(s->tx, &s->dp2, s->msg, steps, t, s->T);
         if (s->dp1 && s->cycles % 20 == 0)   /* an LLC that lost the first one */
@@ -487,6 +559,10 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
          * only its own following error says how well it follows */
         if (!s->tx && !s->ai && p->have_status && p->st.t_ns > 0 && s->hist_t[k] == p->st.t_ns)
             act[j] = a + cmd[j] - s->hist_cmd[k][j];
+        else if (s->tx && s->hold && p->have_status)
+            /* an E-stop froze the LLC's command where it was then, a play
+             * delay behind this one's: a serving NCK rests there */
+            act[j] = ncp_dist_nm_to_mm(p->st.cmd_nm);
         else
             act[j] = cmd[j] - ncp_dist_nm_to_mm(p->st.ferr_nm);
     }
@@ -552,6 +628,10 @@ static void lcm_stop(struct ncp_backend *b)
                 s->tx->burst_bytes,
                 s->tx->burst_bytes + 8 + (int)strlen(s->tx->kind->channel) + 1,
                 (unsigned long long)s->tx->resent, (unsigned long long)s->tx->overflow);
+    if (s->tx && !s->dp1)
+        fprintf(stderr, "lcm: time scaling: %llu messages (the stream's advance not 1, and "
+                        "%d periods after)\n",
+                (unsigned long long)s->scale_sent, SCALE_AFTER);
     else
         fprintf(stderr, "lcm: DP %d (%s): %llu setpoint messages of %d bytes (all %d axes; %d "
                         "with the LCM header), %.0f per second\n",

@@ -86,7 +86,7 @@ static void sync(struct lcm_tx *x, struct ncp_msg *m)
 }
 
 void lcm_tx_cycle(struct lcm_tx *x, struct ncp_msg *m, int64_t t, int64_t period, int moving,
-                  int32_t taken)
+                  int32_t taken, int at_rest)
 {
     /* no further than the history can serve resends from */
     while (x->next - taken < LCM_TX_HIST - NCP_DIST_BURST &&
@@ -101,7 +101,9 @@ void lcm_tx_cycle(struct lcm_tx *x, struct ncp_msg *m, int64_t t, int64_t period
         /* flow control: no LLC is sent more than it has room for */
         if (x->sent + count - taken > NCP_DIST_RECS)
             break;
-        if (count < NCP_DIST_BURST && x->t_start && x->oldest_wait < HOLD)
+        /* at a standstill a waiting record is the next motion's: a serving
+         * NCK's MDI or jog is planned just before the loop runs it */
+        if (count < NCP_DIST_BURST && x->t_start && x->oldest_wait < HOLD && !at_rest)
             break;
         send_burst(x, m, x->sent, count);
         x->sent += count;
@@ -132,4 +134,12 @@ void lcm_tx_resend(struct lcm_tx *x, struct ncp_msg *m, const uint8_t *b, size_t
     int count = x->sent - from < NCP_DIST_BURST ? x->sent - from : NCP_DIST_BURST;
     send_burst(x, m, from, count);
     x->resent++;
+}
+
+int32_t lcm_tx_void(struct lcm_tx *x)
+{
+    /* popped into the place of the next number, which stays unnumbered */
+    while (ncp_spsc_pop(&x->tapped, slot(x, x->next)) == 0)
+        ;
+    return x->next;
 }

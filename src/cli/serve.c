@@ -265,17 +265,23 @@ static int servable(const struct serve_channel *ch, int several)
                                "channels of [CHANNEL_n]: the LLCs' LCM channels are one set\n",
                        ini), -1;
     int adcai = c->nck == NCP_NCK_ADCAI, fine = adcai ? 4 : 5;
-    if (c->lcm.dp != fine)
-        return fprintf(stderr, "cnc-run serve: --backend lcm --dp %d ([PLANNER] NCK = %s) is not "
-                               "served: at this point each LLC computes its own command from "
-                               "what it was sent ahead, and no message takes that back, so a "
-                               "feed hold, stop or E-stop from the seat could not stop its axis "
-                               "along the path, nor homing or a jog move it; serve runs the "
-                               "distributed NCK at %s's fine setpoints, --dp %d (cnc-run run "
-                               "--backend lcm runs a program at DP %d)\n",
-                       c->lcm.dp, adcai ? "adcai" : "adcbi", adcai ? "ADCAI" : "ADCBI", fine,
-                       c->lcm.dp), -1;
-    return 0;
+    /* ADCBI's DP4 and DP3: each LLC's interpolator follows the loop's time
+     * scaling period by period and drops what an abort drops (lcm.c,
+     * src/axis/llc_scale.c), so a hold, stop or E-stop stops it on the path */
+    if (c->lcm.dp == fine || (!adcai && (c->lcm.dp == 4 || c->lcm.dp == 3)))
+        return 0;
+    return fprintf(stderr, "cnc-run serve: --backend lcm --dp %d ([PLANNER] NCK = %s) is not "
+                           "served: at this point each LLC computes its own command from what "
+                           "it was sent ahead (%s), and no message takes an abort back there "
+                           "yet, so a stop or E-stop from the seat could not end its job; serve "
+                           "runs the distributed NCK at %s (cnc-run run --backend lcm runs a "
+                           "program at DP %d)\n",
+                   c->lcm.dp, adcai ? "adcai" : "adcbi",
+                   c->lcm.dp == 1 ? "it runs the program itself"
+                   : adcai        ? "its own ACC/DEC stages"
+                                  : "its own look-ahead planner",
+                   adcai ? "ADCAI's fine setpoints, --dp 4" : "ADCBI's --dp 5, 4 or 3",
+                   c->lcm.dp), -1;
 }
 
 /* 0, -1 (set-up: exit 1), or -2 (a malformed parameter file or tool

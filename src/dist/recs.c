@@ -100,3 +100,15 @@ void ncp_dist_recs_pop(struct ncp_dist_recs *q)
     if (q->num[(unsigned)q->next % NCP_DIST_RECS] == q->next)
         q->next++;
 }
+
+void ncp_dist_recs_skip(struct ncp_dist_recs *q, int32_t num)
+{
+    if (num > q->next)
+        q->next = num;
+    if (num > q->top)
+        q->top = num;
+    if (num > q->have)
+        q->have = num;
+    while (q->num[(unsigned)q->have % NCP_DIST_RECS] == q->have)
+        q->have++;
+}

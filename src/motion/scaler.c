@@ -388,7 +388,8 @@ static double next_rate(const struct ncp_scaler *s, double target)
 int ncp_scaler_step(struct ncp_scaler *s, double target, struct ncp_spsc *ring,
                     struct ncp_setpoint *out)
 {
-    int dry = 0;
+    int dry = 0, read = 0;
+    double f0 = s->f;
     if (!s->have_c)
         s->have_c = ncp_spsc_pop(ring, &s->c) == 0;
     if (s->jerk > 0)
@@ -414,6 +415,7 @@ int ncp_scaler_step(struct ncp_scaler *s, double target, struct ncp_spsc *ring,
             s->b = s->c;
             s->b_counted = 0;
             s->f -= 1.0;
+            read = 1;
             s->have_c = ncp_spsc_pop(ring, &s->c) == 0;
         }
     }
@@ -421,6 +423,7 @@ int ncp_scaler_step(struct ncp_scaler *s, double target, struct ncp_spsc *ring,
         s->ends++;
         s->b_counted = 1;
     }
+    s->adv = read + s->f - f0;
     double f = s->f;
     blend(s, f, out->pos);
     memcpy(out->dir, s->b.dir, sizeof out->dir);

@@ -560,6 +560,15 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
     return 0;
 }
 
+/* Distributed axes whose LLCs compute their own command from the planner's
+ * records (ADCBI's block-level points): they never see the loop's homing
+ * moves or the offset homing puts between the plan and the axes. */
+static int blocks_lcm(const struct ncp_machine_cfg *cfg)
+{
+    return cfg->backend == NCP_BACKEND_LCM && cfg->nck == NCP_NCK_ADCBI && cfg->lcm.dp >= 1 &&
+           cfg->lcm.dp <= 4;
+}
+
 /* Homing (homing.c): `all` (or nothing) homes the axes of the HOME_SEQUENCE
  * list, letters name axes (`XZ`); either way by sequence, the position
  * loop driving the axes itself. */
@@ -593,6 +602,20 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
                                   cfg->axis[j].home_sequence);
         }
     }
+    if (blocks_lcm(cfg))
+        for (int j = 0; j < NCP_AXES; j++) {
+            if (!(mask & NCP_AXIS_BIT(j)))
+                continue;
+            const struct ncp_axis_cfg *a = &cfg->axis[j];
+            double at = n->svc->have_fb ? n->svc->last_fb.cmd[j] : n->start[j];
+            if (a->home_search_vel != 0 || fabs(at - a->home_offset) > 1e-6)
+                return refuse(why, len, "home %c: not served on --backend lcm --dp %d: the "
+                              "LLCs run the planner's records and homing is the position "
+                              "loop's own motion (HOME_SEARCH_VEL %g) or offset (the axis at "
+                              "%.4f, HOME_OFFSET %g); home on the fine setpoints (DP %d)",
+                              NCP_AXIS_LETTERS[j], cfg->lcm.dp, a->home_search_vel, at,
+                              a->home_offset, cfg->nck == NCP_NCK_ADCAI ? 4 : 5);
+        }
     for (int j = 0; j < NCP_AXES; j++)
         if (mask & NCP_AXIS_BIT(j))
             s->homed[j] = 0;

@@ -149,6 +149,8 @@ static int take_setpoint(struct nck_core *n)
     struct ncp_setpoint before = n->loop->next;
     if (nck_aux_cycle(n)) {
         n->loop->cur = before;   /* a synchronised run writes the next itself */
+        n->cross.be.adv = n->loop->adv_next;
+        n->loop->adv_next = 0;
         return NCP_RT_CONTINUE;
     }
     if (!n->loop->ended && n->setup.virtual_clock &&
@@ -156,8 +158,12 @@ static int take_setpoint(struct nck_core *n)
         stream_expected(n))
         return NCP_RT_RETRY;
     n->loop->cur = n->loop->next;
+    n->cross.be.adv = n->loop->adv_next;
+    n->loop->adv_next = 0;
     if (!n->loop->ended && ncp_scaler_step(&n->loop->scaler, rate_target(n), &n->cross.sps, &n->loop->next) != 0)
         n->loop->dry++;
+    if (!n->loop->ended)
+        n->loop->adv_next = n->loop->scaler.adv;
     if (n->loop->next.aux > n->loop->mach.seq_reached)
         n->loop->mach.seq_reached = n->loop->next.aux;
     if (n->loop->scaler.ends != n->loop->ends_seen) {
@@ -205,6 +211,8 @@ static void discard(struct nck_core *n, const double act[NCP_AXES])
     nck_aux_discard(n);
     n->loop->probe.state = NCK_PROBE_OFF;
     ncp_scaler_rebase(&n->loop->scaler, at);
+    n->loop->adv_next = 0;
+    n->cross.be.discards++;
     n->loop->scaler.decel = n->loop->decel_normal;
     memset(&n->loop->cur, 0, sizeof n->loop->cur);
     memcpy(n->loop->cur.pos, at, sizeof n->loop->cur.pos);
@@ -292,6 +300,7 @@ static int frozen_cycle(struct nck_core *n, int64_t now_ns)
     nck_home_cancel(n);
     double act[NCP_AXES];
     n->cross.be.timing = NULL;
+    n->cross.be.adv = 0;
     n->loop->next = n->loop->cur;
     (void)drive(n, act, 0);
     nck_inject_clear(n);
@@ -333,9 +342,13 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
             if (virt)
                 return NCP_RT_RETRY;
             n->loop->cur = n->loop->next;
+            n->cross.be.adv = n->loop->adv_next;
+            n->loop->adv_next = 0;
         } else if (take_setpoint(n) == NCP_RT_RETRY) {
             return NCP_RT_RETRY;
         }
+    } else {
+        n->cross.be.adv = 0;
     }
     uint64_t home = nck_home_phases(n);   /* the row shows the phase the period ran in */
     double act[NCP_AXES];

@@ -17,6 +17,7 @@ struct nck_loop {
     double jcmd[NCP_AXES], jnext[NCP_AXES], jact[NCP_AXES];  /* cur, next, actual as joints */
     struct ncp_scaler scaler;
     double decel_normal, decel_full;
+    double adv_next;          /* the scaler's read advance that made next (backend.h's adv) */
     int slowing;
     uint64_t dry, underruns, fb_dropped;
     int end_seen;                    /* the output sits on an END sample */

@@ -221,6 +221,37 @@ static void recs_round_trip_and_ring(void **state)
     ncp_dist_recs_free(&q);
 }
 
+/* An abort's void: the records below it are neither run nor asked for again
+ * (have jumps past a gap), and those above it that came already stay. */
+static void recs_skip_voids_an_abort(void **state)
+{
+    (void)state;
+    union ncp_dist_rec u;
+    memset(&u, 0, sizeof u);
+    struct ncp_dist_recs q;
+    assert_int_equal(ncp_dist_recs_init(&q), 0);
+    ncp_dist_recs_put(&q, 0, &u);
+    ncp_dist_recs_put(&q, 1, &u);
+    ncp_dist_recs_put(&q, 4, &u);   /* 2 and 3 lost, 4 the next job's */
+    assert_int_equal(q.have, 2);
+    ncp_dist_recs_skip(&q, 4);
+    assert_int_equal(q.next, 4);
+    assert_int_equal(q.have, 5);
+    assert_int_equal(ncp_dist_recs_level(&q), 1);
+    union ncp_dist_rec got;
+    assert_int_equal(ncp_dist_recs_peek(&q, &got), 1);
+    ncp_dist_recs_pop(&q);
+    ncp_dist_recs_skip(&q, 3);      /* an older word changes nothing */
+    assert_int_equal(q.next, 5);
+    ncp_dist_recs_skip(&q, 9);      /* past all received: the next come from 9 */
+    assert_int_equal(q.next, 9);
+    assert_int_equal(q.have, 9);
+    assert_int_equal(q.top, 9);
+    ncp_dist_recs_put(&q, 8, &u);
+    assert_int_equal(q.stale, 1);
+    ncp_dist_recs_free(&q);
+}
+
 /* DP3's and DP2's records: every double (and the op, its step) comes back
  * bit for bit through a burst. */
 static void la_and_int_round_trip(void **state)
@@ -349,6 +380,7 @@ int main(void)
         cmocka_unit_test(rx_gap_held_and_counted),
         cmocka_unit_test(rx_peek_sees_the_bridge), cmocka_unit_test(rx_duplicates_and_stale_ignored),
         cmocka_unit_test(dice_same_seed_same_losses),
+        cmocka_unit_test(recs_skip_voids_an_abort),
         cmocka_unit_test(recs_round_trip_and_ring),
         cmocka_unit_test(la_and_int_round_trip),
         cmocka_unit_test(clock_shortest_round_trip_wins),

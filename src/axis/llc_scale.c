@@ -1,0 +1,70 @@
+/* The HLC's time scaling at ADCBI's block-level points (time_scale_t,
+ * NCP_HLC_SCALE): how far its position loop read its setpoint stream in each
+ * of its periods. This LLC's interpolator advances by the same amount in the
+ * slot of that period, so a feed hold, stop, override or underrun at the HLC
+ * slows and stops every axis at the same instants of the program's time: the
+ * path stays the program's, and each axis stands where the HLC's command
+ * stands. A period the HLC said nothing about keeps the newest advance heard
+ * before it (1 until the first message): the HLC repeats each advance that
+ * is not 1 in 16 messages and says 1 for 32 periods after the last, so a
+ * silent HLC in a feed hold leaves its axes standing, not running on. */
+#include "axis.h"
+
+#include <string.h>
+
+static unsigned place(const struct llc *l, int64_t t)
+{
+    return (unsigned)((uint64_t)(t / l->period_ns) % LLC_SCALE_HIST);
+}
+
+void llc_on_scale(struct llc *l, const uint8_t *p, size_t len)
+{
+    ncp_time_scale_t m;
+    memset(&m, 0, sizeof m);
+    if (ncp_time_scale_t_decode(p, 0, (int)len, &m) != (int)len || m.sender != NCP_DIST_HLC_ID ||
+        m.count < 1 || m.count > 16)
+        return;
+    /* lcm-gen decodes doubles through int64_t pointers: read back as
+     * doubles, the compiler (LTO, strict aliasing) took them for the
+     * memset's zeros. Bytes copied out are what was decoded. */
+    double adv[16];
+    memcpy(adv, m.adv, sizeof adv);
+    for (int i = 0; i < m.count; i++) {
+        int64_t t = m.t_ns - (int64_t)(m.count - 1 - i) * l->period_ns;
+        unsigned k = place(l, t);
+        l->scale_t[k] = t;
+        l->scale_adv[k] = adv[i];
+    }
+    if (m.t_ns > l->scale_newest_t) {
+        l->scale_newest_t = m.t_ns;
+        l->scale_newest = adv[m.count - 1];
+    }
+    if (m.void_below > l->void_below && m.void_t_ns > 0) {
+        l->void_below = m.void_below;
+        l->void_t = m.void_t_ns;
+        l->void_due = 1;
+    }
+}
+
+double llc_scale_at(const struct llc *l, int64_t slot)
+{
+    if (!l->scale_newest_t)
+        return 1.0;
+    unsigned k = place(l, slot);
+    if (l->scale_t[k] == slot)
+        return l->scale_adv[k];
+    /* past the newest word: it holds; before it and not heard: the HLC
+     * said nothing then, which it does only at its own pace */
+    return slot > l->scale_newest_t ? l->scale_newest : 1.0;
+}
+
+void llc_scale_void(struct llc *l, int64_t slot)
+{
+    if (!l->void_due || slot < l->void_t)
+        return;
+    l->void_due = 0;
+    ncp_dist_recs_skip(&l->recs, l->void_below);
+    l->ex_on = 0;
+    l->stop_rested = 0;
+    l->voided++;
+}
