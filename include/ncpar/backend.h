@@ -88,6 +88,15 @@ struct ncp_drive_info {
     uint16_t error;       /* the last EMCY error code, 0 none */
 };
 
+/* A distributed axis (an LLC of the lcm backend) as the operator's status
+ * shows it, from its last status message. */
+struct ncp_llc_info {
+    int axis;                 /* 0..8 = X..W */
+    int state;                /* ax_status_t's: -1 never heard, else WAITING .. DONE */
+    int64_t clock_offset_ns;  /* how far the HLC's clock is ahead of the LLC's */
+    int32_t ferr_nm;          /* its following error */
+};
+
 struct ncp_backend_ops {
     const char *name;
     /* Before the real-time loop (may block, allocate, talk SDO): brings the
@@ -122,6 +131,9 @@ struct ncp_backend_ops {
      * last frame said, 1 pressed or 0; -1 when the backend has none to read
      * (NULL: the same). Homing then uses the simulated switch. */
     int (*home_switch)(const struct ncp_backend *b, int axis);
+    /* Not real-time (the serving thread): the LLCs as their last status
+     * said, one per row up to max; the count. NULL: no LLCs to show. */
+    int (*llcs)(const struct ncp_backend *b, struct ncp_llc_info *out, int max);
 };
 
 /* The ADCBI planner's calls, as plan_journal sees them. */

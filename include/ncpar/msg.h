@@ -149,6 +149,10 @@ int ncp_msg_state_parse(const char *name);
 /* status_t's estimate states (EST_ constants) by name: "none", "running",
  * "done", "failed", "cancelled"; NULL for anything else. */
 const char *ncp_msg_estimate_name(int state);
+/* status_t's llc_state (ax_status_t's states) by name: "unheard" (-1),
+ * "waiting", "running", "stopping", "stopped", "fault", "done"; NULL for
+ * anything else. */
+const char *ncp_msg_llc_state_name(int state);
 /* event_t's kinds by name ("info", "msg", "debug", "print", "error",
  * "fault"): NULL for anything else. */
 const char *ncp_msg_event_kind_name(int kind);

@@ -296,6 +296,13 @@ struct ncp_nck_snapshot {
     char drive_axis[NCP_NCK_AXES_MAX];
     unsigned drive_node[NCP_NCK_AXES_MAX];
     uint16_t drive_statusword[NCP_NCK_AXES_MAX], drive_error[NCP_NCK_AXES_MAX];
+    /* distributed axes (lcm backend), as their LLCs' last status said:
+     * state -1 never heard, else ax_status_t's */
+    int n_llcs, llc_dp;
+    char llc_axis[NCP_NCK_AXES_MAX];
+    int llc_state[NCP_NCK_AXES_MAX];
+    int64_t llc_clock_offset_ns[NCP_NCK_AXES_MAX];
+    int32_t llc_ferr_nm[NCP_NCK_AXES_MAX];
 };
 
 /* A load's estimate (cnc-run serve): running in the background, done,

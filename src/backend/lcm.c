@@ -59,6 +59,10 @@ struct peer {
     int64_t last_status_ns, last_hb_ns;
     int32_t last_seq;
     int run_lost;                /* periods in a row without a status */
+    /* for the serving thread's status: state (-1 none yet), clock offset
+     * and following error as the last status said */
+    atomic_int pub_state, pub_ferr_nm;
+    atomic_llong pub_clock_ns;
     uint64_t statuses, lost, late;
 };
 
@@ -133,6 +137,9 @@ static void on_status(struct peer *p, const uint8_t *b, size_t len, int64_t now)
         return;
     }
     p->st = st;
+    atomic_store_explicit(&p->pub_state, st.state, memory_order_relaxed);
+    atomic_store_explicit(&p->pub_ferr_nm, st.ferr_nm, memory_order_relaxed);
+    atomic_store_explicit(&p->pub_clock_ns, st.clock_offset_ns, memory_order_relaxed);
     p->last_seq = st.seq;
     p->have_status = 1;
     p->last_status_ns = now;
@@ -705,8 +712,23 @@ static void lcm_close(struct ncp_backend *b)
     b->impl = NULL;
 }
 
+static int lcm_llcs(const struct ncp_backend *b, struct ncp_llc_info *out, int max)
+{
+    struct lcm_be *s = b->impl;
+    int n = 0;
+    for (; s && n < s->n && n < max; n++) {
+        struct peer *p = &s->p[n];
+        out[n] = (struct ncp_llc_info){
+            p->axis, atomic_load_explicit(&p->pub_state, memory_order_relaxed),
+            atomic_load_explicit(&p->pub_clock_ns, memory_order_relaxed),
+            atomic_load_explicit(&p->pub_ferr_nm, memory_order_relaxed) };
+    }
+    return n;
+}
+
 static const struct ncp_backend_ops lcm_ops = {
     "lcm", lcm_start, lcm_cycle, lcm_stop, lcm_describe, lcm_close, lcm_enable, lcm_live, NULL, NULL,
+    lcm_llcs,
 };
 
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
@@ -781,6 +803,7 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
         struct peer *p = &s->p[s->n++];
         char ch[32];
         p->axis = j;
+        atomic_init(&p->pub_state, -1);
         ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_ADVERT);
         p->sub_advert = ncp_msg_subscribe(s->msg, ch);
         ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_STATUS);

@@ -168,7 +168,7 @@ static int sc_home_switch(const struct ncp_backend *b, int axis)
 
 static const struct ncp_backend_ops sc_ops = {
     "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, sc_enable, sc_live, sc_drives,
-    sc_home_switch,
+    sc_home_switch, NULL,
 };
 
 int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,

@@ -88,6 +88,12 @@ void ctl_print_status(const ncp_status_t *s)
             printf(", last EMCY 0x%04X %s", err, ncp_emcy_code_text(err));
         printf("\n");
     }
+    for (int k = 0; k < s->n_llcs && k < 9; k++) {
+        const char *st = ncp_msg_llc_state_name(s->llc_state[k]);
+        printf("llc %c     DP %d: %s, clock offset %d us, following error %d nm\n",
+               s->llc_axis[k], (int)s->llc_dp, st ? st : "?", (int)s->llc_clock_offset_us[k],
+               (int)s->llc_ferr_nm[k]);
+    }
 }
 
 void ctl_print_event(const ncp_event_t *e)

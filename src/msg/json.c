@@ -181,6 +181,15 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
             k ? ", " : "", axis, (int)s->drive_node[k],
             ncp_cia402_state_name(ncp_cia402_state(sw)), sw, err, err ? ncp_emcy_code_text(err) : "");
     }
+    put(&o, "], \"llc_dp\": %d, \"llcs\": [", (int)s->llc_dp);
+    for (int k = 0; k < s->n_llcs && k < 9; k++) {
+        const char *st = ncp_msg_llc_state_name(s->llc_state[k]);
+        char axis = isalpha(s->llc_axis[k]) ? (char)s->llc_axis[k] : '?';
+        put(&o, "%s{\"axis\": \"%c\", \"state\": ", k ? ", " : "", axis);
+        put(&o, st ? "\"%s\"" : "null", st ? st : "");
+        put(&o, ", \"clock_offset_us\": %d, \"ferr_nm\": %d}", (int)s->llc_clock_offset_us[k],
+            (int)s->llc_ferr_nm[k]);
+    }
     put(&o, "]}");
     return o.full ? -1 : (int)o.len;
 }

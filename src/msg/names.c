@@ -4,6 +4,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "ncp_ax_status_t.h"
 #include "ncpar/msg.h"
 
 static const char *const state_names[] = {
@@ -39,6 +40,20 @@ const char *ncp_msg_estimate_name(int state)
 {
     return state >= 0 && state < (int)(sizeof estimate_names / sizeof estimate_names[0])
                ? estimate_names[state] : NULL;
+}
+
+static const char *const llc_names[] = {
+    [NCP_AX_STATUS_T_WAITING] = "waiting", [NCP_AX_STATUS_T_RUNNING] = "running",
+    [NCP_AX_STATUS_T_STOPPING] = "stopping", [NCP_AX_STATUS_T_STOPPED] = "stopped",
+    [NCP_AX_STATUS_T_FAULT] = "fault",     [NCP_AX_STATUS_T_DONE] = "done",
+};
+
+const char *ncp_msg_llc_state_name(int state)
+{
+    if (state == -1)
+        return "unheard";
+    return state >= 0 && state < (int)(sizeof llc_names / sizeof llc_names[0])
+               ? llc_names[state] : NULL;
 }
 
 static const char *const event_kinds[] = {

@@ -1196,5 +1196,16 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
             st->drive_error[k] = d[k].error;
         }
     }
+    if (n->cross.be.ops && n->cross.be.ops->llcs) {
+        struct ncp_llc_info l[NCP_NCK_AXES_MAX];
+        st->n_llcs = n->cross.be.ops->llcs(&n->cross.be, l, NCP_NCK_AXES_MAX);
+        st->llc_dp = n->cfg->lcm.dp;
+        for (int k = 0; k < st->n_llcs; k++) {
+            st->llc_axis[k] = NCP_AXIS_LETTERS[l[k].axis];
+            st->llc_state[k] = l[k].state;
+            st->llc_clock_offset_ns[k] = l[k].clock_offset_ns;
+            st->llc_ferr_nm[k] = l[k].ferr_nm;
+        }
+    }
 }
 

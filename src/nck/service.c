@@ -155,6 +155,16 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
         m.drive_statusword[k] = (int16_t)st.drive_statusword[k];
         m.drive_error[k] = (int16_t)st.drive_error[k];
     }
+    m.n_llcs = (int8_t)(st.n_llcs < 9 ? st.n_llcs : 9);
+    m.llc_dp = (int8_t)st.llc_dp;
+    for (int k = 0; k < m.n_llcs; k++) {
+        m.llc_axis[k] = (uint8_t)st.llc_axis[k];
+        m.llc_state[k] = (int8_t)st.llc_state[k];
+        /* within +-35 min: an offset beyond that is no clock anyone runs */
+        int64_t us = st.llc_clock_offset_ns[k] / 1000;
+        m.llc_clock_offset_us[k] = (int32_t)(us > INT32_MAX ? INT32_MAX : us < -INT32_MAX ? -INT32_MAX : us);
+        m.llc_ferr_nm[k] = st.llc_ferr_nm[k];
+    }
     ncp_msg_send_status(sv->msg, &m);
     if (sv->hook && sv->hook->status)
         sv->hook->status(sv->hook->ctx, &m);

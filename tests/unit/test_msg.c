@@ -15,6 +15,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "ncp_ax_status_t.h"
 #include "ncpar/auth.h"
 #include "ncpar/msg.h"
 
@@ -377,7 +378,8 @@ static void test_status_json(void **state)
     /* the load's estimate and the last run's time */
     assert_non_null(strstr(buf, "\"estimate\": {\"state\": \"done\", \"program_time_s\": "
                                 "101.557000, \"path_length_mm\": 1444.142000"));
-    assert_non_null(strstr(buf, "}, \"program_time_s\": 4.500000, \"drives\": []}"));
+    assert_non_null(strstr(buf, "}, \"program_time_s\": 4.500000, \"drives\": [], "
+                                "\"llc_dp\": 0, \"llcs\": []}"));
     /* CiA 402 drives: state by name, statusword and last EMCY code with its meaning */
     s.n_drives = 2;
     memcpy(s.drive_axis, "XY", 2);
@@ -392,7 +394,23 @@ static void test_status_json(void **state)
                                 "\"Operation enabled\", \"statusword\": \"0x0237\", \"error\": "
                                 "\"0x0000\", \"error_text\": \"\"}, {\"axis\": \"Y\", \"node\": 2, "
                                 "\"state\": \"Fault\", \"statusword\": \"0x0218\", \"error\": "
-                                "\"0x8611\", \"error_text\": \"following error\"}]}"));
+                                "\"0x8611\", \"error_text\": \"following error\"}], "));
+    /* distributed axes: each LLC's state by name, its clock offset and following error */
+    s.n_llcs = 2;
+    s.llc_dp = 4;
+    memcpy(s.llc_axis, "XZ", 2);
+    s.llc_state[0] = NCP_AX_STATUS_T_RUNNING;
+    s.llc_state[1] = -1;
+    s.llc_clock_offset_us[0] = -12;
+    s.llc_ferr_nm[0] = 3071;
+    n = ncp_msg_status_json(&s, buf, sizeof buf);
+    assert_true(n > 0);
+    assert_non_null(strstr(buf, "\"llc_dp\": 4, \"llcs\": [{\"axis\": \"X\", \"state\": "
+                                "\"running\", \"clock_offset_us\": -12, \"ferr_nm\": 3071}, "
+                                "{\"axis\": \"Z\", \"state\": \"unheard\", \"clock_offset_us\": 0, "
+                                "\"ferr_nm\": 0}]}"));
+    assert_string_equal(ncp_msg_llc_state_name(NCP_AX_STATUS_T_DONE), "done");
+    assert_null(ncp_msg_llc_state_name(6));
     /* nothing and no state: nulls */
     memset(&s, 0, sizeof s);
     s.state = 42;
