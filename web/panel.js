@@ -229,6 +229,16 @@ function cycleTime(s) {
   return [est, last].filter(Boolean).join(', ') || '—';
 }
 
+// What drives the axes beyond the simulator: each CiA 402 drive's state and
+// last EMCY, or each LLC's state, DP, clock offset and following error
+function devices(s) {
+  const drives = (s.drives || []).map((d) =>
+    `${d.axis} node ${d.node}: ${d.state} (${d.statusword})${d.error !== '0x0000' ? `, EMCY ${d.error} ${d.error_text}` : ''}`);
+  const llcs = (s.llcs || []).map((l) =>
+    `${l.axis} LLC: ${l.state}, DP ${s.llc_dp}, clock ${l.clock_offset_us >= 0 ? '+' : ''}${l.clock_offset_us} us, f.err ${fmt(l.ferr_nm / 1000, 1)} um`);
+  return { title: drives.length ? 'drives' : 'LLCs', text: drives.concat(llcs).join('\n') };
+}
+
 function onStatus(m) {
   const recvUs = (performance.timeOrigin + performance.now()) * 1000;
   ui.lag.push([m.status.seq, m.utime, recvUs]);
@@ -284,6 +294,10 @@ function onStatus(m) {
   const g = (s.gcodes || []).map((c) => (c === 'G64' && s.g64 && (s.g64.p > 0 || s.g64.q > 0)) ? `G64 P${s.g64.p} Q${s.g64.q}` : c);
   $('gcodes').textContent = g.join(' ') || '—';
   $('mcodes').textContent = (s.mcodes || []).join(' ') || '—';
+  const dev = devices(s);
+  $('devices').textContent = dev.text;
+  $('devices-t').textContent = dev.title;
+  $('devices').hidden = $('devices-t').hidden = !dev.text;
   if (document.activeElement !== $('step')) $('step').checked = !!s.step;
   for (const w of ['feed', 'rapid', 'spindle']) {
     const el = $('ov-' + w);

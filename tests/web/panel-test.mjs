@@ -21,7 +21,7 @@ import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
 
-const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "spindle-coolant", "jog", "touch-off", "tool-table", "server-limits", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
+const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "devices", "spindle-coolant", "jog", "touch-off", "tool-table", "server-limits", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
 
 const [BUILD, WORK, CHROMIUM, FIREFOX] = process.argv.slice(2);
 const ROOT = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..', '..');
@@ -550,6 +550,32 @@ async function session(browser) {
     await page.type('#mdi', 'G21 G90');
     await click(page, '#mdi-send');
     await waitFor(page, 'G21 G90 back', (s) => s.state === 'idle' && s.gcodes.includes('G21') && s.gcodes.includes('G90'), 5000);
+  });
+  await run('devices', async () => {
+    // on the simulated machine no drives or LLCs: the row is hidden
+    check(await page.$eval('#devices', (e) => e.hidden), 'a drives row on the simulated machine');
+    // a status as serve sends it on CAN drives, then on distributed axes (the
+    // DOM is updated in the same task as the status, before the next comes)
+    const show = (extra) => page.evaluate((x) => {
+      const p = window.ncpPanel;
+      p.receive(JSON.stringify({ type: 'status', utime: 0, http: p.http, status: { ...p.status, ...x } }));
+      const d = document.querySelector('#devices');
+      return [document.querySelector('#devices-t').textContent, d.textContent, d.hidden];
+    }, extra);
+    const can = await show({ drives: [
+      { axis: 'X', node: 1, state: 'Operation enabled', statusword: '0x0237', error: '0x0000', error_text: '' },
+      { axis: 'Y', node: 2, state: 'Fault', statusword: '0x0218', error: '0x8611', error_text: 'following error' }],
+    llc_dp: 0, llcs: [] });
+    check(can[0] === 'drives' && !can[2] && can[1] === 'X node 1: Operation enabled (0x0237)\n' +
+      'Y node 2: Fault (0x0218), EMCY 0x8611 following error', `drives shown: ${JSON.stringify(can)}`);
+    const lcm = await show({ drives: [], llc_dp: 4, llcs: [
+      { axis: 'X', state: 'running', clock_offset_us: 12, ferr_nm: 3071 },
+      { axis: 'Z', state: 'fault', clock_offset_us: -3, ferr_nm: -120 }] });
+    check(lcm[0] === 'LLCs' && !lcm[2] && lcm[1] === 'X LLC: running, DP 4, clock +12 us, f.err 3.1 um\n' +
+      'Z LLC: fault, DP 4, clock -3 us, f.err -0.1 um', `LLCs shown: ${JSON.stringify(lcm)}`);
+    await shot(page, '06c-llcs');
+    // the next status from the simulated machine hides the row again
+    await page.waitForFunction(() => document.querySelector('#devices').hidden, { timeout: 3000 });
   });
   await run('spindle-coolant', async () => {
     await page.$eval('#spindle-rpm', (e) => { e.value = '1200'; });
