@@ -573,7 +573,6 @@ async function session(browser) {
       { axis: 'Z', state: 'fault', clock_offset_us: -3, ferr_nm: -120 }] });
     check(lcm[0] === 'LLCs' && !lcm[2] && lcm[1] === 'X LLC: running, DP 4, clock +12 us, f.err 3.1 um\n' +
       'Z LLC: fault, DP 4, clock -3 us, f.err -0.1 um', `LLCs shown: ${JSON.stringify(lcm)}`);
-    await shot(page, '06c-llcs');
     // the next status from the simulated machine hides the row again
     await page.waitForFunction(() => document.querySelector('#devices').hidden, { timeout: 3000 });
   });
