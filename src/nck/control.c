@@ -187,6 +187,7 @@ static void begin_drop(struct ncp_nck *s, int hold, int full, int after, int res
     }
     s->drop_after = after;
     s->drop_reset = reset;
+    s->drop_by_estop = after == NCP_ST_ESTOP;
     set_state(s, NCP_ST_STOPPING);
 }
 
@@ -233,7 +234,7 @@ static void drop_step(struct ncp_nck *s)
         persist(s);
         if (s->hist.open) {   /* a program run ended by the drop */
             int64_t now = atomic_load_explicit(&n->ctl->now_ns, memory_order_acquire);
-            history_end(s, s->drop_after == NCP_ST_ESTOP   ? "estop"
+            history_end(s, s->drop_by_estop                ? "estop"
                            : s->drop_after == NCP_ST_FAULT ? "fault"
                                                            : "stopped",
                         now > s->run_t0_ns ? (double)(now - s->run_t0_ns) * 1e-9 : 0);
@@ -763,9 +764,13 @@ static int cmd_estop(struct ncp_nck *s)
     if (s->drop != NCK_DROP_NONE && s->drop != NCK_DROP_HOLD) {
         s->drop_after = NCP_ST_ESTOP;   /* already dropping: end there */
         s->drop_reset |= interp;
+        s->drop_by_estop = 1;
     } else {
         begin_drop(s, 0, 0, NCP_ST_ESTOP, interp);
     }
+    /* The setpoints froze above: that is the E-stop the operator must see at
+     * once, while the job and the planner's queue are dropped behind it. */
+    set_state(s, NCP_ST_ESTOP);
     nck_post(n, NCP_EV_FAULT, NULL, 0, 0, "E-stop: setpoints frozen, drives off");
     return 0;
 }
@@ -800,6 +805,12 @@ static int cmd_reset(struct ncp_nck *s, char *why, size_t len)
                                                 ncp_nck_state_name(s->state));
     atomic_store(&n->cross.loop_fault, NCK_LF_NONE);
     s->error[0] = 0;
+    if (s->drop != NCK_DROP_NONE) {
+        /* the E-stop's drop is still under way: let it end in idle instead */
+        s->drop_after = NCP_ST_IDLE;
+        set_state(s, NCP_ST_STOPPING);
+        return 0;
+    }
     /* rest at the actual position while still frozen, then let go */
     begin_drop(s, 0, 0, NCP_ST_IDLE, 0);
     return 0;
