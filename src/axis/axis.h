@@ -13,6 +13,9 @@
 #include "ncpar/msg.h"
 #include "ncpar/rt.h"
 
+#include "llc_clock.h"
+#include "llc_scale.h"
+
 enum llc_end {
     LLC_END_NONE,
     LLC_END_DONE,       /* the HLC said the program is done */
@@ -25,29 +28,6 @@ enum llc_end {
     LLC_END_PROGRAM,    /* DP1: its own NCK could not run the program (fault says why) */
     LLC_END_CLOCK,      /* CLOCK = monotonic or ptp, and the probes find the clocks apart */
     LLC_END_DRIVE       /* its CiA 402 drive faulted (fault says how) */
-};
-
-/* The common time base (clock.c): written by the probe thread (the window
- * and the estimate's atomics) or by the position loop (applied, slewing). */
-struct llc_clock {
-    struct ncp_dist_probe_io io;  /* the probe thread and its own socket */
-    char channel[32];             /* NCP_AX_<L>_CLOCK */
-    enum ncp_lcm_clock mode;
-    int64_t tolerance_ns;
-    int64_t base_ns;              /* ptp: CLOCK_REALTIME - CLOCK_MONOTONIC at start, else 0 */
-    /* cnc-axis --clock-skew-us, --clock-drift-ppm: tests only, another
-     * host's clock simulated on this one */
-    int64_t skew_ns, mono0;
-    double drift_ppm;
-    int32_t seq;
-    struct ncp_dist_clock win;
-    _Atomic int64_t est_offset, est_rtt, est_jitter;
-    atomic_int probes;            /* in the estimate's window: 0 none yet */
-    atomic_int ready;             /* the estimate stands (see clock.c) */
-    atomic_ullong sent, answers;
-    int64_t applied;              /* the HLC's clock minus this one, as the grid runs */
-    int64_t slewed;               /* all the slewing, ns */
-    int slewing;
 };
 
 /* Periods an LLC at DP1 plays behind the HLC: more than the 6 standstill
@@ -143,17 +123,7 @@ struct llc {
     ncp_int_burst_t int_burst;
     struct llc_dp1 *dp1;          /* DP1: its own NCK (dp1.c) */
     struct llc_dp1_ai *dp1ai;     /* ADCAI's DP1: its NCK's samples (dp1_ai.c) */
-    /* The HLC's time scaling (llc_scale.c): its stream advance by period,
-     * the newest heard, and the records an abort of its made void */
-#define LLC_SCALE_HIST 64
-    int64_t scale_t[LLC_SCALE_HIST];
-    double scale_adv[LLC_SCALE_HIST];
-    int64_t scale_newest_t;
-    double scale_newest;
-    int32_t void_below;
-    int64_t void_t;
-    int void_due;
-    uint32_t voided;
+    struct llc_scale scale;       /* the HLC's time scaling (llc_scale.h) */
     char fault[200];              /* LLC_END_PROGRAM, LLC_END_DRIVE: why */
     char fault_short[64];         /* the same in what its status carries ("": fault) */
     struct llc_clock clk;
@@ -193,15 +163,6 @@ void llc_plan_advance(struct llc *l);
 struct ncp_dist_recs *llc_exec_ring(struct llc *l);
 int llc_exec_head(struct llc *l, double v0, struct ncp_accdec *a);
 
-/* llc_scale.c: the HLC's time scaling at the block-level points */
-void llc_on_scale(struct llc *l, const uint8_t *p, size_t len);
-/* The stream advance of the HLC's period slot (samples; 1 its own pace). */
-double llc_scale_at(const struct llc *l, int64_t slot);
-/* Drops the records an abort of the HLC's made void, once slot reaches
- * the period it dropped them in; the interpolator starts again from the
- * next record's start. */
-void llc_scale_void(struct llc *l, int64_t slot);
-
 /* dp1.c: DP1 at the LLC (its own NCK on the HLC's program) */
 struct llc_dp1;
 int llc_dp1_init(struct llc *l);
@@ -222,21 +183,6 @@ int llc_dp1_ai_level(const struct llc *l, int inner_done);
 double llc_dp1_ai_play(struct llc *l, int64_t slot);
 double llc_dp1_ai_ahead(struct llc *l, int64_t slot);
 void llc_dp1_ai_report(const struct llc *l);
-
-/* clock.c: the common time base */
-int llc_clock_start(struct llc *l, const char *url, struct ncp_diag *d);
-void llc_clock_stop(struct llc *l);
-/* This LLC's clock (mono_ns: CLOCK_MONOTONIC), and the HLC's as it maps. */
-int64_t llc_clock_local(const struct llc_clock *c, int64_t mono_ns);
-int64_t llc_hlc_time(const struct llc *l, int64_t mono_ns);
-/* The estimate stands: a full window of probes, short round trips or many. */
-int llc_clock_known(const struct llc *l);
-/* Once a period, from the loop: follows the estimate (CLOCK = probe; stepped
- * until grid_known, then slewed) or checks it: 0, or -1 when the clocks are
- * further apart than CLOCK_TOLERANCE_US. */
-int llc_clock_cycle(struct llc *l, int grid_known);
-void llc_clock_status(const struct llc *l, ncp_ax_status_t *s);
-void llc_clock_report(const struct llc *l);
 
 /* drive.c: the servo, simulated or a CiA 402 drive over SocketCAN */
 /* --backend sim|socketcan[:IFACE]: a drive is started (blocking) and the

@@ -341,7 +341,7 @@ static double interpolate(struct llc *l, int64_t slot)
     /* after an abort: where the command stands until the next job's first
      * record (it starts where the HLC rested on this axis's command) */
     struct ncp_accdec first;
-    if (l->voided && !l->ex_on && !llc_exec_head(l, 0, &first))
+    if (l->scale.voided && !l->ex_on && !llc_exec_head(l, 0, &first))
         return l->cmd;
     double pos;
     (void)exec_try(l, slot, 1, &pos);
@@ -359,7 +359,7 @@ static double interpolate_ahead(struct llc *l, int64_t slot)
 {
     double pos;
     struct ncp_accdec first;
-    if (slot < l->t_start || (l->voided && !l->ex_on && !llc_exec_head(l, 0, &first)))
+    if (slot < l->t_start || (l->scale.voided && !l->ex_on && !llc_exec_head(l, 0, &first)))
         return l->cmd;
     (void)exec_try(l, slot, 0, &pos);
     if (l->missing) {

@@ -32,39 +32,39 @@ void llc_on_scale(struct llc *l, const uint8_t *p, size_t len)
     for (int i = 0; i < m.count; i++) {
         int64_t t = m.t_ns - (int64_t)(m.count - 1 - i) * l->period_ns;
         unsigned k = place(l, t);
-        l->scale_t[k] = t;
-        l->scale_adv[k] = adv[i];
+        l->scale.t[k] = t;
+        l->scale.adv[k] = adv[i];
     }
-    if (m.t_ns > l->scale_newest_t) {
-        l->scale_newest_t = m.t_ns;
-        l->scale_newest = adv[m.count - 1];
+    if (m.t_ns > l->scale.newest_t) {
+        l->scale.newest_t = m.t_ns;
+        l->scale.newest = adv[m.count - 1];
     }
-    if (m.void_below > l->void_below && m.void_t_ns > 0) {
-        l->void_below = m.void_below;
-        l->void_t = m.void_t_ns;
-        l->void_due = 1;
+    if (m.void_below > l->scale.void_below && m.void_t_ns > 0) {
+        l->scale.void_below = m.void_below;
+        l->scale.void_t = m.void_t_ns;
+        l->scale.void_due = 1;
     }
 }
 
 double llc_scale_at(const struct llc *l, int64_t slot)
 {
-    if (!l->scale_newest_t)
+    if (!l->scale.newest_t)
         return 1.0;
     unsigned k = place(l, slot);
-    if (l->scale_t[k] == slot)
-        return l->scale_adv[k];
+    if (l->scale.t[k] == slot)
+        return l->scale.adv[k];
     /* past the newest word: it holds; before it and not heard: the HLC
      * said nothing then, which it does only at its own pace */
-    return slot > l->scale_newest_t ? l->scale_newest : 1.0;
+    return slot > l->scale.newest_t ? l->scale.newest : 1.0;
 }
 
 void llc_scale_void(struct llc *l, int64_t slot)
 {
-    if (!l->void_due || slot < l->void_t)
+    if (!l->scale.void_due || slot < l->scale.void_t)
         return;
-    l->void_due = 0;
-    ncp_dist_recs_skip(&l->recs, l->void_below);
+    l->scale.void_due = 0;
+    ncp_dist_recs_skip(&l->recs, l->scale.void_below);
     l->ex_on = 0;
     l->stop_rested = 0;
-    l->voided++;
+    l->scale.voided++;
 }

@@ -1,0 +1,32 @@
+/* The HLC's time scaling at ADCBI's block-level points, as one LLC keeps it
+ * (llc_scale.c): the stream advance the HLC reported for each of its periods,
+ * the newest heard, and the records an abort of its made void. */
+#ifndef NCP_AXIS_LLC_SCALE_H
+#define NCP_AXIS_LLC_SCALE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define LLC_SCALE_HIST 64
+
+struct llc_scale {
+    int64_t t[LLC_SCALE_HIST];
+    double adv[LLC_SCALE_HIST];
+    int64_t newest_t;
+    double newest;
+    int32_t void_below;
+    int64_t void_t;
+    int void_due;
+    uint32_t voided;   /* aborts whose records were dropped */
+};
+
+struct llc;
+void llc_on_scale(struct llc *l, const uint8_t *p, size_t len);
+/* The stream advance of the HLC's period slot (samples; 1 its own pace). */
+double llc_scale_at(const struct llc *l, int64_t slot);
+/* Drops the records an abort of the HLC's made void, once slot reaches
+ * the period it dropped them in; the interpolator starts again from the
+ * next record's start. */
+void llc_scale_void(struct llc *l, int64_t slot);
+
+#endif
