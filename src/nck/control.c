@@ -188,6 +188,7 @@ static void begin_drop(struct ncp_nck *s, int hold, int full, int after, int res
     s->drop_after = after;
     s->drop_reset = reset;
     s->drop_by_estop = after == NCP_ST_ESTOP;
+    s->reset_after_drop = 0;
     set_state(s, NCP_ST_STOPPING);
 }
 
@@ -210,7 +211,9 @@ static void drop_step(struct ncp_nck *s)
     case NCK_DROP_PARK:
         if (!nck_planner_parked(n))
             return;
-        nck_discard(n, atomic_load(&n->cross.frozen));
+        /* E-stop and faults keep the frozen setpoint (the axes coast on
+         * with their drives off); a reset takes where they came to rest */
+        nck_discard(n, atomic_load(&n->cross.frozen) && s->drop_after == NCP_ST_IDLE);
         s->drop = NCK_DROP_DISCARD;
         /* fall through */
     case NCK_DROP_DISCARD:
@@ -239,7 +242,12 @@ static void drop_step(struct ncp_nck *s)
                                                            : "stopped",
                         now > s->run_t0_ns ? (double)(now - s->run_t0_ns) * 1e-9 : 0);
         }
-        set_state(s, s->drop_after);
+        if (s->reset_after_drop) {
+            s->reset_after_drop = 0;
+            begin_drop(s, 0, 0, NCP_ST_IDLE, 0);
+        } else {
+            set_state(s, s->drop_after);
+        }
         break;
     case NCK_DROP_NONE:
         break;
@@ -765,6 +773,7 @@ static int cmd_estop(struct ncp_nck *s)
         s->drop_after = NCP_ST_ESTOP;   /* already dropping: end there */
         s->drop_reset |= interp;
         s->drop_by_estop = 1;
+        s->reset_after_drop = 0;
     } else {
         begin_drop(s, 0, 0, NCP_ST_ESTOP, interp);
     }
@@ -806,8 +815,8 @@ static int cmd_reset(struct ncp_nck *s, char *why, size_t len)
     atomic_store(&n->cross.loop_fault, NCK_LF_NONE);
     s->error[0] = 0;
     if (s->drop != NCK_DROP_NONE) {
-        /* the E-stop's drop is still under way: let it end in idle instead */
-        s->drop_after = NCP_ST_IDLE;
+        /* the E-stop's drop is still under way: the reset's follows it */
+        s->reset_after_drop = 1;
         set_state(s, NCP_ST_STOPPING);
         return 0;
     }

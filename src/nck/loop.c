@@ -290,6 +290,32 @@ static void idle_nap(const struct nck_core *n)
     clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, NULL);
 }
 
+/* Below this speed on every axis, for NCK_STILL_PERIODS in a row, an axis
+ * whose drive is off has stopped coasting. */
+#define NCK_STILL_MM_S 0.1
+#define NCK_STILL_PERIODS 10
+/* After this long frozen the actual position is taken however it moves: a
+ * drive that never settles is its following-error check's to catch. */
+#define NCK_STILL_GIVE_UP_S 5.0
+
+/* The axes stand: a drop to the actual position (a reset, the end of an
+ * E-stop's drop) takes it only then, or the setpoint would stay behind
+ * where they stop and the drives would pull back when they come on. */
+static int plant_still(struct nck_core *n, const double act[NCP_AXES])
+{
+    struct nck_loop *lp = n->loop;
+    double step = NCK_STILL_MM_S * n->cfg->servo_period;
+    int moved = 0;
+    for (int j = 0; j < NCP_AXES; j++) {
+        moved |= fabs(act[j] - lp->frozen_prev[j]) > step;
+        lp->frozen_prev[j] = act[j];
+    }
+    lp->still_periods = moved ? 0 : lp->still_periods + 1;
+    lp->frozen_periods++;
+    return lp->still_periods >= NCK_STILL_PERIODS ||
+           lp->frozen_periods * n->cfg->servo_period >= NCK_STILL_GIVE_UP_S;
+}
+
 /* E-stop or a fault: the setpoint stays where it was, the drives are off. */
 static int frozen_cycle(struct nck_core *n, int64_t now_ns)
 {
@@ -297,6 +323,8 @@ static int frozen_cycle(struct nck_core *n, int64_t now_ns)
         n->cross.be.ops->enable(&n->cross.be, 0);
         n->loop->drives_on = 0;
     }
+    if (n->loop->frozen_periods == 0)
+        memcpy(n->loop->frozen_prev, n->loop->cur.pos, sizeof n->loop->frozen_prev);
     nck_home_cancel(n);
     double act[NCP_AXES];
     n->cross.be.timing = NULL;
@@ -306,8 +334,10 @@ static int frozen_cycle(struct nck_core *n, int64_t now_ns)
     nck_inject_clear(n);
     n->loop->mach.rpm_cmd = 0;   /* E-stop and faults stop the spindle too */
     (void)nck_aux_cycle(n);
+    int still = plant_still(n, act);
     if (atomic_load_explicit(&n->cross.discard_req, memory_order_acquire) !=
-        atomic_load_explicit(&n->cross.discard_ack, memory_order_relaxed))
+            atomic_load_explicit(&n->cross.discard_ack, memory_order_relaxed) &&
+        (still || !atomic_load_explicit(&n->cross.discard_to_actual, memory_order_relaxed)))
         discard(n, act);
     n->loop->cur.v = 0;
     push_cycle(n, now_ns, act, 0);
@@ -330,6 +360,8 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
     publish_stats(n);
     if (atomic_load_explicit(&n->cross.frozen, memory_order_acquire))
         return frozen_cycle(n, now_ns);
+    n->loop->frozen_periods = 0;
+    n->loop->still_periods = 0;
     if (!n->loop->drives_on && n->cross.be.ops->enable) {
         n->cross.be.ops->enable(&n->cross.be, 1);
         n->loop->drives_on = 1;

@@ -24,6 +24,8 @@ struct nck_loop {
     uint64_t ends_seen;              /* the scaler's END count already added to ends_taken */
     int ended, settle, for_expired;  /* batch */
     int drives_on;
+    double frozen_prev[NCP_AXES];    /* the actual position one frozen period ago */
+    int still_periods, frozen_periods;
     int64_t end_ns, now_ns;
     uint32_t line_now, line_done;
     int64_t loop_last_ns;

@@ -592,6 +592,8 @@ static void test_estop_reset(void **state_)
         nap_ms(1);
     }
     assert_int_equal(cmd(&s, NCP_CMD_ESTOP, NULL, 0, 0, NULL), 0);
+    /* what the operator reads from the ACK on, before the job is dropped */
+    assert_int_equal(state(&s), NCP_ST_ESTOP);
     wait_state(&s, NCP_ST_ESTOP);
     double p1[3], p2[3];
     pos(&s, p1);
@@ -607,6 +609,24 @@ static void test_estop_reset(void **state_)
     wait_state(&s, NCP_ST_IDLE);
     pos(&s, p1);
     assert_true(fabs(p1[0]) < 1e-9);
+
+    /* a reset sent in the same breath as the E-stop, while its drop is
+     * still under way, ends in idle with the setpoints let go */
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
+    for (int i = 0; i < 20000; i++) {
+        pos(&s, p1);
+        if (p1[0] > 20)
+            break;
+        nap_ms(1);
+    }
+    assert_int_equal(cmd_now(&s, NCP_CMD_ESTOP, NULL, 0, 0, why), 0);
+    assert_int_equal(state(&s), NCP_ST_ESTOP);
+    assert_int_equal(cmd_now(&s, NCP_CMD_RESET, NULL, 0, 0, why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    assert_int_equal(cmd(&s, NCP_CMD_MDI, "G0 X1", 0, 0, why), 0);
+    wait_state(&s, NCP_ST_IDLE);
+    pos(&s, p1);
+    assert_true(fabs(p1[0] - 1) < 1e-9);
     stop(&s);
 }
 
