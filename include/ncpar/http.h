@@ -40,6 +40,11 @@ struct ncp_http_opts {
     /* put into every hello after its own fields (", \"limits\": ..."): the
      * machine's override limits and travel for the panel; NULL: none */
     const char *hello_extra;
+    /* The program folder: where uploads land, what the program list shows
+     * and where the panel's relative loads start (the machine INI's
+     * [DISPLAY] PROGRAM_PREFIX, its first folder); NULL or "": serve's
+     * working directory. */
+    const char *program_dir;
 };
 
 /* Counters of the socket's input (all since start). */
@@ -90,6 +95,10 @@ enum ncp_http_req ncp_http_parse_request(const char *json, size_t len, int32_t c
  * digits and . _ - +, not starting with . or -, ending in .ngc, .nc or .tap):
  * 1, or 0 with why. */
 int ncp_http_upload_name_ok(const char *name, char *why, size_t why_len);
+/* name in the program folder dir (NULL or "": the working directory): dir/name,
+ * or name itself when it is absolute or there is no folder. 0, or -1 when it
+ * does not fit in cap. */
+int ncp_http_program_path(const char *dir, const char *name, char *out, size_t cap);
 /* s as a JSON string (quoted, escaped) appended to buf at *len; -1 if it
  * does not fit (buf then holds a truncated prefix). */
 int ncp_http_json_string(char *buf, size_t size, size_t *len, const char *s, size_t n);

@@ -224,6 +224,11 @@ static int start_http(const struct serve_args *a, const struct ncp_machine_cfg *
         return fprintf(stderr, "cnc-run serve: --http: no panel in %s (run make)\n", web), -1;
     ho.web_root = web;
     ho.self_exe = exe;
+    /* PROGRAM_PREFIX's first folder (the rest are for M100-M199 only) */
+    static char progs[sizeof cfg->rs274.program_prefix];
+    snprintf(progs, sizeof progs, "%s", cfg->rs274.program_prefix);
+    progs[strcspn(progs, ":")] = 0;
+    ho.program_dir = progs;
     if (ncp_http_parse_listen(a->http, &ho, &d) || !(*out = ncp_http_start(&ho, &d)))
         return fprintf(stderr, "cnc-run serve: %s\n", d.msg), -1;
     const char *v6 = strchr(ho.addr, ':');

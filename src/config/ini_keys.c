@@ -293,7 +293,9 @@ const struct ncp_ini_key ncp_ini_keys[] = {
     REAL("RS274NGC", "ORIENT_OFFSET", -1e9, 1e9, "degrees", "0",
          "Added to the angle of M19 (its R word, 0 without one)."),
     TEXT("DISPLAY", "PROGRAM_PREFIX", "a folder, relative to the INI's folder", NULL,
-         "nc_files", "The first folder searched for the executables M100 .. M199."),
+         "nc_files", "The program folder (its first folder, if several): the panel lists, "
+         "loads and stores uploads there. Also the first folder searched for the "
+         "executables M100 .. M199."),
 
     TEXT("INJECT", "SPEC", "specs separated by commas, as cnc-run run --inject", NULL,
          "miss=0.01", "The faults."),

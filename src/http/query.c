@@ -129,11 +129,12 @@ static int cmp_names(const void *a, const void *b)
     return strcmp(*(char *const *)a, *(char *const *)b);
 }
 
-static int list(struct ncp_http_msg *out)
+static int list(const char *program_dir, struct ncp_http_msg *out)
 {
-    DIR *dir = opendir(".");
+    DIR *dir = opendir(program_dir && program_dir[0] ? program_dir : ".");
     if (!dir)
-        return refusal("cannot read the NCK's folder", out);
+        return refusal("cannot read the program folder", out);
+    int fd = dirfd(dir);
     char **names = calloc(LIST_MAX, sizeof *names);
     if (!names) {
         closedir(dir);
@@ -144,7 +145,8 @@ static int list(struct ncp_http_msg *out)
     while (n < LIST_MAX && (e = readdir(dir))) {
         struct stat st;
         if ((has_suffix(e->d_name, ".ngc") || has_suffix(e->d_name, ".nc") ||
-             has_suffix(e->d_name, ".tap")) && stat(e->d_name, &st) == 0 && S_ISREG(st.st_mode))
+             has_suffix(e->d_name, ".tap")) && fstatat(fd, e->d_name, &st, 0) == 0 &&
+            S_ISREG(st.st_mode))
             if ((names[n] = strdup(e->d_name)))
                 n++;
     }
@@ -325,11 +327,12 @@ static int preview(const char *self, const struct ncp_http_prog *prog, const ato
     return finish(&b, bad, out);
 }
 
-int ncp_http_build_answer(const char *self_exe, const struct ncp_http_prog *prog,
-                          enum ncp_http_req r, const atomic_int *stop, struct ncp_http_msg *out)
+int ncp_http_build_answer(const char *self_exe, const char *program_dir,
+                          const struct ncp_http_prog *prog, enum ncp_http_req r,
+                          const atomic_int *stop, struct ncp_http_msg *out)
 {
     if (r == NCP_HTTP_REQ_LIST)
-        return list(out);
+        return list(program_dir, out);
     if (r == NCP_HTTP_REQ_PROGRAM)
         return program(prog, out);
     return preview(self_exe, prog, stop, out);

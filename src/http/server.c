@@ -22,6 +22,7 @@
 #include "server_int.h"
 #include "ncpar/clock.h"
 
+#include <errno.h>
 #include <libwebsockets.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -30,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/random.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #define CMD_QUEUE 64            /* commands waiting for the serving thread */
@@ -595,6 +597,18 @@ static void query(struct ncp_http *h, struct conn *c, enum ncp_http_req r)
     c->queries++;
 }
 
+/* A load of a plain name is of the program folder's file (the list shows
+ * names, uploads land there): made absolute for the NCK, whose own relative
+ * paths start in serve's working directory. 0, or -1 when it does not fit. */
+static int program_path(const struct ncp_http *h, ncp_command_t *cmd)
+{
+    char path[sizeof cmd->text];
+    if (ncp_http_program_path(h->o.program_dir, (const char *)cmd->text, path, sizeof path))
+        return -1;
+    memcpy(cmd->text, path, sizeof path);
+    return 0;
+}
+
 static void on_message(struct ncp_http *h, struct conn *c)
 {
     if (c->rx_over) {
@@ -616,6 +630,10 @@ static void on_message(struct ncp_http *h, struct conn *c)
         ncp_http_parse_request(c->rx, c->rx_len, c->client_id, &cmd, &unknown, why, sizeof why);
     switch (r) {
     case NCP_HTTP_REQ_COMMAND:
+        if (cmd.kind == NCP_CMD_LOAD && program_path(h, &cmd)) {
+            refuse(h, c, cmd.seq, "the program's path is too long");
+            break;
+        }
         submit(h, c, &cmd);
         break;
     case NCP_HTTP_REQ_BAD:
@@ -806,6 +824,16 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: [HTTP] %s", why);
         goto fail;
     }
+    if (o->program_dir && o->program_dir[0]) {
+        struct stat pd;
+        int err = stat(o->program_dir, &pd) != 0 ? errno : 0;
+        if (err || !S_ISDIR(pd.st_mode)) {
+            ncp_diag_set(d, NCP_ERR_IO, 0, 0,
+                         "--http: the program folder %s ([DISPLAY] PROGRAM_PREFIX): %s",
+                         o->program_dir, err ? strerror(err) : "not a folder");
+            goto fail;
+        }
+    }
     if (make_token(h->token)) {
         ncp_diag_set(d, NCP_ERR_IO, 0, 0, "--http: no random numbers for the token");
         goto fail;
@@ -834,8 +862,9 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
     /* what a serve killed mid-upload left behind: every temporary, as one
      * folder has one serve (a second one's upload in flight would fail and
      * say so, never store a part) */
-    ncp_http_sweep_uploads(0);
-    struct ncp_http_jobs_env env = { .self_exe = h->o.self_exe, .prog_get = prog_get,
+    ncp_http_sweep_uploads(h->o.program_dir, 0);
+    struct ncp_http_jobs_env env = { .self_exe = h->o.self_exe,
+                                     .program_dir = h->o.program_dir, .prog_get = prog_get,
                                      .wake = wake, .ctx = h };
     lws_set_log_level(LLL_ERR, NULL);
     struct lws_context_creation_info info;

@@ -46,8 +46,10 @@ struct ncp_http_msg {
 
 /* The answer to a slow query (list, program, preview) or its refusal, on
  * the worker thread (query.c). prog may be NULL (nothing loaded). stop is
- * polled while the preview's interpreter runs. 0, or -1 out of memory. */
-int ncp_http_build_answer(const char *self_exe, const struct ncp_http_prog *prog,
+ * polled while the preview's interpreter runs; program_dir is the list's
+ * folder (ncp_http_opts). 0, or -1 out of memory. */
+int ncp_http_build_answer(const char *self_exe, const char *program_dir,
+                          const struct ncp_http_prog *prog,
                           enum ncp_http_req r, const atomic_int *stop,
                           struct ncp_http_msg *out);
 
@@ -58,6 +60,7 @@ int ncp_http_build_answer(const char *self_exe, const struct ncp_http_prog *prog
 struct ncp_http_jobs;
 struct ncp_http_jobs_env {
     const char *self_exe;
+    const char *program_dir;
     struct ncp_http_prog *(*prog_get)(void *ctx);   /* a reference, or NULL */
     void (*wake)(void *ctx);
     void *ctx;
@@ -116,6 +119,6 @@ int ncp_http_on_upload(struct lws *wsi, enum lws_callback_reasons reason, void *
 size_t ncp_http_upload_session_size(void);
 /* Removes upload temporaries older than max_age_s left by a serve that was
  * killed mid-upload: the number removed. */
-int ncp_http_sweep_uploads(int max_age_s);
+int ncp_http_sweep_uploads(const char *folder, int max_age_s);
 
 #endif

@@ -11,6 +11,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <libwebsockets.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,11 +20,16 @@
 #include <time.h>
 #include <unistd.h>
 
+/* the program folder ([DISPLAY] PROGRAM_PREFIX: at most 511 characters) and
+ * a name */
+#define UPLOAD_PATH_MAX 640
+
 struct upload {
     int open;                       /* fd is the temporary file */
     int fd;
-    char tmp[32];
+    char tmp[UPLOAD_PATH_MAX];      /* in the program folder, hidden */
     char name[NCP_HTTP_UPLOAD_NAME_MAX + 1];
+    char path[UPLOAD_PATH_MAX];     /* name in the program folder */
     int overwrite;
     unsigned status;                /* 0: good so far; else the HTTP status to answer */
     char why[200];
@@ -103,6 +109,13 @@ static void begin(const struct ncp_http_floor *f, struct lws *wsi, struct upload
         return;
     }
     snprintf(u->name, sizeof u->name, "%s", name);
+    const char *dir = f->opts->program_dir;
+    if (ncp_http_program_path(dir, u->name, u->path, sizeof u->path) ||
+        ncp_http_program_path(dir, ".upload-XXXXXX", u->tmp, sizeof u->tmp)) {
+        refuse(f, u, HTTP_STATUS_INTERNAL_SERVER_ERROR, NCP_HTTP_STAT_UPLOAD_BAD,
+               "the program folder's path is too long");
+        return;
+    }
     const char *ow = lws_get_urlarg_by_name(wsi, "overwrite=", arg, (int)sizeof arg);
     u->overwrite = ow && !strcmp(ow, "1");
     char len[32];
@@ -113,19 +126,19 @@ static void begin(const struct ncp_http_floor *f, struct lws *wsi, struct upload
         refuse(f, u, HTTP_STATUS_REQ_ENTITY_TOO_LARGE, NCP_HTTP_STAT_OVERSIZED, why);
         return;
     }
-    if (!u->overwrite && access(u->name, F_OK) == 0) {
+    if (!u->overwrite && access(u->path, F_OK) == 0) {
         snprintf(why, sizeof why, "%s exists: upload it again with overwrite to replace it",
                  u->name);
         refuse(f, u, HTTP_STATUS_CONFLICT, NCP_HTTP_STAT_UPLOAD_BAD, why);
         return;
     }
-    snprintf(u->tmp, sizeof u->tmp, ".upload-XXXXXX");
     u->fd = mkstemp(u->tmp);
     u->open = u->fd >= 0;
     if (u->open)
         (void)fchmod(u->fd, 0644);   /* a program as any other, not mkstemp's 0600 */
     if (!u->open) {
-        snprintf(why, sizeof why, "cannot write in the program folder: %s", strerror(errno));
+        snprintf(why, sizeof why, "cannot write in the program folder %s: %s",
+                 dir && dir[0] ? dir : "(serve's working directory)", strerror(errno));
         refuse(f, u, HTTP_STATUS_INTERNAL_SERVER_ERROR, NCP_HTTP_STAT_UPLOAD_BAD, why);
     }
 }
@@ -173,7 +186,7 @@ static void finish(const struct ncp_http_floor *f, struct upload *u)
     int rc = close(u->fd);
     u->open = 0;
     if (rc == 0)
-        rc = u->overwrite ? rename(u->tmp, u->name) : link(u->tmp, u->name);
+        rc = u->overwrite ? rename(u->tmp, u->path) : link(u->tmp, u->path);
     int err = errno;
     unlink(u->tmp);   /* after link(), the program keeps its own name */
     if (rc) {
@@ -230,11 +243,12 @@ size_t ncp_http_upload_session_size(void)
     return sizeof(struct upload);
 }
 
-int ncp_http_sweep_uploads(int max_age_s)
+int ncp_http_sweep_uploads(const char *folder, int max_age_s)
 {
-    DIR *dir = opendir(".");
+    DIR *dir = opendir(folder && folder[0] ? folder : ".");
     if (!dir)
         return 0;
+    int fd = dirfd(dir);
     int removed = 0;
     time_t now = time(NULL);
     struct dirent *e;
@@ -242,10 +256,10 @@ int ncp_http_sweep_uploads(int max_age_s)
         struct stat st;
         /* mkstemp's names only: ".upload-" and six characters */
         if (strncmp(e->d_name, ".upload-", 8) != 0 || strlen(e->d_name) != 14 ||
-            lstat(e->d_name, &st) != 0 || !S_ISREG(st.st_mode) ||
+            fstatat(fd, e->d_name, &st, AT_SYMLINK_NOFOLLOW) != 0 || !S_ISREG(st.st_mode) ||
             now - st.st_mtime < max_age_s)
             continue;
-        removed += unlink(e->d_name) == 0;
+        removed += unlinkat(fd, e->d_name, 0) == 0;
     }
     closedir(dir);
     return removed;

@@ -39,3 +39,11 @@ int ncp_http_upload_name_ok(const char *name, char *why, size_t wl)
     }
     return snprintf(why, wl, "a program's name ends in .ngc, .nc or .tap"), 0;
 }
+
+int ncp_http_program_path(const char *dir, const char *name, char *out, size_t cap)
+{
+    int n = name[0] == '/' || !dir || !dir[0]
+                ? snprintf(out, cap, "%s", name)
+                : snprintf(out, cap, "%s%s%s", dir, dir[strlen(dir) - 1] == '/' ? "" : "/", name);
+    return n < 0 || (size_t)n >= cap ? -1 : 0;
+}

@@ -152,6 +152,29 @@ static void upload_names(void **state)
     assert_int_equal(ncp_http_upload_name_ok(longname, why, sizeof why), 0);
 }
 
+/* A name the panel loads or uploads is of the program folder; an absolute
+ * path stays itself; no folder keeps the name as it is. */
+static void program_folder_paths(void **state)
+{
+    (void)state;
+    char out[32];
+    assert_int_equal(ncp_http_program_path("/nc/files", "a.ngc", out, sizeof out), 0);
+    assert_string_equal(out, "/nc/files/a.ngc");
+    assert_int_equal(ncp_http_program_path("/nc/files/", "a.ngc", out, sizeof out), 0);
+    assert_string_equal(out, "/nc/files/a.ngc");
+    assert_int_equal(ncp_http_program_path("/nc/files", "/abs/b.ngc", out, sizeof out), 0);
+    assert_string_equal(out, "/abs/b.ngc");
+    assert_int_equal(ncp_http_program_path(NULL, "c.ngc", out, sizeof out), 0);
+    assert_string_equal(out, "c.ngc");
+    assert_int_equal(ncp_http_program_path("", "c.ngc", out, sizeof out), 0);
+    assert_string_equal(out, "c.ngc");
+    /* 31 characters fit, 32 do not */
+    assert_int_equal(ncp_http_program_path("/nc/files", "012345678901234567890", out,
+                                           sizeof out), 0);
+    assert_int_equal(ncp_http_program_path("/nc/files", "0123456789012345678901", out,
+                                           sizeof out), -1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -160,6 +183,7 @@ int main(void)
         cmocka_unit_test(json_strings_are_escaped),
         cmocka_unit_test(listen_spec),
         cmocka_unit_test(upload_names),
+        cmocka_unit_test(program_folder_paths),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
