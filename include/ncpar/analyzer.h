@@ -143,6 +143,11 @@ struct ncp_analyzer_cfg {
      * rs274's defaults, nothing copied. */
     const struct ncp_var_file *params_in;
     struct ncp_var_file *params_out;
+    /* With params_in: the machine's point (X Y Z A B C U V W, machine coordinates,
+     * mm) the current point starts at instead of the machine's zero, for a
+     * run that starts where a machine stands (the NCK's load estimate).
+     * NULL: the machine's zero. */
+    const double *start_machine;
     /* cnc-run run: on its free the tool table (after G10 L1, L10, L11)
      * becomes tools_out's, to be written back as serve does (NULL: none) */
     struct ncp_analyzer *tools_out;

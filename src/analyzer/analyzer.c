@@ -82,7 +82,11 @@ static void ncp_an_preamble(struct ncp_analyzer *a)
     ncp_an_emit(a, NCP_C_SET_XY_ROTATION)->rotation.degrees = s->rotation;
     if (a->cfg.params_in) {
         static const double zero[NCP_NAX];
-        ncp_frame_relative(a, zero, s->pos);
+        double at[NCP_NAX] = { 0 };
+        if (a->cfg.start_machine)
+            for (int ax = 0; ax < NCP_NAX; ax++)
+                at[ax] = a->cfg.start_machine[ax];
+        ncp_frame_relative(a, a->cfg.start_machine ? at : zero, s->pos);
         memcpy(a->sai.pos, s->pos, sizeof a->sai.pos);
     }
     ncp_an_emit(a, NCP_C_SET_FEED_REFERENCE)->feed_reference.xyz = 1;

@@ -355,6 +355,7 @@ static void start_estimate(struct ncp_nck *s)
         .name = s->program, .text = s->prog.text, .len = s->prog.len, .cfg = n->cfg,
         .acfg = &s->acfg, .interp = s->interp,
         .joints = n->svc->have_fb ? n->svc->last_fb.jcmd : NULL,
+        .machine = n->svc->have_fb ? n->job->map.pos : NULL,
     };
     if (nck_estimate_start(&s->est, &in))
         nck_post(&s->core, NCP_EV_ERROR, s->program, 0, 0, "estimate: %s", s->est.why);

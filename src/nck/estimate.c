@@ -32,6 +32,7 @@ struct nck_estimate_run {
     atomic_int stop;                 /* ncp_nck_opts.interrupt, the interpreter's cancel */
     atomic_int done;
     int64_t t0_ns, t1_ns;
+    double start[NCP_AXES];          /* acfg.start_machine */
 };
 
 static int run_stopped(void *ctx)
@@ -139,6 +140,12 @@ int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *
         if (r->vars.listed[k])
             r->vars.value[k] = ncp_analyzer_param(in->interp, k);
     r->acfg.params_in = &r->vars;
+    /* the program's first move starts where the served machine stands (a
+     * G91 move, or one of fewer axes than the machine has, goes from there) */
+    if (in->machine) {
+        memcpy(r->start, in->machine, sizeof r->start);
+        r->acfg.start_machine = r->start;
+    }
     if (ncp_source_from_memory(&r->src, r->text, in->len, r->name, &d) != NCP_OK) {
         free(text);
         free(r);

@@ -38,6 +38,8 @@ struct nck_estimate_input {
     const struct ncp_analyzer_cfg *acfg;
     const struct ncp_analyzer *interp;
     const double *joints;            /* NCP_AXES, or NULL: the machine's zero */
+    const double *machine;           /* the same point as machine axes (NCP_AXES), where
+                                        the program's first move starts; NULL: zero */
 };
 
 /* Ends an estimate still running (cancel), then starts one. 0, or -1 with
