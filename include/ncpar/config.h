@@ -208,8 +208,11 @@ struct ncp_machine_cfg {
         /* [RS274NGC] PARAMETER_FILE and [EMCIO] TOOL_TABLE, made absolute
          * from the INI's folder as LinuxCNC reads them ("": not given) */
         char parameter_file[512], tool_table[512];
-        /* [DISPLAY] HISTORY_FILE: serve's job history, absolute ("": none) */
+        /* [DISPLAY] HISTORY_FILE: serve's job history, absolute ("": none);
+         * history_given: the INI has the key (NONE turns the history off,
+         * without it serve keeps one in the user's data folder) */
         char history_file[512];
+        int history_given;
         /* [DISPLAY] MAX_FEED_OVERRIDE (1.0), MIN_SPINDLE_OVERRIDE (0.0) and
          * MAX_SPINDLE_OVERRIDE (2.0): ratios, 1.0 = 100 % */
         double max_feed_override, min_spindle_override, max_spindle_override;

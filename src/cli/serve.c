@@ -11,6 +11,7 @@
 #include "rs274_ini.h"
 #include "machine.h"
 #include "signals.h"
+#include "userdata.h"
 
 #include "ncpar/http.h"
 #include "ncpar/nck.h"
@@ -310,6 +311,12 @@ static int load_channel(struct serve_channel *ch, const struct serve_args *a, in
     if (rs274_ini_machine(ch->config, ch->cfg.rs274.user_m_dirs, &ch->ini, &ch->acfg,
                           &ch->sub_path))
         return -1;
+    if (!ch->cfg.op.history_given) {
+        char why[160];
+        if (ncp_cli_default_history(ch->cfg.op.history_file, sizeof ch->cfg.op.history_file,
+                                    why, sizeof why))
+            fprintf(stderr, "cnc-run serve: no job history ([DISPLAY] HISTORY_FILE): %s\n", why);
+    }
     int rc = ncp_cli_load_vars("cnc-run serve", &ch->cfg, &ch->vars);
     return rc == 2 ? -2 : rc ? -1 : 0;
 }

@@ -58,8 +58,12 @@ int ncp_op_cfg_key(struct ncp_op_cfg *op, const char *ini_path, const char *sec,
         return ratio(v, 0.0, 2.0, &op->max_spindle_override, why, len);
     if (!strcasecmp(k, "MIN_SPINDLE_OVERRIDE"))
         return ratio(v, 0.0, 2.0, &op->min_spindle_override, why, len);
-    if (!strcasecmp(k, "HISTORY_FILE"))
+    if (!strcasecmp(k, "HISTORY_FILE")) {
+        op->history_given = 1;
+        if (!strcasecmp(v, "NONE"))
+            return op->history_file[0] = 0, 1;
         return path_key(op->history_file, sizeof op->history_file, ini_path, v, why, len);
+    }
     return 0;
 }
 

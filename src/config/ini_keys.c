@@ -201,8 +201,10 @@ const struct ncp_ini_key ncp_ini_keys[] = {
          "history.jsonl",
          "cnc-run serve's job history: one JSON line appended (whole, then fsync) at the "
          "end of each program run: start, end, program, result (done, error, stopped, "
-         "estop, fault), reason, program time and the estimate made at its load; cnc-ctl "
-         "history shows it. Not given: no history."),
+         "estop, fault), reason, the program's SHA-256, program time, largest following "
+         "error and the estimate made at its load; cnc-ctl history shows it. Not given: "
+         "$XDG_DATA_HOME/ncpar/history.jsonl (~/.local/share/ncpar/history.jsonl); NONE: "
+         "no history."),
     TEXT("EMCIO", "CYCLE_TIME", "LinuxCNC's", NULL, "0.1", "Taken and ignored."),
     TEXT("EMCIO", "EMCIO", "LinuxCNC's", NULL, "io", "Taken and ignored."),
     TEXT("EMCIO", "RANDOM_TOOLCHANGER", "LinuxCNC's", NULL, "0", "Taken and ignored."),

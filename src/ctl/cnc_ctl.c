@@ -574,7 +574,8 @@ static const struct command commands[] = {
      "The last N jobs (20 by default) of the NCK's job history, newest last: start,\n"
      "result (done error stopped estop fault), program time and the estimate made\n"
      "at the load, program, reason; with --json the lines as the NCK wrote them\n"
-     "(start, end, program, result, reason, program_time_s, estimate_s). The file\n"
+     "(start, end, program, sha256, result, reason, program_time_s,\n"
+     "max_following_error_mm, estimate_s). The file\n"
      "is the INI's [DISPLAY] HISTORY_FILE, whose path the NCK gives, read on this host.",
      OPT_JSON | OPT_COUNT, 0, 0, run_history},
     {"load", "PROG", "Loads a program (its path made absolute here).", 0, 1, 1, run_load},

@@ -38,18 +38,23 @@ static void print_line(const char *line, int json)
         fputs(line, stdout);
         return;
     }
-    char start[48], result[16], reason[600], prog[600], t[32], est[32];
+    char start[48], result[16], reason[600], prog[600], t[32], est[32], ferr[32];
     field(line, "start", start, sizeof start);
     field(line, "result", result, sizeof result);
     field(line, "reason", reason, sizeof reason);
     field(line, "program", prog, sizeof prog);
     field(line, "program_time_s", t, sizeof t);
     field(line, "estimate_s", est, sizeof est);
-    char times[80];
+    field(line, "max_following_error_mm", ferr, sizeof ferr);
+    char times[120];
     if (strcmp(est, "null") != 0 && est[0])
         snprintf(times, sizeof times, "%9.3f s (estimate %.3f s)", atof(t), atof(est));
     else
         snprintf(times, sizeof times, "%9.3f s", atof(t));
+    if (ferr[0]) {
+        size_t k = strlen(times);
+        snprintf(times + k, sizeof times - k, "  ferr %.4f mm", atof(ferr));
+    }
     printf("%s  %-8s %s  %s%s%s\n", start, result, times, prog, reason[0] ? ": " : "", reason);
 }
 

@@ -154,8 +154,8 @@ static void history_end(struct ncp_nck *s, const char *result, double program_ti
 {
     char why[NCP_DIAG_MSG_MAX];
     int fault = !strcmp(result, "error") || !strcmp(result, "fault");
-    if (nck_history_end(&s->hist, result, fault ? s->error : "", program_time, why,
-                        sizeof why) != 0)
+    if (nck_history_end(&s->hist, result, fault ? s->error : "", program_time,
+                        s->core.svc->sum.job_ferr_max, why, sizeof why) != 0)
         nck_post(&s->core, NCP_EV_ERROR, NULL, 0, 0, "%s", why);
 }
 
@@ -482,7 +482,8 @@ static int cmd_run(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
     s->run_t0_ns = atomic_load_explicit(&s->core.ctl->now_ns, memory_order_acquire);
     if (start_interp_job(s, &s->prog, (uint32_t)c->ivalue[0], NCK_JOB_PROGRAM))
         return refuse(why, len, "cannot start the interpreter thread");
-    nck_history_begin(&s->hist, s->program,
+    s->core.svc->sum.job_ferr_max = 0;
+    nck_history_begin(&s->hist, s->program, s->prog.text, s->prog.len,
                       s->est.state == NCP_EST_DONE ? s->est.program_time : -1);
     set_state(s, atomic_load(&s->core.job->step) ? NCP_ST_STEPPING : NCP_ST_RUNNING);
     nck_post(&s->core, NCP_EV_INFO, s->program, 0, 0, "running %s%s", s->program,

@@ -37,6 +37,7 @@ struct nck_fb {
 struct nck_summary {
     uint64_t rows, moving;
     double ferr_max, ferr_sum, ferr_axis_max[NCP_AXES];
+    double job_ferr_max;     /* since serve's last program run began */
     double contour_max, contour_sum;
     double hist[NCK_CONTOUR_HISTORY][NCP_AXES];
     size_t hist_n, hist_at;

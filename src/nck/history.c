@@ -7,16 +7,23 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <openssl/sha.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
-void nck_history_begin(struct nck_history *h, const char *program, double estimate)
+void nck_history_begin(struct nck_history *h, const char *program, const char *text,
+                       size_t len, double estimate)
 {
     if (!h->path || !h->path[0])
         return;
     clock_gettime(CLOCK_REALTIME, &h->start);
     snprintf(h->program, sizeof h->program, "%s", program);
+    /* which program ran, whatever its file was renamed to or holds since */
+    unsigned char md[SHA256_DIGEST_LENGTH];
+    SHA256((const unsigned char *)(text ? text : ""), text ? len : 0, md);
+    for (size_t i = 0; i < SHA256_DIGEST_LENGTH; i++)
+        snprintf(h->sha256 + 2 * i, 3, "%02x", md[i]);
     h->estimate = estimate;
     h->open = 1;
 }
@@ -66,7 +73,7 @@ static int append(const char *path, const char *line, size_t n)
 }
 
 int nck_history_end(struct nck_history *h, const char *result, const char *why,
-                    double program_time, char *err, size_t len)
+                    double program_time, double ferr_max, char *err, size_t len)
 {
     if (!h->open)
         return 0;
@@ -83,9 +90,10 @@ int nck_history_end(struct nck_history *h, const char *result, const char *why,
     else
         snprintf(est, sizeof est, "null");
     int n = snprintf(line, sizeof line,
-                     "{\"start\": \"%s\", \"end\": \"%s\", \"program\": \"%s\", \"result\": "
-                     "\"%s\", \"reason\": \"%s\", \"program_time_s\": %.6f, \"estimate_s\": "
-                     "%s}\n", t0, t1, prog, result, reason, program_time, est);
+                     "{\"start\": \"%s\", \"end\": \"%s\", \"program\": \"%s\", \"sha256\": "
+                     "\"%s\", \"result\": \"%s\", \"reason\": \"%s\", \"program_time_s\": %.6f, "
+                     "\"max_following_error_mm\": %.6f, \"estimate_s\": %s}\n",
+                     t0, t1, prog, h->sha256, result, reason, program_time, ferr_max, est);
     if (n < 0 || (size_t)n >= sizeof line)
         return snprintf(err, len, "history: the line for %s is too long", h->program), -1;
     int e = append(h->path, line, (size_t)n);

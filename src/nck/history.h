@@ -13,15 +13,19 @@ struct nck_history {
     int open;                        /* a run began and its line is not written yet */
     struct timespec start;           /* CLOCK_REALTIME */
     char program[256];
+    char sha256[65];                 /* of the text the run interprets, hex */
     double estimate;                 /* s, < 0: none was ready */
 };
 
-/* A program run begins (nothing written yet). */
-void nck_history_begin(struct nck_history *h, const char *program, double estimate);
+/* A program run begins (nothing written yet): its path, the text the load
+ * checked (len bytes: what runs, whatever the file holds by now) and the
+ * load's estimate. */
+void nck_history_begin(struct nck_history *h, const char *program, const char *text,
+                       size_t len, double estimate);
 /* It ended: result "done", "error", "stopped", "estop" or "fault", why ""
- * or the reason, its program time. 0 (written, or no history, or no run
- * open), or -1 with why in err. */
+ * or the reason, its program time and largest following error (mm). 0
+ * (written, or no history, or no run open), or -1 with why in err. */
 int nck_history_end(struct nck_history *h, const char *result, const char *why,
-                    double program_time, char *err, size_t len);
+                    double program_time, double ferr_max, char *err, size_t len);
 
 #endif

@@ -139,6 +139,7 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
     memcpy(s->last, fb->cmd, sizeof s->last);
     s->rows++;
     s->ferr_max = fmax(s->ferr_max, e);
+    s->job_ferr_max = fmax(s->job_ferr_max, e);
     s->contour_max = fmax(s->contour_max, c);
     if (fb->v > 0) {
         s->moving++;
