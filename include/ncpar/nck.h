@@ -132,6 +132,7 @@ struct ncp_nck_result {
     uint64_t calls_in, calls_acted, calls_refused; /* canonical calls the NCK took */
     double spindle_rpm_max;  /* the spindle's highest actual speed */
     uint64_t pauses;         /* program pauses and tool changes waited for */
+    double ext_min[NCP_AXES], ext_max[NCP_AXES]; /* commanded extents (min > max: none) */
     char warning[200];
     struct ncp_rt_stats lat;
     /* timing faults injected ([INJECT], --inject) and a miss limit that
@@ -290,7 +291,12 @@ struct ncp_nck_snapshot {
      * machine at 100 %, and how long finding them took */
     int estimate_state;
     double estimate_s, estimate_path_mm, estimate_ferr_mm, estimate_compute_s;
+    int estimate_pauses;             /* M0, M1, M6 it waits at */
+    double estimate_min[NCP_AXES], estimate_max[NCP_AXES]; /* its extents (min > max: none) */
     double program_time_s;           /* the last program run's, start to end (0: none) */
+    /* while a program runs with an estimate done: what is left of it at
+     * the feed override now (s; -1: none) */
+    double remaining_s;
     /* CiA 402 drives (socketcan backend), as their last frames said */
     int n_drives;
     char drive_axis[NCP_NCK_AXES_MAX];

@@ -30,11 +30,25 @@ static const char *text_of(const uint8_t *t, size_t size, char *buf, size_t bufs
 static void print_estimate(const ncp_status_t *s)
 {
     const char *name = ncp_msg_estimate_name(s->estimate_state);
-    if (s->estimate_state == NCP_STATUS_T_EST_DONE)
-        printf("estimate  program time %.3f s, path %.3f mm, max following error %.4f mm\n",
-               s->estimate_s, s->estimate_path_mm, s->estimate_ferr_mm);
-    else if (s->estimate_state != NCP_STATUS_T_EST_NONE)
+    if (s->estimate_state == NCP_STATUS_T_EST_DONE) {
+        printf("estimate  program time %.3f s, path %.3f mm, max following error %.4f mm, "
+               "%d pauses\n", s->estimate_s, s->estimate_path_mm, s->estimate_ferr_mm,
+               (int)s->estimate_pauses);
+        if (s->estimate_min[0] <= s->estimate_max[0]) {
+            printf("extents  ");
+            for (int i = 0; i < n_axes(s); i++) {
+                const char *at = strchr("XYZABCUVW", s->axes[i]);
+                if (at && s->axes[i])
+                    printf(" %c %.3f..%.3f", s->axes[i], (double)s->estimate_min[at - "XYZABCUVW"],
+                           (double)s->estimate_max[at - "XYZABCUVW"]);
+            }
+            printf("\n");
+        }
+    } else if (s->estimate_state != NCP_STATUS_T_EST_NONE) {
         printf("estimate  %s\n", name ? name : "unknown");
+    }
+    if (s->remaining_s >= 0)
+        printf("remaining %.1f s at the feed override now\n", s->remaining_s);
     if (s->program_time_s > 0)
         printf("last run  program time %.3f s\n", s->program_time_s);
 }

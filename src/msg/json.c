@@ -170,8 +170,27 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
     put_num(&o, "%.6f", s->estimate_ferr_mm);
     put(&o, ", \"compute_s\": ");
     put_num(&o, "%.3f", s->estimate_compute_s);
+    put(&o, ", \"pauses\": %d, \"extents\": ", (int)s->estimate_pauses);
+    if (s->estimate_min[0] > s->estimate_max[0]) {
+        put(&o, "null");
+    } else {
+        for (int side = 0; side < 2; side++) {
+            const float *v = side ? s->estimate_max : s->estimate_min;
+            put(&o, side ? "], \"max\": [" : "{\"min\": [");
+            for (int j = 0; j < 9; j++) {
+                put(&o, j ? ", " : "");
+                put_num(&o, "%.4f", (double)v[j]);
+            }
+        }
+        put(&o, "]}");
+    }
     put(&o, "}, \"program_time_s\": ");
     put_num(&o, "%.6f", s->program_time_s);
+    put(&o, ", \"remaining_s\": ");
+    if (s->remaining_s < 0)
+        put(&o, "null");
+    else
+        put_num(&o, "%.3f", s->remaining_s);
     put(&o, ", \"drives\": [");
     for (int k = 0; k < s->n_drives && k < 9; k++) {
         uint16_t sw = (uint16_t)s->drive_statusword[k], err = (uint16_t)s->drive_error[k];

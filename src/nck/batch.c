@@ -282,6 +282,10 @@ static void collect(const struct nck_core *n, struct ncp_nck_result *res)
     res->spindle_rpm_max = s->rpm_max;
     nck_sched_summary(n, res->sched_summary, sizeof res->sched_summary);
     res->pauses = n->svc->pauses;
+    for (int j = 0; j < NCP_AXES; j++) {
+        res->ext_min[j] = s->rows ? s->ext_min[j] : 1;
+        res->ext_max[j] = s->rows ? s->ext_max[j] : 0;
+    }
     for (int k = 0; k < NCP_C__COUNT; k++) {
         res->calls_in += n->cross.calls_in[k];
         res->calls_acted += n->cross.calls_acted[k];

@@ -483,6 +483,8 @@ static int cmd_run(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
     if (start_interp_job(s, &s->prog, (uint32_t)c->ivalue[0], NCK_JOB_PROGRAM))
         return refuse(why, len, "cannot start the interpreter thread");
     s->core.svc->sum.job_ferr_max = 0;
+    s->core.svc->sum.job_done_s = 0;
+    s->run_from_line = (uint32_t)c->ivalue[0];
     nck_history_begin(&s->hist, s->program, s->prog.text, s->prog.len,
                       s->est.state == NCP_EST_DONE ? s->est.program_time : -1);
     set_state(s, atomic_load(&s->core.job->step) ? NCP_ST_STEPPING : NCP_ST_RUNNING);
@@ -1207,7 +1209,23 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
     st->estimate_path_mm = s->est.path_length;
     st->estimate_ferr_mm = s->est.ferr_max;
     st->estimate_compute_s = s->est.seconds;
+    st->estimate_pauses = s->est.pauses;
+    for (int j = 0; j < NCP_AXES; j++) {
+        st->estimate_min[j] = s->est.state == NCP_EST_DONE ? s->est.ext_min[j] : 1;
+        st->estimate_max[j] = s->est.state == NCP_EST_DONE ? s->est.ext_max[j] : 0;
+    }
     st->program_time_s = s->program_time;
+    /* the stream's time read so far is the estimate's time done (both at
+     * 100 %); what is left goes at the feed override now (rapids at theirs:
+     * an approximation where they differ) */
+    double ovr = st->feed_override / 100.0;
+    int in_run = n->job->kind == NCK_JOB_PROGRAM &&
+                 (s->state == NCP_ST_RUNNING || s->state == NCP_ST_STEPPING ||
+                  s->state == NCP_ST_PAUSED);
+    st->remaining_s = in_run && s->est.state == NCP_EST_DONE && !s->run_from_line
+                          ? fmax(0.0, s->est.program_time - n->svc->sum.job_done_s) /
+                                fmax(ovr, 0.01)
+                          : -1;
     if (n->cross.be.ops && n->cross.be.ops->drives) {
         struct ncp_drive_info d[NCP_NCK_AXES_MAX];
         st->n_drives = n->cross.be.ops->drives(&n->cross.be, d, NCP_NCK_AXES_MAX);

@@ -15,6 +15,7 @@ struct nck_core;
 /* One servo cycle as the position loop saw it. */
 struct nck_fb {
     double t, v;
+    double adv;              /* the scaler's read of the stream (samples; 1: 100 %) */
     double cmd[NCP_AXES], act[NCP_AXES];
     double jcmd[NCP_AXES], jact[NCP_AXES];  /* the joints (= cmd, act under trivkins) */
     double tool_z;                          /* the kinematics' tool length */
@@ -38,6 +39,8 @@ struct nck_summary {
     uint64_t rows, moving;
     double ferr_max, ferr_sum, ferr_axis_max[NCP_AXES];
     double job_ferr_max;     /* since serve's last program run began */
+    double job_done_s;       /* of the stream's time at 100 %, read since it began */
+    double ext_min[NCP_AXES], ext_max[NCP_AXES];  /* commanded, since the start */
     double contour_max, contour_sum;
     double hist[NCK_CONTOUR_HISTORY][NCP_AXES];
     size_t hist_n, hist_at;

@@ -204,6 +204,9 @@ int nck_estimate_poll(struct nck_estimate *e)
         e->program_time = res->program_time;
         e->path_length = res->path_length;
         e->ferr_max = res->ferr_max;
+        e->pauses = (int)res->pauses;
+        memcpy(e->ext_min, res->ext_min, sizeof e->ext_min);
+        memcpy(e->ext_max, res->ext_max, sizeof e->ext_max);
     }
     e->seconds = (double)(r->t1_ns - r->t0_ns) * 1e-9;
     release(r, e->th);

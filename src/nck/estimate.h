@@ -24,6 +24,8 @@ struct nck_estimate {
     pthread_t dying_th;
     int state;                       /* enum ncp_nck_estimate_state */
     double program_time, path_length, ferr_max;  /* s, mm, mm (state DONE) */
+    int pauses;                      /* M0, M1, M6 waited at (state DONE) */
+    double ext_min[NCP_AXES], ext_max[NCP_AXES]; /* commanded extents (state DONE) */
     double seconds;                  /* how long it took to find (host time) */
     char why[256];                   /* FAILED, CANCELLED: why */
 };

@@ -251,6 +251,7 @@ static void push_cycle(struct nck_core *n, int64_t now_ns, const double act[NCP_
     fb.home = home;
     fb.t = (double)now_ns * 1e-9;
     fb.v = n->loop->cur.v;
+    fb.adv = n->cross.be.adv;
     fb.line = n->loop->cur.line;
     fb.flags = n->loop->cur.flags;
     memcpy(fb.cmd, n->loop->cur.pos, sizeof fb.cmd);

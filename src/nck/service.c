@@ -147,6 +147,12 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
     m.estimate_path_mm = st.estimate_path_mm;
     m.estimate_ferr_mm = st.estimate_ferr_mm;
     m.estimate_compute_s = st.estimate_compute_s;
+    m.estimate_pauses = st.estimate_pauses;
+    for (int j = 0; j < 9 && j < NCP_AXES; j++) {
+        m.estimate_min[j] = (float)st.estimate_min[j];
+        m.estimate_max[j] = (float)st.estimate_max[j];
+    }
+    m.remaining_s = st.remaining_s;
     m.program_time_s = st.program_time_s;
     m.n_drives = (int8_t)(st.n_drives < 9 ? st.n_drives : 9);
     for (int k = 0; k < m.n_drives; k++) {

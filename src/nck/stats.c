@@ -140,6 +140,10 @@ void nck_account(struct nck_summary *s, unsigned mask, const struct nck_fb *fb, 
     s->rows++;
     s->ferr_max = fmax(s->ferr_max, e);
     s->job_ferr_max = fmax(s->job_ferr_max, e);
+    for (int j = 0; j < NCP_AXES; j++) {
+        s->ext_min[j] = s->rows > 1 ? fmin(s->ext_min[j], fb->cmd[j]) : fb->cmd[j];
+        s->ext_max[j] = s->rows > 1 ? fmax(s->ext_max[j], fb->cmd[j]) : fb->cmd[j];
+    }
     s->contour_max = fmax(s->contour_max, c);
     if (fb->v > 0) {
         s->moving++;
@@ -273,6 +277,7 @@ int nck_read_cycles(struct nck_core *n)
     int got = 0;
     while (ncp_spsc_pop(&n->cross.fbs, &fb) == 0) {
         nck_account(&n->svc->sum, n->cfg->axis_mask, &fb, n->setup.trace);
+        n->svc->sum.job_done_s += fb.adv * n->cfg->servo_period;
         if (fb.waits != n->svc->last_fb.waits && fb.wait != NCK_WAIT_NONE)
             nck_wait_began(n, &fb);
         n->svc->last_fb = fb;

@@ -362,6 +362,12 @@ static void test_status_json(void **state)
     s.estimate_s = 101.557;
     s.estimate_path_mm = 1444.142;
     s.program_time_s = 4.5;
+    s.estimate_pauses = 2;
+    for (int j = 0; j < 9; j++) {
+        s.estimate_min[j] = (float)-j;
+        s.estimate_max[j] = (float)j + 0.5f;
+    }
+    s.remaining_s = -1;
     snprintf((char *)s.error, sizeof s.error, "line\nbreak");
     char buf[4096];
     int n = ncp_msg_status_json(&s, buf, sizeof buf);
@@ -378,8 +384,19 @@ static void test_status_json(void **state)
     /* the load's estimate and the last run's time */
     assert_non_null(strstr(buf, "\"estimate\": {\"state\": \"done\", \"program_time_s\": "
                                 "101.557000, \"path_length_mm\": 1444.142000"));
-    assert_non_null(strstr(buf, "}, \"program_time_s\": 4.500000, \"drives\": [], "
-                                "\"llc_dp\": 0, \"llcs\": []}"));
+    assert_non_null(strstr(buf, "\"pauses\": 2, \"extents\": {\"min\": [0.0000, -1.0000, "
+                                "-2.0000, -3.0000, -4.0000, -5.0000, -6.0000, -7.0000, "
+                                "-8.0000], \"max\": [0.5000, 1.5000, "));
+    assert_non_null(strstr(buf, "}, \"program_time_s\": 4.500000, \"remaining_s\": null, "
+                                "\"drives\": [], \"llc_dp\": 0, \"llcs\": []}"));
+    /* while a run goes on: what is left; no extents found: null */
+    s.remaining_s = 12.25;
+    s.estimate_min[0] = 1;
+    s.estimate_max[0] = 0;
+    n = ncp_msg_status_json(&s, buf, sizeof buf);
+    assert_true(n > 0);
+    assert_non_null(strstr(buf, "\"remaining_s\": 12.250, "));
+    assert_non_null(strstr(buf, "\"extents\": null}"));
     /* CiA 402 drives: state by name, statusword and last EMCY code with its meaning */
     s.n_drives = 2;
     memcpy(s.drive_axis, "XY", 2);
