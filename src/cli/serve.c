@@ -417,10 +417,12 @@ static int backend_given_twice(const struct serve_args *a, const struct ncp_cell
 static struct serve_channel *load_channels(const struct serve_args *a, int *n, int *bad_input)
 {
     struct ncp_cell *cell = calloc(1, sizeof *cell);
+    if (!cell)
+        return fprintf(stderr, "cnc-run serve: out of memory\n"), NULL;
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
-    int several = !cell ? -1 : a->config ? ncp_cell_load(cell, a->config, &d) : 0;
-    if (cell && several < 0) {
+    int several = a->config ? ncp_cell_load(cell, a->config, &d) : 0;
+    if (several < 0) {
         if (d.line)
             fprintf(stderr, "%s:%u: error: %s\n", a->config, d.line, d.msg);
         else
@@ -431,7 +433,7 @@ static struct serve_channel *load_channels(const struct serve_args *a, int *n, i
     *n = several > 0 ? cell->n : 1;
     struct serve_channel *chs = several < 0 ? NULL : calloc((size_t)*n, sizeof *chs);
     if (!chs) {
-        if (!cell || several >= 0)
+        if (several >= 0)
             fprintf(stderr, "cnc-run serve: out of memory\n");
         free(cell);
         return NULL;
