@@ -96,8 +96,37 @@ static int load(FILE *f, struct ncp_machine_cfg *c, struct ncp_diag *d)
     return ncp_machine_cfg_load(c, path, d);
 }
 
+/* A [CHANNEL_n] key is a channels INI's (ncp_cell_load), not a machine's:
+ * probed in a channel of its own, CONFIG given unless it is the probe. */
+static enum verdict probe_cell(const char *sec, const char *key, const char *value)
+{
+    FILE *f = tmpfile();
+    if (!f) {
+        perror("ini-man: tmpfile");
+        exit(1);
+    }
+    unsigned line = 2;
+    fprintf(f, "[%s]\n%s = %s\n", sec, key, value);
+    if (strcasecmp(key, "CONFIG") != 0)
+        fputs("CONFIG = mill.ini\n", f);
+    fflush(f);
+    char path[64];
+    snprintf(path, sizeof path, "/proc/self/fd/%d", fileno(f));
+    static struct ncp_cell cell;
+    struct ncp_diag d;
+    int rc = ncp_cell_load(&cell, path, &d);
+    fclose(f);
+    if (rc == 1)
+        return TAKEN;
+    if (strstr(d.msg, "unknown key") || strstr(d.msg, "channels are"))
+        return UNKNOWN;
+    return d.line == line && strstr(d.msg, "bad value") ? BAD_VALUE : TAKEN;
+}
+
 static enum verdict probe(const char *sec, const char *key, const char *value)
 {
+    if (!strncasecmp(sec, "CHANNEL_", 8))
+        return probe_cell(sec, key, value);
     unsigned line = 0;
     FILE *f = probe_file(sec, key, value, &line);
     if (!f) {

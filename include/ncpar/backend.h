@@ -196,4 +196,17 @@ int ncp_socketcan_check_cfg(const struct ncp_machine_cfg *cfg, struct ncp_diag *
  * interface name (d->msg says which). */
 int ncp_backend_spec(const char *spec, struct ncp_machine_cfg *cfg, struct ncp_diag *d);
 
+/* ---- channels of one service on their own backends (cell.c) ------------ */
+
+/* Channel ch of a channels INI on its machine cfg (ncp_cell_apply done): a
+ * socketcan channel's axes are all CAN drives, an lcm channel's DP is one
+ * of its variant's. NCP_OK, or an error with d->line the channels INI's. */
+int ncp_backend_cell_channel(const struct ncp_cell_channel *ch, const struct ncp_machine_cfg *cfg,
+                             struct ncp_diag *d);
+/* No two channels (cfgs[k] is cell->ch[k]'s machine) on one CAN interface
+ * (one master sends SYNC on a bus; one node is one drive) or one LCM URL
+ * (one HLC per set of LLCs). NCP_OK, or an error as above. */
+int ncp_backend_cell_shared(const struct ncp_cell *cell, const struct ncp_machine_cfg *const cfgs[],
+                            struct ncp_diag *d);
+
 #endif

@@ -282,6 +282,40 @@ static inline int ncp_kins_active(const struct ncp_machine_cfg *c)
     return c->kins.type != NCP_KINS_TRIVIAL;
 }
 
+/* ---- the channels INI (config_cell.c) -------------------------------------
+ * cnc-run serve --config CELL.ini: one [CHANNEL_n] section per NC channel
+ * (n 0..NCP_CELL_MAX-1), naming its machine INI (CONFIG, relative to the
+ * file's folder) and what drives that machine (BACKEND, and DP for lcm:
+ * each left out takes the machine INI's [EMCMOT] BACKEND, [LCM] DP). The
+ * machine's settings stay in the machine INIs: a file with [CHANNEL_n] and
+ * any other section is refused, so that no key is read from the wrong one.
+ * Its keys are rows of the table below like the machine INI's. */
+#define NCP_CELL_MAX 16
+#define NCP_CELL_PATH_MAX 4096
+struct ncp_cell_channel {
+    int num;                        /* n of [CHANNEL_n] */
+    char config[NCP_CELL_PATH_MAX]; /* the machine INI, as a path from here */
+    int backend;                    /* enum ncp_backend_kind, -1: the machine INI's */
+    char interface[16];             /* socketcan:IFACE; "": the machine's [CAN] INTERFACE */
+    int dp;                         /* 1..5, 0: the machine INI's [LCM] DP */
+    /* where each was given in the channels INI (0: not given) */
+    unsigned line, config_line, backend_line, dp_line;
+};
+struct ncp_cell {
+    int n;
+    struct ncp_cell_channel ch[NCP_CELL_MAX];   /* by ascending num */
+};
+/* 1 when path is a channels INI (read into cell), 0 when it has no
+ * [CHANNEL_n] section (a machine INI: cell->n is 0), or -1 with d->code
+ * set and d->line the line at fault (0: the whole file) and d->msg what is
+ * wrong (without the path: the caller prints PATH:LINE: error: MSG). */
+int ncp_cell_load(struct ncp_cell *cell, const char *path, struct ncp_diag *d);
+/* The channel's BACKEND and DP over its machine's (cfg, loaded from
+ * ch->config): NCP_OK, or NCP_ERR_SEMANTIC with d->line the channels INI's
+ * line (a DP on a channel whose backend is not lcm). */
+int ncp_cell_apply(const struct ncp_cell_channel *ch, struct ncp_machine_cfg *cfg,
+                   struct ncp_diag *d);
+
 /* ---- the table of keys (ini_keys.c) ---------------------------------------
  * The machine INI's sections and keys: every one the reader
  * (ncp_machine_cfg_load, src/config/config.c) takes, with the values it

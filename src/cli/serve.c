@@ -2,7 +2,6 @@
  * machine INI, signals; the service itself is ncp_nck_serve (src/nck/). */
 #include "serve.h"
 #include "backend_opts.h"
-#include "cell.h"
 #include "datadir.h"
 #include "channels.h"
 #include "inject_opts.h"
@@ -13,6 +12,7 @@
 #include "signals.h"
 #include "userdata.h"
 
+#include "ncpar/backend.h"
 #include "ncpar/http.h"
 #include "ncpar/nck.h"
 
@@ -71,21 +71,26 @@ static void usage(FILE *f)
           "                      INI, relative to its folder) serves one NCK per NC channel;\n"
           "                      LCM messages carry the channel (cnc-ctl --channel N), [LCM]\n"
           "                      is the lowest channel's, --trace names a file per channel\n"
-          "                      as cnc-run run --channel's; a shutdown stops every channel\n"
+          "                      as cnc-run run --channel's; a shutdown stops every channel.\n"
+          "                      [CHANNEL_n] BACKEND = sim|socketcan[:IFACE]|lcm and DP give\n"
+          "                      each channel its own backend (no two on one CAN interface\n"
+          "                      or LCM URL). An E-stop stops every channel (one E-stop\n"
+          "                      chain); a channel's fault stops the others along their\n"
+          "                      paths; reset is each channel's own\n"
           "  --lcm-url URL       LCM URL (default: the INI's, else $LCM_DEFAULT_URL, else\n"
           "                      udpm://239.255.76.67:7667?ttl=0)\n"
           "  --prefix P          channel prefix (channels PCMD, PACK, PSTATUS, PEVENT)\n"
           "  --backend sim       the simulated machine (default: the INI's [EMCMOT] BACKEND,\n"
           "                      else sim)\n"
           "  --backend socketcan[:IFACE]  CiA 402 drives in CSP mode over SocketCAN\n"
-          "                      ([CAN] INTERFACE; docs/integrator.md); real clock only,\n"
-          "                      one machine INI. E-stop: Quick Stop on every drive, then\n"
+          "                      ([CAN] INTERFACE; docs/integrator.md); real clock only.\n"
+          "                      E-stop: Quick Stop on every drive, then\n"
           "                      Disable Voltage once at rest; reset: fault reset, back\n"
           "                      to Operation enabled where the axes stand; a drive's\n"
           "                      fault or EMCY is state fault with its code and meaning\n"
           "  --backend lcm       the distributed NCK: one `cnc-axis` per axis of the INI on\n"
           "                      the same LCM URL and key (docs/distributed.md); real clock\n"
-          "                      only, one machine INI (no [CHANNEL_n]). Served at the\n"
+          "                      only. Served at the\n"
           "                      fine-setpoint point only: ADCBI DP 5, ADCAI DP 4. An LLC\n"
           "                      lost or stopped on its own is state fault naming its axis,\n"
           "                      the others held; E-stop holds every LLC's command where\n"
@@ -244,6 +249,7 @@ struct serve_channel {
     int num;
     const char *config;             /* NULL, or config_path or --config */
     char config_path[PATH_MAX];
+    const struct ncp_cell_channel *cc;  /* its [CHANNEL_n], or NULL (one machine INI) */
     struct ncp_machine_cfg cfg;
     char trace_path[PATH_MAX];
     struct ncp_outfile trace_of;
@@ -256,32 +262,31 @@ struct serve_channel {
     const char *tool_table;         /* --tool-table, else [EMCIO] TOOL_TABLE, or NULL */
 };
 
-static int servable(const struct serve_channel *ch, int several)
+/* What serve runs of the lcm backend. Each channel of a channels INI has
+ * its own backend (src/backend/cell.c keeps them apart). */
+static int servable(const struct serve_channel *ch, const char *cell)
 {
     const struct ncp_machine_cfg *c = &ch->cfg;
-    const char *ini = ch->config ? ch->config : "the built-in mill";
-    if (c->backend == NCP_BACKEND_SOCKETCAN && several)
-        return fprintf(stderr, "cnc-run serve: %s: --backend socketcan serves one machine INI, "
-                               "not channels of [CHANNEL_n]: one master sends SYNC on a bus, "
-                               "and each channel would send its own\n", ini), -1;
     if (c->backend != NCP_BACKEND_LCM)
         return 0;
-    if (several)
-        return fprintf(stderr, "cnc-run serve: %s: --backend lcm serves one machine INI, not "
-                               "channels of [CHANNEL_n]: the LLCs' LCM channels are one set\n",
-                       ini), -1;
     int adcai = c->nck == NCP_NCK_ADCAI, fine = adcai ? 4 : 5;
     /* ADCBI's DP4 and DP3: each LLC's interpolator follows the loop's time
      * scaling period by period and drops what an abort drops (lcm.c,
      * src/axis/llc_scale.c), so a hold, stop or E-stop stops it on the path */
     if (c->lcm.dp == fine || (!adcai && (c->lcm.dp == 4 || c->lcm.dp == 3)))
         return 0;
-    return fprintf(stderr, "cnc-run serve: --backend lcm --dp %d ([PLANNER] NCK = %s) is not "
+    char where[PATH_MAX + 64];
+    if (ch->cc)
+        snprintf(where, sizeof where, "%s:%u: error: [CHANNEL_%d] ", cell,
+                 ch->cc->dp_line ? ch->cc->dp_line : ch->cc->line, ch->num);
+    else
+        snprintf(where, sizeof where, "cnc-run serve: ");
+    return fprintf(stderr, "%s--backend lcm --dp %d ([PLANNER] NCK = %s) is not "
                            "served: at this point each LLC computes its own command from what "
                            "it was sent ahead (%s), and no message takes an abort back there "
                            "yet, so a stop or E-stop from the seat could not end its job; serve "
                            "runs the distributed NCK at %s (cnc-run run --backend lcm runs a "
-                           "program at DP %d)\n",
+                           "program at DP %d)\n", where,
                    c->lcm.dp, adcai ? "adcai" : "adcbi",
                    c->lcm.dp == 1 ? "it runs the program itself"
                    : adcai        ? "its own ACC/DEC stages"
@@ -292,15 +297,21 @@ static int servable(const struct serve_channel *ch, int several)
 
 /* 0, -1 (set-up: exit 1), or -2 (a malformed parameter file or tool
  * table: exit 2) */
-static int load_channel(struct serve_channel *ch, const struct serve_args *a, int several)
+static int load_channel(struct serve_channel *ch, const struct serve_args *a)
 {
     const struct ncp_cli_backend_opts bo = { "cnc-run serve", ch->config, a->backend, a->dp,
                                              a->url, a->key_file, a->virtual_clock };
     if (ncp_cli_load_machine(ch->config, &ch->cfg) ||
         ncp_cli_apply_inject("cnc-run serve", a->inject, a->seed, &ch->cfg) ||
-        ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg) ||
-        ncp_cli_apply_backend(&bo, &ch->cfg) ||
-        servable(ch, several))
+        ncp_cli_apply_key_file("cnc-run serve", a->key_file, &ch->cfg))
+        return -1;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (ch->cc && (ncp_cell_apply(ch->cc, &ch->cfg, &d) != NCP_OK ||
+                   ncp_backend_cell_channel(ch->cc, &ch->cfg, &d) != NCP_OK))
+        return fprintf(stderr, "%s:%u: error: %s (channel %d's machine: %s)\n", a->config,
+                       d.line, d.msg, ch->num, ch->config), -1;
+    if (ncp_cli_apply_backend(&bo, &ch->cfg) || servable(ch, a->config))
         return -1;
     ch->tool_table = a->tool_table ? a->tool_table
                      : ch->cfg.op.tool_table[0] ? ch->cfg.op.tool_table : NULL;
@@ -392,35 +403,78 @@ static int shared_parameter_file(const struct serve_channel *chs, int n)
     return 0;
 }
 
+/* --backend and --dp name every channel's backend: not beside a channels
+ * INI whose [CHANNEL_n] names its own. */
+static int backend_given_twice(const struct serve_args *a, const struct ncp_cell *cell)
+{
+    for (int k = 0; (a->backend || a->dp) && k < cell->n; k++) {
+        const struct ncp_cell_channel *c = &cell->ch[k];
+        if (c->backend_line || c->dp_line)
+            return fprintf(stderr, "%s:%u: error: [CHANNEL_%d] %s names the channel's backend: "
+                                   "--backend and --dp are for a channels INI without "
+                                   "BACKEND and DP\n", a->config,
+                           c->backend_line ? c->backend_line : c->dp_line, c->num,
+                           c->backend_line ? "BACKEND" : "DP"), 1;
+    }
+    return 0;
+}
+
 /* The channels from a channels INI, or the one machine INI as channel 0;
  * NULL with *bad_input set when a channel's files are malformed. */
 static struct serve_channel *load_channels(const struct serve_args *a, int *n, int *bad_input)
 {
-    struct ncp_cli_cell *cell = calloc(1, sizeof *cell);
-    int several = !cell ? -1 : a->config ? ncp_cli_cell_load(a->config, cell) : 0;
+    struct ncp_cell *cell = calloc(1, sizeof *cell);
+    if (!cell)
+        return fprintf(stderr, "cnc-run serve: out of memory\n"), NULL;
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    int several = a->config ? ncp_cell_load(cell, a->config, &d) : 0;
+    if (several < 0) {
+        if (d.line)
+            fprintf(stderr, "%s:%u: error: %s\n", a->config, d.line, d.msg);
+        else
+            fprintf(stderr, "%s: error: %s\n", a->config, d.msg);
+    }
+    if (several > 0 && backend_given_twice(a, cell))
+        several = -1;
     *n = several > 0 ? cell->n : 1;
     struct serve_channel *chs = several < 0 ? NULL : calloc((size_t)*n, sizeof *chs);
     if (!chs) {
-        if (!cell || several >= 0)
+        if (several >= 0)
             fprintf(stderr, "cnc-run serve: out of memory\n");
         free(cell);
         return NULL;
     }
     for (int k = 0; k < *n; k++) {
-        chs[k].num = several ? cell->num[k] : 0;
-        if (several)
-            memcpy(chs[k].config_path, cell->config[k], sizeof chs[k].config_path);
+        chs[k].num = several ? cell->ch[k].num : 0;
+        if (several) {
+            snprintf(chs[k].config_path, sizeof chs[k].config_path, "%s", cell->ch[k].config);
+            chs[k].cc = &cell->ch[k];
+        }
         chs[k].config = several ? chs[k].config_path : a->config;
     }
-    free(cell);
     for (int k = 0; k < *n; k++) {
         chs[k].trace_of.fd = -1;
-        int rc = load_channel(&chs[k], a, several);
+        int rc = load_channel(&chs[k], a);
         if (rc) {
             *bad_input = rc == -2;
+            free(cell);
             return free_channels(chs, *n), NULL;
         }
     }
+    if (several) {
+        const struct ncp_machine_cfg *cfgs[NCP_CELL_MAX];
+        for (int k = 0; k < *n; k++)
+            cfgs[k] = &chs[k].cfg;
+        if (ncp_backend_cell_shared(cell, cfgs, &d) != NCP_OK) {
+            fprintf(stderr, "%s:%u: error: %s\n", a->config, d.line, d.msg);
+            free(cell);
+            return free_channels(chs, *n), NULL;
+        }
+    }
+    for (int k = 0; k < *n; k++)
+        chs[k].cc = NULL;   /* the cell is gone after this */
+    free(cell);
     if (shared_parameter_file(chs, *n))
         return free_channels(chs, *n), NULL;
     for (int k = 0; k < *n; k++) {

@@ -44,6 +44,11 @@ const struct ncp_ini_section ncp_ini_sections[] = {
                   "and check read the same keys with --ini INI." },
     { "DISPLAY", "LinuxCNC's display section: how far an operator may turn the overrides "
                  "(cnc-ctl override, the panel), and where user M codes are." },
+    { "CHANNEL_<n>", "Not a machine INI's section: a channels INI (cnc-run serve --config "
+                     "CELL.ini) holds only [CHANNEL_n] sections (n 0 .. 15), one per NC "
+                     "channel, each naming its machine INI and what drives it, so that one "
+                     "service runs channel 0 on the simulator and channel 1 on CAN drives or "
+                     "on cnc-axis LLCs (docs/operator.md)." },
     { "HTTP", "The operator's panel in a browser (cnc-run serve --http): who may reach it "
               "besides its own origin and address (docs/panel-security.md)." },
 };
@@ -308,6 +313,19 @@ const struct ncp_ini_key ncp_ini_keys[] = {
     INT("SCHED", "PERIOD_MS", 1, 1000, "ms", "10", "Period of the scheduler."),
     INT("SCHED", "PRIORITY_MIN", 1, 97, "", "1", "Lowest SCHED_FIFO priority of the band."),
     INT("SCHED", "TRACE_RINGS", 0, 1, "", "0", "1: the rings' fill levels in the trace."),
+
+    TEXT("CHANNEL_<n>", "CONFIG", "a path, relative to the channels INI's folder", NULL,
+         "mill.ini", "The machine INI of channel n; required."),
+    TEXT("CHANNEL_<n>", "BACKEND", "sim, socketcan, socketcan:IFACE or lcm", NULL,
+         "socketcan:can1",
+         "What drives channel n's axes, over its machine INI's [EMCMOT] BACKEND (left out: "
+         "that one): the simulated machine, CiA 402 drives ([AXIS_L] NODE_ID of every axis) "
+         "on IFACE or the machine's [CAN] INTERFACE, or one cnc-axis per axis over the "
+         "machine's [LCM] URL. No two channels share a CAN interface (each master sends its "
+         "own SYNC) or an LCM URL (the LLCs hear one HLC)."),
+    INT("CHANNEL_<n>", "DP", 1, 5, "", NULL,
+        "Distribution point of a BACKEND = lcm channel, over its machine INI's [LCM] DP "
+        "(left out: that one)."),
 };
 const size_t ncp_ini_n_keys = sizeof ncp_ini_keys / sizeof ncp_ini_keys[0];
 

@@ -38,6 +38,7 @@ struct serve_channel {
     int32_t jog_client;              /* whose keep-alives hold a continuous jog */
     int pending;                     /* a command answered later (a load's check) */
     int32_t pending_client, pending_seq;
+    int faulted;                     /* in fault when last polled */
 };
 
 struct serve {
@@ -268,6 +269,28 @@ static const char *unfresh(const ncp_command_t *c, int64_t now_us, char *why, si
 static void act(struct serve *sv, struct serve_channel *ch, struct client *cl,
                 const ncp_command_t *c);
 
+/* The channels of one service share one E-stop chain, as a machine's
+ * channels do in LinuxCNC and Sinumerik: an E-stop of any channel freezes
+ * every channel's setpoints at once (the others before its ACK goes out),
+ * whatever backend each runs on. Each channel comes back with its own reset. */
+static void estop_others(struct serve *sv, const struct serve_channel *from)
+{
+    for (int k = 0; k < sv->n_ch; k++) {
+        struct serve_channel *o = &sv->ch[k];
+        if (o == from)
+            continue;
+        struct ncp_nck_cmd e;
+        memset(&e, 0, sizeof e);
+        e.kind = NCP_CMD_ESTOP;
+        char why[8];
+        int was = o->nck->state;
+        ncp_nck_command(o->nck, &e, why, sizeof why);
+        if (was != NCP_ST_ESTOP)
+            nck_post(&o->nck->core, NCP_EV_INFO, NULL, 0, 0,
+                     "E-stop of channel %d: one E-stop stops every channel", from->num);
+    }
+}
+
 /* An E-stop is never conditional: whatever its sequence number, however
  * often it comes and however late, an authenticated one acts (stopping is
  * never the wrong answer to it), and it is answered. */
@@ -280,7 +303,38 @@ static void on_estop(struct serve *sv, struct serve_channel *ch, struct client *
         refuse_channel(sv, c, &cl->ack);
         return;
     }
+    estop_others(sv, ch);
     act(sv, ch, cl, c);
+}
+
+/* A channel gone into fault (its drives, its LLCs, its following error):
+ * the others stop along their paths rather than run on beside a machine
+ * that stopped under them; they are not faulted, and run again when told. */
+static void fault_stops_others(struct serve *sv)
+{
+    for (int k = 0; k < sv->n_ch; k++) {
+        struct serve_channel *f = &sv->ch[k];
+        /* from the fault on, not once its own drop ended in it */
+        int faulted = f->nck->state == NCP_ST_FAULT ||
+                      (f->nck->drop != NCK_DROP_NONE && f->nck->drop_after == NCP_ST_FAULT);
+        int now = faulted && !f->faulted;
+        f->faulted = faulted;
+        for (int i = 0; now && i < sv->n_ch; i++) {
+            struct serve_channel *o = &sv->ch[i];
+            int st = o->nck->state;
+            if (o == f || !(st == NCP_ST_RUNNING || st == NCP_ST_PAUSED ||
+                            st == NCP_ST_STEPPING || st == NCP_ST_MDI ||
+                            st == NCP_ST_JOGGING || st == NCP_ST_HOMING))
+                continue;
+            struct ncp_nck_cmd c;
+            memset(&c, 0, sizeof c);
+            c.kind = NCP_CMD_STOP;
+            char why[64];
+            if (ncp_nck_command(o->nck, &c, why, sizeof why) == 0)
+                nck_post(&o->nck->core, NCP_EV_ERROR, NULL, 0, 0,
+                         "stopped: channel %d is in fault (%.200s)", f->num, f->nck->error);
+        }
+    }
 }
 
 static void take_command(struct serve *sv, const ncp_command_t *c, int local)
@@ -515,6 +569,8 @@ int ncp_nck_serve_channels(struct ncp_nck *const *ncks, const int *nums, int n,
             if (changed || due)
                 send_status(sv, &sv->ch[k]);
         }
+        if (n > 1)
+            fault_stops_others(sv);
         if (due) {
             next_status += period;
             if (next_status < now)   /* fell behind: no burst to catch up */
