@@ -258,9 +258,12 @@ struct ncp_co_fault {
 #define NCP_402_CW_HOMING_START 0x0010u    /* controlword bit 4 in homing mode */
 #define NCP_402_SW_HOMING_ATTAINED 0x1000u /* statusword bit 12 */
 #define NCP_402_SW_HOMING_ERROR 0x2000u    /* statusword bit 13 */
-/* TPDOs after the start edge before the statusword counts: bits 10 and 12
- * of a homing before may still be up in the first one. */
-#define NCP_CO_HOME_SETTLE_TPDOS 2
+/* A drive in homing mode reports its last homing (bits 10, 12, 13) until
+ * a new one starts, and TPDOs answering SYNCs from before the start edge
+ * may still come in after it. So the end counts once the drive has shown
+ * this homing under way (bit 10 clear), or, for one that ends at once
+ * (method 35), this many TPDOs after the edge. */
+#define NCP_CO_HOME_SETTLE_TPDOS 10
 
 /* Where a drive's homing stands. IDLE follows the NCK's targets (CSP);
  * TO_HOMING and TO_CSP wait for the SDO worker to switch the mode; HOMING
@@ -284,6 +287,7 @@ struct ncp_co_home {
     int phase;              /* enum ncp_co_home_phase: the loop's */
     long periods;           /* in the phase */
     uint32_t tpdos_at;      /* the node's TPDO count when bit 4 went up */
+    int under_way;          /* a TPDO since showed bit 10 clear */
     _Atomic unsigned phase_sw; /* the statusword that said homing attained (0 after a
                                failure or abort), for the worker's log */
     /* The loop asks the SDO worker for a mode of operation (want) by

@@ -139,11 +139,14 @@ int ncp_co_home_step(struct ncp_co_master *m, size_t i)
             return fail(m, i, NCP_CH_WHY_SDO);
         begin(h, NCP_CH_HOMING);
         h->tpdos_at = nd->tpdos;
+        h->under_way = 0;
         m->cw[i] |= NCP_402_CW_HOMING_START;
         break;
     case NCP_CH_HOMING:
         m->cw[i] |= NCP_402_CW_HOMING_START;
-        if (nd->tpdos - h->tpdos_at >= NCP_CO_HOME_SETTLE_TPDOS) {
+        if (nd->tpdos != h->tpdos_at && !(nd->statusword & NCP_402_SW_TARGET_REACHED))
+            h->under_way = 1;
+        if (h->under_way || nd->tpdos - h->tpdos_at >= NCP_CO_HOME_SETTLE_TPDOS) {
             if (nd->statusword & NCP_402_SW_HOMING_ERROR)
                 return fail(m, i, NCP_CH_WHY_ERROR);
             uint16_t done = NCP_402_SW_HOMING_ATTAINED | NCP_402_SW_TARGET_REACHED;

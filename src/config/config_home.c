@@ -52,7 +52,7 @@ int ncp_home_cfg_key(struct ncp_axis_cfg *a, const char *k, const char *v, char 
     if (!strcasecmp(k, "HOME_METHOD")) {
         if (!strcasecmp(v, "nck"))
             return a->home_drive = 0, 1;
-        if (strncasecmp(v, "drive:", 6) || ncp_ini_number(v + 6, -128, 127, &x) ||
+        if (strncasecmp(v, "drive:", 6) != 0 || ncp_ini_number(v + 6, -128, 127, &x) ||
             x != floor(x))
             return snprintf(why, len, "nck, or drive:N, N a CiA 402 homing method (0x6098) "
                                       "-128..127; cnc-drive-sim has 3, 4, 19, 20, 35, 37"), -1;

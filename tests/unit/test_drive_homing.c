@@ -165,7 +165,7 @@ static void test_current_position(void **state)
     configure(r, 35, -500);
     uint16_t sw = 0;
     long k = home(r, &sw);
-    assert_true(k > 0 && k < 20);
+    assert_true(k > NCP_CO_HOME_SETTLE_TPDOS && k < NCP_CO_HOME_SETTLE_TPDOS + 10);
     assert_true(sw & NCP_402_SW_HOMING_ATTAINED);
     assert_true(sw & NCP_402_SW_TARGET_REACHED);
     /* home is here: the drive counts from the home offset */
