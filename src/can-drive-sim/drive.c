@@ -101,8 +101,7 @@ static int apply_controlword(struct drive *dv, uint16_t cw)
         drive_servo_enable(dv);
     }
     if (next == NCP_402_QUICK_STOP_ACTIVE && dv->st == NCP_402_OPERATION_ENABLED) {
-        drive_home_mode(dv, 0); /* a quick stop ends a homing: nothing attained */
-        drive_home_mode(dv, od_get(&dv->od, 0x6061, 0));
+        drive_home_halt(dv); /* a quick stop ends a homing: nothing attained */
         return drive_start_ramp(dv, next, next, dv->now_ms);
     }
     drive_set_state(dv, next);

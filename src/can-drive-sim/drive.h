@@ -116,6 +116,8 @@ uint16_t drive_home_statusword(const struct drive *dv);
 void drive_home_control(struct drive *dv, uint16_t cw, uint16_t prev_cw);
 int32_t drive_home_step(struct drive *dv);
 void drive_home_mode(struct drive *dv, uint32_t mode);
+/* The homing under way ends where the axis stands, nothing attained. */
+void drive_home_halt(struct drive *dv);
 
 /* guard.c: the deadlines of the master's heartbeat, SYNC and RPDO1, and the
  * drive's own reaction (0x6007, 0x605E) when one passes: called whenever the

@@ -118,15 +118,21 @@ void drive_home_control(struct drive *dv, uint16_t cw, uint16_t prev_cw)
     }
 }
 
-void drive_home_mode(struct drive *dv, uint32_t mode)
+void drive_home_halt(struct drive *dv)
 {
     struct drive_homing *h = &dv->home;
-    int was = h->mode6;
-    h->mode6 = mode == 6;
-    if (was && !h->mode6) {
-        h->stage = DH_IDLE;
-        h->v = 0;
-    }
+    if (h->stage != DH_IDLE)
+        h->attained = h->found = 0;
+    h->stage = DH_IDLE;
+    h->v = 0;
+}
+
+void drive_home_mode(struct drive *dv, uint32_t mode)
+{
+    int was = dv->home.mode6;
+    dv->home.mode6 = mode == 6;
+    if (was && !dv->home.mode6)
+        drive_home_halt(dv);
 }
 
 static double param(struct drive *dv, uint16_t index, uint8_t sub)
