@@ -134,6 +134,15 @@ struct ncp_backend_ops {
     /* Not real-time (the serving thread): the LLCs as their last status
      * said, one per row up to max; the count. NULL: no LLCs to show. */
     int (*llcs)(const struct ncp_backend *b, struct ncp_llc_info *out, int max);
+    /* Real-time, the position loop's homing: the axis's drive homes itself
+     * ([AXIS_L] HOME_METHOD = drive:N). go 1 starts it (0, or -1 when the
+     * axis has no such drive); go -1 aborts it (an operator's stop); go 0
+     * asks how it goes: 1 under way, 0 homed (the drive counts from its
+     * home now; the backend held it at its actual position until this
+     * answer and follows cmd again from the next cycle), -1 over without
+     * a home (aborted, or failed: cycle() then reports the fault). NULL:
+     * no drive homes itself on this backend. */
+    int (*drive_home)(struct ncp_backend *b, int axis, int go);
 };
 
 /* The ADCBI planner's calls, as plan_journal sees them. */

@@ -4,6 +4,7 @@
 #ifndef NCPAR_CAN_H
 #define NCPAR_CAN_H
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -229,7 +230,9 @@ enum ncp_co_fault_kind {
     NCP_CO_FAULT_STATE,     /* statusword left Operation enabled */
     NCP_CO_FAULT_BUS,       /* the socket refused frames */
     NCP_CO_FAULT_START,     /* start-up (SDO, state machine): text says what */
+    NCP_CO_FAULT_HOMING,    /* the drive's own homing failed: home_why says how */
 };
+enum ncp_co_home_why { NCP_CH_WHY_ERROR, NCP_CH_WHY_TIMEOUT, NCP_CH_WHY_SDO };
 
 /* What went wrong, recorded on the real-time path as plain values; turned
  * into text afterwards by ncp_co_fault_describe. */
@@ -244,8 +247,64 @@ struct ncp_co_fault {
     uint8_t hb_state;             /* HEARTBEAT, NMT: the last NMT state reported */
     uint32_t cob;                 /* BUS: the frame that could not go out */
     int err;                      /* BUS: errno, 0 = queue full for too long */
-    char text[NCP_DIAG_MSG_MAX];  /* START */
+    char text[NCP_DIAG_MSG_MAX];  /* START; HOMING with SDO: the failed exchange */
+    int home_why;                 /* HOMING: enum ncp_co_home_why */
+    int home_method;              /* HOMING: 0x6098 */
+    long home_ms;                 /* HOMING: how long the drive homed */
 };
+/* ---- the drive's own homing mode (CiA 402 homing, dhome.c) ----------- */
+#define NCP_402_MODE_HOMING 6
+#define NCP_402_MODE_CSP 8
+#define NCP_402_CW_HOMING_START 0x0010u    /* controlword bit 4 in homing mode */
+#define NCP_402_SW_HOMING_ATTAINED 0x1000u /* statusword bit 12 */
+#define NCP_402_SW_HOMING_ERROR 0x2000u    /* statusword bit 13 */
+/* A drive in homing mode reports its last homing (bits 10, 12, 13) until
+ * a new one starts, and TPDOs answering SYNCs from before the start edge
+ * may still come in after it. So the end counts once the drive has shown
+ * this homing under way (bit 10 clear), or, for one that ends at once
+ * (method 35), this many TPDOs after the edge. */
+#define NCP_CO_HOME_SETTLE_TPDOS 10
+
+/* Where a drive's homing stands. IDLE follows the NCK's targets (CSP);
+ * TO_HOMING and TO_CSP wait for the SDO worker to switch the mode; HOMING
+ * has bit 4 up and watches the statusword; HOMED holds the drive at its
+ * actual position until the NCK has taken it (ncp_co_home_poll). */
+enum ncp_co_home_phase { NCP_CH_IDLE, NCP_CH_TO_HOMING, NCP_CH_HOMING, NCP_CH_TO_CSP,
+                         NCP_CH_HOMED, NCP_CH_FAILED, NCP_CH_ABORTING };
+
+/* The homing mode's parameters of one drive (before the loop). */
+struct ncp_co_home_cfg {
+    int on;                 /* the drive homes itself ([AXIS_L] HOME_METHOD = drive:N) */
+    int method;             /* 0x6098, -128..127 */
+    uint32_t search, latch; /* 0x6099:01, :02, counts/s; 0: the drive's own */
+    uint32_t acc;           /* 0x609A, counts/s^2; 0: the drive's own */
+    int32_t offset;         /* 0x607C, counts: the drive's position at its home */
+    long timeout_periods;   /* servo periods the homing may take */
+};
+
+struct ncp_co_home {
+    struct ncp_co_home_cfg cfg;
+    int phase;              /* enum ncp_co_home_phase: the loop's */
+    long periods;           /* in the phase */
+    uint32_t tpdos_at;      /* the node's TPDO count when bit 4 went up */
+    int under_way;          /* a TPDO since showed bit 10 clear */
+    _Atomic unsigned phase_sw; /* the statusword that said homing attained (0 after a
+                               failure or abort), for the worker's log */
+    /* The loop asks the SDO worker for a mode of operation (want) by
+     * counting ask up; the worker answers with done = the ask it served,
+     * failed and why (written before done) when the exchange failed. */
+    _Atomic uint32_t ask, done;
+    _Atomic int want, failed;
+    char why[NCP_DIAG_MSG_MAX];
+};
+
+/* One SDO download of a mode switch. */
+struct ncp_co_sdo_step { uint16_t index; uint8_t sub; uint32_t value; unsigned size; };
+/* The downloads that put a drive in mode (6: offset, method, speeds and
+ * acceleration given, then 0x6060; 8: 0x6060 alone); the count. */
+size_t ncp_co_home_sdo_steps(const struct ncp_co_home_cfg *c, int mode,
+                             struct ncp_co_sdo_step *out, size_t max);
+
 /* "node 5: EMCY (0x085): error code 0x8611 following error; ..." */
 void ncp_co_fault_describe(const struct ncp_co_fault *f, const char *ifname, char *buf,
                            size_t len);
@@ -276,6 +335,8 @@ struct ncp_co_master {
     uint32_t seen[NCP_CO_MAX_NODES];    /* node tpdos at the last look */
     int32_t last_act[NCP_CO_MAX_NODES];
     long mode_cycles;                   /* periods since the mode began */
+    /* the drives' own homing (dhome.c) */
+    struct ncp_co_home home[NCP_CO_MAX_NODES];
     /* blocking cycles call this for every TPDO taken in (tests judge them) */
     void (*on_tpdo)(void *ctx, size_t i);
     void *on_tpdo_ctx;
@@ -331,5 +392,26 @@ void ncp_co_master_seat(struct ncp_co_master *m, int on);
  * 1 while the mode holds the drives; -1 with a STATE fault when a reset
  * found a drive that would not enable within NCP_CO_ENABLE_PERIODS. */
 int ncp_co_master_seat_step(struct ncp_co_master *m);
+
+/* ---- the drive's own homing (dhome.c) -------------------------------- */
+/* Real-time. start: node i (configured, IDLE, in RUN) begins homing; 0,
+ * or -1 when it cannot. abort: an operator's stop: bit 4 down, back to CSP.
+ * poll, for the NCK: 1 under way, 0 homed (the drive's counts start from
+ * its home now; IDLE from here on, the NCK's targets followed again), -1
+ * failed or aborted (IDLE or FAILED). */
+int ncp_co_home_start(struct ncp_co_master *m, size_t i);
+void ncp_co_home_abort(struct ncp_co_master *m, size_t i);
+int ncp_co_home_poll(struct ncp_co_master *m, size_t i);
+/* The seat's E-stop or reset (seat.c): every drive's homing ends, the
+ * drive asked back to CSP where it was in homing mode. */
+void ncp_co_home_drop(struct ncp_co_master *m);
+/* Real-time, every RUN period after the poll: node i's controlword and,
+ * while it homes, its target (the actual position). 1 while the homing
+ * owns the node's target, 0 when idle, -1 with a HOMING fault in m->fault
+ * (a homing error, the timeout, a failed mode switch). */
+int ncp_co_home_step(struct ncp_co_master *m, size_t i);
+/* Not real-time (the SDO worker): serves node i's pending mode switch on
+ * bus (its own socket, filtered to the SDO answers): 1 served, 0 none. */
+int ncp_co_home_serve(struct ncp_co_master *m, struct ncp_can_bus *bus, size_t i);
 
 #endif

@@ -64,6 +64,9 @@ struct ncp_axis_cfg {
      * given); negative = the group's final moves start together. */
     double home, home_offset, home_search_vel, home_latch_vel, home_final_vel;
     int home_sequence, have_home_sequence, home_ignore_limits;
+    /* HOME_METHOD = drive:N: the axis's CiA 402 drive homes itself with
+     * homing method N (home_drive 0: the NCK homes it) */
+    int home_drive, home_method;
     /* [SIM] HOME_SWITCH_<axis>: where the simulated switch is, in the
      * simulated machine's own coordinates (have_home_switch 0: at
      * HOME_OFFSET, as LinuxCNC's sim configs place it) */

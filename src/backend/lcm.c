@@ -728,7 +728,7 @@ static int lcm_llcs(const struct ncp_backend *b, struct ncp_llc_info *out, int m
 
 static const struct ncp_backend_ops lcm_ops = {
     "lcm", lcm_start, lcm_cycle, lcm_stop, lcm_describe, lcm_close, lcm_enable, lcm_live, NULL, NULL,
-    lcm_llcs,
+    lcm_llcs, NULL,
 };
 
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,

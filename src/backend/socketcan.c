@@ -13,16 +13,23 @@
  * stop() (after the loop): hold, shutdown, NMT pre-operational.
  * enable() (a serving NCK's E-stop, fault and reset, real-time): Quick Stop
  * on every drive then Disable Voltage at rest, or the walk back to
- * Operation enabled at the actual positions (src/can/seat.c). */
+ * Operation enabled at the actual positions (src/can/seat.c).
+ * drive_home() (real-time): an axis with HOME_METHOD = drive:N homes in its
+ * drive's own homing mode (src/can/dhome.c); the mode switches are SDO
+ * exchanges, which a worker thread serves outside the loop on a socket of
+ * its own, polling every WORKER_NAP_MS for what the loop asked. */
 #include "ncpar/backend.h"
 #include "ncpar/can.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #define POLL_MAX 64 /* frames taken in per period: a backlog drains over a few */
+#define WORKER_NAP_MS 2
 
 /* The master's nodes are the configured axes in order: node k drives axis
  * ax[k]. (With a joint layer these become the joints.) */
@@ -39,7 +46,38 @@ struct sc {
     atomic_int idle_failed;
     /* for the seat's status: statusword | last EMCY code << 16, per node */
     atomic_uint pub[NCP_CO_MAX_NODES];
+    /* the drives' own homing: the SDO worker and its socket (homes: how
+     * many drives home themselves; 0: neither exists) */
+    int homes;
+    struct ncp_can_bus sdo;
+    pthread_t worker;
+    int worker_started;
+    atomic_int worker_run;
 };
+
+static void *worker_main(void *arg)
+{
+    struct sc *s = arg;
+    struct timespec nap = {0, WORKER_NAP_MS * 1000000L};
+    while (atomic_load(&s->worker_run)) {
+        int served = 0;
+        for (int k = 0; k < s->n; k++)
+            if (s->m.home[k].cfg.on)
+                served |= ncp_co_home_serve(&s->m, &s->sdo, (size_t)k);
+        if (!served)
+            nanosleep(&nap, NULL);
+    }
+    return NULL;
+}
+
+static void worker_stop(struct sc *s)
+{
+    if (!s->worker_started)
+        return;
+    atomic_store(&s->worker_run, 0);
+    pthread_join(s->worker, NULL);
+    s->worker_started = 0;
+}
 
 static void *idle_main(void *arg)
 {
@@ -85,6 +123,10 @@ static int sc_start(struct ncp_backend *b, double pos[NCP_AXES])
     atomic_store(&s->idle_run, 1);
     atomic_store(&s->idle_failed, 0);
     s->idle_started = pthread_create(&s->idle, NULL, idle_main, s) == 0;
+    if (s->homes) {
+        atomic_store(&s->worker_run, 1);
+        s->worker_started = pthread_create(&s->worker, NULL, worker_main, s) == 0;
+    }
     return 0;
 }
 
@@ -109,9 +151,16 @@ static int sc_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const dou
     /* E-stopped or being reset: the drives hear their controlwords every
      * period, faults or not, and the NCK's frozen setpoints are not theirs */
     int seat = ncp_co_master_seat_step(m);
-    for (int k = 0; seat == 0 && k < s->n; k++)
+    for (int k = 0; seat == 0 && k < s->n; k++) {
+        /* a drive homing itself gets the homing's controlword and target */
+        int h = s->homes ? ncp_co_home_step(m, (size_t)k) : 0;
+        if (h < 0)
+            bad = 1;
+        if (h != 0)
+            continue;
         if (ncp_mm_to_counts(next[s->ax[k]], s->cpm[k], &m->target[k]))
             return -1; /* cannot happen within the checked soft limits */
+    }
     int rc = ncp_co_master_send(m);
     return bad || seat < 0 || rc ? -1 : 0;
 }
@@ -134,10 +183,28 @@ static int sc_drives(const struct ncp_backend *b, struct ncp_drive_info *out, in
     return n;
 }
 
+static int sc_drive_home(struct ncp_backend *b, int axis, int go)
+{
+    struct sc *s = b->impl;
+    for (int k = 0; k < s->n; k++) {
+        if (s->ax[k] != axis)
+            continue;
+        if (go > 0)
+            return ncp_co_home_start(&s->m, (size_t)k);
+        if (go < 0) {
+            ncp_co_home_abort(&s->m, (size_t)k);
+            return 0;
+        }
+        return ncp_co_home_poll(&s->m, (size_t)k);
+    }
+    return -1;
+}
+
 static void sc_stop(struct ncp_backend *b)
 {
     struct sc *s = b->impl;
     idle_stop(s);
+    worker_stop(s);
     ncp_co_master_stop(&s->m);
 }
 
@@ -150,6 +217,8 @@ static void sc_describe(const struct ncp_backend *b, char *buf, size_t len)
 static void sc_close(struct ncp_backend *b)
 {
     struct sc *s = b->impl;
+    worker_stop(s);
+    ncp_can_close(&s->sdo);
     ncp_co_master_close(&s->m);
     free(s);
     b->impl = NULL;
@@ -168,8 +237,46 @@ static int sc_home_switch(const struct ncp_backend *b, int axis)
 
 static const struct ncp_backend_ops sc_ops = {
     "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, sc_enable, sc_live, sc_drives,
-    sc_home_switch, NULL,
+    sc_home_switch, NULL, sc_drive_home,
 };
+
+/* Counts per second from mm per second, within what 0x6099/0x609A hold. */
+static uint32_t per_s(double mm, double cpm)
+{
+    double c = fabs(mm) * cpm;
+    return c >= 1 && c < 4e9 ? (uint32_t)c : 0;
+}
+
+/* The homing mode's parameters of every drive that homes itself, and the
+ * worker's own socket, which sees only the SDO answers. */
+static int open_homing(struct sc *s, const struct ncp_machine_cfg *cfg, struct ncp_diag *d)
+{
+    uint32_t ids[NCP_CO_MAX_NODES];
+    for (int k = 0; k < s->n; k++) {
+        const struct ncp_axis_cfg *a = &cfg->axis[s->ax[k]];
+        if (!a->home_drive)
+            continue;
+        double travel = a->max_limit - a->min_limit, cpm = s->cpm[k];
+        /* long enough to cross 1.5 travels searching and one latching,
+         * a minute for a speed left to the drive */
+        double t = 10 + (a->home_search_vel != 0 ? 1.5 * travel / fabs(a->home_search_vel) : 60) +
+                   (a->home_latch_vel != 0 ? travel / fabs(a->home_latch_vel) : 60);
+        int32_t off = 0;
+        (void)ncp_mm_to_counts(a->home_offset, cpm, &off);
+        s->m.home[k].cfg = (struct ncp_co_home_cfg){
+            .on = 1, .method = a->home_method,
+            .search = per_s(a->home_search_vel, cpm), .latch = per_s(a->home_latch_vel, cpm),
+            .acc = per_s(a->max_acc, cpm), .offset = off,
+            .timeout_periods = (long)(t / cfg->servo_period),
+        };
+        ids[s->homes++] = NCP_COB_SDO_TX + s->m.node[k].id;
+    }
+    if (!s->homes)
+        return NCP_OK;
+    if (ncp_can_open(&s->sdo, cfg->can.interface, d) != NCP_OK)
+        return d->code;
+    return ncp_can_filter(&s->sdo, ids, (size_t)s->homes, d);
+}
 
 int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
                                FILE *log, struct ncp_diag *d)
@@ -198,14 +305,22 @@ int ncp_backend_open_socketcan(struct ncp_backend *b, const struct ncp_machine_c
         .abort_option = cfg->can.abort_option,
         .fault_reaction = cfg->can.fault_reaction,
     };
-    /* a homing search reads the drive's home switch (0x60FD in TPDO2) */
+    /* the NCK's homing search reads the drive's home switch (0x60FD in
+     * TPDO2); a drive that homes itself reads its own */
     for (int k = 0; k < s->n; k++)
-        mc.map_din |= cfg->axis[s->ax[k]].home_search_vel != 0;
+        mc.map_din |= cfg->axis[s->ax[k]].home_search_vel != 0 && !cfg->axis[s->ax[k]].home_drive;
+    s->sdo.fd = -1;
     if (ncp_co_master_open(&s->m, cfg->can.interface, nodes, s->n, &mc, d) != NCP_OK) {
         free(s);
         return d->code;
     }
     s->m.log = log;
+    if (open_homing(s, cfg, d) != NCP_OK) {
+        ncp_can_close(&s->sdo);
+        ncp_co_master_close(&s->m);
+        free(s);
+        return d->code;
+    }
     for (int i = 0; i < s->n; i++) {
         double dec = cfg->axis[s->ax[i]].max_acc * s->cpm[i];
         s->m.quick_stop_dec[i] = dec >= 1 && dec < 4e9 ? (uint32_t)dec : 0;

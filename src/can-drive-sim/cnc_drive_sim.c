@@ -41,9 +41,16 @@ static void usage(FILE *f)
           "                            the stop of 0x6007 (default 100, 0 = never)\n"
           "  --home-switch COUNTS      home switch (0x60FD bit 2, in TPDO2 where the master\n"
           "                            maps it) pressed at and above this actual position\n"
+          "  --index-pitch COUNTS      encoder index pulse at every multiple of COUNTS\n"
+          "                            (homing methods 3 and 4)\n"
           "  --verbose                 log state changes on stderr\n"
           "Answers NMT, SDO (expedited), SYNC and RPDO1/TPDO1 (controlword+target,\n"
           "statusword+actual); heartbeat period from object 0x1017 (default 100 ms).\n"
+          "Homing mode (0x6060 = 6, started by controlword bit 4): methods 35 and 37 home\n"
+          "on the current position; 19 and 20 on the home switch's edge (moving negative\n"
+          "from the pressed side, positive from the released side), 3 and 4 on the first\n"
+          "index pulse past it; speeds 0x6099:01/02, acceleration 0x609A, and at home the\n"
+          "position becomes the home offset 0x607C.\n"
           "Guards the master: its heartbeat (consumer 0x1016:01), SYNC and RPDO1\n"
           "(deadline 0x1400:05); when one stops while enabled the drive sends EMCY\n"
           "(0x8130, 0x8700, 0x8250) and stops as 0x6007 and 0x605E say.\n",
@@ -72,7 +79,7 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         {"verbose", no_argument, 0, 'v'},            {"help", no_argument, 0, 'h'},
         {"config", required_argument, 0, 'c'},       {"axis", required_argument, 0, 'x'},
         {"sync-loss-ms", required_argument, 0, 'L'}, {"count-from-motion", no_argument, 0, 'M'},
-        {"home-switch", required_argument, 0, 'S'},
+        {"home-switch", required_argument, 0, 'S'},  {"index-pitch", required_argument, 0, 'I'},
         {0, 0, 0, 0}};
     *o = (struct drive_opts){.node = 0, .fault_after = -1, .emcy_after = -1,
                              .hb_stop_after = -1, .abort_index = -1, .max_step = 1000000,
@@ -97,6 +104,7 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
             o->have_home_switch = 1;
             o->home_switch = (int32_t)num(optarg, "--home-switch", -(1L << 30), 1L << 30);
             break;
+        case 'I': o->index_pitch = (int32_t)num(optarg, "--index-pitch", 1, 1L << 30); break;
         case 'x':
             if (!optarg[0] || optarg[1] || !strchr("XYZxyz", optarg[0])) {
                 fprintf(stderr, "cnc-drive-sim: --axis is X, Y or Z\n");

@@ -35,6 +35,8 @@ void drive_set_state(struct drive *dv, enum ncp_cia402_state s)
 uint16_t drive_statusword(const struct drive *dv)
 {
     uint16_t sw = ncp_cia402_statusword(dv->st);
+    if (dv->home.mode6 && dv->st == NCP_402_OPERATION_ENABLED)
+        return sw | drive_home_statusword(dv);
     return dv->halted && dv->st == NCP_402_QUICK_STOP_ACTIVE ? sw | NCP_402_SW_TARGET_REACHED : sw;
 }
 
@@ -49,6 +51,7 @@ void drive_boot(struct drive *dv)
     dv->heartbeat_on = 1;
     dv->last_master_hb = dv->last_sync = dv->last_rpdo = -1;
     dv->lost = 0;
+    dv->home = (struct drive_homing){0};
     drive_set_state(dv, dv->o.fault_at_start ? NCP_402_FAULT : NCP_402_SWITCH_ON_DISABLED);
     if (dv->o.fault_at_start)
         od_set(&dv->od, 0x603F, 0, 0x5530);
@@ -97,9 +100,12 @@ static int apply_controlword(struct drive *dv, uint16_t cw)
         dv->prev_actual = dv->actual;
         drive_servo_enable(dv);
     }
-    if (next == NCP_402_QUICK_STOP_ACTIVE && dv->st == NCP_402_OPERATION_ENABLED)
+    if (next == NCP_402_QUICK_STOP_ACTIVE && dv->st == NCP_402_OPERATION_ENABLED) {
+        drive_home_halt(dv); /* a quick stop ends a homing: nothing attained */
         return drive_start_ramp(dv, next, next, dv->now_ms);
+    }
     drive_set_state(dv, next);
+    drive_home_control(dv, cw, dv->prev_cw);
     return 0;
 }
 
@@ -130,8 +136,7 @@ static int32_t plant_step(int32_t actual, int32_t target, int32_t max_step)
  * asked for it at every SYNC. */
 static int send_inputs(struct drive *dv)
 {
-    uint32_t din = dv->o.have_home_switch && dv->actual >= dv->o.home_switch
-                       ? NCP_402_DIN_HOME_SWITCH : 0;
+    uint32_t din = drive_home_switch(dv) ? NCP_402_DIN_HOME_SWITCH : 0;
     od_set(&dv->od, 0x60FD, 0, din);
     uint32_t tt = od_get(&dv->od, 0x1801, 2);
     if (od_get(&dv->od, 0x1A01, 0) != 1 || od_get(&dv->od, 0x1A01, 1) != 0x60FD0020u ||
@@ -153,8 +158,9 @@ static int on_sync(struct drive *dv)
             dv->syncs_moving++;
         long k = dv->o.count_from_motion ? dv->syncs_moving : dv->syncs_enabled;
         dv->prev_actual = dv->actual;
-        dv->actual = dv->servo ? drive_servo_step(dv)
-                               : plant_step(dv->actual, dv->target, dv->o.max_step);
+        dv->actual = dv->home.mode6 ? drive_home_step(dv)
+                     : dv->servo    ? drive_servo_step(dv)
+                                    : plant_step(dv->actual, dv->target, dv->o.max_step);
         od_set(&dv->od, 0x6064, 0, (uint32_t)dv->actual);
         if (k == dv->o.emcy_after && drive_go_fault(dv, 0x8611, 1) < 0)
             return -1;
@@ -199,8 +205,16 @@ static uint32_t check_write(struct drive *dv, const struct od_entry *e, uint32_t
 static void after_write(struct drive *dv, struct od_entry *e, uint32_t v)
 {
     e->value = v;
-    if (e->index == 0x6060)
+    if (e->index == 0x6060) {
         od_set(&dv->od, 0x6061, 0, v);
+        drive_home_mode(dv, v);
+        /* a position mode again: the drive holds where homing left it */
+        if (v == 8 && dv->st == NCP_402_OPERATION_ENABLED) {
+            dv->target = dv->prev_actual = dv->actual;
+            drive_servo_enable(dv);
+        }
+        od_set(&dv->od, 0x6041, 0, drive_statusword(dv));
+    }
     else if (e->index == 0x6040)
         (void)apply_controlword(dv, (uint16_t)v);
     else if (e->index == 0x607A)

@@ -32,6 +32,21 @@ struct drive_opts {
      * or above it */
     int have_home_switch;
     int32_t home_switch;
+    /* --index-pitch COUNTS: the encoder's index pulse at every multiple of
+     * it (homing methods 3 and 4); 0 none */
+    int32_t index_pitch;
+};
+
+/* The drive's own homing mode (0x6060 = 6, homing.c). */
+enum drive_home_stage { DH_IDLE, DH_SEEK, DH_LATCH, DH_INDEX, DH_BRAKE };
+struct drive_homing {
+    int mode6;            /* in homing mode (0x6061 = 6) */
+    int stage;            /* enum drive_home_stage */
+    int attained, error;  /* statusword bits 12 and 13 */
+    int found;            /* home found: the brake ends in attained */
+    int dir;              /* direction of the latch (and index) stage */
+    double pos, v;        /* counts, counts per second */
+    int32_t ref;          /* the drive's position minus the encoder's: homing sets it */
 };
 
 struct drive {
@@ -62,6 +77,7 @@ struct drive {
     enum ncp_cia402_state after_stop; /* where the ramp ends */
     int halted;           /* a quick stop's ramp ended (statusword bit 10) */
     long long now_ms;     /* the drive's clock at the frame being handled */
+    struct drive_homing home;
 };
 
 /* 0x60C2: value * 10^index s, the period the master runs SYNC at. */
@@ -90,6 +106,18 @@ uint16_t drive_statusword(const struct drive *dv);
  * Operation enabled) is one that stays in Quick stop active. */
 int drive_start_ramp(struct drive *dv, enum ncp_cia402_state during,
                      enum ncp_cia402_state after, long long now_ms);
+
+/* homing.c: the drive's own homing mode. Home switch pressed (0x60FD bit
+ * 2), on the encoder's counts; the statusword bits of homing mode; bit 4 of
+ * the controlword going up (start) or down (interrupt); one SYNC of it,
+ * returning the actual position; 0x6060 written. */
+int drive_home_switch(const struct drive *dv);
+uint16_t drive_home_statusword(const struct drive *dv);
+void drive_home_control(struct drive *dv, uint16_t cw, uint16_t prev_cw);
+int32_t drive_home_step(struct drive *dv);
+void drive_home_mode(struct drive *dv, uint32_t mode);
+/* The homing under way ends where the axis stands, nothing attained. */
+void drive_home_halt(struct drive *dv);
 
 /* guard.c: the deadlines of the master's heartbeat, SYNC and RPDO1, and the
  * drive's own reaction (0x6007, 0x605E) when one passes: called whenever the

@@ -22,3 +22,11 @@ $(BUILD)/tests/test_drive_guard: tests/unit/test_drive_guard.c \
 	@mkdir -p $(@D)
 	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -Isrc/can-drive-sim -o $@ $(filter %.c %.o %.a,$^) \
 	    -lcmocka -lm -linih -lstdc++
+
+# The drive's own homing mode driven by the master's homing state machine
+# (src/can/dhome.c) over a socket pair, the same way.
+$(BUILD)/tests/test_drive_homing: tests/unit/test_drive_homing.c \
+        $(filter-out %/cnc_drive_sim.o,$(DRIVE_SIM_OBJS)) $(BUILD)/libncpar-can.a | $(GEN_STAMP)
+	@mkdir -p $(@D)
+	$(Q)$(CC) $(CPPFLAGS) $(ALL_CFLAGS) -Isrc/can-drive-sim -o $@ $(filter %.c %.o %.a,$^) \
+	    -lcmocka -lm -linih -lstdc++

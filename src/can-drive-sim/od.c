@@ -44,6 +44,12 @@ void od_init(struct od *od)
     add(od, 0x6064, 0, 4, OD_RO, 0);
     add(od, 0x607A, 0, 4, OD_RW, 0);
     add(od, 0x6085, 0, 4, OD_RW, 2000000);    /* quick stop deceleration, counts/s^2 */
+    add(od, 0x607C, 0, 4, OD_RW, 0);          /* home offset: the position at home */
+    add(od, 0x6098, 0, 1, OD_RW, 35);         /* homing method (INTEGER8) */
+    add(od, 0x6099, 0, 1, OD_RO, 2);          /* homing speeds, counts/s: */
+    add(od, 0x6099, 1, 4, OD_RW, 20000);      /* ... searching the switch */
+    add(od, 0x6099, 2, 4, OD_RW, 2000);       /* ... latching */
+    add(od, 0x609A, 0, 4, OD_RW, 200000);     /* homing acceleration, counts/s^2 */
     add(od, 0x60FD, 0, 4, OD_RO, 0);          /* digital inputs: bit 2 home switch */
     add(od, 0x60C2, 1, 1, OD_RW, 1);          /* interpolation period value */
     add(od, 0x60C2, 2, 1, OD_RW, 0xFD);       /* ... index: 10^-3 s */

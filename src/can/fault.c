@@ -33,6 +33,33 @@ static void describe_state(const struct ncp_co_fault *f, char *buf, size_t len)
              code);
 }
 
+static void describe_homing(const struct ncp_co_fault *f, char *buf, size_t len)
+{
+    unsigned sw = f->statusword;
+    switch (f->home_why) {
+    case NCP_CH_WHY_ERROR:
+        snprintf(buf, len,
+                 "node %u: the drive's own homing (method %d) ended in a homing error "
+                 "(statusword 0x6041 = 0x%04X, bit 13) after %.1f s; the axis is not homed: "
+                 "check its home switch, index pulse and HOME_METHOD",
+                 f->node, f->home_method, sw, (double)f->home_ms / 1000);
+        break;
+    case NCP_CH_WHY_TIMEOUT:
+        snprintf(buf, len,
+                 "node %u: the drive's own homing (method %d) did not end within %.1f s "
+                 "(statusword 0x6041 = 0x%04X: %s); the axis is not homed: is its home "
+                 "switch within reach at HOME_SEARCH_VEL?",
+                 f->node, f->home_method, (double)f->home_ms / 1000, sw,
+                 (sw & NCP_402_SW_HOMING_ATTAINED) ? "homing attained, target not reached"
+                                                   : "homing still in progress");
+        break;
+    default:
+        snprintf(buf, len, "%s (the drive's own homing, method %d); the axis is not homed",
+                 f->text, f->home_method);
+        break;
+    }
+}
+
 void ncp_co_fault_describe(const struct ncp_co_fault *f, const char *ifname, char *buf,
                            size_t len)
 {
@@ -76,6 +103,9 @@ void ncp_co_fault_describe(const struct ncp_co_fault *f, const char *ifname, cha
         break;
     case NCP_CO_FAULT_START:
         snprintf(buf, len, "%s", f->text);
+        break;
+    case NCP_CO_FAULT_HOMING:
+        describe_homing(f, buf, len);
         break;
     }
 }

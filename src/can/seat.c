@@ -29,6 +29,9 @@ void ncp_co_master_seat(struct ncp_co_master *m, int on)
         return;
     m->mode = on ? NCP_CO_ENABLING : NCP_CO_ESTOP;
     m->mode_cycles = 0;
+    /* a drive that was homing itself stops with the others and is back in
+     * CSP for the reset's walk */
+    ncp_co_home_drop(m);
     for (size_t i = 0; i < m->n; i++) {
         m->enabled[i] = 0;
         m->still[i] = 0;

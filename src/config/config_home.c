@@ -49,6 +49,17 @@ int ncp_home_cfg_key(struct ncp_axis_cfg *a, const char *k, const char *v, char 
         a->have_home_sequence = 1;
         return 1;
     }
+    if (!strcasecmp(k, "HOME_METHOD")) {
+        if (!strcasecmp(v, "nck"))
+            return a->home_drive = 0, 1;
+        if (strncasecmp(v, "drive:", 6) != 0 || ncp_ini_number(v + 6, -128, 127, &x) ||
+            x != floor(x))
+            return snprintf(why, len, "nck, or drive:N, N a CiA 402 homing method (0x6098) "
+                                      "-128..127; cnc-drive-sim has 3, 4, 19, 20, 35, 37"), -1;
+        a->home_drive = 1;
+        a->home_method = (int)x;
+        return 1;
+    }
     if (!strcasecmp(k, "HOME_IGNORE_LIMITS"))
         return flag(v, &a->home_ignore_limits) ? snprintf(why, len, "0 or 1 (NO or YES)"), -1 : 1;
     if (!strcasecmp(k, "HOME_USE_INDEX")) {
@@ -82,11 +93,12 @@ int ncp_home_cfg_check(const struct ncp_machine_cfg *c, int axis, char *why, siz
 {
     const struct ncp_axis_cfg *a = &c->axis[axis];
     double vs = fabs(a->home_search_vel), vl = fabs(a->home_latch_vel);
-    if (vs > 0 && vl == 0)
+    /* the drive's own homing takes the speeds as they are, latch alone too */
+    if (!a->home_drive && vs > 0 && vl == 0)
         return snprintf(why, len, "HOME_LATCH_VEL must not be 0 with a home switch "
                                   "(HOME_SEARCH_VEL %g): the switch is latched at it",
                         a->home_search_vel), -1;
-    if (vs == 0 && vl > 0)
+    if (!a->home_drive && vs == 0 && vl > 0)
         return snprintf(why, len, "HOME_LATCH_VEL %g without HOME_SEARCH_VEL is LinuxCNC's "
                                   "index-only homing: the simulated machine has no encoder index",
                         a->home_latch_vel), -1;

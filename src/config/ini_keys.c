@@ -107,6 +107,14 @@ const struct ncp_ini_key ncp_ini_keys[] = {
          "The limit switch is the home switch."),
     WORD("AXIS_<L>", "HOME_USE_INDEX", "0|NO|FALSE", "0",
          "The simulated machine has no encoder index: only 0."),
+    TEXT("AXIS_<L>", "HOME_METHOD", "nck, or drive:N with N a CiA 402 homing method, -128 to 127",
+         "nck", "drive:35",
+         "Who homes the axis. nck: the position loop, on the keys above. drive:N (socketcan "
+         "backend): the axis's drive in its own homing mode (0x6060 = 6), method N (0x6098), "
+         "speeds |HOME_SEARCH_VEL| and |HOME_LATCH_VEL| (0x6099), MAX_ACCELERATION (0x609A), "
+         "its position at home HOME_OFFSET (0x607C); then the axis goes to HOME. "
+         "cnc-drive-sim implements methods 3, 4, 19, 20 (home switch, with and without index "
+         "pulse), 35 and 37 (the current position)."),
 
     REAL("JOINT_<n>", "MIN_LIMIT", -1e6, 1e6, "mm (deg)", "the axis's", "Joint limit."),
     REAL("JOINT_<n>", "MAX_LIMIT", -1e6, 1e6, "mm (deg)", "the axis's", "Joint limit."),

@@ -11,6 +11,11 @@
  * backend reads one (CiA 402 drives: 0x60FD bit 2); the simulated switch is
  * pressed on the search's side of [SIM] HOME_SWITCH_<axis> (HOME_OFFSET
  * without it).
+ * An axis with HOME_METHOD = drive:N is homed by its drive instead (the
+ * backend's drive_home): its command follows the actual position while
+ * the drive homes, and once the drive is homed its counts are the machine
+ * position (the drive's position at home is HOME_OFFSET, 0x607C), so the
+ * axis stands latched there and goes on to HOME as any other.
  * The loop functions are on the real-time path: no allocation, locks or
  * system calls. */
 #include "nck_int.h"
@@ -77,11 +82,22 @@ static void begin_phase(struct nck_homing *h, int j, int phase)
     h->ax[j].from = h->ax[j].pos;
 }
 
+static void stop_all(struct nck_core *n, int result, int axis);
+
 static void begin_axis(struct nck_core *n, int j)
 {
     struct nck_homing *h = &n->loop->home;
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
     h->ax[j].queued = 0;
+    if (a->home_drive) {
+        struct ncp_backend *be = &n->cross.be;
+        begin_phase(h, j, NCK_HP_DRIVE);
+        if (!be->ops->drive_home || be->ops->drive_home(be, j, 1) != 0) {
+            h->ax[j].phase = NCK_HP_NONE;
+            stop_all(n, NCK_HOME_NO_DRIVE, j);
+        }
+        return;
+    }
     if (a->home_search_vel == 0) {
         /* no switch: the axis is homed where it stands */
         double phys = n->loop->probe.last[j] + h->off[j];
@@ -215,6 +231,15 @@ static void step_axis(struct nck_core *n, int j, double dt)
     struct nck_homing *h = &n->loop->home;
     const struct ncp_axis_cfg *a = &n->cfg->axis[j];
     struct nck_home_axis *x = &h->ax[j];
+    if (x->phase == NCK_HP_DRIVE) {
+        /* the drive moves; the command follows it (nck_home_sense) */
+        struct ncp_backend *be = &n->cross.be;
+        if (x->stopping && !x->aborted) {
+            be->ops->drive_home(be, j, -1);
+            x->aborted = 1;
+        }
+        return;
+    }
     if (x->phase == NCK_HP_FINAL && !x->stopping) {
         double vf = a->home_final_vel > 0 ? a->home_final_vel : a->max_vel;
         if (approach(x, a->home, vf, a->max_acc, dt))
@@ -272,6 +297,34 @@ int nck_home_take(struct nck_core *n)
     return 1;
 }
 
+/* An axis its drive homes: the command is the actual position, so that
+ * nothing jumps when the drive follows it again; once homed, the drive's
+ * counts are the machine position. */
+static void drive_sense(struct nck_core *n, int j, double act)
+{
+    struct nck_homing *h = &n->loop->home;
+    struct nck_home_axis *x = &h->ax[j];
+    struct ncp_backend *be = &n->cross.be;
+    x->pos = act;
+    int r = be->ops->drive_home(be, j, 0);
+    if (r == 1)
+        return;
+    x->v = 0;
+    x->stopping = 0;
+    if (r < 0 || n->cross.home.result != NCK_HOME_OK) {
+        /* aborted, or failed (the backend's fault stops the loop) */
+        if (n->cross.home.result == NCK_HOME_OK)
+            stop_all(n, NCK_HOME_STOPPED, j);
+        x->phase = NCK_HP_NONE;
+        return;
+    }
+    double phys = act + h->off[j];
+    n->cross.home.latched[j] = phys;
+    set_position(n, j, phys, phys);
+    /* the drive's home is HOME_OFFSET: latched, then on to HOME */
+    x->phase = NCK_HP_LATCHED;
+}
+
 void nck_home_sense(struct nck_core *n, const double act[NCP_AXES])
 {
     struct nck_homing *h = &n->loop->home;
@@ -279,6 +332,10 @@ void nck_home_sense(struct nck_core *n, const double act[NCP_AXES])
         return;
     for (int j = 0; j < NCP_AXES; j++) {
         struct nck_home_axis *x = &h->ax[j];
+        if (x->phase == NCK_HP_DRIVE) {
+            drive_sense(n, j, act[j]);
+            continue;
+        }
         if (x->stopping || x->phase < NCK_HP_OFF_SWITCH || x->phase > NCK_HP_LATCH)
             continue;
         const struct ncp_axis_cfg *a = &n->cfg->axis[j];
@@ -355,6 +412,13 @@ int nck_home_report(const struct nck_core *n, char *buf, size_t len)
                  SEARCH_TRAVEL * (a->max_limit - a->min_limit), a->home_search_vel, switch_at(a));
         return -1;
     }
+    if (h->result == NCK_HOME_NO_DRIVE) {
+        snprintf(buf, len, "homing %c: HOME_METHOD = drive:%d has the axis's drive home itself, "
+                           "and this backend has no drive that does (CiA 402 drives: --backend "
+                           "socketcan, with a NODE_ID for the axis); the machine is not homed",
+                 NCP_AXIS_LETTERS[h->fail_axis], n->cfg->axis[h->fail_axis].home_method);
+        return -1;
+    }
     if (h->result == NCK_HOME_STOPPED) {
         snprintf(buf, len, "homing stopped before it was complete; the machine is not homed");
         return -1;
@@ -363,7 +427,13 @@ int nck_home_report(const struct nck_core *n, char *buf, size_t len)
         if (!(h->mask & n->cfg->axis_mask & NCP_AXIS_BIT(j)))
             continue;
         const struct ncp_axis_cfg *a = &n->cfg->axis[j];
-        int k = a->home_search_vel == 0
+        int k = a->home_drive
+                    ? snprintf(buf + at, len - at, "%shomed %c by its drive (node %d, homing "
+                               "method %d): position HOME_OFFSET %.4f where the drive found "
+                               "home, now at %.4f, then to HOME %.4f", at ? "\n" : "",
+                               NCP_AXIS_LETTERS[j], a->node_id, a->home_method, a->home_offset,
+                               h->latched[j], a->home)
+                : a->home_search_vel == 0
                     ? snprintf(buf + at, len - at, "%shomed %c: no switch, position set to "
                                "HOME_OFFSET %.4f where it stood, then to HOME %.4f",
                                at ? "\n" : "", NCP_AXIS_LETTERS[j], a->home_offset, a->home)

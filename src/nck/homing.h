@@ -11,12 +11,14 @@ struct nck_core;
  * its own, away from the planner, through LinuxCNC's phases; the trace's
  * `home` column shows each axis's phase as one digit. */
 enum nck_home_phase { NCK_HP_NONE, NCK_HP_OFF_SWITCH, NCK_HP_SEARCH, NCK_HP_BACK_OFF,
-                      NCK_HP_LATCH, NCK_HP_LATCHED, NCK_HP_FINAL };
-enum nck_home_result { NCK_HOME_OK, NCK_HOME_NOT_FOUND, NCK_HOME_STOPPED };
+                      NCK_HP_LATCH, NCK_HP_LATCHED, NCK_HP_FINAL,
+                      NCK_HP_DRIVE /* HOME_METHOD = drive:N: the drive homes itself */ };
+enum nck_home_result { NCK_HOME_OK, NCK_HOME_NOT_FOUND, NCK_HOME_STOPPED, NCK_HOME_NO_DRIVE };
 struct nck_home_axis {
     int phase;             /* enum nck_home_phase */
     int queued;            /* waits for its HOME_SEQUENCE's turn */
     int stopping;          /* the phase's event came: braking to a stop */
+    int aborted;           /* NCK_HP_DRIVE: the drive was told to stop homing */
     double pos, v;         /* commanded position (machine coordinates), velocity */
     double from;           /* where the phase began: a search's travel is bounded */
 };
