@@ -270,10 +270,12 @@ static int servable(const struct serve_channel *ch, const char *cell)
     if (c->backend != NCP_BACKEND_LCM)
         return 0;
     int adcai = c->nck == NCP_NCK_ADCAI, fine = adcai ? 4 : 5;
-    /* ADCBI's DP4 and DP3: each LLC's interpolator follows the loop's time
-     * scaling period by period and drops what an abort drops (lcm.c,
-     * src/axis/llc_scale.c), so a hold, stop or E-stop stops it on the path */
-    if (c->lcm.dp == fine || (!adcai && (c->lcm.dp == 4 || c->lcm.dp == 3)))
+    /* ADCBI's DP4, DP3 and DP2: each LLC's interpolator follows the loop's
+     * time scaling period by period and drops what an abort drops (lcm.c,
+     * src/axis/llc_scale.c; at DP2 what its own planner made before the
+     * abort's DROP call, dp_block.c), so a hold, stop or E-stop stops it on
+     * the path and the next job starts clean */
+    if (c->lcm.dp == fine || (!adcai && c->lcm.dp >= 2 && c->lcm.dp <= 4))
         return 0;
     char where[PATH_MAX + 64];
     if (ch->cc)
@@ -291,7 +293,7 @@ static int servable(const struct serve_channel *ch, const char *cell)
                    c->lcm.dp == 1 ? "it runs the program itself"
                    : adcai        ? "its own ACC/DEC stages"
                                   : "its own look-ahead planner",
-                   adcai ? "ADCAI's fine setpoints, --dp 4" : "ADCBI's --dp 5, 4 or 3",
+                   adcai ? "ADCAI's fine setpoints, --dp 4" : "ADCBI's --dp 5, 4, 3 or 2",
                    c->lcm.dp), -1;
 }
 
