@@ -68,8 +68,10 @@ int llc_scale_void(struct llc *l, int64_t slot)
 {
     if (!l->scale.void_due || slot < l->scale.void_t)
         return 0;
-    if (llc_scale_void_waits(l, slot))
+    if (llc_scale_void_waits(l, slot)) {
+        l->scale.drop_waits++;
         return 1;
+    }
     l->scale.void_due = 0;
     /* DP2: the HLC's calls all stay (this planner replays every one, the
      * aborted job's too, to stay the HLC's); what it made before the

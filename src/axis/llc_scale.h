@@ -23,6 +23,7 @@ struct llc_scale {
      * number of its own records then (those before are the aborted job's) */
     int32_t drops;
     int32_t drop_own[LLC_DROPS];
+    uint32_t drop_waits;   /* periods stood for a DROP its planner had not replayed */
 };
 
 struct llc;
