@@ -145,9 +145,11 @@ struct ncp_backend_ops {
     int (*drive_home)(struct ncp_backend *b, int axis, int go);
 };
 
-/* The ADCBI planner's calls, as plan_journal sees them. */
+/* The ADCBI planner's calls, as plan_journal sees them; DROP is no call but
+ * the mark of an abort: the job whose calls came before it was dropped (a
+ * RESET follows). */
 enum ncp_plan_call { NCP_PLAN_PUSH, NCP_PLAN_FINISH, NCP_PLAN_RESTART, NCP_PLAN_RESET,
-                     NCP_PLAN_STEP };
+                     NCP_PLAN_STEP, NCP_PLAN_DROP };
 
 struct ncp_backend {
     const struct ncp_backend_ops *ops;

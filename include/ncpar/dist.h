@@ -141,7 +141,7 @@ void ncp_dist_rec_decode(const ncp_accdec_rec_t *r, struct ncp_accdec *a);
 /* ---- ADCBI DP3 (LAbuf) and DP2 (INTbuf) records (blocks.c) -------------- */
 /* DP2: a call the HLC's planner got, after `step` of its steps. */
 struct ncp_dist_op {
-    int op;                 /* NCP_INT_REC_T_PUSH .. RESET */
+    int op;                 /* NCP_INT_REC_T_PUSH .. DROP */
     int32_t step;
     struct ncp_seg s;       /* PUSH: the block; RESET: the position in s.end */
 };

@@ -252,6 +252,13 @@ static int report(const struct llc *l)
                         "stale %u, duplicate %u, too early %u\n",
                 ax, l->dp ? l->dp : 4, (int)l->recs.next, l->recs.gaps, l->resends, l->recs.stale,
                 l->recs.duplicate, l->recs.early);
+    if (l->dp4 && !l->dp1ai && l->dp == 2)
+        fprintf(stderr, "cnc-axis %c: aborts of the HLC's: %u dropped with what this LLC's "
+                        "planner made for them (%u periods stood for it to replay one)\n",
+                ax, (unsigned)l->scale.voided, (unsigned)l->scale.drop_waits);
+    else if (l->dp4 && !l->dp1ai)
+        fprintf(stderr, "cnc-axis %c: aborts of the HLC's: %u dropped\n", ax,
+                (unsigned)l->scale.voided);
     llc_ai_report(l);
     llc_dp1_ai_report(l);
     llc_clock_report(l);

@@ -90,6 +90,13 @@ static void apply(struct llc *l, const struct ncp_dist_op *o)
     case NCP_INT_REC_T_FINISH: ncp_planner_finish(l->plan); break;
     case NCP_INT_REC_T_RESTART: ncp_planner_restart(l->plan); break;
     case NCP_INT_REC_T_RESET: ncp_planner_reset(l->plan, o->s.end); break;
+    case NCP_INT_REC_T_DROP:
+        /* what this planner made so far is the aborted job's: the
+         * interpolator drops it at the HLC's period of the abort
+         * (llc_scale.c); a RESET to where the HLC rested comes next */
+        l->scale.drops++;
+        l->scale.drop_own[(unsigned)l->scale.drops % LLC_DROPS] = l->own_n;
+        break;
     default: break;   /* a newer HLC's call this LLC does not know */
     }
 }

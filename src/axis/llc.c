@@ -335,9 +335,8 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
 
 static double interpolate(struct llc *l, int64_t slot)
 {
-    if (slot < l->t_start)
+    if (slot < l->t_start || llc_scale_void(l, slot))
         return l->cmd;
-    llc_scale_void(l, slot);
     /* after an abort: where the command stands until the next job's first
      * record (it starts where the HLC rested on this axis's command) */
     struct ncp_accdec first;
@@ -359,7 +358,8 @@ static double interpolate_ahead(struct llc *l, int64_t slot)
 {
     double pos;
     struct ncp_accdec first;
-    if (slot < l->t_start || (l->scale.voided && !l->ex_on && !llc_exec_head(l, 0, &first)))
+    if (slot < l->t_start || llc_scale_void_waits(l, slot) ||
+        (l->scale.voided && !l->ex_on && !llc_exec_head(l, 0, &first)))
         return l->cmd;
     (void)exec_try(l, slot, 0, &pos);
     if (l->missing) {

@@ -58,13 +58,30 @@ double llc_scale_at(const struct llc *l, int64_t slot)
     return slot > l->scale.newest_t ? l->scale.newest : 1.0;
 }
 
-void llc_scale_void(struct llc *l, int64_t slot)
+int llc_scale_void_waits(const struct llc *l, int64_t slot)
+{
+    return l->scale.void_due && slot >= l->scale.void_t && l->dp == 2 &&
+           l->scale.drops < l->scale.void_below;
+}
+
+int llc_scale_void(struct llc *l, int64_t slot)
 {
     if (!l->scale.void_due || slot < l->scale.void_t)
-        return;
+        return 0;
+    if (llc_scale_void_waits(l, slot)) {
+        l->scale.drop_waits++;
+        return 1;
+    }
     l->scale.void_due = 0;
-    ncp_dist_recs_skip(&l->recs, l->scale.void_below);
+    /* DP2: the HLC's calls all stay (this planner replays every one, the
+     * aborted job's too, to stay the HLC's); what it made before the
+     * abort's DROP is what the interpolator drops */
+    if (l->dp == 2)
+        ncp_dist_recs_skip(&l->own, l->scale.drop_own[(unsigned)l->scale.void_below % LLC_DROPS]);
+    else
+        ncp_dist_recs_skip(&l->recs, l->scale.void_below);
     l->ex_on = 0;
     l->stop_rested = 0;
     l->scale.voided++;
+    return 0;
 }

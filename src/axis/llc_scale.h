@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #define LLC_SCALE_HIST 64
+#define LLC_DROPS 8   /* DP2: aborts whose planner records are told apart */
 
 struct llc_scale {
     int64_t t[LLC_SCALE_HIST];
@@ -18,6 +19,11 @@ struct llc_scale {
     int64_t void_t;
     int void_due;
     uint32_t voided;   /* aborts whose records were dropped */
+    /* DP2: the DROP calls this LLC's planner replayed, and for each the
+     * number of its own records then (those before are the aborted job's) */
+    int32_t drops;
+    int32_t drop_own[LLC_DROPS];
+    uint32_t drop_waits;   /* periods stood for a DROP its planner had not replayed */
 };
 
 struct llc;
@@ -26,7 +32,11 @@ void llc_on_scale(struct llc *l, const uint8_t *p, size_t len);
 double llc_scale_at(const struct llc *l, int64_t slot);
 /* Drops the records an abort of the HLC's made void, once slot reaches
  * the period it dropped them in; the interpolator starts again from the
- * next record's start. */
-void llc_scale_void(struct llc *l, int64_t slot);
+ * next record's start. 1: due, but at DP2 this LLC's planner has not
+ * replayed the abort yet (the axis stands meanwhile, as the HLC's stream
+ * does), 0 otherwise. */
+int llc_scale_void(struct llc *l, int64_t slot);
+/* The same 1 without dropping anything (feed-forward's look ahead). */
+int llc_scale_void_waits(const struct llc *l, int64_t slot);
 
 #endif

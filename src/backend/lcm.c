@@ -438,7 +438,12 @@ static void scale_put(struct lcm_be *s, double adv)
  * a period ahead of this stream until a standstill's mark, as before the
  * scaling), and in a hold (0) they must not move. An abort (the loop dropped its stream) makes
  * every record numbered so far void: the planner was parked before, so
- * every record of the aborted job is among them. */
+ * every record of the aborted job is among them. At DP2 the records are the
+ * planner's calls, which each LLC's planner must replay all of to stay the
+ * HLC's (the aborted job's included, and the DROP mark and RESET the
+ * planner thread journals once parked, which a drop here could lose):
+ * there void_below counts the aborts, and each LLC drops what its own
+ * planner made before that many DROP marks (dp_block.c). */
 static void scale_cycle(struct lcm_be *s, const struct ncp_backend *b, int64_t t, int64_t skipped)
 {
     for (int64_t k = 0; k < skipped && k < SCALE_WINDOW; k++)
@@ -446,7 +451,7 @@ static void scale_cycle(struct lcm_be *s, const struct ncp_backend *b, int64_t t
     scale_put(s, b->adv);
     if (b->discards != s->discards_seen) {
         s->discards_seen = b->discards;
-        s->void_below = lcm_tx_void(s->tx);
+        s->void_below = s->tx->kind == &lcm_kind_int ? s->void_below + 1 : lcm_tx_void(s->tx);
         s->void_t = t;
         s->scale_left = SCALE_AFTER;
     }

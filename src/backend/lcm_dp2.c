@@ -28,6 +28,7 @@ void lcm_dp2_journal(struct lcm_tx *x, struct lcm_dp2 *d, enum ncp_plan_call c,
     o.op = c == NCP_PLAN_PUSH     ? NCP_INT_REC_T_PUSH
            : c == NCP_PLAN_FINISH ? NCP_INT_REC_T_FINISH
            : c == NCP_PLAN_RESTART ? NCP_INT_REC_T_RESTART
+           : c == NCP_PLAN_DROP    ? NCP_INT_REC_T_DROP
                                    : NCP_INT_REC_T_RESET;
     o.step = d->steps_own;
     if (s)

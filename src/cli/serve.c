@@ -270,10 +270,12 @@ static int servable(const struct serve_channel *ch, const char *cell)
     if (c->backend != NCP_BACKEND_LCM)
         return 0;
     int adcai = c->nck == NCP_NCK_ADCAI, fine = adcai ? 4 : 5;
-    /* ADCBI's DP4 and DP3: each LLC's interpolator follows the loop's time
-     * scaling period by period and drops what an abort drops (lcm.c,
-     * src/axis/llc_scale.c), so a hold, stop or E-stop stops it on the path */
-    if (c->lcm.dp == fine || (!adcai && (c->lcm.dp == 4 || c->lcm.dp == 3)))
+    /* ADCBI's DP4, DP3 and DP2: each LLC's interpolator follows the loop's
+     * time scaling period by period and drops what an abort drops (lcm.c,
+     * src/axis/llc_scale.c; at DP2 what its own planner made before the
+     * abort's DROP call, dp_block.c), so a hold, stop or E-stop stops it on
+     * the path and the next job starts clean */
+    if (c->lcm.dp == fine || (!adcai && c->lcm.dp >= 2 && c->lcm.dp <= 4))
         return 0;
     char where[PATH_MAX + 64];
     if (ch->cc)
@@ -283,15 +285,18 @@ static int servable(const struct serve_channel *ch, const char *cell)
         snprintf(where, sizeof where, "cnc-run serve: ");
     return fprintf(stderr, "%s--backend lcm --dp %d ([PLANNER] NCK = %s) is not "
                            "served: at this point each LLC computes its own command from what "
-                           "it was sent ahead (%s), and no message takes an abort back there "
-                           "yet, so a stop or E-stop from the seat could not end its job; serve "
-                           "runs the distributed NCK at %s (cnc-run run --backend lcm runs a "
-                           "program at DP %d)\n", where,
+                           "it was sent ahead (%s), and %s; serve runs the distributed NCK at %s "
+                           "(cnc-run run --backend lcm runs a program at DP %d)\n",
+                   where,
                    c->lcm.dp, adcai ? "adcai" : "adcbi",
                    c->lcm.dp == 1 ? "it runs the program itself"
-                   : adcai        ? "its own ACC/DEC stages"
-                                  : "its own look-ahead planner",
-                   adcai ? "ADCAI's fine setpoints, --dp 4" : "ADCBI's --dp 5, 4 or 3",
+                                  : "its own stages below the point, at the program's pace",
+                   c->lcm.dp == 1 ? "no message takes an aborted job back out of its NCK yet: "
+                                    "a stop or E-stop from the seat could not end it"
+                                  : "they follow neither the HLC's feed hold nor an abort yet: "
+                                    "a pause, stop or E-stop from the seat could not stop "
+                                    "them on the path or end the job",
+                   adcai ? "ADCAI's fine setpoints, --dp 4" : "ADCBI's --dp 5, 4, 3 or 2",
                    c->lcm.dp), -1;
 }
 

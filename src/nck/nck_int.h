@@ -114,6 +114,9 @@ void nck_plan_push(struct nck_core *n, const struct ncp_seg *s);
 void nck_plan_finish(struct nck_core *n);
 void nck_plan_restart(struct nck_core *n);
 void nck_plan_reset(struct nck_core *n, const double pos[NCP_AXES]);
+/* An abort dropped the job planned so far (parked): said to the journal of
+ * an HLC at ADCBI's DP2, whose LLCs' planners replay it. */
+void nck_plan_dropped(const struct nck_core *n);
 int nck_plan_step(struct nck_core *n, struct ncp_setpoint *out);
 void nck_plan_stats(const struct nck_core *n, struct ncp_planner_stats *st);
 /* Servo periods per setpoint of the stream the position loop reads. */

@@ -81,6 +81,11 @@ void nck_plan_restart(struct nck_core *n)
         ncp_planner_restart(n->plan->planner);
 }
 
+void nck_plan_dropped(const struct nck_core *n)
+{
+    journal(n, NCP_PLAN_DROP, NULL, NULL);
+}
+
 void nck_plan_reset(struct nck_core *n, const double pos[NCP_AXES])
 {
     journal(n, NCP_PLAN_RESET, NULL, pos);

@@ -73,6 +73,7 @@ static void parked(struct nck_core *n, int *finishing, int *aux_stop)
            atomic_load_explicit(&n->cross.unpark_req, memory_order_acquire) ==
                atomic_load_explicit(&n->cross.unpark_ack, memory_order_relaxed))
         nap_ns(200000);
+    nck_plan_dropped(n);
     nck_plan_reset(n, n->cross.rest);
     *finishing = 0;
     *aux_stop = 0;
