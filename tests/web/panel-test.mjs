@@ -10,6 +10,8 @@
 // and coolant, jog, touch-off, upload; the layout
 // on a 10-inch touch panel; then what others on the network might send: no
 // token, malformed JSON, unknown commands, an oversized message and a flood.
+// Then the panel on a distributed serve: its LLCs' row as they run and one
+// dies (lcm-case.mjs, in a network namespace of its own).
 // Then the core of the session again in Firefox (WebDriver BiDi), and its
 // preview views. Each case
 // prints PASS/FAIL/SKIP; every wait is bounded; screenshots of each step land
@@ -20,8 +22,9 @@ import fs from 'node:fs';
 import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
+import { lcmDevices } from './lcm-case.mjs';
 
-const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "devices", "spindle-coolant", "jog", "touch-off", "tool-table", "server-limits", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
+const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "devices", "lcm-devices", "spindle-coolant", "jog", "touch-off", "tool-table", "server-limits", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
 
 const [BUILD, WORK, CHROMIUM, FIREFOX] = process.argv.slice(2);
 const ROOT = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..', '..');
@@ -942,13 +945,15 @@ async function firefox() {
   }
 }
 
+const CHROMIUM_ARGS = ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'];
+
 async function main() {
   fs.mkdirSync(WORK, { recursive: true });
   let browser;
   try {
     browser = await puppeteer.launch({
       executablePath: CHROMIUM, headless: true,
-      args: ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+      args: CHROMIUM_ARGS,
       timeout: 30000,
     });
   } catch (e) {
@@ -956,7 +961,7 @@ async function main() {
     await firefox();
     return 0;
   }
-  const watchdog = setTimeout(() => { console.log('FAIL web-timeout: the browser test took over 300 s'); process.exit(1); }, 300000);
+  const watchdog = setTimeout(() => { console.log('FAIL web-timeout: the browser test took over 360 s'); process.exit(1); }, 360000);
   try {
     try {
       await session(browser);
@@ -964,6 +969,8 @@ async function main() {
     } finally {
       await browser.close();
     }
+    // a browser of its own, in the distributed machine's network namespace
+    await lcmDevices({ BUILD, WORK, ROOT, CHROMIUM, puppeteer, launchArgs: CHROMIUM_ARGS, report, shot });
     // one browser at a time: the machine's CPUs are the NCK's too
     await firefox();
   } finally {
