@@ -164,6 +164,9 @@ export async function lcmDevices({ BUILD, WORK, ROOT, CHROMIUM, puppeteer, launc
       for (const l of d.s.llcs) offsets.add(`${l.axis}${l.clock_offset_us}`);
       await new Promise((r) => setTimeout(r, 50));
     }
+    // three LLC rows make the left column taller than 800 px: E-stop stays in sight
+    const estop = await page.$eval('#estop', (e) => { const r = e.getBoundingClientRect(); return [r.top, r.bottom, innerHeight]; });
+    if (estop[0] < 0 || estop[1] > estop[2]) throw new Error(`E-stop out of sight at ${estop[0]}..${estop[1]} px`);
     await shot(page, '20-lcm-running');
     // At its end serve idles, and at DP 5 it goes on sending setpoints (the
     // axes at rest) so the LLCs keep following, as serve's status says
