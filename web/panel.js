@@ -5,6 +5,7 @@ import { createPreview } from './preview.js';
 import { toolPoint } from './canon.js';
 import { createProgress } from './progress.js';
 import { initMachine, allowed } from './machine.js';
+import { initTools } from './tools.js';
 
 const $ = (id) => document.getElementById(id);
 const params = new URLSearchParams(location.search);
@@ -67,7 +68,7 @@ function setOnline(up) {
 function refreshEnabled() {
   const state = ui.status && ui.status.state;
   for (const el of document.querySelectorAll('button, input, select'))
-    el.disabled = !('view' in el.dataset) && !allowed(el, ui.canCommand, state);
+    el.disabled = !('view' in el.dataset) && !('tab' in el.dataset) && !allowed(el, ui.canCommand, state);
 }
 
 // Once a link is dropped, nothing it still delivers counts; a stalled link's
@@ -113,7 +114,7 @@ setInterval(() => {
 
 function send(obj) {
   if (!ui.ws || ui.ws.readyState !== WebSocket.OPEN) return 0;
-  if (obj.cmd !== 'keepalive' && !['list', 'program', 'preview'].includes(obj.cmd)) obj.seq = ++ui.seq;
+  if (obj.cmd !== 'keepalive' && !['list', 'program', 'preview', 'tools', 'history'].includes(obj.cmd)) obj.seq = ++ui.seq;
   ui.ws.send(JSON.stringify(obj));
   return obj.seq || 0;
 }
@@ -171,11 +172,12 @@ function onMessage(text) {
       if (ui.travelShown) { ui.travelShown = null; preview.setTravel(null); }
       setOnline(true);
       log('info', m.authed ? (m.readonly ? 'connected, read-only' : 'connected') : 'connected without a valid token: watching only');
-      if (m.authed) ask('list');
+      if (m.authed) { ask('list'); tools.hello(); }
       break;
     case 'status': onStatus(m); break;
     case 'ack':
       if (m.result !== 'accepted') log('rejected', `#${m.seq}: ${m.reason}`);
+      tools.onAck(m);
       break;
     case 'refused':
       // seq 0: a query's answer (the worker could not answer it), or its
@@ -198,6 +200,7 @@ function onMessage(text) {
       break;
     case 'program': answered('program'); showProgram(m.path, m.text); break;
     case 'preview': answered('preview'); setCanon(m.canon); break;
+    case 'tools': case 'history': answered(m.type); tools.onAnswer(m); break;
   }
 }
 
@@ -282,6 +285,7 @@ function onStatus(m) {
     c[5].textContent = fmt(s.pos_cmd[a] - s.pos_act[a], 4);
   });
   machine.show(s);
+  tools.onStatus(s, prev);
   showTravel(s, axes, off);
   $('line').textContent = s.line || '—';
   $('vel').textContent = `${fmt(s.vel, 0)} mm/min`;
@@ -505,5 +509,6 @@ document.addEventListener('keyup', (e) => { if (jogKeys[e.key]) stopJog(); });
 window.addEventListener('blur', stopJog);
 
 const machine = initMachine({ $, send, log });
+const tools = initTools({ $, send, ask, log, ui });
 setOnline(false);
 connect();

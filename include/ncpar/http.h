@@ -45,6 +45,10 @@ struct ncp_http_opts {
      * [DISPLAY] PROGRAM_PREFIX, its first folder); NULL or "": serve's
      * working directory. */
     const char *program_dir;
+    /* what the panel's Tools and History tabs read (channel 0's tool table
+     * and [DISPLAY] HISTORY_FILE, as the NCK's FILES command names them);
+     * NULL: the machine keeps none, and the tab says so */
+    const char *tool_table, *history_file;
 };
 
 /* Counters of the socket's input (all since start). */
@@ -85,6 +89,8 @@ enum ncp_http_req {
     NCP_HTTP_REQ_LIST,          /* the programs in the NCK's folder */
     NCP_HTTP_REQ_PROGRAM,       /* the loaded program's text */
     NCP_HTTP_REQ_PREVIEW,       /* the loaded program's canonical commands */
+    NCP_HTTP_REQ_TOOLS,         /* the tool table file's text */
+    NCP_HTTP_REQ_HISTORY,       /* the job history file's last lines */
 };
 /* Parses one message: a flat JSON object {"cmd": NAME, ...fields}. unknown is
  * set when the JSON was well formed but NAME is no command. */

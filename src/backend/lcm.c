@@ -396,6 +396,10 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
         snprintf(why, sizeof why, "heartbeat lost (silent for %lld ms)",
                  (long long)((now - p->last_hb_ns) / 1000000));
         fail(s, p, why);
+        /* its last status said running: the operator must not read that
+         * of an LLC that is gone (a status of its, should it come back,
+         * stands again) */
+        atomic_store_explicit(&p->pub_state, NCP_AX_STATUS_T_FAULT, memory_order_relaxed);
     } else if (p->st.state == NCP_AX_STATUS_T_STOPPING || p->st.state == NCP_AX_STATUS_T_STOPPED ||
                p->st.state == NCP_AX_STATUS_T_FAULT) {
         if (p->st.fault[0]) {

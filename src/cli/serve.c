@@ -207,13 +207,16 @@ static void hello_facts(const struct ncp_machine_cfg *cfg, char *buf, size_t len
 }
 
 static int start_http(const struct serve_args *a, const struct ncp_machine_cfg *cfg,
-                      struct ncp_http **out)
+                      const char *tool_table, struct ncp_http **out)
 {
     static char exe[PATH_MAX], web[PATH_MAX], facts[1024];
     hello_facts(cfg, facts, sizeof facts);
     struct ncp_http_opts ho = { .readonly = a->http_readonly,
                                 .allow_origin = cfg->http.allow_origin,
-                                .allow_host = cfg->http.allow_host, .hello_extra = facts };
+                                .allow_host = cfg->http.allow_host, .hello_extra = facts,
+                                .tool_table = tool_table,
+                                .history_file = cfg->op.history_file[0] ? cfg->op.history_file
+                                                                        : NULL };
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
@@ -515,7 +518,7 @@ int ncp_cli_serve(int argc, char **argv)
     struct ncp_diag d;
     memset(&d, 0, sizeof d);
     struct ncp_http *http = NULL;
-    if (a.http && start_http(&a, &chs[0].cfg, &http)) {
+    if (a.http && start_http(&a, &chs[0].cfg, chs[0].tool_table, &http)) {
         for (int k = 0; k < n; k++)
             close_trace(&chs[k]);
         free_channels(chs, n);

@@ -54,7 +54,7 @@ static void *worker(void *arg)
         pthread_mutex_unlock(&j->mu);
         struct ncp_http_prog *prog = j->env.prog_get(j->env.ctx);
         struct ncp_http_msg msg = { NULL, 0 };
-        int bad = ncp_http_build_answer(j->env.self_exe, j->env.program_dir, prog, job.r, &j->stop, &msg);
+        int bad = ncp_http_build_answer(&j->env.paths, prog, job.r, &j->stop, &msg);
         if (prog)
             ncp_http_prog_put(prog);
         pthread_mutex_lock(&j->mu);

@@ -4,7 +4,7 @@
 HTTP_LWS ?= $(shell test -r /usr/include/libwebsockets.h && echo 1 || echo 0)
 ifeq ($(HTTP_LWS),1)
 LIB_SRCS += src/http/server.c src/http/gate.c src/http/jobs.c src/http/query.c \
-            src/http/upload.c
+            src/http/files.c src/http/upload.c
 # cnc-run is static: libwebsockets' own dependencies are named
 HTTP_LDLIBS = -lwebsockets -lssl -lcrypto -lz -lcap
 else

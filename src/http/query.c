@@ -327,13 +327,14 @@ static int preview(const char *self, const struct ncp_http_prog *prog, const ato
     return finish(&b, bad, out);
 }
 
-int ncp_http_build_answer(const char *self_exe, const char *program_dir,
-                          const struct ncp_http_prog *prog, enum ncp_http_req r,
-                          const atomic_int *stop, struct ncp_http_msg *out)
+int ncp_http_build_answer(const struct ncp_http_paths *paths, const struct ncp_http_prog *prog,
+                          enum ncp_http_req r, const atomic_int *stop, struct ncp_http_msg *out)
 {
+    if (r == NCP_HTTP_REQ_TOOLS || r == NCP_HTTP_REQ_HISTORY)
+        return ncp_http_file_answer(paths, r, out);
     if (r == NCP_HTTP_REQ_LIST)
-        return list(program_dir, out);
+        return list(paths->program_dir, out);
     if (r == NCP_HTTP_REQ_PROGRAM)
         return program(prog, out);
-    return preview(self_exe, prog, stop, out);
+    return preview(paths->self_exe, prog, stop, out);
 }

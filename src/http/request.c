@@ -48,6 +48,8 @@ static const struct verb verbs[] = {
     { "list", -NCP_HTTP_REQ_LIST, { { 0, NONE } } },
     { "program", -NCP_HTTP_REQ_PROGRAM, { { 0, NONE } } },
     { "preview", -NCP_HTTP_REQ_PREVIEW, { { 0, NONE } } },
+    { "tools", -NCP_HTTP_REQ_TOOLS, { { 0, NONE } } },
+    { "history", -NCP_HTTP_REQ_HISTORY, { { 0, NONE } } },
 };
 
 static const struct field *field_of(const struct verb *v, const char *key)

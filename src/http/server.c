@@ -863,8 +863,9 @@ struct ncp_http *ncp_http_start(const struct ncp_http_opts *o, struct ncp_diag *
      * folder has one serve (a second one's upload in flight would fail and
      * say so, never store a part) */
     ncp_http_sweep_uploads(h->o.program_dir, 0);
-    struct ncp_http_jobs_env env = { .self_exe = h->o.self_exe,
-                                     .program_dir = h->o.program_dir, .prog_get = prog_get,
+    struct ncp_http_jobs_env env = { .paths = { h->o.self_exe, h->o.program_dir,
+                                                h->o.tool_table, h->o.history_file },
+                                     .prog_get = prog_get,
                                      .wake = wake, .ctx = h };
     lws_set_log_level(LLL_ERR, NULL);
     struct lws_context_creation_info info;

@@ -44,14 +44,27 @@ struct ncp_http_msg {
     size_t len;
 };
 
-/* The answer to a slow query (list, program, preview) or its refusal, on
- * the worker thread (query.c). prog may be NULL (nothing loaded). stop is
- * polled while the preview's interpreter runs; program_dir is the list's
- * folder (ncp_http_opts). 0, or -1 out of memory. */
-int ncp_http_build_answer(const char *self_exe, const char *program_dir,
-                          const struct ncp_http_prog *prog,
+/* What the worker's answers read: cnc-run (the preview's parser), the
+ * program folder and the files the Tools and History tabs show (NULL: none
+ * kept). */
+struct ncp_http_paths {
+    const char *self_exe;
+    const char *program_dir;    /* the list's folder (ncp_http_opts) */
+    const char *tool_table, *history_file;
+};
+
+/* The answer to a slow query (list, program, preview, tools, history) or its
+ * refusal, on the worker thread (query.c). prog may be NULL (nothing loaded).
+ * stop is polled while the preview's interpreter runs. 0, or -1 out of
+ * memory. */
+int ncp_http_build_answer(const struct ncp_http_paths *paths, const struct ncp_http_prog *prog,
                           enum ncp_http_req r, const atomic_int *stop,
                           struct ncp_http_msg *out);
+/* The tool table's or the job history's text as the Tools and History tabs
+ * read it ({"type": "tools"|"history", "path": ..., "text": ...}) or the
+ * refusal saying why not (files.c): 0, or -1 out of memory. */
+int ncp_http_file_answer(const struct ncp_http_paths *paths, enum ncp_http_req r,
+                         struct ncp_http_msg *out);
 
 /* The worker (jobs.c): slow queries in order, one at a time, at a lower
  * priority than the socket thread; their answers wait for the socket thread
@@ -59,8 +72,7 @@ int ncp_http_build_answer(const char *self_exe, const char *program_dir,
  * gone by the time its answer is ready. */
 struct ncp_http_jobs;
 struct ncp_http_jobs_env {
-    const char *self_exe;
-    const char *program_dir;
+    struct ncp_http_paths paths;
     struct ncp_http_prog *(*prog_get)(void *ctx);   /* a reference, or NULL */
     void (*wake)(void *ctx);
     void *ctx;

@@ -52,6 +52,11 @@ static void commands_map_onto_the_lcm_type(void **state)
     assert_int_equal(parse("{\"cmd\":\"keepalive\"}", &c, &unknown, why), NCP_HTTP_REQ_COMMAND);
     assert_int_equal(parse(" {\"cmd\":\"preview\"} ", &c, &unknown, why), NCP_HTTP_REQ_PREVIEW);
     assert_int_equal(parse("{\"cmd\":\"list\"}", &c, &unknown, why), NCP_HTTP_REQ_LIST);
+    /* the Tools and History tabs' reads: no field names a file */
+    assert_int_equal(parse("{\"cmd\":\"tools\"}", &c, &unknown, why), NCP_HTTP_REQ_TOOLS);
+    assert_int_equal(parse("{\"cmd\":\"history\"}", &c, &unknown, why), NCP_HTTP_REQ_HISTORY);
+    assert_int_equal(parse("{\"cmd\":\"tools\",\"path\":\"/etc/passwd\"}", &c, &unknown, why),
+                     NCP_HTTP_REQ_TOOLS);
 }
 
 static void bad_messages_are_refused(void **state)

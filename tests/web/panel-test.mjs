@@ -10,6 +10,10 @@
 // and coolant, jog, touch-off, upload; the layout
 // on a 10-inch touch panel; then what others on the network might send: no
 // token, malformed JSON, unknown commands, an oversized message and a flood.
+// Then the Tools and History tabs on a machine that keeps a tool table and a
+// job history (tools-case.mjs).
+// Then the panel on a distributed serve: its LLCs' row as they run and one
+// dies (lcm-case.mjs, in a network namespace of its own).
 // Then the core of the session again in Firefox (WebDriver BiDi), and its
 // preview views. Each case
 // prints PASS/FAIL/SKIP; every wait is bounded; screenshots of each step land
@@ -20,8 +24,10 @@ import fs from 'node:fs';
 import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
+import { lcmDevices } from './lcm-case.mjs';
+import { toolCases } from './tools-case.mjs';
 
-const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "devices", "spindle-coolant", "jog", "touch-off", "tool-table", "server-limits", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
+const CASES = ["static", "connecting", "connect", "page-stall", "home-axis", "load", "preview-views", "cycle-start", "to-go", "busy-disabled", "feed-hold", "resume", "status-lag", "status-lag-p99", "preview-cut", "touch-layout", "mdi", "modal-codes", "devices", "lcm-devices", "spindle-coolant", "jog", "touch-off", "tool-table", "history", "tool-refused", "server-limits", "upload", "upload-refused", "no-token", "bad-input", "readonly", "link-stalled", "connection-lost", "firefox-connect", "firefox-load", "firefox-cycle-start", "firefox-feed-hold", "firefox-resume", "firefox-mdi", "firefox-views"];
 
 const [BUILD, WORK, CHROMIUM, FIREFOX] = process.argv.slice(2);
 const ROOT = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..', '..');
@@ -642,11 +648,6 @@ async function session(browser) {
     await click(page, '#mdi-send');
     await waitFor(page, 'G54 back', (s) => s.state === 'idle' && s.g5x.name === 'G54', 5000);
   });
-  await run('tool-table', async () => {
-    // the service has no tool table command: the control says so, disabled
-    const t = await page.$eval('#tools', (b) => ({ disabled: b.disabled, title: b.title }));
-    check(t.disabled && /no command/.test(t.title), `tool table control ${JSON.stringify(t)}`);
-  });
   // This server sends no limits yet; a hello that carries them (override
   // ranges, soft limits in machine coordinates) sets the sliders and the
   // preview's box, and one without them brings the defaults back.
@@ -942,13 +943,15 @@ async function firefox() {
   }
 }
 
+const CHROMIUM_ARGS = ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'];
+
 async function main() {
   fs.mkdirSync(WORK, { recursive: true });
   let browser;
   try {
     browser = await puppeteer.launch({
       executablePath: CHROMIUM, headless: true,
-      args: ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+      args: CHROMIUM_ARGS,
       timeout: 30000,
     });
   } catch (e) {
@@ -956,14 +959,17 @@ async function main() {
     await firefox();
     return 0;
   }
-  const watchdog = setTimeout(() => { console.log('FAIL web-timeout: the browser test took over 300 s'); process.exit(1); }, 300000);
+  const watchdog = setTimeout(() => { console.log('FAIL web-timeout: the browser test took over 360 s'); process.exit(1); }, 360000);
   try {
     try {
       await session(browser);
       await readonly(browser);
+      await toolCases(browser, { ROOT, WORK, report, check, sleep, startServer, stopServer, openPanel, waitFor, click, shot });
     } finally {
       await browser.close();
     }
+    // a browser of its own, in the distributed machine's network namespace
+    await lcmDevices({ BUILD, WORK, ROOT, CHROMIUM, puppeteer, launchArgs: CHROMIUM_ARGS, report, shot });
     // one browser at a time: the machine's CPUs are the NCK's too
     await firefox();
   } finally {
