@@ -228,6 +228,9 @@ function cycleTime(s) {
   const est = e.state === 'done' ? `${duration(e.program_time_s)} (estimate)`
     : e.state === 'running' ? 'estimating…'
     : e.state === 'failed' ? 'no estimate (see the log)' : '';
+  // while it runs: what is left of the estimate at the feed override now
+  if (s.remaining_s != null && e.state === 'done')
+    return `${duration(s.remaining_s)} left of ${duration(e.program_time_s)} (estimate)`;
   const last = s.program_time_s > 0 ? `last run ${duration(s.program_time_s)}` : '';
   return [est, last].filter(Boolean).join(', ') || '—';
 }
@@ -237,9 +240,11 @@ function cycleTime(s) {
 function devices(s) {
   const drives = (s.drives || []).map((d) =>
     `${d.axis} node ${d.node}: ${d.state} (${d.statusword})${d.error !== '0x0000' ? `, EMCY ${d.error} ${d.error_text}` : ''}`);
+  // one short line per LLC (state, clock offset, following error), the DP
+  // in the title: three of them must not push the DRO out of the column
   const llcs = (s.llcs || []).map((l) =>
-    `${l.axis} LLC: ${l.state}, DP ${s.llc_dp}, clock ${l.clock_offset_us >= 0 ? '+' : ''}${l.clock_offset_us} us, f.err ${fmt(l.ferr_nm / 1000, 1)} um`);
-  return { title: drives.length ? 'drives' : 'LLCs', text: drives.concat(llcs).join('\n') };
+    `${l.axis}: ${l.state}, ${l.clock_offset_us >= 0 ? '+' : ''}${l.clock_offset_us} us, ${fmt(l.ferr_nm / 1000, 1)} um`);
+  return { title: drives.length ? 'drives' : `LLCs DP ${s.llc_dp}`, text: drives.concat(llcs).join('\n') };
 }
 
 function onStatus(m) {

@@ -69,17 +69,17 @@ const devicesNow = (page) => page.evaluate(() => ({
   rows: document.querySelector('#devices').textContent.split('\n'),
 }));
 
-// Each row against the status: "X LLC: running, DP 5, clock +12 us, f.err 3.1 um".
+// Each row against the status: "X: running, +12 us, 3.1 um" under "LLCs DP 5".
 // The LLCs' states by axis, or the mismatch as text.
 function rowsAgree(d) {
   const llcs = d.s.llcs || [];
-  if (d.hidden || d.title !== 'LLCs') return `the row is ${d.hidden ? 'hidden' : `titled '${d.title}'`}`;
+  if (d.hidden || d.title !== `LLCs DP ${d.s.llc_dp}`) return `the row is ${d.hidden ? 'hidden' : `titled '${d.title}'`}`;
   if (llcs.length !== 3 || d.rows.length !== 3) return `${llcs.length} LLCs in the status, rows ${JSON.stringify(d.rows)}`;
   const states = {};
   for (let k = 0; k < 3; k++) {
-    const l = llcs[k], m = d.rows[k].match(/^([XYZ]) LLC: (\w+), DP (\d), clock ([-+]\d+) us, f\.err -?[\d.]+ um$/);
+    const l = llcs[k], m = d.rows[k].match(/^([XYZ]): (\w+), ([-+]\d+) us, -?[\d.]+ um$/);
     if (!m) return `row '${d.rows[k]}'`;
-    if (m[1] !== l.axis || m[2] !== l.state || Number(m[3]) !== d.s.llc_dp || Number(m[4]) !== l.clock_offset_us)
+    if (m[1] !== l.axis || m[2] !== l.state || Number(m[3]) !== l.clock_offset_us)
       return `row '${d.rows[k]}' for ${JSON.stringify(l)} at DP ${d.s.llc_dp}`;
     states[m[1]] = m[2];
   }
@@ -167,6 +167,13 @@ export async function lcmDevices({ BUILD, WORK, ROOT, CHROMIUM, puppeteer, launc
     // three LLC rows make the left column taller than 800 px: E-stop stays in sight
     const estop = await page.$eval('#estop', (e) => { const r = e.getBoundingClientRect(); return [r.top, r.bottom, innerHeight]; });
     if (estop[0] < 0 || estop[1] > estop[2]) throw new Error(`E-stop out of sight at ${estop[0]}..${estop[1]} px`);
+    // and the DRO with them: one line per LLC keeps X in its column's view
+    const dro = await page.evaluate(() => {
+      const x = document.querySelector('#dro tbody tr').getBoundingClientRect();
+      const col = document.querySelector('#dro').closest('section, aside, div').getBoundingClientRect();
+      return [x.top, x.bottom, Math.max(col.top, 0), Math.min(col.bottom, innerHeight)];
+    });
+    if (dro[0] < dro[2] || dro[1] > dro[3]) throw new Error(`the DRO's X row at ${dro[0]}..${dro[1]} px, out of its column's view ${dro[2]}..${dro[3]}`);
     await shot(page, '20-lcm-running');
     // At its end serve idles, and at DP 5 it goes on sending setpoints (the
     // axes at rest) so the LLCs keep following, as serve's status says

@@ -385,6 +385,13 @@ async function session(browser) {
       await click(page, '#tool-changed');
     }
     runStart = await waitFor(page, 'running', (s) => s.state === 'running');
+    // the cycle time now says what is left of the estimate, as status has it
+    await page.waitForFunction(() => {
+      const s = window.ncpPanel.status;
+      return s.remaining_s != null && / left of 1 min 41\.6 s \(estimate\)$/.test(document.querySelector('#estimate').textContent);
+    }, { timeout: 3000 }).catch(async () => {
+      throw new Fail(`cycle time while running shows '${await page.$eval('#estimate', (e) => e.textContent)}'`);
+    });
     const lines = new Set();
     let moved = false, lastLine = 0, advanced = 0;
     const deadline = Date.now() + 8000;
@@ -577,8 +584,8 @@ async function session(browser) {
     const lcm = await show({ drives: [], llc_dp: 4, llcs: [
       { axis: 'X', state: 'running', clock_offset_us: 12, ferr_nm: 3071 },
       { axis: 'Z', state: 'fault', clock_offset_us: -3, ferr_nm: -120 }] });
-    check(lcm[0] === 'LLCs' && !lcm[2] && lcm[1] === 'X LLC: running, DP 4, clock +12 us, f.err 3.1 um\n' +
-      'Z LLC: fault, DP 4, clock -3 us, f.err -0.1 um', `LLCs shown: ${JSON.stringify(lcm)}`);
+    check(lcm[0] === 'LLCs DP 4' && !lcm[2] && lcm[1] === 'X: running, +12 us, 3.1 um\n' +
+      'Z: fault, -3 us, -0.1 um', `LLCs shown: ${JSON.stringify(lcm)}`);
     // the next status from the simulated machine hides the row again
     await page.waitForFunction(() => document.querySelector('#devices').hidden, { timeout: 3000 });
   });
