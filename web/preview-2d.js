@@ -1,7 +1,7 @@
 // The preview without WebGL: the same drawing on a 2D canvas, as an
 // orthographic projection for each of the views (the iso one a plain
 // axonometric one), zoomed with the wheel and panned by dragging.
-import { COLORS, css, VIEWS, travelBox } from './preview-common.js';
+import { COLORS, css, VIEWS, extentsBox, fitBox } from './preview-common.js';
 
 // Screen right and screen up, as work directions, for each view.
 const AXES2D = {
@@ -18,7 +18,7 @@ export function twoDView(canvas, state) {
   function fit() {
     canvas.width = canvas.clientWidth * devicePixelRatio;
     canvas.height = canvas.clientHeight * devicePixelRatio;
-    const tb = travelBox(state.path, state.travel);
+    const tb = fitBox(state.path, state.travel);
     if (!tb) { fitted = null; return; }
     const [r, u] = AXES2D[viewName];
     const corners = [];
@@ -39,18 +39,21 @@ export function twoDView(canvas, state) {
     if (!fitted) return;
     const path = state.path || { segs: [], feed: [], rapid: [] }, lw = devicePixelRatio;
     ctx.lineWidth = lw;
-    // the travel box's 12 edges
-    const [lo, hi] = fitted.box;
-    ctx.strokeStyle = css(COLORS.box);
+    // the 12 edges of the program's extents, and of the travel around them
     ctx.setLineDash([]);
-    ctx.beginPath();
-    for (let i = 0; i < 8; i++) for (let k = 0; k < 3; k++) {
-      if ((i >> k) & 1) continue;
-      const a = [0, 1, 2].map((j) => (i >> j) & 1 ? hi[j] : lo[j]);
-      const b = a.slice(); b[k] = hi[k];
-      seg(a, b);
+    for (const [bx, color] of [[state.travel, COLORS.travel], [extentsBox(state.path), COLORS.box]]) {
+      if (!bx) continue;
+      const [lo, hi] = bx;
+      ctx.strokeStyle = css(color);
+      ctx.beginPath();
+      for (let i = 0; i < 8; i++) for (let k = 0; k < 3; k++) {
+        if ((i >> k) & 1) continue;
+        const a = [0, 1, 2].map((j) => (i >> j) & 1 ? hi[j] : lo[j]);
+        const b = a.slice(); b[k] = hi[k];
+        seg(a, b);
+      }
+      ctx.stroke();
     }
-    ctx.stroke();
     // feeds: cut, then still to cut; rapids dashed
     const at = (arr, i) => [[arr[6 * i], arr[6 * i + 1], arr[6 * i + 2]], [arr[6 * i + 3], arr[6 * i + 4], arr[6 * i + 5]]];
     for (const [cut, color] of [[true, COLORS.cut], [false, COLORS.feed]]) {

@@ -3,7 +3,7 @@
 
 export const COLORS = {
   bg: 0x0b0d10, feed: 0x4fb3ff, rapid: 0xe0a040, cut: 0x5cff8a, tool: 0xff4060,
-  box: 0x8a7fd0, grid: 0x1c232b, gridMajor: 0x2c3a48,
+  box: 0x8a7fd0, travel: 0x4a5563, grid: 0x1c232b, gridMajor: 0x2c3a48,
 };
 export const css = (c) => '#' + c.toString(16).padStart(6, '0');
 
@@ -17,10 +17,21 @@ export const VIEWS = {
   iso: [-0.5, -1.1, 0.9],
 };
 
-// The box the preview draws: the machine's travel when the panel knows it
-// (soft limits in work coordinates), else the program's own extents.
+// The machine's box: its travel when the panel knows it (soft limits in
+// work coordinates), else the program's own extents.
 export function travelBox(path, travel) {
   if (travel) return travel;
+  return extentsBox(path);
+}
+
+// The program's extents, [min, max] (null: nothing to draw).
+export function extentsBox(path) {
   if (!path || !isFinite(path.min[0])) return null;
   return [path.min.slice(), path.max.slice()];
+}
+
+// What the view fits: the program, so that a part small beside the travel
+// is drawn large enough to read; the travel alone before a program loads.
+export function fitBox(path, travel) {
+  return extentsBox(path) || travel || null;
 }

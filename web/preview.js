@@ -6,7 +6,7 @@
 // where WebGL works; preview-2d.js where it does not.
 import { parseCanon } from './canon.js';
 import { twoDView } from './preview-2d.js';
-import { COLORS, VIEWS, travelBox } from './preview-common.js';
+import { COLORS, VIEWS, travelBox, extentsBox, fitBox } from './preview-common.js';
 
 const TRAIL_MAX = 200000;
 
@@ -180,11 +180,14 @@ function threeView(THREE, OrbitControls, box, canvas2d, state) {
         group.add(l);
       }
       if (p.rapid.length) group.add(lines(p.rapid, new THREE.LineDashedMaterial({ color: COLORS.rapid, dashSize: 1.5, gapSize: 1.2 })));
-      const tb = travelBox(p, state.travel);
+      // the program's extents, the machine's travel around them (dimmer),
+      // and the view fitted to the program
+      const box3 = ([lo, hi]) => new THREE.Box3(new THREE.Vector3(...lo), new THREE.Vector3(...hi));
+      const ext = extentsBox(p), tb = fitBox(p, state.travel);
+      if (ext) group.add(new THREE.Box3Helper(box3(ext), new THREE.Color(COLORS.box)));
+      if (state.travel) group.add(new THREE.Box3Helper(box3(state.travel), new THREE.Color(COLORS.travel)));
       if (tb) {
         const [lo, hi] = tb;
-        const bx = new THREE.Box3(new THREE.Vector3(...lo), new THREE.Vector3(...hi));
-        group.add(new THREE.Box3Helper(bx, new THREE.Color(COLORS.box)));
         // a 10 mm grid on the work's Z0 plane, over the box and the origin
         const span = Math.max(hi[0], hi[1], 0) - Math.min(lo[0], lo[1], 0);
         const cells = Math.max(2, Math.ceil(span / 10) + 2);

@@ -18,6 +18,7 @@
 
 #include "ncpar/num.h"
 
+#include <ctype.h>
 #include <getopt.h>
 #include <unistd.h>
 #include <signal.h>
@@ -195,15 +196,30 @@ static int parse(int argc, char **argv, struct serve_args *a)
  * build without it is a usage error before any axis is powered. Its [HTTP]
  * keys are the first channel's machine INI's. */
 /* The hello's machine facts: the override sliders' ranges ([DISPLAY]
- * MAX_FEED_OVERRIDE and the spindle's MIN/MAX), as the panel reads them.
- * Not the travel box yet: the panel's preview fits its view to the box it
- * is given, and a part small beside the travel would be drawn too small to
- * read (tests/web's preview-cut). */
+ * MAX_FEED_OVERRIDE and the spindle's MIN/MAX) and the travel (each axis's
+ * soft limits, machine coordinates), as the panel reads them: it draws the
+ * travel around the program and fits its view to the program. */
 static void hello_facts(const struct ncp_machine_cfg *cfg, char *buf, size_t len)
 {
-    snprintf(buf, len, ", \"limits\": {\"feed\": [0, %g], \"rapid\": [0, 100], "
-             "\"spindle\": [%g, %g]}", cfg->op.max_feed_override * 100,
-             cfg->op.min_spindle_override * 100, cfg->op.max_spindle_override * 100);
+    int n = snprintf(buf, len, ", \"limits\": {\"feed\": [0, %g], \"rapid\": [0, 100], "
+                     "\"spindle\": [%g, %g]}, \"travel\": ", cfg->op.max_feed_override * 100,
+                     cfg->op.min_spindle_override * 100, cfg->op.max_spindle_override * 100);
+    for (int side = 0; side < 2 && n > 0 && (size_t)n < len; side++) {
+        n += snprintf(buf + n, len - (size_t)n, side ? ", \"max\": {" : "{\"min\": {");
+        int first = 1;
+        for (int j = 0; j < NCP_AXES && n > 0 && (size_t)n < len; j++) {
+            if (!(cfg->axis_mask & NCP_AXIS_BIT(j)))
+                continue;
+            n += snprintf(buf + n, len - (size_t)n, "%s\"%c\": %.6g", first ? "" : ", ",
+                          (char)tolower((unsigned char)NCP_AXIS_LETTERS[j]),
+                          side ? cfg->axis[j].max_limit : cfg->axis[j].min_limit);
+            first = 0;
+        }
+        if (n > 0 && (size_t)n < len)
+            n += snprintf(buf + n, len - (size_t)n, "}");
+    }
+    if (n > 0 && (size_t)n < len)
+        snprintf(buf + n, len - (size_t)n, "}");
 }
 
 static int start_http(const struct serve_args *a, const struct ncp_machine_cfg *cfg,

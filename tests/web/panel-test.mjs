@@ -291,6 +291,10 @@ async function session(browser) {
     // spindle 0-200 %
     const ov = await page.$$eval('#ov-feed, #ov-spindle', (e) => e.map((x) => [Number(x.min), Number(x.max)]));
     check(JSON.stringify(ov) === '[[0,100],[0,200]]', `override ranges ${JSON.stringify(ov)}, not feed 0-100, spindle 0-200`);
+    // and its travel: the built-in mill's soft limits, X and Y +-500, Z -250..50
+    const travel = await page.evaluate(() => window.ncpPanel.travel);
+    check(travel && travel.min.x === -500 && travel.max.y === 500 && travel.min.z === -250 && travel.max.z === 50,
+      `the hello's travel ${JSON.stringify(travel)}`);
     await shot(page, '01-connected');
   });
   await run('connecting', async () => {
@@ -655,11 +659,12 @@ async function session(browser) {
     await click(page, '#mdi-send');
     await waitFor(page, 'G54 back', (s) => s.state === 'idle' && s.g5x.name === 'G54', 5000);
   });
-  // This server sends no limits yet; a hello that carries them (override
-  // ranges, soft limits in machine coordinates) sets the sliders and the
-  // preview's box, and one without them brings the defaults back.
+  // Another hello's limits (override ranges, soft limits in machine
+  // coordinates) set the sliders and the preview's travel box, and one
+  // without them brings the defaults back.
   await run('server-limits', async () => {
     const st = await status(page);
+    const viewBefore = await page.evaluate(() => { window.ncpPanel.preview.setView('iso'); return window.ncpPanel.preview.view(); });
     const hello = (extra) => page.evaluate((m) => window.ncpPanel.receive(JSON.stringify(m)),
       { type: 'hello', authed: true, readonly: false, ...extra });
     await hello({ limits: { feed: [0, 120], spindle: [60, 140] },
@@ -671,6 +676,10 @@ async function session(browser) {
     const off = st.g5x.offset;
     check(Math.abs(box[0][0] - (-10 - off.x)) < 1e-6 && Math.abs(box[1][1] - (200 - off.y)) < 1e-6,
       `the box ${JSON.stringify(box)} is not the travel less ${st.g5x.name}'s offset`);
+    // the view still fits the program, not the travel around it
+    const viewAfter = await page.evaluate(() => { window.ncpPanel.preview.setView('iso'); return window.ncpPanel.preview.view(); });
+    check(Math.abs(viewAfter.distance - viewBefore.distance) < 0.01 * viewBefore.distance,
+      `the view went from ${viewBefore.distance.toFixed(1)} to ${viewAfter.distance.toFixed(1)} away: fitted to the travel`);
     await shot(page, '07c-travel');
     await hello({});
     await page.waitForFunction(() => !window.ncpPanel.travelShown, { timeout: 3000 });
