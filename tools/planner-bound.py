@@ -35,9 +35,13 @@ Every estimate is taken on the generous side, so the bound stays a bound:
 - the machine starts and ends at rest; in between the fastest profile that
   these bounds allow (forward and backward passes over the junction speeds,
   then a trapezoid on each segment).
-Where every line moves one axis alone and every corner joins two axes
-(staircases, squares), a per-axis floor (axis_floor) is tighter and taken
-when higher: there the corner model above gives the turn itself for free.
+A per-axis floor for corners between two axes (each axis rest to rest over
+its side, less a saving per corner) was taken here until bench/piece-lp, the
+linear program over servo samples, found motions faster than it on stairs
+(6 ms on 3 blocks: an axis going on the same way need not stop) and on three
+sides of a square (9 ms: the path need only be within P of either side, not
+of the corner point, so one axis may start while the other is still up to P
+short). It is withdrawn, not mended.
 
 Motion is read from `cnc-run parse --canon`: STRAIGHT_FEED and ARC_FEED in the
 XY plane (G17) with a helical Z, as bench/gen-planner.py writes them.
@@ -141,55 +145,6 @@ def geometry(seg, vmax, amax):
     return length, vcap, an, tang(a0), tang(a1), r
 
 
-def single_axis(u):
-    """The axis a line moves alone, or None."""
-    moving = [i for i in range(3) if abs(u[i]) > 1e-12]
-    return moving[0] if len(moving) == 1 else None
-
-
-def axis_corner_saving(tol, ai, aj):
-    """The most a corner between a line along axis i and one along axis j can
-    save against stopping there: max of sqrt(2 e_i / a_i) + sqrt(2 e_j / a_j)
-    over e_i^2 + e_j^2 <= tol^2 (see axis_floor)."""
-    best = 0.0
-    for k in range(2001):
-        th = (math.pi / 2) * k / 2000
-        best = max(best, math.sqrt(2 * tol * math.cos(th) / ai) + math.sqrt(2 * tol * math.sin(th) / aj))
-    return best
-
-
-def axis_floor(segs, g, tol, amax):
-    """A tighter bound where every line moves one axis alone and every corner
-    is between two different axes (staircases, squares), or None (g: the
-    segments' geometry()).
-
-    Each axis then runs from rest to rest over its side: on the line before
-    a corner the other axis stands still, and after it this one does. Where
-    the path passes closest to the corner c, at q within P of it, axis i (the
-    one arriving) is e_i short of c_i and axis j (the one leaving) e_j past
-    c_j, e_i^2 + e_j^2 <= P^2, neither beyond its corner coordinate (the path
-    stays inside the corner, as a blend does). Axis j left rest at c_j, so it
-    reaches e_j no earlier than its fastest start does, sqrt(2 e_j / a_j) in;
-    axis i must still stop by c_i, so from there it needs at least what its
-    fastest stop has left, sqrt(2 e_i / a_i). Summed over the sides: the time
-    of every side from rest to rest (per axis, feed and velocity included)
-    less, per corner, the most that sum of square roots can be."""
-    if tol <= 0 or any(s[0] != "line" for s in segs):
-        return None
-    axes = [single_axis(x[3]) for x in g]
-    if any(a is None for a in axes) or any(x[0] < 2 * tol for x in g):
-        return None
-    corners, saving = [], 0.0
-    for k in range(1, len(g)):
-        if axes[k] == axes[k - 1]:
-            if sum(p * q for p, q in zip(g[k - 1][4], g[k][3])) < 1 - 1e-12:
-                return None        # a reversal along one axis
-            continue
-        corners.append(k)
-        saving += axis_corner_saving(tol, amax[axes[k - 1]], amax[axes[k]])
-    return profile(g, [x[0] for x in g], corners) - saving
-
-
 def profile(g, length, stops, vj=None):
     """The fastest trapezoids over the segments with junction speed caps vj
     (default: the segments' own caps), at rest at the start, the end and the
@@ -243,9 +198,7 @@ def bound(segs, tol, vmax, amax):
                 length[k - 1] -= cut / 2
                 length[k] -= cut / 2
         vj[k] = cap
-    t = profile(g, length, (), vj)
-    floor = axis_floor(segs, g, tol, amax)
-    return t if floor is None else max(t, floor)
+    return profile(g, length, (), vj)
 
 
 def main():
