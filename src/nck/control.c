@@ -963,9 +963,13 @@ static void homing_ended(struct ncp_nck *s)
             *next++ = 0;
         nck_post(n, rc ? NCP_EV_ERROR : NCP_EV_INFO, NULL, 0, 0, "%s", line);
     }
-    if (rc)
+    /* a fault that ended the homing (a drive's) keeps its own message as
+     * the error: the homing's report is its consequence, said as an EVENT */
+    int faulted = s->state == NCP_ST_FAULT ||
+                  (s->drop != NCK_DROP_NONE && s->drop_after == NCP_ST_FAULT);
+    if (rc && !faulted)
         snprintf(s->error, sizeof s->error, "%s", report);
-    else
+    else if (!rc)
         nck_post(n, NCP_EV_INFO, NULL, 0, 0, "homed");
     if (s->state != NCP_ST_HOMING)
         return;
