@@ -187,7 +187,6 @@ static void begin_drop(struct ncp_nck *s, int hold, int full, int after, int res
     }
     s->drop_after = after;
     s->drop_reset = reset;
-    s->drop_by_estop = after == NCP_ST_ESTOP;
     s->reset_after_drop = 0;
     set_state(s, NCP_ST_STOPPING);
 }
@@ -237,7 +236,7 @@ static void drop_step(struct ncp_nck *s)
         persist(s);
         if (s->hist.open) {   /* a program run ended by the drop */
             int64_t now = atomic_load_explicit(&n->ctl->now_ns, memory_order_acquire);
-            history_end(s, s->drop_by_estop                ? "estop"
+            history_end(s, s->drop_after == NCP_ST_ESTOP   ? "estop"
                            : s->drop_after == NCP_ST_FAULT ? "fault"
                                                            : "stopped",
                         now > s->run_t0_ns ? (double)(now - s->run_t0_ns) * 1e-9 : 0);
@@ -776,7 +775,6 @@ static int cmd_estop(struct ncp_nck *s)
     if (s->drop != NCK_DROP_NONE && s->drop != NCK_DROP_HOLD) {
         s->drop_after = NCP_ST_ESTOP;   /* already dropping: end there */
         s->drop_reset |= interp;
-        s->drop_by_estop = 1;
         s->reset_after_drop = 0;
     } else {
         begin_drop(s, 0, 0, NCP_ST_ESTOP, interp);

@@ -62,7 +62,6 @@ struct ncp_nck {
     enum nck_drop drop;
     int drop_after;                  /* state after the drop */
     int drop_reset;                  /* the interpreter's end-of-program reset after it */
-    int drop_by_estop;               /* an E-stop began or joined it (the history's reason) */
     int reset_after_drop;            /* a reset came while an E-stop's or fault's drop ran */
     uint32_t run_from_line;          /* the program run's --from-line (0: from its start) */
     int homed[NCP_AXES];
