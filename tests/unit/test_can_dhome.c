@@ -45,6 +45,16 @@ static void answer(struct ncp_co_master *m, int want, const char *why)
     atomic_store(&h->done, atomic_load(&h->ask));
 }
 
+/* A master whose axis 0 was asked to home and whose drive is now in homing
+ * mode (the worker's SDO answered). */
+static void homing_mode_asked(struct ncp_co_master *m)
+{
+    master_of(m);
+    ncp_co_home_start(m, 0);
+    ncp_co_home_step(m, 0);
+    answer(m, NCP_402_MODE_HOMING, NULL);
+}
+
 static void test_sdo_steps(void **state)
 {
     (void)state;
@@ -133,10 +143,7 @@ static void test_timeout(void **state)
 {
     (void)state;
     struct ncp_co_master m;
-    master_of(&m);
-    ncp_co_home_start(&m, 0);
-    ncp_co_home_step(&m, 0);
-    answer(&m, NCP_402_MODE_HOMING, NULL);
+    homing_mode_asked(&m);
     int rc = 1;
     long k = 0;
     for (; rc == 1 && k < 100; k++) {
@@ -179,10 +186,7 @@ static void test_estop_drops_homing(void **state)
 {
     (void)state;
     struct ncp_co_master m;
-    master_of(&m);
-    ncp_co_home_start(&m, 0);
-    ncp_co_home_step(&m, 0);
-    answer(&m, NCP_402_MODE_HOMING, NULL);
+    homing_mode_asked(&m);
     ncp_co_home_step(&m, 0);
     assert_int_equal(m.home[0].phase, NCP_CH_HOMING);
     ncp_co_master_seat(&m, 0);

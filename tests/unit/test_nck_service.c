@@ -575,6 +575,19 @@ static void test_jog_input(void **state_)
     stop(&s);
 }
 
+/* Runs the loaded program until X has passed x (20 s of wall time at most). */
+static void run_past_x(struct svc *s, double x)
+{
+    assert_int_equal(cmd(s, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
+    for (int i = 0; i < 20000; i++) {
+        double p[3];
+        pos(s, p);
+        if (p[0] > x)
+            break;
+        nap_ms(1);
+    }
+}
+
 static void test_estop_reset(void **state_)
 {
     (void)state_;
@@ -583,14 +596,7 @@ static void test_estop_reset(void **state_)
     home_all(&s);
     write_prog(&s, "G1 X200 F6000\nM2\n");
     assert_int_equal(cmd(&s, NCP_CMD_LOAD, s.prog, 0, 0, NULL), 0);
-    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
-    for (int i = 0; i < 20000; i++) {
-        double p[3];
-        pos(&s, p);
-        if (p[0] > 20)
-            break;
-        nap_ms(1);
-    }
+    run_past_x(&s, 20);
     assert_int_equal(cmd(&s, NCP_CMD_ESTOP, NULL, 0, 0, NULL), 0);
     /* what the operator reads from the ACK on, before the job is dropped */
     assert_int_equal(state(&s), NCP_ST_ESTOP);
@@ -612,13 +618,7 @@ static void test_estop_reset(void **state_)
 
     /* a reset sent in the same breath as the E-stop, while its drop is
      * still under way, ends in idle with the setpoints let go */
-    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, NULL), 0);
-    for (int i = 0; i < 20000; i++) {
-        pos(&s, p1);
-        if (p1[0] > 20)
-            break;
-        nap_ms(1);
-    }
+    run_past_x(&s, 20);
     assert_int_equal(cmd_now(&s, NCP_CMD_ESTOP, NULL, 0, 0, why), 0);
     assert_int_equal(state(&s), NCP_ST_ESTOP);
     assert_int_equal(cmd_now(&s, NCP_CMD_RESET, NULL, 0, 0, why), 0);
