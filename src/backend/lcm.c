@@ -150,17 +150,22 @@ static void keep_error(struct peer *p, int kind, const char *text)
     atomic_store_explicit(&p->err_kind, kind, memory_order_release);
 }
 
-/* What an LLC's status says of its end: an error but the program's end. */
+/* What an LLC's status says of its end: an error but the program's end.
+ * Every status of every LLC comes here: nothing is copied unless it is an
+ * error to keep (an LLC that stopped says so in each status until it goes). */
 static void status_error(struct peer *p, const ncp_ax_status_t *st)
 {
+    int kind = st->end > NCP_AX_STATUS_T_END_DONE && st->end <= NCP_AX_STATUS_T_END_DRIVE
+                   ? st->end
+               : st->end == NCP_AX_STATUS_T_END_NONE && (st->state == NCP_AX_STATUS_T_STOPPING ||
+                                                        st->state == NCP_AX_STATUS_T_FAULT)
+                   ? NCP_STATUS_T_LLC_ERR_OTHER
+                   : 0;
+    if (!kind || atomic_load_explicit(&p->err_kind, memory_order_relaxed) != 0)
+        return;
     char text[sizeof st->fault + 1];
     snprintf(text, sizeof text, "%.*s", (int)sizeof st->fault, (const char *)st->fault);
-    if (st->end > NCP_AX_STATUS_T_END_DONE && st->end <= NCP_AX_STATUS_T_END_DRIVE)
-        keep_error(p, st->end, text);
-    else if (st->end == NCP_AX_STATUS_T_END_NONE &&
-             (st->state == NCP_AX_STATUS_T_STOPPING || st->state == NCP_AX_STATUS_T_FAULT))
-        keep_error(p, NCP_STATUS_T_LLC_ERR_OTHER,
-                   text[0] ? text : "stopped on its own without saying why (see its output)");
+    keep_error(p, kind, text[0] ? text : "stopped on its own without saying why (see its output)");
 }
 
 static void on_status(struct peer *p, const uint8_t *b, size_t len, int64_t now)
