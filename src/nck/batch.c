@@ -131,6 +131,13 @@ static enum precheck_end precheck(const struct ncp_nck_opts *o, const double sta
 
 /* ---- the run ------------------------------------------------------------------------- */
 
+/* How far the interpreter is, ahead of motion (a stretch that does not move
+ * the machine is interpreted without a line in motion to show for it). */
+static uint32_t line_read(const struct nck_core *n)
+{
+    return atomic_load_explicit(&n->job->line_read, memory_order_relaxed);
+}
+
 /* How far the run is in the program: percent of total_lines, an estimate's
  * held below 100 until the program ends. */
 static double done_pct(const struct nck_summary *s, const struct ncp_nck_opts *o)
@@ -145,9 +152,10 @@ static void progress(const struct nck_core *n, const struct ncp_nck_opts *o)
 {
     const struct nck_summary *s = &n->svc->sum;
     fprintf(o->progress,
-            "\r  line %u/%s%u (%3.0f%%)  t %.2f s  feed %.0f mm/min  max latency %.1f us  ",
-            s->line, o->total_approx ? "~" : "", o->total_lines, done_pct(s, o), s->t,
-            s->v * 60, (double)atomic_load(&n->cross.pub_lat_max_ns) / 1e3);
+            "\r  line %u/%s%u (%3.0f%%) read %u  t %.2f s  feed %.0f mm/min  max latency %.1f us  ",
+            s->line, o->total_approx ? "~" : "", o->total_lines, done_pct(s, o),
+            line_read(n), s->t, s->v * 60,
+            (double)atomic_load(&n->cross.pub_lat_max_ns) / 1e3);
     fflush(o->progress);
 }
 
@@ -155,8 +163,10 @@ static void progress(const struct nck_core *n, const struct ncp_nck_opts *o)
 static void note_running(const struct nck_core *n, const struct ncp_nck_opts *o)
 {
     const struct nck_summary *s = &n->svc->sum;
-    fprintf(o->notes, "running: line %u of %s%u (%.0f%%), %.1f s of machine time\n", s->line,
-            o->total_approx ? "about " : "", o->total_lines, done_pct(s, o), s->t);
+    fprintf(o->notes,
+            "running: line %u of %s%u (%.0f%%), %.1f s of machine time; interpreted to line %u\n",
+            s->line, o->total_approx ? "about " : "", o->total_lines, done_pct(s, o), s->t,
+            line_read(n));
     fflush(o->notes);
 }
 
