@@ -65,6 +65,10 @@ void ncp_nck_ctl_init(struct ncp_nck_ctl *c, double feed_override);
 void ncp_nck_set_feed_override(struct ncp_nck_ctl *c, double ov);
 void ncp_nck_feed_hold(struct ncp_nck_ctl *c, int hold);
 
+/* Without a terminal (a log, a script) a run says how far it is this often,
+ * a line each time: seldom enough that a run of hours leaves a short log. */
+#define NCP_NCK_NOTE_S 5
+
 struct ncp_nck_opts {
     const struct ncp_machine_cfg *cfg;
     /* Runs the program, handing command slots to out in program order
@@ -77,8 +81,12 @@ struct ncp_nck_opts {
     double feed_override;    /* 1.0 = 100 % (0.01 .. 2.0) */
     FILE *trace;             /* per-cycle CSV or NULL */
     FILE *progress;          /* live progress line (a terminal) or NULL */
-    uint32_t total_lines;    /* for the progress line */
-    FILE *notes;             /* the check before motion says how far it is, or NULL */
+    uint32_t total_lines;    /* for the progress line and notes (0: not known) */
+    int total_approx;        /* total_lines is an estimate (a long program is not
+                              * read through before motion to count its lines) */
+    /* the check before motion says how far it is, and so does the run every
+     * NCP_NCK_NOTE_S seconds when there is no progress line; or NULL */
+    FILE *notes;
     struct ncp_nck_ctl *ctl; /* live override / hold, or NULL */
     /* polled while the run goes on: non-zero asks for a controlled stop, or
      * NULL. Atomic: a signal handler (lock-free atomics are safe there) or

@@ -226,19 +226,24 @@ static int parse_opts(int argc, char **argv, struct run_opts *o)
     return 0;
 }
 
-/* Through a window (ncpar/feeder.h): counting must not leave a long mapped
- * program held whole for the rest of the run. */
-static uint32_t count_lines(const struct ncp_source *src)
+/* The lines of a program held in memory are counted; a mapped one (longer
+ * than NCP_SOURCE_COPY_MAX) is not read through before motion, which would
+ * take a pass over gigabytes before the first move: its count is estimated
+ * from its first stretch, the rest taken to have lines as long on average. */
+#define COUNT_SAMPLE ((uint64_t)1 << 20)
+
+static uint32_t count_lines(const struct ncp_source *src, int *approx)
 {
-    struct ncp_source_window w;
-    ncp_source_window_start(&w, src, 0);
-    uint32_t n = 1;
-    for (const char *p = src->text, *e = src->text + src->len;
-         p < e && (p = memchr(p, '\n', (size_t)(e - p))) != NULL; p++) {
-        ncp_source_window_at(&w, (uint64_t)(p - src->text));
-        n++;
+    uint64_t end = src->len;
+    *approx = src->mapped && end > COUNT_SAMPLE;
+    if (*approx)
+        end = ncp_source_chunk_end(src, 0, COUNT_SAMPLE);
+    uint64_t n = ncp_source_count_newlines(src, 0, end);
+    if (*approx) {
+        double est = (double)src->len * (double)n / (double)(end ? end : 1);
+        n = est < UINT32_MAX - 1.0 ? (uint64_t)est : UINT32_MAX - 1;
     }
-    return n;
+    return (uint32_t)(n + 1);
 }
 
 /* DP 1: the LLCs read the program (and its tool table) themselves, on this
@@ -577,12 +582,15 @@ static int run_program(const struct run_opts *o, const struct ncp_machine_cfg *c
     with_vars.params_out = vars_out;
     with_vars.tools_out = tools_out;
     struct ncp_cli_interp ic = { src, with_vars, o->mode };
+    int approx;
+    uint32_t total = count_lines(src, &approx);
     struct ncp_nck_opts no = {
         .cfg = cfg, .interpret = ncp_cli_interpret, .interp_ctx = &ic,
         .virtual_clock = o->virtual_clock, .for_s = o->for_s,
         .feed_override = o->feed_override, .trace = trace,
         .progress = isatty(2) ? stderr : NULL,
-        .total_lines = count_lines(src),
+        .total_lines = total,
+        .total_approx = approx,
         .notes = stderr,
         .interrupt = &run_signal,
         .home = o->home,

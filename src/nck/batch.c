@@ -131,15 +131,43 @@ static enum precheck_end precheck(const struct ncp_nck_opts *o, const double sta
 
 /* ---- the run ------------------------------------------------------------------------- */
 
+/* How far the interpreter is, ahead of motion (a stretch that does not move
+ * the machine is interpreted without a line in motion to show for it). */
+static uint32_t line_read(const struct nck_core *n)
+{
+    return atomic_load_explicit(&n->job->line_read, memory_order_relaxed);
+}
+
+/* How far the run is in the program: percent of total_lines, an estimate's
+ * held below 100 until the program ends. */
+static double done_pct(const struct nck_summary *s, const struct ncp_nck_opts *o)
+{
+    if (!o->total_lines)
+        return 0;
+    double pct = 100.0 * s->line / o->total_lines;
+    return o->total_approx && pct > 99 ? 99 : pct;
+}
+
 static void progress(const struct nck_core *n, const struct ncp_nck_opts *o)
 {
     const struct nck_summary *s = &n->svc->sum;
-    uint32_t total = o->total_lines;
     fprintf(o->progress,
-            "\r  line %u/%u (%3.0f%%)  t %.2f s  feed %.0f mm/min  max latency %.1f us  ",
-            s->line, total, total ? 100.0 * s->line / total : 0.0, s->t, s->v * 60,
+            "\r  line %u/%s%u (%3.0f%%) read %u  t %.2f s  feed %.0f mm/min  max latency %.1f us  ",
+            s->line, o->total_approx ? "~" : "", o->total_lines, done_pct(s, o),
+            line_read(n), s->t, s->v * 60,
             (double)atomic_load(&n->cross.pub_lat_max_ns) / 1e3);
     fflush(o->progress);
+}
+
+/* The progress line's content as a line of its own, for a log. */
+static void note_running(const struct nck_core *n, const struct ncp_nck_opts *o)
+{
+    const struct nck_summary *s = &n->svc->sum;
+    fprintf(o->notes,
+            "running: line %u of %s%u (%.0f%%), %.1f s of machine time; interpreted to line %u\n",
+            s->line, o->total_approx ? "about " : "", o->total_lines, done_pct(s, o), s->t,
+            line_read(n));
+    fflush(o->notes);
 }
 
 /* [SIM] AUTO_RESUME_S < 0: a pause goes on at SIGUSR1. A count, not a flag:
@@ -193,7 +221,7 @@ static void homing_done(struct nck_core *n, const struct ncp_nck_opts *o, struct
 /* Reads the loop's cycles until the loop has ended and its ring is empty. */
 static void drain(struct nck_core *n, const struct ncp_nck_opts *o, struct batch_home *bh)
 {
-    int64_t last_print = 0;
+    int64_t last_print = 0, next_note = 0;
     sig_atomic_t usr1_seen = usr1;
     if (o->trace) {
         errno = 0;
@@ -222,6 +250,14 @@ static void drain(struct nck_core *n, const struct ncp_nck_opts *o, struct batch
         if (o->progress && ncp_mono_ns() - last_print > 200000000) {
             last_print = ncp_mono_ns();
             progress(n, o);
+        } else if (!o->progress && o->notes && !o->quiet) {
+            int64_t now = ncp_mono_ns();
+            if (!next_note)
+                next_note = now + NCP_NCK_NOTE_S * 1000000000LL;
+            else if (now >= next_note) {
+                next_note = now + NCP_NCK_NOTE_S * 1000000000LL;
+                note_running(n, o);
+            }
         }
         if (!got) {
             struct timespec ts = { 0, o->virtual_clock ? 50000 : 1000000 };

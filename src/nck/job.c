@@ -638,6 +638,8 @@ static int emit_segments(void *ctx, const struct ncp_cmd *cmd);
 static int emit_job(void *ctx, const struct ncp_cmd *cmd)
 {
     struct nck_core *n = ctx;
+    if (NCP_CMD_FILE(cmd) == 0)   /* a subroutine file's lines are not the program's */
+        atomic_store_explicit(&n->job->line_read, cmd->line, memory_order_relaxed);
     int rc = emit_segments(ctx, cmd);
     if (rc)
         atomic_store(&n->job->emit_stopped, 1);

@@ -51,6 +51,9 @@ struct nck_job {
     _Atomic uint32_t busters_done;
     uint32_t busters_asked;      /* the analyzer's thread */
     _Atomic int emit_stopped;    /* emit refused or failed: no answer will come */
+    /* the program's last line handed over by the interpreter (job thread;
+     * read for the progress line: motion may lag far behind it) */
+    _Atomic uint32_t line_read;
     struct ncp_machine_sync answer;
     /* the canon map: the job thread's while a job runs, the caller's
      * between jobs (moves, homing, an unpark's rest) */
