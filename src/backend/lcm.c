@@ -544,7 +544,7 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         if (s->dp1 && s->cycles % 20 == 0)   /* an LLC that lost the first one */
             lcm_dp1_send(s->dp1, s->msg);
     } else if (s->ai) {
-        lcm_ai_cycle(s->ai, s->msg, t, cmd);
+        lcm_ai_cycle(s->ai, s->msg, t, skipped, b, cmd);
     } else {
         send_fine(s, t, cmd);
     }
@@ -644,7 +644,9 @@ static void lcm_stop(struct ncp_backend *b)
                 s->tx->burst_bytes,
                 s->tx->burst_bytes + 8 + (int)strlen(s->tx->kind->channel) + 1,
                 (unsigned long long)s->tx->resent, (unsigned long long)s->tx->overflow);
-    if (s->tx && !s->dp1)
+    if (s->ai)
+        ;   /* its line says how the read positions went */
+    else if (s->tx && !s->dp1)
         fprintf(stderr, "lcm: time scaling: %llu messages (the stream's advance not 1, and "
                         "%d periods after)\n",
                 (unsigned long long)s->scale_sent, SCALE_AFTER);
