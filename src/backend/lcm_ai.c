@@ -44,7 +44,7 @@ int lcm_ai_init(struct lcm_ai *x, int dp, const struct ncp_machine_cfg *cfg)
     ncp_dist_ai_init();
     /* every sample the planner may have put in the stream beyond LEAD */
     return ncp_spsc_init(&x->tapped, sizeof(struct ncp_adcai_tap),
-                         (size_t)cfg->setpoint_ring + 2 * LEAD + 64);
+                         (size_t)cfg->setpoint_ring + (size_t)2 * LEAD + 64);
 }
 
 void lcm_ai_free(struct lcm_ai *x)
