@@ -174,6 +174,9 @@ struct ncp_backend {
     int64_t read_k;
     double read_f;
     int64_t drop_k;
+    /* The loop drives the axes itself this cycle (homing), not from the
+     * stream: an HLC whose LLCs make their own setpoints sends it them. */
+    int homing;
     /* An HLC at a block-level point sends on what the ADCBI planner starts:
      * the NCK hands it to the planner's tap (planner thread; NULL: none). */
     void (*plan_tap)(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec);

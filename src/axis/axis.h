@@ -80,6 +80,11 @@ struct llc {
     double fault_ferr;    /* the following error LLC_END_FERROR saw */
     int32_t seq;
     int done_req;
+    /* block-level and ADCAI points: the HLC's fine setpoints played (its
+     * homing), the last period one came for; the axis then holds until its
+     * own stream starts again after it */
+    int fine_mode;
+    int64_t fine_last;
     int hold;             /* the HLC's heartbeat says hold (fine setpoints only) */
     int64_t hold_until;   /* after a hold: the HLC's period of its RUN, played from */
     int64_t done_at;      /* the HLC's last period, as its done said */
@@ -153,6 +158,8 @@ double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing);
 int llc_ai_stalled(const struct llc *l);
 /* Samples made ahead of the read position. */
 int64_t llc_ai_level(const struct llc *l);
+/* A job of the HLC's started after period after, by period slot. */
+int llc_ai_job_started(const struct llc *l, int64_t after, int64_t slot);
 /* The stages one by one (DP1): begin at mm (returned in nm) at point dp, one
  * rough record's sum in, one servo period's setpoint out (nm). */
 int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm);

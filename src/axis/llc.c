@@ -272,6 +272,31 @@ static int ai_ahead(struct llc *l, int64_t slot, double *mm)
     return !missing;
 }
 
+/* Where this LLC makes its own setpoints (block-level and ADCAI points;
+ * serve homes only at ADCAI's, control.c):
+ * 1 the HLC sent its own for slot (its homing, the loop's own motion),
+ * played as at DP5; 2 none came since, and the axis holds where they left
+ * it until the HLC's stream starts again after them (the NCK restarts its
+ * planner where homing ended: an abort's void or a new ADCAI job); 0 its
+ * own stream. */
+static int fine_phase(struct llc *l, int64_t slot)
+{
+    int32_t nm;
+    if (ncp_dist_rx_peek(&l->rx, slot, &nm)) {
+        l->fine_mode = 1;
+        l->fine_last = slot;
+        return 1;
+    }
+    if (!l->fine_mode)
+        return 0;
+    int restarted = l->ai ? llc_ai_job_started(l, l->fine_last, slot)
+                          : l->scale.void_due && l->scale.void_t > l->fine_last &&
+                                slot >= l->scale.void_t;
+    if (restarted)
+        l->fine_mode = 0;
+    return restarted ? 0 : 2;
+}
+
 /* The block-level points' record source for the interpolator. A record it
  * needs at speed that is not here is missing (at a standstill: see
  * interpolate()). */
@@ -481,9 +506,13 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
      * period (it plays further behind than the HLC's done takes to come) */
     int own = l->dp4 || l->dp1ai || llc_ai_streaming(l);
     int play_on = l->done_req && own && slot <= l->done_at;
+    int fine = 0;
     if (l->end == LLC_END_NONE && (!l->done_req || play_on)) {
         l->state = NCP_AX_STATUS_T_RUNNING;
+        fine = l->dp4 || llc_ai_streaming(l) ? fine_phase(l, slot) : 0;
         next_cmd = l->dp1ai                ? play_ai(l, slot)
+                   : fine == 1             ? follow(l, slot)
+                   : fine == 2             ? l->cmd
                    : l->dp4                ? interpolate(l, slot)
                    : llc_ai_streaming(l) ? follow_ai(l, slot)
                                            : follow(l, slot);
@@ -516,11 +545,13 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
     if (hold_now(l, slot))
         cmd_ahead = l->cmd;
-    else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp1ai)
+    else if (fine == 2)
+        cmd_ahead = l->cmd;
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && l->dp1ai)
         cmd_ahead = llc_dp1_ai_ahead(l, slot + T);
-    else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && l->dp4)
         cmd_ahead = interpolate_ahead(l, slot + T);
-    else if (l->state == NCP_AX_STATUS_T_RUNNING && llc_ai_streaming(l) &&
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && llc_ai_streaming(l) &&
              ai_ahead(l, slot + T, &ahead_mm))
         cmd_ahead = l->cmd + fmax(-lim, fmin(lim, ahead_mm - l->cmd));
     else if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))

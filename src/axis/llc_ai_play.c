@@ -252,6 +252,16 @@ double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing)
     return mm;
 }
 
+int llc_ai_job_started(const struct llc *l, int64_t after, int64_t slot)
+{
+    for (int i = 0; i < LLC_AI_JOBS; i++) {
+        const struct llc_ai_job *j = &l->ai->jobs[i];
+        if (j->known && j->t > after && j->t <= slot)
+            return 1;
+    }
+    return 0;
+}
+
 int llc_ai_stalled(const struct llc *l)
 {
     return l->ai && l->ai->stalled;

@@ -49,6 +49,7 @@
 #define STOP_WAIT_NS 3000000000LL
 #define SCALE_WINDOW 16   /* periods each time_scale_t carries */
 #define SCALE_AFTER 32    /* periods an advance of 1 is still said after one that was not */
+#define HOMING_AFTER 20   /* periods fine setpoints still go out after homing */
 
 struct peer {
     int axis;
@@ -91,6 +92,7 @@ struct lcm_be {
     int rest;                /* the path stood still last period */
     int hold;                /* drives off (serve's E-stop, a fault): HOLD every period */
     int release;             /* periods left that say RUN after a hold (one may be lost) */
+    int homing_left;         /* block-level and ADCAI points: periods of fine setpoints left */
     double prev_cmd[NCP_AXES];
     struct lcm_clock clk;    /* answers the LLCs' clock probes; the HLC's clock */
     uint64_t ends_sent;      /* heartbeats saying done (or stop) at the end */
@@ -547,6 +549,18 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         lcm_ai_cycle(s->ai, s->msg, t, skipped, b, cmd);
     } else {
         send_fine(s, t, cmd);
+    }
+    /* homing is the loop's own motion, in no record: where the LLCs make
+     * their own setpoints they play these meanwhile, and for a while after
+     * (the last ones may be lost); the NCK then restarts the planner where
+     * homing left the axes (an abort of nothing), which restarts theirs */
+    if ((s->tx || s->ai) && !s->dp1) {
+        if (b->homing)
+            s->homing_left = HOMING_AFTER;
+        if (s->homing_left > 0) {
+            s->homing_left -= !b->homing;
+            send_fine(s, t, cmd);
+        }
     }
     if (s->hold || s->release > 0 || now - s->last_hb >= s->hb_period) {
         s->release -= s->release > 0;

@@ -577,8 +577,14 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
  * moves or the offset homing puts between the plan and the axes. */
 static int blocks_lcm(const struct ncp_machine_cfg *cfg)
 {
-    return cfg->backend == NCP_BACKEND_LCM && cfg->lcm.dp >= 1 &&
-           cfg->lcm.dp <= (cfg->nck == NCP_NCK_ADCAI ? 3 : 4);
+    return cfg->backend == NCP_BACKEND_LCM && cfg->nck == NCP_NCK_ADCBI && cfg->lcm.dp >= 1 &&
+           cfg->lcm.dp <= 4;
+}
+
+static int cfg_ai_stages(const struct ncp_machine_cfg *cfg)
+{
+    return cfg->backend == NCP_BACKEND_LCM && cfg->nck == NCP_NCK_ADCAI && cfg->lcm.dp >= 2 &&
+           cfg->lcm.dp <= 3;
 }
 
 /* Homing (homing.c): `all` (or nothing) homes the axes of the HOME_SEQUENCE
@@ -622,7 +628,7 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
             double at = n->svc->have_fb ? n->svc->last_fb.cmd[j] : n->start[j];
             if (a->home_search_vel != 0 || fabs(at - a->home_offset) > 1e-6)
                 return refuse(why, len, "home %c: not served on --backend lcm --dp %d: the "
-                              "LLCs make their setpoints of the records sent and homing is the position "
+                              "LLCs run the planner's records and homing is the position "
                               "loop's own motion (HOME_SEARCH_VEL %g) or offset (the axis at "
                               "%.4f, HOME_OFFSET %g); home on the fine setpoints (DP %d)",
                               NCP_AXIS_LETTERS[j], cfg->lcm.dp, a->home_search_vel, at,
@@ -975,7 +981,13 @@ static void homing_ended(struct ncp_nck *s)
     sync_interp(s);
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
-    set_state(s, NCP_ST_IDLE);
+    /* ADCAI's LLCs at DP3 and DP2 played homing on the loop's own
+     * setpoints; their stages start again where it left the axes, as the
+     * planner does after an abort (lcm_ai.c numbers a new job) */
+    if (cfg_ai_stages(n->cfg))
+        begin_drop(s, 0, 0, NCP_ST_IDLE, 0);
+    else
+        set_state(s, NCP_ST_IDLE);
 }
 
 static void check_fault(struct ncp_nck *s)

@@ -404,8 +404,10 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
         } else if (take_setpoint(n) == NCP_RT_RETRY) {
             return NCP_RT_RETRY;
         }
+        n->cross.be.homing = 0;
     } else {
         n->cross.be.adv = 0;
+        n->cross.be.homing = 1;
     }
     uint64_t home = nck_home_phases(n);   /* the row shows the phase the period ran in */
     double act[NCP_AXES];
