@@ -80,9 +80,9 @@ struct llc {
     double fault_ferr;    /* the following error LLC_END_FERROR saw */
     int32_t seq;
     int done_req;
-    /* block-level and ADCAI points: the HLC's fine setpoints played (its
-     * homing), the last period one came for; the axis then holds until its
-     * own stream starts again after it */
+    /* ADCAI's DP3 and DP2: the HLC's fine setpoints played (its homing),
+     * the last period one came for; the axis then holds until its own
+     * stream starts again after it */
     int fine_mode;
     int64_t fine_last;
     int hold;             /* the HLC's heartbeat says hold (fine setpoints only) */

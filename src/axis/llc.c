@@ -272,13 +272,11 @@ static int ai_ahead(struct llc *l, int64_t slot, double *mm)
     return !missing;
 }
 
-/* Where this LLC makes its own setpoints (block-level and ADCAI points;
- * serve homes only at ADCAI's, control.c):
- * 1 the HLC sent its own for slot (its homing, the loop's own motion),
- * played as at DP5; 2 none came since, and the axis holds where they left
- * it until the HLC's stream starts again after them (the NCK restarts its
- * planner where homing ended: an abort's void or a new ADCAI job); 0 its
- * own stream. */
+/* ADCAI's DP3 and DP2: 1 the HLC sent its own setpoint for slot (its
+ * homing, the loop's own motion), played as at DP5; 2 none came since, and
+ * the axis holds where they left it until the HLC's stream starts again
+ * after them (the NCK restarts its planner where homing ended: a new job);
+ * 0 its own stream. */
 static int fine_phase(struct llc *l, int64_t slot)
 {
     int32_t nm;
@@ -289,9 +287,7 @@ static int fine_phase(struct llc *l, int64_t slot)
     }
     if (!l->fine_mode)
         return 0;
-    int restarted = l->ai ? llc_ai_job_started(l, l->fine_last, slot)
-                          : l->scale.void_due && l->scale.void_t > l->fine_last &&
-                                slot >= l->scale.void_t;
+    int restarted = llc_ai_job_started(l, l->fine_last, slot);
     if (restarted)
         l->fine_mode = 0;
     return restarted ? 0 : 2;
@@ -509,7 +505,7 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     int fine = 0;
     if (l->end == LLC_END_NONE && (!l->done_req || play_on)) {
         l->state = NCP_AX_STATUS_T_RUNNING;
-        fine = l->dp4 || llc_ai_streaming(l) ? fine_phase(l, slot) : 0;
+        fine = llc_ai_streaming(l) ? fine_phase(l, slot) : 0;
         next_cmd = l->dp1ai                ? play_ai(l, slot)
                    : fine == 1             ? follow(l, slot)
                    : fine == 2             ? l->cmd

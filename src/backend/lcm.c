@@ -550,11 +550,12 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
     } else {
         send_fine(s, t, cmd);
     }
-    /* homing is the loop's own motion, in no record: where the LLCs make
-     * their own setpoints they play these meanwhile, and for a while after
-     * (the last ones may be lost); the NCK then restarts the planner where
-     * homing left the axes (an abort of nothing), which restarts theirs */
-    if ((s->tx || s->ai) && !s->dp1) {
+    /* homing is the loop's own motion, in no record: at ADCAI's DP3 and
+     * DP2 the LLCs play these meanwhile, and for a while after (the last
+     * ones may be lost); the NCK then restarts the planner where homing left
+     * the axes (an abort of nothing), which starts their stages again
+     * (ADCBI's block-level points refuse homing that moves, control.c) */
+    if (s->ai) {
         if (b->homing)
             s->homing_left = HOMING_AFTER;
         if (s->homing_left > 0) {
