@@ -236,14 +236,18 @@ function cycleTime(s) {
 }
 
 // What drives the axes beyond the simulator: each CiA 402 drive's state and
-// last EMCY, or each LLC's state, DP, clock offset and following error
+// last EMCY, or each LLC's state, DP, clock offset, following error and
+// last error
 function devices(s) {
   const drives = (s.drives || []).map((d) =>
     `${d.axis} node ${d.node}: ${d.state} (${d.statusword})${d.error !== '0x0000' ? `, EMCY ${d.error} ${d.error_text}` : ''}`);
   // one short line per LLC (state, clock offset, following error), the DP
-  // in the title: three of them must not push the DRO out of the column
+  // in the title: three of them must not push the DRO out of the column.
+  // Its last error (kept until a reset) in a few words: the whole text is
+  // the event in the log
   const llcs = (s.llcs || []).map((l) =>
-    `${l.axis}: ${l.state}, ${l.clock_offset_us >= 0 ? '+' : ''}${l.clock_offset_us} us, ${fmt(l.ferr_nm / 1000, 1)} um`);
+    `${l.axis}: ${l.state}, ${l.clock_offset_us >= 0 ? '+' : ''}${l.clock_offset_us} us, ${fmt(l.ferr_nm / 1000, 1)} um` +
+    (l.error ? `, last error: ${l.error}` : ''));
   return { title: drives.length ? 'drives' : `LLCs DP ${s.llc_dp}`, text: drives.concat(llcs).join('\n') };
 }
 

@@ -89,12 +89,18 @@ struct ncp_drive_info {
 };
 
 /* A distributed axis (an LLC of the lcm backend) as the operator's status
- * shows it, from its last status message. */
+ * shows it, from its last status message, and its last error: why it
+ * stopped, as it said or as the HLC found, kept until a reset acknowledges
+ * it (llc_ack). */
+#define NCP_LLC_ERROR_MAX 128
 struct ncp_llc_info {
     int axis;                 /* 0..8 = X..W */
     int state;                /* ax_status_t's: -1 never heard, else WAITING .. DONE */
     int64_t clock_offset_ns;  /* how far the HLC's clock is ahead of the LLC's */
     int32_t ferr_nm;          /* its following error */
+    int error;                /* status_t's LLC_ERR_: 0 none */
+    unsigned error_count;     /* errors kept for it so far: a new one counts up */
+    char error_text[NCP_LLC_ERROR_MAX];   /* "" none */
 };
 
 struct ncp_backend_ops {
@@ -143,6 +149,11 @@ struct ncp_backend_ops {
      * a home (aborted, or failed: cycle() then reports the fault). NULL:
      * no drive homes itself on this backend. */
     int (*drive_home)(struct ncp_backend *b, int axis, int go);
+    /* Not real-time (the serving thread, on a reset): each LLC's last error
+     * is acknowledged where that LLC is back (its last status says waiting,
+     * running or done); one still stopped or unheard keeps it. NULL: no
+     * LLCs. */
+    void (*llc_ack)(struct ncp_backend *b);
 };
 
 /* The ADCBI planner's calls, as plan_journal sees them; DROP is no call but

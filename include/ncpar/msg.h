@@ -153,6 +153,11 @@ const char *ncp_msg_estimate_name(int state);
  * "waiting", "running", "stopping", "stopped", "fault", "done"; NULL for
  * anything else. */
 const char *ncp_msg_llc_state_name(int state);
+/* status_t's llc_error (LLC_ERR_ constants) as the operator reads it in a
+ * few words ("setpoints lost", "following error", "unheard (killed or cut
+ * off)", ...): "" for none (0), NULL for anything unknown. The whole text
+ * is the event that told it. */
+const char *ncp_msg_llc_error_name(int error);
 /* event_t's kinds by name ("info", "msg", "debug", "print", "error",
  * "fault"): NULL for anything else. */
 const char *ncp_msg_event_kind_name(int kind);

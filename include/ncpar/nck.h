@@ -309,6 +309,7 @@ struct ncp_nck_snapshot {
     int llc_state[NCP_NCK_AXES_MAX];
     int64_t llc_clock_offset_ns[NCP_NCK_AXES_MAX];
     int32_t llc_ferr_nm[NCP_NCK_AXES_MAX];
+    int llc_error[NCP_NCK_AXES_MAX];  /* its last error, status_t's LLC_ERR_ (0 none) */
 };
 
 /* A load's estimate (cnc-run serve): running in the background, done,

@@ -131,6 +131,7 @@ struct llc {
     struct llc_scale scale;       /* the HLC's time scaling (llc_scale.h) */
     char fault[200];              /* LLC_END_PROGRAM, LLC_END_DRIVE: why */
     char fault_short[64];         /* the same in what its status carries ("": fault) */
+    char end_text[64];            /* its status's word on the end, once said (llc_end_text) */
     struct llc_clock clk;
     int64_t hlc_now;              /* this period's time on the HLC's clock */
     int fault_reports;            /* LLC_END_CLOCK before motion: statuses saying so */
@@ -227,6 +228,9 @@ int64_t llc_start_at(const struct llc *l, int32_t k);
 /* src as much as a status's fault field (n bytes) carries, cut at a word
  * with "..." when it does not fit. */
 void llc_fault_short(char *dst, size_t n, const char *src);
+/* Why the loop ends (l->end), in the words its status carries (fault[64]):
+ * "" for none and for the program's end. */
+void llc_end_text(const struct llc *l, char *dst, size_t n);
 int64_t llc_now(void);
 
 #endif

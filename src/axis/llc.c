@@ -138,6 +138,18 @@ static int32_t nm(double mm)
     return v;
 }
 
+_Static_assert(LLC_END_DONE == NCP_AX_STATUS_T_END_DONE &&
+               LLC_END_HLC_STOP == NCP_AX_STATUS_T_END_HLC_STOP &&
+               LLC_END_HLC_SILENT == NCP_AX_STATUS_T_END_HLC_SILENT &&
+               LLC_END_LOST == NCP_AX_STATUS_T_END_LOST &&
+               LLC_END_FERROR == NCP_AX_STATUS_T_END_FERROR &&
+               LLC_END_MISSING == NCP_AX_STATUS_T_END_MISSING &&
+               LLC_END_SIGNAL == NCP_AX_STATUS_T_END_SIGNAL &&
+               LLC_END_PROGRAM == NCP_AX_STATUS_T_END_PROGRAM &&
+               LLC_END_CLOCK == NCP_AX_STATUS_T_END_CLOCK &&
+               LLC_END_DRIVE == NCP_AX_STATUS_T_END_DRIVE,
+               "a status's end is the LLC's own");
+
 void llc_publish_status(struct llc *l, int64_t slot)
 {
     ncp_ax_status_t s;
@@ -149,11 +161,12 @@ void llc_publish_status(struct llc *l, int64_t slot)
     s.act_nm = nm(l->act);
     s.ferr_nm = nm(l->ferr);
     s.state = (int8_t)l->state;
-    if (l->end == LLC_END_PROGRAM || l->end == LLC_END_DRIVE)
-        snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault_short[0] ? l->fault_short
-                                                                          : l->fault);
-    else if (l->end == LLC_END_CLOCK)
-        snprintf((char *)s.fault, sizeof s.fault, "%s", l->fault);
+    /* why it stops, said in every status from then on (one may be lost):
+     * worded once, not every period of the ramp */
+    s.end = (int8_t)l->end;
+    if (l->end != LLC_END_NONE && l->end != LLC_END_DONE && !l->end_text[0])
+        llc_end_text(l, l->end_text, sizeof l->end_text);
+    memcpy(s.fault, l->end_text, sizeof s.fault);
     llc_clock_status(l, &s);
     /* DP1: its own NCK's records, the HLC waits for the first */
     if (l->dp4 || l->dp == 1) {
@@ -163,9 +176,6 @@ void llc_publish_status(struct llc *l, int64_t slot)
         s.stale = (int32_t)l->recs.stale;
         s.duplicate = (int32_t)l->recs.duplicate;
         s.rec_next = l->recs.next;
-        if (l->end == LLC_END_MISSING)
-            snprintf((char *)s.fault, sizeof s.fault, "record %d missing when needed",
-                     (int)l->missing_rec);
     } else {
         s.buffer_level = (int16_t)(llc_ai_streaming(l) ? llc_ai_level(l)
                                                        : ncp_dist_rx_level(&l->rx, slot));

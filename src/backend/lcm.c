@@ -65,6 +65,16 @@ struct peer {
     atomic_int pub_state, pub_ferr_nm;
     atomic_llong pub_clock_ns;
     uint64_t statuses, lost, late;
+    /* its last error for the operator: err_kind (status_t's LLC_ERR_, 0
+     * none) hands err_text over. At 0 the text is the taking side's (start,
+     * the idle thread, the position loop, stop: one at a time), which
+     * writes it, then the kind; from then on it is the serving thread's,
+     * which reads it and on a reset may give it back (0). No lock on the
+     * real-time path and no torn text; the error that stopped the LLC
+     * stands, not what followed from it (its silence once it left). */
+    atomic_int err_kind;
+    unsigned err_count;
+    char err_text[NCP_LLC_ERROR_MAX];
 };
 
 struct lcm_be {
@@ -128,6 +138,38 @@ static void heartbeat(struct lcm_be *s, int command, char axis)
         (void)ncp_msg_publish(s->msg, NCP_DIST_CH_HLC_HEARTBEAT, buf, (size_t)n);
 }
 
+_Static_assert(NCP_STATUS_T_LLC_ERR_HLC_STOP == NCP_AX_STATUS_T_END_HLC_STOP &&
+               NCP_STATUS_T_LLC_ERR_DRIVE == NCP_AX_STATUS_T_END_DRIVE &&
+               NCP_STATUS_T_LLC_ERR_UNHEARD == NCP_AX_STATUS_T_END_DRIVE + 1,
+               "an LLC's error is its end, where it said one");
+
+static void keep_error(struct peer *p, int kind, const char *text)
+{
+    if (atomic_load_explicit(&p->err_kind, memory_order_acquire) != 0)
+        return;
+    snprintf(p->err_text, sizeof p->err_text, "%s", text);
+    p->err_count++;
+    atomic_store_explicit(&p->err_kind, kind, memory_order_release);
+}
+
+/* What an LLC's status says of its end: an error but the program's end.
+ * Every status of every LLC comes here: nothing is copied unless it is an
+ * error to keep (an LLC that stopped says so in each status until it goes). */
+static void status_error(struct peer *p, const ncp_ax_status_t *st)
+{
+    int kind = st->end > NCP_AX_STATUS_T_END_DONE && st->end <= NCP_AX_STATUS_T_END_DRIVE
+                   ? st->end
+               : st->end == NCP_AX_STATUS_T_END_NONE && (st->state == NCP_AX_STATUS_T_STOPPING ||
+                                                        st->state == NCP_AX_STATUS_T_FAULT)
+                   ? NCP_STATUS_T_LLC_ERR_OTHER
+                   : 0;
+    if (!kind || atomic_load_explicit(&p->err_kind, memory_order_relaxed) != 0)
+        return;
+    char text[sizeof st->fault + 1];
+    snprintf(text, sizeof text, "%.*s", (int)sizeof st->fault, (const char *)st->fault);
+    keep_error(p, kind, text[0] ? text : "stopped on its own without saying why (see its output)");
+}
+
 static void on_status(struct peer *p, const uint8_t *b, size_t len, int64_t now)
 {
     ncp_ax_status_t st;
@@ -139,6 +181,7 @@ static void on_status(struct peer *p, const uint8_t *b, size_t len, int64_t now)
         return;
     }
     p->st = st;
+    status_error(p, &st);
     atomic_store_explicit(&p->pub_state, st.state, memory_order_relaxed);
     atomic_store_explicit(&p->pub_ferr_nm, st.ferr_nm, memory_order_relaxed);
     atomic_store_explicit(&p->pub_clock_ns, st.clock_offset_ns, memory_order_relaxed);
@@ -271,7 +314,7 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
         take(s, now);
         int ready = 0;
         for (int i = 0; i < s->n; i++) {
-            const struct peer *p = &s->p[i];
+            struct peer *p = &s->p[i];
             if (p->st.state == NCP_AX_STATUS_T_FAULT) {
                 s->fault_axis = NCP_AXIS_LETTERS[p->axis];
                 snprintf(s->fault, sizeof s->fault, "axis %c's LLC: DP 1: %.*s",
@@ -284,6 +327,7 @@ static int dp1_wait(struct lcm_be *s, int64_t deadline)
                 char why[120];
                 snprintf(why, sizeof why, "heartbeat lost (silent for %lld ms) while its NCK "
                          "started on the program", (long long)((now - p->last_hb_ns) / 1000000));
+                keep_error(p, NCP_STATUS_T_LLC_ERR_UNHEARD, why);
                 fail(s, p, why);
                 return -1;
             }
@@ -389,6 +433,7 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
         if (p->st.t_ns > 0 && ++p->run_lost > s->cfg->lcm.max_lost_periods) {
             snprintf(why, sizeof why, "no status for %d periods ([LCM] MAX_LOST_PERIODS %d)",
                      p->run_lost, s->cfg->lcm.max_lost_periods);
+            keep_error(p, NCP_STATUS_T_LLC_ERR_UNHEARD, why);
             fail(s, p, why);
         }
     } else {
@@ -397,6 +442,7 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
     if (now - p->last_hb_ns > s->hb_timeout) {
         snprintf(why, sizeof why, "heartbeat lost (silent for %lld ms)",
                  (long long)((now - p->last_hb_ns) / 1000000));
+        keep_error(p, NCP_STATUS_T_LLC_ERR_UNHEARD, why);
         fail(s, p, why);
         /* its last status said running: the operator must not read that
          * of an LLC that is gone (a status of its, should it come back,
@@ -747,14 +793,32 @@ static int lcm_llcs(const struct ncp_backend *b, struct ncp_llc_info *out, int m
         out[n] = (struct ncp_llc_info){
             p->axis, atomic_load_explicit(&p->pub_state, memory_order_relaxed),
             atomic_load_explicit(&p->pub_clock_ns, memory_order_relaxed),
-            atomic_load_explicit(&p->pub_ferr_nm, memory_order_relaxed) };
+            atomic_load_explicit(&p->pub_ferr_nm, memory_order_relaxed), 0, 0, "" };
+        /* the text and count are ours to read once the kind is set */
+        out[n].error = atomic_load_explicit(&p->err_kind, memory_order_acquire);
+        if (out[n].error) {
+            out[n].error_count = p->err_count;
+            snprintf(out[n].error_text, sizeof out[n].error_text, "%s", p->err_text);
+        }
     }
     return n;
 }
 
+static void lcm_llc_ack(struct ncp_backend *b)
+{
+    struct lcm_be *s = b->impl;
+    for (int i = 0; s && i < s->n; i++) {
+        struct peer *p = &s->p[i];
+        int st = atomic_load_explicit(&p->pub_state, memory_order_relaxed);
+        if (st == NCP_AX_STATUS_T_WAITING || st == NCP_AX_STATUS_T_RUNNING ||
+            st == NCP_AX_STATUS_T_DONE)
+            atomic_store_explicit(&p->err_kind, 0, memory_order_release);
+    }
+}
+
 static const struct ncp_backend_ops lcm_ops = {
     "lcm", lcm_start, lcm_cycle, lcm_stop, lcm_describe, lcm_close, lcm_enable, lcm_live, NULL, NULL,
-    lcm_llcs, NULL,
+    lcm_llcs, NULL, lcm_llc_ack,
 };
 
 int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,
@@ -830,6 +894,7 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
         char ch[32];
         p->axis = j;
         atomic_init(&p->pub_state, -1);
+        atomic_init(&p->err_kind, 0);
         ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_ADVERT);
         p->sub_advert = ncp_msg_subscribe(s->msg, ch);
         ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_STATUS);

@@ -55,7 +55,7 @@ static void sim_enable(struct ncp_backend *b, int on)
 
 static const struct ncp_backend_ops sim_ops = {
     "sim", sim_start, sim_cycle, sim_stop, sim_describe, sim_close, sim_enable, NULL, NULL, NULL, NULL,
-    NULL,
+    NULL, NULL,
 };
 
 int ncp_backend_open_sim(struct ncp_backend *b, const struct ncp_machine_cfg *cfg,

@@ -237,7 +237,7 @@ static int sc_home_switch(const struct ncp_backend *b, int axis)
 
 static const struct ncp_backend_ops sc_ops = {
     "socketcan", sc_start, sc_cycle, sc_stop, sc_describe, sc_close, sc_enable, sc_live, sc_drives,
-    sc_home_switch, NULL, sc_drive_home,
+    sc_home_switch, NULL, sc_drive_home, NULL,
 };
 
 /* Counts per second from mm per second, within what 0x6099/0x609A hold. */

@@ -104,9 +104,14 @@ void ctl_print_status(const ncp_status_t *s)
     }
     for (int k = 0; k < s->n_llcs && k < 9; k++) {
         const char *st = ncp_msg_llc_state_name(s->llc_state[k]);
-        printf("llc %c     DP %d: %s, clock offset %d us, following error %d nm\n",
+        const char *err = ncp_msg_llc_error_name(s->llc_error[k]);
+        printf("llc %c     DP %d: %s, clock offset %d us, following error %d nm",
                s->llc_axis[k], (int)s->llc_dp, st ? st : "?", (int)s->llc_clock_offset_us[k],
                (int)s->llc_ferr_nm[k]);
+        /* kept until a reset; its whole text was an event (cnc-ctl events) */
+        if (!err || err[0])
+            printf(", last error: %s", err ? err : "?");
+        printf("\n");
     }
 }
 

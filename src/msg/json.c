@@ -206,8 +206,13 @@ int ncp_msg_status_json(const ncp_status_t *s, char *buf, size_t size)
         char axis = isalpha(s->llc_axis[k]) ? (char)s->llc_axis[k] : '?';
         put(&o, "%s{\"axis\": \"%c\", \"state\": ", k ? ", " : "", axis);
         put(&o, st ? "\"%s\"" : "null", st ? st : "");
-        put(&o, ", \"clock_offset_us\": %d, \"ferr_nm\": %d}", (int)s->llc_clock_offset_us[k],
-            (int)s->llc_ferr_nm[k]);
+        const char *err = ncp_msg_llc_error_name(s->llc_error[k]);
+        put(&o, ", \"clock_offset_us\": %d, \"ferr_nm\": %d, \"error\": ",
+            (int)s->llc_clock_offset_us[k], (int)s->llc_ferr_nm[k]);
+        if (err)
+            put(&o, "\"%s\"}", err);
+        else
+            put(&o, "\"error %d\"}", (int)s->llc_error[k]);
     }
     put(&o, "]}");
     return o.full ? -1 : (int)o.len;

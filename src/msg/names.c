@@ -56,6 +56,27 @@ const char *ncp_msg_llc_state_name(int state)
                ? llc_names[state] : NULL;
 }
 
+static const char *const llc_errors[] = {
+    [NCP_STATUS_T_LLC_ERR_NONE] = "",
+    [NCP_STATUS_T_LLC_ERR_HLC_STOP] = "stopped by the HLC",
+    [NCP_STATUS_T_LLC_ERR_HLC_SILENT] = "the HLC's heartbeat lost",
+    [NCP_STATUS_T_LLC_ERR_LOST] = "setpoints lost",
+    [NCP_STATUS_T_LLC_ERR_FERROR] = "following error",
+    [NCP_STATUS_T_LLC_ERR_MISSING] = "a record missing",
+    [NCP_STATUS_T_LLC_ERR_SIGNAL] = "stopped by a signal",
+    [NCP_STATUS_T_LLC_ERR_PROGRAM] = "its NCK stopped on the program",
+    [NCP_STATUS_T_LLC_ERR_CLOCK] = "the clocks apart",
+    [NCP_STATUS_T_LLC_ERR_DRIVE] = "drive fault",
+    [NCP_STATUS_T_LLC_ERR_UNHEARD] = "unheard (killed or cut off)",
+    [NCP_STATUS_T_LLC_ERR_OTHER] = "stopped on its own",
+};
+
+const char *ncp_msg_llc_error_name(int error)
+{
+    return error >= 0 && error < (int)(sizeof llc_errors / sizeof llc_errors[0])
+               ? llc_errors[error] : NULL;
+}
+
 static const char *const event_kinds[] = {
     [NCP_EVENT_T_INFO] = "info",   [NCP_EVENT_T_MSG] = "msg",     [NCP_EVENT_T_DEBUG] = "debug",
     [NCP_EVENT_T_PRINT] = "print", [NCP_EVENT_T_ERROR] = "error", [NCP_EVENT_T_FAULT] = "fault",

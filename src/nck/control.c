@@ -816,12 +816,16 @@ static int cmd_files(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, 
 static int cmd_reset(struct ncp_nck *s, char *why, size_t len)
 {
     struct nck_core *n = &s->core;
-    if (s->state != NCP_ST_ESTOP && s->state != NCP_ST_FAULT)
-        return s->state == NCP_ST_IDLE ? (s->error[0] = 0, 0)
-                                       : refuse(why, len, "nothing to reset while %s",
-                                                ncp_nck_state_name(s->state));
-    atomic_store(&n->cross.loop_fault, NCK_LF_NONE);
+    if (s->state != NCP_ST_ESTOP && s->state != NCP_ST_FAULT && s->state != NCP_ST_IDLE)
+        return refuse(why, len, "nothing to reset while %s", ncp_nck_state_name(s->state));
+    /* the operator has read the errors: the NCK's, and each LLC's that is
+     * back (one still stopped or gone keeps its own) */
     s->error[0] = 0;
+    nck_llcs_ack(s);
+    s->changed = 1;
+    if (s->state == NCP_ST_IDLE)
+        return 0;
+    atomic_store(&n->cross.loop_fault, NCK_LF_NONE);
     if (s->drop != NCK_DROP_NONE) {
         /* the E-stop's drop is still under way: the reset's follows it */
         s->reset_after_drop = 1;
@@ -1025,6 +1029,7 @@ int ncp_nck_poll(struct ncp_nck *s)
     struct nck_core *n = &s->core;
     nck_read_cycles(n);
     check_fault(s);
+    nck_llcs_poll(s);
     if (s->drop != NCK_DROP_NONE)
         drop_step(s);
     int st = s->state;
@@ -1259,6 +1264,7 @@ void ncp_nck_get_status(const struct ncp_nck *s, struct ncp_nck_snapshot *st)
             st->llc_state[k] = l[k].state;
             st->llc_clock_offset_ns[k] = l[k].clock_offset_ns;
             st->llc_ferr_nm[k] = l[k].ferr_nm;
+            st->llc_error[k] = l[k].error;
         }
     }
 }

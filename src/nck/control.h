@@ -82,6 +82,11 @@ struct ncp_nck {
     int64_t run_t0_ns;               /* the loop's time when the program run began */
     double program_time;             /* the last program run's, s (0: none yet) */
     struct nck_history hist;         /* [DISPLAY] HISTORY_FILE */
+    unsigned llc_errors_told[NCP_NCK_AXES_MAX];  /* each LLC's error count told (llcs.c) */
 };
+
+/* llcs.c: each LLC's new last error as an event; a reset's acknowledgement */
+void nck_llcs_poll(struct ncp_nck *s);
+void nck_llcs_ack(struct ncp_nck *s);
 
 #endif

@@ -171,6 +171,7 @@ static void send_status(struct serve *sv, const struct serve_channel *ch)
         int64_t us = st.llc_clock_offset_ns[k] / 1000;
         m.llc_clock_offset_us[k] = (int32_t)(us > INT32_MAX ? INT32_MAX : us < -INT32_MAX ? -INT32_MAX : us);
         m.llc_ferr_nm[k] = st.llc_ferr_nm[k];
+        m.llc_error[k] = (int8_t)st.llc_error[k];
     }
     ncp_msg_send_status(sv->msg, &m);
     if (sv->hook && sv->hook->status)

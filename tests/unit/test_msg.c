@@ -420,14 +420,29 @@ static void test_status_json(void **state)
     s.llc_state[1] = -1;
     s.llc_clock_offset_us[0] = -12;
     s.llc_ferr_nm[0] = 3071;
+    /* and each one's last error in a few words ("" none) */
+    s.llc_error[1] = NCP_STATUS_T_LLC_ERR_UNHEARD;
     n = ncp_msg_status_json(&s, buf, sizeof buf);
     assert_true(n > 0);
     assert_non_null(strstr(buf, "\"llc_dp\": 4, \"llcs\": [{\"axis\": \"X\", \"state\": "
-                                "\"running\", \"clock_offset_us\": -12, \"ferr_nm\": 3071}, "
+                                "\"running\", \"clock_offset_us\": -12, \"ferr_nm\": 3071, "
+                                "\"error\": \"\"}, "
                                 "{\"axis\": \"Z\", \"state\": \"unheard\", \"clock_offset_us\": 0, "
-                                "\"ferr_nm\": 0}]}"));
+                                "\"ferr_nm\": 0, \"error\": \"unheard (killed or cut off)\"}]}"));
+    s.llc_error[0] = NCP_STATUS_T_LLC_ERR_LOST;
+    s.llc_error[1] = 99;   /* a newer NCK's: its number */
+    n = ncp_msg_status_json(&s, buf, sizeof buf);
+    assert_true(n > 0);
+    assert_non_null(strstr(buf, "\"ferr_nm\": 3071, \"error\": \"setpoints lost\"}"));
+    assert_non_null(strstr(buf, "\"ferr_nm\": 0, \"error\": \"error 99\"}]}"));
     assert_string_equal(ncp_msg_llc_state_name(NCP_AX_STATUS_T_DONE), "done");
     assert_null(ncp_msg_llc_state_name(6));
+    assert_string_equal(ncp_msg_llc_error_name(NCP_STATUS_T_LLC_ERR_NONE), "");
+    assert_string_equal(ncp_msg_llc_error_name(NCP_STATUS_T_LLC_ERR_FERROR), "following error");
+    for (int e = NCP_STATUS_T_LLC_ERR_HLC_STOP; e <= NCP_STATUS_T_LLC_ERR_OTHER; e++)
+        assert_true(ncp_msg_llc_error_name(e) && ncp_msg_llc_error_name(e)[0]);
+    assert_null(ncp_msg_llc_error_name(1));   /* the program's end is no error */
+    assert_null(ncp_msg_llc_error_name(-1));
     /* nothing and no state: nulls */
     memset(&s, 0, sizeof s);
     s.state = 42;

@@ -10,7 +10,9 @@
 // show each LLC's axis, state, DP and clock offset as the status has them at
 // every status read: "running" while the program runs; still following once
 // serve idles (at DP 5 serve streams the axes at rest between jobs, so the
-// LLCs say running); "fault" for an LLC killed, serve's fault naming it.
+// LLCs say running); "fault" for an LLC killed, serve's fault naming it,
+// and its row its last error ("unheard", the HLC's word: it said nothing),
+// which the log has in full and a reset does not clear while it is gone.
 import { spawn, spawnSync } from 'node:child_process';
 import crypto from 'node:crypto';
 import fs from 'node:fs';
@@ -69,7 +71,8 @@ const devicesNow = (page) => page.evaluate(() => ({
   rows: document.querySelector('#devices').textContent.split('\n'),
 }));
 
-// Each row against the status: "X: running, +12 us, 3.1 um" under "LLCs DP 5".
+// Each row against the status: "X: running, +12 us, 3.1 um" under "LLCs DP 5",
+// ", last error: ..." after it where the status has one for that LLC.
 // The LLCs' states by axis, or the mismatch as text.
 function rowsAgree(d) {
   const llcs = d.s.llcs || [];
@@ -77,9 +80,9 @@ function rowsAgree(d) {
   if (llcs.length !== 3 || d.rows.length !== 3) return `${llcs.length} LLCs in the status, rows ${JSON.stringify(d.rows)}`;
   const states = {};
   for (let k = 0; k < 3; k++) {
-    const l = llcs[k], m = d.rows[k].match(/^([XYZ]): (\w+), ([-+]\d+) us, -?[\d.]+ um$/);
+    const l = llcs[k], m = d.rows[k].match(/^([XYZ]): (\w+), ([-+]\d+) us, -?[\d.]+ um(?:, last error: (.+))?$/);
     if (!m) return `row '${d.rows[k]}'`;
-    if (m[1] !== l.axis || m[2] !== l.state || Number(m[3]) !== l.clock_offset_us)
+    if (m[1] !== l.axis || m[2] !== l.state || Number(m[3]) !== l.clock_offset_us || (m[4] || '') !== l.error)
       return `row '${d.rows[k]}' for ${JSON.stringify(l)} at DP ${d.s.llc_dp}`;
     states[m[1]] = m[2];
   }
@@ -188,10 +191,25 @@ export async function lcmDevices({ BUILD, WORK, ROOT, CHROMIUM, puppeteer, launc
     const ended = await until("Y's LLC shown in fault once it is gone",
       (st, s) => s.state === 'fault' && st.Y === 'fault', 5000);
     if (!/axis Y/.test(ended.s.error)) throw new Error(`the fault does not name axis Y: ${ended.s.error}`);
+    // its last error in its row (X and Z are held: none), the whole text in the log
+    const told = await until("Y's last error in its row",
+      () => true, 1000);
+    const yRow = told.rows.find((r) => r.startsWith('Y: '));
+    if (!/, last error: unheard \(killed or cut off\)$/.test(yRow) || told.rows.some((r) => !r.startsWith('Y: ') && /last error/.test(r)))
+      throw new Error(`the LLC rows once Y is gone: ${JSON.stringify(told.rows)}`);
+    await page.waitForFunction(() => /axis Y's LLC, last error: (no status for|heartbeat lost)/.test(document.querySelector('#log').textContent), { timeout: 3000 });
     await shot(page, '22-lcm-llc-lost');
+    // a reset: Y is not back, so its last error stays in its row
+    await page.waitForSelector('#reset:not([disabled])', { timeout: 5000 });
+    await new Promise((r) => setTimeout(r, 600));   // past serve's heartbeat watch (500 ms)
+    await page.click('#reset');
+    await new Promise((r) => setTimeout(r, 500));
+    const kept = await until("Y's last error after a reset", () => true, 1000);
+    if (!kept.rows.some((r) => /^Y: .*, last error: unheard \(killed or cut off\)$/.test(r)))
+      throw new Error(`the LLC rows after a reset, Y still gone: ${JSON.stringify(kept.rows)}`);
     report('lcm-devices', 'PASS');
     console.log(`# lcm-devices: running ${JSON.stringify(running.rows)}; at the end (${after.s.state}) ` +
-      `${JSON.stringify(idleStates)}; Y killed: ${JSON.stringify(ended.rows)}; ${offsets.size} clock offsets seen while running`);
+      `${JSON.stringify(idleStates)}; Y killed: ${JSON.stringify(told.rows)}; ${offsets.size} clock offsets seen while running`);
   } catch (e) {
     report('lcm-devices', e instanceof Skip ? 'SKIP' : 'FAIL', e.message.split('\n')[0]);
   } finally {

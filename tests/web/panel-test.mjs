@@ -586,10 +586,10 @@ async function session(browser) {
     check(can[0] === 'drives' && !can[2] && can[1] === 'X node 1: Operation enabled (0x0237)\n' +
       'Y node 2: Fault (0x0218), EMCY 0x8611 following error', `drives shown: ${JSON.stringify(can)}`);
     const lcm = await show({ drives: [], llc_dp: 4, llcs: [
-      { axis: 'X', state: 'running', clock_offset_us: 12, ferr_nm: 3071 },
-      { axis: 'Z', state: 'fault', clock_offset_us: -3, ferr_nm: -120 }] });
+      { axis: 'X', state: 'running', clock_offset_us: 12, ferr_nm: 3071, error: '' },
+      { axis: 'Z', state: 'stopped', clock_offset_us: -3, ferr_nm: -120, error: 'setpoints lost' }] });
     check(lcm[0] === 'LLCs DP 4' && !lcm[2] && lcm[1] === 'X: running, +12 us, 3.1 um\n' +
-      'Z: fault, -3 us, -0.1 um', `LLCs shown: ${JSON.stringify(lcm)}`);
+      'Z: stopped, -3 us, -0.1 um, last error: setpoints lost', `LLCs shown: ${JSON.stringify(lcm)}`);
     // the next status from the simulated machine hides the row again
     await page.waitForFunction(() => document.querySelector('#devices').hidden, { timeout: 3000 });
   });
