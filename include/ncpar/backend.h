@@ -176,6 +176,18 @@ struct ncp_backend {
      * has its LLCs follow both (lcm.c). */
     double adv;
     uint32_t discards;
+    /* And where it read: the index of the sample cmd lies at or past
+     * (read_k, counting every sample the planner thread has put in the
+     * stream; the two before the first after a start or an abort stand for
+     * where the stream began) and the fraction towards the next (read_f).
+     * After an abort the next job's first sample is drop_k. An HLC at ADCAI's
+     * DP2 and DP3 has its LLCs play their own samples at the same place. */
+    int64_t read_k;
+    double read_f;
+    int64_t drop_k;
+    /* The loop drives the axes itself this cycle (homing), not from the
+     * stream: an HLC whose LLCs make their own setpoints sends it them. */
+    int homing;
     /* An HLC at a block-level point sends on what the ADCBI planner starts:
      * the NCK hands it to the planner's tap (planner thread; NULL: none). */
     void (*plan_tap)(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec);

@@ -26,6 +26,7 @@
 #include "ncp_fine_ipo_t.h"
 #include "ncp_heartbeat_t.h"
 #include "ncp_time_scale_t.h"
+#include "ncp_ai_scale_t.h"
 #include "ncp_int_burst_t.h"
 #include "ncp_la_burst_t.h"
 #include "ncp_plan_mark_t.h"
@@ -191,11 +192,13 @@ static inline int ncp_dist_recs_level(const struct ncp_dist_recs *q) { return q-
  * accdec_ai_t (DP3). Decoded by hand, as fine_ipo_t, for the LLC's loop. */
 #define NCP_DIST_CH_ROUGH "NCP_HLC_ROUGH"
 #define NCP_DIST_CH_ACCDEC_AI "NCP_HLC_ACCDEC_AI"
+#define NCP_DIST_CH_AI_SCALE "NCP_HLC_AI_SCALE"   /* ai_scale_t: the HLC's read position */
 
 struct ncp_dist_ai {
     int32_t seq;
     int16_t sender;
-    int64_t t_ns;
+    int64_t k;                   /* the stream index of its first sample */
+    int32_t job;                 /* the HLC's aborts before it */
     int8_t flag;                 /* DP2 only */
     int8_t n;
     int32_t sum_nm[NCP_AXES];

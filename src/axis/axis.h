@@ -80,6 +80,11 @@ struct llc {
     double fault_ferr;    /* the following error LLC_END_FERROR saw */
     int32_t seq;
     int done_req;
+    /* ADCAI's DP3 and DP2: the HLC's fine setpoints played (its homing),
+     * the last period one came for; the axis then holds until its own
+     * stream starts again after it */
+    int fine_mode;
+    int64_t fine_last;
     int hold;             /* the HLC's heartbeat says hold (fine setpoints only) */
     int64_t hold_until;   /* after a hold: the HLC's period of its RUN, played from */
     int64_t done_at;      /* the HLC's last period, as its done said */
@@ -142,9 +147,20 @@ void llc_ai_report(const struct llc *l);
  * whole (the filters and the fine interpolator hold nothing more), so the
  * last setpoint put is where the axis rests until the next record. */
 int llc_ai_at_rest(const struct llc_ai *a);
-/* The stream held the axis in this period while it was moving: the HLC
- * stamped the next record periods after the last one ended (a stall). */
-int llc_ai_held_in_motion(const struct llc_ai *a, int64_t slot);
+/* llc_ai_play.c: ai_scale_t, the HLC's read of its stream */
+void llc_ai_on_scale(struct llc *l, const uint8_t *p, size_t len);
+/* The HLC's read position is known: the axis plays its samples. */
+int llc_ai_streaming(const struct llc *l);
+/* The command of slot, mm, at the HLC's read position then (commit 0: only
+ * looked at, for feed-forward); *missing when a sample it needs is not here
+ * (l->cmd is returned). */
+double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing);
+/* The slot last played stood because the HLC's loop skipped its period. */
+int llc_ai_stalled(const struct llc *l);
+/* Samples made ahead of the read position. */
+int64_t llc_ai_level(const struct llc *l);
+/* A job of the HLC's started after period after, by period slot. */
+int llc_ai_job_started(const struct llc *l, int64_t after, int64_t slot);
 /* The stages one by one (DP1): begin at mm (returned in nm) at point dp, one
  * rough record's sum in, one servo period's setpoint out (nm). */
 int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm);

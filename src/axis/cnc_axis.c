@@ -166,6 +166,7 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_STEPS);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_PROGRAM);
     ncp_msg_subscribe(l->msg, NCP_DIST_CH_SCALE);
+    ncp_msg_subscribe(l->msg, NCP_DIST_CH_AI_SCALE);
     /* each axis its own losses: the seed plus its index */
     struct ncp_msg_inject in = { cfg->lcm.inject_loss, cfg->lcm.inject_delay_us * 1000LL,
                                  (uint64_t)cfg->lcm.inject_seed + 1u + (uint64_t)o->axis };

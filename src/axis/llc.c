@@ -98,7 +98,7 @@ static void on_sync(struct llc *l, const uint8_t *p, size_t len)
 
 /* Subscriptions, in the order cnc_axis.c makes them. */
 enum { SUB_FINE, SUB_HLC_HEARTBEAT, SUB_ACCDEC, SUB_SYNC, SUB_ROUGH, SUB_ACCDEC_AI, SUB_LA,
-       SUB_INT, SUB_STEPS, SUB_PROGRAM, SUB_SCALE };
+       SUB_INT, SUB_STEPS, SUB_PROGRAM, SUB_SCALE, SUB_AI_SCALE };
 
 void llc_take(struct llc *l, int64_t now)
 {
@@ -126,6 +126,8 @@ void llc_take(struct llc *l, int64_t now)
             llc_on_program(l, p, len);
         else if (sub == SUB_SCALE)
             llc_on_scale(l, p, len);
+        else if (sub == SUB_AI_SCALE)
+            llc_ai_on_scale(l, p, len);
     }
 }
 
@@ -175,7 +177,8 @@ void llc_publish_status(struct llc *l, int64_t slot)
         s.duplicate = (int32_t)l->recs.duplicate;
         s.rec_next = l->recs.next;
     } else {
-        s.buffer_level = (int16_t)ncp_dist_rx_level(&l->rx, slot);
+        s.buffer_level = (int16_t)(llc_ai_streaming(l) ? llc_ai_level(l)
+                                                       : ncp_dist_rx_level(&l->rx, slot));
         s.lost = (int32_t)l->rx.lost;
         s.stale = (int32_t)l->rx.stale;
         s.duplicate = (int32_t)l->rx.duplicate;
@@ -226,20 +229,12 @@ static double follow(struct llc *l, int64_t slot)
     double target = ncp_dist_nm_to_mm(ncp_dist_rx_play(&l->rx, slot));
     if (l->rx.held != l->held_seen) {
         /* a stream that stops with the axis at rest (the program's end, the
-         * HLC between jobs) is no loss: heartbeats watch the HLC then. At
-         * ADCAI's DP2 and DP3 the last setpoint of a stop is still a step
-         * (the filters' tail ends in one): there the stages say whether
-         * the motion they were given is over */
+         * HLC between jobs) is no loss: heartbeats watch the HLC then */
         if (l->run_held++ == 0)
-            l->held_moving = l->cmd != l->cmd_prev && !(l->ai && llc_ai_at_rest(l->ai));
+            l->held_moving = l->cmd != l->cmd_prev;
     } else {
         l->run_held = 0;
     }
-    /* a hold the HLC's stall put in the stream is counted and traced as
-     * held, but it is the HLC's time, not a loss: MAX_LOST_PERIODS is not
-     * run down by it (the HLC's heartbeat watches a stalled HLC) */
-    if (l->ai && llc_ai_held_in_motion(l->ai, slot))
-        l->rx.held++;
     l->held_seen = l->rx.held;
     /* a setpoint at MAX_VELOCITY is no jump: 1 nm of rounding allowed */
     double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9 + 1e-6;
@@ -248,6 +243,64 @@ static double follow(struct llc *l, int64_t slot)
         l->clamped++;
     }
     return l->cmd + step;
+}
+
+/* ADCAI's DP2 and DP3: this axis's samples at the HLC's read position
+ * (llc_ai_play.c). A sample missing holds the axis and counts as a setpoint
+ * lost does (MAX_LOST_PERIODS); a period the HLC's loop skipped stands the
+ * stream still in motion, traced as held, but it is the HLC's time, not a
+ * loss (the HLC's heartbeat watches a stalled HLC). */
+static double follow_ai(struct llc *l, int64_t slot)
+{
+    const struct ncp_axis_cfg *a = &l->cfg->axis[l->axis];
+    int missing;
+    double target = llc_ai_play(l, slot, 1, &missing);
+    if (missing) {
+        l->rx.held++;
+        if (l->run_held++ == 0)
+            l->held_moving = l->cmd != l->cmd_prev;
+    } else {
+        l->run_held = 0;
+    }
+    if (llc_ai_stalled(l))
+        l->rx.held++;
+    l->held_seen = l->rx.held;
+    double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9 + 1e-6;
+    if (fabs(step) > lim) {
+        step = copysign(lim, step);
+        l->clamped++;
+    }
+    return l->cmd + step;
+}
+
+/* Feed-forward's next setpoint at ADCAI's DP2 and DP3: 1 when its samples
+ * are here. */
+static int ai_ahead(struct llc *l, int64_t slot, double *mm)
+{
+    int missing;
+    *mm = llc_ai_play(l, slot, 0, &missing);
+    return !missing;
+}
+
+/* ADCAI's DP3 and DP2: 1 the HLC sent its own setpoint for slot (its
+ * homing, the loop's own motion), played as at DP5; 2 none came since, and
+ * the axis holds where they left it until the HLC's stream starts again
+ * after them (the NCK restarts its planner where homing ended: a new job);
+ * 0 its own stream. */
+static int fine_phase(struct llc *l, int64_t slot)
+{
+    int32_t nm;
+    if (ncp_dist_rx_peek(&l->rx, slot, &nm)) {
+        l->fine_mode = 1;
+        l->fine_last = slot;
+        return 1;
+    }
+    if (!l->fine_mode)
+        return 0;
+    int restarted = llc_ai_job_started(l, l->fine_last, slot);
+    if (restarted)
+        l->fine_mode = 0;
+    return restarted ? 0 : 2;
 }
 
 /* The block-level points' record source for the interpolator. A record it
@@ -457,10 +510,18 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     uint32_t gaps = l->rx.held + l->rx.bridged, bridged = l->rx.bridged;
     /* where this LLC computes its command, it runs up to the HLC's last
      * period (it plays further behind than the HLC's done takes to come) */
-    int play_on = l->done_req && (l->dp4 || l->dp1ai) && slot <= l->done_at;
+    int own = l->dp4 || l->dp1ai || llc_ai_streaming(l);
+    int play_on = l->done_req && own && slot <= l->done_at;
+    int fine = 0;
     if (l->end == LLC_END_NONE && (!l->done_req || play_on)) {
         l->state = NCP_AX_STATUS_T_RUNNING;
-        next_cmd = l->dp1ai ? play_ai(l, slot) : l->dp4 ? interpolate(l, slot) : follow(l, slot);
+        fine = llc_ai_streaming(l) ? fine_phase(l, slot) : 0;
+        next_cmd = l->dp1ai                ? play_ai(l, slot)
+                   : fine == 1             ? follow(l, slot)
+                   : fine == 2             ? l->cmd
+                   : l->dp4                ? interpolate(l, slot)
+                   : llc_ai_streaming(l) ? follow_ai(l, slot)
+                                           : follow(l, slot);
         /* the HLC's E-stop, heard at once rather than a play delay later
          * in its frozen setpoints: they are still taken (no loss), the
          * command stays; at a block-level point the interpolator runs on
@@ -468,7 +529,7 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
          * and its abort's records are dropped (llc_scale.c) */
         if (hold_now(l, slot))
             next_cmd = l->cmd;
-        if (l->dp4 || l->dp1ai)
+        if (own)
             l->rx.played_t = slot;   /* where a late loop catches up from */
     } else {
         l->state = l->end == LLC_END_NONE || l->end == LLC_END_DONE ? NCP_AX_STATUS_T_DONE
@@ -485,14 +546,20 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
      * does (one period's acceleration in its velocity: ~10 um of contour
      * at 1 m/s^2), so it is traced (gap 4) and counted */
     int32_t ahead;
+    double ahead_mm;
     int guessed = 0;
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
     if (hold_now(l, slot))
         cmd_ahead = l->cmd;
-    else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp1ai)
+    else if (fine == 2)
+        cmd_ahead = l->cmd;
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && l->dp1ai)
         cmd_ahead = llc_dp1_ai_ahead(l, slot + T);
-    else if (l->state == NCP_AX_STATUS_T_RUNNING && l->dp4)
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && l->dp4)
         cmd_ahead = interpolate_ahead(l, slot + T);
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && llc_ai_streaming(l) &&
+             ai_ahead(l, slot + T, &ahead_mm))
+        cmd_ahead = l->cmd + fmax(-lim, fmin(lim, ahead_mm - l->cmd));
     else if (l->state == NCP_AX_STATUS_T_RUNNING && ncp_dist_rx_peek(&l->rx, slot + T, &ahead))
         cmd_ahead = l->cmd + fmax(-lim, fmin(lim, ncp_dist_nm_to_mm(ahead) - l->cmd));
     else {

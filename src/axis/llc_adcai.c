@@ -1,46 +1,28 @@
 /* The LLC at ADCAI's DP2 (roughIPObuf) and DP3 (ACCDECbuf): each rough
  * period's record, as it arrives, goes through this axis's stages below the
  * point (DP2: its ACC/DEC filters, then fine interpolation; DP3: fine
- * interpolation) into the setpoint buffer, one position per servo period
- * from the period the HLC stamped on it. From there the position loop plays
- * them as it plays DP5's, 3.5-4.5 periods behind the HLC (llc.c).
+ * interpolation) into samples numbered by the HLC's stream index, the first
+ * being the record's k. llc_ai_play.c plays them at the HLC's read position.
  *
  * The stages are src/adcai's, on integer nanometres, fed the same
  * increments as the HLC's central chain (the differences of the sums the
- * HLC sends), so the axis commands exactly what a central ADCAI run does.
- * A record lost is bridged as soon as a later one arrives: the missing
- * sums on the straight line to the later one's, so the stages get a
- * plausible increment and the later sum puts the axis back on the path, no
- * drift. With nothing later yet, the buffer holds and the loop counts it,
- * as at DP5 (MAX_LOST_PERIODS).
+ * HLC sends), so the axis's samples are exactly the central chain's. Between
+ * two records the chain may have stood (a dwell, a wait, the end of a job):
+ * those samples are where the stages rest. A record lost is bridged as soon
+ * as a later one arrives: the missing sums on the straight line to the later
+ * one's, just before it, so the stages get a plausible increment and the
+ * later sum puts the axis back on the path, no drift.
  *
- * A record stamped later than the one before it ended while the axis was
- * moving is the HLC's loop having skipped periods (a host stall): the
- * periods between hold where the axis was, since no later setpoint may be
- * guessed without leaving the other axes' path. That hold is a gap like a
- * held period at DP5, and the loop counts and traces it as one. */
+ * An abort at the HLC (stop, E-stop) resets its chain with the sums at 0
+ * where its loop rests, and numbers the next job: a record of a later job
+ * resets these stages the same way. Where that job starts on the axis comes
+ * with the HLC's read position (ai_scale_t); the samples are kept relative
+ * to it, so a record may arrive before it. */
 #include "axis.h"
-
-#include "ncpar/adcai.h"
+#include "llc_ai.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-struct llc_ai {
-    int dp;                         /* 1, 2 or 3 once begun, else 0 */
-    int ratio;
-    struct ncp_adcai_accdec *acc;   /* DP2 */
-    struct ncp_adcai_fine *fine;
-    int32_t next_seq;               /* the record expected next */
-    int32_t in_sum;                 /* this axis's input summed so far, nm (wraps) */
-    int64_t out_nm;                 /* the fine interpolator's output, the setpoint */
-    int64_t last_t;                 /* the period of the last setpoint put (0: none) */
-    int64_t moved_nm;               /* the last setpoint's step, nm */
-    int64_t hold_from, hold_to;     /* periods held in motion, [from, to] (to < from: none) */
-    int32_t put_seq;
-    int started;
-    uint32_t records, lost, stale;
-};
 
 struct llc_ai *llc_ai_new(const struct ncp_machine_cfg *cfg)
 {
@@ -51,13 +33,15 @@ struct llc_ai *llc_ai_new(const struct ncp_machine_cfg *cfg)
     if (!a)
         return NULL;
     a->ratio = ratio;
-    a->hold_to = -1;
+    a->scurve = cfg->profile == NCP_PROFILE_SCURVE;
     a->acc = ncp_adcai_accdec_new(n[0], n[1]);
     a->fine = ncp_adcai_fine_new(ratio, cfg->profile == NCP_PROFILE_SCURVE ? 2 : 1);
     if (!a->acc || !a->fine) {
         llc_ai_free(a);
         return NULL;
     }
+    for (int i = 0; i < LLC_AI_SAMPLES; i++)
+        a->smp_k[i] = -1;
     ncp_dist_ai_init();
     return a;
 }
@@ -69,17 +53,6 @@ void llc_ai_free(struct llc_ai *a)
     ncp_adcai_accdec_free(a->acc);
     ncp_adcai_fine_free(a->fine);
     free(a);
-}
-
-static void put(struct llc *l, int64_t t)
-{
-    (void)ncp_dist_rx_put(&l->rx, l->ai->put_seq++, t, (int32_t)l->ai->out_nm);
-    l->ai->last_t = t;
-}
-
-int llc_ai_held_in_motion(const struct llc_ai *a, int64_t slot)
-{
-    return slot >= a->hold_from && slot <= a->hold_to;
 }
 
 int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm)
@@ -125,33 +98,44 @@ int llc_ai_ratio(const struct llc_ai *a)
     return a->ratio;
 }
 
-/* One record through the stages: ratio setpoints from period t on. */
-static void stages(struct llc *l, int64_t t, int32_t sum)
+const struct llc_ai_job *llc_ai_job(const struct llc_ai *a, int32_t job)
 {
-    struct llc_ai *a = l->ai;
-    int64_t T = l->period_ns;
-    llc_ai_load(a, l->axis, sum);
-    /* the periods the HLC's stream stood still before this record: at rest
-     * where it is (the buffer would bridge towards the record, a creep) */
-    if (a->last_t) {
-        int64_t from = a->last_t + T;
-        if (from < t - (NCP_DIST_RX_SLOTS - 8) * T)
-            from = t - (NCP_DIST_RX_SLOTS - 8) * T;
-        if (from < t && a->moved_nm != 0) {
-            /* a range that may not have been played yet joins this one */
-            int recent = a->hold_to >= from - (a->ratio + NCP_DIST_PLAY_DELAY + 2) * T;
-            a->hold_from = recent && a->hold_from < from ? a->hold_from : from;
-            a->hold_to = t - T;
-        }
-        for (int64_t s = from; s < t; s += T)
-            put(l, s);
+    const struct llc_ai_job *j = &a->jobs[(uint32_t)job % LLC_AI_JOBS];
+    return j->known && j->job == job ? j : NULL;
+}
+
+static void put(struct llc_ai *a, int64_t k)
+{
+    unsigned i = (unsigned)((uint64_t)k % LLC_AI_SAMPLES);
+    a->smp_k[i] = k;
+    a->smp_job[i] = a->job;
+    a->smp_nm[i] = (int32_t)a->out_nm;
+}
+
+/* One record through the stages: ratio samples from k on, and before them
+ * the samples the chain stood at since the last one. */
+static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum)
+{
+    for (int64_t s = a->top_k > k - LLC_AI_SAMPLES ? a->top_k : k - LLC_AI_SAMPLES; s < k; s++)
+        put(a, s);
+    llc_ai_load(a, axis, sum);
+    for (int i = 0; i < a->ratio; i++) {
+        (void)llc_ai_step(a, axis);
+        put(a, k + i);
     }
-    for (int k = 0; k < a->ratio; k++) {
-        int64_t before = a->out_nm;
-        (void)llc_ai_step(a, l->axis);
-        a->moved_nm = a->out_nm - before;
-        put(l, t + k * T);
-    }
+    a->top_k = k + a->ratio;
+}
+
+/* A later job's first record: the stages start again, at rest at 0. */
+static void new_job(struct llc_ai *a, int32_t job, int64_t k)
+{
+    ncp_adcai_accdec_reset(a->acc);
+    ncp_adcai_fine_reset(a->fine);
+    a->job = job;
+    a->in_sum = 0;
+    a->out_nm = 0;
+    const struct llc_ai_job *j = llc_ai_job(a, job);
+    a->top_k = j && j->k <= k ? j->k : k;
 }
 
 void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len)
@@ -159,33 +143,48 @@ void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len)
     struct llc_ai *a = l->ai;
     struct ncp_dist_ai r;
     if (!a || ncp_dist_decode_ai(p, len, dp, &r) != 0 || r.sender != NCP_DIST_HLC_ID ||
-        r.n <= l->slot || r.t_ns <= 0 || (a->dp && a->dp != dp))
+        r.n <= l->slot || r.k < 0 || (a->dp && a->dp != dp))
         return;
-    /* the HLC's sums start at 0 where it found the axis: here */
-    if (!a->started)
-        llc_ai_begin(a, dp, l->cmd);
+    if (!a->started) {
+        a->started = 1;
+        a->dp = dp;
+        a->job = r.job;
+        a->next_seq = r.seq;
+        const struct llc_ai_job *j = llc_ai_job(a, r.job);
+        a->top_k = j && j->k <= r.k ? j->k : r.k;
+    }
     int32_t gap = r.seq - a->next_seq;
-    if (gap < 0) {
-        a->stale++;   /* a duplicate, or one already bridged */
+    if (gap < 0 || r.job < a->job || (r.job == a->job && r.k < a->top_k)) {
+        a->stale++;   /* a duplicate, one already bridged, or an aborted job's */
         l->rx.stale++;
         return;
     }
-    int64_t span = (int64_t)a->ratio * l->period_ns;
-    for (int32_t i = 1; i <= gap; i++) {
-        int32_t d = (int32_t)((uint32_t)r.sum_nm[l->slot] - (uint32_t)a->in_sum);
-        stages(l, r.t_ns - (gap + 1 - i) * span,
-               (int32_t)((uint32_t)a->in_sum + (uint32_t)(int32_t)((int64_t)d / (gap + 2 - i))));
-    }
+    a->next_seq = r.seq + 1;
     a->lost += (uint32_t)gap;
     l->rx.lost += (uint32_t)gap;
-    stages(l, r.t_ns, r.sum_nm[l->slot]);
-    a->next_seq = r.seq + 1;
+    if (r.job != a->job) {
+        new_job(a, r.job, r.k);
+        gap = 0;   /* what went missing before a job's start is no part of it */
+    }
+    /* the lost records lay just before this one, as far as the samples
+     * since the last one leave room for them */
+    int64_t room = (r.k - a->top_k) / a->ratio;
+    if (gap > room)
+        gap = (int32_t)room;
+    for (int32_t i = 1; i <= gap; i++) {
+        int32_t d = (int32_t)((uint32_t)r.sum_nm[l->slot] - (uint32_t)a->in_sum);
+        stages(a, l->axis, r.k - (int64_t)(gap + 1 - i) * a->ratio,
+               (int32_t)((uint32_t)a->in_sum + (uint32_t)(int32_t)((int64_t)d / (gap + 2 - i))));
+    }
+    stages(a, l->axis, r.k, r.sum_nm[l->slot]);
 }
 
 void llc_ai_report(const struct llc *l)
 {
     const struct llc_ai *a = l->ai;
     if (a && a->dp >= 2)
-        fprintf(stderr, "cnc-axis %c: DP %d: records %u, lost and bridged %u, stale %u\n",
-                NCP_AXIS_LETTERS[l->axis], a->dp, a->records, a->lost, a->stale);
+        fprintf(stderr, "cnc-axis %c: DP %d: records %u, lost and bridged %u, stale %u; read "
+                        "positions %u, jobs %u\n",
+                NCP_AXIS_LETTERS[l->axis], a->dp, a->records, a->lost, a->stale, a->scales,
+                a->jobs_played);
 }

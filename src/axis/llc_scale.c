@@ -17,6 +17,20 @@ static unsigned place(const struct llc *l, int64_t t)
     return (unsigned)((uint64_t)(t / l->period_ns) % LLC_SCALE_HIST);
 }
 
+void llc_scale_put(struct llc *l, int64_t t_ns, const double *adv, int count)
+{
+    for (int i = 0; i < count; i++) {
+        int64_t t = t_ns - (int64_t)(count - 1 - i) * l->period_ns;
+        unsigned k = place(l, t);
+        l->scale.t[k] = t;
+        l->scale.adv[k] = adv[i];
+    }
+    if (t_ns > l->scale.newest_t) {
+        l->scale.newest_t = t_ns;
+        l->scale.newest = adv[count - 1];
+    }
+}
+
 void llc_on_scale(struct llc *l, const uint8_t *p, size_t len)
 {
     ncp_time_scale_t m;
@@ -29,16 +43,7 @@ void llc_on_scale(struct llc *l, const uint8_t *p, size_t len)
      * memset's zeros. Bytes copied out are what was decoded. */
     double adv[16];
     memcpy(adv, m.adv, sizeof adv);
-    for (int i = 0; i < m.count; i++) {
-        int64_t t = m.t_ns - (int64_t)(m.count - 1 - i) * l->period_ns;
-        unsigned k = place(l, t);
-        l->scale.t[k] = t;
-        l->scale.adv[k] = adv[i];
-    }
-    if (m.t_ns > l->scale.newest_t) {
-        l->scale.newest_t = m.t_ns;
-        l->scale.newest = adv[m.count - 1];
-    }
+    llc_scale_put(l, m.t_ns, adv, m.count);
     if (m.void_below > l->scale.void_below && m.void_t_ns > 0) {
         l->scale.void_below = m.void_below;
         l->scale.void_t = m.void_t_ns;

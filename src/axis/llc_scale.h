@@ -28,6 +28,9 @@ struct llc_scale {
 
 struct llc;
 void llc_on_scale(struct llc *l, const uint8_t *p, size_t len);
+/* count periods' advances, the last of period t_ns, into the history (the
+ * same for ADCAI's ai_scale_t, llc_ai_play.c). */
+void llc_scale_put(struct llc *l, int64_t t_ns, const double *adv, int count);
 /* The stream advance of the HLC's period slot (samples; 1 its own pace). */
 double llc_scale_at(const struct llc *l, int64_t slot);
 /* Drops the records an abort of the HLC's made void, once slot reaches

@@ -49,6 +49,7 @@
 #define STOP_WAIT_NS 3000000000LL
 #define SCALE_WINDOW 16   /* periods each time_scale_t carries */
 #define SCALE_AFTER 32    /* periods an advance of 1 is still said after one that was not */
+#define HOMING_AFTER 20   /* periods fine setpoints still go out after homing */
 
 struct peer {
     int axis;
@@ -101,6 +102,7 @@ struct lcm_be {
     int rest;                /* the path stood still last period */
     int hold;                /* drives off (serve's E-stop, a fault): HOLD every period */
     int release;             /* periods left that say RUN after a hold (one may be lost) */
+    int homing_left;         /* block-level and ADCAI points: periods of fine setpoints left */
     double prev_cmd[NCP_AXES];
     struct lcm_clock clk;    /* answers the LLCs' clock probes; the HLC's clock */
     uint64_t ends_sent;      /* heartbeats saying done (or stop) at the end */
@@ -590,9 +592,22 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
         if (s->dp1 && s->cycles % 20 == 0)   /* an LLC that lost the first one */
             lcm_dp1_send(s->dp1, s->msg);
     } else if (s->ai) {
-        lcm_ai_cycle(s->ai, s->msg, t, cmd);
+        lcm_ai_cycle(s->ai, s->msg, t, skipped, b, cmd);
     } else {
         send_fine(s, t, cmd);
+    }
+    /* homing is the loop's own motion, in no record: at ADCAI's DP3 and
+     * DP2 the LLCs play these meanwhile, and for a while after (the last
+     * ones may be lost); the NCK then restarts the planner where homing left
+     * the axes (an abort of nothing), which starts their stages again
+     * (ADCBI's block-level points refuse homing that moves, control.c) */
+    if (s->ai) {
+        if (b->homing)
+            s->homing_left = HOMING_AFTER;
+        if (s->homing_left > 0) {
+            s->homing_left -= !b->homing;
+            send_fine(s, t, cmd);
+        }
     }
     if (s->hold || s->release > 0 || now - s->last_hb >= s->hb_period) {
         s->release -= s->release > 0;
@@ -690,7 +705,9 @@ static void lcm_stop(struct ncp_backend *b)
                 s->tx->burst_bytes,
                 s->tx->burst_bytes + 8 + (int)strlen(s->tx->kind->channel) + 1,
                 (unsigned long long)s->tx->resent, (unsigned long long)s->tx->overflow);
-    if (s->tx && !s->dp1)
+    if (s->ai)
+        ;   /* its line says how the read positions went */
+    else if (s->tx && !s->dp1)
         fprintf(stderr, "lcm: time scaling: %llu messages (the stream's advance not 1, and "
                         "%d periods after)\n",
                 (unsigned long long)s->scale_sent, SCALE_AFTER);

@@ -91,8 +91,8 @@ static void usage(FILE *f)
           "                      fault or EMCY is state fault with its code and meaning\n"
           "  --backend lcm       the distributed NCK: one `cnc-axis` per axis of the INI on\n"
           "                      the same LCM URL and key (docs/distributed.md); real clock\n"
-          "                      only. Served at ADCBI DP 5, 4, 3 and 2 and ADCAI DP 4\n"
-          "                      (ADCBI DP 1 and ADCAI DP 3, 2 are refused). An LLC\n"
+          "                      only. Served at ADCBI DP 5, 4, 3, 2 and ADCAI DP 4, 3, 2\n"
+          "                      (DP 1, where each LLC runs the program, is refused). An LLC\n"
           "                      lost or stopped on its own is state fault naming its axis,\n"
           "                      the others held; E-stop holds every LLC's command where\n"
           "                      it is (their heartbeat watch stops them if serve dies)\n"
@@ -293,8 +293,11 @@ static int servable(const struct serve_channel *ch, const char *cell)
      * time scaling period by period and drops what an abort drops (lcm.c,
      * src/axis/llc_scale.c; at DP2 what its own planner made before the
      * abort's DROP call, dp_block.c), so a hold, stop or E-stop stops it on
-     * the path and the next job starts clean */
-    if (c->lcm.dp == fine || (!adcai && c->lcm.dp >= 2 && c->lcm.dp <= 4))
+     * the path and the next job starts clean. ADCAI's DP3 and DP2: each LLC
+     * plays its stages' samples at the loop's read position and starts its
+     * stages again with the job after an abort (lcm_ai.c,
+     * src/axis/llc_ai_play.c) */
+    if (c->lcm.dp == fine || (c->lcm.dp >= 2 && c->lcm.dp <= (adcai ? 3 : 4)))
         return 0;
     char where[PATH_MAX + 64];
     if (ch->cc)
@@ -303,19 +306,12 @@ static int servable(const struct serve_channel *ch, const char *cell)
     else
         snprintf(where, sizeof where, "cnc-run serve: ");
     return fprintf(stderr, "%s--backend lcm --dp %d ([PLANNER] NCK = %s) is not "
-                           "served: at this point each LLC computes its own command from what "
-                           "it was sent ahead (%s), and %s; serve runs the distributed NCK at %s "
-                           "(cnc-run run --backend lcm runs a program at DP %d)\n",
-                   where,
-                   c->lcm.dp, adcai ? "adcai" : "adcbi",
-                   c->lcm.dp == 1 ? "it runs the program itself"
-                                  : "its own stages below the point, at the program's pace",
-                   c->lcm.dp == 1 ? "no message takes an aborted job back out of its NCK yet: "
-                                    "a stop or E-stop from the seat could not end it"
-                                  : "they follow neither the HLC's feed hold nor an abort yet: "
-                                    "a pause, stop or E-stop from the seat could not stop "
-                                    "them on the path or end the job",
-                   adcai ? "ADCAI's fine setpoints, --dp 4" : "ADCBI's --dp 5, 4, 3 or 2",
+                           "served: at this point each LLC runs the program itself, and no "
+                           "message takes an aborted job back out of its NCK yet: a stop or "
+                           "E-stop from the seat could not end it; serve runs the distributed "
+                           "NCK at %s (cnc-run run --backend lcm runs a program at DP %d)\n",
+                   where, c->lcm.dp, adcai ? "adcai" : "adcbi",
+                   adcai ? "ADCAI's --dp 4, 3 or 2" : "ADCBI's --dp 5, 4, 3 or 2",
                    c->lcm.dp), -1;
 }
 

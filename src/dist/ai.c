@@ -20,10 +20,10 @@ int ncp_dist_encode_ai(uint8_t *buf, size_t size, int dp, const struct ncp_dist_
     int32_t sum[NCP_AXES];
     memcpy(sum, r->sum_nm, sizeof sum);
     if (dp == 2) {
-        ncp_rough_ipo_t m = { r->seq, r->sender, r->t_ns, r->flag, r->n, sum };
+        ncp_rough_ipo_t m = { r->seq, r->sender, r->k, r->job, r->flag, r->n, sum };
         return ncp_rough_ipo_t_encode(buf, 0, (int)size, &m);
     }
-    ncp_accdec_ai_t m = { r->seq, r->sender, r->t_ns, r->n, sum };
+    ncp_accdec_ai_t m = { r->seq, r->sender, r->k, r->job, r->n, sum };
     return ncp_accdec_ai_t_encode(buf, 0, (int)size, &m);
 }
 
@@ -35,10 +35,10 @@ static uint64_t be(const uint8_t *p, int bytes)
     return v;
 }
 
-/* fingerprint 8, seq 4, sender 2, t_ns 8, [flag 1,] n 1, then n times 4 */
+/* fingerprint 8, seq 4, sender 2, k 8, job 4, [flag 1,] n 1, then n times 4 */
 int ncp_dist_decode_ai(const uint8_t *buf, size_t len, int dp, struct ncp_dist_ai *r)
 {
-    size_t fixed = dp == 2 ? 24 : 23;
+    size_t fixed = dp == 2 ? 28 : 27;
     if ((dp != 2 && dp != 3) || len < fixed ||
         (int64_t)be(buf, 8) != (dp == 2 ? rough_hash : accdec_hash))
         return -1;
@@ -47,8 +47,9 @@ int ncp_dist_decode_ai(const uint8_t *buf, size_t len, int dp, struct ncp_dist_a
         return -1;
     r->seq = (int32_t)(uint32_t)be(buf + 8, 4);
     r->sender = (int16_t)(uint16_t)be(buf + 12, 2);
-    r->t_ns = (int64_t)be(buf + 14, 8);
-    r->flag = dp == 2 ? (int8_t)buf[22] : 0;
+    r->k = (int64_t)be(buf + 14, 8);
+    r->job = (int32_t)(uint32_t)be(buf + 22, 4);
+    r->flag = dp == 2 ? (int8_t)buf[26] : 0;
     r->n = (int8_t)n;
     for (int i = 0; i < n; i++)
         r->sum_nm[i] = (int32_t)(uint32_t)be(buf + fixed + (size_t)4 * (size_t)i, 4);

@@ -581,6 +581,12 @@ static int blocks_lcm(const struct ncp_machine_cfg *cfg)
            cfg->lcm.dp <= 4;
 }
 
+static int cfg_ai_stages(const struct ncp_machine_cfg *cfg)
+{
+    return cfg->backend == NCP_BACKEND_LCM && cfg->nck == NCP_NCK_ADCAI && cfg->lcm.dp >= 2 &&
+           cfg->lcm.dp <= 3;
+}
+
 /* Homing (homing.c): `all` (or nothing) homes the axes of the HOME_SEQUENCE
  * list, letters name axes (`XZ`); either way by sequence, the position
  * loop driving the axes itself. */
@@ -979,7 +985,13 @@ static void homing_ended(struct ncp_nck *s)
     sync_interp(s);
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
-    set_state(s, NCP_ST_IDLE);
+    /* ADCAI's LLCs at DP3 and DP2 played homing on the loop's own
+     * setpoints; their stages start again where it left the axes, as the
+     * planner does after an abort (lcm_ai.c numbers a new job) */
+    if (cfg_ai_stages(n->cfg))
+        begin_drop(s, 0, 0, NCP_ST_IDLE, 0);
+    else
+        set_state(s, NCP_ST_IDLE);
 }
 
 static void check_fault(struct ncp_nck *s)

@@ -101,6 +101,7 @@ static int init_motion(struct nck_core *n)
     n->loop->decel_normal = 0.5 * a_min;
     n->loop->decel_full = a_min;
     ncp_scaler_init(&n->loop->scaler, n->start, n->loop->decel_normal, c->servo_period);
+    n->loop->read_k_next = -2;   /* a and b: the start, before the first sample */
     int ratio = nck_plan_stream_ratio(c);
     if (ratio < 1)
         return -1;

@@ -202,6 +202,7 @@ static void finish(struct nck_core *n)
     n->loop->next.v = 0;
     memcpy(n->cross.home.final, n->loop->next.pos, sizeof n->cross.home.final);
     ncp_scaler_rebase(&n->loop->scaler, n->loop->next.pos);
+    nck_loop_note_read(n);
     n->loop->ends_seen = n->loop->scaler.ends;
     atomic_store_explicit(&n->cross.home.done, h->taken, memory_order_release);
 }

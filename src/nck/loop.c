@@ -144,6 +144,25 @@ static int stream_expected(const struct nck_core *n)
            !end_in_ring(n) && !atomic_load_explicit(&n->cross.job_waiting, memory_order_relaxed);
 }
 
+/* Where the scaler read the stream for next (backend.h's read_k): the
+ * samples it holds are a, b and, fetched ahead, c, each popped in turn from
+ * the ring whose head counts them all. */
+void nck_loop_note_read(struct nck_core *n)
+{
+    int64_t head = (int64_t)atomic_load_explicit(&n->cross.sps.head, memory_order_relaxed);
+    n->loop->read_k_next = head - (n->loop->scaler.have_c ? 3 : 2);
+    n->loop->read_f_next = n->loop->scaler.f;
+}
+
+/* next becomes this cycle's command: its read goes to the backend. */
+void nck_loop_take_read(struct nck_core *n)
+{
+    n->cross.be.adv = n->loop->adv_next;
+    n->cross.be.read_k = n->loop->read_k_next;
+    n->cross.be.read_f = n->loop->read_f_next;
+    n->loop->adv_next = 0;
+}
+
 /* The servo sees one setpoint ahead (the command runs one period late), so
  * its feed-forward uses the velocity of the interval it is about to drive. */
 static int take_setpoint(struct nck_core *n)
@@ -153,8 +172,7 @@ static int take_setpoint(struct nck_core *n)
     struct ncp_setpoint before = n->loop->next;
     if (nck_aux_cycle(n)) {
         n->loop->cur = before;   /* a synchronised run writes the next itself */
-        n->cross.be.adv = n->loop->adv_next;
-        n->loop->adv_next = 0;
+        nck_loop_take_read(n);
         return NCP_RT_CONTINUE;
     }
     if (!n->loop->ended && n->setup.virtual_clock &&
@@ -162,12 +180,13 @@ static int take_setpoint(struct nck_core *n)
         stream_expected(n))
         return NCP_RT_RETRY;
     n->loop->cur = n->loop->next;
-    n->cross.be.adv = n->loop->adv_next;
-    n->loop->adv_next = 0;
+    nck_loop_take_read(n);
     if (!n->loop->ended && ncp_scaler_step(&n->loop->scaler, rate_target(n), &n->cross.sps, &n->loop->next) != 0)
         n->loop->dry++;
-    if (!n->loop->ended)
+    if (!n->loop->ended) {
         n->loop->adv_next = n->loop->scaler.adv;
+        nck_loop_note_read(n);
+    }
     if (n->loop->next.aux > n->loop->mach.seq_reached)
         n->loop->mach.seq_reached = n->loop->next.aux;
     if (n->loop->scaler.ends != n->loop->ends_seen) {
@@ -216,6 +235,8 @@ static void discard(struct nck_core *n, const double act[NCP_AXES])
     n->loop->probe.state = NCK_PROBE_OFF;
     ncp_scaler_rebase(&n->loop->scaler, at);
     n->loop->adv_next = 0;
+    nck_loop_note_read(n);
+    n->cross.be.drop_k = n->loop->read_k_next + 2;
     n->cross.be.discards++;
     n->loop->scaler.decel = n->loop->decel_normal;
     memset(&n->loop->cur, 0, sizeof n->loop->cur);
@@ -379,13 +400,14 @@ int nck_position_cycle(void *ctx, int64_t now_ns)
             if (virt)
                 return NCP_RT_RETRY;
             n->loop->cur = n->loop->next;
-            n->cross.be.adv = n->loop->adv_next;
-            n->loop->adv_next = 0;
+            nck_loop_take_read(n);
         } else if (take_setpoint(n) == NCP_RT_RETRY) {
             return NCP_RT_RETRY;
         }
+        n->cross.be.homing = 0;
     } else {
         n->cross.be.adv = 0;
+        n->cross.be.homing = 1;
     }
     uint64_t home = nck_home_phases(n);   /* the row shows the phase the period ran in */
     double act[NCP_AXES];

@@ -18,6 +18,8 @@ struct nck_loop {
     struct ncp_scaler scaler;
     double decel_normal, decel_full;
     double adv_next;          /* the scaler's read advance that made next (backend.h's adv) */
+    int64_t read_k_next;      /* and where it read then (backend.h's read_k, read_f) */
+    double read_f_next;
     int slowing;
     uint64_t dry, underruns, fb_dropped;
     int end_seen;                    /* the output sits on an END sample */

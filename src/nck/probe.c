@@ -110,6 +110,7 @@ void nck_probe_cycle(struct nck_core *n, const double act[NCP_AXES])
     uint32_t aux = 0;
     if (p->state == NCK_PROBE_DROPPING && drop_to_stop(n, &aux)) {
         ncp_scaler_rebase(&n->loop->scaler, n->loop->cur.pos);
+        nck_loop_note_read(n);
         /* the trace keeps the probe's line while the interpreter catches up */
         n->loop->scaler.a.line = n->loop->scaler.b.line = n->loop->cur.line;
         n->loop->next = n->loop->cur;

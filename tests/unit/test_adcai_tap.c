@@ -135,21 +135,24 @@ static void test_codec(void **state)
     (void)state;
     ncp_dist_ai_init();
     for (int dp = 2; dp <= 3; dp++) {
-        struct ncp_dist_ai r = { 7, NCP_DIST_HLC_ID, 987654321000LL, 1, 3, { -1, 2147483647, 5 } };
+        struct ncp_dist_ai r = { 7, NCP_DIST_HLC_ID, 987654321000LL, -3, 1, 3,
+                                   { -1, 2147483647, 5 } };
         uint8_t buf[128];
         int len = ncp_dist_encode_ai(buf, sizeof buf, dp, &r);
-        /* the paper's 1+4N (DP2) or 4N (DP3), plus fingerprint, seq, sender, period, n */
-        assert_int_equal(len, 8 + 4 + 2 + 8 + (dp == 2) + 1 + 4 * 3);
+        /* the paper's 1+4N (DP2) or 4N (DP3), plus fingerprint, seq, sender,
+         * stream index, job, n */
+        assert_int_equal(len, 8 + 4 + 2 + 8 + 4 + (dp == 2) + 1 + 4 * 3);
         struct ncp_dist_ai h;
         assert_int_equal(ncp_dist_decode_ai(buf, (size_t)len, dp, &h), 0);
         assert_memory_equal(h.sum_nm, r.sum_nm, 3 * sizeof(int32_t));
-        assert_true(h.seq == 7 && h.t_ns == r.t_ns && h.n == 3 && h.flag == (dp == 2));
+        assert_true(h.seq == 7 && h.k == r.k && h.job == -3 && h.n == 3 && h.flag == (dp == 2));
         if (dp == 2) {
             ncp_rough_ipo_t g;
             memset(&g, 0, sizeof g);
             assert_int_equal(ncp_rough_ipo_t_decode(buf, 0, len, &g), len);
             assert_int_equal(g.sum_nm[1], 2147483647);
             assert_int_equal(g.flag, 1);
+            assert_int_equal(g.job, -3);
             ncp_rough_ipo_t_decode_cleanup(&g);
         } else {
             ncp_accdec_ai_t g;
