@@ -28,6 +28,7 @@
 #include <string.h>
 
 #define LEAD 128          /* samples a record is sent ahead of the loop's read */
+#define SENDS_MAX 16      /* records a period at most: a start's lead builds up over a few */
 #define SCALE_AFTER 32    /* periods an advance of 1 is still said after one that was not */
 #define SCALE_EVERY 100   /* periods between messages at the stream's own pace */
 
@@ -127,7 +128,7 @@ void lcm_ai_cycle(struct lcm_ai *x, struct ncp_msg *m, int64_t t, int64_t skippe
         base_at(x, cmd);
         x->left = SCALE_AFTER;
     }
-    for (;;) {
+    for (int sends = 0; sends < SENDS_MAX;) {
         if (!x->have_front) {
             x->have_front = ncp_spsc_pop(&x->tapped, &x->front) == 0;
             if (!x->have_front)
@@ -142,8 +143,10 @@ void lcm_ai_cycle(struct lcm_ai *x, struct ncp_msg *m, int64_t t, int64_t skippe
         }
         if (k > b->read_k + LEAD)
             break;
-        if (x->front.start)
+        if (x->front.start) {
             send_record(x, m, k, &x->front);
+            sends++;
+        }
         x->have_front = 0;
     }
     for (int64_t i = 0; i < skipped && i < LCM_AI_WINDOW; i++)
