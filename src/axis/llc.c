@@ -289,8 +289,8 @@ static int ai_ahead(struct llc *l, int64_t slot, double *mm)
  * 0 its own stream. */
 static int fine_phase(struct llc *l, int64_t slot)
 {
-    int32_t nm;
-    if (ncp_dist_rx_peek(&l->rx, slot, &nm)) {
+    int32_t at;
+    if (ncp_dist_rx_peek(&l->rx, slot, &at)) {
         l->fine_mode = 1;
         l->fine_last = slot;
         return 1;
