@@ -38,6 +38,7 @@ struct ncp_pipe_worker {
     int index;
     uint64_t items;              /* written by this worker's thread only */
     double cpu_ms;               /* its thread's CPU time, set as it ends */
+    double wall_ms;              /* its stage's span, set as it ends */
 };
 
 struct ncp_pipe {
