@@ -59,9 +59,10 @@ static void print_thread(const char *role, int index, const struct ncp_stage_sta
         snprintf(busy, sizeof busy, "%5.1f %%", 100.0 * s->cpu_ms / s->wall_ms);
     double share = total_cpu > 0 ? 100.0 * s->cpu_ms / total_cpu : 0;
     fprintf(stderr,
-            "cnc-run: thread %-10s cpu %9.1f ms  wall %9.1f ms  busy %s  "
+            "cnc-run: thread %-10s cpu %9.1f ms  sys %8.1f ms  wall %9.1f ms  busy %s  "
             "share %5.1f %%  waits %llu/%llu/%llu\n",
-            name, s->cpu_ms, s->wall_ms, busy, share, (unsigned long long)s->empty_waits,
+            name, s->cpu_ms, s->sys_ms, s->wall_ms, busy, share,
+            (unsigned long long)s->empty_waits,
             (unsigned long long)s->full_waits, (unsigned long long)s->sleeps);
 }
 

@@ -55,6 +55,7 @@ int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *
                    struct ncp_diag *d)
 {
     double t0 = (double)ncp_mono_ns() / 1e6, cpu0 = ncp_pipe_thread_cpu_ms();
+    double sys0 = ncp_pipe_thread_sys_ms();
     struct ncp_text_feed *feed = malloc(sizeof *feed);
     struct serial_sink *sink = malloc(sizeof *sink);
     struct ncp_analyzer *an = NULL;
@@ -108,6 +109,7 @@ done:
          * time per stage is read against this */
         stats->analyzer.cpu_ms = ncp_pipe_thread_cpu_ms() - cpu0;
         stats->analyzer.wall_ms = stats->wall_ms;
+        stats->analyzer.sys_ms = ncp_pipe_thread_sys_ms() - sys0;
         stats->analyzer.items = stats->blocks;
     }
     if (!acfg || an != acfg->instance)
