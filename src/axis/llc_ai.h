@@ -47,7 +47,7 @@ struct llc_ai {
         double f;
         int32_t job;
         int64_t job_t;      /* the period its job started in */
-        double adv[16];     /* the advances up to it, oldest first */
+        double adv[4];      /* the advances up to it, oldest first */
     } marks[LLC_AI_MARKS];
     int have_marks;
     /* the play: the job, the read position of the last slot played */

@@ -44,12 +44,12 @@ void llc_ai_on_scale(struct llc *l, const uint8_t *p, size_t len)
     ncp_ai_scale_t m;
     memset(&m, 0, sizeof m);
     if (!a || ncp_ai_scale_t_decode(p, 0, (int)len, &m) != (int)len ||
-        m.sender != NCP_DIST_HLC_ID || m.count < 1 || m.count > 16 || m.n <= l->slot ||
+        m.sender != NCP_DIST_HLC_ID || m.count < 1 || m.count > 4 || m.n <= l->slot ||
         m.n > NCP_AXES || m.job < 0)
         return;
     /* lcm-gen decodes doubles through int64_t pointers: copied out as
      * bytes (see llc_scale.c) */
-    double adv[16], f;
+    double adv[4], f;
     memcpy(adv, m.adv, sizeof adv);
     memcpy(&f, &m.read_f, sizeof f);
     struct llc_ai_job *j = &a->jobs[(uint32_t)m.job % LLC_AI_JOBS];
@@ -75,8 +75,8 @@ void llc_ai_on_scale(struct llc *l, const uint8_t *p, size_t len)
     k->f = f;
     k->job = m.job;
     k->job_t = m.job_t_ns;
-    for (int i = 0; i < 16; i++)
-        k->adv[i] = i >= 16 - m.count ? adv[i - (16 - m.count)] : 1.0;
+    for (int i = 0; i < 4; i++)
+        k->adv[i] = i >= 4 - m.count ? adv[i - (4 - m.count)] : 1.0;
     a->have_marks = 1;
     a->scales++;
     /* the HLC's grid, as at the other points */
@@ -135,10 +135,10 @@ static int read_at(const struct llc *l, int64_t slot, struct readpos *r, int *be
     if (w->t >= slot) {
         /* a period the loop slept through (-1) read nothing */
         for (int64_t u = w->t; u > slot; u -= T)
-            r->f -= fmax(0.0, w->adv[15 - (w->t - u) / T]);
+            r->f -= fmax(0.0, w->adv[3 - (w->t - u) / T]);
     } else {
         int64_t n = (slot - w->t) / T;
-        r->f += (double)n * fmax(0.0, w->adv[15]);
+        r->f += (double)n * fmax(0.0, w->adv[3]);
     }
     normalise(r);
     struct readpos prev = { a->play_job, a->play_k, a->play_f };
