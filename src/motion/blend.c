@@ -186,7 +186,11 @@ static int plane_arc(const struct ncp_seg *s)
  * corner parabola through the pull of X (a circle tangent at those points
  * where s is too small for a parabola). Its distance from the programmed
  * path is at most the blend's from X plus X's from the corner plus the arc's
- * sagitta over the cut. Returns 0 when the cut gives no proper blend. */
+ * sagitta over the cut. Where the line turns the same way as the arc, the
+ * tangent meets it only behind the corner, on its extension (q < 0): X is
+ * then that far outside, which the same sum counts (so only under a G64 P),
+ * and the blend still ends on the line as long as s reaches past the corner. Returns 0 when the cut
+ * gives no proper blend. */
 static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, double arc_trim,
                     struct ncp_seg *arc, struct ncp_seg *prev_out, struct ncp_seg *cur_out,
                     double *dev)
@@ -208,7 +212,9 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
     cross3(d, t2, a);
     cross3(d, t1, b);
     double s = dot3(a, n) / nn, q = dot3(b, n) / nn;
-    if (s <= 0 || q < 0 || q + s > 0.5 * cur->length)
+    /* X behind the corner only where P bounds how far outside it lies: as
+     * the cut grows it runs away from the path far faster than in front */
+    if (s <= 0 || q + s <= 0 || (q < 0 && prev->tolerance <= 0) || q + s > 0.5 * cur->length)
         return 0;
     double phi = acos(c), r = s / tan(0.5 * phi);
     double xc = 0, nin[3], nl = 0, du = 0;

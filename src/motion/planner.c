@@ -938,11 +938,120 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     return 1;
 }
 
+/* Pieces a programmed arc's ends are cut into (push_arc), each: a middle
+ * piece joins them, so an arc is queued as at most 2 ARC_END_PIECES + 1. */
+#define ARC_END_PIECES 2
+#define ARC_PIECES_MAX (2 * ARC_END_PIECES + 1)
+/* Each piece at least this many times G64 P long: the blend into the line
+ * after an arc may cut up to half of its last piece, and a corner turning by
+ * 30 degrees or more needs at most 4 P / |u2 - u1| <= 8 P of it. */
+#define ARC_PIECE_MIN_P 16
+/* Cut only where the turn takes at least this share of the arc's
+ * acceleration bound at its cruise cap: below it the tangent has most of it
+ * already. */
+#define ARC_PIECE_AN 0.5
+
+/* The part of arc s from l0 to l1 of its parameter (eval_arc's l). */
+static void arc_piece(const struct ncp_seg *s, double l0, double l1, struct ncp_seg *o)
+{
+    double tan[NCP_AXES], a = s->angle * l0, c = cos(a), sn = sin(a);
+    *o = *s;
+    for (int i = 0; i < 3; i++) {
+        o->u[i] = c * s->u[i] + sn * s->w[i];
+        o->w[i] = c * s->w[i] - sn * s->u[i];
+        o->center[i] = s->center[i] + s->normal[i] * s->axial * l0;
+    }
+    o->axial = s->axial * (l1 - l0);
+    o->angle = s->angle * (l1 - l0);
+    o->r0 = s->r0 + (s->r1 - s->r0) * l0;
+    o->r1 = s->r0 + (s->r1 - s->r0) * l1;
+    o->length = s->length * (l1 - l0);
+    ncp_seg_eval(s, s->length * l0, o->start, tan);
+    if (l1 < 1)
+        ncp_seg_eval(s, s->length * l1, o->end, tan);
+}
+
+/* Where arc s is cut (cut[0] = 0 < ... < cut[n] = 1, fractions of its
+ * length); returns n, the number of pieces. An arc's tangent gets more of
+ * its acceleration bound the slower it runs (plan_acc_at), but one
+ * trapezoid runs at one constant acceleration, that of its top speed: an arc
+ * braking from its cruise cap (where the turn leaves the tangent half the
+ * bound) to a slow corner or a stop brakes at that half all the way. The
+ * speed changes near the ends, within the braking distance d from the cap,
+ * and a speed change's distance grows as the square of the speed: cut at
+ * d (k / ARC_END_PIECES)^2 from each end, so that each end piece spans about
+ * the same speed and brakes (or speeds up) at what its own top leaves. */
+static int arc_cuts(const struct ncp_planner *p, const struct ncp_seg *s,
+                    double cut[ARC_PIECES_MAX + 1])
+{
+    cut[0] = 0;
+    cut[1] = 1;
+    if (s->kind != NCP_SEG_ARC || plan_scurve(p) || s->length <= 0)
+        return 1;
+    double piece_min = 0;
+    if (s->term == NCP_TERM_CONTINUOUS) {
+        if (s->tolerance <= 0)
+            return 1;  /* the blend after it may take up to half of the arc */
+        piece_min = ARC_PIECE_MIN_P * s->tolerance;
+    }
+    struct plan_seg ps;
+    memset(&ps, 0, sizeof ps);
+    ps.s = *s;
+    arc_limits(p, &ps, ARC_AN_SHARE);
+    if (!(ps.kappa > 0) || !(ps.a_eff > 0) ||
+        ps.vmax * ps.vmax * ps.kappa < ARC_PIECE_AN * ps.a_eff)
+        return 1;
+    double d = ps.vmax * ps.vmax / (2 * ps.a_eff), len = s->length;
+    double from_end[ARC_END_PIECES] = { 0 };
+    int m = 0;
+    for (int k = 1; k <= ARC_END_PIECES; k++) {
+        /* each piece piece_min or longer, the middle one included */
+        double x = fmax(d * (double)(k * k) / (ARC_END_PIECES * ARC_END_PIECES),
+                        (m ? from_end[m - 1] : 0) + piece_min);
+        if (2 * x + piece_min > len)
+            break;
+        from_end[m++] = x;
+    }
+    /* room for them and for the next push (a blend and a segment) */
+    while (m > 0 && p->count + (size_t)(2 * m + 1) + 2 > p->cap)
+        m--;
+    for (int k = 0; k < m; k++) {
+        cut[1 + k] = from_end[k] / len;
+        cut[2 * m - k] = 1 - from_end[k] / len;
+    }
+    cut[2 * m + 1] = 1;
+    return 2 * m + 1;
+}
+
+/* Queues s, an arc in pieces (arc_cuts): they meet tangent with the same
+ * curvature, so the path is the same and no corner is added. Each takes a
+ * place in the look-ahead window (LOOKAHEAD counts segments; counted as one,
+ * the window's blends would fill the ring and leave no room to cut). Only
+ * the last keeps how s ends (an exact stop, single block). */
+static void push_arc(struct ncp_planner *p, const struct ncp_seg *s)
+{
+    double cut[ARC_PIECES_MAX + 1];
+    int n = arc_cuts(p, s, cut);
+    if (n <= 1) {
+        push_one(p, s, 0);
+        return;
+    }
+    for (int k = 0; k < n; k++) {
+        struct ncp_seg piece;
+        arc_piece(s, cut[k], cut[k + 1], &piece);
+        if (k + 1 < n)
+            piece.term = NCP_TERM_CONTINUOUS;
+        push_one(p, &piece, 0);
+        if (k > 0)
+            p->st.segments--;  /* the statistics count programmed segments */
+    }
+}
+
 static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
 {
     struct ncp_seg cur = *s;
     try_blend(p, &cur);
-    push_one(p, &cur, 0);
+    push_arc(p, &cur);
 }
 
 /* Queues what fairing handed on. */

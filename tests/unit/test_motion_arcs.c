@@ -2,8 +2,9 @@
  * moves below its cruise cap spends the acceleration its centripetal part
  * leaves free on the tangent; arcs joined with the small kinks of four-decimal
  * CAM output keep their cruise speed; a G64 blend where a line meets an arc
- * stays within P and does not stop. Every run also keeps every axis within its
- * velocity and acceleration limits. */
+ * stays within P and does not stop; an arc queued in pieces brakes with what
+ * each speed leaves. Every run also keeps every axis within its velocity and
+ * acceleration limits. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -141,12 +142,62 @@ static void test_line_arc_blend_within_p(void **state)
     free(r);
 }
 
+/* A half circle of radius 2 mm from rest to rest at F3000. The fastest run
+ * the planner's arc model allows (the acceleration vector within the disc
+ * of the axes' 1000 mm/s^2, the turn at v^2 / r, the tangent with what is
+ * left, sqrt(a^2 - (v^2 / r)^2), the speed at most sqrt(0.866 a r) =
+ * 41.6 mm/s), integrated here over the length: 0.194 s. As one trapezoid
+ * the arc speeds up and brakes at the single acceleration its top speed
+ * leaves (500 mm/s^2): 0.235 s. Queued in pieces cut near its ends, each
+ * piece takes its own: the run must come within 5 % of the integral, on
+ * the radius and within every axis's limits. */
+static void test_arc_brakes_with_what_each_speed_leaves(void **state)
+{
+    (void)state;
+    struct ncp_machine_cfg cfg;
+    lcnc_like_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text("G21 G90 G17 G64 P0.01 Q0\nG3 X-4 Y0 I-2 J0 F3000\nM2\n", &cfg, &n, &res);
+    const double T = cfg.servo_period, rad = 2, len = M_PI * rad;
+    double cap = fmin(50, sqrt(0.866 * AMAX * rad)), t_opt = 0;
+    enum { STEPS = 100000 };
+    static double vf[STEPS + 1];
+    vf[0] = 0;
+    for (int i = 0; i < STEPS; i++) {
+        double an = vf[i] * vf[i] / rad, at = sqrt(fmax(0, AMAX * AMAX - an * an));
+        vf[i + 1] = fmin(cap, sqrt(vf[i] * vf[i] + 2 * at * len / STEPS));
+    }
+    /* rest to rest on a symmetric path: braking mirrors speeding up */
+    for (int i = 0; i < STEPS; i++) {
+        double v0 = fmin(vf[i], vf[STEPS - i]), v1 = fmin(vf[i + 1], vf[STEPS - i - 1]);
+        t_opt += 2 * (len / STEPS) / (v0 + v1);
+    }
+    size_t first = 0, last = 0;
+    double off = 0;
+    for (size_t k = 0; k < n; k++) {
+        if (hypot(r[k].cmd[0], r[k].cmd[1]) < 2e-6)
+            first = k;
+        if (!last && hypot(r[k].cmd[0] + 4, r[k].cmd[1]) < 2e-6)
+            last = k;
+        off = fmax(off, fabs(hypot(r[k].cmd[0] + 2, r[k].cmd[1]) - rad));
+    }
+    double t = (double)(last - first) * T, w = worst_acc(r, n, T);
+    if (!last || t > 1.05 * t_opt || off > 2e-6 || w > 1 + 1e-9)
+        fail_msg("half circle r 2: %.3f s from rest to rest (the arc model's fastest %.3f s, want "
+                 "within 5 %%), %.6f mm off the radius, axis acceleration %.4f of the limit",
+                 t, t_opt, off, w);
+    print_message("half circle r 2: %.3f s, fastest %.3f s\n", t, t_opt);
+    free(r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_short_arc_accelerates_with_the_free_share),
         cmocka_unit_test(test_near_tangent_arcs_keep_cruise_speed),
         cmocka_unit_test(test_line_arc_blend_within_p),
+        cmocka_unit_test(test_arc_brakes_with_what_each_speed_leaves),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

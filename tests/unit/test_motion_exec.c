@@ -133,13 +133,19 @@ static void replay_equals_planner(enum ncp_profile prof, int ratio)
         nsp++;
     }
     ncp_planner_free(p);
-    /* every programmed segment and the corner arcs between them */
-    size_t blends = 0;
-    for (size_t k = 0; k < rs.n; k++)
+    /* every programmed segment and the corner arcs between them; an arc may
+     * come in pieces, one after the other on the same line */
+    size_t blends = 0, pieces = 0;
+    for (size_t k = 0; k < rs.n; k++) {
         blends += rs.r[k].blend;
+        if (k > 0 && !rs.r[k].blend && !rs.r[k - 1].blend && rs.la[k].s.kind == NCP_SEG_ARC &&
+            rs.la[k - 1].s.kind == NCP_SEG_ARC && rs.la[k].s.line == rs.la[k - 1].s.line &&
+            !memcmp(rs.la[k].s.start, rs.la[k - 1].s.end, sizeof rs.la[k].s.start))
+            pieces++;
+    }
     if (blends < 5)
         fail_msg("%zu corner arcs among %zu records", blends, rs.n);
-    assert_int_equal(rs.n - blends, segs);
+    assert_int_equal(rs.n - blends - pieces, segs);
 
     for (int stage = 0; stage < 2; stage++) {   /* ACCDECbuf records, then LAbuf */
         struct ncp_exec e;
