@@ -211,7 +211,15 @@ static void sc_stop(struct ncp_backend *b)
 static void sc_describe(const struct ncp_backend *b, char *buf, size_t len)
 {
     const struct sc *s = b->impl;
-    ncp_co_fault_describe(&s->m.fault, s->m.bus.ifname, buf, len);
+    /* a homing's fault names the axis too: the operator homed an axis,
+     * not a node */
+    int at = 0;
+    for (int k = 0; k < s->n && s->m.fault.kind == NCP_CO_FAULT_HOMING; k++)
+        if (s->m.node[k].id == s->m.fault.node)
+            at = snprintf(buf, len, "homing %c: ", NCP_AXIS_LETTERS[s->ax[k]]);
+    if (at < 0 || (size_t)at >= len)
+        at = 0;
+    ncp_co_fault_describe(&s->m.fault, s->m.bus.ifname, buf + at, len - (size_t)at);
 }
 
 static void sc_close(struct ncp_backend *b)

@@ -43,6 +43,11 @@ static void usage(FILE *f)
           "                            maps it) pressed at and above this actual position\n"
           "  --index-pitch COUNTS      encoder index pulse at every multiple of COUNTS\n"
           "                            (homing methods 3 and 4)\n"
+          "  --homing-error MS         the first homing ends MS ms in with a homing error\n"
+          "                            (statusword bit 13), the axis stopped; later ones\n"
+          "                            succeed\n"
+          "  --homing-stall            the homing never sees the switch: it searches on,\n"
+          "                            never attained\n"
           "  --verbose                 log state changes on stderr\n"
           "Answers NMT, SDO (expedited), SYNC and RPDO1/TPDO1 (controlword+target,\n"
           "statusword+actual); heartbeat period from object 0x1017 (default 100 ms).\n"
@@ -80,6 +85,7 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
         {"config", required_argument, 0, 'c'},       {"axis", required_argument, 0, 'x'},
         {"sync-loss-ms", required_argument, 0, 'L'}, {"count-from-motion", no_argument, 0, 'M'},
         {"home-switch", required_argument, 0, 'S'},  {"index-pitch", required_argument, 0, 'I'},
+        {"homing-error", required_argument, 0, 'E'}, {"homing-stall", no_argument, 0, 'T'},
         {0, 0, 0, 0}};
     *o = (struct drive_opts){.node = 0, .fault_after = -1, .emcy_after = -1,
                              .hb_stop_after = -1, .abort_index = -1, .max_step = 1000000,
@@ -104,6 +110,8 @@ static const char *parse(int argc, char **argv, struct drive_opts *o)
             o->have_home_switch = 1;
             o->home_switch = (int32_t)num(optarg, "--home-switch", -(1L << 30), 1L << 30);
             break;
+        case 'E': o->homing_error_ms = num(optarg, "--homing-error", 1, 600000); break;
+        case 'T': o->homing_stall = 1; break;
         case 'I': o->index_pitch = (int32_t)num(optarg, "--index-pitch", 1, 1L << 30); break;
         case 'x':
             if (!optarg[0] || optarg[1] || !strchr("XYZxyz", optarg[0])) {

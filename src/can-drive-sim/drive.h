@@ -35,6 +35,12 @@ struct drive_opts {
     /* --index-pitch COUNTS: the encoder's index pulse at every multiple of
      * it (homing methods 3 and 4); 0 none */
     int32_t index_pitch;
+    /* homing that fails, for the master's error paths: a homing error
+     * (bit 13) this many ms into the first homing (0: never), as a fault
+     * the operator then fixes; a search that never finds the switch, so
+     * nothing is ever attained */
+    long homing_error_ms;
+    int homing_stall;
 };
 
 /* The drive's own homing mode (0x6060 = 6, homing.c). */
@@ -47,6 +53,7 @@ struct drive_homing {
     int dir;              /* direction of the latch (and index) stage */
     double pos, v;        /* counts, counts per second */
     int32_t ref;          /* the drive's position minus the encoder's: homing sets it */
+    double elapsed;       /* seconds of this homing, for --homing-error */
 };
 
 struct drive {
@@ -60,6 +67,7 @@ struct drive {
     long syncs_enabled, tpdos;
     long syncs_moving;    /* SYNCs since the target first moved, 0 before */
     int32_t enabled_at;   /* the target at enabling */
+    int homing_error_given; /* --homing-error's one homing error is past */
     int heartbeat_on;
     /* servo plant (o.config): one axis of the sim backend's machine */
     int servo;

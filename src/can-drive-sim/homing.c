@@ -13,7 +13,12 @@
  * and reports homing attained (statusword bit 12) with target reached (bit
  * 10). Any other method, or a switch or index the method needs and the
  * drive was not given, is a homing error (bit 13). Bit 4 going down
- * interrupts the homing: the axis brakes, nothing attained. */
+ * interrupts the homing: the axis brakes, nothing attained.
+ * For the master's failure paths: --homing-error MS ends the first homing
+ * MS ms in with a homing error (the axis stops where it is; later homings
+ * succeed, the fault fixed), --homing-stall
+ * has the search never see the switch, so the axis searches on and no
+ * homing is ever attained. */
 #include <math.h>
 #include <stdio.h>
 
@@ -81,6 +86,7 @@ static void begin(struct drive *dv)
     h->attained = h->error = h->found = 0;
     h->pos = dv->actual;
     h->v = 0;
+    h->elapsed = 0;
     if (m == 35 || m == 37) {
         set_home(dv, encoder(dv, h->pos));
         dv->actual = (int32_t)lround(h->pos);
@@ -146,6 +152,14 @@ int32_t drive_home_step(struct drive *dv)
     if (h->stage == DH_IDLE)
         return dv->actual;
     double t = drive_period_s(dv), dvmax = param(dv, 0x609A, 0) * t;
+    h->elapsed += t;
+    if (dv->o.homing_error_ms > 0 && !dv->homing_error_given &&
+        h->elapsed * 1000 >= (double)dv->o.homing_error_ms) {
+        dv->homing_error_given = 1;
+        refuse(dv, "--homing-error");
+        h->v = 0;
+        return (int32_t)lround(h->pos);
+    }
     double want = 0;
     int wanted_pressed = h->dir < 0;
     switch (h->stage) {
@@ -158,7 +172,7 @@ int32_t drive_home_step(struct drive *dv)
     double before = encoder(dv, h->pos);
     h->pos += h->v * t;
     double now = encoder(dv, h->pos);
-    int on = pressed_at(dv, now);
+    int on = !dv->o.homing_stall && pressed_at(dv, now);
     switch (h->stage) {
     case DH_SEEK:
         if (on == wanted_pressed)

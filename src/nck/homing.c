@@ -312,6 +312,16 @@ static void drive_sense(struct nck_core *n, int j, double act)
         return;
     x->v = 0;
     x->stopping = 0;
+    /* The command followed the drive two periods late (this period's was
+     * taken from the actual of two before), and the following error is
+     * checked again from this period on. The drive jumps to its home
+     * offset at home and may be back in CSP a period later (its TPDOs
+     * bunched in one late period, the mode switch quick): compared with a
+     * command from before the jump, that is a following error of the whole
+     * offset. The drive got its own actual as target all along, so the
+     * command of this period and the next is its actual. */
+    n->loop->jcmd[j] = n->loop->jact[j];
+    n->loop->next.pos[j] = act;
     if (r < 0 || n->cross.home.result != NCK_HOME_OK) {
         /* aborted, or failed (the backend's fault stops the loop) */
         if (n->cross.home.result == NCK_HOME_OK)

@@ -256,6 +256,60 @@ static void test_interrupted(void **state)
     assert_true(r->dv.actual - at <= 1 && at - r->dv.actual <= 1);
 }
 
+/* cnc-drive-sim --homing-error MS: the first homing ends in a homing
+ * error MS ms in, the axis standing; the next one homes. */
+static void test_error_option(void **state)
+{
+    struct rig *r = *state;
+    r->dv.o.homing_error_ms = 50;
+    configure(r, 3, 0);
+    uint16_t sw = 0;
+    assert_int_equal(home(r, &sw), -1);
+    assert_int_equal(r->m.fault.kind, NCP_CO_FAULT_HOMING);
+    assert_int_equal(r->m.fault.home_why, NCP_CH_WHY_ERROR);
+    assert_true(r->m.fault.statusword & NCP_402_SW_HOMING_ERROR);
+    /* 50 SYNCs of 1 ms into the homing, and its answer a period later */
+    assert_true(r->m.fault.home_ms >= 50 && r->m.fault.home_ms <= 55);
+    int32_t at = r->dv.actual;
+    assert_true(at > 0 && at < 5000); /* stopped on its way to the switch */
+    period(r);
+    assert_int_equal(r->dv.actual, at);
+    /* the operator's reset: the master idle and fault-free again */
+    serve_by_hand(r);
+    ncp_co_home_drop(&r->m);
+    r->m.fault.kind = NCP_CO_FAULT_NONE;
+    period(r);
+    serve_by_hand(r);
+    sw = 0;
+    assert_true(home(r, &sw) > 0);
+    assert_true(sw & NCP_402_SW_HOMING_ATTAINED);
+    assert_int_equal(sw & NCP_402_SW_HOMING_ERROR, 0);
+}
+
+/* cnc-drive-sim --homing-stall: the search never sees the switch, the
+ * master's timeout ends the homing. */
+static void test_stall_option(void **state)
+{
+    struct rig *r = *state;
+    r->dv.o.homing_stall = 1;
+    configure(r, 3, 0);
+    r->m.home[0].cfg.timeout_periods = 400;
+    uint16_t sw = 0;
+    assert_int_equal(home(r, &sw), -1);
+    assert_int_equal(r->m.fault.kind, NCP_CO_FAULT_HOMING);
+    assert_int_equal(r->m.fault.home_why, NCP_CH_WHY_TIMEOUT);
+    assert_int_equal(r->m.fault.home_ms, 401);
+    assert_int_equal(r->m.fault.statusword & (NCP_402_SW_HOMING_ATTAINED |
+                                              NCP_402_SW_TARGET_REACHED), 0);
+    /* searched on past the switch at 5000, at 20 counts per period */
+    assert_true(r->dv.actual > 6000);
+    char buf[256];
+    ncp_co_fault_describe(&r->m.fault, "vcan0", buf, sizeof buf);
+    assert_non_null(strstr(buf, "node 4: the drive's own homing (method 3) did not end within "
+                                "0.4 s"));
+    assert_non_null(strstr(buf, "homing still in progress"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -263,6 +317,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_switch_and_index, setup, teardown),
         cmocka_unit_test_setup_teardown(test_error, setup, teardown),
         cmocka_unit_test_setup_teardown(test_interrupted, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_error_option, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_stall_option, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
