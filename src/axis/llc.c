@@ -222,10 +222,22 @@ void llc_advertise(struct llc *l)
         (void)ncp_msg_publish(l->msg, l->ch_advert, buf, (size_t)n);
 }
 
+/* target, or as far towards it as MAX_VELOCITY goes in a period (counted):
+ * a setpoint at MAX_VELOCITY is no jump, 1 nm of rounding allowed. */
+static double within_max_vel(struct llc *l, double target)
+{
+    double lim = l->cfg->axis[l->axis].max_vel * (double)l->period_ns * 1e-9 + 1e-6;
+    double step = target - l->cmd;
+    if (fabs(step) > lim) {
+        step = copysign(lim, step);
+        l->clamped++;
+    }
+    return l->cmd + step;
+}
+
 /* Running: the received setpoint, at most MAX_VELOCITY away from the last. */
 static double follow(struct llc *l, int64_t slot)
 {
-    const struct ncp_axis_cfg *a = &l->cfg->axis[l->axis];
     double target = ncp_dist_nm_to_mm(ncp_dist_rx_play(&l->rx, slot));
     if (l->rx.held != l->held_seen) {
         /* a stream that stops with the axis at rest (the program's end, the
@@ -236,13 +248,7 @@ static double follow(struct llc *l, int64_t slot)
         l->run_held = 0;
     }
     l->held_seen = l->rx.held;
-    /* a setpoint at MAX_VELOCITY is no jump: 1 nm of rounding allowed */
-    double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9 + 1e-6;
-    if (fabs(step) > lim) {
-        step = copysign(lim, step);
-        l->clamped++;
-    }
-    return l->cmd + step;
+    return within_max_vel(l, target);
 }
 
 /* ADCAI's DP2 and DP3: this axis's samples at the HLC's read position
@@ -252,7 +258,6 @@ static double follow(struct llc *l, int64_t slot)
  * loss (the HLC's heartbeat watches a stalled HLC). */
 static double follow_ai(struct llc *l, int64_t slot)
 {
-    const struct ncp_axis_cfg *a = &l->cfg->axis[l->axis];
     int missing;
     double target = llc_ai_play(l, slot, 1, &missing);
     if (missing) {
@@ -265,12 +270,7 @@ static double follow_ai(struct llc *l, int64_t slot)
     if (llc_ai_stalled(l))
         l->rx.held++;
     l->held_seen = l->rx.held;
-    double step = target - l->cmd, lim = a->max_vel * (double)l->period_ns * 1e-9 + 1e-6;
-    if (fabs(step) > lim) {
-        step = copysign(lim, step);
-        l->clamped++;
-    }
-    return l->cmd + step;
+    return within_max_vel(l, target);
 }
 
 /* Feed-forward's next setpoint at ADCAI's DP2 and DP3: 1 when its samples
