@@ -290,8 +290,8 @@ static int ai_ahead(struct llc *l, int64_t slot, double *mm)
  * which the records are offset by homing's offset); 0 its own stream. */
 static int fine_phase(struct llc *l, int64_t slot)
 {
-    int32_t nm;
-    if (ncp_dist_rx_peek(&l->rx, slot, &nm)) {
+    int32_t got;
+    if (ncp_dist_rx_peek(&l->rx, slot, &got)) {
         l->fine_mode = 1;
         l->fine_last = slot;
         return 1;
@@ -552,9 +552,7 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     double ahead_mm;
     int guessed = 0;
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
-    if (hold_now(l, slot))
-        cmd_ahead = l->cmd;
-    else if (fine == 2)
+    if (hold_now(l, slot) || fine == 2)
         cmd_ahead = l->cmd;
     else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && l->dp1ai)
         cmd_ahead = llc_dp1_ai_ahead(l, slot + T);
