@@ -298,9 +298,14 @@ static int fine_phase(struct llc *l, int64_t slot)
     }
     if (!l->fine_mode)
         return 0;
+    /* block-level points: the abort's void (serve), or the path's next
+     * start where no abort follows homing (`cnc-run run --home`, whose
+     * records start where the plan stands: exact only without an offset) */
+    int64_t start = l->ai ? 0 : llc_start_at(l, l->starts_done);
     int restarted = l->ai ? llc_ai_job_started(l, l->fine_last, slot)
-                          : l->scale.void_due && l->scale.void_t > l->fine_last &&
-                                slot >= l->scale.void_t;
+                          : (l->scale.void_due && l->scale.void_t > l->fine_last &&
+                             slot >= l->scale.void_t) ||
+                                (start > l->fine_last && slot >= start);
     if (restarted)
         l->fine_mode = 0;
     return restarted ? 0 : 2;

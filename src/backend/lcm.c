@@ -598,6 +598,8 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
             taken = s->p[i].st.rec_next < taken ? s->p[i].st.rec_next : taken;
         int32_t steps = atomic_load_explicit(&s->dp2.steps, memory_order_acquire);
         lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken, s->rest);
+        if (start)   /* the LLCs' stream starts again here (no abort after homing) */
+            s->homing_left = 0;
         if (s->tx->kind == &lcm_kind_int)
             lcm_dp2_mark(s->tx, &s->dp2, s->msg, steps, t, s->T);
         if (s->dp1 && s->cycles % 20 == 0)   /* an LLC that lost the first one */
