@@ -132,6 +132,9 @@ struct ncp_stage_stats {
     uint64_t empty_waits; /* times the input ring was empty when the stage wanted to read */
     uint64_t sleeps;      /* futex sleeps (a wait that outlasted the short spin) */
     double cpu_ms;        /* CPU time of the stage's thread (shows the load balance) */
+    double wall_ms;       /* from the thread entering its stage to leaving it: cpu_ms
+                           * against it is how busy the thread was */
+    double sys_ms;        /* of cpu_ms, in the kernel (writing the text out, futexes) */
 };
 
 /* ncp_run_stats.warnings bits: the run went on with a weaker setting. */

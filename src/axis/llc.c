@@ -290,8 +290,8 @@ static int ai_ahead(struct llc *l, int64_t slot, double *mm)
  * which the records are offset by homing's offset); 0 its own stream. */
 static int fine_phase(struct llc *l, int64_t slot)
 {
-    int32_t got;
-    if (ncp_dist_rx_peek(&l->rx, slot, &got)) {
+    int32_t at;
+    if (ncp_dist_rx_peek(&l->rx, slot, &at)) {
         l->fine_mode = 1;
         l->fine_last = slot;
         return 1;

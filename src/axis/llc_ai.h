@@ -13,6 +13,7 @@
  * (lcm_ai.c's LEAD) plus a record and the play delay behind it. */
 #define LLC_AI_SAMPLES 1024
 #define LLC_AI_JOBS 4   /* jobs (the HLC's aborts) told apart at once */
+#define LLC_AI_MARKS 16 /* the HLC's words on its read kept: more than a play delay's */
 
 struct llc_ai_job {
     int32_t job;
@@ -39,16 +40,21 @@ struct llc_ai {
     int32_t smp_job[LLC_AI_SAMPLES];
     int32_t smp_nm[LLC_AI_SAMPLES];   /* relative to its job's start */
     struct llc_ai_job jobs[LLC_AI_JOBS];
-    /* the HLC's newest read position said (ai_scale_t) */
-    int have_anchor;
-    int64_t anchor_t, anchor_k;
-    double anchor_f;
-    int32_t anchor_job;
+    /* the HLC's last words on its read (ai_scale_t), by period */
+    struct llc_ai_mark {
+        int64_t t;          /* its period (0: none) */
+        int64_t k;          /* the read position after it */
+        double f;
+        int32_t job;
+        int64_t job_t;      /* the period its job started in */
+        double adv[4];      /* the advances up to it, oldest first */
+    } marks[LLC_AI_MARKS];
+    int have_marks;
     /* the play: the job, the read position of the last slot played */
     int playing;
     int32_t play_job;
     int64_t play_slot, play_k;
-    double play_f, play_adv;
+    double play_f;
     int stalled;                    /* the last slot played: the HLC's stream stopped dead */
     uint32_t records, lost, stale, scales, jobs_played;
 };

@@ -1,17 +1,28 @@
 /* The LLC at ADCAI's DP2 and DP3 plays its samples (llc_adcai.c) as the
  * HLC's position loop read the same stream: ai_scale_t gives the loop's
- * advance in each period and, now and then, its read position itself. The
- * read position of a slot is the newest one said at or after it less the
- * advances between (exact while the message carrying it is within its
- * window), else the last slot's plus this slot's advance. At the stream's own
- * pace it lands on the samples themselves; between two it interpolates as
- * the loop does (a straight line, or with the S-curve the loop's quintic on
- * the samples' positions, velocities and accelerations, here taken from this
- * axis's neighbouring samples: the loop's own zero at a path standstill is
- * this axis's zero velocity, which differs only where this axis rests while
- * another moves, between samples). So a feed hold, an override, a stop or a
- * stall at the HLC moves this axis along the same path at the same
- * instants, a play delay later.
+ * advance in each period and its read position. The read position of a
+ * slot comes from the newest word of the HLC's stamped at most
+ * LLC_AI_SEE periods after it: exactly, if that word is of the slot or
+ * later (less the advances between), else that word's position gone on at
+ * its last advance. Words stamped later are not looked at even when they
+ * are here: whether one has come by the time a slot is played is a matter
+ * of timing, and every LLC must play every slot alike, or their axes part
+ * from the path by a sample (a host stall at the HLC showed it: one axis a
+ * sample ahead of another for four periods). A word of the slot's period
+ * leaves the HLC in that period, LLC_AI_SEE periods before the earliest
+ * the slot is played (the play delay, 3.5-4.5 periods), so it is here.
+ *
+ * At the stream's own pace the read position lands on the samples
+ * themselves; between two it interpolates as the loop does (a straight
+ * line, or with the S-curve the loop's quintic on the samples' positions,
+ * velocities and accelerations, here taken from this axis's neighbouring
+ * samples: the loop's own zero at a path standstill is this axis's zero
+ * velocity, which differs only where this axis rests while another moves,
+ * between samples). So a feed hold, an override, a stop or a stall at the
+ * HLC moves this axis along the same path at the same instants, a play
+ * delay later. Where the read went on ahead of what the HLC then says (its
+ * loop slept through periods), the axis stands until the HLC's read is
+ * level again: never back along the path.
  *
  * An abort starts a job: from its period on the read position is the new
  * job's, which begins two samples before its first at its start. */
@@ -33,15 +44,14 @@ void llc_ai_on_scale(struct llc *l, const uint8_t *p, size_t len)
     ncp_ai_scale_t m;
     memset(&m, 0, sizeof m);
     if (!a || ncp_ai_scale_t_decode(p, 0, (int)len, &m) != (int)len ||
-        m.sender != NCP_DIST_HLC_ID || m.count < 1 || m.count > 16 || m.n <= l->slot ||
+        m.sender != NCP_DIST_HLC_ID || m.count < 1 || m.count > 4 || m.n <= l->slot ||
         m.n > NCP_AXES || m.job < 0)
         return;
     /* lcm-gen decodes doubles through int64_t pointers: copied out as
      * bytes (see llc_scale.c) */
-    double adv[16], f;
+    double adv[4], f;
     memcpy(adv, m.adv, sizeof adv);
     memcpy(&f, &m.read_f, sizeof f);
-    llc_scale_put(l, m.t_ns, adv, m.count);
     struct llc_ai_job *j = &a->jobs[(uint32_t)m.job % LLC_AI_JOBS];
     if (!j->known || j->job != m.job) {
         j->job = m.job;
@@ -50,13 +60,24 @@ void llc_ai_on_scale(struct llc *l, const uint8_t *p, size_t len)
         j->base_nm = m.base_nm[l->slot];
         j->known = 1;
     }
-    if (!a->have_anchor || m.t_ns > a->anchor_t) {
-        a->have_anchor = 1;
-        a->anchor_t = m.t_ns;
-        a->anchor_k = m.read_k;
-        a->anchor_f = f;
-        a->anchor_job = m.job;
+    /* kept in place of the oldest (a duplicate in place of itself) */
+    struct llc_ai_mark *k = &a->marks[0];
+    for (int i = 0; i < LLC_AI_MARKS; i++) {
+        if (a->marks[i].t == m.t_ns) {
+            k = &a->marks[i];
+            break;
+        }
+        if (a->marks[i].t < k->t)
+            k = &a->marks[i];
     }
+    k->t = m.t_ns;
+    k->k = m.read_k;
+    k->f = f;
+    k->job = m.job;
+    k->job_t = m.job_t_ns;
+    for (int i = 0; i < 4; i++)
+        k->adv[i] = i >= 4 - m.count ? adv[i - (4 - m.count)] : 1.0;
+    a->have_marks = 1;
     a->scales++;
     /* the HLC's grid, as at the other points */
     if (!l->t_start)
@@ -82,68 +103,46 @@ static void normalise(struct readpos *r)
     }
 }
 
-/* A period's advance: a period the HLC's loop slept through (-1) read
- * nothing. */
-static double adv_at(const struct llc *l, int64_t u)
-{
-    return fmax(0.0, llc_scale_at(l, u));
-}
+#define LLC_AI_SEE 2   /* periods after a slot whose words on it are looked at */
 
 static int before(const struct readpos *a, const struct readpos *b)
 {
     return a->k < b->k || (a->k == b->k && a->f < b->f - 1e-9);
 }
 
-/* The HLC's read position for slot: 0, or -1 before anything said it.
- * Between the HLC's words it goes on at the last advance heard; where that
- * ran ahead of what the HLC then says (its loop stalled, or a hold's first
- * word was lost), the axis stands (*behind) until the HLC's read is there
- * again: never back along the path. */
+/* The newest word stamped by deadline whose job had started by slot. */
+static const struct llc_ai_mark *word_for(const struct llc_ai *a, int64_t slot, int64_t deadline)
+{
+    const struct llc_ai_mark *w = NULL;
+    for (int i = 0; i < LLC_AI_MARKS; i++) {
+        const struct llc_ai_mark *m = &a->marks[i];
+        if (m->t > 0 && m->t <= deadline && m->job_t <= slot && (!w || m->t > w->t))
+            w = m;
+    }
+    return w;
+}
+
+/* The HLC's read position for slot: 0, or -1 before anything said it. */
 static int read_at(const struct llc *l, int64_t slot, struct readpos *r, int *behind)
 {
     const struct llc_ai *a = l->ai;
-    int64_t T = l->period_ns, from;
+    int64_t T = l->period_ns;
     *behind = 0;
-    struct readpos prev = { a->play_job, a->play_k, a->play_f };
-    int have_prev = a->playing;
-    if (have_prev) {
-        *r = prev;
-        from = a->play_slot;
-    } else if (a->have_anchor) {
-        *r = (struct readpos){ a->anchor_job, a->anchor_k, a->anchor_f };
-        from = a->anchor_t;
-    } else {
+    const struct llc_ai_mark *w = word_for(a, slot, slot + LLC_AI_SEE * T);
+    if (!w)
         return -1;
-    }
-    /* an abort at the HLC by then: the next job's stream */
-    for (int i = 0; i < LLC_AI_JOBS; i++) {
-        const struct llc_ai_job *j = &a->jobs[i];
-        if (j->known && j->job > r->job && j->t > 0 && j->t <= slot) {
-            *r = (struct readpos){ j->job, j->k - 2, 0.0 };
-            from = j->t;
-            have_prev = 0;
-        }
-    }
-    int anchored = a->have_anchor && a->anchor_job == r->job;
-    if (anchored && a->anchor_t >= slot && a->anchor_t - slot < 16 * T) {
-        *r = (struct readpos){ a->anchor_job, a->anchor_k, a->anchor_f };
-        for (int64_t u = a->anchor_t; u > slot; u -= T)
-            r->f -= adv_at(l, u);
+    *r = (struct readpos){ w->job, w->k, w->f };
+    if (w->t >= slot) {
+        /* a period the loop slept through (-1) read nothing */
+        for (int64_t u = w->t; u > slot; u -= T)
+            r->f -= fmax(0.0, w->adv[3 - (w->t - u) / T]);
     } else {
-        if (anchored && a->anchor_t > from && a->anchor_t < slot) {
-            *r = (struct readpos){ a->anchor_job, a->anchor_k, a->anchor_f };
-            from = a->anchor_t;
-        }
-        if (from > slot)
-            return -1;   /* the first word heard is of a later period */
-        /* a long silence of this loop (stalled) counts its periods, not more */
-        if (slot - from > 4096 * T)
-            from = slot - 4096 * T;
-        for (int64_t u = from + T; u <= slot; u += T)
-            r->f += adv_at(l, u);
+        int64_t n = (slot - w->t) / T;
+        r->f += (double)n * fmax(0.0, w->adv[3]);
     }
     normalise(r);
-    if (have_prev && before(r, &prev)) {
+    struct readpos prev = { a->play_job, a->play_k, a->play_f };
+    if (a->playing && prev.job == r->job && before(r, &prev)) {
         *r = prev;
         *behind = 1;
     }
@@ -220,7 +219,7 @@ static int command_at(const struct llc_ai *a, const struct readpos *r, double *m
 
 int llc_ai_streaming(const struct llc *l)
 {
-    return l->ai && l->ai->dp >= 2 && (l->ai->have_anchor || l->ai->playing);
+    return l->ai && l->ai->dp >= 2 && (l->ai->have_marks || l->ai->playing);
 }
 
 double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing)
@@ -237,17 +236,15 @@ double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing)
         mm = l->cmd;
     }
     if (commit) {
-        double adv = llc_scale_at(l, slot);
-        /* the HLC's loop slept through this period, or the axis waits for
-         * its read to come back level: a hold, counted as one, no loss */
-        a->stalled = a->playing && (behind || adv < 0);
+        /* the axis waits for the HLC's read to come back level (its loop
+         * slept through periods): a hold, counted as one, no loss */
+        a->stalled = a->playing && behind;
         a->jobs_played += a->playing && r.job != a->play_job;
         a->playing = 1;
         a->play_job = r.job;
         a->play_k = r.k;
         a->play_f = r.f;
         a->play_slot = slot;
-        a->play_adv = adv;
     }
     return mm;
 }

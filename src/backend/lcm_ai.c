@@ -9,8 +9,9 @@
  *
  * Each period the loop's advance goes into ai_scale_t's window, and the
  * message goes out every period while the advance is not 1 (a feed hold, a
- * stop, an override, a start) and for 32 periods after, otherwise every
- * 100: each LLC plays its own samples at the loop's read position, a play
+ * stop, an override, a start) and for 8 periods after, otherwise every
+ * 100 (an LLC looks at words at most 2 periods after a slot, and each
+ * carries the last 4 periods' advances: one lost is in the next): each LLC plays its own samples at the loop's read position, a play
  * delay later, so every axis slows, stops and goes on along the program's
  * path as the HLC's command does. A period the loop slept through (a host
  * stall) read nothing: it is said as such (-1), and the LLCs, which went on
@@ -28,7 +29,8 @@
 #include <string.h>
 
 #define LEAD 128          /* samples a record is sent ahead of the loop's read */
-#define SCALE_AFTER 32    /* periods an advance of 1 is still said after one that was not */
+#define SENDS_MAX 16      /* records a period at most: a start's lead builds up over a few */
+#define SCALE_AFTER 8     /* periods an advance of 1 is still said after one that was not */
 #define SCALE_EVERY 100   /* periods between messages at the stream's own pace */
 
 int lcm_ai_init(struct lcm_ai *x, int dp, const struct ncp_machine_cfg *cfg)
@@ -127,7 +129,7 @@ void lcm_ai_cycle(struct lcm_ai *x, struct ncp_msg *m, int64_t t, int64_t skippe
         base_at(x, cmd);
         x->left = SCALE_AFTER;
     }
-    for (;;) {
+    for (int sends = 0; sends < SENDS_MAX;) {
         if (!x->have_front) {
             x->have_front = ncp_spsc_pop(&x->tapped, &x->front) == 0;
             if (!x->have_front)
@@ -142,8 +144,10 @@ void lcm_ai_cycle(struct lcm_ai *x, struct ncp_msg *m, int64_t t, int64_t skippe
         }
         if (k > b->read_k + LEAD)
             break;
-        if (x->front.start)
+        if (x->front.start) {
             send_record(x, m, k, &x->front);
+            sends++;
+        }
         x->have_front = 0;
     }
     for (int64_t i = 0; i < skipped && i < LCM_AI_WINDOW; i++)

@@ -10,7 +10,7 @@
 #include "ncpar/msg.h"
 #include "ncpar/rt.h"
 
-#define LCM_AI_WINDOW 16   /* periods each ai_scale_t carries */
+#define LCM_AI_WINDOW 4   /* periods each ai_scale_t carries */
 
 struct lcm_ai {
     int dp, n;

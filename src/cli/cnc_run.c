@@ -21,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_PROGRAM = 2, EXIT_RUNTIME = 3 };
@@ -40,6 +41,69 @@ static void print_waits(const struct ncp_stage_stats *s)
             (unsigned long long)s->full_waits, (unsigned long long)s->sleeps);
 }
 
+/* One line per thread: its CPU and wall time, how busy it was and its part of
+ * the run's CPU, and how often it found its rings empty or full. The stage
+ * with the most CPU time bounds the run; busy well below 100 % is time
+ * spent waiting for another stage (or for a CPU on a loaded host). */
+static void print_thread(const char *role, int index, const struct ncp_stage_stats *s,
+                         double total_cpu)
+{
+    char name[24];
+    if (index >= 0)
+        snprintf(name, sizeof name, "%s %d", role, index);
+    else
+        snprintf(name, sizeof name, "%s", role);
+    /* a span under a millisecond (an idle prefaulter) says nothing about load */
+    char busy[16] = "    -";
+    if (s->wall_ms >= 1.0)
+        snprintf(busy, sizeof busy, "%5.1f %%", 100.0 * s->cpu_ms / s->wall_ms);
+    double share = total_cpu > 0 ? 100.0 * s->cpu_ms / total_cpu : 0;
+    fprintf(stderr,
+            "cnc-run: thread %-10s cpu %9.1f ms  sys %8.1f ms  wall %9.1f ms  busy %s  "
+            "share %5.1f %%  waits %llu/%llu/%llu\n",
+            name, s->cpu_ms, s->sys_ms, s->wall_ms, busy, share,
+            (unsigned long long)s->empty_waits,
+            (unsigned long long)s->full_waits, (unsigned long long)s->sleeps);
+}
+
+static void print_threads(const struct ncp_run_stats *st, const struct ncp_thread_map *map)
+{
+    if (map->mode == NCP_MODE_SERIAL) {
+        print_thread("serial", -1, &st->analyzer, st->analyzer.cpu_ms);
+        return;
+    }
+    int lexers = map->n_lexers < NCP_MAX_LEXERS ? map->n_lexers : NCP_MAX_LEXERS;
+    int execs = map->n_executors < NCP_MAX_EXECUTORS ? map->n_executors : NCP_MAX_EXECUTORS;
+    int output = !(map->inline_output && map->n_executors == 0);
+    double total = st->feeder.cpu_ms + st->analyzer.cpu_ms + (output ? st->output.cpu_ms : 0);
+    for (int i = 0; i < lexers; i++)
+        total += st->lexer[i].cpu_ms;
+    for (int j = 0; j < execs; j++)
+        total += st->executor[j].cpu_ms;
+    print_thread(lexers ? "feeder" : "prefaulter", -1, &st->feeder, total);
+    for (int i = 0; i < lexers; i++)
+        print_thread("lexer", i, &st->lexer[i], total);
+    print_thread("analyzer", -1, &st->analyzer, total);
+    for (int j = 0; j < execs; j++)
+        print_thread("executor", j, &st->executor[j], total);
+    if (output)
+        print_thread("output", -1, &st->output, total);
+}
+
+/* The whole process's CPU time (every thread, the main one's start-up and
+ * the writer's closing included): what the stage threads do not account for
+ * is the rest. */
+static void print_process_cpu(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0)
+        return;
+    double user = (double)ru.ru_utime.tv_sec * 1e3 + (double)ru.ru_utime.tv_usec / 1e3;
+    double sys = (double)ru.ru_stime.tv_sec * 1e3 + (double)ru.ru_stime.tv_usec / 1e3;
+    fprintf(stderr, "cnc-run: process cpu %.1f ms (user %.1f, sys %.1f)\n", user + sys, user,
+            sys);
+}
+
 /* One summary line, and for the pipeline the CPU time per stage thread: the
  * load balance that decides what more cores can gain. */
 static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_map *map)
@@ -52,6 +116,7 @@ static void print_stats(const struct ncp_run_stats *st, const struct ncp_thread_
             (unsigned long long)st->blocks, (unsigned long long)st->commands, st->wall_ms,
             st->setup_ms, bps, st->threads, ncp_thread_mode_name(map->mode),
             serial ? 0 : map->n_lexers, serial ? 0 : map->n_executors);
+    print_threads(st, map);
     if (serial)
         return;
     if (map->n_lexers == 0)
@@ -355,6 +420,8 @@ static int parse_run(struct parse_opts *o, int argc, char **argv)
             print_choice(&map, prog_bytes, cpus);
     }
     ncp_source_close(&src);
+    if (o->stats)
+        print_process_cpu(); /* after the text is written out and the input let go */
     return status;
 }
 

@@ -38,6 +38,8 @@ struct ncp_pipe_worker {
     int index;
     uint64_t items;              /* written by this worker's thread only */
     double cpu_ms;               /* its thread's CPU time, set as it ends */
+    double wall_ms;              /* its stage's span, set as it ends */
+    double sys_ms;               /* its thread's kernel CPU time, set as it ends */
 };
 
 struct ncp_pipe {
@@ -159,7 +161,8 @@ void ncp_pipe_abort(struct ncp_pipe *p);
 void ncp_pipe_open_gate(struct ncp_pipe *p);
 
 double ncp_pipe_now_ms(void);
-/* CPU time of the calling thread so far. */
+/* CPU time of the calling thread so far; of it, in the kernel. */
 double ncp_pipe_thread_cpu_ms(void);
+double ncp_pipe_thread_sys_ms(void);
 
 #endif

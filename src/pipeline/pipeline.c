@@ -293,6 +293,8 @@ static void stage_stats(struct ncp_stage_stats *st, const struct ncp_pipe_worker
     if (w) {
         st->items = w->items;
         st->cpu_ms = w->cpu_ms;
+        st->wall_ms = w->wall_ms;
+        st->sys_ms = w->sys_ms;
     }
 }
 

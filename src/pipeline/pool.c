@@ -41,9 +41,10 @@ static void *member_main(void *arg)
             return NULL;
         if (m->waits_gate)
             ncp_pipe_wait_gate(pool->p, pool->map.start_timeout_us);
-        double cpu0 = ncp_pipe_thread_cpu_ms();
-        ncp_pipe_run_stage(m->w); /* ends with the thread's absolute CPU time in w->cpu_ms */
+        double cpu0 = ncp_pipe_thread_cpu_ms(), sys0 = ncp_pipe_thread_sys_ms();
+        ncp_pipe_run_stage(m->w); /* ends with the thread's absolute CPU times in w */
         m->w->cpu_ms -= cpu0;
+        m->w->sys_ms -= sys0;
         if (atomic_fetch_add(&pool->done, 1) + 1 == (uint32_t)pool->s.started)
             ncp_futex_wake_all(&pool->done);
     }

@@ -4,6 +4,7 @@
 #include "ncpar/lex.h"
 #include "ncpar/pipeline.h"
 #include "emit.h"
+#include "pipe.h"
 #include "ncpar/blocks.h"
 #include "ncpar/clock.h"
 
@@ -53,7 +54,8 @@ int ncp_serial_run(const struct ncp_source *src, const struct ncp_analyzer_cfg *
                    const struct ncp_output *out, struct ncp_run_stats *stats,
                    struct ncp_diag *d)
 {
-    double t0 = (double)ncp_mono_ns() / 1e6;
+    double t0 = (double)ncp_mono_ns() / 1e6, cpu0 = ncp_pipe_thread_cpu_ms();
+    double sys0 = ncp_pipe_thread_sys_ms();
     struct ncp_text_feed *feed = malloc(sizeof *feed);
     struct serial_sink *sink = malloc(sizeof *sink);
     struct ncp_analyzer *an = NULL;
@@ -103,6 +105,12 @@ done:
         stats->commands = sink ? sink->emitted : 0;
         stats->wall_ms = (double)ncp_mono_ns() / 1e6 - t0;
         stats->threads = 1;
+        /* the one thread does every stage's work: the parallel layouts' CPU
+         * time per stage is read against this */
+        stats->analyzer.cpu_ms = ncp_pipe_thread_cpu_ms() - cpu0;
+        stats->analyzer.wall_ms = stats->wall_ms;
+        stats->analyzer.sys_ms = ncp_pipe_thread_sys_ms() - sys0;
+        stats->analyzer.items = stats->blocks;
     }
     if (!acfg || an != acfg->instance)
         ncp_analyzer_free(an);

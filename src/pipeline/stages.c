@@ -10,6 +10,7 @@
 #include "ncpar/clock.h"
 
 #include <stddef.h>
+#include <sys/resource.h>
 #include <time.h>
 
 static double clock_ms(clockid_t clock)
@@ -29,12 +30,21 @@ double ncp_pipe_thread_cpu_ms(void)
     return clock_ms(CLOCK_THREAD_CPUTIME_ID);
 }
 
+double ncp_pipe_thread_sys_ms(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_THREAD, &ru) != 0)
+        return 0;
+    return (double)ru.ru_stime.tv_sec * 1e3 + (double)ru.ru_stime.tv_usec / 1e3;
+}
+
 /* Every stage thread ends here: nothing it holds back may keep another stage
  * asleep, and its CPU time goes into the run's statistics. */
 static void *stage_done(void *arg)
 {
     ncp_ring_wake_owed();
     ((struct ncp_pipe_worker *)arg)->cpu_ms = ncp_pipe_thread_cpu_ms();
+    ((struct ncp_pipe_worker *)arg)->sys_ms = ncp_pipe_thread_sys_ms();
     return NULL;
 }
 

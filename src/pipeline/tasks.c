@@ -22,7 +22,10 @@ void ncp_pipe_run_stage(struct ncp_pipe_worker *w)
     struct ncp_pipe_thread t = { kind_of(w), w->index, w->p };
     if (h && h->started)
         h->started(h->ctx, &t);
+    /* the monotonic clock is read without a syscall, and only here */
+    double t0 = ncp_pipe_now_ms();
     w->fn(w);
+    w->wall_ms = ncp_pipe_now_ms() - t0;
     if (h && h->ended)
         h->ended(h->ctx, &t);
 }
