@@ -188,6 +188,10 @@ struct ncp_backend {
     /* The loop drives the axes itself this cycle (homing), not from the
      * stream: an HLC whose LLCs make their own setpoints sends it them. */
     int homing;
+    /* Homing's offset the loop adds to its joints to make cmd (cmd = the
+     * plan's joint + home_off): an HLC whose LLCs run the planner's records
+     * tells them, the records being in the plan's coordinates. */
+    double home_off[NCP_AXES];
     /* An HLC at a block-level point sends on what the ADCBI planner starts:
      * the NCK hands it to the planner's tap (planner thread; NULL: none). */
     void (*plan_tap)(void *impl, const struct ncp_la *la, const struct ncp_accdec *rec);

@@ -80,11 +80,14 @@ struct llc {
     double fault_ferr;    /* the following error LLC_END_FERROR saw */
     int32_t seq;
     int done_req;
-    /* ADCAI's DP3 and DP2: the HLC's fine setpoints played (its homing),
-     * the last period one came for; the axis then holds until its own
-     * stream starts again after it */
+    /* ADCAI's DP3 and DP2, ADCBI's block-level points: the HLC's fine
+     * setpoints played (its homing), the last period one came for; the axis
+     * then holds until its own stream starts again after it */
     int fine_mode;
     int64_t fine_last;
+    /* Block-level points: what the planner's records add to be this axis
+     * (homing's offset, mm), as the abort that started them said */
+    double rec_off;
     int hold;             /* the HLC's heartbeat says hold (fine setpoints only) */
     int64_t hold_until;   /* after a hold: the HLC's period of its RUN, played from */
     int64_t done_at;      /* the HLC's last period, as its done said */

@@ -282,11 +282,12 @@ static int ai_ahead(struct llc *l, int64_t slot, double *mm)
     return !missing;
 }
 
-/* ADCAI's DP3 and DP2: 1 the HLC sent its own setpoint for slot (its
- * homing, the loop's own motion), played as at DP5; 2 none came since, and
- * the axis holds where they left it until the HLC's stream starts again
- * after them (the NCK restarts its planner where homing ended: a new job);
- * 0 its own stream. */
+/* ADCAI's DP3 and DP2, ADCBI's block-level points: 1 the HLC sent its own
+ * setpoint for slot (its homing, the loop's own motion), played as at DP5;
+ * 2 none came since, and the axis holds where they left it until the HLC's
+ * stream starts again after them (the NCK restarts its planner where homing
+ * ended: a new ADCAI job, or the abort's void at block-level points, from
+ * which the records are offset by homing's offset); 0 its own stream. */
 static int fine_phase(struct llc *l, int64_t slot)
 {
     int32_t at;
@@ -297,7 +298,14 @@ static int fine_phase(struct llc *l, int64_t slot)
     }
     if (!l->fine_mode)
         return 0;
-    int restarted = llc_ai_job_started(l, l->fine_last, slot);
+    /* block-level points: the abort's void (serve), or the path's next
+     * start where no abort follows homing (`cnc-run run --home`, whose
+     * records start where the plan stands: exact only without an offset) */
+    int64_t start = l->ai ? 0 : llc_start_at(l, l->starts_done);
+    int restarted = l->ai ? llc_ai_job_started(l, l->fine_last, slot)
+                          : (l->scale.void_due && l->scale.void_t > l->fine_last &&
+                             slot >= l->scale.void_t) ||
+                                (start > l->fine_last && slot >= start);
     if (restarted)
         l->fine_mode = 0;
     return restarted ? 0 : 2;
@@ -345,7 +353,7 @@ static int exec_try(struct llc *l, int64_t slot, int commit, double *pos)
         /* every axis from where the first record starts: a standstill is
          * then the same on every LLC and the HLC */
         if (!llc_exec_head(l, 0, &first))
-            first.s.start[l->axis] = l->cmd;
+            first.s.start[l->axis] = l->cmd - l->rec_off;
         ncp_exec_init(&l->ex, first.s.start, (double)l->period_ns * 1e-9);
         memcpy(l->ex_prev, first.s.start, sizeof l->ex_prev);
         l->ex_on = l->ex_rest = 1;
@@ -412,7 +420,7 @@ static double interpolate(struct llc *l, int64_t slot)
         l->state = NCP_AX_STATUS_T_STOPPING;
         return ramp(l);
     }
-    return pos;
+    return pos + l->rec_off;
 }
 
 /* Feed-forward's next setpoint at DP4: the interpolator's next step, looked
@@ -429,7 +437,7 @@ static double interpolate_ahead(struct llc *l, int64_t slot)
         l->missing = 0;
         return 2 * l->cmd - l->cmd_prev;
     }
-    return pos;
+    return pos + l->rec_off;
 }
 
 /* Asks the HLC again for what a later record or its count shows missing,
@@ -515,7 +523,7 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     int fine = 0;
     if (l->end == LLC_END_NONE && (!l->done_req || play_on)) {
         l->state = NCP_AX_STATUS_T_RUNNING;
-        fine = llc_ai_streaming(l) ? fine_phase(l, slot) : 0;
+        fine = l->dp4 || llc_ai_streaming(l) ? fine_phase(l, slot) : 0;
         next_cmd = l->dp1ai                ? play_ai(l, slot)
                    : fine == 1             ? follow(l, slot)
                    : fine == 2             ? l->cmd

@@ -44,10 +44,13 @@ void llc_on_scale(struct llc *l, const uint8_t *p, size_t len)
     double adv[16];
     memcpy(adv, m.adv, sizeof adv);
     llc_scale_put(l, m.t_ns, adv, m.count);
-    if (m.void_below > l->scale.void_below && m.void_t_ns > 0) {
+    /* a new abort by its period: one after homing drops no record (the
+     * count stays) but restarts the interpolator with homing's offset */
+    if (m.void_t_ns > l->scale.void_t && m.void_below >= l->scale.void_below) {
         l->scale.void_below = m.void_below;
         l->scale.void_t = m.void_t_ns;
         l->scale.void_due = 1;
+        l->scale.void_off = ncp_dist_nm_to_mm(m.void_off_nm[l->axis]);
     }
 }
 
@@ -87,6 +90,7 @@ int llc_scale_void(struct llc *l, int64_t slot)
         ncp_dist_recs_skip(&l->recs, l->scale.void_below);
     l->ex_on = 0;
     l->stop_rested = 0;
+    l->rec_off = l->scale.void_off;
     l->scale.voided++;
     return 0;
 }

@@ -18,6 +18,7 @@ struct llc_scale {
     int32_t void_below;
     int64_t void_t;
     int void_due;
+    double void_off;   /* homing's offset on this axis from that drop on (mm) */
     uint32_t voided;   /* aborts whose records were dropped */
     /* DP2: the DROP calls this LLC's planner replayed, and for each the
      * number of its own records then (those before are the aborted job's) */

@@ -116,6 +116,7 @@ struct lcm_be {
     uint32_t discards_seen;
     int32_t void_below;
     int64_t void_t;
+    int32_t void_off_nm[NCP_AXES];   /* homing's offset at that drop */
     uint64_t scale_sent;
 };
 
@@ -506,6 +507,15 @@ static void scale_cycle(struct lcm_be *s, const struct ncp_backend *b, int64_t t
         s->void_below = s->tx->kind == &lcm_kind_int ? s->void_below + 1 : lcm_tx_void(s->tx);
         s->void_t = t;
         s->scale_left = SCALE_AFTER;
+        /* the records after this drop start where the plan stands, which
+         * homing may have moved off the axes' counts; the offset changes
+         * only in homing, which ends in a drop (control.c) */
+        for (int j = 0; j < NCP_AXES; j++)
+            if (ncp_dist_mm_to_nm(b->home_off[j], &s->void_off_nm[j]) != 0)
+                s->void_off_nm[j] = 0;
+        /* its fine setpoints stop here: the LLCs' stream starts again */
+        if (!b->homing)
+            s->homing_left = 0;
     }
     if (s->scale_left <= 0)
         return;
@@ -519,6 +529,7 @@ static void scale_cycle(struct lcm_be *s, const struct ncp_backend *b, int64_t t
     memcpy(m.adv, s->scale_adv, sizeof m.adv);
     m.void_below = s->void_below;
     m.void_t_ns = s->void_t;
+    memcpy(m.void_off_nm, s->void_off_nm, sizeof m.void_off_nm);
     uint8_t buf[256];
     int n = ncp_time_scale_t_encode(buf, 0, sizeof buf, &m);
     if (n > 0 && ncp_msg_publish(s->msg, NCP_DIST_CH_SCALE, buf, (size_t)n) == 0)
@@ -568,7 +579,7 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
          * the two round differently near 0, and a standstill one side
          * counted and the other not would shift every mark after it */
         int moving = 0;
-        for (int j = 0; j < NCP_AXES && s->cycles > 0; j++)
+        for (int j = 0; j < NCP_AXES && s->cycles > 0 && !b->homing; j++)
             moving |= cmd[j] != s->prev_cmd[j];
         /* after an abort the next job starts from a standstill, as the
          * LLCs' interpolators do once they dropped its records (the
@@ -587,6 +598,8 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
             taken = s->p[i].st.rec_next < taken ? s->p[i].st.rec_next : taken;
         int32_t steps = atomic_load_explicit(&s->dp2.steps, memory_order_acquire);
         lcm_tx_cycle(s->tx, s->msg, t, s->T, start, taken, s->rest);
+        if (start)   /* the LLCs' stream starts again here (no abort after homing) */
+            s->homing_left = 0;
         if (s->tx->kind == &lcm_kind_int)
             lcm_dp2_mark(s->tx, &s->dp2, s->msg, steps, t, s->T);
         if (s->dp1 && s->cycles % 20 == 0)   /* an LLC that lost the first one */
@@ -596,12 +609,12 @@ static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const do
     } else {
         send_fine(s, t, cmd);
     }
-    /* homing is the loop's own motion, in no record: at ADCAI's DP3 and
-     * DP2 the LLCs play these meanwhile, and for a while after (the last
-     * ones may be lost); the NCK then restarts the planner where homing left
-     * the axes (an abort of nothing), which starts their stages again
-     * (ADCBI's block-level points refuse homing that moves, control.c) */
-    if (s->ai) {
+    /* homing is the loop's own motion, in no record: where the LLCs make
+     * their own setpoints (ADCAI's DP3 and DP2, ADCBI's block-level points)
+     * they play these meanwhile, and for a while after (the last ones may
+     * be lost); the NCK then restarts the planner where homing left the
+     * axes (an abort of nothing), which starts their stream again */
+    if (s->ai || (s->tx && !s->dp1)) {
         if (b->homing)
             s->homing_left = HOMING_AFTER;
         if (s->homing_left > 0) {

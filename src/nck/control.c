@@ -572,19 +572,24 @@ static int cmd_jog(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, si
     return 0;
 }
 
-/* Distributed axes whose LLCs compute their own command from the planner's
- * records (ADCBI's block-level points): they never see the loop's homing
- * moves or the offset homing puts between the plan and the axes. */
-static int blocks_lcm(const struct ncp_machine_cfg *cfg)
+/* ADCBI's DP1: each LLC runs the program itself, from its own planner, and
+ * never sees the loop's homing moves or the offset homing puts between the
+ * plan and the axes. */
+static int own_program_lcm(const struct ncp_machine_cfg *cfg)
 {
-    return cfg->backend == NCP_BACKEND_LCM && cfg->nck == NCP_NCK_ADCBI && cfg->lcm.dp >= 1 &&
-           cfg->lcm.dp <= 4;
+    return cfg->backend == NCP_BACKEND_LCM && cfg->nck == NCP_NCK_ADCBI && cfg->lcm.dp == 1;
 }
 
-static int cfg_ai_stages(const struct ncp_machine_cfg *cfg)
+/* Where the LLCs make their own setpoints from the HLC's stream (ADCAI's
+ * DP3 and DP2, ADCBI's block-level DP4-DP2): they play the loop's own
+ * setpoints while it homes, then their stream starts again where homing left
+ * the axes, after an abort of nothing (lcm.c, llc.c fine_phase). */
+static int lcm_restarts_after_home(const struct ncp_machine_cfg *cfg)
 {
-    return cfg->backend == NCP_BACKEND_LCM && cfg->nck == NCP_NCK_ADCAI && cfg->lcm.dp >= 2 &&
-           cfg->lcm.dp <= 3;
+    if (cfg->backend != NCP_BACKEND_LCM)
+        return 0;
+    return cfg->nck == NCP_NCK_ADCAI ? cfg->lcm.dp >= 2 && cfg->lcm.dp <= 3
+                                     : cfg->lcm.dp >= 2 && cfg->lcm.dp <= 4;
 }
 
 /* Homing (homing.c): `all` (or nothing) homes the axes of the HOME_SEQUENCE
@@ -620,7 +625,7 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
                                   cfg->axis[j].home_sequence);
         }
     }
-    if (blocks_lcm(cfg))
+    if (own_program_lcm(cfg))
         for (int j = 0; j < NCP_AXES; j++) {
             if (!(mask & NCP_AXIS_BIT(j)))
                 continue;
@@ -628,11 +633,11 @@ static int cmd_home(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
             double at = n->svc->have_fb ? n->svc->last_fb.cmd[j] : n->start[j];
             if (a->home_search_vel != 0 || fabs(at - a->home_offset) > 1e-6)
                 return refuse(why, len, "home %c: not served on --backend lcm --dp %d: the "
-                              "LLCs run the planner's records and homing is the position "
+                              "LLCs run the program themselves and homing is the position "
                               "loop's own motion (HOME_SEARCH_VEL %g) or offset (the axis at "
-                              "%.4f, HOME_OFFSET %g); home on the fine setpoints (DP %d)",
+                              "%.4f, HOME_OFFSET %g); home at DP 2-5",
                               NCP_AXIS_LETTERS[j], cfg->lcm.dp, a->home_search_vel, at,
-                              a->home_offset, cfg->nck == NCP_NCK_ADCAI ? 4 : 5);
+                              a->home_offset);
         }
     for (int j = 0; j < NCP_AXES; j++)
         if (mask & NCP_AXIS_BIT(j))
@@ -985,10 +990,11 @@ static void homing_ended(struct ncp_nck *s)
     sync_interp(s);
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
-    /* ADCAI's LLCs at DP3 and DP2 played homing on the loop's own
-     * setpoints; their stages start again where it left the axes, as the
-     * planner does after an abort (lcm_ai.c numbers a new job) */
-    if (cfg_ai_stages(n->cfg))
+    /* LLCs that make their own setpoints played homing on the loop's own;
+     * their stream starts again where it left the axes, as the planner's
+     * does after an abort (lcm_ai.c numbers a new job; at block-level
+     * points the abort's void, which carries homing's offset, lcm.c) */
+    if (lcm_restarts_after_home(n->cfg))
         begin_drop(s, 0, 0, NCP_ST_IDLE, 0);
     else
         set_state(s, NCP_ST_IDLE);

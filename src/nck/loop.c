@@ -68,6 +68,7 @@ static int drive(struct nck_core *n, double act[NCP_AXES], int with_faults)
         c[j] = n->loop->jcmd[j] + n->loop->home.off[j];
         x[j] = n->loop->jnext[j] + n->loop->home.off[j];
         a[j] = c[j];  /* a backend reports only the machine's joints */
+        n->cross.be.home_off[j] = n->loop->home.off[j];
     }
     /* timing faults act on what the servos get: the joints */
     int rc = with_faults ? nck_servo_cycle(n, c, x, a) : n->cross.be.ops->cycle(&n->cross.be, c, x, a);
