@@ -122,7 +122,9 @@ static const struct llc_ai_mark *word_for(const struct llc_ai *a, int64_t slot, 
     return w;
 }
 
-/* The HLC's read position for slot: 0, or -1 before anything said it. */
+/* The HLC's read position for slot: 0, or -1 before anything said it.
+ * *behind: the axis stands for the HLC, whose loop slept through the slot
+ * (-1: it read nothing) or whose read is behind where this one went on. */
 static int read_at(const struct llc *l, int64_t slot, struct readpos *r, int *behind)
 {
     const struct llc_ai *a = l->ai;
@@ -133,12 +135,14 @@ static int read_at(const struct llc *l, int64_t slot, struct readpos *r, int *be
         return -1;
     *r = (struct readpos){ w->job, w->k, w->f };
     if (w->t >= slot) {
-        /* a period the loop slept through (-1) read nothing */
         for (int64_t u = w->t; u > slot; u -= T)
             r->f -= fmax(0.0, w->adv[3 - (w->t - u) / T]);
+        int64_t i = 3 - (w->t - slot) / T;
+        *behind = i >= 0 && w->adv[i] < 0;
     } else {
         int64_t n = (slot - w->t) / T;
         r->f += (double)n * fmax(0.0, w->adv[3]);
+        *behind = w->adv[3] < 0;
     }
     normalise(r);
     struct readpos prev = { a->play_job, a->play_k, a->play_f };

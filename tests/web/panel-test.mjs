@@ -334,8 +334,8 @@ async function session(browser) {
     const src = fs.readFileSync(path.join(ROOT, 'ncprograms', 'demo.ngc'), 'utf8').split('\n');
     const shown = await page.$$eval('#program div', (d) => d.map((e) => e.textContent));
     check(shown.length === src.length && shown[5].trim() === src[5].trim(), 'the program text differs from demo.ngc');
-    // serve's estimate of the demo's cycle time (101.557 s on the built-in mill)
-    await page.waitForFunction(() => /^1 min 41\.6 s \(estimate\)/.test(document.querySelector('#estimate').textContent), { timeout: 5000 })
+    // serve's estimate of the demo's cycle time (101.548 s on the built-in mill)
+    await page.waitForFunction(() => /^1 min 41\.5 s \(estimate\)/.test(document.querySelector('#estimate').textContent), { timeout: 5000 })
       .catch(async () => { throw new Fail(`cycle time shows '${await page.$eval('#estimate', (e) => e.textContent)}'`); });
     // the preview's segments come from `cnc-run parse --canon`
     await page.waitForFunction(() => document.querySelector('#preview canvas'), { timeout: 8000 });
@@ -392,7 +392,7 @@ async function session(browser) {
     // the cycle time now says what is left of the estimate, as status has it
     await page.waitForFunction(() => {
       const s = window.ncpPanel.status;
-      return s.remaining_s != null && / left of 1 min 41\.6 s \(estimate\)$/.test(document.querySelector('#estimate').textContent);
+      return s.remaining_s != null && / left of 1 min 41\.5 s \(estimate\)$/.test(document.querySelector('#estimate').textContent);
     }, { timeout: 3000 }).catch(async () => {
       throw new Fail(`cycle time while running shows '${await page.$eval('#estimate', (e) => e.textContent)}'`);
     });
