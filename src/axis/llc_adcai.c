@@ -126,7 +126,8 @@ static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum)
     a->top_k = k + a->ratio;
 }
 
-/* A later job's first record: the stages start again, at rest at 0. */
+/* A job's first record (the first this LLC hears, or an abort's next job's):
+ * the stages start again, at rest at 0. */
 static void new_job(struct llc_ai *a, int32_t job, int64_t k)
 {
     ncp_adcai_accdec_reset(a->acc);
@@ -148,10 +149,8 @@ void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len)
     if (!a->started) {
         a->started = 1;
         a->dp = dp;
-        a->job = r.job;
         a->next_seq = r.seq;
-        const struct llc_ai_job *j = llc_ai_job(a, r.job);
-        a->top_k = j && j->k <= r.k ? j->k : r.k;
+        new_job(a, r.job, r.k);
     }
     int32_t gap = r.seq - a->next_seq;
     if (gap < 0 || r.job < a->job || (r.job == a->job && r.k < a->top_k)) {

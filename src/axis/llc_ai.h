@@ -53,7 +53,7 @@ struct llc_ai {
     /* the play: the job, the read position of the last slot played */
     int playing;
     int32_t play_job;
-    int64_t play_slot, play_k;
+    int64_t play_k;
     double play_f;
     int stalled;                    /* the last slot played: the HLC's stream stopped dead */
     uint32_t records, lost, stale, scales, jobs_played;

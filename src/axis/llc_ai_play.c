@@ -223,7 +223,7 @@ static int command_at(const struct llc_ai *a, const struct readpos *r, double *m
 
 int llc_ai_streaming(const struct llc *l)
 {
-    return l->ai && l->ai->dp >= 2 && (l->ai->have_marks || l->ai->playing);
+    return l->ai && l->ai->dp >= 2 && l->ai->have_marks;
 }
 
 double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing)
@@ -248,7 +248,6 @@ double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing)
         a->play_job = r.job;
         a->play_k = r.k;
         a->play_f = r.f;
-        a->play_slot = slot;
     }
     return mm;
 }
