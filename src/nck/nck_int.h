@@ -71,7 +71,7 @@ void nck_release(struct nck_core *n);
 void nck_park_planner(struct nck_core *n);
 int nck_planner_parked(const struct nck_core *n);
 void nck_discard(struct nck_core *n, int to_actual);
-/* loop.c: the scaler's read of the stream for the next command (after a
+/* read_pos.c: the scaler's read of the stream for the next command (after a
  * step or a rebase), and the next command's read handed to the backend. */
 void nck_loop_note_read(struct nck_core *n);
 void nck_loop_take_read(struct nck_core *n);

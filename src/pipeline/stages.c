@@ -7,36 +7,8 @@
 #include "futex.h"
 #include "ncpar/executor.h"
 #include "ncpar/lex.h"
-#include "ncpar/clock.h"
 
 #include <stddef.h>
-#include <sys/resource.h>
-#include <time.h>
-
-static double clock_ms(clockid_t clock)
-{
-    struct timespec ts;
-    clock_gettime(clock, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
-}
-
-double ncp_pipe_now_ms(void)
-{
-    return (double)ncp_mono_ns() / 1e6;
-}
-
-double ncp_pipe_thread_cpu_ms(void)
-{
-    return clock_ms(CLOCK_THREAD_CPUTIME_ID);
-}
-
-double ncp_pipe_thread_sys_ms(void)
-{
-    struct rusage ru;
-    if (getrusage(RUSAGE_THREAD, &ru) != 0)
-        return 0;
-    return (double)ru.ru_stime.tv_sec * 1e3 + (double)ru.ru_stime.tv_usec / 1e3;
-}
 
 /* Every stage thread ends here: nothing it holds back may keep another stage
  * asleep, and its CPU time goes into the run's statistics. */
