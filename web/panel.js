@@ -114,7 +114,7 @@ setInterval(() => {
 
 function send(obj) {
   if (!ui.ws || ui.ws.readyState !== WebSocket.OPEN) return 0;
-  if (obj.cmd !== 'keepalive' && !['list', 'program', 'preview', 'tools', 'history'].includes(obj.cmd)) obj.seq = ++ui.seq;
+  if (obj.cmd !== 'keepalive' && !['list', 'program', 'preview', 'tools', 'history', 'got'].includes(obj.cmd)) obj.seq = ++ui.seq;
   ui.ws.send(JSON.stringify(obj));
   return obj.seq || 0;
 }
@@ -156,12 +156,16 @@ function onMessage(text) {
   switch (m.type) {
     case 'part': {
       // a large answer comes in parts, so that acks and statuses are not
-      // held behind it: joined, it is read as one message
+      // held behind it: joined, it is read as one message. Each part read
+      // is told: the server keeps only a few parts ahead of the panel's
+      // reading, so that an ack never waits behind megabytes in the socket
       ui.parts = ui.parts || {};
-      const t = (ui.parts[m.id] || '') + m.data;
-      if (!m.last) { ui.parts[m.id] = t; break; }
+      const p = ui.parts[m.id] || (ui.parts[m.id] = { text: '', n: 0 });
+      p.text += m.data;
+      p.n++;
+      if (!m.last) { send({ cmd: 'got', id: m.id, parts: p.n }); break; }
       delete ui.parts[m.id];
-      onMessage(t);
+      onMessage(p.text);
       break;
     }
     case 'hello':

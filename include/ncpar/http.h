@@ -91,6 +91,8 @@ enum ncp_http_req {
     NCP_HTTP_REQ_PREVIEW,       /* the loaded program's canonical commands */
     NCP_HTTP_REQ_TOOLS,         /* the tool table file's text */
     NCP_HTTP_REQ_HISTORY,       /* the job history file's last lines */
+    NCP_HTTP_REQ_GOT,           /* the panel has read a large answer's parts:
+                                 * cmd->ivalue[0] its id, [1] how many */
 };
 /* Parses one message: a flat JSON object {"cmd": NAME, ...fields}. unknown is
  * set when the JSON was well formed but NAME is no command. */

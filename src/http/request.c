@@ -50,6 +50,7 @@ static const struct verb verbs[] = {
     { "preview", -NCP_HTTP_REQ_PREVIEW, { { 0, NONE } } },
     { "tools", -NCP_HTTP_REQ_TOOLS, { { 0, NONE } } },
     { "history", -NCP_HTTP_REQ_HISTORY, { { 0, NONE } } },
+    { "got", -NCP_HTTP_REQ_GOT, { { "id", I0 }, { "parts", I1 } } },
 };
 
 static const struct field *field_of(const struct verb *v, const char *key)
@@ -100,6 +101,25 @@ static int put_field(ncp_command_t *c, const struct field *fd, const struct ncp_
     return 0;
 }
 
+/* {"cmd": "got", "id": ID, "parts": N}: both, positive integers, nothing else. */
+static enum ncp_http_req parse_got(const struct verb *v, const struct ncp_fj *o,
+                                   ncp_command_t *c, char *why, size_t wl)
+{
+    for (int i = 0; i < o->n; i++) {
+        const struct ncp_fj_field *f = &o->f[i];
+        if (!strcmp(f->key, "cmd"))
+            continue;
+        const struct field *fd = field_of(v, f->key);
+        if (!fd)
+            return snprintf(why, wl, "got takes no \"%s\"", f->key), NCP_HTTP_REQ_BAD;
+        if (put_field(c, fd, f, why, wl))
+            return NCP_HTTP_REQ_BAD;
+    }
+    if (c->ivalue[0] < 1 || c->ivalue[1] < 1)
+        return snprintf(why, wl, "got needs \"id\" and \"parts\" from 1"), NCP_HTTP_REQ_BAD;
+    return NCP_HTTP_REQ_GOT;
+}
+
 enum ncp_http_req ncp_http_parse_request(const char *json, size_t len, int32_t client_id,
                                          ncp_command_t *c, int *unknown, char *why,
                                          size_t wl)
@@ -119,9 +139,11 @@ enum ncp_http_req ncp_http_parse_request(const char *json, size_t len, int32_t c
         *unknown = 1;
         return snprintf(why, wl, "unknown command \"%.40s\"", name->str), NCP_HTTP_REQ_BAD;
     }
-    if (v->kind < 0)
+    if (v->kind < 0 && v->kind != -NCP_HTTP_REQ_GOT)
         return (enum ncp_http_req)-v->kind;
     memset(c, 0, sizeof *c);
+    if (v->kind == -NCP_HTTP_REQ_GOT)
+        return parse_got(v, &o, c, why, wl);
     c->kind = (int16_t)v->kind;
     c->client_id = client_id;
     if (v->kind == NCP_CMD_HOME)

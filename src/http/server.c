@@ -42,7 +42,8 @@
 #define UNAUTH_MAX 4            /* sockets without the token, */
 #define UNAUTH_MS 2000          /* each closed this long after it opened */
 #define QUERIES_PER_CONN 2      /* slow queries one socket may have waiting */
-#define PART 65536              /* a larger message goes out in parts of this much */
+#define PART 65536              /* a larger message goes out in parts of this much, */
+#define PARTS_AHEAD 4           /* at most this many ahead of what the panel has read */
 #define STR_(x) #x
 #define NCP_HTTP_STR(x) STR_(x)
 #define RATE_PER_S 50.0         /* commands per socket: a continuous jog's keep-alive */
@@ -52,6 +53,7 @@ struct outmsg {
     unsigned char *buf;         /* LWS_PRE bytes, then the message */
     size_t len, off;            /* off: bytes already written (parts) */
     uint64_t id;                /* names its parts */
+    unsigned parts_sent, parts_got;  /* the latter as the panel says (got) */
 };
 
 struct conn {
@@ -273,7 +275,7 @@ static void enqueue(struct ncp_http *h, struct conn *c, unsigned char *b, size_t
         pop(c, c->out[c->out_head].off ? 1 : 0);
         count(h, &h->stats.dropped);
     }
-    c->out[(c->out_head + c->out_n++) % OUT_QUEUE] = (struct outmsg){ b, len, 0, ++c->parts };
+    c->out[(c->out_head + c->out_n++) % OUT_QUEUE] = (struct outmsg){ b, len, 0, ++c->parts, 0, 0 };
     lws_callback_on_writable(c->wsi);
 }
 
@@ -476,6 +478,7 @@ static int write_part(struct conn *c, struct outmsg *m)
     while (m->off + n < m->len && n > 1 && (text[m->off + n] & 0xc0) == 0x80)
         n--;
     int last = m->off + n == m->len;
+    m->parts_sent++;
     size_t size = LWS_PRE + 64 + 6 * n + 8;
     unsigned char *b = malloc(size);
     if (!b)
@@ -491,6 +494,32 @@ static int write_part(struct conn *c, struct outmsg *m)
     if (last)
         pop(c, 0);
     return rc < (int)k ? -1 : 0;
+}
+
+/* A large message's next part may go: not more than PARTS_AHEAD of them
+ * ahead of the panel's reading. The socket's own buffers (megabytes on a
+ * fast link) would otherwise fill with parts, and an ack written after them
+ * reaches the panel only once it has read and parsed all of those. */
+static int part_may_go(const struct outmsg *m)
+{
+    return m->parts_sent - m->parts_got < PARTS_AHEAD;
+}
+
+/* Something this socket could be sent now: asking for a writable callback
+ * otherwise would only spin. */
+static int has_writable(const struct ncp_http *h, const struct conn *c)
+{
+    if (h->status_len && c->status_sent != h->status_msg_seq)
+        return 1;
+    if (!c->out_n)
+        return 0;
+    const struct outmsg *m = &c->out[c->out_head];
+    if (m->len <= PART || part_may_go(m))
+        return 1;
+    for (unsigned i = 1; i < c->out_n; i++)
+        if (c->out[(c->out_head + i) % OUT_QUEUE].len <= PART)
+            return 1;
+    return 0;
 }
 
 /* One message per call. A large one goes in parts, each a message of its
@@ -513,8 +542,9 @@ static int write_next(struct ncp_http *h, struct conn *c)
             m = &c->out[(c->out_head + small) % OUT_QUEUE];
             rc = lws_write(c->wsi, m->buf + LWS_PRE, m->len, LWS_WRITE_TEXT) < (int)m->len;
             pop(c, small);
-        } else if (m->len > PART && m->off && status_due) {
-            rc = write_status(h, c);
+        } else if (m->len > PART && ((m->off && status_due) || !part_may_go(m))) {
+            if (status_due)
+                rc = write_status(h, c);
         } else if (m->len > PART) {
             rc = write_part(c, m);
         } else {
@@ -526,9 +556,35 @@ static int write_next(struct ncp_http *h, struct conn *c)
     }
     if (rc)
         return -1;
-    if (c->out_n || (h->status_len && c->status_sent != h->status_msg_seq))
+    if (has_writable(h, c))
         lws_callback_on_writable(c->wsi);
     return 0;
+}
+
+/* The panel has read n parts of message id: a part held back may go. 1 when
+ * that was news, 0 when no such message or parts were sent (then the
+ * message is refused like any other bad one). */
+static int take_got(struct conn *c, uint64_t id, unsigned n)
+{
+    if (!c->out_n)
+        return 0;
+    struct outmsg *m = &c->out[c->out_head];
+    if (m->id != id || n <= m->parts_got || n > m->parts_sent)
+        return 0;
+    m->parts_got = n;
+    lws_callback_on_writable(c->wsi);
+    return 1;
+}
+
+/* Whether message id was sent whole to c (its id given, no longer queued). */
+static int got_of_sent(const struct conn *c, uint64_t id)
+{
+    if (id == 0 || id > c->parts)
+        return 0;
+    for (unsigned i = 0; i < c->out_n; i++)
+        if (c->out[(c->out_head + i) % OUT_QUEUE].id == id)
+            return 0;
+    return 1;
 }
 
 /* A socket's command into the serving thread's queue; an E-stop into its
@@ -616,6 +672,18 @@ static void on_message(struct ncp_http *h, struct conn *c)
         refuse(h, c, 0, "message too large");
         return;
     }
+    /* what the panel has read of a large answer: before the rate, since
+     * parts are not held back by it either, and only a got that names parts
+     * sent and not yet read is taken here (a few per part at most) */
+    if (memmem(c->rx, c->rx_len, "\"got\"", 5)) {
+        ncp_command_t got;
+        int unknown;
+        char why[128];
+        if (ncp_http_parse_request(c->rx, c->rx_len, c->client_id, &got, &unknown, why,
+                                   sizeof why) == NCP_HTTP_REQ_GOT &&
+            take_got(c, (uint64_t)got.ivalue[0], (unsigned)got.ivalue[1]))
+            return;
+    }
     /* no answer to a flood: answering would be one more. An E-stop is
      * never held back by its socket's rate: only one that names it is
      * parsed past the limit. */
@@ -639,6 +707,14 @@ static void on_message(struct ncp_http *h, struct conn *c)
     case NCP_HTTP_REQ_BAD:
         count(h, unknown ? &h->stats.unknown : &h->stats.bad_json);
         refuse(h, c, 0, why);
+        break;
+    case NCP_HTTP_REQ_GOT:
+        /* the last parts' gots cross the message's end on the wire: a
+         * message sent whole is no news, and no error either */
+        if (!got_of_sent(c, (uint64_t)cmd.ivalue[0])) {
+            count(h, &h->stats.bad_json);
+            refuse(h, c, 0, "got: no such parts sent");
+        }
         break;
     default:
         query(h, c, r);

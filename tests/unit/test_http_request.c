@@ -59,6 +59,28 @@ static void commands_map_onto_the_lcm_type(void **state)
                      NCP_HTTP_REQ_TOOLS);
 }
 
+/* The panel telling how many parts of a large answer it has read. */
+static void got_names_a_message_and_its_parts(void **state)
+{
+    (void)state;
+    ncp_command_t c;
+    int unknown;
+    char why[128];
+    assert_int_equal(parse("{\"cmd\":\"got\",\"id\":7,\"parts\":3}", &c, &unknown, why),
+                     NCP_HTTP_REQ_GOT);
+    assert_int_equal(c.ivalue[0], 7);
+    assert_int_equal(c.ivalue[1], 3);
+    assert_int_equal(parse("{\"cmd\":\"got\",\"id\":7}", &c, &unknown, why), NCP_HTTP_REQ_BAD);
+    assert_non_null(strstr(why, "parts"));
+    assert_int_equal(parse("{\"cmd\":\"got\",\"id\":0,\"parts\":1}", &c, &unknown, why),
+                     NCP_HTTP_REQ_BAD);
+    assert_int_equal(parse("{\"cmd\":\"got\",\"id\":1,\"parts\":1.5}", &c, &unknown, why),
+                     NCP_HTTP_REQ_BAD);
+    assert_int_equal(parse("{\"cmd\":\"got\",\"id\":1,\"parts\":1,\"seq\":4}", &c, &unknown,
+                           why), NCP_HTTP_REQ_BAD);
+    assert_non_null(strstr(why, "seq"));
+}
+
 static void bad_messages_are_refused(void **state)
 {
     (void)state;
@@ -184,6 +206,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(commands_map_onto_the_lcm_type),
+        cmocka_unit_test(got_names_a_message_and_its_parts),
         cmocka_unit_test(bad_messages_are_refused),
         cmocka_unit_test(json_strings_are_escaped),
         cmocka_unit_test(listen_spec),
