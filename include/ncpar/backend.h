@@ -101,6 +101,7 @@ struct ncp_llc_info {
     int error;                /* status_t's LLC_ERR_: 0 none */
     unsigned error_count;     /* errors kept for it so far: a new one counts up */
     char error_text[NCP_LLC_ERROR_MAX];   /* "" none */
+    unsigned returns;         /* times it was heard again after it was lost */
 };
 
 struct ncp_backend_ops {
@@ -151,8 +152,9 @@ struct ncp_backend_ops {
     int (*drive_home)(struct ncp_backend *b, int axis, int go);
     /* Not real-time (the serving thread, on a reset): each LLC's last error
      * is acknowledged where that LLC is back (its last status says waiting,
-     * running or done); one still stopped or unheard keeps it. NULL: no
-     * LLCs. */
+     * running or done); one still stopped or unheard keeps it. A fault of a
+     * lost LLC ends with the next cycle() where every LLC is back and can
+     * join (lcm.c). NULL: no LLCs. */
     void (*llc_ack)(struct ncp_backend *b);
 };
 

@@ -60,6 +60,12 @@ struct peer {
     int64_t last_status_ns, last_hb_ns;
     int32_t last_seq;
     int run_lost;                /* periods in a row without a status */
+    /* lost (its heartbeat or its statuses gone): whatever it says next is
+     * an LLC back, a process started again (its counts from 0) or one that
+     * stalled, and is taken whatever its sequence number; returns counts
+     * those for the serving thread (its axis is no longer homed) */
+    int gone;
+    atomic_uint returns;
     /* for the serving thread's status: state (-1 none yet), clock offset
      * and following error as the last status said */
     atomic_int pub_state, pub_ferr_nm;
@@ -92,6 +98,7 @@ struct lcm_be {
     char fault_axis;
     pthread_t idle;
     atomic_int idle_run;
+    atomic_int retake;       /* a reset asks: the LLCs all back, the fault is over */
     int idle_started;
     uint64_t sent_fine;
     int fine_bytes;
@@ -177,9 +184,14 @@ static void on_status(struct peer *p, const uint8_t *b, size_t len, int64_t now)
     memset(&st, 0, sizeof st);
     if (ncp_ax_status_t_decode(b, 0, (int)len, &st) != (int)len || st.sender != p->axis + 1)
         return;
-    if (p->have_status && st.seq - p->last_seq <= 0) {
+    if (p->have_status && st.seq - p->last_seq <= 0 && !p->gone) {
         p->late++;   /* a duplicate or an older one: the newer stands */
         return;
+    }
+    if (p->gone) {
+        p->gone = 0;
+        p->run_lost = 0;
+        atomic_fetch_add_explicit(&p->returns, 1, memory_order_relaxed);
     }
     p->st = st;
     status_error(p, &st);
@@ -436,6 +448,7 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
                      p->run_lost, s->cfg->lcm.max_lost_periods);
             keep_error(p, NCP_STATUS_T_LLC_ERR_UNHEARD, why);
             fail(s, p, why);
+            p->gone = 1;
         }
     } else {
         p->run_lost = 0;
@@ -445,6 +458,7 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
                  (long long)((now - p->last_hb_ns) / 1000000));
         keep_error(p, NCP_STATUS_T_LLC_ERR_UNHEARD, why);
         fail(s, p, why);
+        p->gone = 1;
         /* its last status said running: the operator must not read that
          * of an LLC that is gone (a status of its, should it come back,
          * stands again) */
@@ -549,12 +563,44 @@ static void journal(void *impl, enum ncp_plan_call c, const struct ncp_seg *seg,
     lcm_dp2_journal(s->tx, &s->dp2, c, seg, pos);
 }
 
+/* A reset after an LLC was lost: the fault is over once every LLC is heard
+ * again and says it waits or runs (one started again, or the others held).
+ * At DP5 an LLC plays whatever setpoints come, so one started again joins
+ * at once: the reset's rest at the actual position (its status's) makes its
+ * first setpoints where its axis stands, and the hold until then keeps it
+ * there. Where the LLCs run records of a job (block-level points, ADCAI,
+ * DP1), one started again lacks that job's past: it is not taken, and the
+ * fault says so. */
+static void take_back(struct lcm_be *s, int64_t now)
+{
+    for (int i = 0; i < s->n; i++) {
+        const struct peer *p = &s->p[i];
+        if (p->gone || !p->have_status || now - p->last_hb_ns > s->hb_timeout ||
+            (p->st.state != NCP_AX_STATUS_T_WAITING && p->st.state != NCP_AX_STATUS_T_RUNNING))
+            return;
+    }
+    if (s->tx || s->ai || s->dp1) {
+        snprintf(s->fault, sizeof s->fault,
+                 "every LLC is heard again, but at DP %d of %s an LLC that started again "
+                 "cannot join: its records of the job are gone; restart serve",
+                 s->cfg->lcm.dp, s->cfg->nck == NCP_NCK_ADCAI ? "ADCAI" : "ADCBI");
+        return;
+    }
+    s->faulted = 0;
+    s->fault[0] = 0;
+    s->fault_axis = 0;
+    for (int i = 0; i < s->n; i++)
+        s->p[i].run_lost = 0;
+}
+
 static int lcm_cycle(struct ncp_backend *b, const double cmd[NCP_AXES], const double next[NCP_AXES],
                      double act[NCP_AXES])
 {
     (void)next;
     struct lcm_be *s = b->impl;
     int64_t now = hlc_now(s);
+    if (atomic_exchange_explicit(&s->retake, 0, memory_order_acquire) && s->faulted)
+        take_back(s, now);
     if (s->cycles == 0)
         s->t0 = now;
     /* this period on the grid the LLCs play by: the loop's absolute schedule
@@ -806,7 +852,8 @@ static int lcm_llcs(const struct ncp_backend *b, struct ncp_llc_info *out, int m
         out[n] = (struct ncp_llc_info){
             p->axis, atomic_load_explicit(&p->pub_state, memory_order_relaxed),
             atomic_load_explicit(&p->pub_clock_ns, memory_order_relaxed),
-            atomic_load_explicit(&p->pub_ferr_nm, memory_order_relaxed), 0, 0, "" };
+            atomic_load_explicit(&p->pub_ferr_nm, memory_order_relaxed), 0, 0, "",
+            atomic_load_explicit(&p->returns, memory_order_relaxed) };
         /* the text and count are ours to read once the kind is set */
         out[n].error = atomic_load_explicit(&p->err_kind, memory_order_acquire);
         if (out[n].error) {
@@ -827,6 +874,8 @@ static void lcm_llc_ack(struct ncp_backend *b)
             st == NCP_AX_STATUS_T_DONE)
             atomic_store_explicit(&p->err_kind, 0, memory_order_release);
     }
+    if (s)
+        atomic_store_explicit(&s->retake, 1, memory_order_release);
 }
 
 static const struct ncp_backend_ops lcm_ops = {
@@ -908,6 +957,7 @@ int ncp_backend_open_lcm(struct ncp_backend *b, const struct ncp_machine_cfg *cf
         p->axis = j;
         atomic_init(&p->pub_state, -1);
         atomic_init(&p->err_kind, 0);
+        atomic_init(&p->returns, 0);
         ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_ADVERT);
         p->sub_advert = ncp_msg_subscribe(s->msg, ch);
         ncp_dist_ax_channel(ch, sizeof ch, j, NCP_DIST_AX_STATUS);

@@ -83,6 +83,7 @@ struct ncp_nck {
     double program_time;             /* the last program run's, s (0: none yet) */
     struct nck_history hist;         /* [DISPLAY] HISTORY_FILE */
     unsigned llc_errors_told[NCP_NCK_AXES_MAX];  /* each LLC's error count told (llcs.c) */
+    unsigned llc_returns_told[NCP_NCK_AXES_MAX]; /* and its returns after it was lost */
 };
 
 /* llcs.c: each LLC's new last error as an event; a reset's acknowledgement */
