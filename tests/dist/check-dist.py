@@ -91,9 +91,10 @@ def central_rows(dcmd, ccmd, tol=1.5e-6, reach=100):
     def fits(i, j):
         return 0 <= j < len(ccmd) and all(abs(dcmd[i][m] - ccmd[j][m]) <= tol for m in range(3))
     rows, o = [], 0
+    steps = sorted(range(-reach, reach + 1), key=abs)
     for i in range(len(dcmd)):
         if not fits(i, i - o):
-            for step in sorted(range(-reach, reach + 1), key=abs):
+            for step in steps:
                 if fits(i, i - o - step) and (i + 1 == len(dcmd) or fits(i + 1, i + 1 - o - step)):
                     o += step
                     break
@@ -219,13 +220,15 @@ def main():
         # time (at a block-level point a standstill left a period or two off
         # the central run's) leaves the plant's response a little off for a
         # while too, but moves no point off the path: only the comparison of
-        # the responses leaves that wake out. Only a plant that was on the
+        # the responses leaves that wake out, as it leaves out the wake of
+        # whatever came before the trace's first period (serve's traces
+        # start after homing's last move). Only a plant that was on the
         # central response when either came (or still in a wake) has a wake
         # to measure: one that is off it anyway (a defect of the LLC's
         # servo) gets the fixed counts above and no more.
         kick = any(g != "0" for g in gaps) or rows[i] is None
-        shifted = i > 0 and rows[i - 1] is not None and rows[i] is not None and \
-            rows[i] != rows[i - 1] + 1
+        shifted = i == 0 or (rows[i - 1] is not None and rows[i] is not None and
+                             rows[i] != rows[i - 1] + 1)
         if (kick or shifted) and (i == 0 or in_wake[i - 1] or in_shift[i - 1] or
                                   not off_central[i - 1]):
             off = [k for k in range(i + 1, min(len(slots), i + 1 + WAKE_MAX))
@@ -277,8 +280,8 @@ def main():
     worst = max(resp, default=0.0)
     ok = worst <= WAKE_TOL
     failed += not ok
-    print(f"{'ok' if ok else 'FAIL'}: the plant's following error vs the central run's at the same"
-          f" sample: max {worst * 1000:.3f} um apart over {len(resp)} of those periods"
+    print(f"{'ok' if ok else 'FAIL'}: plant's response vs central (following error at the same"
+          f" sample): max {worst * 1000:.3f} um apart over {len(resp)} of those periods"
           f" (limit {WAKE_TOL * 1000:.1f} um)")
     # on a loaded host the HLC's loop is late now and then; a quarter of the
     # run still makes the comparison mean something
