@@ -231,7 +231,7 @@ def main():
                              rows[i] != rows[i - 1] + 1)
         if (kick or shifted) and (i == 0 or in_wake[i - 1] or in_shift[i - 1] or
                                   not off_central[i - 1]):
-            off = [k for k in range(i + 1, min(len(slots), i + 1 + WAKE_MAX))
+            off = [k for k in range(i, min(len(slots), i + 1 + WAKE_MAX))
                    if off_central[k]]
             for k in range(i, off[-1] + 1 if off else i):
                 (in_wake if kick else in_shift)[k] = True
