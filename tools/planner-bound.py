@@ -16,9 +16,15 @@ Every estimate is taken on the generous side, so the bound stays a bound:
   middle lies P inside the arc's, its ends on the tangents beyond the arc,
   whose segments either side lose that reach), r + P from half a turn on;
   its length is at least the inner edge's, (r - P) times the sweep (with a
-  helix's rise). Taken as r itself this was no bound: bench/piece-lp found a
-  piece of `sharp` (a small tangent arc between lines) done in 0.331 s
-  against 0.364;
+  helix's rise). Taken as r itself it would not be a bound: a motion within
+  P of a short arc may turn on a wider circle than the arc's. (bench/piece-lp
+  once reported a piece of `sharp` from block 120, a small arc into a line
+  turning the same way, done in 0.331 s and later 0.354 s, below this bound:
+  its samples had been assigned to the nearest piece of path, and that
+  piece's last line crosses its first, so the motion went from the first
+  line to the last at the crossing and skipped 6 of the 8 blocks. Assigned
+  in the path's order, the fastest motion there takes 0.401 s, the bound
+  0.358 s);
 - a corner from tangent u1 to u2 is passed at v with v^2 |u2 - u1|^2 <=
   8 A_w P, where w = (u2 - u1) / |u2 - u1| and A_w = sum_i amax_i |w_i| is
   the most acceleration the axes together can give along w. Derivation: a
