@@ -94,6 +94,15 @@ _Static_assert(offsetof(struct ncp_cmd, text) >= offsetof(struct ncp_cmd, diag) 
 
 size_t ncp_cmd_pack_in_place(struct ncp_cmd *c)
 {
+    if (calls_only(c)) {
+        /* head and calls are the record already: only its size goes in */
+        uint16_t units = (uint16_t)((sizeof(struct packed_cmd_head) + c->n_ops * OP_BYTES) / UNIT);
+        uint32_t msg_len = 0;
+        memcpy((unsigned char *)c + offsetof(struct packed_cmd_head, units), &units, sizeof units);
+        memcpy((unsigned char *)c + offsetof(struct packed_cmd_head, msg_len), &msg_len,
+               sizeof msg_len);
+        return (size_t)units * UNIT;
+    }
     size_t msg, total = record_bytes(c, &msg);
     unsigned char *base = (unsigned char *)c;
     uint16_t n_ops = (uint16_t)ops_of(c), text_used = (uint16_t)text_of(c);
@@ -150,6 +159,25 @@ void ncp_cmd_unpack(const void *src, struct ncp_cmd *c)
     }
     if (h.text_used)
         memcpy(c->text, p, h.text_used);
+}
+
+int ncp_cmd_packed_calls_only(const void *src)
+{
+    struct packed_cmd_head h;
+    memcpy(&h, src, sizeof h);
+    return !(h.flags & NCP_CMD_F_ERROR) && h.text_used == 0 && h.n_ops <= NCP_CMD_MAX_OPS;
+}
+
+void ncp_cmd_copy_calls(const struct ncp_cmd *src, struct ncp_cmd *dst)
+{
+    unsigned n = ops_of(src);
+    dst->cmd_id = src->cmd_id;
+    dst->line = src->line;
+    dst->n_ops = (uint16_t)n;
+    dst->flags = src->flags;
+    dst->text_used = 0;
+    dst->out_len = src->out_len;
+    copy_ops(dst->ops, src->ops, n);
 }
 
 void ncp_cmd_pack_pad(void *dst)

@@ -21,6 +21,17 @@ size_t ncp_cmd_pack_in_place(struct ncp_cmd *c);
 size_t ncp_cmd_packed_units(const void *src);
 /* Restores what formatting and emitting read: header, calls, text, error. */
 void ncp_cmd_unpack(const void *src, struct ncp_cmd *c);
+/* Whether a record is head and calls only (no error, no text: every CAM
+ * command). Such a record can be executed where it stands, read as a struct
+ * ncp_cmd: its head and calls are where a slot has them, and executing it
+ * touches nothing past them but out_len (over the record's msg_len, which a
+ * calls-only record does not use) and an error, which goes elsewhere
+ * (ncp_exec_cmd_into_diag). */
+int ncp_cmd_packed_calls_only(const void *src);
+/* Header, calls and out_len of a command executed in place, to a slot of its
+ * own (the error's, which is not copied): where it is emitted from when
+ * executing it found an error. */
+void ncp_cmd_copy_calls(const struct ncp_cmd *src, struct ncp_cmd *dst);
 /* A filler up to the end of the ring (no command has the id 2^64 - 1). */
 void ncp_cmd_pack_pad(void *dst);
 int ncp_cmd_packed_is_pad(const void *src);
