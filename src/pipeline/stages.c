@@ -221,7 +221,7 @@ static const struct ncp_block *feed_next(void *ctx)
             in = &p->block_in[p->chunk % (uint64_t)p->n];
             continue;
         }
-        ncp_block_unpack(rec, &p->an_block);
+        ncp_block_unpack_over(rec, &p->an_block, &p->an_plain);
         ncp_rec_release(in, units);
         break;
     }
@@ -331,6 +331,7 @@ void *ncp_pipe_analyzer(void *arg)
         p->an_rc = p->an_diag.code;
     } else {
         struct ncp_block_feed feed = { p, feed_next, feed_release, p->src };
+        p->an_plain = 0;
         for (int i = 0; i < p->n; i++)
             ncp_rec_reader_start(&p->block_in[i], &p->parsed[i], &block_stream);
         if (p->ahead) { /* started with the run (ncp_pipe_set_run) */
