@@ -161,7 +161,7 @@ int ncp_exec_resolve(struct ncp_cmd *cmd)
  * for the machine to do. */
 static const char exit_resets[] = "ON_RESET()\nON_RESET()\n";
 
-static int exec_into(struct ncp_cmd *cmd, char *dst, struct ncp_diag *g)
+static void exec_into(struct ncp_cmd *cmd, char *dst, struct ncp_diag *g)
 {
     int had_error = (cmd->flags & NCP_CMD_F_ERROR) != 0;
     resolve_into(cmd, g);
@@ -171,20 +171,22 @@ static int exec_into(struct ncp_cmd *cmd, char *dst, struct ncp_diag *g)
         memcpy(dst + cmd->out_len, exit_resets, sizeof exit_resets - 1);
         cmd->out_len += (uint32_t)(sizeof exit_resets - 1);
     }
-    return cmd->flags & NCP_CMD_F_ERROR ? g->code : NCP_OK;
 }
 
 int ncp_exec_cmd(struct ncp_cmd *cmd)
 {
-    return exec_into(cmd, cmd->out, &cmd->diag);
+    exec_into(cmd, cmd->out, &cmd->diag);
+    return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }
 
 int ncp_exec_cmd_into(struct ncp_cmd *cmd, char *dst)
 {
-    return exec_into(cmd, dst, &cmd->diag);
+    exec_into(cmd, dst, &cmd->diag);
+    return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }
 
 int ncp_exec_cmd_into_diag(struct ncp_cmd *cmd, char *dst, struct ncp_diag *diag)
 {
-    return exec_into(cmd, dst, diag);
+    exec_into(cmd, dst, diag);
+    return cmd->flags & NCP_CMD_F_ERROR ? diag->code : NCP_OK;
 }
