@@ -212,7 +212,7 @@ static const struct ncp_block *feed_next(void *ctx)
     struct ncp_rec_reader *in = &p->block_in[p->chunk % (uint64_t)p->n];
     for (;;) {
         uint32_t units;
-        const void *rec = ncp_rec_take(in, &units);
+        const void *rec = ncp_rec_take_as(in, &block_stream, &units);
         if (!rec)
             return NULL;
         if (ncp_block_packed_is_end_mark(rec)) {
@@ -431,7 +431,7 @@ static void output_packed(struct ncp_pipe *p)
                 continue;
         }
         uint32_t units;
-        const void *rec = ncp_rec_take(&in, &units);
+        const void *rec = ncp_rec_take_as(&in, &cmd_stream, &units);
         if (!rec)
             break;
         p->output.items++;
