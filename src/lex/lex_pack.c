@@ -290,13 +290,13 @@ static void unpack_plain(const unsigned char *p, struct ncp_block *b)
     unpack_plain_parts(p, b);
 }
 
-void ncp_block_unpack_over(const void *src, struct ncp_block *b, unsigned *plain)
+size_t ncp_block_unpack_over(const void *src, struct ncp_block *b, unsigned *plain)
 {
     const unsigned char *p = src;
     if (!(p[offsetof(struct packed_head, form)] & FORM_PLAIN)) {
         ncp_block_unpack(src, b);
         *plain = 0;
-        return;
+        return ncp_block_packed_units(src);
     }
     unsigned n = plain_words(p);
     if (*plain == 0)
@@ -306,6 +306,9 @@ void ncp_block_unpack_over(const void *src, struct ncp_block *b, unsigned *plain
     unpack_plain_parts(p, b);
     if (n + 1 > *plain)
         *plain = n + 1;
+    uint16_t units;
+    memcpy(&units, p + offsetof(struct packed_head, units), sizeof units);
+    return units;
 }
 
 void ncp_block_unpack(const void *src, struct ncp_block *b)

@@ -226,8 +226,7 @@ static const struct ncp_block *take_record(struct ncp_lex_ahead *la)
     struct ncp_block *b = &f->block;
     __builtin_prefetch(la->rec + AHEAD_PREFETCH, 0);
     __builtin_prefetch(la->rec + AHEAD_PREFETCH + 64, 0);
-    ncp_block_unpack_over(la->rec, b, &la->plain);
-    la->rec += ncp_block_packed_units(la->rec) * NCP_PACK_UNIT;
+    la->rec += ncp_block_unpack_over(la->rec, b, &la->plain) * NCP_PACK_UNIT;
     b->line = f->line;
     b->err.line = f->line; /* the lexer's, error or not */
     f->line++;

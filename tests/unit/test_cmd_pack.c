@@ -62,6 +62,15 @@ static void test_round_trip(void **state)
         /* nothing written past the slot's room */
         assert_int_equal(buf[NCP_CMD_IN_PLACE_BYTES], 0xA5);
         assert_int_equal(ncp_cmd_packed_units(buf) * 8, want);
+        /* the inline calls-only path makes the record the general one makes */
+        static union {
+            struct ncp_cmd c;
+            unsigned char b[NCP_CMD_PACK_MAX + 64];
+        } general;
+        memset(general.b, 0xA5, sizeof general.b);
+        memcpy(general.b, &in, NCP_CMD_IN_PLACE_BYTES);
+        assert_int_equal(ncp_cmd_pack_general(&general.c), want);
+        assert_memory_equal(general.b, buf, want);
         assert_false(ncp_cmd_packed_is_pad(buf));
         memset(&out, 0x5A, sizeof out);
         ncp_cmd_unpack(buf, &out);

@@ -1148,7 +1148,7 @@ static void test_unpack_over(void **state)
             ncp_lex_block("#1=2 G1 X[#1] (MSG, x)", 22, 1, 0, &over);
             plain = 0;
         }
-        ncp_block_unpack_over(buf, &over, &plain);
+        assert_int_equal(ncp_block_unpack_over(buf, &over, &plain), ncp_block_packed_units(buf));
         assert_same_block(&lexed, &over);
     }
 }
