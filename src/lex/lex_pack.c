@@ -248,7 +248,7 @@ static void plain_constants(struct ncp_block *b, unsigned from, unsigned to)
 }
 
 /* What differs from one plain block to the next. */
-static void unpack_plain_parts(const unsigned char *p, struct ncp_block *b)
+static inline void unpack_plain_parts(const unsigned char *p, struct ncp_block *b)
 {
     uint64_t offset;
     uint32_t line;
@@ -290,22 +290,30 @@ static void unpack_plain(const unsigned char *p, struct ncp_block *b)
     unpack_plain_parts(p, b);
 }
 
+/* Anything but a plain record over a block already set up for as many
+ * words: out of line, so the common case below saves no registers. */
+static __attribute__((noinline)) size_t unpack_over_slow(const unsigned char *p,
+                                                          struct ncp_block *b, unsigned *plain)
+{
+    if (!(p[offsetof(struct packed_head, form)] & FORM_PLAIN)) {
+        ncp_block_unpack(p, b);
+        *plain = 0;
+        return ncp_block_packed_units(p);
+    }
+    unsigned n = plain_words(p);
+    plain_constants(b, *plain ? *plain - 1 : 0, n);
+    unpack_plain_parts(p, b);
+    *plain = n + 1;
+    return ncp_block_packed_units(p);
+}
+
 size_t ncp_block_unpack_over(const void *src, struct ncp_block *b, unsigned *plain)
 {
     const unsigned char *p = src;
-    if (!(p[offsetof(struct packed_head, form)] & FORM_PLAIN)) {
-        ncp_block_unpack(src, b);
-        *plain = 0;
-        return ncp_block_packed_units(src);
-    }
-    unsigned n = plain_words(p);
-    if (*plain == 0)
-        plain_constants(b, 0, n);
-    else if (n > *plain - 1)
-        plain_constants(b, *plain - 1, n);
+    /* *plain - 1 words set up: a plain record of no more words than that */
+    if (!(p[offsetof(struct packed_head, form)] & FORM_PLAIN) || plain_words(p) >= *plain)
+        return unpack_over_slow(p, b, plain);
     unpack_plain_parts(p, b);
-    if (n + 1 > *plain)
-        *plain = n + 1;
     uint16_t units;
     memcpy(&units, p + offsetof(struct packed_head, units), sizeof units);
     return units;
