@@ -34,6 +34,12 @@ int ncp_exec_write_prints(const struct ncp_cmd *cmd, FILE *f);
 /* Both, as an executor thread does; and both with the text into dst. */
 int ncp_exec_cmd(struct ncp_cmd *cmd);
 int ncp_exec_cmd_into(struct ncp_cmd *cmd, char *dst);
+/* ncp_exec_cmd_into with an error found here written to *diag, cmd->diag
+ * left alone: for a command executed where it stands in a packed record of
+ * the pipeline's ring, which ends at its calls (the bytes where a slot has
+ * its diag belong to the records after it). Returns diag->code with
+ * NCP_CMD_F_ERROR, else NCP_OK. */
+int ncp_exec_cmd_into_diag(struct ncp_cmd *cmd, char *dst, struct ncp_diag *diag);
 
 /* Longest "%.4f" text of any double (DBL_MAX has 309 integer digits) + NUL. */
 #define NCP_FMT_FIXED4_MAX 328

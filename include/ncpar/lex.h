@@ -187,6 +187,12 @@ size_t ncp_block_packed_size(const struct ncp_block *b);
 size_t ncp_block_pack(const struct ncp_block *b, void *dst);
 size_t ncp_block_packed_units(const void *src);
 void ncp_block_unpack(const void *src, struct ncp_block *b);
+/* ncp_block_unpack into a block that only these calls write, one record
+ * after another: what every plain block has alike is written once, not per
+ * block (most of a plain record's unpacking). *plain is the calls' own state:
+ * 0 to start with, and again whenever anything else has written b. Returns
+ * the record's size in units, as ncp_block_packed_units. */
+size_t ncp_block_unpack_over(const void *src, struct ncp_block *b, unsigned *plain);
 /* ncp_lex_line (line number 0) and ncp_block_pack in one: the line at text
  * lexed straight into a packed record at dst, which has room bytes (what
  * follows the record there may be overwritten). The record's size, or 0 if

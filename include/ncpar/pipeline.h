@@ -111,7 +111,10 @@ struct ncp_output {
      * (NULL when there is none, e.g. after a failed write), where the thread
      * that formats a command (serial, inline or packed output) writes it, and
      * the call that then takes the command with its cmd->out_len bytes
-     * written there, in place of emit. Spares copying every line. */
+     * written there, in place of emit. Spares copying every line. commit
+     * may read the command's head, calls and text, and its diag with
+     * NCP_CMD_F_ERROR, nothing else: the output thread hands it commands
+     * where they stand in its ring, which end there. */
     char *(*reserve)(void *ctx);
     int (*commit)(void *ctx, const struct ncp_cmd *cmd);
     /* Optional: the output is a machine, which the analyzer waits for at a

@@ -7,6 +7,7 @@
  * "%d", %T = the op's text. Templates mirror rs274 -g (LinuxCNC 2.9 saicanon)
  * byte for byte, odd spacing included. */
 #include "fmt_num.h"
+#include "format.h"
 #include "ncpar/executor.h"
 
 #include <math.h>
@@ -382,6 +383,11 @@ void ncp_exec_format(struct ncp_cmd *cmd)
 
 void ncp_exec_format_into(struct ncp_cmd *cmd, char *dst)
 {
+    ncp_exec_format_diag(cmd, dst, &cmd->diag);
+}
+
+void ncp_exec_format_diag(struct ncp_cmd *cmd, char *dst, struct ncp_diag *g)
+{
     pthread_once(&ncp_tpls_once, ncp_tpls_build);
     struct ncp_out o = {dst, dst + NCP_CMD_OUT_MAX, 0};
     unsigned n_ops = cmd->n_ops;
@@ -399,10 +405,10 @@ void ncp_exec_format_into(struct ncp_cmd *cmd, char *dst)
             o.p = line;
             cmd->n_ops = (uint16_t)k;
             if (!(cmd->flags & NCP_CMD_F_ERROR)) {
-                ncp_diag_set(&cmd->diag, NCP_ERR_LIMIT, cmd->line, 0,
+                ncp_diag_set(g, NCP_ERR_LIMIT, cmd->line, 0,
                              "canonical output of this block exceeds %d bytes",
                              NCP_CMD_OUT_MAX);
-                cmd->diag.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
+                g->file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
             }
             cmd->flags |= NCP_CMD_F_ERROR;
             break;

@@ -4,6 +4,7 @@
  * words. */
 #include "ncpar/geom.h"
 #include "ncpar/executor.h"
+#include "format.h"
 
 #include <math.h>
 #include <string.h>
@@ -48,13 +49,12 @@ static void ncp_plane_axes(int plane, char *a, char *b)
     *b = second[p];
 }
 
-static int ncp_arc_error(struct ncp_cmd *cmd, const struct ncp_canon *op, int status,
-                         const struct ncp_arc_out *out)
+static int ncp_arc_error(const struct ncp_cmd *cmd, const struct ncp_canon *op, int status,
+                         const struct ncp_arc_out *out, struct ncp_diag *g)
 {
     char a, b;
     ncp_plane_axes(op->arc.plane, &a, &b);
     const struct ncp_canon_arc *q = &op->arc;
-    struct ncp_diag *g = &cmd->diag;
     switch (status) {
     case NCP_ARC_SAME_POINT:
         return ncp_diag_set(g, NCP_ERR_GEOMETRY, cmd->line, 0,
@@ -91,14 +91,15 @@ static struct ncp_canon *ncp_inverse_feed_before(struct ncp_cmd *cmd, unsigned k
 }
 
 /* ARC_REQUEST fields -> ARC_FEED fields, in place. */
-static int ncp_resolve_arc(struct ncp_cmd *cmd, struct ncp_canon *op, struct ncp_canon *feed_op)
+static int ncp_resolve_arc(const struct ncp_cmd *cmd, struct ncp_canon *op,
+                           struct ncp_canon *feed_op, struct ncp_diag *g)
 {
     struct ncp_arc_in in;
     struct ncp_arc_out out;
     ncp_arc_in_from_op(op, &in);
     int status = ncp_geom_arc_solve(&in, &out);
     if (status != NCP_ARC_OK)
-        return ncp_arc_error(cmd, op, status, &out);
+        return ncp_arc_error(cmd, op, status, &out, g);
 
     double axis_end = op->arc.axis_end;
     double a = op->arc.abc[0], b = op->arc.abc[1], c = op->arc.abc[2];
@@ -124,7 +125,9 @@ static int ncp_resolve_arc(struct ncp_cmd *cmd, struct ncp_canon *op, struct ncp
     return NCP_OK;
 }
 
-int ncp_exec_resolve(struct ncp_cmd *cmd)
+/* The error, if any, goes to *g: cmd->diag, or a slot of the caller's for a
+ * command read where it stands in a packed record (no room for one there). */
+static int resolve_into(struct ncp_cmd *cmd, struct ncp_diag *g)
 {
     unsigned n_ops = cmd->n_ops;
     if (n_ops > NCP_CMD_MAX_OPS)
@@ -134,15 +137,20 @@ int ncp_exec_resolve(struct ncp_cmd *cmd)
         if (op->kind != NCP_C_ARC_REQUEST)
             continue;
         struct ncp_canon *feed_op = ncp_inverse_feed_before(cmd, k);
-        if (ncp_resolve_arc(cmd, op, feed_op) != NCP_OK) {
+        if (ncp_resolve_arc(cmd, op, feed_op, g) != NCP_OK) {
             /* rs274 sets the G93 rate only once the arc is known good */
             cmd->n_ops = (uint16_t)(feed_op ? k - 1 : k);
-            cmd->diag.file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
+            g->file = ncp_diag_file_of_tag(NCP_CMD_FILE(cmd));
             cmd->flags |= NCP_CMD_F_ERROR;
             break;
         }
     }
-    return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
+    return cmd->flags & NCP_CMD_F_ERROR ? g->code : NCP_OK;
+}
+
+int ncp_exec_resolve(struct ncp_cmd *cmd)
+{
+    return resolve_into(cmd, &cmd->diag);
 }
 
 /* rs274's driver resets the canon twice as it exits, after any error. The
@@ -153,12 +161,12 @@ int ncp_exec_resolve(struct ncp_cmd *cmd)
  * for the machine to do. */
 static const char exit_resets[] = "ON_RESET()\nON_RESET()\n";
 
-static void exec_into(struct ncp_cmd *cmd, char *dst)
+static void exec_into(struct ncp_cmd *cmd, char *dst, struct ncp_diag *g)
 {
     int had_error = (cmd->flags & NCP_CMD_F_ERROR) != 0;
-    ncp_exec_resolve(cmd);
+    resolve_into(cmd, g);
     int failed_here = !had_error && (cmd->flags & NCP_CMD_F_ERROR);
-    ncp_exec_format_into(cmd, dst);
+    ncp_exec_format_diag(cmd, dst, g);
     if (failed_here && cmd->out_len + sizeof exit_resets - 1 <= NCP_CMD_OUT_MAX) {
         memcpy(dst + cmd->out_len, exit_resets, sizeof exit_resets - 1);
         cmd->out_len += (uint32_t)(sizeof exit_resets - 1);
@@ -167,12 +175,18 @@ static void exec_into(struct ncp_cmd *cmd, char *dst)
 
 int ncp_exec_cmd(struct ncp_cmd *cmd)
 {
-    exec_into(cmd, cmd->out);
+    exec_into(cmd, cmd->out, &cmd->diag);
     return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
 }
 
 int ncp_exec_cmd_into(struct ncp_cmd *cmd, char *dst)
 {
-    exec_into(cmd, dst);
+    exec_into(cmd, dst, &cmd->diag);
     return cmd->flags & NCP_CMD_F_ERROR ? cmd->diag.code : NCP_OK;
+}
+
+int ncp_exec_cmd_into_diag(struct ncp_cmd *cmd, char *dst, struct ncp_diag *diag)
+{
+    exec_into(cmd, dst, diag);
+    return cmd->flags & NCP_CMD_F_ERROR ? diag->code : NCP_OK;
 }

@@ -226,8 +226,29 @@ size_t ncp_block_packed_units(const void *src)
     return units;
 }
 
-/* Everything a plain block does not have, as the lexer leaves it. */
-static void unpack_plain(const unsigned char *p, struct ncp_block *b)
+/* What every plain block has alike (nothing of what it does not have, as
+ * the lexer leaves it), and its words' parts that are the same in every
+ * plain word, for words [from, to). */
+static void plain_constants(struct ncp_block *b, unsigned from, unsigned to)
+{
+    b->words_only = 1;
+    b->n_assign = b->n_code = b->pool_used = 0;
+    b->comment_kind = NCP_CMT_NONE;
+    b->comment_off = b->comment_len = 0;
+    b->err.code = NCP_OK;
+    b->err.col = 0;
+    b->err.file = NULL;
+    b->err.msg[0] = '\0';
+    b->oword.kind = NCP_O_NONE;
+    for (unsigned k = from; k < to; k++) {
+        struct ncp_word *w = &b->words[k];
+        w->v.start = w->v.len = 0;
+        w->v.is_const = 1;
+    }
+}
+
+/* What differs from one plain block to the next. */
+static inline void unpack_plain_parts(const unsigned char *p, struct ncp_block *b)
 {
     uint64_t offset;
     uint32_t line;
@@ -239,20 +260,11 @@ static void unpack_plain(const unsigned char *p, struct ncp_block *b)
     unsigned form = p[offsetof(struct packed_head, form)];
     b->offset = offset;
     b->line = line;
+    b->err.line = line;
     b->length = length;
     b->block_delete = (form & FORM_BLOCK_DELETE) != 0;
     b->has_n = (form & FORM_HAS_N) != 0;
-    b->words_only = 1;
     b->n_words = (uint16_t)n_words;
-    b->n_assign = b->n_code = b->pool_used = 0;
-    b->comment_kind = NCP_CMT_NONE;
-    b->comment_off = b->comment_len = 0;
-    b->err.code = NCP_OK;
-    b->err.line = line;
-    b->err.col = 0;
-    b->err.file = NULL;
-    b->err.msg[0] = '\0';
-    b->oword.kind = NCP_O_NONE;
     p += PLAIN_HEAD;
     b->n_number = 0.0;
     if (form & FORM_HAS_N) {
@@ -264,9 +276,47 @@ static void unpack_plain(const unsigned char *p, struct ncp_block *b)
         memcpy(&w->v.value, p, sizeof w->v.value);
         memcpy(&w->col, p + 8, sizeof w->col);
         w->letter = (char)p[10];
-        w->v.start = w->v.len = 0;
-        w->v.is_const = 1;
     }
+}
+
+static unsigned plain_words(const unsigned char *p)
+{
+    return p[offsetof(struct packed_head, n_words)];
+}
+
+static void unpack_plain(const unsigned char *p, struct ncp_block *b)
+{
+    plain_constants(b, 0, plain_words(p));
+    unpack_plain_parts(p, b);
+}
+
+/* Anything but a plain record over a block already set up for as many
+ * words: out of line, so the common case below saves no registers. */
+static __attribute__((noinline)) size_t unpack_over_slow(const unsigned char *p,
+                                                          struct ncp_block *b, unsigned *plain)
+{
+    if (!(p[offsetof(struct packed_head, form)] & FORM_PLAIN)) {
+        ncp_block_unpack(p, b);
+        *plain = 0;
+        return ncp_block_packed_units(p);
+    }
+    unsigned n = plain_words(p);
+    plain_constants(b, *plain ? *plain - 1 : 0, n);
+    unpack_plain_parts(p, b);
+    *plain = n + 1;
+    return ncp_block_packed_units(p);
+}
+
+size_t ncp_block_unpack_over(const void *src, struct ncp_block *b, unsigned *plain)
+{
+    const unsigned char *p = src;
+    /* *plain - 1 words set up: a plain record of no more words than that */
+    if (!(p[offsetof(struct packed_head, form)] & FORM_PLAIN) || plain_words(p) >= *plain)
+        return unpack_over_slow(p, b, plain);
+    unpack_plain_parts(p, b);
+    uint16_t units;
+    memcpy(&units, p + offsetof(struct packed_head, units), sizeof units);
+    return units;
 }
 
 void ncp_block_unpack(const void *src, struct ncp_block *b)

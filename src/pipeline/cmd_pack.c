@@ -4,17 +4,8 @@
 #include <stdint.h>
 #include <string.h>
 
-#define UNIT 8u
+#define UNIT NCP_CMD_UNIT
 
-struct packed_cmd_head {
-    uint64_t cmd_id;
-    uint32_t line;
-    uint16_t n_ops, flags;
-    uint16_t text_used, units;
-    uint32_t msg_len;          /* with F_ERROR: the diagnostic's text, without NUL */
-};
-
-static const uint64_t pad_id = UINT64_MAX;
 
 static unsigned ops_of(const struct ncp_cmd *c)
 {
@@ -33,7 +24,7 @@ static size_t msg_of(const struct ncp_cmd *c)
 
 static size_t bytes_of(const struct ncp_cmd *c, size_t msg)
 {
-    size_t n = sizeof(struct packed_cmd_head) + ops_of(c) * sizeof c->ops[0] + text_of(c);
+    size_t n = sizeof(struct ncp_packed_cmd_head) + ops_of(c) * sizeof c->ops[0] + text_of(c);
     if (c->flags & NCP_CMD_F_ERROR)
         n += offsetof(struct ncp_diag, msg) + msg;
     return (n + UNIT - 1) / UNIT * UNIT;
@@ -46,7 +37,7 @@ static int calls_only(const struct ncp_cmd *c)
     return !(c->flags & NCP_CMD_F_ERROR) && c->text_used == 0 && c->n_ops <= NCP_CMD_MAX_OPS;
 }
 
-_Static_assert(sizeof(struct packed_cmd_head) % UNIT == 0 && sizeof(struct ncp_canon) % UNIT == 0,
+_Static_assert(sizeof(struct ncp_packed_cmd_head) % UNIT == 0 && sizeof(struct ncp_canon) % UNIT == 0,
                "a calls-only record needs no padding");
 
 /* The record's size, and the length of its error text (0 without one). */
@@ -54,7 +45,7 @@ static size_t record_bytes(const struct ncp_cmd *c, size_t *msg)
 {
     *msg = 0;
     if (calls_only(c))
-        return sizeof(struct packed_cmd_head) + c->n_ops * sizeof c->ops[0];
+        return sizeof(struct ncp_packed_cmd_head) + c->n_ops * sizeof c->ops[0];
     *msg = msg_of(c);
     return bytes_of(c, *msg);
 }
@@ -80,26 +71,26 @@ static void copy_ops(void *dst, const void *src, unsigned n)
 /* The command is written where its record goes: its head and calls already
  * stand where the record wants them, and only the error and the text (rare)
  * move down behind the calls. */
-_Static_assert(offsetof(struct ncp_cmd, cmd_id) == offsetof(struct packed_cmd_head, cmd_id) &&
-                   offsetof(struct ncp_cmd, line) == offsetof(struct packed_cmd_head, line) &&
-                   offsetof(struct ncp_cmd, n_ops) == offsetof(struct packed_cmd_head, n_ops) &&
-                   offsetof(struct ncp_cmd, flags) == offsetof(struct packed_cmd_head, flags) &&
+_Static_assert(offsetof(struct ncp_cmd, cmd_id) == offsetof(struct ncp_packed_cmd_head, cmd_id) &&
+                   offsetof(struct ncp_cmd, line) == offsetof(struct ncp_packed_cmd_head, line) &&
+                   offsetof(struct ncp_cmd, n_ops) == offsetof(struct ncp_packed_cmd_head, n_ops) &&
+                   offsetof(struct ncp_cmd, flags) == offsetof(struct ncp_packed_cmd_head, flags) &&
                    offsetof(struct ncp_cmd, text_used) ==
-                       offsetof(struct packed_cmd_head, text_used) &&
-                   offsetof(struct ncp_cmd, ops) == sizeof(struct packed_cmd_head),
+                       offsetof(struct ncp_packed_cmd_head, text_used) &&
+                   offsetof(struct ncp_cmd, ops) == sizeof(struct ncp_packed_cmd_head),
                "a command's head and calls are its record's");
 /* each part moves down, never onto a part still to move */
 _Static_assert(offsetof(struct ncp_cmd, text) >= offsetof(struct ncp_cmd, diag) + sizeof(struct ncp_diag),
                "the text follows the error");
 
-size_t ncp_cmd_pack_in_place(struct ncp_cmd *c)
+size_t ncp_cmd_pack_general(struct ncp_cmd *c)
 {
     size_t msg, total = record_bytes(c, &msg);
     unsigned char *base = (unsigned char *)c;
     uint16_t n_ops = (uint16_t)ops_of(c), text_used = (uint16_t)text_of(c);
     uint16_t units = (uint16_t)(total / UNIT);
     uint32_t msg_len = (uint32_t)msg;
-    unsigned char *p = base + sizeof(struct packed_cmd_head) + n_ops * sizeof c->ops[0];
+    unsigned char *p = base + sizeof(struct ncp_packed_cmd_head) + n_ops * sizeof c->ops[0];
     if (c->flags & NCP_CMD_F_ERROR) {
         memmove(p, &c->diag, offsetof(struct ncp_diag, msg));
         p += offsetof(struct ncp_diag, msg);
@@ -113,23 +104,17 @@ size_t ncp_cmd_pack_in_place(struct ncp_cmd *c)
     if (pad)
         memset(p, 0, pad);
     /* the head's own fields last: units and msg_len lie over out_len */
-    memcpy(base + offsetof(struct packed_cmd_head, n_ops), &n_ops, sizeof n_ops);
-    memcpy(base + offsetof(struct packed_cmd_head, text_used), &text_used, sizeof text_used);
-    memcpy(base + offsetof(struct packed_cmd_head, units), &units, sizeof units);
-    memcpy(base + offsetof(struct packed_cmd_head, msg_len), &msg_len, sizeof msg_len);
+    memcpy(base + offsetof(struct ncp_packed_cmd_head, n_ops), &n_ops, sizeof n_ops);
+    memcpy(base + offsetof(struct ncp_packed_cmd_head, text_used), &text_used, sizeof text_used);
+    memcpy(base + offsetof(struct ncp_packed_cmd_head, units), &units, sizeof units);
+    memcpy(base + offsetof(struct ncp_packed_cmd_head, msg_len), &msg_len, sizeof msg_len);
     return total;
 }
 
-size_t ncp_cmd_packed_units(const void *src)
-{
-    struct packed_cmd_head h;
-    memcpy(&h, src, sizeof h);
-    return h.units;
-}
 
 void ncp_cmd_unpack(const void *src, struct ncp_cmd *c)
 {
-    struct packed_cmd_head h;
+    struct ncp_packed_cmd_head h;
     const unsigned char *p = src;
     memcpy(&h, p, sizeof h);
     p += sizeof h;
@@ -152,14 +137,17 @@ void ncp_cmd_unpack(const void *src, struct ncp_cmd *c)
         memcpy(c->text, p, h.text_used);
 }
 
-void ncp_cmd_pack_pad(void *dst)
+
+void ncp_cmd_copy_calls(const struct ncp_cmd *src, struct ncp_cmd *dst)
 {
-    memcpy(dst, &pad_id, sizeof pad_id);
+    unsigned n = ops_of(src);
+    dst->cmd_id = src->cmd_id;
+    dst->line = src->line;
+    dst->n_ops = (uint16_t)n;
+    dst->flags = src->flags;
+    dst->text_used = 0;
+    dst->out_len = src->out_len;
+    copy_ops(dst->ops, src->ops, n);
 }
 
-int ncp_cmd_packed_is_pad(const void *src)
-{
-    uint64_t v;
-    memcpy(&v, src, sizeof v);
-    return v == pad_id;
-}
+

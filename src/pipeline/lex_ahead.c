@@ -88,6 +88,7 @@ void ncp_lex_ahead_start(struct ncp_lex_ahead *la, const struct ncp_source *src)
     ncp_text_feed_start(&la->feed, src);
     la->recs_left = 0;
     la->rec = NULL;
+    la->plain = 0;
     enter_chunk(la, 0);
 }
 
@@ -225,8 +226,7 @@ static const struct ncp_block *take_record(struct ncp_lex_ahead *la)
     struct ncp_block *b = &f->block;
     __builtin_prefetch(la->rec + AHEAD_PREFETCH, 0);
     __builtin_prefetch(la->rec + AHEAD_PREFETCH + 64, 0);
-    ncp_block_unpack(la->rec, b);
-    la->rec += ncp_block_packed_units(la->rec) * NCP_PACK_UNIT;
+    la->rec += ncp_block_unpack_over(la->rec, b, &la->plain) * NCP_PACK_UNIT;
     b->line = f->line;
     b->err.line = f->line; /* the lexer's, error or not */
     f->line++;
@@ -245,8 +245,10 @@ const struct ncp_block *ncp_lex_ahead_next(void *ctx)
             return take_record(la);
         if (f->off >= f->src->end)
             return NULL;
-        if (f->off < la->chunk_end)
+        if (f->off < la->chunk_end) {
+            la->plain = 0; /* the block is lexed over */
             return ncp_text_feed_next(f);
+        }
         leave_chunk(la);
         enter_chunk(la, la->chunk + 1);
     }

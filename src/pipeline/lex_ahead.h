@@ -65,6 +65,7 @@ struct ncp_lex_ahead {
     alignas(64) struct ncp_text_feed feed;
     uint64_t chunk, chunk_end;        /* its chunk and where that ends in the text */
     uint64_t a_waits, a_slept;        /* chunks it found still being lexed; slept for */
+    unsigned plain;                   /* feed.block's state for ncp_block_unpack_over */
     const unsigned char *rec;         /* the helper's next packed block */
     uint32_t recs_left;
     uint64_t rec_stop;

@@ -85,6 +85,7 @@ struct ncp_pipe {
     int inline_stopped;          /* the inline output stopped */
     struct ncp_diag an_diag;     /* ncp_analyzer_new failure */
     struct ncp_block an_block;   /* the block it holds, unpacked */
+    unsigned an_plain;           /* an_block's state for ncp_block_unpack_over */
     struct ncp_rec_writer cmd_out; /* packed output: its end of cmds[0] */
     struct ncp_rec_reader block_in[NCP_MAX_LEXERS]; /* its ends of parsed[] */
 

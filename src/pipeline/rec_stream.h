@@ -92,14 +92,18 @@ static inline void ncp_rec_commit(struct ncp_rec_writer *w, uint32_t units)
  * abort. Read it, then ncp_rec_release(units). */
 const void *ncp_rec_take_slow(struct ncp_rec_reader *rd, uint32_t *units);
 
-static inline const void *ncp_rec_take(struct ncp_rec_reader *rd, uint32_t *units)
+/* ncp_rec_take with the reader's kind given where it is known at compile
+ * time (a static const struct): its tests are then direct calls the compiler
+ * can inline, not two calls through pointers per record. */
+static inline const void *ncp_rec_take_as(struct ncp_rec_reader *rd,
+                                          const struct ncp_record_kind *kind, uint32_t *units)
 {
     if (rd->avail == 0 || ncp_ring_aborted(rd->r))
         return ncp_rec_take_slow(rd, units);
     const unsigned char *rec = rd->cur;
-    if (rd->kind->is_pad(rec))
+    if (kind->is_pad(rec))
         return ncp_rec_take_slow(rd, units);
-    uint32_t n = (uint32_t)rd->kind->units(rec);
+    uint32_t n = (uint32_t)kind->units(rec);
     if (n > rd->avail || n == 0)
         return ncp_rec_take_slow(rd, units);
     if ((size_t)rd->avail * NCP_PACK_UNIT > NCP_REC_PREFETCH + 128u) {
@@ -108,6 +112,11 @@ static inline const void *ncp_rec_take(struct ncp_rec_reader *rd, uint32_t *unit
     }
     *units = n;
     return rec;
+}
+
+static inline const void *ncp_rec_take(struct ncp_rec_reader *rd, uint32_t *units)
+{
+    return ncp_rec_take_as(rd, rd->kind, units);
 }
 
 static inline void ncp_rec_release(struct ncp_rec_reader *rd, uint32_t units)

@@ -212,7 +212,7 @@ static const struct ncp_block *feed_next(void *ctx)
     struct ncp_rec_reader *in = &p->block_in[p->chunk % (uint64_t)p->n];
     for (;;) {
         uint32_t units;
-        const void *rec = ncp_rec_take(in, &units);
+        const void *rec = ncp_rec_take_as(in, &block_stream, &units);
         if (!rec)
             return NULL;
         if (ncp_block_packed_is_end_mark(rec)) {
@@ -221,7 +221,7 @@ static const struct ncp_block *feed_next(void *ctx)
             in = &p->block_in[p->chunk % (uint64_t)p->n];
             continue;
         }
-        ncp_block_unpack(rec, &p->an_block);
+        ncp_block_unpack_over(rec, &p->an_block, &p->an_plain);
         ncp_rec_release(in, units);
         break;
     }
@@ -331,6 +331,7 @@ void *ncp_pipe_analyzer(void *arg)
         p->an_rc = p->an_diag.code;
     } else {
         struct ncp_block_feed feed = { p, feed_next, feed_release, p->src };
+        p->an_plain = 0;
         for (int i = 0; i < p->n; i++)
             ncp_rec_reader_start(&p->block_in[i], &p->parsed[i], &block_stream);
         if (p->ahead) { /* started with the run (ncp_pipe_set_run) */
@@ -387,17 +388,31 @@ void *ncp_pipe_executor(void *arg)
     return stage_done(arg);
 }
 
-/* The next packed command, unpacked into the output thread's own slot; NULL
- * at the end of the data or on abort. */
-static struct ncp_cmd *take_packed(struct ncp_pipe *p, struct ncp_rec_reader *in)
+/* One packed command executed and handed to the output; 1 when the run stops
+ * after it. A calls-only record (every CAM command) is executed where it
+ * stands, its text formatted straight into the output's buffer: nothing of it
+ * is copied (cmd_pack.h says why it may be read as a slot). An error found
+ * while executing it goes to this thread's own slot, the record's head and
+ * calls follow it there, and the command is emitted from there. Any other
+ * record, or an output without a buffer of its own (emit reads the whole
+ * slot), is unpacked into that slot first. */
+static int exec_emit_record(struct ncp_pipe *p, const void *rec)
 {
-    uint32_t units;
-    const void *rec = ncp_rec_take(in, &units);
-    if (!rec)
-        return NULL;
-    ncp_cmd_unpack(rec, p->out_cmd);
-    ncp_rec_release(in, units);
-    return p->out_cmd;
+    const struct ncp_output *out = p->out;
+    struct ncp_cmd *own = p->out_cmd;
+    char *dst;
+    if (!ncp_cmd_packed_calls_only(rec) || !out || !out->reserve ||
+        (dst = out->reserve(out->ctx)) == NULL) {
+        ncp_cmd_unpack(rec, own);
+        return ncp_exec_emit_cmd(own, out, &p->err, &p->emit_failed);
+    }
+    /* the reader's to write: the writer is done with it until it is released */
+    struct ncp_cmd *c = (struct ncp_cmd *)rec;
+    if (ncp_exec_cmd_into_diag(c, dst, &own->diag) != NCP_OK) {
+        ncp_cmd_copy_calls(c, own);
+        c = own;
+    }
+    return ncp_emit_stop(c, out->commit(out->ctx, c) != 0, &p->err, &p->emit_failed);
 }
 
 /* Without executor threads: each packed command executed here. With no
@@ -409,17 +424,20 @@ static void output_packed(struct ncp_pipe *p)
     struct ncp_lex_ahead *ahead = p->ahead;
     struct ncp_rec_reader in;
     ncp_rec_reader_start(&in, &p->cmds[0], &cmd_stream);
-    struct ncp_cmd *c;
     for (;;) {
         if (ahead && ncp_rec_poll(&in) == 0) {
             ncp_ring_wake_owed();
             if (ncp_lex_ahead_help(ahead))
                 continue;
         }
-        if ((c = take_packed(p, &in)) == NULL)
+        uint32_t units;
+        const void *rec = ncp_rec_take_as(&in, &cmd_stream, &units);
+        if (!rec)
             break;
         p->output.items++;
-        if (ncp_exec_emit_cmd(c, p->out, &p->err, &p->emit_failed))
+        int stop = exec_emit_record(p, rec);
+        ncp_rec_release(&in, units);
+        if (stop)
             break;
     }
 }

@@ -12,6 +12,7 @@
 
 #include "../../src/pipeline/cmd_pack.h"
 #include "ncpar/diag.h"
+#include "ncpar/executor.h"
 
 static void fill(struct ncp_cmd *c, uint64_t seed)
 {
@@ -61,6 +62,15 @@ static void test_round_trip(void **state)
         /* nothing written past the slot's room */
         assert_int_equal(buf[NCP_CMD_IN_PLACE_BYTES], 0xA5);
         assert_int_equal(ncp_cmd_packed_units(buf) * 8, want);
+        /* the inline calls-only path makes the record the general one makes */
+        static union {
+            struct ncp_cmd c;
+            unsigned char b[NCP_CMD_PACK_MAX + 64];
+        } general;
+        memset(general.b, 0xA5, sizeof general.b);
+        memcpy(general.b, &in, NCP_CMD_IN_PLACE_BYTES);
+        assert_int_equal(ncp_cmd_pack_general(&general.c), want);
+        assert_memory_equal(general.b, buf, want);
         assert_false(ncp_cmd_packed_is_pad(buf));
         memset(&out, 0x5A, sizeof out);
         ncp_cmd_unpack(buf, &out);
@@ -86,10 +96,102 @@ static void test_round_trip(void **state)
     assert_true(ncp_cmd_packed_is_pad(pad));
 }
 
+/* An arc request in the XY plane from (0, 0) to (2, 0): centre (1, 0) draws
+ * it; in the radius form with the end at the start it is an error. */
+static void arc_request(struct ncp_canon *op, int fails)
+{
+    memset(op, 0, sizeof *op);
+    op->kind = NCP_C_ARC_REQUEST;
+    op->arc.dir = 1;
+    op->arc.turns = 1;
+    op->arc.first_end = fails ? 0.0 : 2.0;
+    op->arc.radius_form = fails;
+    if (fails)
+        op->arc.radius = 1.0;
+    else
+        op->arc.first_centre = 1.0;
+}
+
+static void calls_only_cmd(struct ncp_cmd *c, unsigned n_ops, int arc_fails)
+{
+    memset(c, 0, sizeof *c);
+    c->cmd_id = 41;
+    c->line = 17;
+    c->n_ops = (uint16_t)n_ops;
+    for (unsigned k = 0; k < n_ops; k++) {
+        c->ops[k].kind = NCP_C_STRAIGHT_FEED;
+        for (int d = 0; d < 6; d++)
+            c->ops[k].move.end[d] = k + d * 0.25;
+    }
+    if (arc_fails >= 0)
+        arc_request(&c->ops[n_ops - 1], arc_fails);
+}
+
+/* The output thread executes a calls-only record where it stands in the
+ * ring: it must come out as the unpacked command does, and an error found
+ * there must go to the slot it is given, never past the record (those bytes
+ * belong to the records after it). */
+static void test_execute_in_place(void **state)
+{
+    (void)state;
+    static struct ncp_cmd in, own, ref;
+    static union {
+        struct ncp_cmd c;
+        unsigned char b[NCP_CMD_PACK_MAX + 64];
+    } slot;
+    static char text[NCP_CMD_OUT_MAX], want[NCP_CMD_OUT_MAX];
+    for (unsigned n = 1; n <= NCP_CMD_MAX_OPS; n++) {
+        for (int arc = -1; arc <= 1; arc++) {
+            calls_only_cmd(&in, n, arc);
+            memset(slot.b, 0xA5, sizeof slot.b);
+            memcpy(slot.b, &in, NCP_CMD_IN_PLACE_BYTES);
+            size_t size = ncp_cmd_pack_in_place(&slot.c);
+            assert_true(ncp_cmd_packed_calls_only(slot.b));
+            memset(slot.b + size, 0xA5, sizeof slot.b - size); /* the next records */
+            ncp_cmd_unpack(slot.b, &ref);
+            int ref_rc = ncp_exec_cmd_into(&ref, want);
+            memset(&own, 0, sizeof own);
+            int rc = ncp_exec_cmd_into_diag(&slot.c, text, &own.diag);
+            assert_int_equal(rc, ref_rc);
+            assert_int_equal(rc != NCP_OK, arc == 1);
+            for (size_t i = size; i < sizeof slot.b; i++)
+                assert_int_equal(slot.b[i], 0xA5);
+            assert_int_equal(slot.c.out_len, ref.out_len);
+            assert_memory_equal(text, want, ref.out_len);
+            ncp_cmd_copy_calls(&slot.c, &own);
+            assert_int_equal(own.cmd_id, ref.cmd_id);
+            assert_int_equal(own.line, ref.line);
+            assert_int_equal(own.n_ops, ref.n_ops);
+            assert_int_equal(own.flags, ref.flags);
+            assert_int_equal(own.out_len, ref.out_len);
+            if (ref.n_ops)
+                assert_memory_equal(own.ops, ref.ops, ref.n_ops * sizeof ref.ops[0]);
+            if (rc != NCP_OK) {
+                assert_int_equal(own.diag.code, ref.diag.code);
+                assert_int_equal(own.diag.line, ref.diag.line);
+                assert_string_equal(own.diag.msg, ref.diag.msg);
+            }
+        }
+    }
+    /* an error or text: not executed where it stands */
+    calls_only_cmd(&in, 1, -1);
+    in.text_used = 3;
+    memcpy(slot.b, &in, NCP_CMD_IN_PLACE_BYTES);
+    ncp_cmd_pack_in_place(&slot.c);
+    assert_false(ncp_cmd_packed_calls_only(slot.b));
+    calls_only_cmd(&in, 1, -1);
+    in.flags = NCP_CMD_F_ERROR;
+    ncp_diag_set(&in.diag, NCP_ERR_SYNTAX, 17, 1, "bad");
+    memcpy(slot.b, &in, NCP_CMD_IN_PLACE_BYTES);
+    ncp_cmd_pack_in_place(&slot.c);
+    assert_false(ncp_cmd_packed_calls_only(slot.b));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trip),
+        cmocka_unit_test(test_execute_in_place),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1123,6 +1123,36 @@ static void test_lex_line_packed(void **state)
     }
 }
 
+/* One block unpacked over, record after record (the analyzer's block when
+ * blocks are lexed ahead): plain records of more and fewer words and general
+ * ones in any order, and the block lexed over in between, must each come out
+ * as the block that was packed. */
+static void test_unpack_over(void **state)
+{
+    (void)state;
+    static const char *const lines[] = {
+        "G1 X1.5 Y-2 Z0.25", "G0 X1", "/N10 G1 X1 Y2 Z3 A4 B5 C6 F7", "N20 G2 X1 Y1 I0 J1",
+        "#1 = [#2 + 3]", "G1 X[#1]", "(just a comment)", "G1 X1 X2 Y", "M3 S1000",
+        "o100 if [#1 LT 2]", "G1 X1 Y2 Z3 U4 V5 W6 A7 B8 C9 F10", "", "G1 X1 (c)",
+    };
+    static struct ncp_block lexed, over;
+    static unsigned char buf[NCP_BLOCK_PACK_MAX + 64];
+    unsigned plain = 0, seed = 3;
+    memset(&over, 0x5A, sizeof over);
+    for (int r = 0; r < 2000; r++) {
+        seed = seed * 1103515245u + 12345u;
+        const char *line = lines[(seed >> 16) % (sizeof lines / sizeof lines[0])];
+        ncp_lex_block(line, strlen(line), (uint32_t)r + 1, (uint64_t)r * 40, &lexed);
+        ncp_block_pack(&lexed, buf);
+        if ((seed >> 8) % 17 == 0) { /* written by someone else in between */
+            ncp_lex_block("#1=2 G1 X[#1] (MSG, x)", 22, 1, 0, &over);
+            plain = 0;
+        }
+        assert_int_equal(ncp_block_unpack_over(buf, &over, &plain), ncp_block_packed_units(buf));
+        assert_same_block(&lexed, &over);
+    }
+}
+
 static void test_pack_round_trip(void **state)
 {
     (void)state;
@@ -1193,6 +1223,7 @@ int main(void)
         cmocka_unit_test(test_long_lines),
         cmocka_unit_test(test_nul_and_garbage),
         cmocka_unit_test(test_pack_round_trip),
+        cmocka_unit_test(test_unpack_over),
         cmocka_unit_test(test_lex_line_packed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
