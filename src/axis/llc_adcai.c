@@ -13,6 +13,16 @@
  * one's, just before it, so the stages get a plausible increment and the
  * later sum puts the axis back on the path, no drift.
  *
+ * Where the HLC sent no record the chain's input stood, and its stages ran
+ * on until they rested: so do these. Without a loss they rest where the
+ * HLC's did, after the same record; a bridge, though, may have put part of
+ * a motion's last increment on records after the one that ended it (the
+ * straight line to the next sum), so these stages still move where the
+ * HLC's stream has no more records (its chain rested): past the last
+ * record they run on too, while a bridged record is in their memory, and
+ * rest on the sum the HLC said last. Otherwise stages still moving past
+ * the last record mean a record missing, and the axis holds for it.
+ *
  * An abort at the HLC (stop, E-stop) resets its chain with the sums at 0
  * where its loop rests, and numbers the next job: a record of a later job
  * resets these stages the same way. Where that job starts on the axis comes
@@ -35,7 +45,11 @@ struct llc_ai *llc_ai_new(const struct ncp_machine_cfg *cfg)
     a->ratio = ratio;
     a->scurve = cfg->profile == NCP_PROFILE_SCURVE;
     a->acc = ncp_adcai_accdec_new(n[0], n[1]);
-    a->fine = ncp_adcai_fine_new(ratio, cfg->profile == NCP_PROFILE_SCURVE ? 2 : 1);
+    a->fine = ncp_adcai_fine_new(ratio, a->scurve ? 2 : 1);
+    /* each window a record long per element; fine's averages a rough
+     * period each, after the record it spreads */
+    a->acc_memory = n[0] + n[1];
+    a->fine_memory = (a->scurve ? 2 : 1) + 1;
     if (!a->acc || !a->fine) {
         llc_ai_free(a);
         return NULL;
@@ -65,17 +79,23 @@ int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm)
     return nm;
 }
 
-void llc_ai_load(struct llc_ai *a, int axis, int32_t sum)
+/* One rough period's increment of this axis into the stages. */
+static void feed(struct llc_ai *a, int axis, int32_t inc)
 {
     int32_t in[NCP_AXES] = { 0 }, out[NCP_AXES];
-    in[axis] = (int32_t)((uint32_t)sum - (uint32_t)a->in_sum);
-    a->in_sum = sum;
+    in[axis] = inc;
     /* below DP3 the filters are this LLC's too */
     if (a->dp != 3) {
         ncp_adcai_accdec_step(a->acc, in, out);
         in[axis] = out[axis];
     }
     ncp_adcai_fine_load(a->fine, in);
+}
+
+void llc_ai_load(struct llc_ai *a, int axis, int32_t sum)
+{
+    feed(a, axis, (int32_t)((uint32_t)sum - (uint32_t)a->in_sum));
+    a->in_sum = sum;
     a->records++;
 }
 
@@ -112,10 +132,24 @@ static void put(struct llc_ai *a, int64_t k)
     a->smp_nm[i] = (int32_t)a->out_nm;
 }
 
-/* One record through the stages: ratio samples from k on, and before them
- * the samples the chain stood at since the last one. */
-static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum)
+/* The stages' next rough period with the input standing (no record: the
+ * chain's input stood), its samples up to until at most. */
+static void stand_period(struct llc_ai *a, int axis, int64_t until)
 {
+    feed(a, axis, 0);
+    for (int i = 0; i < a->ratio && a->top_k < until; i++) {
+        (void)llc_ai_step(a, axis);
+        put(a, a->top_k++);
+    }
+}
+
+/* One record through the stages: ratio samples from k on, and before them
+ * the samples the chain stood at since the last one (the stages running
+ * on until they rest). guess: a bridged record's sum. */
+static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum, int guess)
+{
+    while (a->top_k < k && !llc_ai_at_rest(a))
+        stand_period(a, axis, k);
     for (int64_t s = a->top_k > k - LLC_AI_SAMPLES ? a->top_k : k - LLC_AI_SAMPLES; s < k; s++)
         put(a, s);
     llc_ai_load(a, axis, sum);
@@ -124,6 +158,19 @@ static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum)
         put(a, k + i);
     }
     a->top_k = k + a->ratio;
+    if (guess)
+        a->guess_left = (a->dp == 3 ? 0 : a->acc_memory) + a->fine_memory;
+    else if (a->guess_left > 0)
+        a->guess_left--;
+}
+
+void llc_ai_run_on(struct llc_ai *a, int axis, int32_t job, int64_t k)
+{
+    if (!a->started || job != a->job || a->guess_left == 0)
+        return;
+    /* whole rough periods, as the HLC's chain ran them */
+    while (a->top_k <= k && !llc_ai_at_rest(a))
+        stand_period(a, axis, a->top_k + a->ratio);
 }
 
 /* A job's first record (the first this LLC hears, or an abort's next job's):
@@ -135,6 +182,7 @@ static void new_job(struct llc_ai *a, int32_t job, int64_t k)
     a->job = job;
     a->in_sum = 0;
     a->out_nm = 0;
+    a->guess_left = 0;
     const struct llc_ai_job *j = llc_ai_job(a, job);
     a->top_k = j && j->k <= k ? j->k : k;
 }
@@ -173,9 +221,10 @@ void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len)
     for (int32_t i = 1; i <= gap; i++) {
         int32_t d = (int32_t)((uint32_t)r.sum_nm[l->slot] - (uint32_t)a->in_sum);
         stages(a, l->axis, r.k - (int64_t)(gap + 1 - i) * a->ratio,
-               (int32_t)((uint32_t)a->in_sum + (uint32_t)(int32_t)((int64_t)d / (gap + 2 - i))));
+               (int32_t)((uint32_t)a->in_sum + (uint32_t)(int32_t)((int64_t)d / (gap + 2 - i))),
+               1);
     }
-    stages(a, l->axis, r.k, r.sum_nm[l->slot]);
+    stages(a, l->axis, r.k, r.sum_nm[l->slot], 0);
 }
 
 void llc_ai_report(const struct llc *l)
