@@ -13,15 +13,18 @@
  * one's, just before it, so the stages get a plausible increment and the
  * later sum puts the axis back on the path, no drift.
  *
- * Where the HLC sent no record the chain's input stood, and its stages ran
- * on until they rested: so do these. Without a loss they rest where the
- * HLC's did, after the same record; a bridge, though, may have put part of
+ * The HLC sends no record only where its chain rests, and a chain at rest
+ * stands on its input's sum. Without a loss these stages rest where the
+ * HLC's do, after the same record; a bridge, though, may have put part of
  * a motion's last increment on records after the one that ended it (the
- * straight line to the next sum), so these stages still move where the
- * HLC's stream has no more records (its chain rested): past the last
- * record they run on too, while a bridged record is in their memory, and
- * rest on the sum the HLC said last. Otherwise stages still moving past
- * the last record mean a record missing, and the axis holds for it.
+ * straight line to the next sum), so these stages may still move where the
+ * HLC's records end. Run on, they would reach the sum after the HLC's
+ * stream ended, and its read stops there, short of it: so past the last
+ * record, while a bridged record is in their memory, they settle on the
+ * sum the HLC said last, as its chain did (a step of what the bridge held
+ * back, within MAX_VELOCITY). Stages the HLC's own (no bridge in their
+ * memory) still moving past the last record mean a record missing: the
+ * axis holds for it.
  *
  * An abort at the HLC (stop, E-stop) resets its chain with the sums at 0
  * where its loop rests, and numbers the next job: a record of a later job
@@ -46,8 +49,8 @@ struct llc_ai *llc_ai_new(const struct ncp_machine_cfg *cfg)
     a->scurve = cfg->profile == NCP_PROFILE_SCURVE;
     a->acc = ncp_adcai_accdec_new(n[0], n[1]);
     a->fine = ncp_adcai_fine_new(ratio, a->scurve ? 2 : 1);
-    /* each window a record long per element; fine's averages a rough
-     * period each, after the record it spreads */
+    /* in records: ACC/DEC's windows count rough periods; fine holds the
+     * record it spreads and its averages, a rough period each */
     a->acc_memory = n[0] + n[1];
     a->fine_memory = (a->scurve ? 2 : 1) + 1;
     if (!a->acc || !a->fine) {
@@ -79,23 +82,17 @@ int64_t llc_ai_begin(struct llc_ai *a, int dp, double mm)
     return nm;
 }
 
-/* One rough period's increment of this axis into the stages. */
-static void feed(struct llc_ai *a, int axis, int32_t inc)
+void llc_ai_load(struct llc_ai *a, int axis, int32_t sum)
 {
     int32_t in[NCP_AXES] = { 0 }, out[NCP_AXES];
-    in[axis] = inc;
+    in[axis] = (int32_t)((uint32_t)sum - (uint32_t)a->in_sum);
+    a->in_sum = sum;
     /* below DP3 the filters are this LLC's too */
     if (a->dp != 3) {
         ncp_adcai_accdec_step(a->acc, in, out);
         in[axis] = out[axis];
     }
     ncp_adcai_fine_load(a->fine, in);
-}
-
-void llc_ai_load(struct llc_ai *a, int axis, int32_t sum)
-{
-    feed(a, axis, (int32_t)((uint32_t)sum - (uint32_t)a->in_sum));
-    a->in_sum = sum;
     a->records++;
 }
 
@@ -132,24 +129,22 @@ static void put(struct llc_ai *a, int64_t k)
     a->smp_nm[i] = (int32_t)a->out_nm;
 }
 
-/* The stages' next rough period with the input standing (no record: the
- * chain's input stood), its samples up to until at most. */
-static void stand_period(struct llc_ai *a, int axis, int64_t until)
+/* The chain rested: the stages at rest, their output on their input. */
+static void settle(struct llc_ai *a)
 {
-    feed(a, axis, 0);
-    for (int i = 0; i < a->ratio && a->top_k < until; i++) {
-        (void)llc_ai_step(a, axis);
-        put(a, a->top_k++);
-    }
+    ncp_adcai_accdec_reset(a->acc);
+    ncp_adcai_fine_reset(a->fine);
+    a->out_nm += (int32_t)((uint32_t)a->in_sum - (uint32_t)(int32_t)a->out_nm);
+    a->guess_left = 0;
 }
 
 /* One record through the stages: ratio samples from k on, and before them
- * the samples the chain stood at since the last one (the stages running
- * on until they rest). guess: a bridged record's sum. */
+ * the samples the chain stood at since the last one (it rested there).
+ * guess: a bridged record's sum. */
 static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum, int guess)
 {
-    while (a->top_k < k && !llc_ai_at_rest(a))
-        stand_period(a, axis, k);
+    if (a->top_k < k && !llc_ai_at_rest(a))
+        settle(a);
     for (int64_t s = a->top_k > k - LLC_AI_SAMPLES ? a->top_k : k - LLC_AI_SAMPLES; s < k; s++)
         put(a, s);
     llc_ai_load(a, axis, sum);
@@ -164,13 +159,11 @@ static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum, int guess
         a->guess_left--;
 }
 
-void llc_ai_run_on(struct llc_ai *a, int axis, int32_t job, int64_t k)
+void llc_ai_settle(struct llc_ai *a, int32_t job, int64_t k)
 {
-    if (!a->started || job != a->job || a->guess_left == 0)
-        return;
-    /* whole rough periods, as the HLC's chain ran them */
-    while (a->top_k <= k && !llc_ai_at_rest(a))
-        stand_period(a, axis, a->top_k + a->ratio);
+    if (a->started && job == a->job && k >= a->top_k && a->guess_left > 0 &&
+        !llc_ai_at_rest(a))
+        settle(a);
 }
 
 /* A job's first record (the first this LLC hears, or an abort's next job's):

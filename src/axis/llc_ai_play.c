@@ -171,7 +171,7 @@ static int sample(const struct llc_ai *a, int32_t job, int64_t k, double *nm)
         return 0;
     }
     /* past the last record, the stages rested: the chain stands there
-     * (llc_ai_run_on ran them on where a bridge left them moving) */
+     * (llc_ai_settle rests them where a bridge left them moving) */
     if (job == a->job && k >= a->top_k && llc_ai_at_rest(a)) {
         *nm = (double)(j->base_nm + a->out_nm);
         return 0;
@@ -236,8 +236,8 @@ double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing)
     *missing = 0;
     if (read_at(l, slot, &r, &behind) != 0)
         return l->cmd;
-    /* the samples the read needs, up to the quintic's last */
-    llc_ai_run_on(a, l->axis, r.job, r.k + 2);
+    /* the last sample the read needs (the quintic's) */
+    llc_ai_settle(a, r.job, r.k + 2);
     if (command_at(a, &r, &mm) != 0) {
         *missing = 1;
         mm = l->cmd;
