@@ -150,6 +150,9 @@ void llc_ai_report(const struct llc *l);
  * whole (the filters and the fine interpolator hold nothing more), so the
  * last setpoint put is where the axis rests until the next record. */
 int llc_ai_at_rest(const struct llc_ai *a);
+/* Sample k of job is needed: past the last record, stages a bridged record
+ * left moving settle where the HLC's chain rested (llc_adcai.c). */
+void llc_ai_settle(struct llc_ai *a, int32_t job, int64_t k);
 /* llc_ai_play.c: ai_scale_t, the HLC's read of its stream */
 void llc_ai_on_scale(struct llc *l, const uint8_t *p, size_t len);
 /* The HLC's read position is known: the axis plays its samples. */

@@ -13,6 +13,19 @@
  * one's, just before it, so the stages get a plausible increment and the
  * later sum puts the axis back on the path, no drift.
  *
+ * The HLC sends no record only where its chain rests, and a chain at rest
+ * stands on its input's sum. Without a loss these stages rest where the
+ * HLC's do, after the same record; a bridge, though, may have put part of
+ * a motion's last increment on records after the one that ended it (the
+ * straight line to the next sum), so these stages may still move where the
+ * HLC's records end. Run on, they would reach the sum after the HLC's
+ * stream ended, and its read stops there, short of it: so past the last
+ * record, while a bridged record is in their memory, they settle on the
+ * sum the HLC said last, as its chain did (a step of what the bridge held
+ * back, within MAX_VELOCITY). Stages the HLC's own (no bridge in their
+ * memory) still moving past the last record mean a record missing: the
+ * axis holds for it.
+ *
  * An abort at the HLC (stop, E-stop) resets its chain with the sums at 0
  * where its loop rests, and numbers the next job: a record of a later job
  * resets these stages the same way. Where that job starts on the axis comes
@@ -35,7 +48,11 @@ struct llc_ai *llc_ai_new(const struct ncp_machine_cfg *cfg)
     a->ratio = ratio;
     a->scurve = cfg->profile == NCP_PROFILE_SCURVE;
     a->acc = ncp_adcai_accdec_new(n[0], n[1]);
-    a->fine = ncp_adcai_fine_new(ratio, cfg->profile == NCP_PROFILE_SCURVE ? 2 : 1);
+    a->fine = ncp_adcai_fine_new(ratio, a->scurve ? 2 : 1);
+    /* in records: ACC/DEC's windows count rough periods; fine holds the
+     * record it spreads and its averages, a rough period each */
+    a->acc_memory = n[0] + n[1];
+    a->fine_memory = (a->scurve ? 2 : 1) + 1;
     if (!a->acc || !a->fine) {
         llc_ai_free(a);
         return NULL;
@@ -112,10 +129,22 @@ static void put(struct llc_ai *a, int64_t k)
     a->smp_nm[i] = (int32_t)a->out_nm;
 }
 
-/* One record through the stages: ratio samples from k on, and before them
- * the samples the chain stood at since the last one. */
-static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum)
+/* The chain rested: the stages at rest, their output on their input. */
+static void settle(struct llc_ai *a)
 {
+    ncp_adcai_accdec_reset(a->acc);
+    ncp_adcai_fine_reset(a->fine);
+    a->out_nm += (int32_t)((uint32_t)a->in_sum - (uint32_t)(int32_t)a->out_nm);
+    a->guess_left = 0;
+}
+
+/* One record through the stages: ratio samples from k on, and before them
+ * the samples the chain stood at since the last one (it rested there).
+ * guess: a bridged record's sum. */
+static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum, int guess)
+{
+    if (a->top_k < k && !llc_ai_at_rest(a))
+        settle(a);
     for (int64_t s = a->top_k > k - LLC_AI_SAMPLES ? a->top_k : k - LLC_AI_SAMPLES; s < k; s++)
         put(a, s);
     llc_ai_load(a, axis, sum);
@@ -124,6 +153,17 @@ static void stages(struct llc_ai *a, int axis, int64_t k, int32_t sum)
         put(a, k + i);
     }
     a->top_k = k + a->ratio;
+    if (guess)
+        a->guess_left = (a->dp == 3 ? 0 : a->acc_memory) + a->fine_memory;
+    else if (a->guess_left > 0)
+        a->guess_left--;
+}
+
+void llc_ai_settle(struct llc_ai *a, int32_t job, int64_t k)
+{
+    if (a->started && job == a->job && k >= a->top_k && a->guess_left > 0 &&
+        !llc_ai_at_rest(a))
+        settle(a);
 }
 
 /* A job's first record (the first this LLC hears, or an abort's next job's):
@@ -135,6 +175,7 @@ static void new_job(struct llc_ai *a, int32_t job, int64_t k)
     a->job = job;
     a->in_sum = 0;
     a->out_nm = 0;
+    a->guess_left = 0;
     const struct llc_ai_job *j = llc_ai_job(a, job);
     a->top_k = j && j->k <= k ? j->k : k;
 }
@@ -173,9 +214,10 @@ void llc_ai_take(struct llc *l, int dp, const uint8_t *p, size_t len)
     for (int32_t i = 1; i <= gap; i++) {
         int32_t d = (int32_t)((uint32_t)r.sum_nm[l->slot] - (uint32_t)a->in_sum);
         stages(a, l->axis, r.k - (int64_t)(gap + 1 - i) * a->ratio,
-               (int32_t)((uint32_t)a->in_sum + (uint32_t)(int32_t)((int64_t)d / (gap + 2 - i))));
+               (int32_t)((uint32_t)a->in_sum + (uint32_t)(int32_t)((int64_t)d / (gap + 2 - i))),
+               1);
     }
-    stages(a, l->axis, r.k, r.sum_nm[l->slot]);
+    stages(a, l->axis, r.k, r.sum_nm[l->slot], 0);
 }
 
 void llc_ai_report(const struct llc *l)

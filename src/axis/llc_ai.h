@@ -35,6 +35,11 @@ struct llc_ai {
     int32_t next_seq;
     int32_t in_sum;
     int64_t out_nm;
+    /* records the stages remember (ACC/DEC's windows, fine's record and
+     * averages), and how many more they will until a bridged one is out of
+     * them: till then their state is a guess, not the HLC's chain's */
+    int acc_memory, fine_memory;
+    int guess_left;
     int64_t top_k;                  /* one past the last sample made */
     int64_t smp_k[LLC_AI_SAMPLES];
     int32_t smp_job[LLC_AI_SAMPLES];

@@ -170,7 +170,8 @@ static int sample(const struct llc_ai *a, int32_t job, int64_t k, double *nm)
         *nm = (double)j->base_nm + a->smp_nm[i];
         return 0;
     }
-    /* past the last record, the stages drained: the chain stands there */
+    /* past the last record, the stages rested: the chain stands there
+     * (llc_ai_settle rests them where a bridge left them moving) */
     if (job == a->job && k >= a->top_k && llc_ai_at_rest(a)) {
         *nm = (double)(j->base_nm + a->out_nm);
         return 0;
@@ -235,6 +236,8 @@ double llc_ai_play(struct llc *l, int64_t slot, int commit, int *missing)
     *missing = 0;
     if (read_at(l, slot, &r, &behind) != 0)
         return l->cmd;
+    /* the last sample the read needs (the quintic's) */
+    llc_ai_settle(a, r.job, r.k + 2);
     if (command_at(a, &r, &mm) != 0) {
         *missing = 1;
         mm = l->cmd;
