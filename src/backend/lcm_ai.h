@@ -15,6 +15,7 @@
 struct lcm_ai {
     int dp, n;
     int64_t T;                     /* the servo period, ns */
+    int ratio;                     /* servo periods a rough period */
     int axis[NCP_AXES];            /* the machine's axes in the LLCs' order */
     struct ncp_spsc tapped;        /* planner thread -> position loop, a setpoint each */
     struct ncp_adcai_tap front;    /* popped, not yet due to be sent */
@@ -34,6 +35,12 @@ struct lcm_ai {
     int64_t last_scale_t;
     uint64_t sent, overflow, scale_sent, dropped;
     int bytes;
+    /* the last record as sent, said again while no later one follows */
+    uint8_t last[128];
+    int last_len;
+    int repeats_left;
+    int64_t last_t;
+    uint64_t repeated;
 };
 
 int lcm_ai_init(struct lcm_ai *x, int dp, const struct ncp_machine_cfg *cfg);
