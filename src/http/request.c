@@ -101,20 +101,37 @@ static int put_field(ncp_command_t *c, const struct field *fd, const struct ncp_
     return 0;
 }
 
-/* {"cmd": "got", "id": ID, "parts": N}: both, positive integers, nothing else. */
-static enum ncp_http_req parse_got(const struct verb *v, const struct ncp_fj *o,
-                                   ncp_command_t *c, char *why, size_t wl)
+/* The message's fields but "cmd" into c: the verb's own, and "seq" where
+ * takes_seq (a got has none). 0, or -1 with why said. */
+static int put_fields(const struct verb *v, const struct ncp_fj *o, int takes_seq,
+                      ncp_command_t *c, char *why, size_t wl)
 {
     for (int i = 0; i < o->n; i++) {
         const struct ncp_fj_field *f = &o->f[i];
         if (!strcmp(f->key, "cmd"))
             continue;
+        if (takes_seq && !strcmp(f->key, "seq")) {
+            if (f->type != NCP_FJ_NUMBER || f->num != floor(f->num) || f->num < 1 ||
+                f->num > 2147483647.0)
+                return snprintf(why, wl, "\"seq\" must be an integer from 1"), -1;
+            c->seq = (int32_t)f->num;
+            continue;
+        }
         const struct field *fd = field_of(v, f->key);
         if (!fd)
-            return snprintf(why, wl, "got takes no \"%s\"", f->key), NCP_HTTP_REQ_BAD;
+            return snprintf(why, wl, "%s takes no \"%s\"", v->name, f->key), -1;
         if (put_field(c, fd, f, why, wl))
-            return NCP_HTTP_REQ_BAD;
+            return -1;
     }
+    return 0;
+}
+
+/* {"cmd": "got", "id": ID, "parts": N}: both, positive integers, nothing else. */
+static enum ncp_http_req parse_got(const struct verb *v, const struct ncp_fj *o,
+                                   ncp_command_t *c, char *why, size_t wl)
+{
+    if (put_fields(v, o, 0, c, why, wl))
+        return NCP_HTTP_REQ_BAD;
     if (c->ivalue[0] < 1 || c->ivalue[1] < 1)
         return snprintf(why, wl, "got needs \"id\" and \"parts\" from 1"), NCP_HTTP_REQ_BAD;
     return NCP_HTTP_REQ_GOT;
@@ -148,23 +165,8 @@ enum ncp_http_req ncp_http_parse_request(const char *json, size_t len, int32_t c
     c->client_id = client_id;
     if (v->kind == NCP_CMD_HOME)
         snprintf((char *)c->text, sizeof c->text, "all");
-    for (int i = 0; i < o.n; i++) {
-        const struct ncp_fj_field *f = &o.f[i];
-        if (!strcmp(f->key, "cmd"))
-            continue;
-        if (!strcmp(f->key, "seq")) {
-            if (f->type != NCP_FJ_NUMBER || f->num != floor(f->num) || f->num < 1 ||
-                f->num > 2147483647.0)
-                return snprintf(why, wl, "\"seq\" must be an integer from 1"), NCP_HTTP_REQ_BAD;
-            c->seq = (int32_t)f->num;
-            continue;
-        }
-        const struct field *fd = field_of(v, f->key);
-        if (!fd)
-            return snprintf(why, wl, "%s takes no \"%s\"", v->name, f->key), NCP_HTTP_REQ_BAD;
-        if (put_field(c, fd, f, why, wl))
-            return NCP_HTTP_REQ_BAD;
-    }
+    if (put_fields(v, &o, 1, c, why, wl))
+        return NCP_HTTP_REQ_BAD;
     if (c->seq == 0 && v->kind != NCP_CMD_KEEPALIVE)
         return snprintf(why, wl, "no \"seq\""), NCP_HTTP_REQ_BAD;
     /* the LCM path's own validation, on the bytes it would have received */

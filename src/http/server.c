@@ -505,6 +505,18 @@ static int part_may_go(const struct outmsg *m)
     return m->parts_sent - m->parts_got < PARTS_AHEAD;
 }
 
+/* The first message small enough to go whole that waits behind a large
+ * one at the head (its place in the queue), or 0: none, or the head is small. */
+static unsigned small_behind(const struct conn *c)
+{
+    if (!c->out_n || c->out[c->out_head].len <= PART)
+        return 0;
+    for (unsigned i = 1; i < c->out_n; i++)
+        if (c->out[(c->out_head + i) % OUT_QUEUE].len <= PART)
+            return i;
+    return 0;
+}
+
 /* Something this socket could be sent now: asking for a writable callback
  * otherwise would only spin. */
 static int has_writable(const struct ncp_http *h, const struct conn *c)
@@ -514,12 +526,7 @@ static int has_writable(const struct ncp_http *h, const struct conn *c)
     if (!c->out_n)
         return 0;
     const struct outmsg *m = &c->out[c->out_head];
-    if (m->len <= PART || part_may_go(m))
-        return 1;
-    for (unsigned i = 1; i < c->out_n; i++)
-        if (c->out[(c->out_head + i) % OUT_QUEUE].len <= PART)
-            return 1;
-    return 0;
+    return m->len <= PART || part_may_go(m) || small_behind(c);
 }
 
 /* One message per call. A large one goes in parts, each a message of its
@@ -533,11 +540,7 @@ static int write_next(struct ncp_http *h, struct conn *c)
     int rc = 0;
     if (c->out_n) {
         struct outmsg *m = &c->out[c->out_head];
-        unsigned small = 0;
-        if (m->len > PART)
-            for (unsigned i = 1; i < c->out_n && !small; i++)
-                if (c->out[(c->out_head + i) % OUT_QUEUE].len <= PART)
-                    small = i;
+        unsigned small = small_behind(c);
         if (small) {
             m = &c->out[(c->out_head + small) % OUT_QUEUE];
             rc = lws_write(c->wsi, m->buf + LWS_PRE, m->len, LWS_WRITE_TEXT) < (int)m->len;
@@ -672,16 +675,18 @@ static void on_message(struct ncp_http *h, struct conn *c)
         refuse(h, c, 0, "message too large");
         return;
     }
+    ncp_command_t cmd;
+    int unknown;
+    char why[128];
+    enum ncp_http_req r = NCP_HTTP_REQ_BAD;
     /* what the panel has read of a large answer: before the rate, since
      * parts are not held back by it either, and only a got that names parts
      * sent and not yet read is taken here (a few per part at most) */
-    if (memmem(c->rx, c->rx_len, "\"got\"", 5)) {
-        ncp_command_t got;
-        int unknown;
-        char why[128];
-        if (ncp_http_parse_request(c->rx, c->rx_len, c->client_id, &got, &unknown, why,
-                                   sizeof why) == NCP_HTTP_REQ_GOT &&
-            take_got(c, (uint64_t)got.ivalue[0], (unsigned)got.ivalue[1]))
+    int parsed = memmem(c->rx, c->rx_len, "\"got\"", 5) != NULL;
+    if (parsed) {
+        r = ncp_http_parse_request(c->rx, c->rx_len, c->client_id, &cmd, &unknown, why,
+                                   sizeof why);
+        if (r == NCP_HTTP_REQ_GOT && take_got(c, (uint64_t)cmd.ivalue[0], (unsigned)cmd.ivalue[1]))
             return;
     }
     /* no answer to a flood: answering would be one more. An E-stop is
@@ -691,11 +696,9 @@ static void on_message(struct ncp_http *h, struct conn *c)
         count(h, &h->stats.flood);
         return;
     }
-    ncp_command_t cmd;
-    int unknown;
-    char why[128];
-    enum ncp_http_req r =
-        ncp_http_parse_request(c->rx, c->rx_len, c->client_id, &cmd, &unknown, why, sizeof why);
+    if (!parsed)
+        r = ncp_http_parse_request(c->rx, c->rx_len, c->client_id, &cmd, &unknown, why,
+                                   sizeof why);
     switch (r) {
     case NCP_HTTP_REQ_COMMAND:
         if (cmd.kind == NCP_CMD_LOAD && program_path(h, &cmd)) {
