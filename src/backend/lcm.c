@@ -435,6 +435,14 @@ static void lcm_live(struct ncp_backend *b)
     idle_stop(b->impl);
 }
 
+/* The HLC no longer hears p: its error (unless it said one first), the
+ * fault, and whatever it says next taken as an LLC back (on_status). */
+static void lose(struct lcm_be *s, struct peer *p, const char *why)
+{
+    keep_error(p, NCP_STATUS_T_LLC_ERR_UNHEARD, why);
+    fail(s, p, why);
+    p->gone = 1;
+}
 
 static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_t now)
 {
@@ -446,9 +454,7 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
         if (p->st.t_ns > 0 && ++p->run_lost > s->cfg->lcm.max_lost_periods) {
             snprintf(why, sizeof why, "no status for %d periods ([LCM] MAX_LOST_PERIODS %d)",
                      p->run_lost, s->cfg->lcm.max_lost_periods);
-            keep_error(p, NCP_STATUS_T_LLC_ERR_UNHEARD, why);
-            fail(s, p, why);
-            p->gone = 1;
+            lose(s, p, why);
         }
     } else {
         p->run_lost = 0;
@@ -456,9 +462,7 @@ static void check_peer(struct lcm_be *s, struct peer *p, uint64_t before, int64_
     if (now - p->last_hb_ns > s->hb_timeout) {
         snprintf(why, sizeof why, "heartbeat lost (silent for %lld ms)",
                  (long long)((now - p->last_hb_ns) / 1000000));
-        keep_error(p, NCP_STATUS_T_LLC_ERR_UNHEARD, why);
-        fail(s, p, why);
-        p->gone = 1;
+        lose(s, p, why);
         /* its last status said running: the operator must not read that
          * of an LLC that is gone (a status of its, should it come back,
          * stands again) */

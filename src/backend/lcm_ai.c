@@ -19,7 +19,8 @@
  *
  * The record before a standstill (a job's end, a dwell) has no later one
  * to bridge it from: lost, its axis would rest short of where the chain
- * rests, by that record's increment (0.28 um once at 20 % loss). It is said
+ * rests, by that record's increment (488 nm at DP 3 when the last two of
+ * ends.ngc were lost at 20 % loss, tests/dist adcai-ends-loss-dp3). It is said
  * again when no later record went out for a rough period and REPEAT_EVERY
  * servo periods more (in motion one goes every rough period), REPEATS times,
  * the same bytes: an LLC that has it takes the copy as stale.

@@ -21,7 +21,7 @@ void nck_llcs_poll(struct ncp_nck *s)
             s->homed[l[k].axis] = 0;
             s->changed = 1;
             nck_post(n, NCP_EV_INFO, NULL, 0, 0,
-                     "axis %c's LLC is heard again: %c is not homed (a reset takes it back)",
+                     "axis %c's LLC is heard again: %c is no longer homed",
                      NCP_AXIS_LETTERS[l[k].axis], NCP_AXIS_LETTERS[l[k].axis]);
         }
         if (!l[k].error || l[k].error_count == s->llc_errors_told[k])
