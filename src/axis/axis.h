@@ -78,6 +78,10 @@ struct llc {
     int64_t lost_at_ns;   /* when LLC_END_LOST was decided */
     uint64_t waits;       /* periods before the HLC's first setpoint */
     double fault_ferr;    /* the following error LLC_END_FERROR saw */
+    /* The last wake-up that left periods out (on this LLC's clock) and how
+     * late it was: a following error soon after it is the host's stall,
+     * which the fault then says (fault_late_ns, 0 for none) */
+    int64_t late_at, late_ns, fault_late_ns;
     int32_t seq;
     int done_req;
     /* ADCAI's DP3 and DP2, ADCBI's block-level points: the HLC's fine

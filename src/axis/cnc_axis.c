@@ -306,6 +306,10 @@ static int report(const struct llc *l)
     case LLC_END_FERROR:
         fprintf(stderr, "cnc-axis %c: error: following error %.4f mm exceeds FERROR %.4f mm; "
                         "ramped to a standstill\n", ax, l->fault_ferr, l->cfg->axis[l->axis].ferror);
+        if (l->fault_late_ns)
+            fprintf(stderr, "cnc-axis %c: its loop had woken %.1f ms late just before: the drive "
+                            "held its setpoint that long while the path went on (a stall of this "
+                            "host, not of the machine)\n", ax, (double)l->fault_late_ns * 1e-6);
         break;
     case LLC_END_SIGNAL:
         fprintf(stderr, "cnc-axis %c: stopped by a signal; ramped to a standstill at %.4f mm\n",

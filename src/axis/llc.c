@@ -475,6 +475,12 @@ static double play_ai(struct llc *l, int64_t slot)
     return ramp(l);
 }
 
+/* A following error within this many periods of a wake-up that left
+ * periods out is said to follow it: the command's catch-up, at most
+ * MAX_VELOCITY, and the servo's settling after it take a few hundred
+ * periods of 1 ms (the plant damps roughly as exp(-70 t)) */
+#define LATE_BLAMED_PERIODS 300
+
 static void check_ends(struct llc *l, int64_t now)
 {
     if (l->end != LLC_END_NONE)
@@ -490,6 +496,8 @@ static void check_ends(struct llc *l, int64_t now)
     else if (fabs(l->ferr) > l->cfg->axis[l->axis].ferror) {
         l->end = LLC_END_FERROR;
         l->fault_ferr = l->ferr;
+        if (l->late_at && now - l->late_at <= LATE_BLAMED_PERIODS * l->period_ns)
+            l->fault_late_ns = l->late_ns;
     }
 }
 
@@ -718,6 +726,8 @@ int llc_cycle(void *ctx, int64_t now_ns)
     int64_t from = l->rx.played_t ? l->rx.played_t + T : slot;
     int64_t most = l->dp4 || l->dp1ai ? 64 : 8;
     if (slot - from > most * T) {
+        l->late_at = now;
+        l->late_ns = slot - from;
         left_out(l, from, slot - most * T);
         from = slot - most * T;
     }

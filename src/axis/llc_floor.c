@@ -52,8 +52,13 @@ void llc_end_text(const struct llc *l, char *dst, size_t n)
                  l->cfg->lcm.max_lost_periods, (long long)((l->lost_at_ns - l->last_hlc_ns) / 1000000));
         break;
     case LLC_END_FERROR:
-        snprintf(dst, n, "following error %.4f mm exceeds FERROR %.4f mm", l->fault_ferr,
-                 l->cfg->axis[l->axis].ferror);
+        /* a host that stalled this loop is said, the numbers kept whole */
+        if (l->fault_late_ns)
+            snprintf(dst, n, "following error %.4f mm > FERROR %.4f mm: loop %.0f ms late",
+                     l->fault_ferr, l->cfg->axis[l->axis].ferror, (double)l->fault_late_ns * 1e-6);
+        else
+            snprintf(dst, n, "following error %.4f mm exceeds FERROR %.4f mm", l->fault_ferr,
+                     l->cfg->axis[l->axis].ferror);
         break;
     case LLC_END_MISSING: snprintf(dst, n, "record %d missing when needed", (int)l->missing_rec); break;
     case LLC_END_SIGNAL: snprintf(dst, n, "stopped by a signal (SIGINT or SIGTERM)"); break;
