@@ -3,6 +3,7 @@
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
 
+#include <stdint.h>
 #include <time.h>
 
 int ncp_dist_probe_io_open(struct ncp_dist_probe_io *io, const struct ncp_lcm_cfg *l,
@@ -58,10 +59,26 @@ void ncp_dist_probe_io_close(struct ncp_dist_probe_io *io)
     io->msg = NULL;
 }
 
+/* The two clocks cannot be read at once: a preemption between the reads
+ * would put its whole length into the offset (milliseconds on a loaded
+ * host, where PTP asks for microseconds). The realtime read is bracketed by
+ * two monotonic ones and set against their middle; of a few tries the one
+ * with the narrowest bracket stands. */
+#define OFFSET_TRIES 5
 int64_t ncp_dist_realtime_offset(void)
 {
-    struct timespec r, m;
-    clock_gettime(CLOCK_REALTIME, &r);
-    clock_gettime(CLOCK_MONOTONIC, &m);
-    return ((int64_t)r.tv_sec - m.tv_sec) * 1000000000LL + (r.tv_nsec - m.tv_nsec);
+    int64_t best = 0, best_gap = INT64_MAX;
+    for (int i = 0; i < OFFSET_TRIES; i++) {
+        struct timespec m0, r, m1;
+        clock_gettime(CLOCK_MONOTONIC, &m0);
+        clock_gettime(CLOCK_REALTIME, &r);
+        clock_gettime(CLOCK_MONOTONIC, &m1);
+        int64_t a = (int64_t)m0.tv_sec * 1000000000LL + m0.tv_nsec;
+        int64_t b = (int64_t)m1.tv_sec * 1000000000LL + m1.tv_nsec;
+        if (b - a < best_gap) {
+            best_gap = b - a;
+            best = (int64_t)r.tv_sec * 1000000000LL + r.tv_nsec - (a + (b - a) / 2);
+        }
+    }
+    return best;
 }

@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include <string.h>
+#include <time.h>
 
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
@@ -355,6 +356,27 @@ static void clock_slew_is_bounded(void **state)
                 -4000000000000000000LL + 1000);
 }
 
+static int64_t now_of(clockid_t id)
+{
+    struct timespec t;
+    clock_gettime(id, &t);
+    return (int64_t)t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+
+/* realtime less monotonic, read within a bracket of both clocks (a 1 us
+ * slack for the clocks' own steps): sign and units, however it is read */
+static void realtime_offset_within_its_bracket(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 100; i++) {
+        int64_t m0 = now_of(CLOCK_MONOTONIC), r0 = now_of(CLOCK_REALTIME);
+        int64_t off = ncp_dist_realtime_offset();
+        int64_t r1 = now_of(CLOCK_REALTIME), m1 = now_of(CLOCK_MONOTONIC);
+        assert_true(off >= r0 - m1 - 1000);
+        assert_true(off <= r1 - m0 + 1000);
+    }
+}
+
 static void clock_url_next_port(void **state)
 {
     (void)state;
@@ -386,6 +408,7 @@ int main(void)
         cmocka_unit_test(clock_shortest_round_trip_wins),
         cmocka_unit_test(clock_slew_is_bounded),
         cmocka_unit_test(clock_url_next_port),
+        cmocka_unit_test(realtime_offset_within_its_bracket),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
