@@ -290,8 +290,8 @@ static int biarc_inside(const struct ncp_planner *p, const struct biarc *bi, int
     return 1;
 }
 
-/* Midpoint and unit direction of faired chord k. */
-static void chord_mid(const struct ncp_planner *p, int k, double m[3], double t[3])
+/* Midpoint and unit direction of faired chord k; 0 where it has none. */
+static int chord_mid(const struct ncp_planner *p, int k, double m[3], double t[3])
 {
     double l = 0;
     for (int j = 0; j < 3; j++) {
@@ -302,6 +302,7 @@ static void chord_mid(const struct ncp_planner *p, int k, double m[3], double t[
     l = sqrt(l);
     for (int j = 0; j < 3; j++)
         t[j] = l > 0 ? t[j] / l : 0;
+    return l > 1e-9;  /* else no direction to be tangent to */
 }
 
 /* The farthest chord b in (a, last] whose midpoint a biarc from p0 along
@@ -312,13 +313,16 @@ static int fit_reach(const struct ncp_planner *p, int a, int last, const double 
     struct biarc bi[PLAN_FAIR_MAX];
     double s[PLAN_FAIR_MAX][PLAN_FAIR_MAX];
     int top = a, ok[PLAN_FAIR_MAX] = { 0 };
+    if (dot3(t0, t0) < 0.5)
+        return a;
     /* every end is tried, not only up to the first miss: a vertex stepped
      * off the curve (Z rounded per block) may stop one biarc where a longer
      * one passes it closer */
     for (int b = a + 1; b <= last; b++) {
         double m[3], t[3], sk[PLAN_FAIR_MAX];
         struct biarc cand;
-        chord_mid(p, b, m, t);
+        if (!chord_mid(p, b, m, t))
+            continue;
         for (int q = 0; q < FIT_LEGS; q++) {
             if (!biarc_make(p0, t0, m, t, fit_legs[q], &cand) ||
                 !biarc_covers(p, &cand, a, b, budget, sk))
