@@ -75,15 +75,17 @@ int ncp_fair_takes(const struct ncp_planner *p, const struct ncp_seg *s)
     return turn(last, s) <= FAIR_TURN_MAX;
 }
 
-/* Smooths pt[1 .. n-1] (pt[0] and pt[n] stay), from the programmed points. */
+/* Smooths pt[1 .. n-1] (pt[0] and pt[n] stay), from the programmed points;
+ * pt[1] stays too where line 0 is the rest of a fitted arc's last line. */
 static void relax(struct ncp_planner *p, int n)
 {
     double (*pt)[3] = p->fair_pt, nxt[PLAN_FAIR_MAX + 1][3];
     double lim = FAIR_SHARE * p->fair_seg[0].tolerance;
-    for (int i = 1; i < n; i++)
+    int first = p->fit_half ? 2 : 1;
+    for (int i = first; i < n; i++)
         memcpy(pt[i], p->fair_orig[i], sizeof pt[i]);
     for (int pass = 0; pass < FAIR_PASSES; pass++) {
-        for (int i = 1; i < n; i++) {
+        for (int i = first; i < n; i++) {
             double l1 = dist3(pt[i - 1], pt[i]), l2 = dist3(pt[i], pt[i + 1]), d[3], m = 0;
             double t = l1 + l2 > 0 ? l1 / (l1 + l2) : 0.5;
             for (int j = 0; j < 3; j++) {
@@ -96,35 +98,33 @@ static void relax(struct ncp_planner *p, int n)
             for (int j = 0; j < 3; j++)
                 nxt[i][j] = p->fair_orig[i][j] + k * d[j];
         }
-        for (int i = 1; i < n; i++)
+        for (int i = first; i < n; i++)
             memcpy(pt[i], nxt[i], sizeof pt[i]);
     }
 }
 
-/* Hands the first m of the n held lines to the planner (fair_out), each
- * through its moved ends with what is left of P for the blends at them. */
-static void emit(struct ncp_planner *p, int n, int m)
+void ncp_fair_line_out(struct ncp_planner *p, int n, int k, const double a[3], const double b[3],
+                       int more)
 {
-    double moved[PLAN_FAIR_MAX + 1] = { 0 };
-    for (int i = 0; i <= n; i++)
-        moved[i] = dist3(p->fair_pt[i], p->fair_orig[i]);
-    for (int k = 0; k < m; k++) {
-        struct ncp_seg s = p->fair_seg[k];
-        double e = fmax(moved[k], moved[k + 1]);
-        if (k + 2 <= n)
-            e = fmax(e, moved[k + 2]);
-        memcpy(s.start, p->fair_pt[k], sizeof p->fair_pt[k]);
-        memcpy(s.end, p->fair_pt[k + 1], sizeof p->fair_pt[k + 1]);
-        ncp_seg_set_length(&s);
-        s.tolerance -= e;
-        p->fair_out[p->fair_out_n++] = s;
-    }
+    /* a segment whose ends moved by at most e lies within e of the
+     * programmed one; the blend at its end turns onto line k + 1 */
+    double e = 0;
+    for (int i = k; i <= k + 2 && i <= n; i++)
+        e = fmax(e, dist3(p->fair_pt[i], p->fair_orig[i]));
+    struct ncp_seg s = p->fair_seg[k];
+    memcpy(s.start, a, 3 * sizeof a[0]);
+    memcpy(s.end, b, 3 * sizeof b[0]);
+    ncp_seg_set_length(&s);
+    s.tolerance -= e;
+    p->fair_out_flags[p->fair_out_n] = more ? PLAN_OUT_MORE : 0;
+    p->fair_out[p->fair_out_n++] = s;
 }
 
 void ncp_fair_add(struct ncp_planner *p, const struct ncp_seg *s)
 {
     int n = p->fair_n;
     if (!n) {
+        p->fit_half = 0;
         memcpy(p->fair_orig[0], s->start, sizeof p->fair_orig[0]);
         memcpy(p->fair_pt[0], s->start, sizeof p->fair_pt[0]);
     }
@@ -134,14 +134,14 @@ void ncp_fair_add(struct ncp_planner *p, const struct ncp_seg *s)
     p->fair_n = ++n;
     if (n < p->fair_max)
         return;
-    /* the first n - FAIR_KEEP go; the rest start again from the last vertex sent */
+    /* up to the first n - FAIR_KEEP go; the rest start again from where
+     * the last piece sent ended */
     relax(p, n);
-    int m = n - FAIR_KEEP;
-    emit(p, n, m);
-    memmove(p->fair_seg, p->fair_seg + m, (size_t)FAIR_KEEP * sizeof p->fair_seg[0]);
-    memmove(p->fair_orig, p->fair_orig + m, (size_t)(FAIR_KEEP + 1) * sizeof p->fair_orig[0]);
-    memmove(p->fair_pt, p->fair_pt + m, (size_t)(FAIR_KEEP + 1) * sizeof p->fair_pt[0]);
-    p->fair_n = FAIR_KEEP;
+    int m = ncp_fit_emit(p, n, n - FAIR_KEEP, 0);
+    memmove(p->fair_seg, p->fair_seg + m, (size_t)(n - m) * sizeof p->fair_seg[0]);
+    memmove(p->fair_orig, p->fair_orig + m, (size_t)(n - m + 1) * sizeof p->fair_orig[0]);
+    memmove(p->fair_pt, p->fair_pt + m, (size_t)(n - m + 1) * sizeof p->fair_pt[0]);
+    p->fair_n = n - m;
 }
 
 void ncp_fair_flush(struct ncp_planner *p)
@@ -151,5 +151,6 @@ void ncp_fair_flush(struct ncp_planner *p)
         return;
     p->fair_n = 0;
     relax(p, n);
-    emit(p, n, n);
+    ncp_fit_emit(p, n, n, 1);
+    p->fit_half = 0;
 }

@@ -61,7 +61,7 @@ static int head_record(void *ctx, double v0, struct ncp_accdec *rec)
     struct ncp_la la = {
         .s = ps->s, .vmax = ps->vmax, .acc = ps->acc, .acc_full = ps->acc_full,
         .jerk = ps->jerk, .a_eff = ps->a_eff, .kappa = ps->kappa, .a_cap = ps->a_cap,
-        .v_end = p->count > 1 ? plan_at(p, 1)->v_in : 0, .blend = (uint8_t)ps->blend,
+        .v_end = p->count > 1 ? plan_at(p, 1)->v_in : 0, .blend = (uint8_t)(ps->blend || ps->fitted),
         .after_stop = (uint8_t)p->ended,
     };
     p->ended = 0;

@@ -386,6 +386,11 @@ static double entry_for(int scurve, const struct plan_seg *ps, double v1)
  * speed through the corner gets nearly all of it. */
 #define ARC_AN_SHARE 0.866
 #define BLEND_AN_SHARE 0.95
+/* A fitted arc (fit.c) is short and runs into the next at the same speed:
+ * its turn may take what a corner parabola's does (PARAB_TURN_SHARE), and
+ * below the cruise cap the tangent gets the rest (plan_acc_at). On
+ * bench/gen-planner.py's tiny 0.866 gave 4.93 s, 0.95 4.79 and 0.99 4.73. */
+#define FIT_AN_SHARE 0.99
 
 /* A corner (kink) turns the velocity vector within one servo period. A servo
  * sample's second difference is a weighted mean of the continuous acceleration
@@ -522,7 +527,7 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
         ps->vmax = 0;
         ps->acc = 1;
     } else if (ps->s.kind == NCP_SEG_ARC) {
-        arc_limits(p, ps, ps->blend ? BLEND_AN_SHARE : ARC_AN_SHARE);
+        arc_limits(p, ps, ps->blend ? BLEND_AN_SHARE : ps->fitted ? FIT_AN_SHARE : ARC_AN_SHARE);
     } else if (ps->s.kind == NCP_SEG_PARAB) {
         parabola_limits(p, ps);
     } else {
@@ -590,11 +595,44 @@ static void seg_limits(struct ncp_planner *p, struct plan_seg *ps)
     ps->vjunc = v;
 }
 
+/* The top speed x of ncp_plan_seg_reach in closed form, -1 where rounding
+ * puts it on no branch. acc(x) = c max(acc_full, min(a_cap, S)), c = acc /
+ * acc_full, S = sqrt(a_eff^2 - kappa^2 x^4): on the middle branch
+ * (y - v^2)^2 = 4 len^2 c^2 (a_eff^2 - kappa^2 y^2) with y = x^2, a
+ * quadratic in y; on the others the acceleration is constant. */
+static double reach_closed(const struct plan_seg *ps, double v, double len)
+{
+    double c = ps->acc / ps->acc_full, v2 = v * v, k2 = ps->kappa * ps->kappa;
+    double a2 = ps->a_eff * ps->a_eff;
+    if (isfinite(ps->a_cap)) {
+        double y = v2 + 2 * len * c * ps->a_cap;
+        if (a2 - k2 * y * y >= ps->a_cap * ps->a_cap)
+            return sqrt(y);
+    }
+    double q = 4 * len * len * c * c, k = 1 + q * k2;
+    double d = v2 * v2 - k * (v2 * v2 - q * a2);
+    if (d >= 0) {
+        double y = (v2 + sqrt(d)) / k, sy = a2 - k2 * y * y;
+        if (y >= v2 && sy >= ps->acc_full * ps->acc_full &&
+            (!isfinite(ps->a_cap) || sy <= ps->a_cap * ps->a_cap))
+            return sqrt(y);
+    }
+    double y = v2 + 2 * len * ps->acc;
+    return a2 - k2 * y * y <= ps->acc_full * ps->acc_full ? sqrt(y) : -1;
+}
+
 double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, double len)
 {
     double lo = plan_reach(scurve, ps->acc, ps->jerk, v, len);
-    if (ps->kappa <= 0 || scurve)
+    /* every caller takes the least of this and a cap at or below vmax:
+     * where the cruise cap's acceleration already reaches it, more is moot
+     * (a chain of short arcs runs this in every backward pass) */
+    if (ps->kappa <= 0 || scurve || lo >= ps->vmax)
         return lo;
+    /* a hair below the root, so that rounding keeps it reachable */
+    double x = reach_closed(ps, v, len) * (1 - 1e-12);
+    if (x >= lo && x * x <= v * v + 2 * len * plan_acc_at(ps, x))
+        return x;
     /* the move's top speed x is the end reached: x^2 = v^2 + 2 len acc(x),
      * acc falling with x, so the largest such x is found by bisection
      * between the cruise cap's acceleration and the one at v */
@@ -660,6 +698,7 @@ static void push_one(struct ncp_planner *p, const struct ncp_seg *s, int blend)
     memset(ps, 0, sizeof *ps);
     ps->s = *s;
     ps->blend = blend;
+    ps->fitted = p->pushing_fit && !blend && s->kind == NCP_SEG_ARC;
     seg_limits(p, ps);
     p->count++;
     p->programmed += !blend;
@@ -1054,11 +1093,18 @@ static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
     push_arc(p, &cur);
 }
 
-/* Queues what fairing handed on. */
+/* Queues what fairing and arc fitting handed on: a fitted arc runs as a
+ * feed (no G2/G3 in the trace), and the statistics count each programmed
+ * line once however many pieces it became. */
 static void fair_drain(struct ncp_planner *p)
 {
-    for (int i = 0; i < p->fair_out_n; i++)
+    for (int i = 0; i < p->fair_out_n; i++) {
+        p->pushing_fit = (p->fair_out_flags[i] & PLAN_OUT_FITTED) != 0;
         push_line(p, &p->fair_out[i]);
+        p->pushing_fit = 0;
+        if (p->fair_out_flags[i] & PLAN_OUT_MORE)
+            p->st.segments--;
+    }
     p->fair_out_n = 0;
 }
 

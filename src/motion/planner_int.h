@@ -20,12 +20,20 @@ struct plan_seg {
     double vjunc;   /* entry speed cap from the junction with the previous segment */
     double v_in;    /* planned entry speed (backward pass: can still stop at the end) */
     int blend;      /* a G64 corner arc, not a programmed segment */
+    /* an arc fitted through a CAM chain's lines (fit.c): feed path, not a
+     * G2/G3, with its own share of the acceleration bound for the turn */
+    int fitted;
 };
 
 /* At most this many programmed lines are joined into one (LinuxCNC's bound). */
 #define PLAN_CHAIN_MAX 100
 /* At most this many short lines are held back to be faired (fair.c). */
 #define PLAN_FAIR_MAX 32
+/* What fairing and arc fitting may hand on from one window (fit.c). */
+#define PLAN_FIT_OUT_MAX (4 * PLAN_FAIR_MAX + 4)
+/* fair_out_flags: a fitted arc; a further piece of the same programmed line */
+#define PLAN_OUT_FITTED 1u
+#define PLAN_OUT_MORE 2u
 
 struct ncp_planner {
     struct ncp_machine_cfg cfg;
@@ -54,9 +62,17 @@ struct ncp_planner {
     int fair_n, fair_max;
     struct ncp_seg fair_seg[PLAN_FAIR_MAX];
     double fair_orig[PLAN_FAIR_MAX + 1][3], fair_pt[PLAN_FAIR_MAX + 1][3];
-    /* faired lines for the planner to queue, in order */
+    /* fair_seg[0] was partly run as the end of a fitted arc (fit.c):
+     * fair_pt[0] is where that arc ended, on the faired line, and fair_pt[1]
+     * stays where it was so that the line keeps the arc's end tangent */
+    int fit_half;
+    /* faired lines and fitted arcs for the planner to queue, in order; a line
+     * is at most two pieces of line and two of arc per biarc through it */
     int fair_out_n;
-    struct ncp_seg fair_out[PLAN_FAIR_MAX];
+    struct ncp_seg fair_out[PLAN_FIT_OUT_MAX];
+    /* per piece of fair_out: PLAN_OUT_FITTED, PLAN_OUT_MORE */
+    uint8_t fair_out_flags[PLAN_FIT_OUT_MAX];
+    int pushing_fit;         /* fair_drain is queueing a fitted arc */
     struct ncp_planner_stats st;
 };
 
@@ -74,6 +90,15 @@ int ncp_fair_takes(const struct ncp_planner *p, const struct ncp_seg *s);
 void ncp_fair_add(struct ncp_planner *p, const struct ncp_seg *s);
 /* fair.c: fairs every line held back and hands it on (fair_out). */
 void ncp_fair_flush(struct ncp_planner *p);
+/* fair.c: hands on the part of held line k (of n) from a to b, on its faired
+ * course, with the P its blends may use; more: not the line's first piece. */
+void ncp_fair_line_out(struct ncp_planner *p, int n, int k, const double a[3], const double b[3],
+                       int more);
+/* fit.c: hands on the held lines (of n) up to line m (to the end on flush)
+ * as fitted arcs where they fit and as faired lines where not; returns
+ * how many lines are done with: the window moves on by that many, its first
+ * line partly run when p->fit_half is set. */
+int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush);
 
 /* scurve.c: evaluation of a jerk-limited profile (ncp_trap with j > 0). */
 double ncp_scurve_eval(const struct ncp_trap *tp, double t, double *v);

@@ -1,0 +1,148 @@
+/* Arcs fitted through CAM chains (src/motion/fit.c), from whole virtual-clock
+ * runs on LinuxCNC-like limits (100 mm/s, 1000 mm/s^2 per axis, 1 ms): two
+ * turns of a 1 mm radius circle written as G1 chords of 0.02 and 0.08 mm in
+ * turn (0.05 mm on average), G64 P0.01. A corner's blend may use only half
+ * of its shorter chord, so each vertex's parabola turns over 0.02 mm what
+ * the circle turns over 0.05: about 20 mm/s. Run as arcs at the circle's
+ * radius the chain reaches sqrt(0.99 a r) = 31 mm/s, while every sample
+ * stays within P of the programmed chords, every axis within its limits and
+ * every sample keeps its block's line number. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "trace_rows.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ncpar/feeder.h"
+#include "ncpar/motion.h"
+#include "ncpar/nck.h"
+#include "gcode_src.h"
+
+#include "lcnc_limits.h"
+
+#define RADIUS 1.0
+#define TURNS 2
+#define P_TOL 0.01
+#define FIRST_LINE 3   /* the program's first chord is on its line 3 */
+#define MAX_CHORDS 400
+
+static double pts[MAX_CHORDS + 1][3];
+static int chords;
+
+/* The program: chords of 0.02 and 0.08 mm in turn around the circle through
+ * the origin, centred at (0, RADIUS), its points rounded as written. */
+static char *circle_chain(void)
+{
+    char *prog = malloc((size_t)64 * (MAX_CHORDS + 4));
+    assert_non_null(prog);
+    int len = sprintf(prog, "G21 G90 G17 G94 G64 P%.2f Q0\nG1 F3000\n", P_TOL);
+    double ang = 0, end = TURNS * 2 * M_PI;
+    memset(pts[0], 0, sizeof pts[0]);
+    chords = 0;
+    while (ang < end - 1e-9 && chords < MAX_CHORDS) {
+        double c = chords % 2 ? 0.08 : 0.02;
+        ang = fmin(end, ang + 2 * asin(c / (2 * RADIUS)));
+        double x = RADIUS * sin(ang), y = RADIUS - RADIUS * cos(ang);
+        len += sprintf(prog + len, "G1 X%.4f Y%.4f Z0\n", x, y);
+        chords++;
+        pts[chords][0] = round(x * 1e4) / 1e4;
+        pts[chords][1] = round(y * 1e4) / 1e4;
+        pts[chords][2] = 0;
+    }
+    sprintf(prog + len, "M2\n");
+    return prog;
+}
+
+static double dist_chord(const double p[3], int k)
+{
+    double d[3], q2 = 0, t = 0, e2 = 0;
+    for (int j = 0; j < 3; j++) {
+        d[j] = pts[k + 1][j] - pts[k][j];
+        q2 += d[j] * d[j];
+        t += (p[j] - pts[k][j]) * d[j];
+    }
+    t = q2 > 0 ? fmin(1, fmax(0, t / q2)) : 0;
+    for (int j = 0; j < 3; j++)
+        e2 += (pts[k][j] + t * d[j] - p[j]) * (pts[k][j] + t * d[j] - p[j]);
+    return sqrt(e2);
+}
+
+/* Distance from p to the programmed chords near chord *i (taken in order:
+ * the circle's second turn runs over its first). */
+static double dist_chain(const double p[3], int *i)
+{
+    double best = INFINITY;
+    int at = *i;
+    for (int k = *i > 4 ? *i - 4 : 0; k < chords && k < *i + 20; k++) {
+        double d = dist_chord(p, k);
+        if (d < best) {
+            best = d;
+            at = k;
+        }
+    }
+    *i = at;
+    return best;
+}
+
+static void test_circle_chords_run_as_arcs(void **state)
+{
+    (void)state;
+    char *prog = circle_chain();
+    struct ncp_machine_cfg cfg;
+    lcnc_like_cfg(&cfg);
+    cfg.profile = NCP_PROFILE_TRAPEZOID;
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(prog, &cfg, &n, &res);
+    free(prog);
+    int at = 0;
+    double dev = 0, vtop = 0;
+    for (size_t k = 0; k < n; k++) {
+        dev = fmax(dev, dist_chain(r[k].cmd, &at));
+        /* each moving sample on a block of the chain, near its chord:
+         * within P of it or of a neighbour's (a sample just past a vertex) */
+        if (k > 0 && r[k].v > 0) {
+            int c = (int)r[k].line - FIRST_LINE;
+            if (c < 0 || c >= chords)
+                fail_msg("sample %zu on line %u, not a chord's", k, r[k].line);
+            double near = dist_chord(r[k].cmd, c);
+            if (c > 0)
+                near = fmin(near, dist_chord(r[k].cmd, c - 1));
+            if (c + 1 < chords)
+                near = fmin(near, dist_chord(r[k].cmd, c + 1));
+            if (near > P_TOL + 1e-6)
+                fail_msg("sample %zu of line %u lies %.5f mm from its chord", k, r[k].line, near);
+            if (r[k].motion != 1)
+                fail_msg("sample %zu of line %u is not marked a feed (motion %d)", k, r[k].line,
+                         r[k].motion);
+        }
+        /* the second turn, where the chain runs at its own pace */
+        if (k * cfg.servo_period > 0.25 && k + 100 < n)
+            vtop = fmax(vtop, r[k].v);
+    }
+    double acc = worst_acc(r, n, cfg.servo_period), t = (double)n * cfg.servo_period;
+    free(r);
+    print_message("%d chords, %.3f s, top speed %.1f mm/s, deviation %.5f mm, axis acceleration "
+                  "%.4f of the limit\n", chords, t, vtop, dev, acc);
+    if (dev > P_TOL + 1e-6 || acc > 1 + 1e-9)
+        fail_msg("deviation %.5f mm (P %.2f), axis acceleration %.4f of the limit", dev, P_TOL,
+                 acc);
+    /* sqrt(0.99 a r) = 31.5 mm/s on the circle; the blends reach about 20 */
+    if (vtop < 28)
+        fail_msg("the chain reached only %.1f mm/s (want >= 28: the circle's radius)", vtop);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_circle_chords_run_as_arcs),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
