@@ -173,12 +173,26 @@ static size_t first_of_line(const struct by_line *b, unsigned line)
     return lo;
 }
 
+/* The first line from `line` on that has rows: a run of lines that G64 Q
+ * merged into one segment runs under the run's last line, so a corner at
+ * the run's start is among that line's rows, and one inside the run may be
+ * in the blend to the next segment, which runs under the next line that
+ * has rows */
+static unsigned line_with_rows(const struct by_line *b, unsigned line)
+{
+    size_t i = first_of_line(b, line);
+    return i < b->n ? b->r[b->idx[i]].line : line;
+}
+
 /* Distance from p to the commanded polyline near the rows of either line. */
 static double dist_to_path(const struct by_line *b, const double p[3], unsigned l1, unsigned l2)
 {
     double best = INFINITY;
-    unsigned lines[2] = { l1, l2 };
-    for (int m = 0; m < (l1 == l2 ? 1 : 2); m++) {
+    unsigned first = line_with_rows(b, l1), second = line_with_rows(b, l2);
+    if (second == first)
+        second = line_with_rows(b, first + 1);
+    unsigned lines[2] = { first, second };
+    for (int m = 0; m < (lines[0] == lines[1] ? 1 : 2); m++) {
         for (size_t i = first_of_line(b, lines[m]); i < b->n && b->r[b->idx[i]].line == lines[m];
              i++) {
             size_t k = b->idx[i];
