@@ -103,23 +103,6 @@ static void relax(struct ncp_planner *p, int n)
     }
 }
 
-void ncp_fair_line_out(struct ncp_planner *p, int n, int k, const double a[3], const double b[3],
-                       int more)
-{
-    /* a segment whose ends moved by at most e lies within e of the
-     * programmed one; the blend at its end turns onto line k + 1 */
-    double e = 0;
-    for (int i = k; i <= k + 2 && i <= n; i++)
-        e = fmax(e, dist3(p->fair_pt[i], p->fair_orig[i]));
-    struct ncp_seg s = p->fair_seg[k];
-    memcpy(s.start, a, 3 * sizeof a[0]);
-    memcpy(s.end, b, 3 * sizeof b[0]);
-    ncp_seg_set_length(&s);
-    s.tolerance -= e;
-    p->fair_out_flags[p->fair_out_n] = more ? PLAN_OUT_MORE : 0;
-    p->fair_out[p->fair_out_n++] = s;
-}
-
 void ncp_fair_add(struct ncp_planner *p, const struct ncp_seg *s)
 {
     int n = p->fair_n;

@@ -57,6 +57,34 @@ static double norm3(const double a[3])
 }
 
 /* The arc from p0 along the unit t0 through e. 0 when it sweeps too far. */
+/* How far fairing moved vertex i from where it was programmed. */
+static double moved(const struct ncp_planner *p, int i)
+{
+    double d[3];
+    for (int j = 0; j < 3; j++)
+        d[j] = p->fair_pt[i][j] - p->fair_orig[i][j];
+    return norm3(d);
+}
+
+/* Hands on the part of held line k (of n) from a to b, on its faired
+ * course, with the P its blends may use; more: not the line's first piece. */
+static void line_out(struct ncp_planner *p, int n, int k, const double a[3], const double b[3],
+                     int more)
+{
+    /* a segment whose ends moved by at most e lies within e of the
+     * programmed one; the blend at its end turns onto line k + 1 */
+    double e = 0;
+    for (int i = k; i <= k + 2 && i <= n; i++)
+        e = fmax(e, moved(p, i));
+    struct ncp_seg s = p->fair_seg[k];
+    memcpy(s.start, a, 3 * sizeof a[0]);
+    memcpy(s.end, b, 3 * sizeof b[0]);
+    ncp_seg_set_length(&s);
+    s.tolerance -= e;
+    p->fair_out_flags[p->fair_out_n] = more ? PLAN_OUT_MORE : 0;
+    p->fair_out[p->fair_out_n++] = s;
+}
+
 static int arc_to(const double p0[3], const double t0[3], const double e[3], struct fit_arc *a)
 {
     double c[3], perp[3];
@@ -424,7 +452,7 @@ int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush)
                 chord_mid(p, b, p0, t0);
                 continue;
             }
-            ncp_fair_line_out(p, n, i, p0, p->fair_pt[i + 1], 1);
+            line_out(p, n, i, p0, p->fair_pt[i + 1], 1);
             i++;
             on_arc = 0;
             continue;
@@ -436,14 +464,14 @@ int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush)
         int b = budget > 0 && fit_on(p) && i < last ? fit_reach(p, i, last, mid, tm, budget, &bi, at)
                                                     : i;
         if (b > i) {
-            ncp_fair_line_out(p, n, i, p->fair_pt[i], mid, 0);
+            line_out(p, n, i, p->fair_pt[i], mid, 0);
             biarc_out(p, &bi, i, b, at, budget);
             i = b;
             chord_mid(p, b, p0, t0);
             on_arc = 1;
             continue;
         }
-        ncp_fair_line_out(p, n, i, p->fair_pt[i], p->fair_pt[i + 1], 0);
+        line_out(p, n, i, p->fair_pt[i], p->fair_pt[i + 1], 0);
         i++;
     }
     p->fit_half = on_arc && i < n;

@@ -90,10 +90,6 @@ int ncp_fair_takes(const struct ncp_planner *p, const struct ncp_seg *s);
 void ncp_fair_add(struct ncp_planner *p, const struct ncp_seg *s);
 /* fair.c: fairs every line held back and hands it on (fair_out). */
 void ncp_fair_flush(struct ncp_planner *p);
-/* fair.c: hands on the part of held line k (of n) from a to b, on its faired
- * course, with the P its blends may use; more: not the line's first piece. */
-void ncp_fair_line_out(struct ncp_planner *p, int n, int k, const double a[3], const double b[3],
-                       int more);
 /* fit.c: hands on the held lines (of n) up to line m (to the end on flush)
  * as fitted arcs where they fit and as faired lines where not; returns
  * how many lines are done with: the window moves on by that many, its first
