@@ -468,7 +468,7 @@ def windows_bound(pts, err, feed, vmax, amax, skip=False, ratio=RATIO, span=SPAN
 
 LENGTHS = (0.25, 0.4, 0.5, 1.0, 2.0)   # window lengths tried, mm (the largest bound is taken)
 SKIP = (0.4,)             # and with each window held to the one two back too (slower)
-MOST = 1500              # windows at most (longer ones on long paths: time)
+MOST = 600              # windows at most (longer ones on long paths: time)
 
 
 def window_bounds(segs, tol, vmax, amax):
