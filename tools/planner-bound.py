@@ -118,9 +118,12 @@ follows the curve can do. The windows read the turns of many blocks at once:
   the bounds; the largest is taken. They gain on curves sampled by short
   chords (tiny: 2.271 -> 3.499 s); where corners between long lines
   decide the time the trapezoids stay the larger. Both are loose on tiny
-  still: bench/piece-lp's optimum on 80-block pieces is 1.17-1.37 times
-  the windows, most of it the e's relaxed pair by pair (with e = 0 the
-  windows of 0.3 mm would give 20 % more on the piece from block 1).
+  still: bench/piece-lp's optimum on 80-block pieces is 1.17-1.38 times
+  the windows. Tried and not kept: each e_k's part along the curve's normal
+  kept the same in both of its pairs (in five cells of [-P, P], a state of
+  the programme beside the window's box) gained under 1 % at the window
+  lengths that give the most, so the pairwise relaxation of the e's is not
+  where the rest lies.
 Checked: on a polyline of 0.1 mm chords round three quarters of a circle of
 radius 2 mm at F6000 it comes out above the trapezoids and below the time
 of a motion on the circle at the speed sqrt(A R / sqrt 2) (every axis
