@@ -24,18 +24,6 @@
 /* What a blend leaves of the line before it, mm. */
 #define BLEND_LINE_LEFT 1e-3
 
-static double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double o[3])
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static void direction(const struct ncp_seg *s, double u[3])
 {
     for (int i = 0; i < 3; i++)

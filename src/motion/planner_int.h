@@ -76,6 +76,19 @@ struct ncp_planner {
     struct ncp_planner_stats st;
 };
 
+/* X Y Z vector products, for the blends' and the fitted arcs' geometry. */
+static inline double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void cross3(const double a[3], const double b[3], double o[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 static inline struct plan_seg *plan_at(struct ncp_planner *p, size_t k)
 {
     return &p->q[(p->head + k) % p->cap];

@@ -11,6 +11,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "chord_dist.h"
 #include "trace_rows.h"
 
 #include <math.h>
@@ -68,17 +69,9 @@ static double dist_chain(const double p[3], int *i)
     double best = INFINITY;
     int at = *i;
     for (int k = *i > 20 ? *i - 20 : 0; k < CHORDS && k < *i + 20; k++) {
-        double d[3], q2 = 0, t = 0, e2 = 0;
-        for (int j = 0; j < 3; j++) {
-            d[j] = pts[k + 1][j] - pts[k][j];
-            q2 += d[j] * d[j];
-            t += (p[j] - pts[k][j]) * d[j];
-        }
-        t = q2 > 0 ? fmin(1, fmax(0, t / q2)) : 0;
-        for (int j = 0; j < 3; j++)
-            e2 += (pts[k][j] + t * d[j] - p[j]) * (pts[k][j] + t * d[j] - p[j]);
-        if (sqrt(e2) < best) {
-            best = sqrt(e2);
+        double e = chord_dist(p, pts[k], pts[k + 1]);
+        if (e < best) {
+            best = e;
             at = k;
         }
     }

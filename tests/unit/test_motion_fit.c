@@ -13,6 +13,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "chord_dist.h"
 #include "trace_rows.h"
 
 #include <math.h>
@@ -62,16 +63,7 @@ static char *circle_chain(void)
 
 static double dist_chord(const double p[3], int k)
 {
-    double d[3], q2 = 0, t = 0, e2 = 0;
-    for (int j = 0; j < 3; j++) {
-        d[j] = pts[k + 1][j] - pts[k][j];
-        q2 += d[j] * d[j];
-        t += (p[j] - pts[k][j]) * d[j];
-    }
-    t = q2 > 0 ? fmin(1, fmax(0, t / q2)) : 0;
-    for (int j = 0; j < 3; j++)
-        e2 += (pts[k][j] + t * d[j] - p[j]) * (pts[k][j] + t * d[j] - p[j]);
-    return sqrt(e2);
+    return chord_dist(p, pts[k], pts[k + 1]);
 }
 
 /* Distance from p to the programmed chords near chord *i (taken in order:
