@@ -239,7 +239,6 @@ def geometry(seg, vmax, amax, tol=0.0):
         sweep = 2 * math.pi
     sweep += 2 * math.pi * turns
     dz = e[2] - s[2]
-    length = math.hypot(r * sweep, dz)
     sg = 1 if ccw else -1
 
     def tang(a):
