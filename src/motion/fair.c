@@ -33,14 +33,6 @@
  * every line sent had FAIR_PASSES neighbours on both sides */
 #define FAIR_KEEP (2 * FAIR_PASSES)
 
-static double dist3(const double a[3], const double b[3])
-{
-    double d = 0;
-    for (int j = 0; j < 3; j++)
-        d += (a[j] - b[j]) * (a[j] - b[j]);
-    return sqrt(d);
-}
-
 static int fair_line(const struct ncp_planner *p, const struct ncp_seg *s)
 {
     return p->fair_max > 2 * FAIR_KEEP && s->kind == NCP_SEG_LINE && !s->traverse &&

@@ -18,7 +18,6 @@
  * against LinuxCNC 2.9's". */
 #include "planner_int.h"
 
-
 #include <math.h>
 #include <string.h>
 
@@ -44,16 +43,6 @@ static double norm3(const double a[3])
     return sqrt(dot3(a, a));
 }
 
-/* The arc from p0 along the unit t0 through e. 0 when it sweeps too far. */
-/* How far fairing moved vertex i from where it was programmed. */
-static double moved(const struct ncp_planner *p, int i)
-{
-    double d[3];
-    for (int j = 0; j < 3; j++)
-        d[j] = p->fair_pt[i][j] - p->fair_orig[i][j];
-    return norm3(d);
-}
-
 /* Hands on the part of held line k (of n) from a to b, on its faired
  * course, with the P its blends may use; more: not the line's first piece. */
 static void line_out(struct ncp_planner *p, int n, int k, const double a[3], const double b[3],
@@ -63,7 +52,7 @@ static void line_out(struct ncp_planner *p, int n, int k, const double a[3], con
      * programmed one; the blend at its end turns onto line k + 1 */
     double e = 0;
     for (int i = k; i <= k + 2 && i <= n; i++)
-        e = fmax(e, moved(p, i));
+        e = fmax(e, dist3(p->fair_pt[i], p->fair_orig[i]));
     struct ncp_seg s = p->fair_seg[k];
     memcpy(s.start, a, 3 * sizeof a[0]);
     memcpy(s.end, b, 3 * sizeof b[0]);
@@ -73,6 +62,7 @@ static void line_out(struct ncp_planner *p, int n, int k, const double a[3], con
     p->fair_out[p->fair_out_n++] = s;
 }
 
+/* The arc from p0 along the unit t0 through e. 0 when it sweeps too far. */
 static int arc_to(const double p0[3], const double t0[3], const double e[3], struct fit_arc *a)
 {
     double c[3], perp[3];
@@ -128,7 +118,7 @@ static void arc_eval(const struct fit_arc *a, double s, double p[3], double t[3]
 /* Distance from q to the arc and the arc length of its nearest point. */
 static double arc_dist(const struct fit_arc *a, const double q[3], double *at)
 {
-    double d[3], e[3], best, s_end = a->len;
+    double d[3], e[3], s_end = a->len;
     if (a->r > 0) {
         for (int j = 0; j < 3; j++)
             d[j] = q[j] - a->c[j];
@@ -152,17 +142,9 @@ static double arc_dist(const struct fit_arc *a, const double q[3], double *at)
     }
     /* beyond its ends: the nearer end */
     arc_eval(a, s_end, e, NULL);
-    for (int j = 0; j < 3; j++) {
-        d[j] = q[j] - a->p0[j];
-        e[j] = q[j] - e[j];
-    }
-    best = norm3(d);
-    *at = 0;
-    if (norm3(e) < best) {
-        best = norm3(e);
-        *at = s_end;
-    }
-    return best;
+    double d0 = dist3(q, a->p0), d1 = dist3(q, e);
+    *at = d1 < d0 ? s_end : 0;
+    return fmin(d0, d1);
 }
 
 static double biarc_dist(const struct biarc *b, const double q[3], double *at)
@@ -233,21 +215,6 @@ static double biarc_rmin(const struct biarc *b)
     return fmin(r0, r1);
 }
 
-static double seg_dist(const double q[3], const double a[3], const double b[3])
-{
-    double ab2 = 0, t = 0, d2 = 0;
-    for (int j = 0; j < 3; j++) {
-        ab2 += (b[j] - a[j]) * (b[j] - a[j]);
-        t += (q[j] - a[j]) * (b[j] - a[j]);
-    }
-    t = ab2 > 0 ? fmin(1, fmax(0, t / ab2)) : 0;
-    for (int j = 0; j < 3; j++) {
-        double e = a[j] + t * (b[j] - a[j]) - q[j];
-        d2 += e * e;
-    }
-    return sqrt(d2);
-}
-
 /* Every programmed vertex a+1..b within budget of the biarc, passed in
  * order (at[] its arc lengths there), and every programmed chord's middle
  * between them too. */
@@ -290,7 +257,7 @@ static int biarc_inside(const struct ncp_planner *p, const struct biarc *bi, int
         uint64_t near = 0;
         biarc_eval(bi, bi->len * i / steps, q);
         for (int c = k > a ? k - 1 : a; c <= b && c <= k + 2; c++) {
-            double d = seg_dist(q, p->fair_seg[c].start, p->fair_seg[c].end);
+            double d = plan_chord_dist(q, p->fair_seg[c].start, p->fair_seg[c].end, 3);
             if (d <= lim)
                 near |= (uint64_t)1 << (c - a);
             if (d < best) {
@@ -374,12 +341,11 @@ static void arc_out(struct ncp_planner *p, const struct biarc *bi, int k, double
         if (x1 - x0 <= 1e-9 || p->fair_out_n >= PLAN_FIT_OUT_MAX)
             continue;
         struct ncp_seg s = p->fair_seg[k];
-        double t[3];
         /* the arc used the budget of P: a blend on it (none is expected:
          * it meets its neighbours tangent) gets what is left */
         s.tolerance -= budget;
-        arc_eval(a, x0, s.start, t);
-        arc_eval(a, x1, s.end, t);
+        arc_eval(a, x0, s.start, NULL);
+        arc_eval(a, x1, s.end, NULL);
         if (a->r > 0) {
             double phi = x0 / a->r, c = cos(phi), sn = sin(phi);
             s.kind = NCP_SEG_ARC;
@@ -429,38 +395,28 @@ int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush)
         chord_mid(p, 0, p0, t0);
         memcpy(p0, p->fair_pt[0], sizeof p0);
     }
-    for (;;) {
-        if (on_arc) {
-            if (i >= n || (!flush && i >= m))
-                break;
-            int b = budget > 0 && fit_on(p) ? fit_reach(p, i, last, p0, t0, budget, &bi, at) : i;
-            if (b > i) {
-                biarc_out(p, &bi, i, b, at, budget);
-                i = b;
-                chord_mid(p, b, p0, t0);
-                continue;
-            }
-            line_out(p, n, i, p0, p->fair_pt[i + 1], 1);
-            i++;
-            on_arc = 0;
-            continue;
-        }
-        if (i >= n || (!flush && i >= m))
-            break;
+    int fit = budget > 0 && fit_on(p);
+    /* each round starts at line i, from the last arc's end (on_arc) or
+     * from the faired chord's midpoint, and runs a biarc from there or the
+     * line to its end */
+    while (i < n && (flush || i < m)) {
         double mid[3], tm[3];
-        chord_mid(p, i, mid, tm);
-        int b = budget > 0 && fit_on(p) && i < last ? fit_reach(p, i, last, mid, tm, budget, &bi, at)
-                                                    : i;
+        if (!on_arc)
+            chord_mid(p, i, mid, tm);
+        int b = fit ? fit_reach(p, i, last, on_arc ? p0 : mid, on_arc ? t0 : tm, budget, &bi, at)
+                    : i;
         if (b > i) {
-            line_out(p, n, i, p->fair_pt[i], mid, 0);
+            if (!on_arc)
+                line_out(p, n, i, p->fair_pt[i], mid, 0);
             biarc_out(p, &bi, i, b, at, budget);
             i = b;
             chord_mid(p, b, p0, t0);
             on_arc = 1;
             continue;
         }
-        line_out(p, n, i, p->fair_pt[i], p->fair_pt[i + 1], 0);
+        line_out(p, n, i, on_arc ? p0 : p->fair_pt[i], p->fair_pt[i + 1], on_arc);
         i++;
+        on_arc = 0;
     }
     p->fit_half = on_arc && i < n;
     if (p->fit_half) {

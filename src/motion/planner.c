@@ -1136,23 +1136,6 @@ static int chain_may_start(const struct ncp_seg *s)
            s->merge_tol > 0 && s->length > 0 && !ncp_seg_moves_other(s);
 }
 
-/* Distance from q to the segment a-b. */
-static double dist_to_chord(const double q[NCP_AXES], const double a[NCP_AXES],
-                            const double b[NCP_AXES])
-{
-    double ab2 = 0, t = 0, d2 = 0;
-    for (int j = 0; j < NCP_AXES; j++) {
-        ab2 += (b[j] - a[j]) * (b[j] - a[j]);
-        t += (q[j] - a[j]) * (b[j] - a[j]);
-    }
-    t = ab2 > 0 ? fmin(1, fmax(0, t / ab2)) : 0;
-    for (int j = 0; j < NCP_AXES; j++) {
-        double e = a[j] + t * (b[j] - a[j]) - q[j];
-        d2 += e * e;
-    }
-    return sqrt(d2);
-}
-
 /* May s join the chain? It must continue it with the same feed and mode,
  * with no machine function (M62, M67, ...) sent between them, and the line from the chain's start to s's end must pass within Q of every
  * point programmed so far. */
@@ -1167,7 +1150,7 @@ static int chain_takes(const struct ncp_planner *p, const struct ncp_seg *s)
         if (fabs(s->start[j] - c->end[j]) > 1e-9)
             return 0;
     for (int i = 0; i < p->chain_n; i++)
-        if (dist_to_chord(p->chain_pt[i], c->start, s->end) > s->merge_tol)
+        if (plan_chord_dist(p->chain_pt[i], c->start, s->end, NCP_AXES) > s->merge_tol)
             return 0;
     return 1;
 }

@@ -76,7 +76,8 @@ struct ncp_planner {
     struct ncp_planner_stats st;
 };
 
-/* X Y Z vector products, for the blends' and the fitted arcs' geometry. */
+/* X Y Z vector products and distances, for the blends', fairing's and the
+ * fitted arcs' geometry. */
 static inline double dot3(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -87,6 +88,29 @@ static inline void cross3(const double a[3], const double b[3], double o[3])
     o[0] = a[1] * b[2] - a[2] * b[1];
     o[1] = a[2] * b[0] - a[0] * b[2];
     o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static inline double dist3(const double a[3], const double b[3])
+{
+    double d[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+    return sqrt(dot3(d, d));
+}
+
+/* Distance from q to the segment a-b over their first dims coordinates
+ * (G64 Q's chains measure all axes, the fitted arcs X Y Z). */
+static inline double plan_chord_dist(const double *q, const double *a, const double *b, int dims)
+{
+    double ab2 = 0, t = 0, d2 = 0;
+    for (int j = 0; j < dims; j++) {
+        ab2 += (b[j] - a[j]) * (b[j] - a[j]);
+        t += (q[j] - a[j]) * (b[j] - a[j]);
+    }
+    t = ab2 > 0 ? fmin(1, fmax(0, t / ab2)) : 0;
+    for (int j = 0; j < dims; j++) {
+        double e = a[j] + t * (b[j] - a[j]) - q[j];
+        d2 += e * e;
+    }
+    return sqrt(d2);
 }
 
 static inline struct plan_seg *plan_at(struct ncp_planner *p, size_t k)
