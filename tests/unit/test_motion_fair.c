@@ -66,17 +66,7 @@ static char *cam_chain(void)
 /* Distance from p to the programmed polyline, near chord i. */
 static double dist_chain(const double p[3], int *i)
 {
-    double best = INFINITY;
-    int at = *i;
-    for (int k = *i > 20 ? *i - 20 : 0; k < CHORDS && k < *i + 20; k++) {
-        double e = chord_dist(p, pts[k], pts[k + 1]);
-        if (e < best) {
-            best = e;
-            at = k;
-        }
-    }
-    *i = at;
-    return best;
+    return chain_dist((const double(*)[3])pts, CHORDS, p, i, 20, 20);
 }
 
 static void run_chain(enum ncp_profile profile, double *time, double *dev, double *acc)

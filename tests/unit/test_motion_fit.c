@@ -70,17 +70,7 @@ static double dist_chord(const double p[3], int k)
  * the circle's second turn runs over its first). */
 static double dist_chain(const double p[3], int *i)
 {
-    double best = INFINITY;
-    int at = *i;
-    for (int k = *i > 4 ? *i - 4 : 0; k < chords && k < *i + 20; k++) {
-        double d = dist_chord(p, k);
-        if (d < best) {
-            best = d;
-            at = k;
-        }
-    }
-    *i = at;
-    return best;
+    return chain_dist((const double(*)[3])pts, chords, p, i, 4, 20);
 }
 
 static void test_circle_chords_run_as_arcs(void **state)
