@@ -1,5 +1,6 @@
 /* The clock probes' own socket and thread, the same on both sides (the HLC
  * answers, each LLC asks): see ncpar/dist.h. */
+#include "ncpar/clock.h"
 #include "ncpar/dist.h"
 #include "ncpar/msg.h"
 
@@ -69,12 +70,10 @@ int64_t ncp_dist_realtime_offset(void)
 {
     int64_t best = 0, best_gap = INT64_MAX;
     for (int i = 0; i < OFFSET_TRIES; i++) {
-        struct timespec m0, r, m1;
-        clock_gettime(CLOCK_MONOTONIC, &m0);
+        struct timespec r;
+        int64_t a = ncp_mono_ns();
         clock_gettime(CLOCK_REALTIME, &r);
-        clock_gettime(CLOCK_MONOTONIC, &m1);
-        int64_t a = (int64_t)m0.tv_sec * 1000000000LL + m0.tv_nsec;
-        int64_t b = (int64_t)m1.tv_sec * 1000000000LL + m1.tv_nsec;
+        int64_t b = ncp_mono_ns();
         if (b - a < best_gap) {
             best_gap = b - a;
             best = (int64_t)r.tv_sec * 1000000000LL + r.tv_nsec - (a + (b - a) / 2);
