@@ -218,6 +218,22 @@ def arc_within(r, sweep, tol):
     return r + reach, reach * math.tan(half)
 
 
+def arc_of(seg):
+    """An ARC_FEED's centre (x, y), radius, start and end angles and sweep
+    (rad, its whole turns included) and whether it runs counter-clockwise."""
+    (cx, cy), rot = seg[4], seg[5]
+    s, e = seg[1], seg[2]
+    r = math.hypot(s[0] - cx, s[1] - cy)
+    a0 = math.atan2(s[1] - cy, s[0] - cx)
+    a1 = math.atan2(e[1] - cy, e[0] - cx)
+    ccw = rot > 0
+    sweep = (a1 - a0) % (2 * math.pi) if ccw else (a0 - a1) % (2 * math.pi)
+    if sweep < 1e-12:
+        sweep = 2 * math.pi
+    sweep += 2 * math.pi * (abs(rot) - 1)
+    return cx, cy, r, a0, a1, sweep, ccw
+
+
 def geometry(seg, vmax, amax, tol=0.0):
     """(length, speed cap, acceleration cap, entry tangent, exit tangent,
     radius or inf, the length taken from the segments either side)"""
@@ -227,17 +243,8 @@ def geometry(seg, vmax, amax, tol=0.0):
         vcap = min([seg[3]] + [vmax[i] / abs(u[i]) for i in range(3) if abs(u[i]) > 1e-12])
         acap = min(amax[i] / abs(u[i]) for i in range(3) if abs(u[i]) > 1e-12)
         return norm(d), vcap, acap, u, u, math.inf, 0.0
-    (cx, cy), rot = seg[4], seg[5]
     s, e = seg[1], seg[2]
-    r = math.hypot(s[0] - cx, s[1] - cy)
-    a0 = math.atan2(s[1] - cy, s[0] - cx)
-    a1 = math.atan2(e[1] - cy, e[0] - cx)
-    ccw = rot > 0
-    turns = abs(rot) - 1
-    sweep = (a1 - a0) % (2 * math.pi) if ccw else (a0 - a1) % (2 * math.pi)
-    if sweep < 1e-12:
-        sweep = 2 * math.pi
-    sweep += 2 * math.pi * turns
+    _, _, r, a0, a1, sweep, ccw = arc_of(seg)
     dz = e[2] - s[2]
     sg = 1 if ccw else -1
 
@@ -339,16 +346,8 @@ class Path:
                 L = norm(sub(sg[2], sg[1]))
                 self.segs.append(("line", sg[1], sg[2]))
             else:
-                (cx, cy), rot = sg[4], sg[5]
                 st, e = sg[1], sg[2]
-                r = math.hypot(st[0] - cx, st[1] - cy)
-                a0 = math.atan2(st[1] - cy, st[0] - cx)
-                a1 = math.atan2(e[1] - cy, e[0] - cx)
-                ccw = rot > 0
-                sweep = (a1 - a0) % (2 * math.pi) if ccw else (a0 - a1) % (2 * math.pi)
-                if sweep < 1e-12:
-                    sweep = 2 * math.pi
-                sweep += 2 * math.pi * (abs(rot) - 1)
+                cx, cy, r, a0, _, sweep, ccw = arc_of(sg)
                 L = math.hypot(r * sweep, e[2] - st[2])
                 self.segs.append(("arc", (cx, cy, r, a0, (1 if ccw else -1) * sweep, st[2], e[2])))
             self.s0.append(s)
