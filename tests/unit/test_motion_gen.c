@@ -58,26 +58,42 @@ struct segs {
     int failed;
 };
 
+static int seg_room(struct segs *g)
+{
+    if (g->n == g->cap) {
+        g->cap = g->cap ? 2 * g->cap : 256;
+        struct ncp_seg *bigger = realloc(g->s, g->cap * sizeof *bigger);
+        if (!bigger)
+            return 0;
+        g->s = bigger;
+    }
+    return 1;
+}
+
+/* Every segment of every call, with the ones a call makes after its first
+ * (a G5.x curve's lines, a rigid tap's way out) as the runtime gets them. */
 static int collect_seg(void *ctx, const struct ncp_cmd *cmd)
 {
     struct segs *g = ctx;
     struct ncp_diag d;
     for (unsigned i = 0; i < cmd->n_ops; i++) {
-        if (g->n == g->cap) {
-            g->cap = g->cap ? 2 * g->cap : 256;
-            struct ncp_seg *bigger = realloc(g->s, g->cap * sizeof *bigger);
-            if (!bigger) {
+        if (!seg_room(g)) {
+            g->failed = 1;
+            return 1;
+        }
+        int rc = ncp_canon_map_op(&g->map, &cmd->ops[i], cmd->line, &g->s[g->n], &d);
+        while (rc == 1) {
+            g->n++;
+            if (!seg_room(g)) {
                 g->failed = 1;
                 return 1;
             }
-            g->s = bigger;
+            rc = ncp_canon_map_more(&g->map, &g->s[g->n], &d);
         }
-        int rc = ncp_canon_map_op(&g->map, &cmd->ops[i], cmd->line, &g->s[g->n], &d);
         if (rc < 0) {
             g->failed = 1;
             return 1;
         }
-        g->n += rc == 1;
     }
     return 0;
 }
