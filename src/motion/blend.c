@@ -13,7 +13,9 @@
  * the even one leaves idle. Between an arc and a line the blend is the
  * parabola through the pull of the arc's tangent and the line (a circle
  * where the cut is too small for one). Each stays within the tolerance P of
- * the corner and uses at most the rest of the line before it and half of the
+ * the programmed path (the line-line parabolas within P of the two lines,
+ * the G64 P band; an arc's blend within P of the corner point, which is
+ * nearer) and uses at most the rest of the line before it and half of the
  * line after it, so neighbouring blends never overlap; the planner
  * (try_blend) makes an even one no larger than the speed it is for needs. */
 #include "planner_int.h"
@@ -28,6 +30,15 @@ static void direction(const struct ncp_seg *s, double u[3])
 {
     for (int i = 0; i < 3; i++)
         u[i] = (s->end[i] - s->start[i]) / s->length;
+}
+
+/* The sine of the turn between unit directions u1 and u2: how far a point
+ * of one line lies from the other per unit of its distance from the corner. */
+static double band_sin(const double u1[3], const double u2[3])
+{
+    double n[3];
+    cross3(u1, u2, n);
+    return sqrt(dot3(n, n));
 }
 
 int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double max_trim,
@@ -53,9 +64,14 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
      * all go to this corner (a micrometre stays, so its direction stays
      * exact); cur keeps half for the corner after */
     double d = fmin(max_trim, fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length));
-    /* the curve passes the corner closest halfway, d |u2 - u1| / 4 from it */
+    /* G64 P bounds the path's distance from the programmed lines, not from
+     * the corner point: the curve's points lie t^2 d sin(phi) from the one
+     * line and (1 - t)^2 d sin(phi) from the other, so at most d sin(phi) / 4
+     * from the nearer one (halfway, where it passes the corner point
+     * d |u2 - u1| / 4 = P / cos(phi/2) away, as every path in the band must
+     * at that speed) */
     if (prev->tolerance > 0)
-        d = fmin(d, 4 * prev->tolerance / du);
+        d = fmin(d, 4 * prev->tolerance / band_sin(u1, u2));
     if (d < 1e-6)
         return 0;
     memset(blend, 0, sizeof *blend);
@@ -81,35 +97,15 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
     return 1;
 }
 
-/* How close an uneven parabola with corner C, start C - u1 and end
- * C + rho u2 (|u1| = |u2| = 1, u1 . u2 = c) passes C: min over l of
- * |(1-l)^2 u1 - rho l^2 u2|. The curve is scaled by r0 for a real blend. */
-static double ratio_reach(double rho, double c)
+/* How far an uneven parabola with corner C, start C - u1 and end C + rho u2
+ * (|u1| = |u2| = 1, turning by phi) strays from the two lines: at parameter l
+ * it lies rho l^2 sin(phi) from the first and (1 - l)^2 sin(phi) from the
+ * second, and the nearer of the two is farthest where they are equal,
+ * l = 1 / (1 + sqrt(rho)). The curve is scaled by r0 for a real blend. */
+static double ratio_depth(double rho, double sin_phi)
 {
-    double best = INFINITY, lo = 0, hi = 1;
-    /* the squared distance is a quartic in l; a coarse scan, then golden
-     * sections around the best sample */
-    for (int k = 0; k <= 32; k++) {
-        double l = k / 32.0, a = (1 - l) * (1 - l), b = rho * l * l;
-        double d2 = a * a + b * b - 2 * a * b * c;
-        if (d2 < best) {
-            best = d2;
-            lo = fmax(0, l - 1 / 32.0);
-            hi = fmin(1, l + 1 / 32.0);
-        }
-    }
-    const double g = 0.5 * (sqrt(5.0) - 1);
-    for (int i = 0; i < 30; i++) {
-        double l1 = hi - g * (hi - lo), l2 = lo + g * (hi - lo);
-        double a1 = (1 - l1) * (1 - l1), b1 = rho * l1 * l1, a2 = (1 - l2) * (1 - l2),
-               b2 = rho * l2 * l2;
-        if (a1 * a1 + b1 * b1 - 2 * a1 * b1 * c < a2 * a2 + b2 * b2 - 2 * a2 * b2 * c)
-            hi = l2;
-        else
-            lo = l1;
-    }
-    double l = 0.5 * (lo + hi), a = (1 - l) * (1 - l), b = rho * l * l;
-    return sqrt(fmax(0, fmin(best, a * a + b * b - 2 * a * b * c)));
+    double q = 1 + sqrt(rho);
+    return rho * sin_phi / (q * q);
 }
 
 int ncp_blend_corner_ratio(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
@@ -123,7 +119,7 @@ int ncp_blend_corner_ratio(const struct ncp_seg *prev, const struct ncp_seg *cur
     double u1[3], u2[3];
     direction(prev, u1);
     direction(cur, u2);
-    double reach = ratio_reach(rho, dot3(u1, u2));
+    double reach = ratio_depth(rho, band_sin(u1, u2));
     if (!(reach > 0))
         return 0;
     /* the largest r0 within P, and within the lines as the even blend is */

@@ -105,10 +105,13 @@ int ncp_planner_idle(const struct ncp_planner *p)
 static void chain_flush(struct ncp_planner *p);
 static void fair_flush(struct ncp_planner *p);
 
+static void edge_release(struct ncp_planner *p, int end_moved);
+
 void ncp_planner_finish(struct ncp_planner *p)
 {
     chain_flush(p);
     fair_flush(p);
+    edge_release(p, 0);
     p->finished = 1;
 }
 
@@ -128,6 +131,8 @@ void ncp_planner_reset(struct ncp_planner *p, const double pos[NCP_AXES])
     p->chain_n = 0;
     p->fair_n = 0;
     p->fair_out_n = 0;
+    p->edge_held = 0;
+    memset(&p->corner, 0, sizeof p->corner);
     /* the last block's line, machine functions and tool stay what the held
      * samples report */
     struct ncp_exec was = p->ex;
@@ -699,6 +704,7 @@ static void push_one(struct ncp_planner *p, const struct ncp_seg *s, int blend)
     ps->s = *s;
     ps->blend = blend;
     ps->fitted = p->pushing_fit && !blend && s->kind == NCP_SEG_ARC;
+    ps->faired = p->pushing_fair && !blend;
     seg_limits(p, ps);
     p->count++;
     p->programmed += !blend;
@@ -762,9 +768,10 @@ static double arc_speed(const struct ncp_planner *p, const struct ncp_seg *arc)
  * programmed corner only as far as the speed it buys needs. The arc's speed
  * grows with its radius, so a bisection finds it. */
 static int size_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
-                      const struct ncp_seg *s, double v_goal, struct ncp_seg *arc, double *d)
+                      const struct ncp_seg *s, double v_goal, double max_trim, struct ncp_seg *arc,
+                      double *d)
 {
-    if (!ncp_blend_corner(tol, s, INFINITY, arc, d))
+    if (!ncp_blend_corner(tol, s, max_trim, arc, d))
         return 0;
     if (arc_speed(p, arc) <= v_goal)
         return 1;
@@ -830,8 +837,8 @@ static double corner_cost(double len1, double a1, double len2, double a2, double
 #define RATIO_GAIN_MIN 1e-4
 static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
                         const struct plan_seg *prev, const struct ncp_seg *s, double v_goal,
-                        const struct ncp_seg *even, double d, struct ncp_seg *out, double *d1,
-                        double *d2)
+                        const struct ncp_seg *even, double d, const struct plan_corner *corner,
+                        struct ncp_seg *out, double *d1, double *d2)
 {
     if (plan_scurve(p) || ncp_kins_active(&p->cfg) || p->cfg.default_linear_acc > 0 ||
         tol->tolerance <= 0 || prev->s.kind != NCP_SEG_LINE || s->kind != NCP_SEG_LINE)
@@ -854,6 +861,9 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
         struct ncp_seg b;
         if (fabs(rho - 1) < 1e-9 || !ncp_blend_corner_ratio(&tol_u, s, rho, &b, &t1, &t2) ||
             t1 > 0.2 * prev->s.length || t2 > 0.2 * s->length)
+            continue;
+        /* beside a moved vertex the lines are not the programmed ones */
+        if (corner && ncp_edge_dev(&b, corner->a, corner->c, corner->b) > tol_u.tolerance)
             continue;
         double v1 = fmin(v_goal, arc_speed(p, &b)) / fmax(1, rho);
         if (v1 <= 0)
@@ -936,14 +946,42 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     if (tol.tolerance > 0)
         tol.tolerance = fmax(0.25 * tol.tolerance, tol.tolerance - p->chord);
     double v_goal = fmin(blend_vmax_any(p, &prev->s), blend_vmax_any(p, s));
-    if (kink_harmless(p, &prev->s, s, v_goal))
+    /* a moved vertex lies off the path: it is always cut off */
+    if (!p->corner.shifted && kink_harmless(p, &prev->s, s, v_goal))
         return 0;
     if (prev->s.kind == NCP_SEG_LINE && s->kind == NCP_SEG_LINE) {
-        if (!size_blend(p, &tol, s, v_goal, &arc.s, &d))
+        double lo = 0, max_trim = INFINITY;
+        struct ncp_seg tol_band = tol;
+        if (p->corner.measured) {
+            /* a line beside the corner left its programmed one (edge.c):
+             * the trims whose blend stays within P of the programmed lines */
+            double hi;
+            if (!ncp_edge_trims(&prev->s, s, &p->corner, tol.tolerance, INFINITY, &lo, &hi))
+                return 0;  /* only where the vertex is on the path (edge_decide) */
+            tol.tolerance = 0;
+            max_trim = hi;
+        } else if (prev->faired != p->pushing_fair && tol.tolerance > 0) {
+            /* between a faired line and one as programmed neither is the
+             * other's band: the blend passes within P of the corner point,
+             * which a parabola within P cos(phi/2) of the lines does */
+            double u1[3], u2[3];
+            for (int i = 0; i < 3; i++) {
+                u1[i] = (prev->s.end[i] - prev->s.start[i]) / prev->s.length;
+                u2[i] = (s->end[i] - s->start[i]) / s->length;
+            }
+            tol.tolerance *= sqrt(fmax(0, 0.5 * (1 + dot3(u1, u2))));
+        }
+        if (!size_blend(p, &tol, s, v_goal, max_trim, &arc.s, &d))
+            return 0;
+        if (d < lo && !ncp_blend_corner(&tol, s, lo, &arc.s, &d))
             return 0;
         double d1 = d, d2 = d;
         struct ncp_seg uneven;
-        if (uneven_blend(p, &tol, prev, s, v_goal, &arc.s, d, &uneven, &d1, &d2))
+        /* uneven where the vertex is programmed, measured where a line
+         * beside it moved */
+        if (!p->corner.shifted &&
+            uneven_blend(p, &tol_band, prev, s, v_goal, &arc.s, d,
+                         p->corner.measured ? &p->corner : NULL, &uneven, &d1, &d2))
             arc.s = uneven;
         prev_out = prev->s;
         prev_out.length -= d1;
@@ -1086,11 +1124,153 @@ static void push_arc(struct ncp_planner *p, const struct ncp_seg *s)
     }
 }
 
-static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
+static void push_now(struct ncp_planner *p, const struct ncp_seg *s)
 {
     struct ncp_seg cur = *s;
     try_blend(p, &cur);
     push_arc(p, &cur);
+}
+
+/* ---- vertices moved out to the band's outer edges (edge.c) ---------------- */
+
+/* A line whose end may move out: a G64 P feed line in X Y Z as programmed
+ * (not faired, not joined by G64 Q), trivial kinematics. */
+static int edge_may_hold(const struct ncp_planner *p, const struct ncp_seg *s)
+{
+    return s->kind == NCP_SEG_LINE && s->term == NCP_TERM_CONTINUOUS && s->tolerance > 0 &&
+           !s->traverse && s->merge_tol <= 0 && s->length > 0 && !p->pushing_fair &&
+           !p->pushing_fit && !ncp_seg_moves_other(s) && !ncp_kins_active(&p->cfg);
+}
+
+/* The blend between the queue's last line and held, with held's end at
+ * `end`, as try_blend will measure it: is there one within P? */
+static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *held,
+                           const double end[3], const struct plan_corner *k)
+{
+    if (!p->count)
+        return 0;
+    const struct ncp_seg *tail = &p->q[(p->head + p->count - 1) % p->cap].s;
+    struct ncp_seg h = *held;
+    memcpy(h.end, end, 3 * sizeof h.end[0]);
+    h.length = dist3(h.start, h.end);
+    double tol = fmax(0.25 * tail->tolerance, tail->tolerance - p->chord), lo, hi;
+    return tail->kind == NCP_SEG_LINE && ncp_edge_trims(tail, &h, k, tol, INFINITY, &lo, &hi);
+}
+
+/* Whether the vertex between held line h and the line cur after it moves
+ * out (k: its programmed points): where the corner holds the speed below
+ * what the lines are blended for, the blend at the moved vertex is within P
+ * and faster, and the blend at h's start still fits with h's end moved.
+ * The blend at the moved vertex is measured here with cur's end where it is
+ * programmed; should cur's end move in turn, that move is made only if this
+ * blend still fits (this same check, one line on), so the vertex is never
+ * left uncut. */
+static void edge_decide(struct ncp_planner *p, struct ncp_seg *h, struct ncp_seg *cur,
+                        struct plan_corner *k)
+{
+    double tol = fmax(0.25 * h->tolerance, h->tolerance - p->chord), moved[3], lo, hi, d;
+    if (h->tolerance != cur->tolerance || !ncp_edge_vertex(k->a, k->c, k->b, tol, moved))
+        return;
+    /* the queue's last line is blended into h: as programmed there, or
+     * measured where it moved too */
+    int start_line = p->count && p->q[(p->head + p->count - 1) % p->cap].s.kind == NCP_SEG_LINE &&
+                     p->q[(p->head + p->count - 1) % p->cap].s.term == NCP_TERM_CONTINUOUS;
+    if (start_line && !p->edge_start.measured && !p->edge_start.shifted &&
+        !p->edge_start.valid)
+        return;
+    double v_goal = fmin(blend_vmax(p, h), blend_vmax(p, cur));
+    struct ncp_seg tl = *h, bl;
+    tl.tolerance = tol;
+    if (!ncp_blend_corner(&tl, cur, 0.5 * h->length, &bl, &d))
+        return;
+    double v_inner = arc_speed(p, &bl);
+    if (v_inner >= v_goal)
+        return;
+    /* where an uneven parabola within the inner half pays (both axes at
+     * their limit), the corner stays: the moved one is run even */
+    struct plan_seg hp;
+    struct ncp_seg uneven;
+    double d1, d2;
+    memset(&hp, 0, sizeof hp);
+    hp.s = *h;
+    if (uneven_blend(p, &tl, &hp, cur, v_goal, &bl, d, NULL, &uneven, &d1, &d2))
+        return;
+    struct ncp_seg h2 = *h, c2 = *cur;
+    memcpy(h2.end, moved, sizeof moved);
+    memcpy(c2.start, moved, sizeof moved);
+    h2.length = dist3(h2.start, h2.end);
+    c2.length = dist3(c2.start, c2.end);
+    if (!ncp_edge_trims(&h2, &c2, k, tol, 0.5 * h2.length - 1e-3, &lo, &hi))
+        return;
+    /* kept where the simple cost of uneven_blend says it is faster */
+    h2.tolerance = 0;
+    double d_out;
+    if (!ncp_blend_corner(&h2, &c2, hi, &bl, &d_out))
+        return;
+    double v_out = fmin(v_goal, arc_speed(p, &bl)), a1 = line_acc(p, h), a2 = line_acc(p, cur);
+    if (corner_cost(h2.length, a1, c2.length, a2, v_inner, v_goal, v_out, v_out, d_out, d_out,
+                    2 * d_out / v_out) >
+        corner_cost(h->length, a1, cur->length, a2, v_inner, v_goal, v_inner, v_inner, d, d,
+                    2 * d / v_inner) - RATIO_GAIN_MIN)
+        return;
+    if (start_line && (p->edge_start.measured || p->edge_start.shifted || p->edge_start.valid)) {
+        struct plan_corner ks = p->edge_start;
+        ks.measured = 1;
+        if (!edge_blend_fits(p, h, moved, &ks))
+            return;
+    }
+    h2.tolerance = h->tolerance;
+    *h = h2;
+    *cur = c2;
+    k->shifted = 1;
+}
+
+/* Queues the held line, its start corner as decided (measured where a line
+ * beside it moved). */
+static void edge_release(struct ncp_planner *p, int end_moved)
+{
+    if (!p->edge_held)
+        return;
+    p->corner = p->edge_start;
+    p->corner.measured = p->corner.valid && (p->corner.shifted || p->corner.measured || end_moved);
+    p->edge_held = 0;
+    push_now(p, &p->edge_line);
+    memset(&p->corner, 0, sizeof p->corner);
+}
+
+static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
+{
+    if (!edge_may_hold(p, s)) {
+        /* a line after a moved one is measured against the programmed lines */
+        int after_moved = p->edge_held && p->edge_start.shifted && s->kind == NCP_SEG_LINE;
+        double a[3];
+        memcpy(a, p->edge_start.c, sizeof a);
+        edge_release(p, 0);
+        if (after_moved) {
+            p->corner.valid = p->corner.measured = 1;
+            memcpy(p->corner.a, a, sizeof a);
+            memcpy(p->corner.c, s->start, sizeof p->corner.c);
+            memcpy(p->corner.b, s->end, sizeof p->corner.b);
+        }
+        push_now(p, s);
+        memset(&p->corner, 0, sizeof p->corner);
+        return;
+    }
+    struct ncp_seg cur = *s;
+    struct plan_corner k;
+    memset(&k, 0, sizeof k);
+    memcpy(k.c, s->start, sizeof k.c);
+    if (p->edge_held) {
+        k.valid = 1;
+        memcpy(k.a, p->edge_start.c, sizeof k.a);
+        memcpy(k.b, s->end, sizeof k.b);
+        edge_decide(p, &p->edge_line, &cur, &k);
+        k.measured = k.shifted || p->edge_start.shifted;
+        edge_release(p, k.shifted);
+    }
+    p->edge_line = cur;
+    p->edge_start = k;
+    p->edge_held = 1;
 }
 
 /* Queues what fairing and arc fitting handed on: a fitted arc runs as a
@@ -1098,10 +1278,13 @@ static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
  * line once however many pieces it became. */
 static void fair_drain(struct ncp_planner *p)
 {
+    if (p->fair_out_n)
+        edge_release(p, 0);
     for (int i = 0; i < p->fair_out_n; i++) {
         p->pushing_fit = (p->fair_out_flags[i] & PLAN_OUT_FITTED) != 0;
+        p->pushing_fair = 1;
         push_line(p, &p->fair_out[i]);
-        p->pushing_fit = 0;
+        p->pushing_fit = p->pushing_fair = 0;
         if (p->fair_out_flags[i] & PLAN_OUT_MORE)
             p->st.segments--;
     }

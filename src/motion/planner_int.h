@@ -23,6 +23,9 @@ struct plan_seg {
     /* an arc fitted through a CAM chain's lines (fit.c): feed path, not a
      * G2/G3, with its own share of the acceleration bound for the turn */
     int fitted;
+    /* a line fairing moved (fair.c): its corner with a line as programmed
+     * is held to the corner point, the band being the programmed lines' */
+    int faired;
 };
 
 /* At most this many programmed lines are joined into one (LinuxCNC's bound). */
@@ -34,6 +37,16 @@ struct plan_seg {
 /* fair_out_flags: a fitted arc; a further piece of the same programmed line */
 #define PLAN_OUT_FITTED 1u
 #define PLAN_OUT_MORE 2u
+
+/* A corner between two lines under G64 P whose vertex may be moved out
+ * (edge.c): the programmed points around it, a before the corner c, b after. */
+struct plan_corner {
+    int valid;               /* a, c, b hold: the corner is between two such lines */
+    int shifted;             /* the vertex runs at the outer edges' meeting point */
+    int measured;            /* a line beside it left the programmed one: the blend
+                              * is sized by measuring it against a, c, b */
+    double a[3], c[3], b[3];
+};
 
 struct ncp_planner {
     struct ncp_machine_cfg cfg;
@@ -73,6 +86,14 @@ struct ncp_planner {
     /* per piece of fair_out: PLAN_OUT_FITTED, PLAN_OUT_MORE */
     uint8_t fair_out_flags[PLAN_FIT_OUT_MAX];
     int pushing_fit;         /* fair_drain is queueing a fitted arc */
+    int pushing_fair;        /* fair_drain is queueing what fairing moved already */
+    /* a G64 P line held back until the next segment shows which way its end
+     * turns (edge.c); the corner at its start as decided when it came */
+    int edge_held;
+    struct ncp_seg edge_line;
+    struct plan_corner edge_start;
+    /* the corner try_blend is blending (measured or shifted: edge.c) */
+    struct plan_corner corner;
     struct ncp_planner_stats st;
 };
 
@@ -132,6 +153,22 @@ void ncp_fair_flush(struct ncp_planner *p);
  * how many lines are done with: the window moves on by that many, its first
  * line partly run when p->fit_half is set. */
 int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush);
+
+/* edge.c: how far the corner parabola blend strays from the programmed
+ * polyline a-c-b at most (sampled, with the chords' bow between samples). */
+double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
+                    const double b[3]);
+/* edge.c: the even blends between prev and cur (trims d up to max_trim and
+ * the lines' share) that stay within tol of k's programmed polyline: the
+ * trims from *lo to *hi. 0 when none does. */
+int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
+                   const struct plan_corner *k, double tol, double max_trim, double *lo,
+                   double *hi);
+/* edge.c: the vertex moved out along the outer bisector of a-c-b to where
+ * the lines' outer edges at distance tol meet. 0 for a turn too slight or
+ * too sharp to gain from it. */
+int ncp_edge_vertex(const double a[3], const double c[3], const double b[3], double tol,
+                    double out[3]);
 
 /* scurve.c: evaluation of a jerk-limited profile (ncp_trap with j > 0). */
 double ncp_scurve_eval(const struct ncp_trap *tp, double t, double *v);

@@ -1,0 +1,140 @@
+/* Corners run on the band's outer edges. G64 P lets the path stray P from
+ * the programmed lines; a blend tangent to the lines themselves can only use
+ * the inner half of that band. Moving the vertex out along the outer
+ * bisector, to where the lines' outer edges (P outside each) meet, lets the
+ * blend start P outside and cut in to P inside: twice the depth, so twice
+ * the trim and sqrt(2) times the speed of the parabola within P of the
+ * lines. The moved line from one vertex to the next stays within P of its
+ * programmed line (both ends are at most P off it, square to it, and a
+ * straight line between them no further), and the vertex itself, outside
+ * the band, is always cut off by a blend that is measured against the
+ * programmed polyline (ncp_edge_trims): the planner holds each such line
+ * back until the next segment shows how its end turns (planner.c). */
+#include "planner_int.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Samples of a blend measured against the programmed polyline. */
+#define EDGE_SAMPLES 48
+/* Trims tried, in steps of 2^(1/4) up to the largest the lines allow, before
+ * the edges of the range within P are bisected: at a moved vertex that range
+ * spans a factor of about 2 (4 P / sin(phi) to 8 P / sin(phi)), however
+ * long the lines, so these steps cannot miss it. */
+#define EDGE_SCAN 64
+#define EDGE_STEP 1.189207115002721
+#define EDGE_BISECT 24
+/* Turns this slight gain little from moving the vertex (the blend is long
+ * already), turns this sharp move it far beyond the corner (1 / cos(phi/2)). */
+#define EDGE_TURN_MIN (5 * M_PI / 180)
+#define EDGE_TURN_MAX (160 * M_PI / 180)
+
+static double polyline_dist(const double q[3], const double a[3], const double c[3],
+                            const double b[3])
+{
+    return fmin(plan_chord_dist(q, a, c, 3), plan_chord_dist(q, c, b, 3));
+}
+
+double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
+                    const double b[3])
+{
+    /* the parabola is the quadratic Bezier start, centre, end: its second
+     * derivative is constant, so a chord of dt bows at most |B''| dt^2 / 8 */
+    double bow = 0, worst = 0;
+    for (int i = 0; i < 3; i++) {
+        double dd = 2 * (blend->start[i] - 2 * blend->center[i] + blend->end[i]);
+        bow += dd * dd;
+    }
+    bow = sqrt(bow) / (8.0 * EDGE_SAMPLES * EDGE_SAMPLES);
+    for (int k = 0; k <= EDGE_SAMPLES; k++) {
+        double t = (double)k / EDGE_SAMPLES, q[3];
+        for (int i = 0; i < 3; i++)
+            q[i] = (1 - t) * (1 - t) * blend->start[i] + 2 * t * (1 - t) * blend->center[i] +
+                   t * t * blend->end[i];
+        worst = fmax(worst, polyline_dist(q, a, c, b));
+    }
+    return worst + bow;
+}
+
+/* The even blend of trim d, measured; INFINITY where there is none. */
+static double dev_at(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
+                     const struct plan_corner *k, double d)
+{
+    struct ncp_seg bl;
+    double got;
+    if (!ncp_blend_corner(free_prev, cur, d, &bl, &got))
+        return INFINITY;
+    return ncp_edge_dev(&bl, k->a, k->c, k->b);
+}
+
+int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
+                   const struct plan_corner *k, double tol, double max_trim, double *lo,
+                   double *hi)
+{
+    /* without P the blend takes what the lines allow: the range to search */
+    struct ncp_seg free_prev = *prev, bl;
+    free_prev.tolerance = 0;
+    double dmax;
+    if (!ncp_blend_corner(&free_prev, cur, max_trim, &bl, &dmax))
+        return 0;
+    /* a blend too short stays near the moved vertex, one too long cuts in
+     * too deep: the trims within tol are one range between them */
+    double trim[EDGE_SCAN + 2];
+    trim[0] = 0;
+    trim[EDGE_SCAN + 1] = dmax * EDGE_STEP;
+    for (int i = 1; i <= EDGE_SCAN; i++)
+        trim[i] = dmax * pow(EDGE_STEP, i - EDGE_SCAN);
+    int first = -1, last = -1;
+    for (int i = 1; i <= EDGE_SCAN; i++) {
+        int ok = dev_at(&free_prev, cur, k, trim[i]) <= tol;
+        if (ok && first < 0)
+            first = i;
+        if (ok)
+            last = i;
+        else if (first >= 0)
+            break;
+    }
+    if (first < 0)
+        return 0;
+    double a = trim[first - 1], b = trim[first];
+    for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
+        double m = 0.5 * (a + b);
+        if (dev_at(&free_prev, cur, k, m) <= tol)
+            b = m;
+        else
+            a = m;
+    }
+    *lo = b;
+    a = trim[last];
+    b = fmin(dmax, trim[last + 1]);
+    for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
+        double m = 0.5 * (a + b);
+        if (dev_at(&free_prev, cur, k, m) <= tol)
+            a = m;
+        else
+            b = m;
+    }
+    *hi = a;
+    return 1;
+}
+
+int ncp_edge_vertex(const double a[3], const double c[3], const double b[3], double tol,
+                    double out[3])
+{
+    double u1[3], u2[3], w[3], l1 = dist3(a, c), l2 = dist3(c, b);
+    if (!(l1 > 0) || !(l2 > 0) || !(tol > 0))
+        return 0;
+    for (int i = 0; i < 3; i++) {
+        u1[i] = (c[i] - a[i]) / l1;
+        u2[i] = (b[i] - c[i]) / l2;
+        w[i] = u1[i] - u2[i];  /* out of the turn */
+    }
+    double cphi = fmax(-1, fmin(1, dot3(u1, u2))), phi = acos(cphi), wl = sqrt(dot3(w, w));
+    if (phi < EDGE_TURN_MIN || phi > EDGE_TURN_MAX || wl <= 0)
+        return 0;
+    /* the outer edges meet tol / cos(phi/2) out along the bisector */
+    double shift = tol / cos(0.5 * phi);
+    for (int i = 0; i < 3; i++)
+        out[i] = c[i] + shift * w[i] / wl;
+    return 1;
+}
