@@ -105,13 +105,13 @@ int ncp_planner_idle(const struct ncp_planner *p)
 static void chain_flush(struct ncp_planner *p);
 static void fair_flush(struct ncp_planner *p);
 
-static void edge_release(struct ncp_planner *p, int end_moved);
+static void edge_release(struct ncp_planner *p);
 
 void ncp_planner_finish(struct ncp_planner *p)
 {
     chain_flush(p);
     fair_flush(p);
-    edge_release(p, 0);
+    edge_release(p);
     p->finished = 1;
 }
 
@@ -131,7 +131,7 @@ void ncp_planner_reset(struct ncp_planner *p, const double pos[NCP_AXES])
     p->chain_n = 0;
     p->fair_n = 0;
     p->fair_out_n = 0;
-    p->edge_held = 0;
+    p->edge_n = 0;
     memset(&p->corner, 0, sizeof p->corner);
     /* the last block's line, machine functions and tool stay what the held
      * samples report */
@@ -1157,16 +1157,16 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *he
     return tail->kind == NCP_SEG_LINE && ncp_edge_trims(tail, &h, k, tol, INFINITY, &lo, &hi);
 }
 
-/* Whether the vertex between held line h and the line cur after it moves
- * out (k: its programmed points): where the corner holds the speed below
- * what the lines are blended for, the blend at the moved vertex is within P
- * and faster, and the blend at h's start still fits with h's end moved.
- * The blend at the moved vertex is measured here with cur's end where it is
+/* Whether the vertex between held lines h and cur moves out (k: its
+ * programmed points): where the corner holds the speed below what the lines
+ * are blended for, the blend at the moved vertex is within P and faster,
+ * and the blend at h's start (k_start) still fits with h's end moved. The
+ * blend at the moved vertex is measured here with cur's end where it is
  * programmed; should cur's end move in turn, that move is made only if this
  * blend still fits (this same check, one line on), so the vertex is never
  * left uncut. */
-static void edge_decide(struct ncp_planner *p, struct ncp_seg *h, struct ncp_seg *cur,
-                        struct plan_corner *k)
+static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start,
+                        struct ncp_seg *h, struct ncp_seg *cur, struct plan_corner *k)
 {
     double tol = fmax(0.25 * h->tolerance, h->tolerance - p->chord), moved[3], lo, hi, d;
     if (h->tolerance != cur->tolerance || !ncp_edge_vertex(k->a, k->c, k->b, tol, moved))
@@ -1175,8 +1175,7 @@ static void edge_decide(struct ncp_planner *p, struct ncp_seg *h, struct ncp_seg
      * measured where it moved too */
     int start_line = p->count && p->q[(p->head + p->count - 1) % p->cap].s.kind == NCP_SEG_LINE &&
                      p->q[(p->head + p->count - 1) % p->cap].s.term == NCP_TERM_CONTINUOUS;
-    if (start_line && !p->edge_start.measured && !p->edge_start.shifted &&
-        !p->edge_start.valid)
+    if (start_line && !k_start->valid)
         return;
     double v_goal = fmin(blend_vmax(p, h), blend_vmax(p, cur));
     struct ncp_seg tl = *h, bl;
@@ -1213,8 +1212,8 @@ static void edge_decide(struct ncp_planner *p, struct ncp_seg *h, struct ncp_seg
         corner_cost(h->length, a1, cur->length, a2, v_inner, v_goal, v_inner, v_inner, d, d,
                     2 * d / v_inner) - RATIO_GAIN_MIN)
         return;
-    if (start_line && (p->edge_start.measured || p->edge_start.shifted || p->edge_start.valid)) {
-        struct plan_corner ks = p->edge_start;
+    if (start_line) {
+        struct plan_corner ks = *k_start;
         ks.measured = 1;
         if (!edge_blend_fits(p, h, moved, &ks))
             return;
@@ -1225,52 +1224,55 @@ static void edge_decide(struct ncp_planner *p, struct ncp_seg *h, struct ncp_seg
     k->shifted = 1;
 }
 
-/* Queues the held line, its start corner as decided (measured where a line
- * beside it moved). */
-static void edge_release(struct ncp_planner *p, int end_moved)
+/* Queues the first held line, its start corner measured where a line beside
+ * it moved (the one before, this one, or the next one: `next_moved`). */
+static void edge_pop(struct ncp_planner *p, int next_moved)
 {
-    if (!p->edge_held)
-        return;
-    p->corner = p->edge_start;
-    p->corner.measured = p->corner.valid && (p->corner.shifted || p->corner.measured || end_moved);
-    p->edge_held = 0;
-    push_now(p, &p->edge_line);
+    p->corner = p->edge_start[0];
+    p->corner.measured = p->corner.valid && (p->corner.shifted || p->corner.measured || next_moved);
+    struct ncp_seg line = p->edge_line[0];
+    if (--p->edge_n) {
+        p->edge_line[0] = p->edge_line[1];
+        p->edge_start[0] = p->edge_start[1];
+        p->edge_start[0].measured |= p->corner.shifted;
+    }
+    push_now(p, &line);
     memset(&p->corner, 0, sizeof p->corner);
+}
+
+/* Queues every held line: the vertex between them stays (the segment after
+ * them is no G64 P line, so the second line's end is no such corner). */
+static void edge_release(struct ncp_planner *p)
+{
+    while (p->edge_n)
+        edge_pop(p, 0);
 }
 
 static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
 {
     if (!edge_may_hold(p, s)) {
-        /* a line after a moved one is measured against the programmed lines */
-        int after_moved = p->edge_held && p->edge_start.shifted && s->kind == NCP_SEG_LINE;
-        double a[3];
-        memcpy(a, p->edge_start.c, sizeof a);
-        edge_release(p, 0);
-        if (after_moved) {
-            p->corner.valid = p->corner.measured = 1;
-            memcpy(p->corner.a, a, sizeof a);
-            memcpy(p->corner.c, s->start, sizeof p->corner.c);
-            memcpy(p->corner.b, s->end, sizeof p->corner.b);
-        }
+        edge_release(p);
         push_now(p, s);
-        memset(&p->corner, 0, sizeof p->corner);
         return;
     }
-    struct ncp_seg cur = *s;
+    if (p->edge_n == 2) {
+        /* the second line's end turns into s, a G64 P line: the vertex
+         * between the held two may move */
+        struct plan_corner *k = &p->edge_start[1];
+        edge_decide(p, &p->edge_start[0], &p->edge_line[0], &p->edge_line[1], k);
+        edge_pop(p, k->shifted);
+    }
     struct plan_corner k;
     memset(&k, 0, sizeof k);
     memcpy(k.c, s->start, sizeof k.c);
-    if (p->edge_held) {
+    if (p->edge_n) {
         k.valid = 1;
-        memcpy(k.a, p->edge_start.c, sizeof k.a);
+        memcpy(k.a, p->edge_start[p->edge_n - 1].c, sizeof k.a);
         memcpy(k.b, s->end, sizeof k.b);
-        edge_decide(p, &p->edge_line, &cur, &k);
-        k.measured = k.shifted || p->edge_start.shifted;
-        edge_release(p, k.shifted);
     }
-    p->edge_line = cur;
-    p->edge_start = k;
-    p->edge_held = 1;
+    p->edge_line[p->edge_n] = *s;
+    p->edge_start[p->edge_n] = k;
+    p->edge_n++;
 }
 
 /* Queues what fairing and arc fitting handed on: a fitted arc runs as a
@@ -1279,7 +1281,7 @@ static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
 static void fair_drain(struct ncp_planner *p)
 {
     if (p->fair_out_n)
-        edge_release(p, 0);
+        edge_release(p);
     for (int i = 0; i < p->fair_out_n; i++) {
         p->pushing_fit = (p->fair_out_flags[i] & PLAN_OUT_FITTED) != 0;
         p->pushing_fair = 1;

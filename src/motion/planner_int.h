@@ -87,11 +87,12 @@ struct ncp_planner {
     uint8_t fair_out_flags[PLAN_FIT_OUT_MAX];
     int pushing_fit;         /* fair_drain is queueing a fitted arc */
     int pushing_fair;        /* fair_drain is queueing what fairing moved already */
-    /* a G64 P line held back until the next segment shows which way its end
-     * turns (edge.c); the corner at its start as decided when it came */
-    int edge_held;
-    struct ncp_seg edge_line;
-    struct plan_corner edge_start;
+    /* G64 P lines held back (edge.c): a vertex between the first two moves
+     * only once the segment after the second shows that the second's end is
+     * a corner between such lines too; the corner at each one's start */
+    int edge_n;
+    struct ncp_seg edge_line[2];
+    struct plan_corner edge_start[2];
     /* the corner try_blend is blending (measured or shifted: edge.c) */
     struct plan_corner corner;
     struct ncp_planner_stats st;
