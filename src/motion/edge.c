@@ -15,8 +15,11 @@
 #include <math.h>
 #include <string.h>
 
-/* Samples of a blend measured against the programmed polyline. */
+/* Pieces of a blend measured against the programmed polyline. */
 #define EDGE_SAMPLES 48
+/* A blend that leaves a moved line runs P from the programmed one exactly:
+ * rounding may not reject it. */
+#define EDGE_ROUND 1e-9
 /* Trims tried, in steps of 2^(1/4) up to the largest the lines allow, before
  * the edges of the range within P are bisected: at a moved vertex that range
  * spans a factor of about 2 (4 P / sin(phi) to 8 P / sin(phi)), however
@@ -29,31 +32,31 @@
 #define EDGE_TURN_MIN (5 * M_PI / 180)
 #define EDGE_TURN_MAX (160 * M_PI / 180)
 
-static double polyline_dist(const double q[3], const double a[3], const double c[3],
-                            const double b[3])
-{
-    return fmin(plan_chord_dist(q, a, c, 3), plan_chord_dist(q, c, b, 3));
-}
-
 double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
                     const double b[3])
 {
-    /* the parabola is the quadratic Bezier start, centre, end: its second
-     * derivative is constant, so a chord of dt bows at most |B''| dt^2 / 8 */
-    double bow = 0, worst = 0;
-    for (int i = 0; i < 3; i++) {
-        double dd = 2 * (blend->start[i] - 2 * blend->center[i] + blend->end[i]);
-        bow += dd * dd;
+    /* the parabola is the quadratic Bezier start, centre, end; each piece
+     * between two samples is one too, inside the triangle of its ends and
+     * the meeting of its end tangents, and the distance to a segment is
+     * convex: so the piece lies within the largest of the three corners'
+     * distances to whichever programmed segment is nearer for all three */
+    double worst = 0, q0[3], q1[3], ctrl[3];
+    for (int k = 0; k < EDGE_SAMPLES; k++) {
+        double t0 = (double)k / EDGE_SAMPLES, t1 = (double)(k + 1) / EDGE_SAMPLES;
+        for (int i = 0; i < 3; i++) {
+            double p0 = blend->start[i], pc = blend->center[i], p1 = blend->end[i];
+            q0[i] = (1 - t0) * (1 - t0) * p0 + 2 * t0 * (1 - t0) * pc + t0 * t0 * p1;
+            q1[i] = (1 - t1) * (1 - t1) * p0 + 2 * t1 * (1 - t1) * pc + t1 * t1 * p1;
+            /* B(t0) + (t1 - t0) / 2 B'(t0) */
+            ctrl[i] = q0[i] + (t1 - t0) * ((1 - t0) * (pc - p0) + t0 * (p1 - pc));
+        }
+        double on_first = fmax(plan_chord_dist(q0, a, c, 3),
+                               fmax(plan_chord_dist(q1, a, c, 3), plan_chord_dist(ctrl, a, c, 3)));
+        double on_second = fmax(plan_chord_dist(q0, c, b, 3),
+                                fmax(plan_chord_dist(q1, c, b, 3), plan_chord_dist(ctrl, c, b, 3)));
+        worst = fmax(worst, fmin(on_first, on_second));
     }
-    bow = sqrt(bow) / (8.0 * EDGE_SAMPLES * EDGE_SAMPLES);
-    for (int k = 0; k <= EDGE_SAMPLES; k++) {
-        double t = (double)k / EDGE_SAMPLES, q[3];
-        for (int i = 0; i < 3; i++)
-            q[i] = (1 - t) * (1 - t) * blend->start[i] + 2 * t * (1 - t) * blend->center[i] +
-                   t * t * blend->end[i];
-        worst = fmax(worst, polyline_dist(q, a, c, b));
-    }
-    return worst + bow;
+    return worst;
 }
 
 /* The even blend of trim d, measured; INFINITY where there is none. */
@@ -86,7 +89,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         trim[i] = dmax * pow(EDGE_STEP, i - EDGE_SCAN);
     int first = -1, last = -1;
     for (int i = 1; i <= EDGE_SCAN; i++) {
-        int ok = dev_at(&free_prev, cur, k, trim[i]) <= tol;
+        int ok = dev_at(&free_prev, cur, k, trim[i]) <= tol + EDGE_ROUND;
         if (ok && first < 0)
             first = i;
         if (ok)
@@ -99,7 +102,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     double a = trim[first - 1], b = trim[first];
     for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
         double m = 0.5 * (a + b);
-        if (dev_at(&free_prev, cur, k, m) <= tol)
+        if (dev_at(&free_prev, cur, k, m) <= tol + EDGE_ROUND)
             b = m;
         else
             a = m;
@@ -109,7 +112,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     b = fmin(dmax, trim[last + 1]);
     for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
         double m = 0.5 * (a + b);
-        if (dev_at(&free_prev, cur, k, m) <= tol)
+        if (dev_at(&free_prev, cur, k, m) <= tol + EDGE_ROUND)
             a = m;
         else
             b = m;
