@@ -108,13 +108,38 @@ static double ratio_depth(double rho, double sin_phi)
     return rho * sin_phi / (q * q);
 }
 
+int ncp_blend_corner_ratio_at(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
+                              double r0, struct ncp_seg *blend, double *trim_prev, double *trim_cur)
+{
+    double d;
+    struct ncp_seg free_prev = *prev;
+    free_prev.tolerance = 0;
+    if (rho <= 0 || !ncp_blend_corner(&free_prev, cur, INFINITY, blend, &d))
+        return 0;
+    /* within the lines as the even blend is */
+    r0 = fmin(r0, fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length / rho));
+    if (r0 < 1e-6)
+        return 0;
+    double u1[3], u2[3];
+    direction(prev, u1);
+    direction(cur, u2);
+    for (int i = 0; i < 3; i++) {
+        blend->start[i] = prev->end[i] - u1[i] * r0;
+        blend->end[i] = prev->end[i] + u2[i] * rho * r0;
+    }
+    blend->tolerance = 0;
+    blend->r0 = r0;
+    blend->r1 = rho * r0;
+    blend->length = blend->r0 + blend->r1;
+    *trim_prev = blend->r0;
+    *trim_cur = blend->r1;
+    return 1;
+}
+
 int ncp_blend_corner_ratio(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
                            struct ncp_seg *blend, double *trim_prev, double *trim_cur)
 {
-    if (prev->tolerance <= 0 || rho <= 0 || rho == 1)
-        return 0;
-    double d;
-    if (!ncp_blend_corner(prev, cur, INFINITY, blend, &d))
+    if (prev->tolerance <= 0 || rho <= 0 || rho == 1 || prev->length <= 0 || cur->length <= 0)
         return 0;
     double u1[3], u2[3];
     direction(prev, u1);
@@ -122,21 +147,9 @@ int ncp_blend_corner_ratio(const struct ncp_seg *prev, const struct ncp_seg *cur
     double reach = ratio_depth(rho, band_sin(u1, u2));
     if (!(reach > 0))
         return 0;
-    /* the largest r0 within P, and within the lines as the even blend is */
-    double r0 = fmin(prev->tolerance / reach,
-                     fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length / rho));
-    if (r0 < 1e-6)
-        return 0;
-    for (int i = 0; i < 3; i++) {
-        blend->start[i] = prev->end[i] - u1[i] * r0;
-        blend->end[i] = prev->end[i] + u2[i] * rho * r0;
-    }
-    blend->r0 = r0;
-    blend->r1 = rho * r0;
-    blend->length = blend->r0 + blend->r1;
-    *trim_prev = blend->r0;
-    *trim_cur = blend->r1;
-    return 1;
+    /* the largest r0 within P */
+    return ncp_blend_corner_ratio_at(prev, cur, rho, prev->tolerance / reach, blend, trim_prev,
+                                     trim_cur);
 }
 
 /* The same segment run backwards (lines, and arcs without axial travel). */

@@ -59,26 +59,28 @@ double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double
     return worst;
 }
 
-/* The even blend of trim d, measured; INFINITY where there is none. */
+/* The blend of trim d (rho d off cur), measured; INFINITY where there is none. */
 static double dev_at(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
-                     const struct plan_corner *k, double d)
+                     const struct plan_corner *k, double rho, double d)
 {
     struct ncp_seg bl;
-    double got;
-    if (!ncp_blend_corner(free_prev, cur, d, &bl, &got))
+    double got, got_cur;
+    if (rho == 1 ? !ncp_blend_corner(free_prev, cur, d, &bl, &got)
+                 : !ncp_blend_corner_ratio_at(free_prev, cur, rho, d, &bl, &got, &got_cur))
         return INFINITY;
     return ncp_edge_dev(&bl, k->a, k->c, k->b);
 }
 
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
-                   const struct plan_corner *k, double tol, double max_trim, double *lo,
-                   double *hi)
+                   const struct plan_corner *k, double tol, double rho, double max_trim,
+                   double *lo, double *hi)
 {
     /* without P the blend takes what the lines allow: the range to search */
     struct ncp_seg free_prev = *prev, bl;
     free_prev.tolerance = 0;
-    double dmax;
-    if (!ncp_blend_corner(&free_prev, cur, max_trim, &bl, &dmax))
+    double dmax, got_cur;
+    if (rho == 1 ? !ncp_blend_corner(&free_prev, cur, max_trim, &bl, &dmax)
+                 : !ncp_blend_corner_ratio_at(&free_prev, cur, rho, max_trim, &bl, &dmax, &got_cur))
         return 0;
     /* a blend too short stays near the moved vertex, one too long cuts in
      * too deep: the trims within tol are one range between them */
@@ -89,7 +91,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         trim[i] = dmax * pow(EDGE_STEP, i - EDGE_SCAN);
     int first = -1, last = -1;
     for (int i = 1; i <= EDGE_SCAN; i++) {
-        int ok = dev_at(&free_prev, cur, k, trim[i]) <= tol + EDGE_ROUND;
+        int ok = dev_at(&free_prev, cur, k, rho, trim[i]) <= tol + EDGE_ROUND;
         if (ok && first < 0)
             first = i;
         if (ok)
@@ -102,7 +104,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     double a = trim[first - 1], b = trim[first];
     for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
         double m = 0.5 * (a + b);
-        if (dev_at(&free_prev, cur, k, m) <= tol + EDGE_ROUND)
+        if (dev_at(&free_prev, cur, k, rho, m) <= tol + EDGE_ROUND)
             b = m;
         else
             a = m;
@@ -112,7 +114,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     b = fmin(dmax, trim[last + 1]);
     for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
         double m = 0.5 * (a + b);
-        if (dev_at(&free_prev, cur, k, m) <= tol + EDGE_ROUND)
+        if (dev_at(&free_prev, cur, k, rho, m) <= tol + EDGE_ROUND)
             a = m;
         else
             b = m;

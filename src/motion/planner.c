@@ -838,8 +838,9 @@ static double corner_cost(double len1, double a1, double len2, double a2, double
 static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
                         const struct plan_seg *prev, const struct ncp_seg *s, double v_goal,
                         const struct ncp_seg *even, double d, const struct plan_corner *corner,
-                        struct ncp_seg *out, double *d1, double *d2)
+                        double v_n, double *cost, struct ncp_seg *out, double *d1, double *d2)
 {
+    *cost = INFINITY;
     if (plan_scurve(p) || ncp_kins_active(&p->cfg) || p->cfg.default_linear_acc > 0 ||
         tol->tolerance <= 0 || prev->s.kind != NCP_SEG_LINE || s->kind != NCP_SEG_LINE)
         return 0;
@@ -850,27 +851,38 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
     double v_even = fmin(v_goal, arc_speed(p, even));
     if (v_even >= v_goal * (1 - 1e-9) || v_even <= 0)
         return 0;
+    if (v_n <= 0)
+        v_n = v_even;
     double a1 = line_acc(p, &prev->s), a2 = line_acc(p, s);
     double len1 = prev->s.length, len2 = s->length;
     struct ncp_seg tol_u = *tol;
     tol_u.tolerance -= fmax(0, p->chord_all - p->chord);
-    double best = corner_cost(len1, a1, len2, a2, v_even, v_goal, v_even, v_even, d, d, 2 * d / v_even);
-    int found = 0;
+    double best = corner_cost(len1, a1, len2, a2, v_n, v_goal, v_even, v_even, d, d, 2 * d / v_even);
+    *cost = best;
+    int found = 0, moved = corner && corner->shifted;
     for (int k = 0; k <= RATIO_STEPS; k++) {
-        double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2;
+        double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2, lo, hi;
         struct ncp_seg b;
-        if (fabs(rho - 1) < 1e-9 || !ncp_blend_corner_ratio(&tol_u, s, rho, &b, &t1, &t2) ||
-            t1 > 0.2 * prev->s.length || t2 > 0.2 * s->length)
+        if (fabs(rho - 1) < 1e-9)
+            continue;
+        /* at a moved vertex: the largest blend measured within P of the
+         * programmed lines; elsewhere the largest within P of the lines */
+        if (moved ? !ncp_edge_trims(&prev->s, s, corner, tol_u.tolerance, rho,
+                                    fmin(0.2 * len1, 0.2 * len2 / rho), &lo, &hi) ||
+                        !ncp_blend_corner_ratio_at(&prev->s, s, rho, hi, &b, &t1, &t2)
+                  : !ncp_blend_corner_ratio(&tol_u, s, rho, &b, &t1, &t2))
+            continue;
+        if (t1 > 0.2 * len1 + 1e-12 || t2 > 0.2 * len2 + 1e-12)
             continue;
         /* beside a moved vertex the lines are not the programmed ones */
-        if (corner && ncp_edge_dev(&b, corner->a, corner->c, corner->b) > tol_u.tolerance)
+        if (corner && !moved && ncp_edge_dev(&b, corner->a, corner->c, corner->b) > tol_u.tolerance)
             continue;
         double v1 = fmin(v_goal, arc_speed(p, &b)) / fmax(1, rho);
         if (v1 <= 0)
             continue;
-        double c = corner_cost(len1, a1, len2, a2, v_even, v_goal, v1, rho * v1, t1, t2, 2 * t1 / v1);
+        double c = corner_cost(len1, a1, len2, a2, v_n, v_goal, v1, rho * v1, t1, t2, 2 * t1 / v1);
         if (c < best - RATIO_GAIN_MIN) {
-            best = c;
+            best = *cost = c;
             *out = b;
             *d1 = t1;
             *d2 = t2;
@@ -956,7 +968,7 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
             /* a line beside the corner left its programmed one (edge.c):
              * the trims whose blend stays within P of the programmed lines */
             double hi;
-            if (!ncp_edge_trims(&prev->s, s, &p->corner, tol.tolerance, INFINITY, &lo, &hi))
+            if (!ncp_edge_trims(&prev->s, s, &p->corner, tol.tolerance, 1, INFINITY, &lo, &hi))
                 return 0;  /* only where the vertex is on the path (edge_decide) */
             tol.tolerance = 0;
             max_trim = hi;
@@ -977,11 +989,10 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
             return 0;
         double d1 = d, d2 = d;
         struct ncp_seg uneven;
-        /* uneven where the vertex is programmed, measured where a line
-         * beside it moved */
-        if (!p->corner.shifted &&
-            uneven_blend(p, &tol_band, prev, s, v_goal, &arc.s, d,
-                         p->corner.measured ? &p->corner : NULL, &uneven, &d1, &d2))
+        /* uneven ones measured where a line beside the corner moved */
+        double cost;
+        if (uneven_blend(p, &tol_band, prev, s, v_goal, &arc.s, d,
+                         p->corner.measured ? &p->corner : NULL, 0, &cost, &uneven, &d1, &d2))
             arc.s = uneven;
         prev_out = prev->s;
         prev_out.length -= d1;
@@ -1154,7 +1165,7 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *he
     memcpy(h.end, end, 3 * sizeof h.end[0]);
     h.length = dist3(h.start, h.end);
     double tol = fmax(0.25 * tail->tolerance, tail->tolerance - p->chord), lo, hi;
-    return tail->kind == NCP_SEG_LINE && ncp_edge_trims(tail, &h, k, tol, INFINITY, &lo, &hi);
+    return tail->kind == NCP_SEG_LINE && ncp_edge_trims(tail, &h, k, tol, 1, INFINITY, &lo, &hi);
 }
 
 /* Whether the vertex between held lines h and cur moves out (k: its
@@ -1185,32 +1196,38 @@ static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start
     double v_inner = arc_speed(p, &bl);
     if (v_inner >= v_goal)
         return;
-    /* where an uneven parabola within the inner half pays (both axes at
-     * their limit), the corner stays: the moved one is run even */
+    /* the fastest corner with the vertex where it is (even or uneven) and
+     * moved (the same), by the simple cost of uneven_blend, the corner's
+     * even speed standing for its neighbours' in both */
     struct plan_seg hp;
     struct ncp_seg uneven;
-    double d1, d2;
+    double d1, d2, cost_in, cost_out;
     memset(&hp, 0, sizeof hp);
     hp.s = *h;
-    if (uneven_blend(p, &tl, &hp, cur, v_goal, &bl, d, NULL, &uneven, &d1, &d2))
-        return;
+    double a1 = line_acc(p, h), a2 = line_acc(p, cur);
+    if (!uneven_blend(p, &tl, &hp, cur, v_goal, &bl, d, NULL, v_inner, &cost_in, &uneven, &d1, &d2))
+        cost_in = corner_cost(h->length, a1, cur->length, a2, v_inner, v_goal, v_inner, v_inner, d,
+                              d, 2 * d / v_inner);
     struct ncp_seg h2 = *h, c2 = *cur;
     memcpy(h2.end, moved, sizeof moved);
     memcpy(c2.start, moved, sizeof moved);
     h2.length = dist3(h2.start, h2.end);
     c2.length = dist3(c2.start, c2.end);
-    if (!ncp_edge_trims(&h2, &c2, k, tol, 0.5 * h2.length - 1e-3, &lo, &hi))
-        return;
-    /* kept where the simple cost of uneven_blend says it is faster */
-    h2.tolerance = 0;
+    struct ncp_seg free_h2 = h2;
+    free_h2.tolerance = 0;
     double d_out;
-    if (!ncp_blend_corner(&h2, &c2, hi, &bl, &d_out))
+    if (!ncp_edge_trims(&h2, &c2, k, tol, 1, 0.5 * h2.length - 1e-3, &lo, &hi) ||
+        !ncp_blend_corner(&free_h2, &c2, hi, &bl, &d_out))
         return;
-    double v_out = fmin(v_goal, arc_speed(p, &bl)), a1 = line_acc(p, h), a2 = line_acc(p, cur);
-    if (corner_cost(h2.length, a1, c2.length, a2, v_inner, v_goal, v_out, v_out, d_out, d_out,
-                    2 * d_out / v_out) >
-        corner_cost(h->length, a1, cur->length, a2, v_inner, v_goal, v_inner, v_inner, d, d,
-                    2 * d / v_inner) - RATIO_GAIN_MIN)
+    double v_out = fmin(v_goal, arc_speed(p, &bl));
+    struct plan_corner km = *k;
+    km.shifted = 1;
+    hp.s = h2;
+    if (!uneven_blend(p, &tl, &hp, &c2, v_goal, &bl, d_out, &km, v_inner, &cost_out, &uneven, &d1,
+                      &d2))
+        cost_out = corner_cost(h2.length, a1, c2.length, a2, v_inner, v_goal, v_out, v_out, d_out,
+                               d_out, 2 * d_out / v_out);
+    if (cost_out > cost_in - RATIO_GAIN_MIN)
         return;
     if (start_line) {
         struct plan_corner ks = *k_start;

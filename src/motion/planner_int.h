@@ -159,12 +159,13 @@ int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush);
  * polyline a-c-b at most (sampled, with the chords' bow between samples). */
 double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
                     const double b[3]);
-/* edge.c: the even blends between prev and cur (trims d up to max_trim and
- * the lines' share) that stay within tol of k's programmed polyline: the
- * trims from *lo to *hi. 0 when none does. */
+/* edge.c: the blends between prev and cur, even (rho 1) or uneven (trim d
+ * off prev, rho d off cur), d up to max_trim and the lines' share, that stay
+ * within tol of k's programmed polyline: d from *lo to *hi. 0 when none
+ * does. */
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
-                   const struct plan_corner *k, double tol, double max_trim, double *lo,
-                   double *hi);
+                   const struct plan_corner *k, double tol, double rho, double max_trim,
+                   double *lo, double *hi);
 /* edge.c: the vertex moved out along the outer bisector of a-c-b to where
  * the lines' outer edges at distance tol meet. 0 for a turn too slight or
  * too sharp to gain from it. */
@@ -221,6 +222,11 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
  * lengths trimmed off prev's end and cur's start. 0 when not possible (no P). */
 int ncp_blend_corner_ratio(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
                            struct ncp_seg *blend, double *trim_prev, double *trim_cur);
+
+/* blend.c: the same with the trim off prev given (r0; rho r0 off cur), as
+ * far as the lines allow, whatever P says. */
+int ncp_blend_corner_ratio_at(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
+                              double r0, struct ncp_seg *blend, double *trim_prev, double *trim_cur);
 
 /* blend.c: the same where one side is an arc in a plane and the other a line
  * in it: the arc gives up arc_trim of its length, the line what the blend

@@ -375,6 +375,60 @@ static void test_corners_use_the_outer_edges(void **state)
     free(r);
 }
 
+#define HEX_SIDES 12
+
+/* Two turns round a hexagon of 5 mm sides from a rapid's end, P0.01: every
+ * corner turns 60 degrees, so the even parabola loads one axis more than
+ * the other and an uneven one pays (test_uneven_corner_loads_both_axes);
+ * with the vertex moved out as well (test_corners_use_the_outer_edges) the
+ * uneven blend is sized by measuring it against the programmed lines. The
+ * run must take at most 1.620 s of machine time: 1.638 when a moved vertex
+ * could only be run even (so none moved: the uneven blend at the
+ * programmed vertex paid more), 1.602 with both; every sample within P of the
+ * lines, the trace outside the programmed lines by at least P/2 near some
+ * corner (a vertex moved), every axis within its limits. */
+static void test_uneven_corners_at_moved_vertices(void **state)
+{
+    (void)state;
+    static double pts[HEX_SIDES + 1][2];
+    char prog[1024];
+    int len = snprintf(prog, sizeof prog, "G21 G90 G17 G64 P0.01 Q0\nG0 X0 Y0\nG1 F3000\n");
+    for (int i = 1; i <= HEX_SIDES; i++) {
+        double ang = (i - 1) * M_PI / 3;
+        pts[i][0] = pts[i - 1][0] + 5 * cos(ang);
+        pts[i][1] = pts[i - 1][1] + 5 * sin(ang);
+        len += snprintf(prog + len, sizeof prog - (size_t)len, "G1 X%.6f Y%.6f\n", pts[i][0],
+                        pts[i][1]);
+    }
+    snprintf(prog + len, sizeof prog - (size_t)len, "M2\n");
+    struct ncp_machine_cfg cfg;
+    lcnc_like_cfg(&cfg);
+    struct ncp_nck_result res;
+    size_t n;
+    struct row *r = run_text(prog, &cfg, &n, &res);
+    const double T = cfg.servo_period;
+    double dev = 0, outside = 0;
+    for (size_t k = 0; k < n; k++) {
+        dev = fmax(dev, dist_polyline(r[k].cmd, (const double(*)[2])pts, HEX_SIDES + 1));
+        /* the hexagon turns left: outside is to the right of each side */
+        for (int i = 1; i < HEX_SIDES; i++) {
+            double ux = pts[i][0] - pts[i - 1][0], uy = pts[i][1] - pts[i - 1][1];
+            double dx = r[k].cmd[0] - pts[i][0], dy = r[k].cmd[1] - pts[i][1];
+            if (hypot(dx, dy) < 0.3 && dx * ux + dy * uy < 0)
+                outside = fmax(outside, -(ux * dy - uy * dx) / 5);
+        }
+    }
+    double w = worst_acc(r, n, T), t = res.program_time;
+    if (t > 1.620 + 1e-9 || dev > 0.01 + 1e-6 || outside < 0.005 || w > 1 + 1e-9)
+        fail_msg("hexagon: %.3f s (want at most 1.620), %.5f mm off the path (P 0.01), at most "
+                 "%.5f mm outside a side before its corner (want a moved vertex: 0.005), axis "
+                 "acceleration %.4f of the limit",
+                 t, dev, outside, w);
+    print_message("hexagon: %.3f s, %.5f mm off the path, %.5f mm outside before a corner\n", t,
+                  dev, outside);
+    free(r);
+}
+
 static void test_corner_faster_than_circle_within_p(void **state)
 {
     (void)state;
@@ -392,6 +446,7 @@ int main(void)
         cmocka_unit_test(test_corner_faster_than_circle_within_p),
         cmocka_unit_test(test_uneven_corner_loads_both_axes),
         cmocka_unit_test(test_corners_use_the_outer_edges),
+        cmocka_unit_test(test_uneven_corners_at_moved_vertices),
         cmocka_unit_test(test_arc_line_corner_is_a_parabola),
         cmocka_unit_test(test_arc_line_corner_turning_with_the_arc),
     };
