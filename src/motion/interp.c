@@ -88,6 +88,7 @@ void ncp_planner_set_tap(struct ncp_planner *p,
 int ncp_planner_step(struct ncp_planner *p, struct ncp_setpoint *out)
 {
     const struct ncp_exec_source src = { head_record, head_done, p };
+    ncp_planner_edge_low(p);
     int more = ncp_exec_step(&p->ex, &src, out);
     if (out->flags & NCP_SP_STARVED)
         p->st.starved++;

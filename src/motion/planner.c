@@ -87,9 +87,12 @@ void ncp_planner_free(struct ncp_planner *p)
 int ncp_planner_full(const struct ncp_planner *p)
 {
     /* a push may add a blend arc too; blends do not count against the window,
-     * a chain of lines held back for G64 Q counts as the one it will become */
-    return p->programmed + (p->chain_n > 0) + (size_t)p->fair_n >= (size_t)p->cfg.lookahead ||
-           p->count + 2 > p->cap;
+     * a chain of lines held back for G64 Q counts as the one it will become,
+     * lines held back for a moved vertex as themselves (a push may queue
+     * them, with their blends) */
+    return p->programmed + (p->chain_n > 0) + (size_t)p->fair_n + (size_t)p->edge_n >=
+               (size_t)p->cfg.lookahead ||
+           p->count + 2 + 2 * (size_t)p->edge_n > p->cap;
 }
 
 size_t ncp_planner_queued(const struct ncp_planner *p)
@@ -835,6 +838,7 @@ static double corner_cost(double len1, double a1, double len2, double a2, double
 /* what an uneven blend must save by the cost, s: where both are about as fast
  * (a corner between two axes, already at the per-axis floor) the even one stays */
 #define RATIO_GAIN_MIN 1e-4
+#define RATIO_MOVED_EVERY 2
 static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
                         const struct plan_seg *prev, const struct ncp_seg *s, double v_goal,
                         const struct ncp_seg *even, double d, const struct plan_corner *corner,
@@ -863,7 +867,8 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
     for (int k = 0; k <= RATIO_STEPS; k++) {
         double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2, lo, hi;
         struct ncp_seg b;
-        if (fabs(rho - 1) < 1e-9)
+        /* at a moved vertex each ratio is a search: every third one */
+        if (fabs(rho - 1) < 1e-9 || (moved && k % RATIO_MOVED_EVERY))
             continue;
         /* at a moved vertex: the largest blend measured within P of the
          * programmed lines; elsewhere the largest within P of the lines */
@@ -1263,6 +1268,19 @@ static void edge_release(struct ncp_planner *p)
 {
     while (p->edge_n)
         edge_pop(p, 0);
+}
+
+/* The queue left to run before the held lines would be needed: below it
+ * they go (their ends as programmed) rather than wait for what comes next,
+ * so a moved vertex is always cut off by its blend while the line before it
+ * is not yet running (try_blend blends no running tail). A virtual clock
+ * steps with a full window, so only a starved real-time run gets here. */
+#define EDGE_RELEASE_QUEUED 3
+
+void ncp_planner_edge_low(struct ncp_planner *p)
+{
+    if (p->edge_n && p->count <= EDGE_RELEASE_QUEUED)
+        edge_release(p);
 }
 
 static void push_line(struct ncp_planner *p, const struct ncp_seg *s)

@@ -155,6 +155,10 @@ void ncp_fair_flush(struct ncp_planner *p);
  * line partly run when p->fit_half is set. */
 int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush);
 
+/* planner.c: queues the lines held back for a moved vertex when little is
+ * left to run (before each step). */
+void ncp_planner_edge_low(struct ncp_planner *p);
+
 /* edge.c: how far the corner parabola blend strays from the programmed
  * polyline a-c-b at most (sampled, with the chords' bow between samples). */
 double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
