@@ -53,13 +53,10 @@ int ncp_blend_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, doub
     double u1[3], u2[3];
     direction(prev, u1);
     direction(cur, u2);
-    double c = dot3(u1, u2), du = 0;
+    double c = dot3(u1, u2);
     /* collinear needs no blend; a near reversal would need a vanishing radius */
     if (c > 1 - 1e-12 || c < -0.999)
         return 0;
-    for (int i = 0; i < 3; i++)
-        du += (u2[i] - u1[i]) * (u2[i] - u1[i]);
-    du = sqrt(du);
     /* prev's start is settled by the corner before: what is left of it may
      * all go to this corner (a micrometre stays, so its direction stays
      * exact); cur keeps half for the corner after */

@@ -133,17 +133,17 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     trim[EDGE_SCAN + 1] = dmax;
     for (int i = 1; i <= EDGE_SCAN; i++)
         trim[i] = reach * pow(EDGE_STEP, i - EDGE_SCAN);
-    int first = -1, last = -1;
+    int first = 0, last = 0;
     for (int i = 1; i <= EDGE_SCAN; i++) {
         int ok = dev_at(&free_prev, cur, k, rho, trim[i]) <= tol + EDGE_ROUND;
-        if (ok && first < 0)
+        if (ok && !first)
             first = i;
         if (ok)
             last = i;
-        else if (first >= 0)
+        else if (first)
             break;
     }
-    if (first < 0)
+    if (first < 1 || last < first)
         return 0;
     double a = trim[first - 1], b = trim[first];
     for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
