@@ -57,8 +57,11 @@ Every estimate is taken on the generous side, so the bound stays a bound:
   corners. The saving: a path within P from a point of the first line to a
   point of the second crosses the bisector no further in than I, so it is
   at most 2 P tan(phi / 2) shorter than the lines (and at most twice the
-  shorter line). Our parabolic blend (per axis v^2 <= 8 P amax_i /
-  (|u2 - u1| |u2_i - u1_i|)) stays below;
+  shorter line). Our parabolic blend stays below: within P of the lines
+  per axis v^2 <= 8 P amax_i / (sin(phi) |u2_i - u1_i|), with its vertex moved
+  out to the outer edges' meeting twice that, and sin(phi) |u2 - u1| =
+  |u2 - u1|^2 cos(phi / 2) with |u2 - u1|^2 <= max_i |u2_i - u1_i| times
+  sum_i |u2_i - u1_i| keeps it under the turn at A_w;
 - the machine starts and ends at rest; in between the fastest profile that
   these bounds allow (forward and backward passes over the junction speeds,
   then a trapezoid on each segment).
