@@ -321,6 +321,22 @@ static void test_arc_line_corner_turning_with_the_arc(void **state)
     }
 }
 
+/* Runs the polyline pts[0..m-1] under G64 P0.01 at F3000 from a rapid to
+ * its first point, on LinuxCNC-like limits. */
+static struct row *run_polyline(const double (*pts)[2], int m, struct ncp_machine_cfg *cfg,
+                                struct ncp_nck_result *res, size_t *n)
+{
+    char prog[2048];
+    int len = snprintf(prog, sizeof prog, "G21 G90 G17 G64 P0.01 Q0\nG0 X%.6f Y%.6f\nG1 F3000\n",
+                       pts[0][0], pts[0][1]);
+    for (int i = 1; i < m && len < (int)sizeof prog - 64; i++)
+        len += snprintf(prog + len, sizeof prog - (size_t)len, "G1 X%.6f Y%.6f\n", pts[i][0],
+                        pts[i][1]);
+    snprintf(prog + len, sizeof prog - (size_t)len, "M2\n");
+    lcnc_like_cfg(cfg);
+    return run_text(prog, cfg, n, res);
+}
+
 #define STEPS 12
 
 /* Stairs: 3 mm steps along X and Y in turn from a rapid's end, P0.01, every
@@ -337,21 +353,14 @@ static void test_corners_use_the_outer_edges(void **state)
 {
     (void)state;
     static double pts[STEPS + 1][2];
-    char prog[1024];
-    int len = snprintf(prog, sizeof prog, "G21 G90 G17 G64 P0.01 Q0\nG0 X0 Y0\nG1 F3000\n");
     for (int i = 0; i <= STEPS; i++) {
         pts[i][0] = 3.0 * ((i + 1) / 2);
         pts[i][1] = 3.0 * (i / 2);
-        if (i > 0)
-            len += snprintf(prog + len, sizeof prog - (size_t)len, "G1 X%.1f Y%.1f\n", pts[i][0],
-                            pts[i][1]);
     }
-    snprintf(prog + len, sizeof prog - (size_t)len, "M2\n");
     struct ncp_machine_cfg cfg;
-    lcnc_like_cfg(&cfg);
     struct ncp_nck_result res;
     size_t n;
-    struct row *r = run_text(prog, &cfg, &n, &res);
+    struct row *r = run_polyline((const double(*)[2])pts, STEPS + 1, &cfg, &res, &n);
     const double T = cfg.servo_period, P = 0.01 - 0.3 * AMAX * T * T;
     const double v_dip = sqrt(2) * sqrt(8 * P * AMAX) * cos(M_PI / 4);
     double dev = 0, pass = 0, v_slow = INFINITY;
@@ -391,21 +400,15 @@ static void test_uneven_corners_at_moved_vertices(void **state)
 {
     (void)state;
     static double pts[HEX_SIDES + 1][2];
-    char prog[1024];
-    int len = snprintf(prog, sizeof prog, "G21 G90 G17 G64 P0.01 Q0\nG0 X0 Y0\nG1 F3000\n");
     for (int i = 1; i <= HEX_SIDES; i++) {
         double ang = (i - 1) * M_PI / 3;
         pts[i][0] = pts[i - 1][0] + 5 * cos(ang);
         pts[i][1] = pts[i - 1][1] + 5 * sin(ang);
-        len += snprintf(prog + len, sizeof prog - (size_t)len, "G1 X%.6f Y%.6f\n", pts[i][0],
-                        pts[i][1]);
     }
-    snprintf(prog + len, sizeof prog - (size_t)len, "M2\n");
     struct ncp_machine_cfg cfg;
-    lcnc_like_cfg(&cfg);
     struct ncp_nck_result res;
     size_t n;
-    struct row *r = run_text(prog, &cfg, &n, &res);
+    struct row *r = run_polyline((const double(*)[2])pts, HEX_SIDES + 1, &cfg, &res, &n);
     const double T = cfg.servo_period;
     double dev = 0, outside = 0;
     for (size_t k = 0; k < n; k++) {
