@@ -51,10 +51,21 @@ static void seg_init(struct edge_seg *g, const double a[3], const double b[3])
     }
 }
 
+/* fmin and fmax are calls here (NaN rules); these are not */
+static inline double lesser(double x, double y)
+{
+    return x < y ? x : y;
+}
+
+static inline double greater(double x, double y)
+{
+    return x > y ? x : y;
+}
+
 static double seg_dist2(const struct edge_seg *g, const double q[3])
 {
     double w[3] = { q[0] - g->a[0], q[1] - g->a[1], q[2] - g->a[2] };
-    double t = g->dd > 0 ? fmin(1, fmax(0, dot3(w, g->d) / g->dd)) : 0, e = 0;
+    double t = g->dd > 0 ? lesser(1, greater(0, dot3(w, g->d) / g->dd)) : 0, e = 0;
     for (int i = 0; i < 3; i++) {
         double c = w[i] - t * g->d[i];
         e += c * c;
@@ -63,7 +74,7 @@ static double seg_dist2(const struct edge_seg *g, const double q[3])
 }
 
 double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
-                    const double b[3])
+                    const double b[3], double limit)
 {
     /* the parabola is the quadratic Bezier start, centre, end; each piece
      * between two samples is one too, inside the triangle of its ends and
@@ -86,9 +97,11 @@ double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double
             ctrl[i] = q0[i] + (t1 - t0) * ((1 - t0) * (pc - p0) + t0 * (p1 - pc));
         }
         double first1 = seg_dist2(&g1, q1), second1 = seg_dist2(&g2, q1);
-        double on_first = fmax(first0, fmax(first1, seg_dist2(&g1, ctrl)));
-        double on_second = fmax(second0, fmax(second1, seg_dist2(&g2, ctrl)));
-        worst = fmax(worst, fmin(on_first, on_second));
+        double on_first = greater(first0, greater(first1, seg_dist2(&g1, ctrl)));
+        double on_second = greater(second0, greater(second1, seg_dist2(&g2, ctrl)));
+        worst = greater(worst, lesser(on_first, on_second));
+        if (worst > limit * limit)
+            break;  /* beyond what the caller asks about: no need to know how far */
         memcpy(q0, q1, sizeof q0);
         first0 = first1;
         second0 = second1;
@@ -98,14 +111,14 @@ double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double
 
 /* The blend of trim d (rho d off cur), measured; INFINITY where there is none. */
 static double dev_at(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
-                     const struct plan_corner *k, double rho, double d)
+                     const struct plan_corner *k, double rho, double d, double limit)
 {
     struct ncp_seg bl;
     double got, got_cur;
     if (rho == 1 ? !ncp_blend_corner(free_prev, cur, d, &bl, &got)
                  : !ncp_blend_corner_ratio_at(free_prev, cur, rho, d, &bl, &got, &got_cur))
         return INFINITY;
-    return ncp_edge_dev(&bl, k->a, k->c, k->b);
+    return ncp_edge_dev(&bl, k->a, k->c, k->b, limit);
 }
 
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
@@ -135,7 +148,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         trim[i] = reach * pow(EDGE_STEP, i - EDGE_SCAN);
     int first = 0, last = 0;
     for (int i = 1; i <= EDGE_SCAN; i++) {
-        int ok = dev_at(&free_prev, cur, k, rho, trim[i]) <= tol + EDGE_ROUND;
+        int ok = dev_at(&free_prev, cur, k, rho, trim[i], tol + EDGE_ROUND) <= tol + EDGE_ROUND;
         if (ok && !first)
             first = i;
         if (ok)
@@ -148,7 +161,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     double a = trim[first - 1], b = trim[first];
     for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
         double m = 0.5 * (a + b);
-        if (dev_at(&free_prev, cur, k, rho, m) <= tol + EDGE_ROUND)
+        if (dev_at(&free_prev, cur, k, rho, m, tol + EDGE_ROUND) <= tol + EDGE_ROUND)
             b = m;
         else
             a = m;
@@ -158,7 +171,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     b = fmin(dmax, trim[last + 1]);
     for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
         double m = 0.5 * (a + b);
-        if (dev_at(&free_prev, cur, k, rho, m) <= tol + EDGE_ROUND)
+        if (dev_at(&free_prev, cur, k, rho, m, tol + EDGE_ROUND) <= tol + EDGE_ROUND)
             a = m;
         else
             b = m;

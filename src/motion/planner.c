@@ -880,7 +880,8 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
         if (t1 > 0.2 * len1 + 1e-12 || t2 > 0.2 * len2 + 1e-12)
             continue;
         /* beside a moved vertex the lines are not the programmed ones */
-        if (corner && !moved && ncp_edge_dev(&b, corner->a, corner->c, corner->b) > tol_u.tolerance)
+        if (corner && !moved &&
+            ncp_edge_dev(&b, corner->a, corner->c, corner->b, tol_u.tolerance) > tol_u.tolerance)
             continue;
         double v1 = fmin(v_goal, arc_speed(p, &b)) / fmax(1, rho);
         if (v1 <= 0)

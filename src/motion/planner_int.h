@@ -160,9 +160,9 @@ int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush);
 void ncp_planner_edge_low(struct ncp_planner *p);
 
 /* edge.c: how far the corner parabola blend strays from the programmed
- * polyline a-c-b at most (sampled, with the chords' bow between samples). */
+ * polyline a-c-b at most; once that is beyond limit, some value beyond it. */
 double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
-                    const double b[3]);
+                    const double b[3], double limit);
 /* edge.c: the blends between prev and cur, even (rho 1) or uneven (trim d
  * off prev, rho d off cur), d up to max_trim and the lines' share, that stay
  * within tol of k's programmed polyline: d from *lo to *hi. 0 when none
