@@ -8,8 +8,9 @@
  * programmed line (both ends are at most P off it, square to it, and a
  * straight line between them no further), and the vertex itself, outside
  * the band, is always cut off by a blend that is measured against the
- * programmed polyline (ncp_edge_trims): the planner holds each such line
- * back until the next segment shows how its end turns (planner.c). */
+ * programmed polyline (ncp_edge_trims): the planner holds such lines back
+ * two deep, so that a vertex moves only where the line after it ends in
+ * such a corner too (planner.c). */
 #include "planner_int.h"
 
 #include <math.h>
@@ -109,16 +110,17 @@ double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double
     return sqrt(worst);
 }
 
-/* The blend of trim d (rho d off cur), measured; INFINITY where there is none. */
-static double dev_at(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
-                     const struct plan_corner *k, double rho, double d, double limit)
+/* Does the blend of trim d (rho d off cur) stay within tol of k's programmed
+ * polyline? No where there is no such blend. */
+static int fits(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
+                const struct plan_corner *k, double rho, double d, double tol)
 {
     struct ncp_seg bl;
     double got, got_cur;
     if (rho == 1 ? !ncp_blend_corner(free_prev, cur, d, &bl, &got)
                  : !ncp_blend_corner_ratio_at(free_prev, cur, rho, d, &bl, &got, &got_cur))
-        return INFINITY;
-    return ncp_edge_dev(&bl, k->a, k->c, k->b, limit);
+        return 0;
+    return ncp_edge_dev(&bl, k->a, k->c, k->b, tol + EDGE_ROUND) <= tol + EDGE_ROUND;
 }
 
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
@@ -148,7 +150,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         trim[i] = reach * pow(EDGE_STEP, i - EDGE_SCAN);
     int first = 0, last = 0;
     for (int i = 1; i <= EDGE_SCAN; i++) {
-        int ok = dev_at(&free_prev, cur, k, rho, trim[i], tol + EDGE_ROUND) <= tol + EDGE_ROUND;
+        int ok = fits(&free_prev, cur, k, rho, trim[i], tol);
         if (ok && !first)
             first = i;
         if (ok)
@@ -161,7 +163,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     double a = trim[first - 1], b = trim[first];
     for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
         double m = 0.5 * (a + b);
-        if (dev_at(&free_prev, cur, k, rho, m, tol + EDGE_ROUND) <= tol + EDGE_ROUND)
+        if (fits(&free_prev, cur, k, rho, m, tol))
             b = m;
         else
             a = m;
@@ -171,7 +173,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     b = fmin(dmax, trim[last + 1]);
     for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
         double m = 0.5 * (a + b);
-        if (dev_at(&free_prev, cur, k, rho, m, tol + EDGE_ROUND) <= tol + EDGE_ROUND)
+        if (fits(&free_prev, cur, k, rho, m, tol))
             a = m;
         else
             b = m;

@@ -766,6 +766,13 @@ static double arc_speed(const struct ncp_planner *p, const struct ncp_seg *arc)
     return ps.vmax;
 }
 
+/* The part of G64 P tol a blend may use: the servo's chords across it cut
+ * in by p->chord (at least a quarter stays). */
+static double blend_tol(const struct ncp_planner *p, double tol)
+{
+    return fmax(0.25 * tol, tol - p->chord);
+}
+
 /* The smallest trim (and so the smallest arc) whose speed reaches v_goal,
  * no more than the largest blend allowed: a blend departs from the
  * programmed corner only as far as the speed it buys needs. The arc's speed
@@ -867,7 +874,8 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
     for (int k = 0; k <= RATIO_STEPS; k++) {
         double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2, lo, hi;
         struct ncp_seg b;
-        /* at a moved vertex each ratio is a search: every third one */
+        /* at a moved vertex each ratio is a search: every
+         * RATIO_MOVED_EVERY-th one */
         if (fabs(rho - 1) < 1e-9 || (moved && k % RATIO_MOVED_EVERY))
             continue;
         /* at a moved vertex: the largest blend measured within P of the
@@ -962,7 +970,7 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
     /* G64 P bounds what the servo gets: its chords across the arc too */
     struct ncp_seg tol = prev->s;
     if (tol.tolerance > 0)
-        tol.tolerance = fmax(0.25 * tol.tolerance, tol.tolerance - p->chord);
+        tol.tolerance = blend_tol(p, tol.tolerance);
     double v_goal = fmin(blend_vmax_any(p, &prev->s), blend_vmax_any(p, s));
     /* a moved vertex lies off the path: it is always cut off */
     if (!p->corner.shifted && kink_harmless(p, &prev->s, s, v_goal))
@@ -1159,19 +1167,17 @@ static int edge_may_hold(const struct ncp_planner *p, const struct ncp_seg *s)
            !p->pushing_fit && !ncp_seg_moves_other(s) && !ncp_kins_active(&p->cfg);
 }
 
-/* The blend between the queue's last line and held, with held's end at
- * `end`, as try_blend will measure it: is there one within P? */
-static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *held,
-                           const double end[3], const struct plan_corner *k)
+/* The blend between the queue's last line (tail) and held, with held's end
+ * at `end`, as try_blend will measure it: is there one within P? */
+static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *tail,
+                           const struct ncp_seg *held, const double end[3],
+                           const struct plan_corner *k)
 {
-    if (!p->count)
-        return 0;
-    const struct ncp_seg *tail = &p->q[(p->head + p->count - 1) % p->cap].s;
     struct ncp_seg h = *held;
     memcpy(h.end, end, 3 * sizeof h.end[0]);
     h.length = dist3(h.start, h.end);
-    double tol = fmax(0.25 * tail->tolerance, tail->tolerance - p->chord), lo, hi;
-    return tail->kind == NCP_SEG_LINE && ncp_edge_trims(tail, &h, k, tol, 1, INFINITY, &lo, &hi);
+    double lo, hi;
+    return ncp_edge_trims(tail, &h, k, blend_tol(p, tail->tolerance), 1, INFINITY, &lo, &hi);
 }
 
 /* Whether the vertex between held lines h and cur moves out (k: its
@@ -1185,13 +1191,13 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *he
 static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start,
                         struct ncp_seg *h, struct ncp_seg *cur, struct plan_corner *k)
 {
-    double tol = fmax(0.25 * h->tolerance, h->tolerance - p->chord), moved[3], lo, hi, d;
+    double tol = blend_tol(p, h->tolerance), moved[3], lo, hi, d;
     if (h->tolerance != cur->tolerance || !ncp_edge_vertex(k->a, k->c, k->b, tol, moved))
         return;
     /* the queue's last line is blended into h: as programmed there, or
      * measured where it moved too */
-    int start_line = p->count && p->q[(p->head + p->count - 1) % p->cap].s.kind == NCP_SEG_LINE &&
-                     p->q[(p->head + p->count - 1) % p->cap].s.term == NCP_TERM_CONTINUOUS;
+    const struct ncp_seg *tail = p->count ? &plan_at(p, p->count - 1)->s : NULL;
+    int start_line = tail && tail->kind == NCP_SEG_LINE && tail->term == NCP_TERM_CONTINUOUS;
     if (start_line && !k_start->valid)
         return;
     double v_goal = fmin(blend_vmax(p, h), blend_vmax(p, cur));
@@ -1238,7 +1244,7 @@ static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start
     if (start_line) {
         struct plan_corner ks = *k_start;
         ks.measured = 1;
-        if (!edge_blend_fits(p, h, moved, &ks))
+        if (!edge_blend_fits(p, tail, h, moved, &ks))
             return;
     }
     h2.tolerance = h->tolerance;
