@@ -50,9 +50,11 @@ struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
      * axis holds sqrt(2/3) of any plane), so a servo step's chord lies at most
      * a_c T^2 / 8 inside it; read at a fraction of a sample (after a rate
      * change, src/rt/scaler.c) a step across a sample cuts in up to twice
-     * that again: 0.3 a T^2 covers both */
+     * that again: 0.3 a T^2 covers both. G64 P is a distance in X Y Z, so
+     * only their limits count: an axis the machine does not have keeps the
+     * default 2000 mm/s^2 and would double the margin of one with 1000 */
     double a_max = 0;
-    for (int j = 0; j < NCP_AXES; j++)
+    for (int j = 0; j < 3; j++)
         a_max = fmax(a_max, cfg->axis[j].max_acc);
     p->chord = 0.3 * a_max * cfg->servo_period * cfg->servo_period;
     /* an uneven corner parabola's acceleration vector may take every axis's
@@ -773,6 +775,13 @@ static double blend_tol(const struct ncp_planner *p, double tol)
     return fmax(0.25 * tol, tol - p->chord);
 }
 
+/* What an uneven parabola gives up of a blend's part of P beyond an even
+ * one's: its chords may cut in by chord_all, more than chord. */
+static double uneven_margin(const struct ncp_planner *p)
+{
+    return fmax(0, p->chord_all - p->chord);
+}
+
 /* The smallest trim (and so the smallest arc) whose speed reaches v_goal,
  * no more than the largest blend allowed: a blend departs from the
  * programmed corner only as far as the speed it buys needs. The arc's speed
@@ -867,7 +876,7 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
     double a1 = line_acc(p, &prev->s), a2 = line_acc(p, s);
     double len1 = prev->s.length, len2 = s->length;
     struct ncp_seg tol_u = *tol;
-    tol_u.tolerance -= fmax(0, p->chord_all - p->chord);
+    tol_u.tolerance -= uneven_margin(p);
     double best = corner_cost(len1, a1, len2, a2, v_n, v_goal, v_even, v_even, d, d, 2 * d / v_even);
     *cost = best;
     int found = 0, moved = corner && corner->shifted;
@@ -1191,8 +1200,10 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *ta
 static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start,
                         struct ncp_seg *h, struct ncp_seg *cur, struct plan_corner *k)
 {
+    /* out as far as an uneven blend may start, so that one can leave it */
     double tol = blend_tol(p, h->tolerance), moved[3], lo, hi, d;
-    if (h->tolerance != cur->tolerance || !ncp_edge_vertex(k->a, k->c, k->b, tol, moved))
+    if (h->tolerance != cur->tolerance ||
+        !ncp_edge_vertex(k->a, k->c, k->b, tol - uneven_margin(p), moved))
         return;
     /* the queue's last line is blended into h: as programmed there, or
      * measured where it moved too */
