@@ -460,37 +460,10 @@ struct band {
     size_t n;                  /* samples checked */
     double worst_d, worst_p;   /* the sample farthest out for its P: distance, P */
     size_t beyond;             /* samples beyond P + POINT_TOL */
+    size_t lost;               /* moving samples of a moving line not among the next segments */
     size_t at;                 /* the row farthest beyond P, its distance and P */
     double at_d, at_p;
 };
-
-/* a moving segment's line and its place among the moving segments */
-struct seg_at {
-    unsigned line;
-    size_t m;
-};
-
-static int cmp_seg_at(const void *a, const void *b)
-{
-    const struct seg_at *x = a, *y = b;
-    if (x->line != y->line)
-        return x->line < y->line ? -1 : 1;
-    return x->m < y->m ? -1 : x->m > y->m;
-}
-
-/* the first of sl (sorted) at line or after */
-static size_t first_seg_at(const struct seg_at *sl, size_t n, unsigned line)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (sl[mid].line < line)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
 
 static double dist3(const double a[3], const double b[3])
 {
@@ -498,78 +471,104 @@ static double dist3(const double a[3], const double b[3])
                 (a[2] - b[2]) * (a[2] - b[2]));
 }
 
+/* How far past the segments of the line before a row's line may lie among
+ * the moving segments: between them lie the blocks that leave no row of
+ * their own, up to a G64 Q run (the planner merges at most 100 lines into
+ * one, under the run's last line) or a stretch of segments each run in less
+ * than a servo period. */
+#define BAND_AHEAD 512
+
 /* Every commanded sample of a G64 P stretch against the programmed segments
  * it may come from. A row carries its block's line, but a blend runs under
  * the next block's line, a run of lines that G64 Q merged under the run's
  * last, and the arcs fitted to a faired CAM chain under the blocks their
- * pieces lie in: so a row of line L is measured against the segments of
- * the lines from the previous line that has rows (two segments before it
- * in line order) to L + 1, and the two moving segments before each of those
- * in program order (a blend into a subroutine's return, a loop's wrap),
- * the nearest of them counting. Its P is the tolerance of the nearest of
- * the corners it may be blending, each corner's P being that of the
- * segment it ends (the planner's prev->tolerance): the corners before the
- * segments of the lines after that previous line up to L. A row whose
- * corner is a G61 end or has no P is not checked (G61 ends are, in
- * check_ends). */
-static struct band check_band(const struct segs *g, const struct by_line *b, const struct row *r,
-                              size_t n)
+ * pieces lie in. The rows run in time order, the moving segments in
+ * program order, so they are walked side by side: a cursor into the
+ * segments moves on to the next segment (within BAND_AHEAD) whose line is
+ * that of a new row line, so a subroutine's or a loop's line is taken from
+ * the call or pass that is running, with its own P. The rows of that line
+ * are measured against the segments from two before the end of the block
+ * before (the one that had rows, in program order: a blend into a
+ * subroutine's return, a loop's wrap) through the line's run of segments
+ * and the one after, the nearest of them counting. Its P is the tolerance
+ * of the nearest of the corners it may be blending, each corner's P being
+ * that of the segment it ends (the planner's prev->tolerance): the corners
+ * from the end of the block before to the last in the line's run. A row
+ * whose corner is a G61 end or has no P is not checked (G61 ends are, in
+ * check_ends); nor is a row of a line no segment ahead moves (a dwell, a
+ * tool change), but a row that moves under a line some segment moves means
+ * the walk lost its place: counted in lost. */
+static struct band check_band(const struct segs *g, const struct row *r, size_t n)
 {
-    struct band bd = { 0, 0, 0, 0, 0, 0, 0 };
+    struct band bd = { 0, 0, 0, 0, 0, 0, 0, 0 };
     const struct ncp_seg **ml = malloc((g->n ? g->n : 1) * sizeof *ml);
     assert_non_null(ml);
     size_t nm = 0;
     for (size_t i = 0; i < g->n; i++)
         if (moves(&g->s[i]) && (g->s[i].kind == NCP_SEG_LINE || g->s[i].kind == NCP_SEG_ARC))
             ml[nm++] = &g->s[i];
-    struct seg_at *sl = malloc((nm ? nm : 1) * sizeof *sl);
-    size_t *cand = malloc((nm ? nm : 1) * sizeof *cand);
-    size_t *corner = malloc((nm ? nm : 1) * sizeof *corner);
-    size_t *seen = calloc(nm ? nm : 1, sizeof *seen);
-    assert_true(sl && cand && corner && seen);
+    /* the lines that move: rows of other lines (a dwell's, the start's line 0)
+     * may still creep by a print unit as the fine interpolation or a feed
+     * hold settles */
+    unsigned last = 0;
     for (size_t m = 0; m < nm; m++)
-        sl[m] = (struct seg_at){ ml[m]->line, m };
-    qsort(sl, nm, sizeof *sl, cmp_seg_at);
-    size_t nc = 0, nk = 0, stamp = 0;
+        last = ml[m]->line > last ? ml[m]->line : last;
+    unsigned char *moving = calloc((size_t)last + 1, 1);
+    assert_non_null(moving);
+    for (size_t m = 0; m < nm; m++)
+        moving[ml[m]->line] = 1;
+    /* from: where the next line is looked for, past the segment the last one
+     * was found at; run_end: past that line's run. The rows of the line found
+     * are measured against ml[c0..c1) and take the P of the corners at the
+     * ends of ml[k0..k1). */
+    size_t from = 0, run_end = 0, c0 = 0, c1 = 0, k0 = 0, k1 = 0;
+    int found = 0;
     for (size_t k = 0; k < n; k++) {
         unsigned line = r[k].line;
         if (k == 0 || line != r[k - 1].line) {
-            stamp++;
-            nc = nk = 0;
-            size_t i0 = first_of_line(b, line);
-            unsigned prev = i0 > 0 ? b->r[b->idx[i0 - 1]].line : 0;
-            size_t lo = first_seg_at(sl, nm, prev), hi = first_seg_at(sl, nm, line + 2);
-            lo = lo >= 2 ? lo - 2 : 0;
-            for (size_t e = lo; e < hi; e++)
-                for (size_t back = 0; back <= 2 && back <= sl[e].m; back++) {
-                    size_t m = sl[e].m - back;
-                    if (seen[m] == stamp)
-                        continue;
-                    seen[m] = stamp;
-                    cand[nc++] = m;
-                    if (m + 1 < nm && ml[m + 1]->line > prev && ml[m + 1]->line <= line)
-                        corner[nk++] = m;
-                }
+            size_t ahead = (from > run_end ? from : run_end) + BAND_AHEAD;
+            size_t at = from, stop = ahead < nm ? ahead : nm;
+            while (at < stop && ml[at]->line != line)
+                at++;
+            found = at < stop;
+            if (found) {
+                /* the segment before `before` ends the line before; a line that
+                 * comes again after a dwell (whose rows find no segment) is
+                 * found inside its own last run */
+                size_t before = at < run_end ? at : run_end, end = at + 1;
+                while (end < nm && ml[end]->line == line)
+                    end++;
+                c0 = before >= 3 ? before - 3 : 0;
+                c1 = end < nm ? end + 1 : nm;
+                k0 = before ? before - 1 : 0;
+                k1 = end - 1;
+                from = at + 1;
+                run_end = end;
+            }
         }
         const double *p = r[k].cmd;
+        if (!found) {
+            bd.lost += line <= last && moving[line] && k > 0 && dist3(p, r[k - 1].cmd) > 0;
+            continue;
+        }
         const struct ncp_seg *cs = NULL;
         double near = INFINITY;
-        for (size_t i = 0; i < nk; i++) {
-            double d = dist3(p, ml[corner[i]]->end);
+        for (size_t m = k0; m < k1; m++) {
+            double d = dist3(p, ml[m]->end);
             if (d < near) {
                 near = d;
-                cs = ml[corner[i]];
+                cs = ml[m];
             }
         }
         if (!cs || cs->term != NCP_TERM_CONTINUOUS || cs->tolerance <= 0)
             continue;
         double d = INFINITY;
-        for (size_t i = 0; i < nc; i++)
-            if (ml[cand[i]]->kind == NCP_SEG_LINE)
-                d = fmin(d, dist_point_edge(p, ml[cand[i]]->start, ml[cand[i]]->end));
-        for (size_t i = 0; i < nc; i++)
-            if (ml[cand[i]]->kind == NCP_SEG_ARC)
-                d = fmin(d, dist_point_arc(ml[cand[i]], p, d));
+        for (size_t m = c0; m < c1; m++)
+            if (ml[m]->kind == NCP_SEG_LINE)
+                d = fmin(d, dist_point_edge(p, ml[m]->start, ml[m]->end));
+        for (size_t m = c0; m < c1; m++)
+            if (ml[m]->kind == NCP_SEG_ARC)
+                d = fmin(d, dist_point_arc(ml[m], p, d));
         double tol = cs->tolerance;
         bd.n++;
         if (d / tol > bd.worst_d / (bd.worst_p > 0 ? bd.worst_p : 1)) {
@@ -585,16 +584,16 @@ static struct band check_band(const struct segs *g, const struct by_line *b, con
             bd.beyond++;
         }
     }
-    free(seen);
-    free(corner);
-    free(cand);
-    free(sl);
+    free(moving);
     free(ml);
     return bd;
 }
 
 static void fail_band(const char *name, const struct row *r, const struct band *bd)
 {
+    if (bd->lost)
+        fail_msg("%s: band: %zu moving samples of lines not among the next segments: the "
+                 "walk along the program lost its place", name, bd->lost);
     if (bd->beyond) {
         const struct row *x = &r[bd->at];
         fail_msg("%s: line %u: sample (%.6f, %.6f, %.6f) at t %.3f lies %.7f mm from the "
@@ -680,7 +679,7 @@ static void run_job(void **state)
     size_t exact = 0, corners = 0;
     check_ends(jb, g, &b, &exact, &corners);
     size_t arc_rows = check_arcs(jb, g, r, n);
-    struct band bd = check_band(g, &b, r, n);
+    struct band bd = check_band(g, r, n);
     fail_band(jb->name, r, &bd);
     if (g->n) {
         const double *end = g->s[g->n - 1].end;
@@ -721,26 +720,52 @@ static const char builtin_prog[] =
     "G90 G0 Z5\n"
     "M2\n";
 
-static char builtin_path[64];
+/* One subroutine, its corner passed twice: first within P0.01, then under a
+ * bare G64, where the blend may take up to half a line and so leaves the
+ * first call's band by far. Every call's samples run under the same lines:
+ * the band must take a sample's P from its own call. */
+static const char calls_prog[] =
+    "G21 G90 G17 G64 P0.01\n"
+    "G0 X0 Y0 Z0\n"
+    "o<corner> sub\n"
+    "  G1 X60 Y0 F6000\n"
+    "  G1 X60 Y60\n"
+    "  G0 X0 Y0\n"
+    "o<corner> endsub\n"
+    "o<corner> call\n"
+    "G64\n"
+    "o<corner> call\n"
+    "M2\n";
+#define CALLS_LINE_AFTER 5   /* G1 X60 Y60: its rows blend the corner at X60 Y0 */
 
-static int make_builtin(void **state)
+#define PATH_ROOM 64
+static char builtin_path[PATH_ROOM], calls_path[PATH_ROOM];
+
+static int write_prog(char path[static PATH_ROOM], const char *text)
 {
-    (void)state;
-    strcpy(builtin_path, "/tmp/test_motion_gen-XXXXXX");
-    int fd = mkstemp(builtin_path);
+    static const char tmpl[] = "/tmp/test_motion_gen-XXXXXX";
+    _Static_assert(sizeof tmpl <= PATH_ROOM, "the temporary file's name fits");
+    memcpy(path, tmpl, sizeof tmpl);
+    int fd = mkstemp(path);
     if (fd < 0)
         return -1;
     FILE *f = fdopen(fd, "w");
     if (!f)
         return -1;
-    fputs(builtin_prog, f);
+    fputs(text, f);
     return fclose(f);
+}
+
+static int make_builtin(void **state)
+{
+    (void)state;
+    return write_prog(builtin_path, builtin_prog) || write_prog(calls_path, calls_prog) ? -1 : 0;
 }
 
 static int remove_builtin(void **state)
 {
     (void)state;
-    return remove(builtin_path);
+    return remove(builtin_path) | remove(calls_path);
 }
 
 /* The checks really check: the same run against tighter limits fails. */
@@ -780,9 +805,10 @@ static void test_checker_catches_violations(void **state)
      * does not, and it is that sample the check names */
     struct by_line b;
     by_line_init(&b, r, n);
-    struct band bd = check_band(g, &b, r, n);
-    if (!bd.n || bd.beyond)
-        fail_msg("band of the untouched trace: %zu samples, %zu beyond", bd.n, bd.beyond);
+    struct band bd = check_band(g, r, n);
+    if (!bd.n || bd.beyond || bd.lost)
+        fail_msg("band of the untouched trace: %zu samples, %zu beyond, %zu lost", bd.n,
+                 bd.beyond, bd.lost);
     static const struct {
         unsigned line;          /* of builtin_prog */
         double cx, cy, by, p;   /* centre (none: cx NAN, push along Y), push, its P */
@@ -805,7 +831,7 @@ static void test_checker_catches_violations(void **state)
             r[at].cmd[0] += push[c].by * dx / l;
             r[at].cmd[1] += push[c].by * dy / l;
         }
-        bd = check_band(g, &b, r, n);
+        bd = check_band(g, r, n);
         if (bd.beyond != 1 || bd.at != at || fabs(bd.at_p - push[c].p) > 1e-12 ||
             fabs(bd.at_d - push[c].by) > 1e-5)
             fail_msg("band: line %u: the pushed sample (row %zu) not caught: %zu beyond, "
@@ -821,16 +847,83 @@ static void test_checker_catches_violations(void **state)
     ncp_source_close(&gc.src);
 }
 
+/* The band takes each call's P: the trace as it is keeps it, though the
+ * bare G64 call leaves P0.01 by far; a sample of the P0.01 call pushed off
+ * its line is caught, with that call's P. */
+static void test_band_per_call(void **state)
+{
+    (void)state;
+    struct job jb = { calls_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine calls", 0 };
+    struct ncp_machine_cfg cfg;
+    load_cfg(&jb, &cfg);
+    struct gcode_ctx gc;
+    open_prog(&jb, &gc);
+    struct segs *g = program_segs(&jb, &cfg, &gc);
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    struct ncp_nck_opts o = { .cfg = &cfg, .interpret = gcode_run, .interp_ctx = &gc,
+                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
+    struct ncp_nck_result res;
+    assert_int_equal(ncp_nck_run(&o, &res), 0);
+    size_t n;
+    struct row *r = read_trace(f, &n);
+    /* the rows of the line after the corner, in each call */
+    size_t first[2] = { 0, 0 }, rows[2] = { 0, 0 }, call = 0;
+    for (size_t k = 0; k < n; k++) {
+        if (r[k].line != CALLS_LINE_AFTER)
+            continue;
+        if (rows[call] && k > first[call] + rows[call])
+            call++;
+        assert_true(call < 2);
+        if (!rows[call])
+            first[call] = k;
+        rows[call]++;
+    }
+    assert_true(rows[0] > 10 && rows[1] > 10);
+    /* the second call's blend: far outside the first call's P0.01 */
+    double out = 0;
+    for (size_t k = first[1]; k < first[1] + rows[1]; k++) {
+        double d = INFINITY;
+        for (size_t i = 0; i < g->n; i++)
+            if (moves(&g->s[i]) && g->s[i].kind == NCP_SEG_LINE)
+                d = fmin(d, dist_point_edge(r[k].cmd, g->s[i].start, g->s[i].end));
+        out = fmax(out, d);
+    }
+    if (out < 0.1)
+        fail_msg("the bare G64 blend stays within %.4f mm: it tests nothing", out);
+    struct band bd = check_band(g, r, n);
+    if (!bd.n || bd.beyond || bd.lost)
+        fail_msg("band of the untouched trace: %zu samples, %zu beyond: line %u, %.7f mm of "
+                 "P %.4f", bd.n, bd.beyond, r[bd.at].line, bd.at_d, bd.at_p);
+    size_t at = first[0] + rows[0] / 2;
+    r[at].cmd[0] += 0.02;
+    bd = check_band(g, r, n);
+    if (bd.beyond != 1 || bd.at != at || fabs(bd.at_p - 0.01) > 1e-12 ||
+        fabs(bd.at_d - 0.02) > 1e-5)
+        fail_msg("band: the pushed sample (row %zu) not caught: %zu beyond, row %zu, %.7f mm "
+                 "of P %.4f", at, bd.beyond, bd.at, bd.at_d, bd.at_p);
+    free(g->s);
+    free(g);
+    free(r);
+    fclose(f);
+    ncp_source_close(&gc.src);
+}
+
 static int builtin_tests(void)
 {
-    static struct job jobs[2] = {
+    static struct job jobs[4] = {
         { builtin_path, NULL, NULL, NCP_PROFILE_TRAPEZOID, "builtin (trapezoid)", 0 },
         { builtin_path, NULL, NULL, NCP_PROFILE_SCURVE, "builtin (scurve)", 0 },
+        { calls_path, NULL, NULL, NCP_PROFILE_TRAPEZOID, "subroutine calls (trapezoid)", 0 },
+        { calls_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine calls (scurve)", 0 },
     };
     const struct CMUnitTest tests[] = {
         { jobs[0].name, run_job, NULL, NULL, &jobs[0] },
         { jobs[1].name, run_job, NULL, NULL, &jobs[1] },
+        { jobs[2].name, run_job, NULL, NULL, &jobs[2] },
+        { jobs[3].name, run_job, NULL, NULL, &jobs[3] },
         cmocka_unit_test(test_checker_catches_violations),
+        cmocka_unit_test(test_band_per_call),
     };
     return cmocka_run_group_tests(tests, make_builtin, remove_builtin);
 }
