@@ -37,12 +37,16 @@
 #define EDGE_TURN_MIN (5 * M_PI / 180)
 #define EDGE_TURN_MAX (160 * M_PI / 180)
 
-/* A programmed segment, set up for many distances. */
+/* A programmed segment, set up for many distances: from a along d, and n
+ * the unit normal towards the inside of the turn (zero where there is no
+ * turn to tell it by). */
 struct edge_seg {
-    double a[3], d[3], dd;
+    double a[3], d[3], dd, n[3];
 };
 
-static void seg_init(struct edge_seg *g, const double a[3], const double b[3])
+/* other: the direction of the corner's other line */
+static void seg_init(struct edge_seg *g, const double a[3], const double b[3],
+                     const double other[3])
 {
     g->dd = 0;
     for (int i = 0; i < 3; i++) {
@@ -50,6 +54,14 @@ static void seg_init(struct edge_seg *g, const double a[3], const double b[3])
         g->d[i] = b[i] - a[i];
         g->dd += g->d[i] * g->d[i];
     }
+    double along = g->dd > 0 ? dot3(other, g->d) / g->dd : 0, nn = 0;
+    for (int i = 0; i < 3; i++) {
+        g->n[i] = other[i] - along * g->d[i];
+        nn += g->n[i] * g->n[i];
+    }
+    nn = nn > 1e-12 * dot3(other, other) ? 1 / sqrt(nn) : 0;
+    for (int i = 0; i < 3; i++)
+        g->n[i] *= nn;
 }
 
 /* fmin and fmax are calls here (NaN rules); these are not */
@@ -63,51 +75,96 @@ static inline double greater(double x, double y)
     return x > y ? x : y;
 }
 
-static double seg_dist2(const struct edge_seg *g, const double q[3])
+/* A corner point of a blend's piece against a programmed segment: the
+ * squared distance, how far along (0 and 1 its ends) and how far inside
+ * the turn (signed) it lies. */
+struct edge_at {
+    double dist2, along, in;
+};
+
+static struct edge_at seg_at(const struct edge_seg *g, const double q[3])
 {
     double w[3] = { q[0] - g->a[0], q[1] - g->a[1], q[2] - g->a[2] };
-    double t = g->dd > 0 ? lesser(1, greater(0, dot3(w, g->d) / g->dd)) : 0, e = 0;
+    struct edge_at r = { 0, g->dd > 0 ? dot3(w, g->d) / g->dd : 0, dot3(w, g->n) };
+    double t = lesser(1, greater(0, r.along));
     for (int i = 0; i < 3; i++) {
         double c = w[i] - t * g->d[i];
-        e += c * c;
+        r.dist2 += c * c;
     }
-    return e;
+    return r;
 }
 
-double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
-                    const double b[3], double limit)
+/* One piece (the triangle of corner points x[3]) against one segment: the
+ * distance to a segment is convex and the signed distance to its line
+ * linear, so the corners bound the piece. Within tol_in of the segment, or
+ * beside it (not beyond its ends) within tol_in inside the turn and
+ * tol_out outside: the servo's chords between samples cut in towards the
+ * inside of the blend, which here (tangent_ok: the blend's tangent not
+ * yet turned a right angle from the segment) points into the turn, so only
+ * the inside needs their margin. */
+static int piece_fits(const struct edge_seg *g, const struct edge_at x[3], int tangent_ok,
+                      double tol_in, double tol_out)
+{
+    double far2 = greater(x[0].dist2, greater(x[1].dist2, x[2].dist2));
+    if (far2 <= tol_in * tol_in)
+        return 1;
+    if (!tangent_ok || far2 > tol_out * tol_out || (g->n[0] == 0 && g->n[1] == 0 && g->n[2] == 0))
+        return 0;
+    for (int k = 0; k < 3; k++)
+        if (x[k].along < 0 || x[k].along > 1 || x[k].in > tol_in)
+            return 0;
+    return 1;
+}
+
+int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, double tol_in)
 {
     /* the parabola is the quadratic Bezier start, centre, end; each piece
      * between two samples is one too, inside the triangle of its ends and
-     * the meeting of its end tangents, and the distance to a segment is
-     * convex: so the piece lies within the largest of the three corners'
-     * distances to whichever programmed segment is nearer for all three */
-    struct edge_seg g1, g2;
-    seg_init(&g1, a, c);
-    seg_init(&g2, c, b);
-    double worst = 0, q0[3], q1[3], ctrl[3], first0, second0;
-    memcpy(q0, blend->start, sizeof q0);
-    first0 = seg_dist2(&g1, q0);
-    second0 = seg_dist2(&g2, q0);
-    for (int k = 0; k < EDGE_PIECES; k++) {
-        double t0 = (double)k / EDGE_PIECES, t1 = (double)(k + 1) / EDGE_PIECES;
-        for (int i = 0; i < 3; i++) {
-            double p0 = blend->start[i], pc = blend->center[i], p1 = blend->end[i];
-            q1[i] = (1 - t1) * (1 - t1) * p0 + 2 * t1 * (1 - t1) * pc + t1 * t1 * p1;
-            /* B(t0) + (t1 - t0) / 2 B'(t0) */
-            ctrl[i] = q0[i] + (t1 - t0) * ((1 - t0) * (pc - p0) + t0 * (p1 - pc));
-        }
-        double first1 = seg_dist2(&g1, q1), second1 = seg_dist2(&g2, q1);
-        double on_first = greater(first0, greater(first1, seg_dist2(&g1, ctrl)));
-        double on_second = greater(second0, greater(second1, seg_dist2(&g2, ctrl)));
-        worst = greater(worst, lesser(on_first, on_second));
-        if (worst > limit * limit)
-            break;  /* beyond what the caller asks about: no need to know how far */
-        memcpy(q0, q1, sizeof q0);
-        first0 = first1;
-        second0 = second1;
+     * the meeting of its end tangents */
+    double u1[3], u2[3], back[3], tol_out = greater(tol_in, k->out) + EDGE_ROUND;
+    tol_in += EDGE_ROUND;
+    for (int i = 0; i < 3; i++) {
+        u1[i] = k->c[i] - k->a[i];
+        u2[i] = k->b[i] - k->c[i];
+        back[i] = -u1[i];
     }
-    return sqrt(worst);
+    /* inside the turn: towards the second line from the first, back along
+     * the first from the second */
+    struct edge_seg g1, g2;
+    seg_init(&g1, k->a, k->c, u2);
+    seg_init(&g2, k->c, k->b, back);
+    const double *p0 = blend->start, *pc = blend->center, *p1 = blend->end;
+    struct edge_at on1[3], on2[3];
+    double q0[3], q1[3], ctrl[3];
+    memcpy(q0, p0, sizeof q0);
+    on1[0] = seg_at(&g1, p0);
+    on2[0] = seg_at(&g2, p0);
+    for (int n = 0; n < EDGE_PIECES; n++) {
+        double t0 = (double)n / EDGE_PIECES, t1 = (double)(n + 1) / EDGE_PIECES;
+        double tan0 = 0, tan1 = 0;
+        for (int i = 0; i < 3; i++) {
+            q1[i] = (1 - t1) * (1 - t1) * p0[i] + 2 * t1 * (1 - t1) * pc[i] + t1 * t1 * p1[i];
+            double d0 = (1 - t0) * (pc[i] - p0[i]) + t0 * (p1[i] - pc[i]);
+            /* B(t0) + (t1 - t0) / 2 B'(t0) */
+            ctrl[i] = q0[i] + (t1 - t0) * d0;
+            tan0 += d0 * u2[i];
+            tan1 += ((1 - t1) * (pc[i] - p0[i]) + t1 * (p1[i] - pc[i])) * u1[i];
+        }
+        on1[1] = seg_at(&g1, q1);
+        on1[2] = seg_at(&g1, ctrl);
+        on2[1] = seg_at(&g2, q1);
+        on2[2] = seg_at(&g2, ctrl);
+        /* the tangent turns one way along the blend: at the piece's end it
+         * has turned furthest from the first line, at its start least far
+         * from the second */
+        if (!piece_fits(&g1, on1, tan1 >= 0, tol_in, tol_out) &&
+            !piece_fits(&g2, on2, tan0 >= 0, tol_in, tol_out))
+            return 0;
+        on1[0] = on1[1];
+        on2[0] = on2[1];
+        memcpy(q0, q1, sizeof q0);
+    }
+    return 1;
 }
 
 /* Does the blend of trim d (rho d off cur) stay within tol of k's programmed
@@ -120,7 +177,7 @@ static int fits(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
     if (rho == 1 ? !ncp_blend_corner(free_prev, cur, d, &bl, &got)
                  : !ncp_blend_corner_ratio_at(free_prev, cur, rho, d, &bl, &got, &got_cur))
         return 0;
-    return ncp_edge_dev(&bl, k->a, k->c, k->b, tol + EDGE_ROUND) <= tol + EDGE_ROUND;
+    return ncp_edge_within(&bl, k, tol);
 }
 
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,

@@ -898,7 +898,7 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
             continue;
         /* beside a moved vertex the lines are not the programmed ones */
         if (corner && !moved &&
-            ncp_edge_dev(&b, corner->a, corner->c, corner->b, tol_u.tolerance) > tol_u.tolerance)
+            !ncp_edge_within(&b, corner, tol_u.tolerance))
             continue;
         double v1 = fmin(v_goal, arc_speed(p, &b)) / fmax(1, rho);
         if (v1 <= 0)
@@ -1167,6 +1167,8 @@ static void push_now(struct ncp_planner *p, const struct ncp_seg *s)
 
 /* ---- vertices moved out to the band's outer edges (edge.c) ---------------- */
 
+#define EDGE_OUT_ROUND 1e-6
+
 /* A line whose end may move out: a G64 P feed line in X Y Z as programmed
  * (not faired, not joined by G64 Q), trivial kinematics. */
 static int edge_may_hold(const struct ncp_planner *p, const struct ncp_seg *s)
@@ -1200,10 +1202,8 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *ta
 static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start,
                         struct ncp_seg *h, struct ncp_seg *cur, struct plan_corner *k)
 {
-    /* out as far as an uneven blend may start, so that one can leave it */
     double tol = blend_tol(p, h->tolerance), moved[3], lo, hi, d;
-    if (h->tolerance != cur->tolerance ||
-        !ncp_edge_vertex(k->a, k->c, k->b, tol - uneven_margin(p), moved))
+    if (h->tolerance != cur->tolerance || !ncp_edge_vertex(k->a, k->c, k->b, k->out, moved))
         return;
     /* the queue's last line is blended into h: as programmed there, or
      * measured where it moved too */
@@ -1320,6 +1320,9 @@ static void push_line(struct ncp_planner *p, const struct ncp_seg *s)
     memcpy(k.c, s->start, sizeof k.c);
     if (p->edge_n) {
         k.valid = 1;
+        /* the whole of P outside: straight lines there need no chord margin
+         * (a blend's chords cut in), and the checks' rounding has 1 nm */
+        k.out = fmax(0, p->edge_line[p->edge_n - 1].tolerance - EDGE_OUT_ROUND);
         memcpy(k.a, p->edge_start[p->edge_n - 1].c, sizeof k.a);
         memcpy(k.b, s->end, sizeof k.b);
     }

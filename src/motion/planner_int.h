@@ -46,6 +46,7 @@ struct plan_corner {
     int measured;            /* a line beside it left the programmed one: the blend
                               * is sized by measuring it against a, c, b */
     double a[3], c[3], b[3];
+    double out;              /* how far outside the lines the path may run (P) */
 };
 
 struct ncp_planner {
@@ -159,10 +160,9 @@ int ncp_fit_emit(struct ncp_planner *p, int n, int m, int flush);
  * left to run (before each step). */
 void ncp_planner_edge_low(struct ncp_planner *p);
 
-/* edge.c: how far the corner parabola blend strays from the programmed
- * polyline a-c-b at most; once that is beyond limit, some value beyond it. */
-double ncp_edge_dev(const struct ncp_seg *blend, const double a[3], const double c[3],
-                    const double b[3], double limit);
+/* edge.c: whether the corner parabola blend stays within k's band: tol_in
+ * inside the programmed polyline a-c-b, k->out outside. */
+int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, double tol_in);
 /* edge.c: the blends between prev and cur, even (rho 1) or uneven (trim d
  * off prev, rho d off cur), d up to max_trim and the lines' share, that stay
  * within tol of k's programmed polyline: d from *lo to *hi. 0 when none
