@@ -152,78 +152,6 @@ static double dist_point_edge(const double p[3], const double a[3], const double
     return sqrt(d2);
 }
 
-/* Row indices sorted by (line, index): the rows of one source line. */
-struct by_line {
-    size_t *idx;
-    const struct row *r;
-    size_t n;
-};
-
-static const struct row *sort_rows;
-static int cmp_row(const void *a, const void *b)
-{
-    size_t i = *(const size_t *)a, k = *(const size_t *)b;
-    unsigned li = sort_rows[i].line, lk = sort_rows[k].line;
-    return li != lk ? (li < lk ? -1 : 1) : (i < k ? -1 : i > k);
-}
-
-static void by_line_init(struct by_line *b, const struct row *r, size_t n)
-{
-    b->idx = malloc((n ? n : 1) * sizeof *b->idx);
-    assert_non_null(b->idx);
-    for (size_t k = 0; k < n; k++)
-        b->idx[k] = k;
-    sort_rows = r;
-    qsort(b->idx, n, sizeof *b->idx, cmp_row);
-    b->r = r;
-    b->n = n;
-}
-
-static size_t first_of_line(const struct by_line *b, unsigned line)
-{
-    size_t lo = 0, hi = b->n;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (b->r[b->idx[mid]].line < line)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
-/* The first line from `line` on that has rows: a run of lines that G64 Q
- * merged into one segment runs under the run's last line, so a corner at
- * the run's start is among that line's rows, and one inside the run may be
- * in the blend to the next segment, which runs under the next line that
- * has rows */
-static unsigned line_with_rows(const struct by_line *b, unsigned line)
-{
-    size_t i = first_of_line(b, line);
-    return i < b->n ? b->r[b->idx[i]].line : line;
-}
-
-/* Distance from p to the commanded polyline near the rows of either line. */
-static double dist_to_path(const struct by_line *b, const double p[3], unsigned l1, unsigned l2)
-{
-    double best = INFINITY;
-    unsigned first = line_with_rows(b, l1), second = line_with_rows(b, l2);
-    if (second == first)
-        second = line_with_rows(b, first + 1);
-    unsigned lines[2] = { first, second };
-    for (int m = 0; m < (lines[0] == lines[1] ? 1 : 2); m++) {
-        for (size_t i = first_of_line(b, lines[m]); i < b->n && b->r[b->idx[i]].line == lines[m];
-             i++) {
-            size_t k = b->idx[i];
-            if (k > 0)
-                best = fmin(best, dist_point_edge(p, b->r[k - 1].cmd, b->r[k].cmd));
-            if (k + 1 < b->n)
-                best = fmin(best, dist_point_edge(p, b->r[k].cmd, b->r[k + 1].cmd));
-        }
-    }
-    return best;
-}
-
 /* Radial distance of p from an arc's (helix's) axis, and how far that lies
  * outside the arc's radius range. */
 static double radius_error(const struct ncp_seg *s, const double p[3])
@@ -383,30 +311,172 @@ static double corner_reach(const struct segs *g, size_t i)
     return half * reach > s->tolerance ? s->tolerance / half : reach;
 }
 
-/* G61/G61.1 ends on the path; the path near G64 P corners (corner_reach).
- * Counts both. */
-static void check_ends(const struct job *jb, const struct segs *g, const struct by_line *b,
-                       size_t *exact, size_t *corners)
+/* ---- the program walked beside the trace ---------------------------------------- */
+
+static double dist3(const double a[3], const double b[3])
 {
-    for (size_t i = 0; i < g->n; i++) {
-        const struct ncp_seg *s = &g->s[i];
-        if (!moves(s))
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+/* How far past the segments of the line before a row's line may lie among
+ * the moving segments: between them lie the blocks that leave no row of
+ * their own, up to a G64 Q run (the planner merges at most 100 lines into
+ * one, under the run's last line) or a stretch of segments each run in less
+ * than a servo period. */
+#define WALK_AHEAD 512
+
+/* The rows [k0, k1), all of one line, and where the walk found that line
+ * among the moving segments: ml[at], the first of ml[at..end), the line's
+ * run of segments; ml[before - 1] ends the block before (the one that had
+ * rows, in program order). */
+struct stretch {
+    size_t k0, k1;
+    int found;
+    size_t before, at, end;
+};
+
+struct walk {
+    const struct ncp_seg **ml;   /* the moving segments (lines, arcs), in program order */
+    size_t nm;
+    struct stretch *st;          /* the rows' runs of one line, in time order */
+    size_t ns;
+};
+
+/* A row carries its block's line, and every call of a subroutine (every
+ * pass of a loop) runs under the same lines, so a line alone does not say
+ * which call's segments a row comes from. The rows run in time order, the
+ * moving segments in program order: they are walked side by side. A cursor
+ * into the segments moves on, at each new row line, to the next segment
+ * (within WALK_AHEAD) of that line: the call or pass that is running. A
+ * line that comes again after a dwell (whose rows find no segment) is found
+ * inside its own last run. The rows of a line no segment ahead moves (a
+ * dwell, a tool change, line 0 at the start) are not found. */
+static struct walk walk_program(const struct segs *g, const struct row *r, size_t n)
+{
+    struct walk w = { malloc((g->n ? g->n : 1) * sizeof *w.ml), 0, NULL, 0 };
+    assert_non_null(w.ml);
+    for (size_t i = 0; i < g->n; i++)
+        if (moves(&g->s[i]) && (g->s[i].kind == NCP_SEG_LINE || g->s[i].kind == NCP_SEG_ARC))
+            w.ml[w.nm++] = &g->s[i];
+    size_t cap = 0;
+    /* from: where the next line is looked for, past the segment the last one
+     * was found at; run_end: past that line's run */
+    size_t from = 0, run_end = 0;
+    for (size_t k = 0; k < n; k++) {
+        if (k > 0 && r[k].line == r[k - 1].line) {
+            w.st[w.ns - 1].k1 = k + 1;
             continue;
-        unsigned next = i + 1 < g->n ? g->s[i + 1].line : s->line;
-        double d = dist_to_path(b, s->end, s->line, next);
-        *exact += s->term != NCP_TERM_CONTINUOUS;
-        *corners += s->term == NCP_TERM_CONTINUOUS && s->tolerance > 0;
-        if (s->term != NCP_TERM_CONTINUOUS && d > POINT_TOL)
-            fail_msg("%s: line %u: G61 end (%.4f, %.4f, %.4f) missed by %.3g mm", jb->name,
-                     s->line, s->end[0], s->end[1], s->end[2], d);
-        if (s->term == NCP_TERM_CONTINUOUS && s->tolerance > 0) {
-            double reach = corner_reach(g, i);
-            if (d > reach + POINT_TOL)
-                fail_msg("%s: line %u: G64 P%.4f corner (%.4f, %.4f, %.4f) missed by %.7f mm, "
-                         "beyond the %.7f mm its turn allows", jb->name, s->line, s->tolerance,
-                         s->end[0], s->end[1], s->end[2], d, reach);
+        }
+        if (w.ns == cap) {
+            cap = cap ? 2 * cap : 256;
+            struct stretch *bigger = realloc(w.st, cap * sizeof *bigger);
+            assert_non_null(bigger);
+            w.st = bigger;
+        }
+        struct stretch *x = &w.st[w.ns++];
+        *x = (struct stretch){ k, k + 1, 0, 0, 0, 0 };
+        size_t ahead = (from > run_end ? from : run_end) + WALK_AHEAD;
+        size_t at = from, stop = ahead < w.nm ? ahead : w.nm;
+        while (at < stop && w.ml[at]->line != r[k].line)
+            at++;
+        if (at == stop)
+            continue;
+        size_t end = at + 1;
+        while (end < w.nm && w.ml[end]->line == r[k].line)
+            end++;
+        x->found = 1;
+        x->before = at < run_end ? at : run_end;
+        x->at = at;
+        x->end = end;
+        from = at + 1;
+        run_end = end;
+    }
+    return w;
+}
+
+static void walk_free(struct walk *w)
+{
+    free(w->st);
+    free(w->ml);
+}
+
+/* the first stretch the walk found from st[i] on */
+static size_t found_from(const struct walk *w, size_t i)
+{
+    while (i < w->ns && !w->st[i].found)
+        i++;
+    return i;
+}
+
+struct ends {
+    size_t exact, corners;     /* G61 ends and G64 P corners checked */
+    size_t missed;             /* of them, passed farther than they allow */
+    size_t at;                 /* the first missed, in program order (index into g->s) */
+    double at_d, at_reach;     /* how far the path passes it, how far it may (G61: 0) */
+};
+
+/* G61/G61.1 ends on the path; the path near G64 P corners (corner_reach),
+ * each end against the rows of its own call or pass. Where the walk found
+ * the segment's line at or before it, within that line's run, they are the
+ * rows from there; else (a line that G64 Q merged into the run of a later
+ * one, which runs under the run's last line; a segment run in less than a
+ * servo period) from the next stretch found. The blend into the next
+ * segment runs under the next block's line, so the rows go on through the
+ * next stretch found after those, with the rows of lines no segment moves
+ * between them (a dwell that splits a line's segments, as in a loop of a
+ * move and a dwell), and one row either side: the path is the polyline
+ * through them. */
+static struct ends check_ends(const struct segs *g, const struct walk *w, const struct row *r,
+                              size_t n)
+{
+    struct ends e = { 0, 0, 0, 0, 0, 0 };
+    /* own: the last stretch found at or before ml[m]; next: the one after */
+    size_t own = w->ns, next = found_from(w, 0);
+    for (size_t m = 0; m < w->nm; m++) {
+        while (next < w->ns && w->st[next].at <= m) {
+            own = next;
+            next = found_from(w, next + 1);
+        }
+        size_t first = own < w->ns && m < w->st[own].end ? own : next;
+        size_t then = first < w->ns ? found_from(w, first + 1) : w->ns;
+        const struct ncp_seg *s = w->ml[m];
+        double d = INFINITY, reach = INFINITY;
+        if (first < w->ns) {
+            size_t lo = w->st[first].k0 ? w->st[first].k0 - 1 : 0;
+            size_t hi = then < w->ns ? w->st[then].k1 : n - 1;
+            hi = hi < n ? hi : n - 1;
+            for (size_t k = lo; k < hi; k++)
+                d = fmin(d, dist_point_edge(s->end, r[k].cmd, r[k + 1].cmd));
+        }
+        if (s->term != NCP_TERM_CONTINUOUS) {
+            e.exact++;
+            reach = 0;
+        } else if (s->tolerance > 0) {
+            e.corners++;
+            reach = corner_reach(g, (size_t)(s - g->s));
+        }
+        if (d > reach + POINT_TOL && !e.missed++) {
+            e.at = (size_t)(s - g->s);
+            e.at_d = d;
+            e.at_reach = reach;
         }
     }
+    return e;
+}
+
+static void fail_ends(const char *name, const struct segs *g, const struct ends *e)
+{
+    if (!e->missed)
+        return;
+    const struct ncp_seg *s = &g->s[e->at];
+    if (s->term != NCP_TERM_CONTINUOUS)
+        fail_msg("%s: line %u: G61 end (%.4f, %.4f, %.4f) missed by %.3g mm (%zu ends or "
+                 "corners missed)", name, s->line, s->end[0], s->end[1], s->end[2], e->at_d,
+                 e->missed);
+    fail_msg("%s: line %u: G64 P%.4f corner (%.4f, %.4f, %.4f) missed by %.7f mm, beyond the "
+             "%.7f mm its turn allows (%zu ends or corners missed)", name, s->line,
+             s->tolerance, s->end[0], s->end[1], s->end[2], e->at_d, e->at_reach, e->missed);
 }
 
 static int cmp_seg_line(const void *a, const void *b)
@@ -465,127 +535,87 @@ struct band {
     double at_d, at_p;
 };
 
-static double dist3(const double a[3], const double b[3])
-{
-    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                (a[2] - b[2]) * (a[2] - b[2]));
-}
-
-/* How far past the segments of the line before a row's line may lie among
- * the moving segments: between them lie the blocks that leave no row of
- * their own, up to a G64 Q run (the planner merges at most 100 lines into
- * one, under the run's last line) or a stretch of segments each run in less
- * than a servo period. */
-#define BAND_AHEAD 512
-
 /* Every commanded sample of a G64 P stretch against the programmed segments
  * it may come from. A row carries its block's line, but a blend runs under
  * the next block's line, a run of lines that G64 Q merged under the run's
  * last, and the arcs fitted to a faired CAM chain under the blocks their
- * pieces lie in. The rows run in time order, the moving segments in
- * program order, so they are walked side by side: a cursor into the
- * segments moves on to the next segment (within BAND_AHEAD) whose line is
- * that of a new row line, so a subroutine's or a loop's line is taken from
- * the call or pass that is running, with its own P. The rows of that line
- * are measured against the segments from two before the end of the block
- * before (the one that had rows, in program order: a blend into a
- * subroutine's return, a loop's wrap) through the line's run of segments
- * and the one after, the nearest of them counting. Its P is the tolerance
- * of the nearest of the corners it may be blending, each corner's P being
- * that of the segment it ends (the planner's prev->tolerance): the corners
- * from the end of the block before to the last in the line's run. A row
- * whose corner is a G61 end or has no P is not checked (G61 ends are, in
- * check_ends); nor is a row of a line no segment ahead moves (a dwell, a
- * tool change), but a row that moves under a line some segment moves means
- * the walk lost its place: counted in lost. */
-static struct band check_band(const struct segs *g, const struct row *r, size_t n)
+ * pieces lie in. The rows of a stretch the walk found (walk_program: of the
+ * call or pass that is running, with its own P) are measured against the
+ * segments from two before the end of the block before (the one that had
+ * rows, in program order: a blend into a subroutine's return, a loop's
+ * wrap) through the line's run of segments and the one after, the nearest
+ * of them counting. Its P is the tolerance of the nearest of the corners it
+ * may be blending, each corner's P being that of the segment it ends (the
+ * planner's prev->tolerance): the corners from the end of the block before
+ * to the last in the line's run. A row whose corner is a G61 end or has no
+ * P is not checked (G61 ends are, in check_ends); nor is a row of a line no
+ * segment ahead moves (a dwell, a tool change), but a row that moves under
+ * a line some segment moves means the walk lost its place: counted in
+ * lost. */
+static struct band check_band(const struct walk *w, const struct row *r)
 {
     struct band bd = { 0, 0, 0, 0, 0, 0, 0, 0 };
-    const struct ncp_seg **ml = malloc((g->n ? g->n : 1) * sizeof *ml);
-    assert_non_null(ml);
-    size_t nm = 0;
-    for (size_t i = 0; i < g->n; i++)
-        if (moves(&g->s[i]) && (g->s[i].kind == NCP_SEG_LINE || g->s[i].kind == NCP_SEG_ARC))
-            ml[nm++] = &g->s[i];
+    const struct ncp_seg *const *ml = w->ml;
     /* the lines that move: rows of other lines (a dwell's, the start's line 0)
      * may still creep by a print unit as the fine interpolation or a feed
      * hold settles */
     unsigned last = 0;
-    for (size_t m = 0; m < nm; m++)
+    for (size_t m = 0; m < w->nm; m++)
         last = ml[m]->line > last ? ml[m]->line : last;
     unsigned char *moving = calloc((size_t)last + 1, 1);
     assert_non_null(moving);
-    for (size_t m = 0; m < nm; m++)
+    for (size_t m = 0; m < w->nm; m++)
         moving[ml[m]->line] = 1;
-    /* from: where the next line is looked for, past the segment the last one
-     * was found at; run_end: past that line's run. The rows of the line found
-     * are measured against ml[c0..c1) and take the P of the corners at the
-     * ends of ml[k0..k1). */
-    size_t from = 0, run_end = 0, c0 = 0, c1 = 0, k0 = 0, k1 = 0;
-    int found = 0;
-    for (size_t k = 0; k < n; k++) {
-        unsigned line = r[k].line;
-        if (k == 0 || line != r[k - 1].line) {
-            size_t ahead = (from > run_end ? from : run_end) + BAND_AHEAD;
-            size_t at = from, stop = ahead < nm ? ahead : nm;
-            while (at < stop && ml[at]->line != line)
-                at++;
-            found = at < stop;
-            if (found) {
-                /* the segment before `before` ends the line before; a line that
-                 * comes again after a dwell (whose rows find no segment) is
-                 * found inside its own last run */
-                size_t before = at < run_end ? at : run_end, end = at + 1;
-                while (end < nm && ml[end]->line == line)
-                    end++;
-                c0 = before >= 3 ? before - 3 : 0;
-                c1 = end < nm ? end + 1 : nm;
-                k0 = before ? before - 1 : 0;
-                k1 = end - 1;
-                from = at + 1;
-                run_end = end;
-            }
-        }
-        const double *p = r[k].cmd;
-        if (!found) {
-            bd.lost += line <= last && moving[line] && k > 0 && dist3(p, r[k - 1].cmd) > 0;
+    for (size_t i = 0; i < w->ns; i++) {
+        const struct stretch *x = &w->st[i];
+        unsigned line = r[x->k0].line;
+        if (!x->found) {
+            for (size_t k = x->k0; k < x->k1; k++)
+                bd.lost += line <= last && moving[line] && k > 0 &&
+                           dist3(r[k].cmd, r[k - 1].cmd) > 0;
             continue;
         }
-        const struct ncp_seg *cs = NULL;
-        double near = INFINITY;
-        for (size_t m = k0; m < k1; m++) {
-            double d = dist3(p, ml[m]->end);
-            if (d < near) {
-                near = d;
-                cs = ml[m];
+        /* the rows are measured against ml[c0..c1) and take the P of the
+         * corners at the ends of ml[e0..e1) */
+        size_t c0 = x->before >= 3 ? x->before - 3 : 0, c1 = x->end < w->nm ? x->end + 1 : w->nm;
+        size_t e0 = x->before ? x->before - 1 : 0, e1 = x->end - 1;
+        for (size_t k = x->k0; k < x->k1; k++) {
+            const double *p = r[k].cmd;
+            const struct ncp_seg *cs = NULL;
+            double near = INFINITY;
+            for (size_t m = e0; m < e1; m++) {
+                double d = dist3(p, ml[m]->end);
+                if (d < near) {
+                    near = d;
+                    cs = ml[m];
+                }
             }
-        }
-        if (!cs || cs->term != NCP_TERM_CONTINUOUS || cs->tolerance <= 0)
-            continue;
-        double d = INFINITY;
-        for (size_t m = c0; m < c1; m++)
-            if (ml[m]->kind == NCP_SEG_LINE)
-                d = fmin(d, dist_point_edge(p, ml[m]->start, ml[m]->end));
-        for (size_t m = c0; m < c1; m++)
-            if (ml[m]->kind == NCP_SEG_ARC)
-                d = fmin(d, dist_point_arc(ml[m], p, d));
-        double tol = cs->tolerance;
-        bd.n++;
-        if (d / tol > bd.worst_d / (bd.worst_p > 0 ? bd.worst_p : 1)) {
-            bd.worst_d = d;
-            bd.worst_p = tol;
-        }
-        if (d > tol + POINT_TOL) {
-            if (!bd.beyond || d - tol > bd.at_d - bd.at_p) {
-                bd.at = k;
-                bd.at_d = d;
-                bd.at_p = tol;
+            if (!cs || cs->term != NCP_TERM_CONTINUOUS || cs->tolerance <= 0)
+                continue;
+            double d = INFINITY;
+            for (size_t m = c0; m < c1; m++)
+                if (ml[m]->kind == NCP_SEG_LINE)
+                    d = fmin(d, dist_point_edge(p, ml[m]->start, ml[m]->end));
+            for (size_t m = c0; m < c1; m++)
+                if (ml[m]->kind == NCP_SEG_ARC)
+                    d = fmin(d, dist_point_arc(ml[m], p, d));
+            double tol = cs->tolerance;
+            bd.n++;
+            if (d / tol > bd.worst_d / (bd.worst_p > 0 ? bd.worst_p : 1)) {
+                bd.worst_d = d;
+                bd.worst_p = tol;
             }
-            bd.beyond++;
+            if (d > tol + POINT_TOL) {
+                if (!bd.beyond || d - tol > bd.at_d - bd.at_p) {
+                    bd.at = k;
+                    bd.at_d = d;
+                    bd.at_p = tol;
+                }
+                bd.beyond++;
+            }
         }
     }
     free(moving);
-    free(ml);
     return bd;
 }
 
@@ -674,13 +704,14 @@ static void run_job(void **state)
     assert_true(n > 3);
 
     check_limits(jb, &cfg, r, n);
-    struct by_line b;
-    by_line_init(&b, r, n);
-    size_t exact = 0, corners = 0;
-    check_ends(jb, g, &b, &exact, &corners);
-    size_t arc_rows = check_arcs(jb, g, r, n);
-    struct band bd = check_band(g, r, n);
+    /* the band first: it says where the walk lost its place, which the ends
+     * would only show as a missed end */
+    struct walk w = walk_program(g, r, n);
+    struct band bd = check_band(&w, r);
     fail_band(jb->name, r, &bd);
+    struct ends e = check_ends(g, &w, r, n);
+    fail_ends(jb->name, g, &e);
+    size_t arc_rows = check_arcs(jb, g, r, n);
     if (g->n) {
         const double *end = g->s[g->n - 1].end;
         for (int j = 0; j < 3; j++)
@@ -690,8 +721,8 @@ static void run_job(void **state)
     }
     print_message("%s: %zu cycles, %zu segments, %zu G61 ends, %zu G64 P corners, "
                   "%zu cycles on arcs; band: %zu samples, worst %.7f mm of P %.4f\n", jb->name,
-                  n, g->n, exact, corners, arc_rows, bd.n, bd.worst_d, bd.worst_p);
-    free(b.idx);
+                  n, g->n, e.exact, e.corners, arc_rows, bd.n, bd.worst_d, bd.worst_p);
+    walk_free(&w);
     free(r);
     free(g->s);
     free(g);
@@ -738,8 +769,25 @@ static const char calls_prog[] =
     "M2\n";
 #define CALLS_LINE_AFTER 5   /* G1 X60 Y60: its rows blend the corner at X60 Y0 */
 
+/* One subroutine called twice, with a G61 end and a G64 P corner: every
+ * call's rows run under the same lines, and each call must pass them. */
+static const char ends_prog[] =
+    "G21 G90 G17\n"
+    "G0 X0 Y0 Z0\n"
+    "o<ends> sub\n"
+    "  G61 G1 X60 Y0 F6000\n"
+    "  G64 P0.01 G1 X60 Y60\n"
+    "  G1 X0 Y60\n"
+    "  G61 G0 X0 Y0\n"
+    "o<ends> endsub\n"
+    "o<ends> call\n"
+    "o<ends> call\n"
+    "M2\n";
+#define ENDS_LINE_EXACT 4    /* G61 G1 X60 Y0: its end is hit */
+#define ENDS_LINE_CORNER 5   /* G64 P0.01 G1 X60 Y60: its corner passed within P / cos 45 */
+
 #define PATH_ROOM 64
-static char builtin_path[PATH_ROOM], calls_path[PATH_ROOM];
+static char builtin_path[PATH_ROOM], calls_path[PATH_ROOM], ends_path[PATH_ROOM];
 
 static int write_prog(char path[static PATH_ROOM], const char *text)
 {
@@ -759,13 +807,16 @@ static int write_prog(char path[static PATH_ROOM], const char *text)
 static int make_builtin(void **state)
 {
     (void)state;
-    return write_prog(builtin_path, builtin_prog) || write_prog(calls_path, calls_prog) ? -1 : 0;
+    return write_prog(builtin_path, builtin_prog) || write_prog(calls_path, calls_prog) ||
+                   write_prog(ends_path, ends_prog)
+               ? -1
+               : 0;
 }
 
 static int remove_builtin(void **state)
 {
     (void)state;
-    return remove(builtin_path) | remove(calls_path);
+    return remove(builtin_path) | remove(calls_path) | remove(ends_path);
 }
 
 /* The checks really check: the same run against tighter limits fails. */
@@ -803,9 +854,8 @@ static void test_checker_catches_violations(void **state)
     /* the band: the trace as it is keeps it; a sample in the middle of a
      * line, an arc, a helix pushed off it (along Y, away from the centre)
      * does not, and it is that sample the check names */
-    struct by_line b;
-    by_line_init(&b, r, n);
-    struct band bd = check_band(g, r, n);
+    struct walk wk = walk_program(g, r, n);
+    struct band bd = check_band(&wk, r);
     if (!bd.n || bd.beyond || bd.lost)
         fail_msg("band of the untouched trace: %zu samples, %zu beyond, %zu lost", bd.n,
                  bd.beyond, bd.lost);
@@ -818,11 +868,13 @@ static void test_checker_catches_violations(void **state)
         { 14, 0, -5, 0.25, 0.2 },      /* G2 X-10 Y-5 Z-4 I-10 J0: a helix */
     };
     for (size_t c = 0; c < sizeof push / sizeof push[0]; c++) {
-        size_t k = first_of_line(&b, push[c].line), rows = 0;
-        while (k + rows < n && r[b.idx[k + rows]].line == push[c].line)
+        size_t k = 0, rows = 0;
+        while (k < n && r[k].line != push[c].line)
+            k++;
+        while (k + rows < n && r[k + rows].line == push[c].line)
             rows++;
         assert_true(rows > 10);
-        size_t at = b.idx[k + rows / 2];
+        size_t at = k + rows / 2;
         double was[3] = { r[at].cmd[0], r[at].cmd[1], r[at].cmd[2] };
         if (isnan(push[c].cx)) {
             r[at].cmd[1] += push[c].by;
@@ -831,7 +883,7 @@ static void test_checker_catches_violations(void **state)
             r[at].cmd[0] += push[c].by * dx / l;
             r[at].cmd[1] += push[c].by * dy / l;
         }
-        bd = check_band(g, r, n);
+        bd = check_band(&wk, r);
         if (bd.beyond != 1 || bd.at != at || fabs(bd.at_p - push[c].p) > 1e-12 ||
             fabs(bd.at_d - push[c].by) > 1e-5)
             fail_msg("band: line %u: the pushed sample (row %zu) not caught: %zu beyond, "
@@ -839,7 +891,7 @@ static void test_checker_catches_violations(void **state)
                      bd.at_p);
         memcpy(r[at].cmd, was, sizeof was);
     }
-    free(b.idx);
+    walk_free(&wk);
     free(g->s);
     free(g);
     free(r);
@@ -891,17 +943,92 @@ static void test_band_per_call(void **state)
     }
     if (out < 0.1)
         fail_msg("the bare G64 blend stays within %.4f mm: it tests nothing", out);
-    struct band bd = check_band(g, r, n);
+    struct walk wk = walk_program(g, r, n);
+    struct band bd = check_band(&wk, r);
     if (!bd.n || bd.beyond || bd.lost)
         fail_msg("band of the untouched trace: %zu samples, %zu beyond: line %u, %.7f mm of "
                  "P %.4f", bd.n, bd.beyond, r[bd.at].line, bd.at_d, bd.at_p);
     size_t at = first[0] + rows[0] / 2;
     r[at].cmd[0] += 0.02;
-    bd = check_band(g, r, n);
+    bd = check_band(&wk, r);
     if (bd.beyond != 1 || bd.at != at || fabs(bd.at_p - 0.01) > 1e-12 ||
         fabs(bd.at_d - 0.02) > 1e-5)
         fail_msg("band: the pushed sample (row %zu) not caught: %zu beyond, row %zu, %.7f mm "
                  "of P %.4f", at, bd.beyond, bd.at, bd.at_d, bd.at_p);
+    walk_free(&wk);
+    free(g->s);
+    free(g);
+    free(r);
+    fclose(f);
+    ncp_source_close(&gc.src);
+}
+
+/* Each call's rows pass its own ends: the trace as it is does; the second
+ * call's rows near the G61 end, then near the G64 P corner, moved off it
+ * (the first call's still pass it) miss that call's end, and only that. */
+static void test_ends_per_call(void **state)
+{
+    (void)state;
+    struct job jb = { ends_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine ends", 0 };
+    struct ncp_machine_cfg cfg;
+    load_cfg(&jb, &cfg);
+    struct gcode_ctx gc;
+    open_prog(&jb, &gc);
+    struct segs *g = program_segs(&jb, &cfg, &gc);
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    struct ncp_nck_opts o = { .cfg = &cfg, .interpret = gcode_run, .interp_ctx = &gc,
+                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
+    struct ncp_nck_result res;
+    assert_int_equal(ncp_nck_run(&o, &res), 0);
+    size_t n;
+    struct row *r = read_trace(f, &n);
+    struct walk wk = walk_program(g, r, n);
+    struct ends e = check_ends(g, &wk, r, n);
+    if (e.exact != 4 || e.corners != 4 || e.missed)
+        fail_msg("ends of the untouched trace: %zu G61 ends, %zu corners, %zu missed", e.exact,
+                 e.corners, e.missed);
+    static const struct {
+        unsigned line;          /* of ends_prog: the segment whose end is pushed away from */
+        double dx, dy;          /* the push, towards the inside of the turn */
+    } push[] = {
+        { ENDS_LINE_EXACT, -0.01, 0.01 },      /* 0.014 off a point to be hit */
+        { ENDS_LINE_CORNER, -0.05, -0.05 },    /* 0.071 off, where 0.014 is allowed */
+    };
+    struct row *was = malloc(n * sizeof *was);
+    assert_non_null(was);
+    memcpy(was, r, n * sizeof *r);
+    for (size_t c = 0; c < sizeof push / sizeof push[0]; c++) {
+        /* the line's second segment: the second call's */
+        size_t i = 0, seen = 0;
+        for (; i < g->n; i++)
+            if (moves(&g->s[i]) && g->s[i].line == push[c].line && seen++ == 1)
+                break;
+        assert_true(i < g->n);
+        const double *p = g->s[i].end;
+        /* the rows within 2 mm of that end come in two stretches, one per
+         * call: the second one's move off it */
+        size_t stretch = 0, moved = 0;
+        for (size_t k = 0; k < n; k++) {
+            int near = dist3(was[k].cmd, p) < 2;
+            stretch += near && (k == 0 || dist3(was[k - 1].cmd, p) >= 2);
+            if (near && stretch == 2) {
+                r[k].cmd[0] += push[c].dx;
+                r[k].cmd[1] += push[c].dy;
+                moved++;
+            }
+        }
+        assert_int_equal(stretch, 2);
+        assert_true(moved > 10);
+        e = check_ends(g, &wk, r, n);
+        if (e.missed != 1 || e.at != i)
+            fail_msg("ends: line %u: the second call's end (segment %zu) moved off, not "
+                     "caught: %zu missed, the first segment %zu, %.7f mm", push[c].line, i,
+                     e.missed, e.at, e.at_d);
+        memcpy(r, was, n * sizeof *r);
+    }
+    free(was);
+    walk_free(&wk);
     free(g->s);
     free(g);
     free(r);
@@ -911,19 +1038,24 @@ static void test_band_per_call(void **state)
 
 static int builtin_tests(void)
 {
-    static struct job jobs[4] = {
+    static struct job jobs[6] = {
         { builtin_path, NULL, NULL, NCP_PROFILE_TRAPEZOID, "builtin (trapezoid)", 0 },
         { builtin_path, NULL, NULL, NCP_PROFILE_SCURVE, "builtin (scurve)", 0 },
         { calls_path, NULL, NULL, NCP_PROFILE_TRAPEZOID, "subroutine calls (trapezoid)", 0 },
         { calls_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine calls (scurve)", 0 },
+        { ends_path, NULL, NULL, NCP_PROFILE_TRAPEZOID, "subroutine ends (trapezoid)", 0 },
+        { ends_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine ends (scurve)", 0 },
     };
     const struct CMUnitTest tests[] = {
         { jobs[0].name, run_job, NULL, NULL, &jobs[0] },
         { jobs[1].name, run_job, NULL, NULL, &jobs[1] },
         { jobs[2].name, run_job, NULL, NULL, &jobs[2] },
         { jobs[3].name, run_job, NULL, NULL, &jobs[3] },
+        { jobs[4].name, run_job, NULL, NULL, &jobs[4] },
+        { jobs[5].name, run_job, NULL, NULL, &jobs[5] },
         cmocka_unit_test(test_checker_catches_violations),
         cmocka_unit_test(test_band_per_call),
+        cmocka_unit_test(test_ends_per_call),
     };
     return cmocka_run_group_tests(tests, make_builtin, remove_builtin);
 }
