@@ -819,23 +819,51 @@ static int remove_builtin(void **state)
     return remove(builtin_path) | remove(calls_path) | remove(ends_path);
 }
 
+/* A self-test's run: the program's segments and its S-curve trace. */
+struct traced {
+    struct ncp_machine_cfg cfg;
+    struct gcode_ctx gc;
+    struct segs *g;
+    FILE *f;
+    struct row *r;
+    size_t n;
+};
+
+static void run_traced(struct traced *t, const char *path, const char *name)
+{
+    struct job jb = { path, NULL, NULL, NCP_PROFILE_SCURVE, { 0 }, 0 };
+    snprintf(jb.name, sizeof jb.name, "%s", name);
+    load_cfg(&jb, &t->cfg);
+    open_prog(&jb, &t->gc);
+    t->g = program_segs(&jb, &t->cfg, &t->gc);
+    t->f = tmpfile();
+    assert_non_null(t->f);
+    struct ncp_nck_opts o = { .cfg = &t->cfg, .interpret = gcode_run, .interp_ctx = &t->gc,
+                              .virtual_clock = 1, .feed_override = 1.0, .trace = t->f };
+    struct ncp_nck_result res;
+    assert_int_equal(ncp_nck_run(&o, &res), 0);
+    t->r = read_trace(t->f, &t->n);
+}
+
+static void traced_free(struct traced *t)
+{
+    free(t->g->s);
+    free(t->g);
+    free(t->r);
+    fclose(t->f);
+    ncp_source_close(&t->gc.src);
+}
+
 /* The checks really check: the same run against tighter limits fails. */
 static void test_checker_catches_violations(void **state)
 {
     (void)state;
-    struct job jb = { builtin_path, NULL, NULL, NCP_PROFILE_SCURVE, "builtin (tightened)", 0 };
-    struct ncp_machine_cfg cfg;
-    load_cfg(&jb, &cfg);
-    struct gcode_ctx gc;
-    open_prog(&jb, &gc);
-    struct segs *g = program_segs(&jb, &cfg, &gc);
-    FILE *f = tmpfile();
-    struct ncp_nck_opts o = { .cfg = &cfg, .interpret = gcode_run, .interp_ctx = &gc,
-                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
-    struct ncp_nck_result res;
-    assert_int_equal(ncp_nck_run(&o, &res), 0);
-    size_t n;
-    struct row *r = read_trace(f, &n);
+    struct traced t;
+    run_traced(&t, builtin_path, "builtin (tightened)");
+    const struct ncp_machine_cfg cfg = t.cfg;
+    struct segs *g = t.g;
+    struct row *r = t.r;
+    size_t n = t.n;
     double vmax[3], amax[3], jmax[3];
     for (int j = 0; j < 3; j++) {
         vmax[j] = 0.9 * cfg.axis[j].max_vel;
@@ -892,11 +920,7 @@ static void test_checker_catches_violations(void **state)
         memcpy(r[at].cmd, was, sizeof was);
     }
     walk_free(&wk);
-    free(g->s);
-    free(g);
-    free(r);
-    fclose(f);
-    ncp_source_close(&gc.src);
+    traced_free(&t);
 }
 
 /* The band takes each call's P: the trace as it is keeps it, though the
@@ -905,20 +929,11 @@ static void test_checker_catches_violations(void **state)
 static void test_band_per_call(void **state)
 {
     (void)state;
-    struct job jb = { calls_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine calls", 0 };
-    struct ncp_machine_cfg cfg;
-    load_cfg(&jb, &cfg);
-    struct gcode_ctx gc;
-    open_prog(&jb, &gc);
-    struct segs *g = program_segs(&jb, &cfg, &gc);
-    FILE *f = tmpfile();
-    assert_non_null(f);
-    struct ncp_nck_opts o = { .cfg = &cfg, .interpret = gcode_run, .interp_ctx = &gc,
-                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
-    struct ncp_nck_result res;
-    assert_int_equal(ncp_nck_run(&o, &res), 0);
-    size_t n;
-    struct row *r = read_trace(f, &n);
+    struct traced t;
+    run_traced(&t, calls_path, "subroutine calls");
+    struct segs *g = t.g;
+    struct row *r = t.r;
+    size_t n = t.n;
     /* the rows of the line after the corner, in each call */
     size_t first[2] = { 0, 0 }, rows[2] = { 0, 0 }, call = 0;
     for (size_t k = 0; k < n; k++) {
@@ -956,11 +971,7 @@ static void test_band_per_call(void **state)
         fail_msg("band: the pushed sample (row %zu) not caught: %zu beyond, row %zu, %.7f mm "
                  "of P %.4f", at, bd.beyond, bd.at, bd.at_d, bd.at_p);
     walk_free(&wk);
-    free(g->s);
-    free(g);
-    free(r);
-    fclose(f);
-    ncp_source_close(&gc.src);
+    traced_free(&t);
 }
 
 /* Each call's rows pass its own ends: the trace as it is does; the second
@@ -969,20 +980,11 @@ static void test_band_per_call(void **state)
 static void test_ends_per_call(void **state)
 {
     (void)state;
-    struct job jb = { ends_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine ends", 0 };
-    struct ncp_machine_cfg cfg;
-    load_cfg(&jb, &cfg);
-    struct gcode_ctx gc;
-    open_prog(&jb, &gc);
-    struct segs *g = program_segs(&jb, &cfg, &gc);
-    FILE *f = tmpfile();
-    assert_non_null(f);
-    struct ncp_nck_opts o = { .cfg = &cfg, .interpret = gcode_run, .interp_ctx = &gc,
-                              .virtual_clock = 1, .feed_override = 1.0, .trace = f };
-    struct ncp_nck_result res;
-    assert_int_equal(ncp_nck_run(&o, &res), 0);
-    size_t n;
-    struct row *r = read_trace(f, &n);
+    struct traced t;
+    run_traced(&t, ends_path, "subroutine ends");
+    struct segs *g = t.g;
+    struct row *r = t.r;
+    size_t n = t.n;
     struct walk wk = walk_program(g, r, n);
     struct ends e = check_ends(g, &wk, r, n);
     if (e.exact != 4 || e.corners != 4 || e.missed)
@@ -1029,11 +1031,7 @@ static void test_ends_per_call(void **state)
     }
     free(was);
     walk_free(&wk);
-    free(g->s);
-    free(g);
-    free(r);
-    fclose(f);
-    ncp_source_close(&gc.src);
+    traced_free(&t);
 }
 
 static int builtin_tests(void)
