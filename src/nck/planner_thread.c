@@ -25,6 +25,10 @@ static void pull_segments(struct nck_core *n, int *finishing, uint32_t *stop_aux
     struct nck_seg_msg m;
     while (!*finishing && !nck_plan_full(n) && ncp_spsc_pop(&n->cross.segs, &m) == 0) {
         if (m.kind == NCK_MSG_SEG) {
+            if (nck_plan_idle(n) && nck_plan_queued(n) == 0) {
+                n->plan->start_arrived_ns = ncp_mono_ns();
+                n->plan->start_stepped = n->plan->start_moved = 0;
+            }
             nck_plan_push(n, &m.seg);
         } else {
             *finishing = 1;
@@ -35,6 +39,32 @@ static void pull_segments(struct nck_core *n, int *finishing, uint32_t *stop_aux
             nck_plan_finish(n);
         }
     }
+}
+
+/* A start from rest: its first setpoint, its first that moves (t: now). */
+static void note_start(struct nck_planner *p, const struct ncp_setpoint *sp, int64_t t)
+{
+    if (!p->start_arrived_ns)
+        return;
+    if (!p->start_stepped) {
+        p->start_stepped = 1;
+        p->starts++;
+        if (t - p->start_arrived_ns > p->start_sp_max_ns)
+            p->start_sp_max_ns = t - p->start_arrived_ns;
+    }
+    if (sp->v > 0) {
+        if (t - p->start_arrived_ns > p->start_move_max_ns)
+            p->start_move_max_ns = t - p->start_arrived_ns;
+        p->start_arrived_ns = 0;
+    }
+}
+
+void nck_planner_starts(const struct nck_core *n, uint64_t *starts, int64_t *sp_max_ns,
+                        int64_t *move_max_ns)
+{
+    *starts = n->plan->starts;
+    *sp_max_ns = n->plan->start_sp_max_ns;
+    *move_max_ns = n->plan->start_move_max_ns;
 }
 
 /* Virtual clock: the window is always full (or a stop is due) before a step,
@@ -73,6 +103,7 @@ static void parked(struct nck_core *n, int *finishing, int *aux_stop)
            atomic_load_explicit(&n->cross.unpark_req, memory_order_acquire) ==
                atomic_load_explicit(&n->cross.unpark_ack, memory_order_relaxed))
         nap_ns(200000);
+    n->plan->start_arrived_ns = 0;
     nck_plan_dropped(n);
     nck_plan_reset(n, n->cross.rest);
     *finishing = 0;
@@ -120,6 +151,8 @@ void *nck_planner_main(void *arg)
                 sp.flags &= ~(uint32_t)NCP_SP_END;
         }
         ncp_spsc_push(&n->cross.sps, &sp);
+        if (n->plan->start_arrived_ns)
+            note_start(n->plan, &sp, ncp_mono_ns());
         if (n->trace_rings) {
             /* response: one step's work; cycle: from one setpoint to the next */
             int64_t t1 = ncp_mono_ns();
@@ -131,6 +164,7 @@ void *nck_planner_main(void *arg)
         if (!more) {
             if (!aux_stop)
                 atomic_fetch_add_explicit(&n->cross.ends_pushed, 1, memory_order_release);
+            n->plan->start_arrived_ns = 0;   /* it ended without moving */
             nck_plan_restart(n);
             /* a synchronised run the position loop moves starts here: the
              * next segment is planned from its end */
