@@ -136,6 +136,11 @@ struct ncp_nck_result {
     uint64_t segments, starved, trace_dropped, replans;
     uint64_t underruns;      /* setpoint ring ran low: slowed down along the path */
     uint64_t dry;            /* cycles it ran empty in motion anyway (held position) */
+    /* starts from rest: how many, and the worst wall time (s) from a start's
+     * first segment reaching the planner thread to its first setpoint, and
+     * to its first setpoint that moves (a dwell or an aux stop first: later) */
+    uint64_t starts;
+    double start_sp_max, start_move_max;
     int fifo;
     uint64_t calls_in, calls_acted, calls_refused; /* canonical calls the NCK took */
     double spindle_rpm_max;  /* the spindle's highest actual speed */

@@ -308,6 +308,10 @@ static void collect(const struct nck_core *n, struct ncp_nck_result *res)
     res->contour_avg = s->moving ? s->contour_sum / (double)s->moving : 0;
     res->underruns = lr.underruns;
     res->dry = lr.dry;
+    int64_t sp_max, move_max;
+    nck_planner_starts(n, &res->starts, &sp_max, &move_max);
+    res->start_sp_max = (double)sp_max * 1e-9;
+    res->start_move_max = (double)move_max * 1e-9;
     res->trace_dropped = lr.fb_dropped;
     res->fifo = n->cross.rt.fifo;
     memcpy(res->warning, n->cross.rt.warning, sizeof res->warning);

@@ -106,6 +106,10 @@ void nck_inject_describe(const struct nck_core *n, char *buf, size_t len);
 
 /* planner_thread.c */
 void *nck_planner_main(void *arg);
+/* The planner thread's starts from rest (ncp_nck_result's starts, ns):
+ * only after nck_finish joined it. */
+void nck_planner_starts(const struct nck_core *n, uint64_t *starts, int64_t *sp_max_ns,
+                        int64_t *move_max_ns);
 
 /* plan_src.c: the planner's protocol (ncpar/motion.h) on whichever variant
  * the NCK runs */

@@ -11,6 +11,13 @@ struct nck_planner {
      * (the other is NULL) */
     struct ncp_planner *planner;
     struct ncp_adcai *adcai;
+    /* starts from rest (wall clock, either clock): when the first segment
+     * reached this thread (0: no start open), whether its first setpoint is
+     * out yet, and the worst of each so far (nck_planner_starts) */
+    int64_t start_arrived_ns;
+    int start_stepped;
+    uint64_t starts;
+    int64_t start_sp_max_ns, start_move_max_ns;
 };
 
 #endif

@@ -344,6 +344,10 @@ void ncp_nck_print_summary(const struct ncp_nck_result *r, const char *prog, FIL
             (unsigned long long)r->lat.misses, (unsigned long long)r->lat.skipped,
             (unsigned long long)r->underruns, (unsigned long long)r->dry,
             (unsigned long long)r->starved);
+    if (r->starts)
+        fprintf(f, "  start from rest: first setpoint %.1f ms, first move %.1f ms after the first "
+                   "segment reached the planner (worst of %llu)\n",
+                r->start_sp_max * 1e3, r->start_move_max * 1e3, (unsigned long long)r->starts);
     if (r->inject_summary[0])
         fprintf(f, "  %s\n", r->inject_summary);
     if (r->sched_summary[0])
