@@ -12,10 +12,10 @@ struct nck_planner {
     struct ncp_planner *planner;
     struct ncp_adcai *adcai;
     /* starts from rest (wall clock, either clock): when the first segment
-     * reached this thread (0: no start open), whether its first setpoint is
-     * out yet, and the worst of each so far (nck_planner_starts) */
+     * reached this thread, whether its first setpoint and first moving
+     * setpoint are out yet, and the worst of each so far (nck_planner_starts) */
     int64_t start_arrived_ns;
-    int start_stepped;
+    int start_stepped, start_moved;
     uint64_t starts;
     int64_t start_sp_max_ns, start_move_max_ns;
 };
