@@ -17,6 +17,12 @@ static void nap_ns(long ns)
     nanosleep(&ts, NULL);
 }
 
+/* At rest with nothing queued: the next segment starts from rest. */
+static int at_rest(struct nck_core *n)
+{
+    return nck_plan_idle(n) && nck_plan_queued(n) == 0;
+}
+
 /* END and SYNC both make the planner run what it has to a stop; after the
  * END setpoint the next job starts afresh (no blend with what went before). */
 static void pull_segments(struct nck_core *n, int *finishing, uint32_t *stop_aux, int *aux_stop,
@@ -25,7 +31,7 @@ static void pull_segments(struct nck_core *n, int *finishing, uint32_t *stop_aux
     struct nck_seg_msg m;
     while (!*finishing && !nck_plan_full(n) && ncp_spsc_pop(&n->cross.segs, &m) == 0) {
         if (m.kind == NCK_MSG_SEG) {
-            if (nck_plan_idle(n) && nck_plan_queued(n) == 0) {
+            if (at_rest(n)) {
                 n->plan->start_arrived_ns = ncp_mono_ns();
                 n->plan->start_stepped = n->plan->start_moved = 0;
             }
@@ -41,11 +47,10 @@ static void pull_segments(struct nck_core *n, int *finishing, uint32_t *stop_aux
     }
 }
 
-/* A start from rest: its first setpoint, its first that moves (t: now). */
+/* A start from rest (p->start_arrived_ns set): its first setpoint, its
+ * first that moves (t: now). */
 static void note_start(struct nck_planner *p, const struct ncp_setpoint *sp, int64_t t)
 {
-    if (!p->start_arrived_ns)
-        return;
     if (!p->start_stepped) {
         p->start_stepped = 1;
         p->starts++;
@@ -78,7 +83,7 @@ static int may_step(struct nck_core *n, int finishing, int64_t *wait_since)
         *wait_since = 0;
         return 1;
     }
-    if (nck_plan_idle(n) && nck_plan_queued(n) == 0)
+    if (at_rest(n))
         return 0;
     if (n->setup.virtual_clock)
         return 0;
@@ -132,7 +137,7 @@ void *nck_planner_main(void *arg)
         pull_segments(n, &finishing, &stop_aux, &aux_stop, &jump);
         if (ncp_spsc_count(&n->cross.sps) >= ncp_spsc_capacity(&n->cross.sps) ||
             !may_step(n, finishing, &wait_since)) {
-            int idle = nck_plan_idle(n) && nck_plan_queued(n) == 0;
+            int idle = at_rest(n);
             if (n->setup.virtual_clock && !idle)
                 sched_yield();
             else
