@@ -135,8 +135,10 @@ int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, do
     seg_init(&g2, k->c, k->b, back);
     const double *p0 = blend->start, *pc = blend->center, *p1 = blend->end;
     struct edge_at on1[3], on2[3];
-    double q0[3], q1[3], ctrl[3];
+    double q0[3], q1[3], ctrl[3], d0[3], d1[3];
     memcpy(q0, p0, sizeof q0);
+    for (int i = 0; i < 3; i++)
+        d0[i] = pc[i] - p0[i];   /* B'(t) / 2 at t = 0 */
     on1[0] = seg_at(&g1, p0);
     on2[0] = seg_at(&g2, p0);
     for (int n = 0; n < EDGE_PIECES; n++) {
@@ -144,11 +146,11 @@ int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, do
         double tan0 = 0, tan1 = 0;
         for (int i = 0; i < 3; i++) {
             q1[i] = (1 - t1) * (1 - t1) * p0[i] + 2 * t1 * (1 - t1) * pc[i] + t1 * t1 * p1[i];
-            double d0 = (1 - t0) * (pc[i] - p0[i]) + t0 * (p1[i] - pc[i]);
+            d1[i] = (1 - t1) * (pc[i] - p0[i]) + t1 * (p1[i] - pc[i]);
             /* B(t0) + (t1 - t0) / 2 B'(t0) */
-            ctrl[i] = q0[i] + (t1 - t0) * d0;
-            tan0 += d0 * u2[i];
-            tan1 += ((1 - t1) * (pc[i] - p0[i]) + t1 * (p1[i] - pc[i])) * u1[i];
+            ctrl[i] = q0[i] + (t1 - t0) * d0[i];
+            tan0 += d0[i] * u2[i];
+            tan1 += d1[i] * u1[i];
         }
         on1[1] = seg_at(&g1, q1);
         on1[2] = seg_at(&g1, ctrl);
@@ -163,6 +165,7 @@ int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, do
         on1[0] = on1[1];
         on2[0] = on2[1];
         memcpy(q0, q1, sizeof q0);
+        memcpy(d0, d1, sizeof d0);
     }
     return 1;
 }
