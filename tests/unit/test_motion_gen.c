@@ -666,20 +666,27 @@ static struct segs *program_segs(const struct job *jb, const struct ncp_machine_
     return g;
 }
 
-static void run_job(void **state)
-{
-    const struct job *jb = *state;
+/* A job's run: the program's segments and its trace (the live driver's
+ * holds and overrides during it where the job asks). */
+struct traced {
     struct ncp_machine_cfg cfg;
-    load_cfg(jb, &cfg);
     struct gcode_ctx gc;
-    open_prog(jb, &gc);
-    struct segs *g = program_segs(jb, &cfg, &gc);
+    struct segs *g;
+    struct row *r;
+    size_t n;
+};
+
+static void run_traced(struct traced *t, const struct job *jb)
+{
+    load_cfg(jb, &t->cfg);
+    open_prog(jb, &t->gc);
+    t->g = program_segs(jb, &t->cfg, &t->gc);
 
     /* NCP_KEEP_TRACE=FILE keeps the (last) trace for a closer look */
     const char *keep = getenv("NCP_KEEP_TRACE");
     FILE *f = keep ? fopen(keep, "w+") : tmpfile();
     assert_non_null(f);
-    struct ncp_nck_opts o = { .cfg = &cfg, .interpret = gcode_run, .interp_ctx = &gc,
+    struct ncp_nck_opts o = { .cfg = &t->cfg, .interpret = gcode_run, .interp_ctx = &t->gc,
                               .virtual_clock = 1, .feed_override = 1.0, .trace = f };
     struct live l;
     pthread_t th;
@@ -698,9 +705,27 @@ static void run_job(void **state)
     }
     if (rc != 0)
         fail_msg("%s: run status %d: %s", jb->name, rc, res.diag.msg);
-    size_t n;
-    struct row *r = read_trace(f, &n);
+    t->r = read_trace(f, &t->n);
     fclose(f);
+}
+
+static void traced_free(struct traced *t)
+{
+    free(t->g->s);
+    free(t->g);
+    free(t->r);
+    ncp_source_close(&t->gc.src);
+}
+
+static void run_job(void **state)
+{
+    const struct job *jb = *state;
+    struct traced t;
+    run_traced(&t, jb);
+    const struct ncp_machine_cfg cfg = t.cfg;
+    struct segs *g = t.g;
+    struct row *r = t.r;
+    size_t n = t.n;
     assert_true(n > 3);
 
     check_limits(jb, &cfg, r, n);
@@ -723,10 +748,7 @@ static void run_job(void **state)
                   "%zu cycles on arcs; band: %zu samples, worst %.7f mm of P %.4f\n", jb->name,
                   n, g->n, e.exact, e.corners, arc_rows, bd.n, bd.worst_d, bd.worst_p);
     walk_free(&w);
-    free(r);
-    free(g->s);
-    free(g);
-    ncp_source_close(&gc.src);
+    traced_free(&t);
 }
 
 /* ---- the built-in program (no arguments) ---------------------------------------------- */
@@ -819,47 +841,13 @@ static int remove_builtin(void **state)
     return remove(builtin_path) | remove(calls_path) | remove(ends_path);
 }
 
-/* A self-test's run: the program's segments and its S-curve trace. */
-struct traced {
-    struct ncp_machine_cfg cfg;
-    struct gcode_ctx gc;
-    struct segs *g;
-    FILE *f;
-    struct row *r;
-    size_t n;
-};
-
-static void run_traced(struct traced *t, const char *path, const char *name)
-{
-    struct job jb = { path, NULL, NULL, NCP_PROFILE_SCURVE, { 0 }, 0 };
-    snprintf(jb.name, sizeof jb.name, "%s", name);
-    load_cfg(&jb, &t->cfg);
-    open_prog(&jb, &t->gc);
-    t->g = program_segs(&jb, &t->cfg, &t->gc);
-    t->f = tmpfile();
-    assert_non_null(t->f);
-    struct ncp_nck_opts o = { .cfg = &t->cfg, .interpret = gcode_run, .interp_ctx = &t->gc,
-                              .virtual_clock = 1, .feed_override = 1.0, .trace = t->f };
-    struct ncp_nck_result res;
-    assert_int_equal(ncp_nck_run(&o, &res), 0);
-    t->r = read_trace(t->f, &t->n);
-}
-
-static void traced_free(struct traced *t)
-{
-    free(t->g->s);
-    free(t->g);
-    free(t->r);
-    fclose(t->f);
-    ncp_source_close(&t->gc.src);
-}
-
 /* The checks really check: the same run against tighter limits fails. */
 static void test_checker_catches_violations(void **state)
 {
     (void)state;
+    static const struct job jb = { builtin_path, NULL, NULL, NCP_PROFILE_SCURVE, "builtin (tightened)", 0 };
     struct traced t;
-    run_traced(&t, builtin_path, "builtin (tightened)");
+    run_traced(&t, &jb);
     const struct ncp_machine_cfg cfg = t.cfg;
     struct segs *g = t.g;
     struct row *r = t.r;
@@ -929,8 +917,9 @@ static void test_checker_catches_violations(void **state)
 static void test_band_per_call(void **state)
 {
     (void)state;
+    static const struct job jb = { calls_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine calls", 0 };
     struct traced t;
-    run_traced(&t, calls_path, "subroutine calls");
+    run_traced(&t, &jb);
     struct segs *g = t.g;
     struct row *r = t.r;
     size_t n = t.n;
@@ -980,8 +969,9 @@ static void test_band_per_call(void **state)
 static void test_ends_per_call(void **state)
 {
     (void)state;
+    static const struct job jb = { ends_path, NULL, NULL, NCP_PROFILE_SCURVE, "subroutine ends", 0 };
     struct traced t;
-    run_traced(&t, ends_path, "subroutine ends");
+    run_traced(&t, &jb);
     struct segs *g = t.g;
     struct row *r = t.r;
     size_t n = t.n;
