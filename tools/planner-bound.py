@@ -79,18 +79,33 @@ trapezoids let every corner and every chord of a curve turn on its own and
 for free, which on dense CAM chords (tiny: 0.02-0.2 mm, turning up to 0.3
 rad each) leaves them at the time at feed, far below what any motion that
 follows the curve can do. The windows read the turns of many blocks at once:
-- the motion x(t) follows the path within P (what "within P of the path, in
-  order" means, and what the trapezoids' corner and arc arguments take too:
-  a motion must run every block, not skip through a crossing): a point can
-  walk the path from its start to its end, never back, in step with the
-  motion, always within P of it (their Frechet distance is at most P; the
-  walker may pass several points while the motion stands, each within P
-  of it). Only "in step" makes the cross-sections below hold where the path
-  comes back near itself (tiny's loops cross), which the band alone, as a
-  set of points, would not. So for path points p_0 .. p_n at arc
-  lengths 0 < l < 2 l < .. (the last the end; p_0, p_n the program's ends)
-  there are times 0 = tau_0 <= tau_1 <= .. <= tau_n = T with |e_k| <= P,
-  e_k = x(tau_k) - p_k, and e_0 = e_n = 0 (the motion starts and ends there);
+- the motion x(t) follows the path within P, in order (what the trapezoids'
+  corner and arc arguments take too: a motion must run every block, not skip
+  through a crossing): a point, the walker, goes along the path from its
+  start to its end, never back, always within P of the motion; it may jump
+  ahead, but never past the whole of a block (a jump starts and ends in one
+  block or in two that follow each other: a blend cutting a corner is such
+  a jump). Only "in order" makes the cross-sections below hold where the
+  path comes back near itself (tiny's loops cross), which the band alone,
+  as a set of points, would not. So for path points p_0 .. p_n in the path's
+  order (p_0, p_n the program's ends) there are times 0 = tau_0 <= tau_1 <=
+  .. <= tau_n = T with |e_k| <= E_k, e_k = x(tau_k) - p_k, e_0 = e_n = 0 (the
+  motion starts and ends there): tau_k the moment the walker reaches or
+  jumps past p_k, where x is within P of the walker's points A just before
+  and B just after (|A - B| <= 2 P). Where the walker goes on without a jump,
+  or jumps along a line, E_k = P (every point of the chord AB is within P of
+  x, and p_k is on it); within an arc of radius r, P plus the height of the
+  arc over a chord of 2 P; across the vertex of two blocks turning by phi,
+  x is within P of both, so no further than P / cos(phi / 2) from the
+  vertex (where the inner edges meet) and, by the same convexity, from the
+  points between A and the vertex and the vertex and B; those lie no
+  further from it than 2 P / sin(the blocks' angle, at most a right angle)
+  along a line (A within 2 P of the other block), twice that and 2 P more
+  beside an arc, whose bend over the reach is added to E. E_k the largest of
+  these that apply to p_k. The walker kept within P of the motion
+  throughout (no jumps: a Frechet distance of P) would give E_k = P
+  everywhere; a motion that cuts a sharp corner within the band is not held
+  to that;
 - window k, t_k = tau_k - tau_(k-1), has the mean velocity m_k = (d_k + e_k -
   e_(k-1)) / t_k, d_k = p_k - p_(k-1). Every axis within V_j and the feed
   within F: |d_k| - |e_k| - |e_(k-1)| <= F t_k, and the same per axis with V_j
@@ -117,8 +132,13 @@ follows the curve can do. The windows read the turns of many blocks at once:
   can only come out low: boxes count as feasible together if the
   constraint can hold anywhere in them (the least |..| over the boxes
   against the most room), and a box costs its lower corner. Windows of
-  0.25, 0.4, 0.5, 1 and 2 mm (fewer, longer ones past MOST windows) give
-  the bounds; the largest is taken. They gain on curves sampled by short
+  0.25, 0.4, 0.5, 1 and 2 mm (fewer, longer ones past MOST windows), and
+  windows from block end to block end (blocks longer than 0.5, 0.7 or 1 mm
+  cut into equal pieces), give the bounds; the largest is taken. A window
+  across a corner reads only its chord, which cuts the corner; one that
+  ends at the corner reads the turn itself (sharp: 12.483 -> 13.608 s). A
+  point is left out where its window would be shorter than SPREAD times
+  the E at its two ends (that merges two windows, which is again a window). They gain on curves sampled by short
   chords (tiny: 2.271 -> 3.499 s); where corners between long lines
   decide the time the trapezoids stay the larger. Both are loose on tiny
   still: bench/piece-lp's optimum on 80-block pieces is 1.17-1.38 times
@@ -473,33 +493,106 @@ def windows_bound(pts, err, feed, vmax, amax, skip=False, ratio=RATIO, span=SPAN
 LENGTHS = (0.25, 0.4, 0.5, 1.0, 2.0)   # window lengths tried, mm (the largest bound is taken)
 SKIP = (0.4,)             # and with each window held to the one two back too (slower)
 MOST = 600              # windows at most (longer ones on long paths: time)
+VERTEX_PIECES = (0.5, 0.7, 1.0)   # windows from block end to block end, blocks cut into pieces of at most this
+SPREAD = 1.5            # a window at least this many times the sum of its ends' E
+
+
+def junctions(segs, path, tol, vmax, amax):
+    """Where a jump of the walker between two blocks may leave it more than P
+    from the motion (the docstring's E): per junction with a turn, its arc
+    length, the E of every point a jump across it can pass, and how far
+    along the path either side such a point can lie."""
+    out = []
+    for k in range(1, len(segs)):
+        g0, g1 = geometry(segs[k - 1], vmax, amax), geometry(segs[k], vmax, amax)
+        c = max(-1.0, min(1.0, sum(p * q for p, q in zip(g0[4], g1[3]))))
+        phi = math.acos(c)
+        if phi <= 1e-9:
+            continue
+        theta = math.pi - phi                       # the angle between the blocks at the vertex
+        # a jump's ends lie within 2 P of each other, each within 2 P of the
+        # other block: no further from the vertex than this along a line
+        reach = 2 * tol / math.sin(min(theta, math.pi / 2)) if theta > 1e-9 else math.inf
+        curv = sum(1.0 / g[5] for g in (g0, g1) if math.isfinite(g[5]) and g[5] > 0)
+        if curv > 0:
+            reach = 2 * reach + 2 * tol             # an arc may bend towards the other block
+        reach = min(reach, path.len[k - 1] + path.len[k])
+        e = tol / math.cos(phi / 2) if phi < math.pi - 1e-6 else math.inf
+        # P + the height of the path's piece between the jump's ends over their chord
+        e = min(e, tol + reach) + reach * reach * curv / 2
+        out.append((path.s0[k], e, reach))
+    return out
+
+
+def point_errors(path, s, tol, joints):
+    """E per path point at arc lengths s: how far from it the motion may be
+    when the walker passes it (0 at the program's ends, at rest there)."""
+    s = np.asarray(s, dtype=float)
+    err = np.full(len(s), float(tol))
+    idx = np.clip(np.searchsorted(path.s0, s, side="right") - 1, 0, len(path.segs) - 1)
+    for i, g in enumerate(path.segs):
+        if g[0] == "arc":
+            r = abs(g[1][2])
+            err[idx == i] = tol + r - math.sqrt(max(r * r - tol * tol, 0.0)) if r > tol else tol + r
+    for at, e, reach in joints:
+        near = np.abs(s - at) <= reach * (1 + 1e-9) + 1e-12
+        err[near] = np.maximum(err[near], e)
+    err[0] = err[-1] = 0.0
+    return err
+
+
+def spread(path, s, err):
+    """The points of s (its first and last kept) with every window longer
+    than SPREAD times the E at its ends, so the window bound's slack leaves
+    it some length; dropping a point only merges two windows."""
+    pts = path.at(s)
+    keep = [0]
+    for i in range(1, len(s) - 1):
+        if np.linalg.norm(pts[i] - pts[keep[-1]]) > SPREAD * (err[i] + err[keep[-1]]) and \
+                np.linalg.norm(pts[-1] - pts[i]) > SPREAD * (err[i] + err[-1]):
+            keep.append(i)
+    keep.append(len(s) - 1)
+    return np.asarray(s)[keep], err[keep]
 
 
 def window_bounds(segs, tol, vmax, amax):
-    """{windows: the window bound} (the docstring), windows of each
-    length in LENGTHS along the path from its start, the last one taking the
-    rest."""
+    """{windows: the window bound} (the docstring): windows of each length in
+    LENGTHS along the path from its start, the last one taking the rest; and
+    windows from block end to block end, longer blocks cut into equal pieces
+    of at most each of VERTEX_PIECES (a window's chord is then its path,
+    where one across a corner cuts it)."""
     if not segs or tol <= 0:
         return {}
     if any(norm(sub(a[2], b[1])) > 1e-9 for a, b in zip(segs, segs[1:])):
         return {}             # a rapid in between: the blocks are not one path
     feed = max(sg[3] for sg in segs)
     path = Path(segs)
+    joints = junctions(segs, path, tol, vmax, amax)
     out = {}
+
+    def run(name, s, skip=False):
+        s, err = spread(path, s, point_errors(path, s, tol, joints))
+        if len(s) < 3:
+            return
+        b = windows_bound(path.at(s), err, feed, vmax, amax) if not skip else \
+            windows_bound(path.at(s), err, feed, vmax, amax, skip=True, ratio=1.03, span=30.0)
+        if b is not None:
+            out[name] = b
+
     for length in sorted(set(max(x, path.total / MOST) for x in LENGTHS)):
         n = int(path.total / length)
         if n < 2:
             continue
         s = np.concatenate([np.arange(n) * length, [path.total]])
-        err = np.full(n + 1, float(tol))
-        err[0] = err[-1] = 0.0
-        b = windows_bound(path.at(s), err, feed, vmax, amax)
-        if b is not None:
-            out["%g mm" % length] = b
+        run("%g mm" % length, s)
         if length in SKIP:
-            b = windows_bound(path.at(s), err, feed, vmax, amax, skip=True, ratio=1.03, span=30.0)
-            if b is not None:
-                out["%g mm, every other too" % length] = b
+            run("%g mm, every other too" % length, s, skip=True)
+    for piece in VERTEX_PIECES:
+        s = []
+        for s0, L in zip(path.s0, path.len):
+            k = max(1, int(math.ceil(L / max(piece, path.total / MOST))))
+            s.extend(s0 + L * np.arange(k) / k)
+        run("blocks in %g mm" % piece, np.array(s + [path.total]))
     return out
 
 
