@@ -83,9 +83,9 @@ follows the curve can do. The windows read the turns of many blocks at once:
   corner and arc arguments take too: a motion must run every block, not skip
   through a crossing): a point, the walker, goes along the path from its
   start to its end, never back, always within P of the motion; it may jump
-  ahead, but never past the whole of a block (a jump starts and ends in one
-  block or in two that follow each other: a blend cutting a corner is such
-  a jump). Only "in order" makes the cross-sections below hold where the
+  ahead, but never past the whole of a block nor half a turn of an arc (a
+  jump starts and ends in one block or in two that follow each other: a
+  blend cutting a corner is such a jump). Only "in order" makes the cross-sections below hold where the
   path comes back near itself (tiny's loops cross), which the band alone,
   as a set of points, would not. So for path points p_0 .. p_n in the path's
   order (p_0, p_n the program's ends) there are times 0 = tau_0 <= tau_1 <=
@@ -100,9 +100,11 @@ follows the curve can do. The windows read the turns of many blocks at once:
   vertex (where the inner edges meet) and, by the same convexity, from the
   points between A and the vertex and the vertex and B; those lie no
   further from it than 2 P / sin(the blocks' angle, at most a right angle)
-  along a line (A within 2 P of the other block), twice that and 2 P more
-  beside an arc, whose bend over the reach is added to E. E_k the largest of
-  these that apply to p_k. The walker kept within P of the motion
+  along a line (A within 2 P of the other block). Beside an arc, which may
+  bend back towards the other block, both blocks are sampled (every P / 4,
+  up to half a turn of an arc) and E is P plus the most any path point
+  between a jump's ends lies from their chord, a step more for the
+  samples. E_k the largest of these that apply to p_k. The walker kept within P of the motion
   throughout (no jumps: a Frechet distance of P) would give E_k = P
   everywhere; a motion that cuts a sharp corner within the band is not held
   to that;
@@ -535,13 +537,69 @@ REFINE = 1               # refining passes on the best placement
 SPREAD = 1.5            # a window at least this many times the sum of its ends' E
 
 
+def seg_dist(pts, a, b):
+    """Distances of points pts (n, 3) from the segments a[j] -> b[j]: (n, m)."""
+    ab = b - a
+    ll = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
+    rel = pts[:, None, :] - a[None, :, :]
+    f = np.clip(np.einsum("nmj,mj->nm", rel, ab) / ll[None, :], 0.0, 1.0)
+    return np.linalg.norm(rel - f[:, :, None] * ab[None, :, :], axis=2)
+
+
+def jump_reach(path, k, tol):
+    """Beside an arc, by samples: for jumps from block k - 1 into block k
+    (their ends within 2 P of each other, at most half a turn of an arc from
+    the vertex), the most P plus the path's height over such a jump's chord,
+    and the farthest from the vertex (along the path) either end lies."""
+    at = path.s0[k]
+    step, coarse = tol / 4, 4 * tol
+
+    def side(i, sign, every, limit=math.inf):
+        g = path.segs[i]
+        most = min(path.len[i], limit)
+        if g[0] == "arc":
+            most = min(most, path.len[i] * math.pi / abs(g[1][4]) * (1 - 1e-9))
+        d = np.arange(0.0, most + every / 2, every)
+        return d, path.at(at + sign * d)
+
+    def pairs(pa, pb, every):
+        return np.linalg.norm(pa[:, None, :] - pb[None, :, :], axis=2) <= 2 * tol + 2 * every
+
+    # where jumps can be, on coarse samples first (a fine pair within 2 P has
+    # coarse samples within 2 P + 2 coarse steps), then every P / 4 up to there
+    da, pa = side(k - 1, -1, coarse)
+    db, pb = side(k, 1, coarse)
+    near = pairs(pa, pb, coarse)
+    da, pa = side(k - 1, -1, step, da[np.nonzero(near.any(axis=1))[0].max()] + coarse)
+    db, pb = side(k, 1, step, db[np.nonzero(near.any(axis=0))[0].max()] + coarse)
+    near = pairs(pa, pb, step)
+    height, reach = 0.0, 0.0
+    for i in np.nonzero(near.any(axis=1))[0]:
+        js = np.nonzero(near[i])[0]
+        a = np.repeat(pa[i][None, :], len(js), axis=0)
+        b = pb[js]
+        # the path between: block k - 1's samples from A to the vertex, and
+        # block k's from the vertex to B (those beyond B masked out)
+        h = seg_dist(pa[:i + 1], a, b).max(axis=0)
+        hb = np.where(np.arange(js.max() + 1)[:, None] <= js[None, :], seg_dist(pb[:js.max() + 1], a, b), 0.0)
+        height = max(height, float(np.maximum(h, hb.max(axis=0)).max()))
+        reach = max(reach, da[i], db[js].max())
+    # a jump's ends and the path may lie between samples: a step more of each
+    return tol + height + step, reach + step
+
+
 def junctions(segs, path, tol, vmax, amax):
     """Where a jump of the walker between two blocks may leave it more than P
-    from the motion (the docstring's E): per junction with a turn, its arc
-    length, the E of every point a jump across it can pass, and how far
-    along the path either side such a point can lie."""
+    from the motion (the docstring's E): per junction, its arc length, the E
+    of every point a jump across it can pass, and how far along the path
+    either side such a point can lie. Between lines exactly; beside an arc
+    (which may bend back towards the other block) by samples."""
     out = []
     for k in range(1, len(segs)):
+        if path.segs[k - 1][0] == "arc" or path.segs[k][0] == "arc":
+            e, reach = jump_reach(path, k, tol)
+            out.append((path.s0[k], e, reach))
+            continue
         g0, g1 = geometry(segs[k - 1], vmax, amax), geometry(segs[k], vmax, amax)
         c = max(-1.0, min(1.0, sum(p * q for p, q in zip(g0[4], g1[3]))))
         phi = math.acos(c)
@@ -551,14 +609,10 @@ def junctions(segs, path, tol, vmax, amax):
         # a jump's ends lie within 2 P of each other, each within 2 P of the
         # other block: no further from the vertex than this along a line
         reach = 2 * tol / math.sin(min(theta, math.pi / 2)) if theta > 1e-9 else math.inf
-        curv = sum(1.0 / g[5] for g in (g0, g1) if math.isfinite(g[5]) and g[5] > 0)
-        if curv > 0:
-            reach = 2 * reach + 2 * tol             # an arc may bend towards the other block
         reach = min(reach, path.len[k - 1] + path.len[k])
         e = tol / math.cos(phi / 2) if phi < math.pi - 1e-6 else math.inf
-        # P + the height of the path's piece between the jump's ends over their chord
-        e = min(e, tol + reach) + reach * reach * curv / 2
-        out.append((path.s0[k], e, reach))
+        # at most P + the distance from the jump's chord of the vertex
+        out.append((path.s0[k], min(e, tol + reach), reach))
     return out
 
 
