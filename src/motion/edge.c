@@ -208,6 +208,8 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     trim[EDGE_SCAN + 1] = dmax;
     for (int i = 1; i <= EDGE_SCAN; i++)
         trim[i] = reach * pow(EDGE_STEP, i - EDGE_SCAN);
+    /* the range's upper end is found from the last trim that fits, so the
+     * scan goes on past the first only where that end is asked for */
     int first = 0, last = 0;
     for (int i = 1; i <= EDGE_SCAN; i++) {
         int ok = fits(&free_prev, cur, k, rho, trim[i], tol);
@@ -217,28 +219,36 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
             last = i;
         else if (first)
             break;
+        if (first && !hi)
+            break;
     }
     if (first < 1 || last < first)
         return 0;
-    double a = trim[first - 1], b = trim[first];
-    for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
-        double m = 0.5 * (a + b);
-        if (fits(&free_prev, cur, k, rho, m, tol))
-            b = m;
-        else
-            a = m;
+    double a, b;
+    if (lo) {
+        a = trim[first - 1];
+        b = trim[first];
+        for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
+            double m = 0.5 * (a + b);
+            if (fits(&free_prev, cur, k, rho, m, tol))
+                b = m;
+            else
+                a = m;
+        }
+        *lo = b;
     }
-    *lo = b;
-    a = trim[last];
-    b = fmin(dmax, trim[last + 1]);
-    for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
-        double m = 0.5 * (a + b);
-        if (fits(&free_prev, cur, k, rho, m, tol))
-            a = m;
-        else
-            b = m;
+    if (hi) {
+        a = trim[last];
+        b = fmin(dmax, trim[last + 1]);
+        for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
+            double m = 0.5 * (a + b);
+            if (fits(&free_prev, cur, k, rho, m, tol))
+                a = m;
+            else
+                b = m;
+        }
+        *hi = a;
     }
-    *hi = a;
     return 1;
 }
 

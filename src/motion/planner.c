@@ -881,7 +881,7 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
     *cost = best;
     int found = 0, moved = corner && corner->shifted;
     for (int k = 0; k <= RATIO_STEPS; k++) {
-        double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2, lo, hi;
+        double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2, hi;
         struct ncp_seg b;
         /* at a moved vertex each ratio is a search: every
          * RATIO_MOVED_EVERY-th one */
@@ -890,7 +890,7 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
         /* at a moved vertex: the largest blend measured within P of the
          * programmed lines; elsewhere the largest within P of the lines */
         if (moved ? !ncp_edge_trims(&prev->s, s, corner, tol_u.tolerance, rho,
-                                    fmin(0.2 * len1, 0.2 * len2 / rho), &lo, &hi) ||
+                                    fmin(0.2 * len1, 0.2 * len2 / rho), NULL, &hi) ||
                         !ncp_blend_corner_ratio_at(&prev->s, s, rho, hi, &b, &t1, &t2)
                   : !ncp_blend_corner_ratio(&tol_u, s, rho, &b, &t1, &t2))
             continue;
@@ -1187,8 +1187,7 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *ta
     struct ncp_seg h = *held;
     memcpy(h.end, end, 3 * sizeof h.end[0]);
     h.length = dist3(h.start, h.end);
-    double lo, hi;
-    return ncp_edge_trims(tail, &h, k, blend_tol(p, tail->tolerance), 1, INFINITY, &lo, &hi);
+    return ncp_edge_trims(tail, &h, k, blend_tol(p, tail->tolerance), 1, INFINITY, NULL, NULL);
 }
 
 /* Whether the vertex between held lines h and cur moves out (k: its
@@ -1202,7 +1201,7 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *ta
 static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start,
                         struct ncp_seg *h, struct ncp_seg *cur, struct plan_corner *k)
 {
-    double tol = blend_tol(p, h->tolerance), moved[3], lo, hi, d;
+    double tol = blend_tol(p, h->tolerance), moved[3], hi, d;
     if (h->tolerance != cur->tolerance || !ncp_edge_vertex(k->a, k->c, k->b, k->out, moved))
         return;
     /* the queue's last line is blended into h: as programmed there, or
@@ -1239,7 +1238,7 @@ static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start
     struct ncp_seg free_h2 = h2;
     free_h2.tolerance = 0;
     double d_out;
-    if (!ncp_edge_trims(&h2, &c2, k, tol, 1, 0.5 * h2.length - 1e-3, &lo, &hi) ||
+    if (!ncp_edge_trims(&h2, &c2, k, tol, 1, 0.5 * h2.length - 1e-3, NULL, &hi) ||
         !ncp_blend_corner(&free_h2, &c2, hi, &bl, &d_out))
         return;
     double v_out = fmin(v_goal, arc_speed(p, &bl));

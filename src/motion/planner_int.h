@@ -165,8 +165,9 @@ void ncp_planner_edge_low(struct ncp_planner *p);
 int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, double tol_in);
 /* edge.c: the blends between prev and cur, even (rho 1) or uneven (trim d
  * off prev, rho d off cur), d up to max_trim and the lines' share, that stay
- * within tol of k's programmed polyline: d from *lo to *hi. 0 when none
- * does. */
+ * within tol of k's programmed polyline: d from *lo to *hi (either may be
+ * NULL where not wanted, and its end of the range is not searched for). 0
+ * when none does. */
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
                    const struct plan_corner *k, double tol, double rho, double max_trim,
                    double *lo, double *hi);
