@@ -116,31 +116,46 @@ static int piece_fits(const struct edge_seg *g, const struct edge_at x[3], int t
     return 1;
 }
 
-int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, double tol_in)
+/* A corner's programmed polyline set up for measuring many blends against
+ * it: the two segments, their directions (c - a and b - c) and the band. */
+struct edge_band {
+    struct edge_seg g[2];
+    double u1[3], u2[3], tol_in, tol_out;
+};
+
+static void band_init(struct edge_band *e, const struct plan_corner *k, double tol_in)
+{
+    double back[3];
+    e->tol_out = greater(tol_in, k->out) + EDGE_ROUND;
+    e->tol_in = tol_in + EDGE_ROUND;
+    for (int i = 0; i < 3; i++) {
+        e->u1[i] = k->c[i] - k->a[i];
+        e->u2[i] = k->b[i] - k->c[i];
+        back[i] = -e->u1[i];
+    }
+    /* inside the turn: towards the second line from the first, back along
+     * the first from the second */
+    seg_init(&e->g[0], k->a, k->c, e->u2);
+    seg_init(&e->g[1], k->c, k->b, back);
+}
+
+/* Whether the parabola p0, pc, p1 stays within e's band. */
+static int band_within(const struct edge_band *e, const double p0[3], const double pc[3],
+                       const double p1[3])
 {
     /* the parabola is the quadratic Bezier start, centre, end; each piece
      * between two samples is one too, inside the triangle of its ends and
      * the meeting of its end tangents */
-    double u1[3], u2[3], back[3], tol_out = greater(tol_in, k->out) + EDGE_ROUND;
-    tol_in += EDGE_ROUND;
-    for (int i = 0; i < 3; i++) {
-        u1[i] = k->c[i] - k->a[i];
-        u2[i] = k->b[i] - k->c[i];
-        back[i] = -u1[i];
-    }
-    /* inside the turn: towards the second line from the first, back along
-     * the first from the second */
-    struct edge_seg g1, g2;
-    seg_init(&g1, k->a, k->c, u2);
-    seg_init(&g2, k->c, k->b, back);
-    const double *p0 = blend->start, *pc = blend->center, *p1 = blend->end;
-    struct edge_at on1[3], on2[3];
+    struct edge_at on[2][3];
     double q0[3], q1[3], ctrl[3], d0[3], d1[3];
     memcpy(q0, p0, sizeof q0);
     for (int i = 0; i < 3; i++)
         d0[i] = pc[i] - p0[i];   /* B'(t) / 2 at t = 0 */
-    on1[0] = seg_at(&g1, p0);
-    on2[0] = seg_at(&g2, p0);
+    /* A piece needs only one segment it fits, and the one the piece before
+     * fitted is tried first: the blend runs beside the first line, then
+     * beside the second. Only a segment tried has its points measured;
+     * have[j] says on[j][0] holds the piece's start measured against it. */
+    int have[2] = { 0, 0 }, near = 0;
     for (int n = 0; n < EDGE_PIECES; n++) {
         double t0 = (double)n / EDGE_PIECES, t1 = (double)(n + 1) / EDGE_PIECES;
         double tan0 = 0, tan1 = 0;
@@ -149,38 +164,56 @@ int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, do
             d1[i] = (1 - t1) * (pc[i] - p0[i]) + t1 * (p1[i] - pc[i]);
             /* B(t0) + (t1 - t0) / 2 B'(t0) */
             ctrl[i] = q0[i] + (t1 - t0) * d0[i];
-            tan0 += d0[i] * u2[i];
-            tan1 += d1[i] * u1[i];
+            tan0 += d0[i] * e->u2[i];
+            tan1 += d1[i] * e->u1[i];
         }
-        on1[1] = seg_at(&g1, q1);
-        on1[2] = seg_at(&g1, ctrl);
-        on2[1] = seg_at(&g2, q1);
-        on2[2] = seg_at(&g2, ctrl);
         /* the tangent turns one way along the blend: at the piece's end it
          * has turned furthest from the first line, at its start least far
          * from the second */
-        if (!piece_fits(&g1, on1, tan1 >= 0, tol_in, tol_out) &&
-            !piece_fits(&g2, on2, tan0 >= 0, tol_in, tol_out))
+        int tangent_ok[2] = { tan1 >= 0, tan0 >= 0 }, tried[2] = { 0, 0 }, fit = -1;
+        for (int m = 0; m < 2 && fit < 0; m++) {
+            int j = near ^ m;
+            const struct edge_seg *g = &e->g[j];
+            if (!have[j])
+                on[j][0] = seg_at(g, q0);
+            on[j][1] = seg_at(g, q1);
+            on[j][2] = seg_at(g, ctrl);
+            tried[j] = 1;
+            if (piece_fits(g, on[j], tangent_ok[j], e->tol_in, e->tol_out))
+                fit = j;
+        }
+        if (fit < 0)
             return 0;
-        on1[0] = on1[1];
-        on2[0] = on2[1];
+        for (int j = 0; j < 2; j++) {
+            have[j] = tried[j];
+            if (tried[j])
+                on[j][0] = on[j][1];
+        }
+        near = fit;
         memcpy(q0, q1, sizeof q0);
         memcpy(d0, d1, sizeof d0);
     }
     return 1;
 }
 
-/* Does the blend of trim d (rho d off cur) stay within tol of k's programmed
- * polyline? No where there is no such blend. */
+int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, double tol_in)
+{
+    struct edge_band e;
+    band_init(&e, k, tol_in);
+    return band_within(&e, blend->start, blend->center, blend->end);
+}
+
+/* Does the blend of trim d (rho d off cur) stay within e's band? No where
+ * there is no such blend. */
 static int fits(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
-                const struct plan_corner *k, double rho, double d, double tol)
+                const struct edge_band *e, double rho, double d)
 {
     struct ncp_seg bl;
     double got, got_cur;
     if (rho == 1 ? !ncp_blend_corner(free_prev, cur, d, &bl, &got)
                  : !ncp_blend_corner_ratio_at(free_prev, cur, rho, d, &bl, &got, &got_cur))
         return 0;
-    return ncp_edge_within(&bl, k, tol);
+    return band_within(e, bl.start, bl.center, bl.end);
 }
 
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
@@ -203,6 +236,8 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     }
     cross3(u1, u2, n);
     double reach = fmin(dmax, EDGE_REACH * tol / fmax(sqrt(dot3(n, n)), 1e-6));
+    struct edge_band band;
+    band_init(&band, k, tol);
     double trim[EDGE_SCAN + 2];
     trim[0] = 0;
     trim[EDGE_SCAN + 1] = dmax;
@@ -212,7 +247,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
      * scan goes on past the first only where that end is asked for */
     int first = 0, last = 0;
     for (int i = 1; i <= EDGE_SCAN; i++) {
-        int ok = fits(&free_prev, cur, k, rho, trim[i], tol);
+        int ok = fits(&free_prev, cur, &band, rho, trim[i]);
         if (ok && !first)
             first = i;
         if (ok)
@@ -230,7 +265,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         b = trim[first];
         for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
             double m = 0.5 * (a + b);
-            if (fits(&free_prev, cur, k, rho, m, tol))
+            if (fits(&free_prev, cur, &band, rho, m))
                 b = m;
             else
                 a = m;
@@ -242,7 +277,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         b = fmin(dmax, trim[last + 1]);
         for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
             double m = 0.5 * (a + b);
-            if (fits(&free_prev, cur, k, rho, m, tol))
+            if (fits(&free_prev, cur, &band, rho, m))
                 a = m;
             else
                 b = m;
