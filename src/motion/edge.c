@@ -203,17 +203,12 @@ int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, do
     return band_within(&e, blend->start, blend->center, blend->end);
 }
 
-/* Does the blend of trim d (rho d off cur) stay within e's band? No where
- * there is no such blend. */
-static int fits(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
-                const struct edge_band *e, double rho, double d)
+/* Does the blend of trim d (fan: rho d off cur) stay within e's band? No
+ * where there is no such blend. */
+static int fits(const struct ncp_blend_fan *fan, const struct edge_band *e, double d)
 {
-    struct ncp_seg bl;
-    double got, got_cur;
-    if (rho == 1 ? !ncp_blend_corner(free_prev, cur, d, &bl, &got)
-                 : !ncp_blend_corner_ratio_at(free_prev, cur, rho, d, &bl, &got, &got_cur))
-        return 0;
-    return band_within(e, bl.start, bl.center, bl.end);
+    double start[3], end[3];
+    return ncp_blend_fan_at(fan, d, start, end) && band_within(e, start, fan->c, end);
 }
 
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
@@ -221,20 +216,17 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
                    double *lo, double *hi)
 {
     /* without P the blend takes what the lines allow: the range to search */
-    struct ncp_seg free_prev = *prev, bl;
-    free_prev.tolerance = 0;
-    double dmax, got_cur;
-    if (rho == 1 ? !ncp_blend_corner(&free_prev, cur, max_trim, &bl, &dmax)
-                 : !ncp_blend_corner_ratio_at(&free_prev, cur, rho, max_trim, &bl, &dmax, &got_cur))
+    struct ncp_blend_fan fan;
+    double s0[3], e0[3];
+    if (!ncp_blend_fan_init(&fan, prev, cur, rho))
+        return 0;
+    double dmax = ncp_blend_fan_at(&fan, max_trim, s0, e0);
+    if (dmax == 0)
         return 0;
     /* a blend too short stays near the moved vertex, one too long cuts in
      * too deep: the trims within tol are one range between them */
-    double u1[3], u2[3], n[3];
-    for (int i = 0; i < 3; i++) {
-        u1[i] = (prev->end[i] - prev->start[i]) / prev->length;
-        u2[i] = (cur->end[i] - cur->start[i]) / cur->length;
-    }
-    cross3(u1, u2, n);
+    double n[3];
+    cross3(fan.u1, fan.u2, n);
     double reach = fmin(dmax, EDGE_REACH * tol / fmax(sqrt(dot3(n, n)), 1e-6));
     struct edge_band band;
     band_init(&band, k, tol);
@@ -247,7 +239,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
      * scan goes on past the first only where that end is asked for */
     int first = 0, last = 0;
     for (int i = 1; i <= EDGE_SCAN; i++) {
-        int ok = fits(&free_prev, cur, &band, rho, trim[i]);
+        int ok = fits(&fan, &band, trim[i]);
         if (ok && !first)
             first = i;
         if (ok)
@@ -265,7 +257,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         b = trim[first];
         for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
             double m = 0.5 * (a + b);
-            if (fits(&free_prev, cur, &band, rho, m))
+            if (fits(&fan, &band, m))
                 b = m;
             else
                 a = m;
@@ -277,7 +269,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         b = fmin(dmax, trim[last + 1]);
         for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
             double m = 0.5 * (a + b);
-            if (fits(&free_prev, cur, &band, rho, m))
+            if (fits(&fan, &band, m))
                 a = m;
             else
                 b = m;
