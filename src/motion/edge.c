@@ -156,6 +156,7 @@ static int band_within(const struct edge_band *e, const double p0[3], const doub
      * beside the second. Only a segment tried has its points measured;
      * have[j] says on[j][0] holds the piece's start measured against it. */
     int have[2] = { 0, 0 }, near = 0;
+    double out2 = e->tol_out * e->tol_out;
     for (int n = 0; n < EDGE_PIECES; n++) {
         double t0 = (double)n / EDGE_PIECES, t1 = (double)(n + 1) / EDGE_PIECES;
         double tan0 = 0, tan1 = 0;
@@ -176,9 +177,15 @@ static int band_within(const struct edge_band *e, const double p0[3], const doub
             const struct edge_seg *g = &e->g[j];
             if (!have[j])
                 on[j][0] = seg_at(g, q0);
+            /* a corner beyond tol_out fails the piece whatever the others
+             * (tol_out >= tol_in): the rest are not measured */
+            if (on[j][0].dist2 > out2)
+                continue;
             on[j][1] = seg_at(g, q1);
-            on[j][2] = seg_at(g, ctrl);
             tried[j] = 1;
+            if (on[j][1].dist2 > out2)
+                continue;
+            on[j][2] = seg_at(g, ctrl);
             if (piece_fits(g, on[j], tangent_ok[j], e->tol_in, e->tol_out))
                 fit = j;
         }
