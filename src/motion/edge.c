@@ -139,27 +139,39 @@ static void band_init(struct edge_band *e, const struct plan_corner *k, double t
     seg_init(&e->g[1], k->c, k->b, back);
 }
 
-/* Whether the parabola p0, pc, p1 stays within e's band. */
+/* Whether the parabola p0, pc, p1 stays within e's band. Where hint is
+ * given and *hint is a piece, that piece is measured first, and a piece
+ * that fails goes to *hint: the blends of one search fail alike, those a
+ * little too large where they cut in deepest. */
 static int band_within(const struct edge_band *e, const double p0[3], const double pc[3],
-                       const double p1[3])
+                       const double p1[3], int *hint)
 {
     /* the parabola is the quadratic Bezier start, centre, end; each piece
      * between two samples is one too, inside the triangle of its ends and
      * the meeting of its end tangents */
     struct edge_at on[2][3];
     double q0[3], q1[3], ctrl[3], d0[3], d1[3];
-    memcpy(q0, p0, sizeof q0);
-    for (int i = 0; i < 3; i++)
-        d0[i] = pc[i] - p0[i];   /* B'(t) / 2 at t = 0 */
     /* A piece needs only one segment it fits, and the one the piece before
      * fitted is tried first: the blend runs beside the first line, then
      * beside the second. Only a segment tried has its points measured;
      * have[j] says on[j][0] holds the piece's start measured against it. */
-    int have[2] = { 0, 0 }, near = 0;
+    int have[2] = { 0, 0 }, near = 0, ahead = hint && *hint >= 0 ? *hint : -1;
     double out2 = e->tol_out * e->tol_out;
-    for (int n = 0; n < EDGE_PIECES; n++) {
+    /* k 0: the piece ahead; k from 1: piece k - 1 */
+    for (int k = ahead < 0; k <= EDGE_PIECES; k++) {
+        int n = k ? k - 1 : ahead;
         double t0 = (double)n / EDGE_PIECES, t1 = (double)(n + 1) / EDGE_PIECES;
         double tan0 = 0, tan1 = 0;
+        if (k <= 1) {
+            /* B(t0) and B'(t0) / 2, as the piece before would leave them */
+            for (int i = 0; i < 3; i++) {
+                q0[i] = n ? (1 - t0) * (1 - t0) * p0[i] + 2 * t0 * (1 - t0) * pc[i] +
+                                t0 * t0 * p1[i]
+                          : p0[i];
+                d0[i] = n ? (1 - t0) * (pc[i] - p0[i]) + t0 * (p1[i] - pc[i]) : pc[i] - p0[i];
+            }
+            have[0] = have[1] = 0;
+        }
         for (int i = 0; i < 3; i++) {
             q1[i] = (1 - t1) * (1 - t1) * p0[i] + 2 * t1 * (1 - t1) * pc[i] + t1 * t1 * p1[i];
             d1[i] = (1 - t1) * (pc[i] - p0[i]) + t1 * (p1[i] - pc[i]);
@@ -167,6 +179,13 @@ static int band_within(const struct edge_band *e, const double p0[3], const doub
             ctrl[i] = q0[i] + (t1 - t0) * d0[i];
             tan0 += d0[i] * e->u2[i];
             tan1 += d1[i] * e->u1[i];
+        }
+        if (k && n == ahead) {
+            /* measured already */
+            have[0] = have[1] = 0;
+            memcpy(q0, q1, sizeof q0);
+            memcpy(d0, d1, sizeof d0);
+            continue;
         }
         /* the tangent turns one way along the blend: at the piece's end it
          * has turned furthest from the first line, at its start least far
@@ -189,8 +208,11 @@ static int band_within(const struct edge_band *e, const double p0[3], const doub
             if (piece_fits(g, on[j], tangent_ok[j], e->tol_in, e->tol_out))
                 fit = j;
         }
-        if (fit < 0)
+        if (fit < 0) {
+            if (hint)
+                *hint = n;
             return 0;
+        }
         for (int j = 0; j < 2; j++) {
             have[j] = tried[j];
             if (tried[j])
@@ -207,15 +229,15 @@ int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, do
 {
     struct edge_band e;
     band_init(&e, k, tol_in);
-    return band_within(&e, blend->start, blend->center, blend->end);
+    return band_within(&e, blend->start, blend->center, blend->end, NULL);
 }
 
 /* Does the blend of trim d (fan: rho d off cur) stay within e's band? No
  * where there is no such blend. */
-static int fits(const struct ncp_blend_fan *fan, const struct edge_band *e, double d)
+static int fits(const struct ncp_blend_fan *fan, const struct edge_band *e, double d, int *hint)
 {
     double start[3], end[3];
-    return ncp_blend_fan_at(fan, d, start, end) && band_within(e, start, fan->c, end);
+    return ncp_blend_fan_at(fan, d, start, end) && band_within(e, start, fan->c, end, hint);
 }
 
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
@@ -244,9 +266,11 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         trim[i] = reach * pow(EDGE_STEP, i - EDGE_SCAN);
     /* the range's upper end is found from the last trim that fits, so the
      * scan goes on past the first only where that end is asked for */
-    int first = 0, last = 0;
+    /* the blends around each end of the range fail alike (band_within's
+     * hint): the one after the last that fits, then the bisection's */
+    int first = 0, last = 0, hint_lo = -1, hint_hi = -1;
     for (int i = 1; i <= EDGE_SCAN; i++) {
-        int ok = fits(&fan, &band, trim[i]);
+        int ok = fits(&fan, &band, trim[i], first ? &hint_hi : NULL);
         if (ok && !first)
             first = i;
         if (ok)
@@ -264,7 +288,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         b = trim[first];
         for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
             double m = 0.5 * (a + b);
-            if (fits(&fan, &band, m))
+            if (fits(&fan, &band, m, &hint_lo))
                 b = m;
             else
                 a = m;
@@ -276,7 +300,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
         b = fmin(dmax, trim[last + 1]);
         for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
             double m = 0.5 * (a + b);
-            if (fits(&fan, &band, m))
+            if (fits(&fan, &band, m, &hint_hi))
                 a = m;
             else
                 b = m;
