@@ -14,6 +14,7 @@
 #include "planner_int.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
 
 /* Pieces of a blend measured against the programmed polyline: each piece's
@@ -240,6 +241,17 @@ static int fits(const struct ncp_blend_fan *fan, const struct edge_band *e, doub
     return ncp_blend_fan_at(fan, d, start, end) && band_within(e, start, fan->c, end, hint);
 }
 
+/* EDGE_STEP^(i - EDGE_SCAN), the scan's trims over its reach: the same
+ * powers for every search, taken once. */
+static double edge_steps[EDGE_SCAN + 1];
+static pthread_once_t edge_steps_once = PTHREAD_ONCE_INIT;
+
+static void edge_steps_make(void)
+{
+    for (int i = 1; i <= EDGE_SCAN; i++)
+        edge_steps[i] = pow(EDGE_STEP, i - EDGE_SCAN);
+}
+
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
                    const struct plan_corner *k, double tol, double rho, double max_trim,
                    double *lo, double *hi)
@@ -262,8 +274,9 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     double trim[EDGE_SCAN + 2];
     trim[0] = 0;
     trim[EDGE_SCAN + 1] = dmax;
+    pthread_once(&edge_steps_once, edge_steps_make);
     for (int i = 1; i <= EDGE_SCAN; i++)
-        trim[i] = reach * pow(EDGE_STEP, i - EDGE_SCAN);
+        trim[i] = reach * edge_steps[i];
     /* the range's upper end is found from the last trim that fits, so the
      * scan goes on past the first only where that end is asked for */
     /* the blends around each end of the range fail alike (band_within's
