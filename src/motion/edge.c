@@ -277,10 +277,10 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     pthread_once(&edge_steps_once, edge_steps_make);
     for (int i = 1; i <= EDGE_SCAN; i++)
         trim[i] = reach * edge_steps[i];
-    /* the range's upper end is found from the last trim that fits, so the
-     * scan goes on past the first only where that end is asked for */
-    /* the blends around each end of the range fail alike (band_within's
-     * hint): the one after the last that fits, then the bisection's */
+    /* The range's upper end is found from the last trim that fits, so the
+     * scan goes on past the first only where that end is asked for. The
+     * blends about each end fail alike (band_within's hint): the one after
+     * the last that fits, then the bisection's. */
     int first = 0, last = 0, hint_lo = -1, hint_hi = -1;
     for (int i = 1; i <= EDGE_SCAN; i++) {
         int ok = fits(&fan, &band, trim[i], first ? &hint_hi : NULL);
