@@ -105,25 +105,57 @@ static double ratio_depth(double rho, double sin_phi)
     return rho * sin_phi / (q * q);
 }
 
+/* f for the corner between prev and cur, where ncp_blend_corner blends it */
+static void fan_set(struct ncp_blend_fan *f, const struct ncp_seg *prev, const struct ncp_seg *cur,
+                    double rho)
+{
+    direction(prev, f->u1);
+    direction(cur, f->u2);
+    memcpy(f->c, prev->end, sizeof f->c);
+    f->rho = rho;
+    /* within the lines as the even blend is */
+    f->room = fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length / rho);
+}
+
+int ncp_blend_fan_init(struct ncp_blend_fan *f, const struct ncp_seg *prev,
+                       const struct ncp_seg *cur, double rho)
+{
+    struct ncp_seg free_prev = *prev, blend;
+    double d;
+    free_prev.tolerance = 0;
+    if (rho <= 0 || !ncp_blend_corner(&free_prev, cur, INFINITY, &blend, &d))
+        return 0;
+    fan_set(f, prev, cur, rho);
+    return 1;
+}
+
+/* At rho 1 the bounds and the end are ncp_blend_corner's: a division by 1
+ * and a product with 1 change no bit. */
+double ncp_blend_fan_at(const struct ncp_blend_fan *f, double r0, double start[3], double end[3])
+{
+    r0 = fmin(r0, f->room);
+    if (r0 < 1e-6)
+        return 0;
+    for (int i = 0; i < 3; i++) {
+        start[i] = f->c[i] - f->u1[i] * r0;
+        end[i] = f->c[i] + f->u2[i] * f->rho * r0;
+    }
+    return r0;
+}
+
 int ncp_blend_corner_ratio_at(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
                               double r0, struct ncp_seg *blend, double *trim_prev, double *trim_cur)
 {
     double d;
     struct ncp_seg free_prev = *prev;
+    struct ncp_blend_fan f;
     free_prev.tolerance = 0;
     if (rho <= 0 || !ncp_blend_corner(&free_prev, cur, INFINITY, blend, &d))
         return 0;
-    /* within the lines as the even blend is */
-    r0 = fmin(r0, fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length / rho));
-    if (r0 < 1e-6)
+    fan_set(&f, prev, cur, rho);
+    r0 = ncp_blend_fan_at(&f, r0, blend->start, blend->end);
+    if (r0 == 0)
         return 0;
-    double u1[3], u2[3];
-    direction(prev, u1);
-    direction(cur, u2);
-    for (int i = 0; i < 3; i++) {
-        blend->start[i] = prev->end[i] - u1[i] * r0;
-        blend->end[i] = prev->end[i] + u2[i] * rho * r0;
-    }
     blend->tolerance = 0;
     blend->r0 = r0;
     blend->r1 = rho * r0;

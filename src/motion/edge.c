@@ -14,6 +14,7 @@
 #include "planner_int.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
 
 /* Pieces of a blend measured against the programmed polyline: each piece's
@@ -116,71 +117,139 @@ static int piece_fits(const struct edge_seg *g, const struct edge_at x[3], int t
     return 1;
 }
 
-int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, double tol_in)
+/* A corner's programmed polyline set up for measuring many blends against
+ * it: the two segments, their directions (c - a and b - c) and the band. */
+struct edge_band {
+    struct edge_seg g[2];
+    double u1[3], u2[3], tol_in, tol_out;
+};
+
+static void band_init(struct edge_band *e, const struct plan_corner *k, double tol_in)
+{
+    double back[3];
+    e->tol_out = greater(tol_in, k->out) + EDGE_ROUND;
+    e->tol_in = tol_in + EDGE_ROUND;
+    for (int i = 0; i < 3; i++) {
+        e->u1[i] = k->c[i] - k->a[i];
+        e->u2[i] = k->b[i] - k->c[i];
+        back[i] = -e->u1[i];
+    }
+    /* inside the turn: towards the second line from the first, back along
+     * the first from the second */
+    seg_init(&e->g[0], k->a, k->c, e->u2);
+    seg_init(&e->g[1], k->c, k->b, back);
+}
+
+/* Whether the parabola p0, pc, p1 stays within e's band. Where hint is
+ * given and *hint is a piece, that piece is measured first, and a piece
+ * that fails goes to *hint: the blends of one search fail alike, those a
+ * little too large where they cut in deepest. */
+static int band_within(const struct edge_band *e, const double p0[3], const double pc[3],
+                       const double p1[3], int *hint)
 {
     /* the parabola is the quadratic Bezier start, centre, end; each piece
      * between two samples is one too, inside the triangle of its ends and
      * the meeting of its end tangents */
-    double u1[3], u2[3], back[3], tol_out = greater(tol_in, k->out) + EDGE_ROUND;
-    tol_in += EDGE_ROUND;
-    for (int i = 0; i < 3; i++) {
-        u1[i] = k->c[i] - k->a[i];
-        u2[i] = k->b[i] - k->c[i];
-        back[i] = -u1[i];
-    }
-    /* inside the turn: towards the second line from the first, back along
-     * the first from the second */
-    struct edge_seg g1, g2;
-    seg_init(&g1, k->a, k->c, u2);
-    seg_init(&g2, k->c, k->b, back);
-    const double *p0 = blend->start, *pc = blend->center, *p1 = blend->end;
-    struct edge_at on1[3], on2[3];
+    struct edge_at on[2][3];
     double q0[3], q1[3], ctrl[3], d0[3], d1[3];
-    memcpy(q0, p0, sizeof q0);
-    for (int i = 0; i < 3; i++)
-        d0[i] = pc[i] - p0[i];   /* B'(t) / 2 at t = 0 */
-    on1[0] = seg_at(&g1, p0);
-    on2[0] = seg_at(&g2, p0);
-    for (int n = 0; n < EDGE_PIECES; n++) {
+    /* A piece needs only one segment it fits, and the one the piece before
+     * fitted is tried first: the blend runs beside the first line, then
+     * beside the second. Only a segment tried has its points measured;
+     * have[j] says on[j][0] holds the piece's start measured against it. */
+    int have[2] = { 0, 0 }, near = 0, ahead = hint && *hint >= 0 ? *hint : -1;
+    double out2 = e->tol_out * e->tol_out;
+    /* k 0: the piece ahead; k from 1: piece k - 1 */
+    for (int k = ahead < 0; k <= EDGE_PIECES; k++) {
+        int n = k ? k - 1 : ahead;
         double t0 = (double)n / EDGE_PIECES, t1 = (double)(n + 1) / EDGE_PIECES;
         double tan0 = 0, tan1 = 0;
+        if (k <= 1) {
+            /* B(t0) and B'(t0) / 2, as the piece before would leave them */
+            for (int i = 0; i < 3; i++) {
+                q0[i] = n ? (1 - t0) * (1 - t0) * p0[i] + 2 * t0 * (1 - t0) * pc[i] +
+                                t0 * t0 * p1[i]
+                          : p0[i];
+                d0[i] = n ? (1 - t0) * (pc[i] - p0[i]) + t0 * (p1[i] - pc[i]) : pc[i] - p0[i];
+            }
+            have[0] = have[1] = 0;
+        }
         for (int i = 0; i < 3; i++) {
             q1[i] = (1 - t1) * (1 - t1) * p0[i] + 2 * t1 * (1 - t1) * pc[i] + t1 * t1 * p1[i];
             d1[i] = (1 - t1) * (pc[i] - p0[i]) + t1 * (p1[i] - pc[i]);
             /* B(t0) + (t1 - t0) / 2 B'(t0) */
             ctrl[i] = q0[i] + (t1 - t0) * d0[i];
-            tan0 += d0[i] * u2[i];
-            tan1 += d1[i] * u1[i];
+            tan0 += d0[i] * e->u2[i];
+            tan1 += d1[i] * e->u1[i];
         }
-        on1[1] = seg_at(&g1, q1);
-        on1[2] = seg_at(&g1, ctrl);
-        on2[1] = seg_at(&g2, q1);
-        on2[2] = seg_at(&g2, ctrl);
+        if (k && n == ahead) {
+            /* measured already */
+            have[0] = have[1] = 0;
+            memcpy(q0, q1, sizeof q0);
+            memcpy(d0, d1, sizeof d0);
+            continue;
+        }
         /* the tangent turns one way along the blend: at the piece's end it
          * has turned furthest from the first line, at its start least far
          * from the second */
-        if (!piece_fits(&g1, on1, tan1 >= 0, tol_in, tol_out) &&
-            !piece_fits(&g2, on2, tan0 >= 0, tol_in, tol_out))
+        int tangent_ok[2] = { tan1 >= 0, tan0 >= 0 }, tried[2] = { 0, 0 }, fit = -1;
+        for (int m = 0; m < 2 && fit < 0; m++) {
+            int j = near ^ m;
+            const struct edge_seg *g = &e->g[j];
+            if (!have[j])
+                on[j][0] = seg_at(g, q0);
+            /* a corner beyond tol_out fails the piece whatever the others
+             * (tol_out >= tol_in): the rest are not measured */
+            if (on[j][0].dist2 > out2)
+                continue;
+            on[j][1] = seg_at(g, q1);
+            tried[j] = 1;
+            if (on[j][1].dist2 > out2)
+                continue;
+            on[j][2] = seg_at(g, ctrl);
+            if (piece_fits(g, on[j], tangent_ok[j], e->tol_in, e->tol_out))
+                fit = j;
+        }
+        if (fit < 0) {
+            if (hint)
+                *hint = n;
             return 0;
-        on1[0] = on1[1];
-        on2[0] = on2[1];
+        }
+        for (int j = 0; j < 2; j++) {
+            have[j] = tried[j];
+            if (tried[j])
+                on[j][0] = on[j][1];
+        }
+        near = fit;
         memcpy(q0, q1, sizeof q0);
         memcpy(d0, d1, sizeof d0);
     }
     return 1;
 }
 
-/* Does the blend of trim d (rho d off cur) stay within tol of k's programmed
- * polyline? No where there is no such blend. */
-static int fits(const struct ncp_seg *free_prev, const struct ncp_seg *cur,
-                const struct plan_corner *k, double rho, double d, double tol)
+int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, double tol_in)
 {
-    struct ncp_seg bl;
-    double got, got_cur;
-    if (rho == 1 ? !ncp_blend_corner(free_prev, cur, d, &bl, &got)
-                 : !ncp_blend_corner_ratio_at(free_prev, cur, rho, d, &bl, &got, &got_cur))
-        return 0;
-    return ncp_edge_within(&bl, k, tol);
+    struct edge_band e;
+    band_init(&e, k, tol_in);
+    return band_within(&e, blend->start, blend->center, blend->end, NULL);
+}
+
+/* Does the blend of trim d (fan: rho d off cur) stay within e's band? No
+ * where there is no such blend. */
+static int fits(const struct ncp_blend_fan *fan, const struct edge_band *e, double d, int *hint)
+{
+    double start[3], end[3];
+    return ncp_blend_fan_at(fan, d, start, end) && band_within(e, start, fan->c, end, hint);
+}
+
+/* EDGE_STEP^(i - EDGE_SCAN), the scan's trims over its reach: the same
+ * powers for every search, taken once. */
+static double edge_steps[EDGE_SCAN + 1];
+static pthread_once_t edge_steps_once = PTHREAD_ONCE_INIT;
+
+static void edge_steps_make(void)
+{
+    for (int i = 1; i <= EDGE_SCAN; i++)
+        edge_steps[i] = pow(EDGE_STEP, i - EDGE_SCAN);
 }
 
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
@@ -188,57 +257,69 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
                    double *lo, double *hi)
 {
     /* without P the blend takes what the lines allow: the range to search */
-    struct ncp_seg free_prev = *prev, bl;
-    free_prev.tolerance = 0;
-    double dmax, got_cur;
-    if (rho == 1 ? !ncp_blend_corner(&free_prev, cur, max_trim, &bl, &dmax)
-                 : !ncp_blend_corner_ratio_at(&free_prev, cur, rho, max_trim, &bl, &dmax, &got_cur))
+    struct ncp_blend_fan fan;
+    double s0[3], e0[3];
+    if (!ncp_blend_fan_init(&fan, prev, cur, rho))
+        return 0;
+    double dmax = ncp_blend_fan_at(&fan, max_trim, s0, e0);
+    if (dmax == 0)
         return 0;
     /* a blend too short stays near the moved vertex, one too long cuts in
      * too deep: the trims within tol are one range between them */
-    double u1[3], u2[3], n[3];
-    for (int i = 0; i < 3; i++) {
-        u1[i] = (prev->end[i] - prev->start[i]) / prev->length;
-        u2[i] = (cur->end[i] - cur->start[i]) / cur->length;
-    }
-    cross3(u1, u2, n);
+    double n[3];
+    cross3(fan.u1, fan.u2, n);
     double reach = fmin(dmax, EDGE_REACH * tol / fmax(sqrt(dot3(n, n)), 1e-6));
+    struct edge_band band;
+    band_init(&band, k, tol);
     double trim[EDGE_SCAN + 2];
     trim[0] = 0;
     trim[EDGE_SCAN + 1] = dmax;
+    pthread_once(&edge_steps_once, edge_steps_make);
     for (int i = 1; i <= EDGE_SCAN; i++)
-        trim[i] = reach * pow(EDGE_STEP, i - EDGE_SCAN);
-    int first = 0, last = 0;
+        trim[i] = reach * edge_steps[i];
+    /* The range's upper end is found from the last trim that fits, so the
+     * scan goes on past the first only where that end is asked for. The
+     * blends about each end fail alike (band_within's hint): the one after
+     * the last that fits, then the bisection's. */
+    int first = 0, last = 0, hint_lo = -1, hint_hi = -1;
     for (int i = 1; i <= EDGE_SCAN; i++) {
-        int ok = fits(&free_prev, cur, k, rho, trim[i], tol);
+        int ok = fits(&fan, &band, trim[i], first ? &hint_hi : NULL);
         if (ok && !first)
             first = i;
         if (ok)
             last = i;
         else if (first)
             break;
+        if (first && !hi)
+            break;
     }
     if (first < 1 || last < first)
         return 0;
-    double a = trim[first - 1], b = trim[first];
-    for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
-        double m = 0.5 * (a + b);
-        if (fits(&free_prev, cur, k, rho, m, tol))
-            b = m;
-        else
-            a = m;
+    double a, b;
+    if (lo) {
+        a = trim[first - 1];
+        b = trim[first];
+        for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
+            double m = 0.5 * (a + b);
+            if (fits(&fan, &band, m, &hint_lo))
+                b = m;
+            else
+                a = m;
+        }
+        *lo = b;
     }
-    *lo = b;
-    a = trim[last];
-    b = fmin(dmax, trim[last + 1]);
-    for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
-        double m = 0.5 * (a + b);
-        if (fits(&free_prev, cur, k, rho, m, tol))
-            a = m;
-        else
-            b = m;
+    if (hi) {
+        a = trim[last];
+        b = fmin(dmax, trim[last + 1]);
+        for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
+            double m = 0.5 * (a + b);
+            if (fits(&fan, &band, m, &hint_hi))
+                a = m;
+            else
+                b = m;
+        }
+        *hi = a;
     }
-    *hi = a;
     return 1;
 }
 

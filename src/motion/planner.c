@@ -849,7 +849,10 @@ static double corner_cost(double len1, double a1, double len2, double a2, double
  * corner below the feed, over ratios from 1/3 to 3, each as large as P and
  * the lines allow; kept when the simple cost above says it is faster. Its
  * profile is rigid (a ramp), so only where nothing else reshapes profiles:
- * trapezoids, trivial kinematics, no [TRAJ] DEFAULT_LINEAR_ACCELERATION. */
+ * trapezoids, trivial kinematics, no [TRAJ] DEFAULT_LINEAR_ACCELERATION.
+ * A caller that only asks whether the corner costs at most `enough` (a
+ * moved vertex against the one where it is) has the search end at the
+ * first blend that does: the answer cannot change. */
 #define RATIO_STEPS 24
 /* what an uneven blend must save by the cost, s: where both are about as fast
  * (a corner between two axes, already at the per-axis floor) the even one stays */
@@ -858,7 +861,8 @@ static double corner_cost(double len1, double a1, double len2, double a2, double
 static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
                         const struct plan_seg *prev, const struct ncp_seg *s, double v_goal,
                         const struct ncp_seg *even, double d, const struct plan_corner *corner,
-                        double v_n, double *cost, struct ncp_seg *out, double *d1, double *d2)
+                        double v_n, double enough, double *cost, struct ncp_seg *out,
+                        double *d1, double *d2)
 {
     *cost = INFINITY;
     if (plan_scurve(p) || ncp_kins_active(&p->cfg) || p->cfg.default_linear_acc > 0 ||
@@ -881,7 +885,7 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
     *cost = best;
     int found = 0, moved = corner && corner->shifted;
     for (int k = 0; k <= RATIO_STEPS; k++) {
-        double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2, lo, hi;
+        double rho = pow(3.0, -1 + 2.0 * k / RATIO_STEPS), t1, t2, hi;
         struct ncp_seg b;
         /* at a moved vertex each ratio is a search: every
          * RATIO_MOVED_EVERY-th one */
@@ -890,7 +894,7 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
         /* at a moved vertex: the largest blend measured within P of the
          * programmed lines; elsewhere the largest within P of the lines */
         if (moved ? !ncp_edge_trims(&prev->s, s, corner, tol_u.tolerance, rho,
-                                    fmin(0.2 * len1, 0.2 * len2 / rho), &lo, &hi) ||
+                                    fmin(0.2 * len1, 0.2 * len2 / rho), NULL, &hi) ||
                         !ncp_blend_corner_ratio_at(&prev->s, s, rho, hi, &b, &t1, &t2)
                   : !ncp_blend_corner_ratio(&tol_u, s, rho, &b, &t1, &t2))
             continue;
@@ -910,6 +914,8 @@ static int uneven_blend(const struct ncp_planner *p, const struct ncp_seg *tol,
             *d1 = t1;
             *d2 = t2;
             found = 1;
+            if (c <= enough)
+                break;
         }
     }
     return found;
@@ -1015,7 +1021,8 @@ static int try_blend(struct ncp_planner *p, struct ncp_seg *s)
         /* uneven ones measured where a line beside the corner moved */
         double cost;
         if (uneven_blend(p, &tol_band, prev, s, v_goal, &arc.s, d,
-                         p->corner.measured ? &p->corner : NULL, 0, &cost, &uneven, &d1, &d2))
+                         p->corner.measured ? &p->corner : NULL, 0, -INFINITY, &cost, &uneven,
+                         &d1, &d2))
             arc.s = uneven;
         prev_out = prev->s;
         prev_out.length -= d1;
@@ -1187,8 +1194,7 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *ta
     struct ncp_seg h = *held;
     memcpy(h.end, end, 3 * sizeof h.end[0]);
     h.length = dist3(h.start, h.end);
-    double lo, hi;
-    return ncp_edge_trims(tail, &h, k, blend_tol(p, tail->tolerance), 1, INFINITY, &lo, &hi);
+    return ncp_edge_trims(tail, &h, k, blend_tol(p, tail->tolerance), 1, INFINITY, NULL, NULL);
 }
 
 /* Whether the vertex between held lines h and cur moves out (k: its
@@ -1202,7 +1208,7 @@ static int edge_blend_fits(const struct ncp_planner *p, const struct ncp_seg *ta
 static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start,
                         struct ncp_seg *h, struct ncp_seg *cur, struct plan_corner *k)
 {
-    double tol = blend_tol(p, h->tolerance), moved[3], lo, hi, d;
+    double tol = blend_tol(p, h->tolerance), moved[3], hi, d;
     if (h->tolerance != cur->tolerance || !ncp_edge_vertex(k->a, k->c, k->b, k->out, moved))
         return;
     /* the queue's last line is blended into h: as programmed there, or
@@ -1228,7 +1234,8 @@ static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start
     memset(&hp, 0, sizeof hp);
     hp.s = *h;
     double a1 = line_acc(p, h), a2 = line_acc(p, cur);
-    if (!uneven_blend(p, &tl, &hp, cur, v_goal, &bl, d, NULL, v_inner, &cost_in, &uneven, &d1, &d2))
+    if (!uneven_blend(p, &tl, &hp, cur, v_goal, &bl, d, NULL, v_inner, -INFINITY, &cost_in, &uneven,
+                      &d1, &d2))
         cost_in = corner_cost(h->length, a1, cur->length, a2, v_inner, v_goal, v_inner, v_inner, d,
                               d, 2 * d / v_inner);
     struct ncp_seg h2 = *h, c2 = *cur;
@@ -1239,15 +1246,15 @@ static void edge_decide(struct ncp_planner *p, const struct plan_corner *k_start
     struct ncp_seg free_h2 = h2;
     free_h2.tolerance = 0;
     double d_out;
-    if (!ncp_edge_trims(&h2, &c2, k, tol, 1, 0.5 * h2.length - 1e-3, &lo, &hi) ||
+    if (!ncp_edge_trims(&h2, &c2, k, tol, 1, 0.5 * h2.length - 1e-3, NULL, &hi) ||
         !ncp_blend_corner(&free_h2, &c2, hi, &bl, &d_out))
         return;
     double v_out = fmin(v_goal, arc_speed(p, &bl));
     struct plan_corner km = *k;
     km.shifted = 1;
     hp.s = h2;
-    if (!uneven_blend(p, &tl, &hp, &c2, v_goal, &bl, d_out, &km, v_inner, &cost_out, &uneven, &d1,
-                      &d2))
+    if (!uneven_blend(p, &tl, &hp, &c2, v_goal, &bl, d_out, &km, v_inner,
+                      cost_in - RATIO_GAIN_MIN, &cost_out, &uneven, &d1, &d2))
         cost_out = corner_cost(h2.length, a1, c2.length, a2, v_inner, v_goal, v_out, v_out, d_out,
                                d_out, 2 * d_out / v_out);
     if (cost_out > cost_in - RATIO_GAIN_MIN)

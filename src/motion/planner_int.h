@@ -165,8 +165,9 @@ void ncp_planner_edge_low(struct ncp_planner *p);
 int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, double tol_in);
 /* edge.c: the blends between prev and cur, even (rho 1) or uneven (trim d
  * off prev, rho d off cur), d up to max_trim and the lines' share, that stay
- * within tol of k's programmed polyline: d from *lo to *hi. 0 when none
- * does. */
+ * within tol of k's programmed polyline: d from *lo to *hi (either may be
+ * NULL where not wanted, and its end of the range is not searched for). 0
+ * when none does. */
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
                    const struct plan_corner *k, double tol, double rho, double max_trim,
                    double *lo, double *hi);
@@ -231,6 +232,19 @@ int ncp_blend_corner_ratio(const struct ncp_seg *prev, const struct ncp_seg *cur
  * far as the lines allow, whatever P says. */
 int ncp_blend_corner_ratio_at(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
                               double r0, struct ncp_seg *blend, double *trim_prev, double *trim_cur);
+
+/* blend.c: the corner points of the blends ncp_blend_corner_ratio_at makes
+ * at one corner (at rho 1 ncp_blend_corner's, prev's P aside), set up once
+ * for many trims r0: the same numbers to the bit. ncp_blend_fan_init is 0
+ * where that corner has no such blend; ncp_blend_fan_at gives the trim off
+ * prev (*trim_prev of ncp_blend_corner_ratio_at), 0 where r0 gives no
+ * blend. u1, u2: the lines' directions; c: the blend's centre. */
+struct ncp_blend_fan {
+    double u1[3], u2[3], c[3], rho, room;
+};
+int ncp_blend_fan_init(struct ncp_blend_fan *f, const struct ncp_seg *prev,
+                       const struct ncp_seg *cur, double rho);
+double ncp_blend_fan_at(const struct ncp_blend_fan *f, double r0, double start[3], double end[3]);
 
 /* blend.c: the same where one side is an arc in a plane and the other a line
  * in it: the arc gives up arc_trim of its length, the line what the blend

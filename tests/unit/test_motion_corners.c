@@ -6,7 +6,9 @@
  * it; a corner between lines is taken faster than on the circle within P,
  * by an uneven parabola where that lets both axes work, and an arc running
  * into a line by a parabola too, whichever way the line turns.
- * Every run also keeps every axis within its limits and the path within P. */
+ * Every run also keeps every axis within its limits and the path within P.
+ * The band search's blends (ncp_blend_fan, set up once per corner) are
+ * those of ncp_blend_corner and ncp_blend_corner_ratio_at to the bit. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -26,6 +28,8 @@
 #include "gcode_src.h"
 
 #include "lcnc_limits.h"
+
+#include "../../src/motion/planner_int.h"
 
 /* Distance from p to the polyline pts[0..m-1] in X Y. */
 static double dist_polyline(const double p[3], const double (*pts)[2], int m)
@@ -459,6 +463,67 @@ static void test_corner_faster_than_circle_within_p(void **state)
     corner_faster_than_circle(-120);
 }
 
+/* A G64 P line from a to b. */
+static struct ncp_seg fan_line(const double a[3], const double b[3])
+{
+    struct ncp_seg s;
+    memset(&s, 0, sizeof s);
+    s.kind = NCP_SEG_LINE;
+    s.term = NCP_TERM_CONTINUOUS;
+    s.feed = 50;
+    s.tolerance = 0.01;
+    memcpy(s.start, a, 3 * sizeof a[0]);
+    memcpy(s.end, b, 3 * sizeof b[0]);
+    s.length = sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                    (b[2] - a[2]) * (b[2] - a[2]));
+    return s;
+}
+
+/* Corners of every sort of turn, trims from none to more than the lines
+ * hold, even and uneven: where ncp_blend_corner (prev's P aside) or
+ * ncp_blend_corner_ratio_at blend, the fan blends with the same trim and
+ * corner points, and where they do not, neither does the fan. */
+static void test_blend_fan_is_the_blends_bit_for_bit(void **state)
+{
+    (void)state;
+    const double rhos[] = { 1, 1.0 / 3, 0.7937005259840998, 1.2599210498948732, 3 };
+    unsigned seed = 12345;
+    int blended = 0;
+    for (int c = 0; c < 200; c++) {
+        double pt[3][3];
+        for (int k = 0; k < 3; k++)
+            for (int i = 0; i < 3; i++) {
+                seed = seed * 1103515245u + 12345u;
+                pt[k][i] = (double)(seed >> 8 & 0xffff) / 4096.0 - 8 + (i == 2 && c % 2 ? 0 : 0.1 * k);
+            }
+        struct ncp_seg prev = fan_line(pt[0], pt[1]), cur = fan_line(pt[1], pt[2]);
+        struct ncp_seg free_prev = prev;
+        free_prev.tolerance = 0;
+        for (size_t r = 0; r < sizeof rhos / sizeof rhos[0]; r++) {
+            struct ncp_blend_fan fan;
+            int init = ncp_blend_fan_init(&fan, &prev, &cur, rhos[r]);
+            for (double trim = 1e-7; trim < 40; trim *= 1.7) {
+                struct ncp_seg bl;
+                double got = 0, got_cur, start[3], end[3];
+                int ok = rhos[r] == 1
+                             ? ncp_blend_corner(&free_prev, &cur, trim, &bl, &got)
+                             : ncp_blend_corner_ratio_at(&prev, &cur, rhos[r], trim, &bl, &got,
+                                                         &got_cur);
+                double fan_got = init ? ncp_blend_fan_at(&fan, trim, start, end) : 0;
+                assert_int_equal(ok, fan_got != 0);
+                if (!ok)
+                    continue;
+                blended++;
+                assert_memory_equal(&got, &fan_got, sizeof got);
+                assert_memory_equal(bl.start, start, sizeof start);
+                assert_memory_equal(bl.end, end, sizeof end);
+                assert_memory_equal(bl.center, fan.c, sizeof fan.c);
+            }
+        }
+    }
+    assert_true(blended > 1000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -470,6 +535,7 @@ int main(void)
         cmocka_unit_test(test_uneven_corners_at_moved_vertices),
         cmocka_unit_test(test_arc_line_corner_is_a_parabola),
         cmocka_unit_test(test_arc_line_corner_turning_with_the_arc),
+        cmocka_unit_test(test_blend_fan_is_the_blends_bit_for_bit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
