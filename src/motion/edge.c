@@ -252,6 +252,13 @@ static void edge_steps_make(void)
         edge_steps[i] = pow(EDGE_STEP, i - EDGE_SCAN);
 }
 
+/* The planner takes the powers when it is made, so that no thread that plans
+ * in time is ever the first to ask (the first pthread_once may wait). */
+void ncp_edge_prepare(void)
+{
+    pthread_once(&edge_steps_once, edge_steps_make);
+}
+
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
                    const struct plan_corner *k, double tol, double rho, double max_trim,
                    double *lo, double *hi)
@@ -274,7 +281,7 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     double trim[EDGE_SCAN + 2];
     trim[0] = 0;
     trim[EDGE_SCAN + 1] = dmax;
-    pthread_once(&edge_steps_once, edge_steps_make);
+    ncp_edge_prepare();
     for (int i = 1; i <= EDGE_SCAN; i++)
         trim[i] = reach * edge_steps[i];
     /* The range's upper end is found from the last trim that fits, so the

@@ -45,6 +45,7 @@ struct ncp_planner *ncp_planner_new(const struct ncp_machine_cfg *cfg,
     if (!p)
         return NULL;
     p->cfg = *cfg;
+    ncp_edge_prepare();
     /* a blend arc's speed keeps its centripetal acceleration a_c below 0.95 of
      * its bound (arc_limits), at most 1.23 times the largest axis limit a (some
      * axis holds sqrt(2/3) of any plane), so a servo step's chord lies at most

@@ -168,6 +168,7 @@ int ncp_edge_within(const struct ncp_seg *blend, const struct plan_corner *k, do
  * within tol of k's programmed polyline: d from *lo to *hi (either may be
  * NULL where not wanted, and its end of the range is not searched for). 0
  * when none does. */
+void ncp_edge_prepare(void);
 int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
                    const struct plan_corner *k, double tol, double rho, double max_trim,
                    double *lo, double *hi);
