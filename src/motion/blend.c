@@ -117,16 +117,25 @@ static void fan_set(struct ncp_blend_fan *f, const struct ncp_seg *prev, const s
     f->room = fmin(prev->length - BLEND_LINE_LEFT, 0.5 * cur->length / rho);
 }
 
-int ncp_blend_fan_init(struct ncp_blend_fan *f, const struct ncp_seg *prev,
-                       const struct ncp_seg *cur, double rho)
+/* f where the corner between prev and cur has a blend (its even one, P
+ * aside, left in *blend); 0 where it has none. */
+static int fan_corner(struct ncp_blend_fan *f, const struct ncp_seg *prev, const struct ncp_seg *cur,
+                      double rho, struct ncp_seg *blend)
 {
-    struct ncp_seg free_prev = *prev, blend;
+    struct ncp_seg free_prev = *prev;
     double d;
     free_prev.tolerance = 0;
-    if (rho <= 0 || !ncp_blend_corner(&free_prev, cur, INFINITY, &blend, &d))
+    if (rho <= 0 || !ncp_blend_corner(&free_prev, cur, INFINITY, blend, &d))
         return 0;
     fan_set(f, prev, cur, rho);
     return 1;
+}
+
+int ncp_blend_fan_init(struct ncp_blend_fan *f, const struct ncp_seg *prev,
+                       const struct ncp_seg *cur, double rho)
+{
+    struct ncp_seg blend;
+    return fan_corner(f, prev, cur, rho, &blend);
 }
 
 /* At rho 1 the bounds and the end are ncp_blend_corner's: a division by 1
@@ -146,13 +155,9 @@ double ncp_blend_fan_at(const struct ncp_blend_fan *f, double r0, double start[3
 int ncp_blend_corner_ratio_at(const struct ncp_seg *prev, const struct ncp_seg *cur, double rho,
                               double r0, struct ncp_seg *blend, double *trim_prev, double *trim_cur)
 {
-    double d;
-    struct ncp_seg free_prev = *prev;
     struct ncp_blend_fan f;
-    free_prev.tolerance = 0;
-    if (rho <= 0 || !ncp_blend_corner(&free_prev, cur, INFINITY, blend, &d))
+    if (!fan_corner(&f, prev, cur, rho, blend))
         return 0;
-    fan_set(&f, prev, cur, rho);
     r0 = ncp_blend_fan_at(&f, r0, blend->start, blend->end);
     if (r0 == 0)
         return 0;

@@ -241,6 +241,21 @@ static int fits(const struct ncp_blend_fan *fan, const struct edge_band *e, doub
     return ncp_blend_fan_at(fan, d, start, end) && band_within(e, start, fan->c, end, hint);
 }
 
+/* The trim nearest the edge of the range between one that fits and one
+ * that does not, either side of it: EDGE_BISECT halvings. */
+static double edge_bisect(const struct ncp_blend_fan *fan, const struct edge_band *e, double fit,
+                          double miss, int *hint)
+{
+    for (int i = 0; i < EDGE_BISECT; i++) {
+        double m = 0.5 * (fit + miss);
+        if (fits(fan, e, m, hint))
+            fit = m;
+        else
+            miss = m;
+    }
+    return fit;
+}
+
 /* EDGE_STEP^(i - EDGE_SCAN), the scan's trims over its reach: the same
  * powers for every search, taken once. */
 static double edge_steps[EDGE_SCAN + 1];
@@ -302,31 +317,13 @@ int ncp_edge_trims(const struct ncp_seg *prev, const struct ncp_seg *cur,
     }
     if (first < 1 || last < first)
         return 0;
-    double a, b;
-    if (lo) {
-        a = trim[first - 1];
-        b = trim[first];
-        for (int i = 0; i < EDGE_BISECT && first > 1; i++) {
-            double m = 0.5 * (a + b);
-            if (fits(&fan, &band, m, &hint_lo))
-                b = m;
-            else
-                a = m;
-        }
-        *lo = b;
-    }
-    if (hi) {
-        a = trim[last];
-        b = fmin(dmax, trim[last + 1]);
-        for (int i = 0; i < EDGE_BISECT && last < EDGE_SCAN; i++) {
-            double m = 0.5 * (a + b);
-            if (fits(&fan, &band, m, &hint_hi))
-                a = m;
-            else
-                b = m;
-        }
-        *hi = a;
-    }
+    if (lo)
+        *lo = first > 1 ? edge_bisect(&fan, &band, trim[first], trim[first - 1], &hint_lo)
+                        : trim[first];
+    if (hi)
+        *hi = last < EDGE_SCAN
+                  ? edge_bisect(&fan, &band, trim[last], fmin(dmax, trim[last + 1]), &hint_hi)
+                  : trim[last];
     return 1;
 }
 
