@@ -498,11 +498,9 @@ def windows_bound(pts, err, feed, vmax, amax, skip=False, ratio=RATIO, span=SPAN
             boxes.append(b)
         return float(cost.min()), np.array(boxes[::-1])
 
-    first = rest(0, grid[0], top[0])
-    last = rest(n - 1, grid[n - 1], top[n - 1])
     if not skip or n < 3:
         best, boxes = chain()
-        coarse = grid
+        edges = grid
         for _ in range(refine):
             if not math.isfinite(best):
                 break
@@ -511,8 +509,8 @@ def windows_bound(pts, err, feed, vmax, amax, skip=False, ratio=RATIO, span=SPAN
             # a bound again, and no lower
             at = grid[np.arange(n), boxes]
             fine = at[:, None] * FINE ** np.arange(-FINE_N, FINE_N + 1)[None, :]
-            coarse = np.concatenate([coarse, np.maximum(fine, tlo[:, None])], axis=1)
-            grid = np.sort(coarse, axis=1)
+            edges = np.concatenate([edges, np.maximum(fine, tlo[:, None])], axis=1)
+            grid = np.sort(edges, axis=1)
             top = np.concatenate([grid[:, 1:], np.full((n, 1), np.inf)], axis=1)
             m = grid.shape[1]
             best, boxes = chain()
@@ -520,6 +518,8 @@ def windows_bound(pts, err, feed, vmax, amax, skip=False, ratio=RATIO, span=SPAN
     # the state: the boxes of the last two windows, and every window also
     # held to the one two back (the gap between their middles: half of each
     # and the whole of the one between)
+    first = rest(0, grid[0], top[0])
+    last = rest(n - 1, grid[n - 1], top[n - 1])
     cost = np.where(first[:, None] & (need(0, 1) <= 0), grid[0][:, None] + grid[1][None, :], np.inf)
     for k in range(1, n - 1):
         far = need(k - 1, k + 1)                                  # (a, c)
