@@ -18,6 +18,7 @@
  * nearer) and uses at most the rest of the line before it and half of the
  * line after it, so neighbouring blends never overlap; the planner
  * (try_blend) makes an even one no larger than the speed it is for needs. */
+#include "blend.h"
 #include "planner_int.h"
 
 #include <math.h>

@@ -11,6 +11,7 @@
  * programmed polyline (ncp_edge_trims): the planner holds such lines back
  * two deep, so that a vertex moves only where the line after it ends in
  * such a corner too (planner.c). */
+#include "blend.h"
 #include "planner_int.h"
 
 #include <math.h>

@@ -2,6 +2,7 @@
  * junction caps, and a backward pass that keeps every queued segment able to
  * stop at the end of the queue. The forward pass is done lazily, one segment at
  * a time, when the interpolator starts a segment (interp.c). */
+#include "blend.h"
 #include "planner_int.h"
 
 #include <math.h>

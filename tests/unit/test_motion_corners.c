@@ -29,6 +29,7 @@
 
 #include "lcnc_limits.h"
 
+#include "../../src/motion/blend.h"
 #include "../../src/motion/planner_int.h"
 
 /* Distance from p to the polyline pts[0..m-1] in X Y. */
