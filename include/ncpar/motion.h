@@ -321,6 +321,7 @@ int ncp_exec_step(struct ncp_exec *e, const struct ncp_exec_source *src,
 struct ncp_la {
     struct ncp_seg s;
     double vmax, acc, acc_full, jerk, a_eff, kappa, a_cap;
+    double box_a[3], box_b[3], box_kappa;  /* a fitted arc's per-axis room */
     double v_end;
     uint8_t blend;
     uint8_t after_stop;     /* as ncp_accdec's */

@@ -44,6 +44,9 @@ void ncp_dist_la_encode(const struct ncp_la *la, ncp_la_rec_t *r)
     const double v[8] = { la->vmax,  la->acc,   la->acc_full, la->jerk,
                           la->a_eff, la->kappa, la->a_cap,    la->v_end };
     memcpy(r->la, v, sizeof v);
+    const double box[7] = { la->box_kappa, la->box_a[0], la->box_a[1], la->box_a[2],
+                            la->box_b[0],  la->box_b[1], la->box_b[2] };
+    memcpy(r->box, box, sizeof box);
     r->flags = (int8_t)((la->blend ? NCP_LA_REC_T_FLAG_BLEND : 0) |
                         (la->after_stop ? NCP_LA_REC_T_FLAG_AFTER_STOP : 0));
 }
@@ -60,6 +63,11 @@ void ncp_dist_la_decode(const ncp_la_rec_t *r, struct ncp_la *la)
     la->kappa = r->la[5];
     la->a_cap = r->la[6];
     la->v_end = r->la[7];
+    la->box_kappa = r->box[0];
+    for (int j = 0; j < 3; j++) {
+        la->box_a[j] = r->box[1 + j];
+        la->box_b[j] = r->box[4 + j];
+    }
     la->blend = (r->flags & NCP_LA_REC_T_FLAG_BLEND) != 0;
     la->after_stop = (r->flags & NCP_LA_REC_T_FLAG_AFTER_STOP) != 0;
 }

@@ -21,6 +21,9 @@ void ncp_la_profile(enum ncp_profile profile, const struct ncp_la *la, double v0
     ps.a_eff = la->a_eff;
     ps.kappa = la->kappa;
     ps.a_cap = la->a_cap;
+    memcpy(ps.box_a, la->box_a, sizeof ps.box_a);
+    memcpy(ps.box_b, la->box_b, sizeof ps.box_b);
+    ps.box_kappa = la->box_kappa;
     int scurve = profile == NCP_PROFILE_SCURVE;
     memset(rec, 0, sizeof *rec);
     rec->s = la->s;
@@ -61,6 +64,8 @@ static int head_record(void *ctx, double v0, struct ncp_accdec *rec)
     struct ncp_la la = {
         .s = ps->s, .vmax = ps->vmax, .acc = ps->acc, .acc_full = ps->acc_full,
         .jerk = ps->jerk, .a_eff = ps->a_eff, .kappa = ps->kappa, .a_cap = ps->a_cap,
+        .box_a = { ps->box_a[0], ps->box_a[1], ps->box_a[2] },
+        .box_b = { ps->box_b[0], ps->box_b[1], ps->box_b[2] }, .box_kappa = ps->box_kappa,
         .v_end = p->count > 1 ? plan_at(p, 1)->v_in : 0, .blend = (uint8_t)(ps->blend || ps->fitted),
         .after_stop = (uint8_t)p->ended,
     };

@@ -225,6 +225,38 @@ static double arc_accel_bound(const struct ncp_planner *p, const struct ncp_seg 
     return a_eff;
 }
 
+/* The most |kc cos(phi) + ks sin(phi) + d| reaches for phi between lo and
+ * hi: at an end, or where the cosine about its phase peaks. */
+static double sinusoid_abs_max(double kc, double ks, double d, double lo, double hi)
+{
+    double amp = hypot(kc, ks), psi = atan2(ks, kc);
+    double best = fmax(fabs(kc * cos(lo) + ks * sin(lo) + d), fabs(kc * cos(hi) + ks * sin(hi) + d));
+    if (amp < 1e-15)
+        return best;
+    if (hi - lo >= 2 * M_PI)
+        return amp + fabs(d);
+    for (double k = ceil((lo - psi) / M_PI); psi + k * M_PI <= hi; k++)
+        best = fmax(best, fabs(amp * (fmod(fabs(k), 2) < 0.5 ? 1 : -1) + d));
+    return best;
+}
+
+/* A short arc sweeps few directions: axis j sees at most nmax_j of the
+ * centripetal acceleration and tmax_j of the tangential (their largest
+ * shares over the sweep), so it stays within its limit while
+ * a_n nmax_j + |a_t| tmax_j does, a box the disc a_eff lies within. Its
+ * centripetal room min_j A_j / nmax_j may so exceed a_eff (up to sqrt 2
+ * on a plane arc whose normal stays near a diagonal). */
+static void arc_sweep_shares(const struct ncp_seg *s, double f_plane, double f_axis,
+                             double nmax[3], double tmax[3])
+{
+    double lo = fmin(0, s->angle), hi = fmax(0, s->angle);
+    double turn = s->angle < 0 ? -f_plane : f_plane, rise = s->axial < 0 ? -f_axis : f_axis;
+    for (int j = 0; j < 3; j++) {
+        nmax[j] = sinusoid_abs_max(s->u[j], s->w[j], 0, lo, hi);
+        tmax[j] = sinusoid_abs_max(turn * s->w[j], -turn * s->u[j], rise * s->normal[j], lo, hi);
+    }
+}
+
 static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps, double an_share)
 {
     const struct ncp_seg *s = &ps->s;
@@ -253,11 +285,30 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps, double 
         if (plan_scurve(p) && a->max_jerk > 0)
             scurve_arc_caps(p, a->max_jerk, share, kappa * m, &vmax, &jerk);
     }
-    if (kappa > 1e-12)
-        vmax = fmin(vmax, sqrt(an_share * a_eff / kappa));
-    double an = vmax * vmax * kappa;
+    double v_cap = kappa > 1e-12 ? fmin(vmax, sqrt(an_share * a_eff / kappa)) : vmax;
+    double an = v_cap * v_cap * kappa, acc = sqrt(fmax(0, a_eff * a_eff - an * an));
+    /* A fitted arc sweeps a few degrees (tiny's median 6): its cap and its
+     * tangent read the box, where its normal near a diagonal leaves each axis
+     * more than the disc would (bench/gen-planner.py's tiny 4.520 -> 4.382 s) */
+    if (kappa > 1e-12 && !plan_scurve(p) && ps->fitted) {
+        double nmax[3], tmax[3], room = INFINITY, box = INFINITY;
+        arc_sweep_shares(s, f_plane, f_axis, nmax, tmax);
+        for (int j = 0; j < 3; j++)
+            if (nmax[j] > 1e-12)
+                room = fmin(room, p->cfg.axis[j].max_acc / nmax[j]);
+        v_cap = fmin(vmax, sqrt(an_share * room / kappa));
+        an = v_cap * v_cap * kappa;
+        ps->box_kappa = kappa;
+        for (int j = 0; j < 3; j++) {
+            ps->box_a[j] = tmax[j] > 1e-12 ? p->cfg.axis[j].max_acc / tmax[j] : INFINITY;
+            ps->box_b[j] = tmax[j] > 1e-12 ? nmax[j] / tmax[j] : 0;
+            box = fmin(box, ps->box_a[j] - an * ps->box_b[j]);
+        }
+        acc = fmax(box, sqrt(fmax(0, a_eff * a_eff - an * an)));
+    }
+    vmax = v_cap;
     ps->vmax = vmax;
-    ps->acc = fmin(acc_lin, sqrt(fmax(0, a_eff * a_eff - an * an)));
+    ps->acc = fmin(acc_lin, acc);
     ps->jerk = jerk;
     /* the S-curve's jerk caps assume the acceleration at the cruise cap */
     ps->a_eff = a_eff;
@@ -643,6 +694,15 @@ double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, doubl
         return lo;
     /* a hair below the root, so that rounding keeps it reachable */
     double x = reach_closed(ps, v, len) * (1 - 1e-12);
+    if (ps->box_kappa > 0) {
+        double c = ps->acc / ps->acc_full, xb = INFINITY;
+        for (int j = 0; j < 3; j++)
+            xb = fmin(xb, sqrt((v * v + 2 * len * c * ps->box_a[j]) /
+                               (1 + 2 * len * c * ps->box_kappa * ps->box_b[j])));
+        xb = fmin(xb, ps->vmax) * (1 - 1e-12);
+        if (xb > x && xb * xb <= v * v + 2 * len * plan_acc_at(ps, xb))
+            x = xb;
+    }
     if (x >= lo && x * x <= v * v + 2 * len * plan_acc_at(ps, x))
         return x;
     /* the move's top speed x is the end reached: x^2 = v^2 + 2 len acc(x),

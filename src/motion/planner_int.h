@@ -17,6 +17,10 @@ struct plan_seg {
      * centripetal part v^2 kappa is smaller and leaves more for the tangent
      * (plan_acc_at); a_cap bounds what the other axes and caps allow. */
     double a_eff, kappa, a_cap;
+    /* A fitted arc's per-axis room as well (arc_limits): the tangent may take
+     * min_j (box_a[j] - v^2 box_kappa box_b[j]) where that beats the disc a_eff.
+     * box_kappa 0: none. */
+    double box_a[3], box_b[3], box_kappa;
     double vjunc;   /* entry speed cap from the junction with the previous segment */
     double v_in;    /* planned entry speed (backward pass: can still stop at the end) */
     int blend;      /* a G64 corner arc, not a programmed segment */
@@ -198,13 +202,21 @@ static inline double plan_reach(int scurve, double acc, double jerk, double v, d
 /* The path acceleration ps allows at speeds up to v: an arc's centripetal
  * acceleration v^2 kappa (a corner parabola's turn, parab_limits) takes less
  * of its bound a_eff below the cruise cap, so the tangent gets the rest,
- * scaled as a corner scaled acc. Never below acc, the value at the cruise cap. */
+ * scaled as a corner scaled acc. Never below acc, the value at the cruise cap.
+ * A fitted arc's box (box_kappa) is read beside the disc: each is a bound on
+ * what every axis allows, so the larger is too. */
 static inline double plan_acc_at(const struct plan_seg *ps, double v)
 {
     if (ps->kappa <= 0 || ps->acc_full <= 0)
         return ps->acc;
     double an = v * v * ps->kappa;
     double at = ps->a_eff > an ? sqrt(ps->a_eff * ps->a_eff - an * an) : 0;
+    if (ps->box_kappa > 0) {
+        double y = v * v * ps->box_kappa, bx = INFINITY;
+        for (int j = 0; j < 3; j++)
+            bx = fmin(bx, ps->box_a[j] - y * ps->box_b[j]);
+        at = fmax(at, bx);
+    }
     return ps->acc / ps->acc_full * fmax(ps->acc_full, fmin(ps->a_cap, at));
 }
 

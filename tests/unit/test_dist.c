@@ -6,6 +6,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <string.h>
 #include <time.h>
 
@@ -269,6 +270,9 @@ static void la_and_int_round_trip(void **state)
     la.kappa = 1e-300;
     la.v_end = 2.0 / 9.0;
     la.blend = 1;
+    la.box_kappa = 1.0 / 11.0;
+    la.box_a[1] = INFINITY;
+    la.box_b[2] = 5.0 / 13.0;
     ncp_la_burst_t m, back;
     memset(&m, 0, sizeof m);
     m.count = 1;
@@ -280,6 +284,7 @@ static void la_and_int_round_trip(void **state)
     ncp_dist_la_decode(&back.recs[0], &la2);
     assert_memory_equal(&la.s, &la2.s, sizeof la.s);
     assert_true(la2.vmax == la.vmax && la2.kappa == la.kappa && la2.v_end == la.v_end);
+    assert_true(la2.box_kappa == la.box_kappa && isinf(la2.box_a[1]) && la2.box_b[2] == la.box_b[2]);
     assert_int_equal(la2.blend, 1);
 
     struct ncp_dist_op o, o2;
