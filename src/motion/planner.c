@@ -450,9 +450,10 @@ static double entry_for(int scurve, const struct plan_seg *ps, double v1)
 #define ARC_AN_SHARE 0.866
 #define BLEND_AN_SHARE 0.95
 /* A fitted arc (fit.c) is short and runs into the next at the same speed:
- * its turn may take what a corner parabola's does (PARAB_TURN_SHARE), and
- * below the cruise cap the tangent gets the rest (plan_acc_at). On
- * bench/gen-planner.py's tiny 0.866 gave 4.93 s, 0.95 4.79 and 0.99 4.73. */
+ * its turn may take what a corner parabola's does (PARAB_TURN_SHARE) of the
+ * room its sweep leaves the axes (arc_sweep_shares), and below the cruise cap
+ * the tangent gets the rest (plan_acc_at). On bench/gen-planner.py's tiny,
+ * of the disc a_eff, 0.866 gave 4.93 s, 0.95 4.79 and 0.99 4.73. */
 #define FIT_AN_SHARE 0.99
 
 /* A corner (kink) turns the velocity vector within one servo period. A servo
