@@ -694,18 +694,24 @@ double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, doubl
     if (ps->kappa <= 0 || scurve || lo >= ps->vmax)
         return lo;
     /* a hair below the root, so that rounding keeps it reachable */
-    double x = reach_closed(ps, v, len) * (1 - 1e-12);
+    double xb = -1;
     if (ps->box_kappa > 0) {
-        double c = ps->acc / ps->acc_full, xb = INFINITY;
+        /* the box's lines are linear in x^2: each gives its root directly */
+        double c = ps->acc / ps->acc_full, y = ps->vmax * ps->vmax;
         for (int j = 0; j < 3; j++)
-            xb = fmin(xb, sqrt((v * v + 2 * len * c * ps->box_a[j]) /
-                               (1 + 2 * len * c * ps->box_kappa * ps->box_b[j])));
-        xb = fmin(xb, ps->vmax) * (1 - 1e-12);
-        if (xb > x && xb * xb <= v * v + 2 * len * plan_acc_at(ps, xb))
-            x = xb;
+            y = fmin(y, (v * v + 2 * len * c * ps->box_a[j]) /
+                            (1 + 2 * len * c * ps->box_kappa * ps->box_b[j]));
+        xb = sqrt(y) * (1 - 1e-12);
+        if (!(xb >= lo && xb * xb <= v * v + 2 * len * plan_acc_at(ps, xb)))
+            xb = -1;
+        else if (y >= ps->vmax * ps->vmax)
+            return xb;  /* the cap: the disc can give no more */
     }
+    double x = reach_closed(ps, v, len) * (1 - 1e-12);
     if (x >= lo && x * x <= v * v + 2 * len * plan_acc_at(ps, x))
-        return x;
+        return fmax(x, xb);
+    if (xb >= lo)
+        return xb;  /* the root wherever the box is what the arc reads there */
     /* the move's top speed x is the end reached: x^2 = v^2 + 2 len acc(x),
      * acc falling with x, so the largest such x is found by bisection
      * between the cruise cap's acceleration and the one at v */
