@@ -43,54 +43,57 @@
 static double pts[MAX_CHORDS + 1][3];
 static int chords;
 
-/* The program: chords of 0.02 and 0.08 mm in turn around the circle through
- * the origin, centred at (0, RADIUS), its points rounded as written. */
-static char *circle_chain(void)
+/* A shape's next point: its parameter *at advanced by about one chord of
+ * length c, the point there in xy; 0 once past the end. */
+typedef int (*chain_step)(double *at, double c, double xy[2]);
+
+/* The program: chords of 0.02 and 0.08 mm in turn along a shape from the
+ * origin, its points rounded as written. */
+static char *write_chain(chain_step step)
 {
     char *prog = malloc((size_t)64 * (MAX_CHORDS + 4));
     assert_non_null(prog);
     int len = sprintf(prog, "G21 G90 G17 G94 G64 P%.2f Q0\nG1 F3000\n", P_TOL);
-    double ang = 0, end = TURNS * 2 * M_PI;
+    double at = 0, xy[2];
     memset(pts[0], 0, sizeof pts[0]);
     chords = 0;
-    while (ang < end - 1e-9 && chords < MAX_CHORDS) {
-        double c = chords % 2 ? 0.08 : 0.02;
-        ang = fmin(end, ang + 2 * asin(c / (2 * RADIUS)));
-        double x = RADIUS * sin(ang), y = RADIUS - RADIUS * cos(ang);
-        len += sprintf(prog + len, "G1 X%.4f Y%.4f Z0\n", x, y);
+    while (chords < MAX_CHORDS && step(&at, chords % 2 ? 0.08 : 0.02, xy)) {
+        len += sprintf(prog + len, "G1 X%.4f Y%.4f Z0\n", xy[0], xy[1]);
         chords++;
-        pts[chords][0] = round(x * 1e4) / 1e4;
-        pts[chords][1] = round(y * 1e4) / 1e4;
+        pts[chords][0] = round(xy[0] * 1e4) / 1e4;
+        pts[chords][1] = round(xy[1] * 1e4) / 1e4;
         pts[chords][2] = 0;
     }
     sprintf(prog + len, "M2\n");
     return prog;
 }
 
+/* TURNS round the circle through the origin, centred at (0, RADIUS). */
+static int circle_step(double *ang, double c, double xy[2])
+{
+    double end = TURNS * 2 * M_PI;
+    if (*ang >= end - 1e-9)
+        return 0;
+    *ang = fmin(end, *ang + 2 * asin(c / (2 * RADIUS)));
+    xy[0] = RADIUS * sin(*ang);
+    xy[1] = RADIUS - RADIUS * cos(*ang);
+    return 1;
+}
+
 /* A wave of amplitude WAVE_A and wavenumber WAVE_K along the diagonal y = x,
- * WAVE_LEN mm long (in its own parameter), chords of 0.02 and 0.08 mm. */
+ * WAVE_LEN mm long in its own parameter. */
 #define WAVE_A 0.09
 #define WAVE_K (10.0 / 3)
 #define WAVE_LEN 12.0
-static char *wave_chain(void)
+static int wave_step(double *s, double c, double xy[2])
 {
-    char *prog = malloc((size_t)64 * (MAX_CHORDS + 4));
-    assert_non_null(prog);
-    int len = sprintf(prog, "G21 G90 G17 G94 G64 P%.2f Q0\nG1 F3000\n", P_TOL);
-    double s = 0, h = sqrt(0.5);
-    memset(pts[0], 0, sizeof pts[0]);
-    chords = 0;
-    while (s < WAVE_LEN - 1e-9 && chords < MAX_CHORDS) {
-        s = fmin(WAVE_LEN, s + (chords % 2 ? 0.08 : 0.02));
-        double w = WAVE_A * sin(WAVE_K * s), x = h * (s - w), y = h * (s + w);
-        len += sprintf(prog + len, "G1 X%.4f Y%.4f Z0\n", x, y);
-        chords++;
-        pts[chords][0] = round(x * 1e4) / 1e4;
-        pts[chords][1] = round(y * 1e4) / 1e4;
-        pts[chords][2] = 0;
-    }
-    sprintf(prog + len, "M2\n");
-    return prog;
+    if (*s >= WAVE_LEN - 1e-9)
+        return 0;
+    *s = fmin(WAVE_LEN, *s + c);
+    double w = WAVE_A * sin(WAVE_K * *s);
+    xy[0] = sqrt(0.5) * (*s - w);
+    xy[1] = sqrt(0.5) * (*s + w);
+    return 1;
 }
 
 static double dist_chord(const double p[3], int k)
@@ -105,17 +108,37 @@ static double dist_chain(const double p[3], int *i)
     return chain_dist((const double(*)[3])pts, chords, p, i, 4, 20);
 }
 
+/* The whole chain on LinuxCNC-like limits, trapezoid profile, virtual clock. */
+static struct row *run_chain(chain_step step, struct ncp_machine_cfg *cfg, size_t *n)
+{
+    char *prog = write_chain(step);
+    lcnc_like_cfg(cfg);
+    cfg->profile = NCP_PROFILE_TRAPEZOID;
+    struct ncp_nck_result res;
+    struct row *r = run_text(prog, cfg, n, &res);
+    free(prog);
+    return r;
+}
+
+/* Frees the rows; every sample within P and every axis within its limit. */
+static void check_band_and_limits(struct row *r, size_t n, double period, double dev,
+                                  const char *speed_is, double speed)
+{
+    double acc = worst_acc(r, n, period);
+    free(r);
+    print_message("%d chords, %.3f s, %s %.1f mm/s, deviation %.5f mm, axis acceleration %.4f "
+                  "of the limit\n", chords, (double)n * period, speed_is, speed, dev, acc);
+    if (dev > P_TOL + 1e-6 || acc > 1 + 1e-9)
+        fail_msg("deviation %.5f mm (P %.2f), axis acceleration %.4f of the limit", dev, P_TOL,
+                 acc);
+}
+
 static void test_circle_chords_run_as_arcs(void **state)
 {
     (void)state;
-    char *prog = circle_chain();
     struct ncp_machine_cfg cfg;
-    lcnc_like_cfg(&cfg);
-    cfg.profile = NCP_PROFILE_TRAPEZOID;
-    struct ncp_nck_result res;
     size_t n;
-    struct row *r = run_text(prog, &cfg, &n, &res);
-    free(prog);
+    struct row *r = run_chain(circle_step, &cfg, &n);
     int at = 0;
     double dev = 0, vtop = 0;
     for (size_t k = 0; k < n; k++) {
@@ -141,14 +164,9 @@ static void test_circle_chords_run_as_arcs(void **state)
         if (k * cfg.servo_period > 0.25 && k + 100 < n)
             vtop = fmax(vtop, r[k].v);
     }
-    double acc = worst_acc(r, n, cfg.servo_period), t = (double)n * cfg.servo_period;
-    free(r);
-    print_message("%d chords, %.3f s, top speed %.1f mm/s, deviation %.5f mm, axis acceleration "
-                  "%.4f of the limit\n", chords, t, vtop, dev, acc);
-    if (dev > P_TOL + 1e-6 || acc > 1 + 1e-9)
-        fail_msg("deviation %.5f mm (P %.2f), axis acceleration %.4f of the limit", dev, P_TOL,
-                 acc);
-    /* sqrt(0.99 a r) = 31.5 mm/s on the circle; the blends reach about 20 */
+    check_band_and_limits(r, n, cfg.servo_period, dev, "top speed", vtop);
+    /* sqrt(0.99 a r) = 31.5 mm/s on the circle (more where a fitted arc's
+     * sweep leaves its axes room); the blends reach about 20 */
     if (vtop < 28)
         fail_msg("the chain reached only %.1f mm/s (want >= 28: the circle's radius)", vtop);
 }
@@ -156,14 +174,9 @@ static void test_circle_chords_run_as_arcs(void **state)
 static void test_diagonal_wave_reads_each_axis(void **state)
 {
     (void)state;
-    char *prog = wave_chain();
     struct ncp_machine_cfg cfg;
-    lcnc_like_cfg(&cfg);
-    cfg.profile = NCP_PROFILE_TRAPEZOID;
-    struct ncp_nck_result res;
     size_t n;
-    struct row *r = run_text(prog, &cfg, &n, &res);
-    free(prog);
+    struct row *r = run_chain(wave_step, &cfg, &n);
     int at = 0;
     double dev = 0, vlow = INFINITY;
     for (size_t k = 0; k < n; k++) {
@@ -175,13 +188,7 @@ static void test_diagonal_wave_reads_each_axis(void **state)
         if (along > 2 && along < WAVE_LEN - 2)
             vlow = fmin(vlow, r[k].v);
     }
-    double acc = worst_acc(r, n, cfg.servo_period), t = (double)n * cfg.servo_period;
-    free(r);
-    print_message("%d chords, %.3f s, slowest in the middle %.1f mm/s, deviation %.5f mm, axis "
-                  "acceleration %.4f of the limit\n", chords, t, vlow, dev, acc);
-    if (dev > P_TOL + 1e-6 || acc > 1 + 1e-9)
-        fail_msg("deviation %.5f mm (P %.2f), axis acceleration %.4f of the limit", dev, P_TOL,
-                 acc);
+    check_band_and_limits(r, n, cfg.servo_period, dev, "slowest in the middle", vlow);
     if (vlow < 34.5)
         fail_msg("the wave slowed to %.1f mm/s (want >= 34.5: each axis's own room)", vlow);
 }
