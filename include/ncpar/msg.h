@@ -59,6 +59,9 @@ struct ncp_msg_opts {
     int encrypt_public;      /* [LCM] STATUS_NEEDS_KEY: STATUS and EVENT encrypted */
     int max_age_ms;          /* ncp_msg_take drops datagrams sealed longer ago or
                                 further ahead than this (0: no limit) */
+    int recv_buf_default;    /* receive buffer (bytes) where the URL names none;
+                                0: the system's default. The kernel caps it at
+                                net.core.rmem_max. */
 };
 
 /* Opens the transport with the key of o->key_file. On error d->msg says why. */

@@ -48,7 +48,8 @@ struct llc_row {          /* one period of the trace, handed to the main thread 
     double cmd, act;
     int state;
     int gap;              /* 0 its own setpoint, 1 bridged, 2 held, 3 left out (late loop),
-                           * 4 the next one late (feed-forward guessed) */
+                           * 4 the next one late (feed-forward guessed), 5 catching up
+                           * with the stream after periods left out (block-level points) */
 };
 
 struct llc {
@@ -73,6 +74,11 @@ struct llc {
     int held_moving;      /* the axis was moving when the setpoints stopped */
     uint32_t clamped;     /* setpoints limited to MAX_VELOCITY */
     uint32_t left_out;    /* periods the loop woke too late to play (llc.c) */
+    /* Block-level points: the interpolator's last sample (mm), and whether
+     * the command is still on its way back to it after periods left out,
+     * closing catch_u (mm) of the distance in the last period (llc.c) */
+    double stream_prev, catch_u;
+    int catching;
     uint32_t ff_guessed;  /* periods in motion without the next setpoint for feed-forward */
     int64_t last_hlc_ns, last_hb_ns, last_adv_ns, settle;
     int64_t lost_at_ns;   /* when LLC_END_LOST was decided */

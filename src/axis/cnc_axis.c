@@ -23,6 +23,9 @@
 
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_FAULT = 3 };
 
+/* the socket's receive buffer unless the LCM URL names one (bytes) */
+#define LLC_RECV_BUF (4 << 20)
+
 static struct llc *the_llc;
 
 static void on_signal(int sig)
@@ -152,6 +155,13 @@ static int setup(struct llc *l, const struct opts *o, const struct ncp_machine_c
         return fprintf(stderr, "cnc-axis: error: %s\n", d.msg), -1;
     mo.opts.url = url;
     mo.opts.prefix = NULL;
+    /* Whatever comes while the loop is stalled waits in this socket, every
+     * process's traffic on the group with it (a few datagrams a period),
+     * and the HLC says each time scaling advance in only 16 messages: the
+     * system's default buffer (208 KiB) ran over in a 90 ms stall, and the
+     * interpolator woke to play a feed hold's ramp at an advance it never
+     * heard (20 to 160 um off the path). */
+    mo.opts.recv_buf_default = LLC_RECV_BUF;
     if (ncp_msg_open(&l->msg, &mo.opts, &d) != NCP_OK)
         return fprintf(stderr, "cnc-axis: error: %s\n", d.msg), -1;
     /* the order llc_take expects */

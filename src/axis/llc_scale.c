@@ -90,6 +90,7 @@ int llc_scale_void(struct llc *l, int64_t slot)
         ncp_dist_recs_skip(&l->recs, l->scale.void_below);
     l->ex_on = 0;
     l->stop_rested = 0;
+    l->catching = 0;   /* the stream it was catching up with is gone */
     l->rec_off = l->scale.void_off;
     l->scale.voided++;
     return 0;

@@ -7,7 +7,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define LLC_SCALE_HIST 64
+/* Periods of advances kept: a loop woken late steps the interpolator
+ * through every period it slept through (llc.c's left_out(), then the 64
+ * it plays), each at the advance the HLC said for it, by then that many
+ * periods older than the newest. 64 lost the oldest of them, and a stall in
+ * a feed hold's ramp ran that axis at 1 there; this covers a stall of 2 s,
+ * far past the HLC's heartbeat watch. */
+#define LLC_SCALE_HIST 2048
 #define LLC_DROPS 8   /* DP2: aborts whose planner records are told apart */
 
 struct llc_scale {

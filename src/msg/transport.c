@@ -151,6 +151,8 @@ int ncp_msg_open(struct ncp_msg **mp, const struct ncp_msg_opts *o, struct ncp_d
     int rc = ncp_msg_parse_url(url, &u, d);
     if (rc != NCP_OK)
         return rc;
+    if (u.recv_buf_size == 0)
+        u.recv_buf_size = o->recv_buf_default;
     if (o->key_file == NULL || *o->key_file == 0)
         return ncp_diag_set(d, NCP_ERR_IO, 0, 0, "LCM without a key file: refused");
     struct ncp_auth *auth = ncp_auth_open(o->key_file, NULL, o->create_key, d);
