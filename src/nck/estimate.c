@@ -14,10 +14,12 @@
 #include <errno.h>
 #include <sched.h>
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/syscall.h>
+#include <time.h>
 #include <unistd.h>
 
 
@@ -31,6 +33,10 @@ struct nck_estimate_run {
     struct ncp_nck_result res;
     atomic_int stop;                 /* ncp_nck_opts.interrupt, the interpreter's cancel */
     atomic_int done;
+    /* the service and the thread each hold one; the last to let go frees
+     * it, so that a cancelled run is never waited for (run_drop) */
+    atomic_int refs;
+    atomic_int *live;                /* its nck_estimate's count of threads not ended */
     int64_t t0_ns, t1_ns;
     double start[NCP_AXES];          /* acfg.start_machine */
 };
@@ -61,6 +67,15 @@ static void lower_priority(void)
         errno = 0;   /* at the service's priority, then: still off its real-time path */
 }
 
+static void run_drop(struct nck_estimate_run *r)
+{
+    if (atomic_fetch_sub_explicit(&r->refs, 1, memory_order_acq_rel) != 1)
+        return;
+    ncp_source_close(&r->src);
+    free(r->text);
+    free(r);
+}
+
 static void *estimate_main(void *arg)
 {
     struct nck_estimate_run *r = arg;
@@ -71,7 +86,10 @@ static void *estimate_main(void *arg)
     };
     ncp_nck_run(&o, &r->res);
     r->t1_ns = ncp_mono_ns();
+    atomic_int *live = r->live;
     atomic_store_explicit(&r->done, 1, memory_order_release);
+    run_drop(r);
+    atomic_fetch_sub_explicit(live, 1, memory_order_release);
     return NULL;
 }
 
@@ -94,22 +112,10 @@ static void estimate_machine(struct ncp_machine_cfg *c, const double *joints)
         memcpy(c->sim_start, joints, sizeof c->sim_start);
 }
 
-static void release(struct nck_estimate_run *r, pthread_t th);
-
-/* The cancelled one, once it has ended (wait: however long that takes). */
-static void reap(struct nck_estimate *e, int wait)
-{
-    if (e->dying && (wait || atomic_load_explicit(&e->dying->done, memory_order_acquire))) {
-        release(e->dying, e->dying_th);
-        e->dying = NULL;
-    }
-}
-
 int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *in)
 {
     nck_estimate_cancel(e, "a new load");
-    reap(e, 1);   /* between jobs: the one a run cancelled has long ended */
-    memset(e, 0, sizeof *e);
+    memset(e, 0, offsetof(struct nck_estimate, live));
     struct nck_estimate_run *r = calloc(1, sizeof *r);
     char *text = r ? malloc(in->len + 1) : NULL;
     struct ncp_diag d;
@@ -154,7 +160,11 @@ int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *
         return -1;
     }
     r->t0_ns = ncp_mono_ns();
+    atomic_init(&r->refs, 2);
+    r->live = &e->live;
+    atomic_fetch_add_explicit(&e->live, 1, memory_order_relaxed);
     if (pthread_create(&e->th, NULL, estimate_main, r) != 0) {
+        atomic_fetch_sub_explicit(&e->live, 1, memory_order_relaxed);
         ncp_source_close(&r->src);
         free(text);
         free(r);
@@ -165,14 +175,6 @@ int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *
     e->run = r;
     e->state = NCP_EST_RUNNING;
     return 0;
-}
-
-static void release(struct nck_estimate_run *r, pthread_t th)
-{
-    pthread_join(th, NULL);
-    ncp_source_close(&r->src);
-    free(r->text);
-    free(r);
 }
 
 /* "line 12: soft limit: ..." as the run would have refused it */
@@ -189,7 +191,6 @@ static void failed(struct nck_estimate *e, const struct ncp_nck_result *res)
 
 int nck_estimate_poll(struct nck_estimate *e)
 {
-    reap(e, 0);
     struct nck_estimate_run *r = e->run;
     if (!r || !atomic_load_explicit(&r->done, memory_order_acquire))
         return 0;
@@ -209,7 +210,8 @@ int nck_estimate_poll(struct nck_estimate *e)
         memcpy(e->ext_max, res->ext_max, sizeof e->ext_max);
     }
     e->seconds = (double)(r->t1_ns - r->t0_ns) * 1e-9;
-    release(r, e->th);
+    pthread_join(e->th, NULL);   /* it has ended: only its exit is left */
+    run_drop(r);
     e->run = NULL;
     return 1;
 }
@@ -221,10 +223,12 @@ void nck_estimate_cancel(struct nck_estimate *e, const char *why)
         return;
     if (nck_estimate_poll(e))   /* it ended meanwhile: its result stands */
         return;
+    /* Never waited for: at SCHED_IDLE beside busy CPUs it may take most of
+     * a second to see the stop, and the thread that cancels it answers the
+     * E-stop. It frees its run itself when it ends (run_drop). */
     atomic_store_explicit(&r->stop, 1, memory_order_relaxed);
-    reap(e, 1);   /* one slot: an older one still ending is waited for (rare) */
-    e->dying = r;
-    e->dying_th = e->th;
+    pthread_detach(e->th);
+    run_drop(r);
     e->run = NULL;
     e->state = NCP_EST_CANCELLED;
     snprintf(e->why, sizeof e->why, "cancelled by %s", why);
@@ -233,5 +237,8 @@ void nck_estimate_cancel(struct nck_estimate *e, const char *why)
 void nck_estimate_free(struct nck_estimate *e)
 {
     nck_estimate_cancel(e, "the NCK's end");
-    reap(e, 1);
+    /* what they borrow (the INI's strings, remaps) goes with the NCK */
+    const struct timespec ms = { 0, 1000000 };
+    while (atomic_load_explicit(&e->live, memory_order_acquire) > 0)
+        nanosleep(&ms, NULL);
 }

@@ -10,6 +10,7 @@
 #include "ncpar/config.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -18,16 +19,16 @@ struct nck_estimate_run;
 struct nck_estimate {
     struct nck_estimate_run *run;    /* the thread's, while state is RUNNING */
     pthread_t th;
-    /* one cancelled and not yet ended: joined once it has (never waited
-     * for on a run's way: its threads run below the service's) */
-    struct nck_estimate_run *dying;
-    pthread_t dying_th;
     int state;                       /* enum ncp_nck_estimate_state */
     double program_time, path_length, ferr_max;  /* s, mm, mm (state DONE) */
     int pauses;                      /* M0, M1, M6 waited at (state DONE) */
     double ext_min[NCP_AXES], ext_max[NCP_AXES]; /* commanded extents (state DONE) */
     double seconds;                  /* how long it took to find (host time) */
     char why[256];                   /* FAILED, CANCELLED: why */
+    /* Threads not yet ended, cancelled ones too (they end on their own):
+     * kept across starts, so it stays last (nck_estimate_start clears the
+     * fields before it) */
+    atomic_int live;
 };
 
 /* What the estimate runs: the program's text as loaded (copied), the
@@ -50,11 +51,12 @@ int nck_estimate_start(struct nck_estimate *e, const struct nck_estimate_input *
 /* 1 when a running estimate has just ended (its result is in e), else 0. */
 int nck_estimate_poll(struct nck_estimate *e);
 /* Asks a running estimate to end within a few blocks of its program, and
- * returns without waiting for it (nck_estimate_poll joins it later): state
- * CANCELLED with why. Nothing when none runs; the result when it had
- * ended already. */
+ * returns without waiting for it (its thread frees what it ran on when it
+ * ends): state CANCELLED with why. Nothing when none runs; the result when
+ * it had ended already. */
 void nck_estimate_cancel(struct nck_estimate *e, const char *why);
-/* Ends and joins whatever still runs (the NCK's end). */
+/* Cancels what still runs and waits until every estimate thread, cancelled
+ * ones too, has ended (the NCK's end). */
 void nck_estimate_free(struct nck_estimate *e);
 
 #endif
