@@ -285,28 +285,29 @@ static void arc_limits(const struct ncp_planner *p, struct plan_seg *ps, double 
         if (plan_scurve(p) && a->max_jerk > 0)
             scurve_arc_caps(p, a->max_jerk, share, kappa * m, &vmax, &jerk);
     }
-    double v_cap = kappa > 1e-12 ? fmin(vmax, sqrt(an_share * a_eff / kappa)) : vmax;
-    double an = v_cap * v_cap * kappa, acc = sqrt(fmax(0, a_eff * a_eff - an * an));
     /* A fitted arc sweeps a few degrees (tiny's median 6): its cap and its
      * tangent read the box, where its normal near a diagonal leaves each axis
      * more than the disc would (bench/gen-planner.py's tiny 4.520 -> 4.382 s) */
-    if (kappa > 1e-12 && !plan_scurve(p) && ps->fitted) {
-        double nmax[3], tmax[3], room = INFINITY, box = INFINITY;
+    double room = a_eff;
+    int box = kappa > 1e-12 && !plan_scurve(p) && ps->fitted;
+    if (box) {
+        double nmax[3], tmax[3];
         arc_sweep_shares(s, f_plane, f_axis, nmax, tmax);
-        for (int j = 0; j < 3; j++)
-            if (nmax[j] > 1e-12)
-                room = fmin(room, p->cfg.axis[j].max_acc / nmax[j]);
-        v_cap = fmin(vmax, sqrt(an_share * room / kappa));
-        an = v_cap * v_cap * kappa;
+        room = INFINITY;
         ps->box_kappa = kappa;
         for (int j = 0; j < 3; j++) {
-            ps->box_a[j] = tmax[j] > 1e-12 ? p->cfg.axis[j].max_acc / tmax[j] : INFINITY;
+            double a = p->cfg.axis[j].max_acc;
+            if (nmax[j] > 1e-12)
+                room = fmin(room, a / nmax[j]);
+            ps->box_a[j] = tmax[j] > 1e-12 ? a / tmax[j] : INFINITY;
             ps->box_b[j] = tmax[j] > 1e-12 ? nmax[j] / tmax[j] : 0;
-            box = fmin(box, ps->box_a[j] - an * ps->box_b[j]);
         }
-        acc = fmax(box, sqrt(fmax(0, a_eff * a_eff - an * an)));
     }
-    vmax = v_cap;
+    if (kappa > 1e-12)
+        vmax = fmin(vmax, sqrt(an_share * room / kappa));
+    double an = vmax * vmax * kappa, acc = sqrt(fmax(0, a_eff * a_eff - an * an));
+    if (box)
+        acc = fmax(acc, plan_box_at(ps, an));
     ps->vmax = vmax;
     ps->acc = fmin(acc_lin, acc);
     ps->jerk = jerk;
@@ -693,7 +694,7 @@ double ncp_plan_seg_reach(int scurve, const struct plan_seg *ps, double v, doubl
      * (a chain of short arcs runs this in every backward pass) */
     if (ps->kappa <= 0 || scurve || lo >= ps->vmax)
         return lo;
-    /* a hair below the root, so that rounding keeps it reachable */
+    /* each root a hair below itself, so that rounding keeps it reachable */
     double xb = -1;
     if (ps->box_kappa > 0) {
         /* the box's lines are linear in x^2: each gives its root directly */

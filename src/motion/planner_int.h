@@ -205,18 +205,23 @@ static inline double plan_reach(int scurve, double acc, double jerk, double v, d
  * scaled as a corner scaled acc. Never below acc, the value at the cruise cap.
  * A fitted arc's box (box_kappa) is read beside the disc: each is a bound on
  * what every axis allows, so the larger is too. */
+/* The tangent a fitted arc's box leaves at centripetal acceleration a_n. */
+static inline double plan_box_at(const struct plan_seg *ps, double a_n)
+{
+    double at = INFINITY;
+    for (int j = 0; j < 3; j++)
+        at = fmin(at, ps->box_a[j] - a_n * ps->box_b[j]);
+    return at;
+}
+
 static inline double plan_acc_at(const struct plan_seg *ps, double v)
 {
     if (ps->kappa <= 0 || ps->acc_full <= 0)
         return ps->acc;
     double an = v * v * ps->kappa;
     double at = ps->a_eff > an ? sqrt(ps->a_eff * ps->a_eff - an * an) : 0;
-    if (ps->box_kappa > 0) {
-        double y = v * v * ps->box_kappa, bx = INFINITY;
-        for (int j = 0; j < 3; j++)
-            bx = fmin(bx, ps->box_a[j] - y * ps->box_b[j]);
-        at = fmax(at, bx);
-    }
+    if (ps->box_kappa > 0)
+        at = fmax(at, plan_box_at(ps, v * v * ps->box_kappa));
     return ps->acc / ps->acc_full * fmax(ps->acc_full, fmin(ps->a_cap, at));
 }
 
