@@ -47,9 +47,8 @@ struct llc_row {          /* one period of the trace, handed to the main thread 
     int64_t t_ns, slot_ns;
     double cmd, act;
     int state;
-    int gap;              /* 0 its own setpoint, 1 bridged, 2 held, 3 left out (late loop),
-                           * 4 the next one late (feed-forward guessed), 5 catching up
-                           * with the stream after periods left out (block-level points) */
+    int gap;              /* 0 its own setpoint, 1 bridged, 2 held, 3 left out (late loop), 4 the
+                           * next one late (feed-forward guessed), 5 rejoining the stream after 3 */
 };
 
 struct llc {
@@ -74,9 +73,8 @@ struct llc {
     int held_moving;      /* the axis was moving when the setpoints stopped */
     uint32_t clamped;     /* setpoints limited to MAX_VELOCITY */
     uint32_t left_out;    /* periods the loop woke too late to play (llc.c) */
-    /* Block-level points: the interpolator's last sample (mm), and whether
-     * the command is still on its way back to it after periods left out,
-     * closing catch_u (mm) of the distance in the last period (llc.c) */
+    /* block-level points, after periods left out: the interpolator's last sample
+     * (mm), the command still on its way back to it, catch_u (mm) closed last period */
     double stream_prev, catch_u;
     int catching;
     uint32_t ff_guessed;  /* periods in motion without the next setpoint for feed-forward */
