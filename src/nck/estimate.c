@@ -210,7 +210,10 @@ int nck_estimate_poll(struct nck_estimate *e)
         memcpy(e->ext_max, res->ext_max, sizeof e->ext_max);
     }
     e->seconds = (double)(r->t1_ns - r->t0_ns) * 1e-9;
-    pthread_join(e->th, NULL);   /* it has ended: only its exit is left */
+    /* not joined: its exit is left, and at SCHED_IDLE beside busy CPUs a
+     * thread preempted between `done` and its return may wait seconds for
+     * the CPU, while the service thread that polls answers the E-stop */
+    pthread_detach(e->th);
     run_drop(r);
     e->run = NULL;
     return 1;
