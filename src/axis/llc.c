@@ -500,13 +500,14 @@ static double ramp(struct llc *l)
     return l->cmd + v * T;
 }
 
-/* ADCAI's DP1: its NCK's samples through this axis's stages; a sample
+/* ADCAI's DP1: its NCK's samples through this axis's stages, the command
+ * on its way back to them after periods left out (rejoin()); a sample
  * missing in motion stops the axis (ramp). */
 static double play_ai(struct llc *l, int64_t slot)
 {
     double c = llc_dp1_ai_play(l, slot);
     if (l->end == LLC_END_NONE)
-        return c;
+        return rejoin(l, c);
     l->state = NCP_AX_STATUS_T_STOPPING;
     return ramp(l);
 }
@@ -603,10 +604,8 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
     double lim = l->cfg->axis[l->axis].max_vel * (double)T * 1e-9 + 1e-6;
     if (hold_now(l, slot) || fine == 2)
         cmd_ahead = l->cmd;
-    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && l->dp1ai)
-        cmd_ahead = llc_dp1_ai_ahead(l, slot + T);
-    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && l->dp4) {
-        cmd_ahead = interpolate_ahead(l, slot + T);
+    else if (l->state == NCP_AX_STATUS_T_RUNNING && !fine && (l->dp1ai || l->dp4)) {
+        cmd_ahead = l->dp1ai ? llc_dp1_ai_ahead(l, slot + T) : interpolate_ahead(l, slot + T);
         /* catching up (rejoin()): the stream's next step and as much again
          * of the distance to it as this one closed */
         if (l->catching)
@@ -633,17 +632,23 @@ static void period(struct llc *l, int64_t now, int64_t slot, int latest)
 }
 
 /* At the block-level points a period left out is still one the HLC's
- * stream went on in: the interpolator takes its step, so that this axis
- * stays at the program's time, which the other axes keep; the command
- * rejoins it in the periods played after (rejoin()).
+ * stream went on in: the interpolator takes its step (at ADCAI's DP1 the
+ * stages their sample), so that this axis stays at the program's time,
+ * which the other axes keep; the command rejoins it in the periods played
+ * after (rejoin()).
  * Left out of the interpolator too, the step kept this axis behind the
  * others until the next standstill, off the path wherever it bent (a loop
  * woken 100 ms late: 35 periods, 0.7 mm off the central path). */
 static void stream_on(struct llc *l, int64_t slot)
 {
     double pos;
-    if (l->end != LLC_END_NONE || (l->done_req && slot > l->done_at) || fine_phase(l, slot) ||
-        stream_step(l, slot, &pos) <= 0)
+    if (l->end != LLC_END_NONE || (l->done_req && slot > l->done_at))
+        return;
+    if (l->dp1ai)
+        pos = llc_dp1_ai_play(l, slot);
+    else if (fine_phase(l, slot) || stream_step(l, slot, &pos) <= 0)
+        return;
+    if (l->end != LLC_END_NONE)
         return;
     /* the command stands: the distance grows by the stream's step */
     l->catch_u = -copysign(1.0, pos - l->cmd) * (pos - l->stream_prev);
@@ -663,7 +668,7 @@ static void left_out(struct llc *l, int64_t from, int64_t to)
     int64_t n = (to - from) / l->period_ns;
     for (int64_t i = 0; i < n; i++) {
         int64_t s = from + i * l->period_ns;
-        if (l->dp4)
+        if (l->dp4 || l->dp1ai)
             stream_on(l, s);
         if (i >= LEFT_OUT_RUN)
             continue;
