@@ -220,6 +220,9 @@ int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const struct ncp_
                                  const char *path, int *written, struct ncp_diag *d);
 /* dst's tool table becomes src's (the baseline after a write). */
 void ncp_analyzer_copy_tools(struct ncp_analyzer *dst, const struct ncp_analyzer *src);
+/* 1 when a's tool entries are b's as the file would write them (a save of
+ * a against b would change no line), else 0. Reads memory only. */
+int ncp_analyzer_same_tools(const struct ncp_analyzer *a, const struct ncp_analyzer *b);
 
 /* The modal codes in force (what every slot is stamped with when handed on);
  * for a resident analyzer between runs, the state the next run starts in. */

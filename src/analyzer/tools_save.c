@@ -132,6 +132,16 @@ int ncp_analyzer_save_tool_table(const struct ncp_analyzer *a, const struct ncp_
     return rc;
 }
 
+int ncp_analyzer_same_tools(const struct ncp_analyzer *a, const struct ncp_analyzer *b)
+{
+    if (a->n_tools != b->n_tools)
+        return 0;
+    for (int k = 0; k < a->n_tools; k++)
+        if (!same_entry(a, k, &b->tools[k], b->tool_more[k], b->tool_no[k]))
+            return 0;
+    return 1;
+}
+
 void ncp_analyzer_copy_tools(struct ncp_analyzer *dst, const struct ncp_analyzer *src)
 {
     dst->n_tools = src->n_tools;

@@ -132,31 +132,29 @@ static void run_state_text(struct ncp_nck *s, const char *text, const char *name
     ncp_source_close(&src);
 }
 
-/* What a job, a stop or the shutdown changed of the offsets and tools, on
- * the disk before the next command: a failure is the operator's to know. */
+/* What a job, a stop or the shutdown changed of the offsets and tools (and
+ * what failed to be written before), handed to the disk writer: on the
+ * disk before the next command that needs it (disk_wait); a failure is the
+ * operator's to know (the writer's event). */
 static void persist(struct ncp_nck *s)
 {
-    char why[NCP_DIAG_MSG_MAX];
-    int w = nck_persist_save(&s->persist, s->interp, why, sizeof why);
-    if (w < 0)
-        nck_post(&s->core, NCP_EV_ERROR, NULL, 0, 0, "%s", why);
-    if (w > 0 && (w & 1))
-        nck_post(&s->core, NCP_EV_INFO, NULL, 0, 0, "offsets saved to %s",
-                 s->persist.var_path);
-    if (w > 0 && (w & 2))
-        nck_post(&s->core, NCP_EV_INFO, NULL, 0, 0, "tool table %s written",
-                 s->persist.tool_path);
+    int changed = nck_persist_changes(&s->persist, s->interp, nck_writer_again(&s->writer));
+    nck_writer_persist(&s->writer, &s->persist, changed);
 }
 
-/* A program run's line in the job history; a failure to write it is the
- * operator's to know, the service goes on. */
+/* A program run's line in the job history, made here and appended by the
+ * disk writer; a failure is the operator's to know, the service goes on. */
 static void history_end(struct ncp_nck *s, const char *result, double program_time)
 {
-    char why[NCP_DIAG_MSG_MAX];
+    char why[NCP_DIAG_MSG_MAX], line[NCK_HISTORY_LINE_MAX];
     int fault = !strcmp(result, "error") || !strcmp(result, "fault");
-    if (nck_history_end(&s->hist, result, fault ? s->error : "", program_time,
-                        s->core.svc->sum.job_ferr_max, why, sizeof why) != 0)
+    int n = nck_history_end(&s->hist, result, fault ? s->error : "", program_time,
+                            s->core.svc->sum.job_ferr_max, line, sizeof line, why, sizeof why);
+    if (n < 0)
         nck_post(&s->core, NCP_EV_ERROR, NULL, 0, 0, "%s", why);
+    else if (n > 0 && nck_writer_line(&s->writer, line, (size_t)n) != 0)
+        nck_post(&s->core, NCP_EV_ERROR, NULL, 0, 0, "the job history's line for %s is lost: "
+                 "%d lines wait for the disk already", s->hist.program, NCK_WRITER_LINES);
 }
 
 /* After a stop, an error or an E-stop: the interpreter's end-of-program reset
@@ -173,6 +171,21 @@ static void reset_interp(struct ncp_nck *s)
 }
 
 /* ---- dropping what is queued --------------------------------------------------------- */
+
+/* What a job or a drop handed to the disk writer is not all on the disk
+ * yet: the state it ends in waits (a kill -9 once it shows loses nothing),
+ * and so do the commands that need the disk (disk_wait); the service
+ * thread answers the rest meanwhile. */
+static int disk_busy(struct ncp_nck *s)
+{
+    return nck_writer_busy(&s->writer);
+}
+
+/* ... or it is, and the state it ends in is not taken yet (the next poll). */
+static int disk_behind(struct ncp_nck *s)
+{
+    return s->drop == NCK_DROP_WRITE || disk_busy(s);
+}
 
 static void begin_drop(struct ncp_nck *s, int hold, int full, int after, int reset)
 {
@@ -224,7 +237,7 @@ static void drop_step(struct ncp_nck *s)
     case NCK_DROP_UNPARK:
         if (!nck_planner_unparked(n))
             return;
-        s->drop = NCK_DROP_NONE;
+        s->drop = NCK_DROP_WRITE;
         atomic_store(&n->cross.full_decel, 0);
         if (s->drop_after == NCP_ST_IDLE)
             atomic_store(&n->cross.frozen, 0);
@@ -241,6 +254,11 @@ static void drop_step(struct ncp_nck *s)
                                                            : "stopped",
                         now > s->run_t0_ns ? (double)(now - s->run_t0_ns) * 1e-9 : 0);
         }
+        /* fall through */
+    case NCK_DROP_WRITE:
+        if (disk_busy(s))
+            return;
+        s->drop = NCK_DROP_NONE;
         if (s->reset_after_drop) {
             s->reset_after_drop = 0;
             begin_drop(s, 0, 0, NCP_ST_IDLE, 0);
@@ -336,13 +354,16 @@ static const char *check_end_name(int why)
     }
 }
 
-/* Ends a load's check early: its interpreter sees it within a few blocks.
- * The first cause asked is the one the load's answer names. */
+/* Ends a load's check early (its interpreter sees it within a few blocks),
+ * and a command's wait for the disk (it is refused, not acted on). The
+ * first cause asked is the one the answer names. */
 static void end_check(struct ncp_nck *s, int why)
 {
     int none = NCK_CHECK_RUNS;
     if (s->loading && atomic_compare_exchange_strong(&s->load_cancel, &none, why))
         s->cancel_ns = ncp_mono_ns();
+    if (s->deferred && s->deferred_end == NCK_CHECK_RUNS)
+        s->deferred_end = why;
 }
 
 /* The cycle time of the program just loaded, from where the machine stands
@@ -440,6 +461,73 @@ static int cmd_load(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
     return NCP_NCK_CMD_PENDING;
 }
 
+static const char *disk_cmd_name(int kind)
+{
+    switch (kind) {
+    case NCP_CMD_LOAD: return "load";
+    case NCP_CMD_RUN: return "run";
+    case NCP_CMD_MDI: return "MDI";
+    default: return "files";
+    }
+}
+
+/* The commands that start something new, or read the files the writer
+ * writes: whatever the jobs before changed (offsets, tools, the history's
+ * lines) is on the disk before they act, so a kill -9 after their answer
+ * loses nothing, and cnc-ctl history reads every line. */
+static int needs_disk(int kind)
+{
+    return kind == NCP_CMD_LOAD || kind == NCP_CMD_RUN || kind == NCP_CMD_MDI ||
+           kind == NCP_CMD_FILES;
+}
+
+/* 0: the command acts now. Else it waits for the disk writer, and the
+ * service thread goes on answering the rest (E-stop, stop, feed hold,
+ * status): NCP_NCK_CMD_PENDING, kept and acted on by ncp_nck_pending once
+ * the writer has caught up; or -1 when another command waits already
+ * (one answer pending at a time, as a load's). */
+static int disk_wait(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, size_t len)
+{
+    if (!needs_disk(c->kind) || (!s->deferred && !disk_behind(s)))
+        return 0;
+    if (s->deferred || s->loading || s->ended_answer)
+        return refuse(why, len, "%s: the NCK is writing to its disk and another command "
+                      "waits for it: again once that one is answered", disk_cmd_name(c->kind));
+    s->deferred = 1;
+    s->deferred_end = NCK_CHECK_RUNS;
+    s->deferred_cmd = *c;
+    s->deferred_ns = ncp_mono_ns();
+    s->deferred_told = 0;
+    return NCP_NCK_CMD_PENDING;
+}
+
+/* The deferred command's answer: refused when a stop (or the like) ended
+ * its wait, acted on once the writer has caught up. */
+static int deferred_answer(struct ncp_nck *s, char *why, size_t len)
+{
+    const char *name = disk_cmd_name(s->deferred_cmd.kind);
+    if (s->deferred_end != NCK_CHECK_RUNS) {
+        s->deferred = 0;
+        s->rejected++;
+        return refuse(why, len, "%s not done: %s came while it waited for the disk (the "
+                      "last job's history and offsets being written)", name,
+                      check_end_name(s->deferred_end));
+    }
+    if (s->drop == NCK_DROP_WRITE)
+        drop_step(s);   /* the state the job ends in, when written: the command's own */
+    if (disk_behind(s)) {
+        /* a disk that hangs (NFS): the operator learns why nothing answers */
+        if (!s->deferred_told && ncp_mono_ns() - s->deferred_ns > 1000000000) {
+            s->deferred_told = 1;
+            nck_post(&s->core, NCP_EV_INFO, NULL, 0, 0, "%s waits for the disk: the last "
+                     "job's history line and offsets are still being written", name);
+        }
+        return NCP_NCK_CMD_PENDING;
+    }
+    s->deferred = 0;
+    return ncp_nck_command(s, &s->deferred_cmd, why, len);
+}
+
 int ncp_nck_pending(struct ncp_nck *s, char *why, size_t len)
 {
     if (len)
@@ -448,6 +536,8 @@ int ncp_nck_pending(struct ncp_nck *s, char *why, size_t len)
         s->ended_answer = 0;
         return refuse(why, len, "%s", s->ended_why);
     }
+    if (s->deferred)
+        return deferred_answer(s, why, len);
     if (!s->loading)
         return refuse(why, len, "no command is pending");
     if (!atomic_load(&s->load_done))
@@ -692,6 +782,9 @@ static int cmd_pause(struct ncp_nck *s, char *why, size_t len)
 {
     if (s->state != NCP_ST_RUNNING && s->state != NCP_ST_STEPPING && s->state != NCP_ST_MDI)
         return refuse(why, len, "nothing to pause while %s", ncp_nck_state_name(s->state));
+    if (s->drop == NCK_DROP_WRITE)
+        return refuse(why, len, "nothing to pause: the job has ended (what it changed is "
+                      "being written to the disk)");
     s->resume_state = s->state;
     ncp_nck_feed_hold(s->core.ctl, 1);
     set_state(s, NCP_ST_PAUSED);
@@ -767,6 +860,8 @@ static int cmd_step(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
 
 static int cmd_stop(struct ncp_nck *s, int full, char *why, size_t len)
 {
+    if (s->drop == NCK_DROP_WRITE)
+        return 0;   /* the job has ended: nothing moves, idle once written */
     if (!moving_state(s->state))
         return s->state == NCP_ST_IDLE || s->state == NCP_ST_STOPPING
                    ? 0
@@ -876,7 +971,10 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
         rc = 0;
         break;
     case NCP_CMD_SET_INPUT: rc = cmd_set_input(s, c, why, len); break;
-    case NCP_CMD_FILES: rc = cmd_files(s, c, why, len); break;
+    case NCP_CMD_FILES:
+        if ((rc = disk_wait(s, c, why, len)) == 0)
+            rc = cmd_files(s, c, why, len);
+        break;
     case NCP_CMD_KEEPALIVE:
         s->jog_last_ns = ncp_mono_ns();
         rc = 0;
@@ -892,6 +990,8 @@ int ncp_nck_command(struct ncp_nck *s, const struct ncp_nck_cmd *c, char *why, s
                         "ends the check)", s->load_path);
             break;
         }
+        if ((rc = disk_wait(s, c, why, len)) != 0)
+            break;
         switch (c->kind) {
         case NCP_CMD_LOAD: rc = cmd_load(s, c, why, len); break;
         case NCP_CMD_RUN: rc = cmd_run(s, c, why, len); break;
@@ -955,7 +1055,15 @@ static void job_ended(struct ncp_nck *s)
     /* the whole job in the trace once it is over, not at the next 64 KiB */
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
-    set_state(s, NCP_ST_IDLE);
+    if (!disk_busy(s)) {
+        set_state(s, NCP_ST_IDLE);
+        return;
+    }
+    /* the job's state until its changes are on the disk, as a drop's end */
+    s->drop = NCK_DROP_WRITE;
+    s->drop_after = NCP_ST_IDLE;
+    s->drop_reset = 0;
+    s->reset_after_drop = 0;
 }
 
 /* The loop is done homing: the axes it homed are homed, and the map and
@@ -1040,7 +1148,7 @@ int ncp_nck_poll(struct ncp_nck *s)
         drop_step(s);
     int st = s->state;
     if ((st == NCP_ST_RUNNING || st == NCP_ST_STEPPING || st == NCP_ST_MDI ||
-         st == NCP_ST_JOGGING) &&
+         st == NCP_ST_JOGGING) && s->drop == NCK_DROP_NONE &&
         atomic_load(&n->job->finished) && nck_motion_done(n))
         job_ended(s);
     if (s->homing_axes && nck_home_finished(n))
@@ -1077,8 +1185,10 @@ int ncp_nck_poll(struct ncp_nck *s)
     }
     if (s->shutdown_pending)
         end_check(s, NCK_CHECK_BY_SHUTDOWN);   /* answered by ncp_nck_pending */
+    /* the writer caught up too: what it writes is said as events before
+     * the service ends */
     if (s->shutdown_pending && s->drop == NCK_DROP_NONE && !moving_state(s->state) &&
-        !s->loading && !s->ended_answer)
+        !s->loading && !s->ended_answer && !s->deferred && !nck_writer_busy(&s->writer))
         s->shutdown = 1;
     int changed = s->changed;
     s->changed = 0;
@@ -1114,8 +1224,9 @@ struct ncp_nck *ncp_nck_new(const struct ncp_nck_setup *setup, struct ncp_diag *
     s->acfg.cancel_ctx = n;
     s->interp = ncp_analyzer_new(&s->acfg, d);
     s->acfg.instance = s->interp;
-    if (s->interp && nck_persist_init(&s->persist, setup->vars, setup->cfg->op.parameter_file,
-                                      s->acfg.tool_table_path, s->interp, d)) {
+    if (s->interp && (nck_persist_init(&s->persist, setup->vars, setup->cfg->op.parameter_file,
+                                       s->acfg.tool_table_path, s->interp, d) ||
+                      nck_writer_start(&s->writer, n, s->hist.path, &s->persist, d))) {
         ncp_nck_free(s);
         return NULL;
     }
@@ -1158,11 +1269,12 @@ void ncp_nck_free(struct ncp_nck *s)
     nck_read_cycles(n);
     if (n->setup.trace)
         nck_trace_flush(&n->svc->sum, n->setup.trace);
-    if (s->interp) {   /* at shutdown: what the last job changed is saved already */
-        char why[NCP_DIAG_MSG_MAX];
-        if (nck_persist_save(&s->persist, s->interp, why, sizeof why) < 0)
-            fprintf(stderr, "cnc-run serve: error: %s\n", why);
-    }
+    /* at shutdown what the last job changed is written already, but for a
+     * write that failed (tried again here) or a service that ended early */
+    int changed = s->interp && s->writer.started
+                      ? nck_persist_changes(&s->persist, s->interp, nck_writer_again(&s->writer))
+                      : 0;
+    nck_writer_stop(&s->writer, &s->persist, changed);
     nck_persist_free(&s->persist);
     nck_release(n);
     ncp_analyzer_free(s->interp);
@@ -1175,7 +1287,8 @@ void ncp_nck_free(struct ncp_nck *s)
 void ncp_nck_request_shutdown(struct ncp_nck *s)
 {
     s->shutdown_pending = 1;
-    if (moving_state(s->state))
+    /* a job that has ended and is being written is not stopped (nor reset) */
+    if (moving_state(s->state) && s->drop != NCK_DROP_WRITE)
         begin_drop(s, 1, 0, NCP_ST_IDLE, 1);
 }
 

@@ -3,6 +3,7 @@
 #define NCPAR_NCK_CONTROL_H
 
 #include "nck_int.h"
+#include "diskwriter.h"
 #include "estimate.h"
 #include "history.h"
 #include "persist.h"
@@ -26,7 +27,8 @@ enum nck_drop {
     NCK_DROP_JOB,        /* end the job thread */
     NCK_DROP_PARK,       /* planner parked? then discard */
     NCK_DROP_DISCARD,    /* setpoints discarded? then unpark */
-    NCK_DROP_UNPARK      /* planner running again? then done */
+    NCK_DROP_UNPARK,     /* planner running again? then hand what changed to the writer */
+    NCK_DROP_WRITE       /* written? then the state after (a job's end comes here too) */
 };
 
 /* The service's NCK: the core plus the state machine (control.c). */
@@ -82,6 +84,15 @@ struct ncp_nck {
     int64_t run_t0_ns;               /* the loop's time when the program run began */
     double program_time;             /* the last program run's, s (0: none yet) */
     struct nck_history hist;         /* [DISPLAY] HISTORY_FILE */
+    struct nck_writer writer;        /* writes the history and the persist files */
+    /* a command that needs the disk caught up (a run, MDI, a load, the
+     * history's path) kept until the writer is, then acted on; answered
+     * by ncp_nck_pending. deferred_end: what ended its wait (enum
+     * nck_check_end, 0: nothing) */
+    int deferred, deferred_end;
+    int deferred_told;               /* its long wait was said */
+    int64_t deferred_ns;             /* since when it waits */
+    struct ncp_nck_cmd deferred_cmd;
     unsigned llc_errors_told[NCP_NCK_AXES_MAX];  /* each LLC's error count told (llcs.c) */
     unsigned llc_returns_told[NCP_NCK_AXES_MAX]; /* and its returns after it was lost */
 };

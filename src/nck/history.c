@@ -55,7 +55,7 @@ static void iso_time(char *out, size_t cap, const struct timespec *t)
     snprintf(out, cap, "%s.%03ldZ", base, t->tv_nsec / 1000000);
 }
 
-static int append(const char *path, const char *line, size_t n)
+int nck_history_append(const char *path, const char *line, size_t n)
 {
     int fd = open(path, O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
     if (fd < 0)
@@ -73,14 +73,15 @@ static int append(const char *path, const char *line, size_t n)
 }
 
 int nck_history_end(struct nck_history *h, const char *result, const char *why,
-                    double program_time, double ferr_max, char *err, size_t len)
+                    double program_time, double ferr_max, char *line, size_t cap, char *err,
+                    size_t len)
 {
     if (!h->open)
         return 0;
     h->open = 0;
     struct timespec end;
     clock_gettime(CLOCK_REALTIME, &end);
-    char t0[40], t1[40], prog[600], reason[600], est[32], line[1600];
+    char t0[40], t1[40], prog[600], reason[600], est[32];
     iso_time(t0, sizeof t0, &h->start);
     iso_time(t1, sizeof t1, &end);
     json_text(prog, sizeof prog, h->program);
@@ -89,16 +90,12 @@ int nck_history_end(struct nck_history *h, const char *result, const char *why,
         snprintf(est, sizeof est, "%.6f", h->estimate);
     else
         snprintf(est, sizeof est, "null");
-    int n = snprintf(line, sizeof line,
+    int n = snprintf(line, cap,
                      "{\"start\": \"%s\", \"end\": \"%s\", \"program\": \"%s\", \"sha256\": "
                      "\"%s\", \"result\": \"%s\", \"reason\": \"%s\", \"program_time_s\": %.6f, "
                      "\"max_following_error_mm\": %.6f, \"estimate_s\": %s}\n",
                      t0, t1, prog, h->sha256, result, reason, program_time, ferr_max, est);
-    if (n < 0 || (size_t)n >= sizeof line)
+    if (n < 0 || (size_t)n >= cap)
         return snprintf(err, len, "history: the line for %s is too long", h->program), -1;
-    int e = append(h->path, line, (size_t)n);
-    if (e)
-        return snprintf(err, len, "cannot append to the job history %s ([DISPLAY] "
-                        "HISTORY_FILE): %s", h->path, strerror(e)), -1;
-    return 0;
+    return n;
 }

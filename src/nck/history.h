@@ -1,12 +1,15 @@
 /* serve's job history ([DISPLAY] HISTORY_FILE, history.c): one JSON line
- * per program run, appended when it ends. Runs on the service thread
- * between jobs, never on the real-time path (the write blocks on the
- * disk). */
+ * per program run, made on the service thread when the run ends and
+ * appended by the NCK's disk writer (diskwriter.h): the append blocks on
+ * the disk, which neither the service thread nor the real-time path may
+ * wait for. */
 #ifndef NCPAR_NCK_HISTORY_H
 #define NCPAR_NCK_HISTORY_H
 
 #include <stddef.h>
 #include <time.h>
+
+#define NCK_HISTORY_LINE_MAX 1600    /* a line, its newline and a 0 */
 
 struct nck_history {
     const char *path;                /* NULL or "": no history */
@@ -23,9 +26,14 @@ struct nck_history {
 void nck_history_begin(struct nck_history *h, const char *program, const char *text,
                        size_t len, double estimate);
 /* It ended: result "done", "error", "stopped", "estop" or "fault", why ""
- * or the reason, its program time and largest following error (mm). 0
- * (written, or no history, or no run open), or -1 with why in err. */
+ * or the reason, its program time and largest following error (mm). Its
+ * line in line[cap] (no I/O), and the line's length; 0 (no history, or no
+ * run open), or -1 with why in err. */
 int nck_history_end(struct nck_history *h, const char *result, const char *why,
-                    double program_time, double ferr_max, char *err, size_t len);
+                    double program_time, double ferr_max, char *line, size_t cap, char *err,
+                    size_t len);
+/* Appends the line (n bytes) whole by one write, then fsync: 0, or the
+ * errno. Blocks on the disk. */
+int nck_history_append(const char *path, const char *line, size_t n);
 
 #endif

@@ -1,7 +1,9 @@
 /* The parameter file and the tool table, kept up to date between jobs
- * (persist.h). A change is written once the job that made it has ended:
- * whatever was accepted is on the disk before the next command runs, so a
- * kill -9 after that loses nothing, and the file is never torn. */
+ * (persist.h). A change is written once the job that made it has ended,
+ * and the commands that change or depend on it wait for the write
+ * (control.c): whatever was accepted is on the disk before the next such
+ * command runs, so a kill -9 after that loses nothing, and the file is
+ * never torn. */
 #include "persist.h"
 
 #include <stdio.h>
@@ -16,9 +18,11 @@ int nck_persist_init(struct nck_persist *p, const struct ncp_var_file *vars,
     p->tool_path = tool_path;
     if (tool_path) {
         /* the interpreter's table is taken below: no second read */
-        if (!(p->tools_base = ncp_analyzer_new(NULL, d)))
+        if (!(p->tools_base = ncp_analyzer_new(NULL, d)) ||
+            !(p->tools_sent = ncp_analyzer_new(NULL, d)))
             return -1;
         ncp_analyzer_copy_tools(p->tools_base, interp);
+        ncp_analyzer_copy_tools(p->tools_sent, interp);
     }
     if (!vars)
         return 0;
@@ -37,7 +41,8 @@ void nck_persist_free(struct nck_persist *p)
     free(p->vf);
     p->vf = NULL;
     ncp_analyzer_free(p->tools_base);
-    p->tools_base = NULL;
+    ncp_analyzer_free(p->tools_sent);
+    p->tools_base = p->tools_sent = NULL;
 }
 
 void nck_persist_restore_text(const struct nck_persist *p, char *buf, size_t len)
@@ -57,35 +62,49 @@ void nck_persist_restore_text(const struct nck_persist *p, char *buf, size_t len
              k == 1 ? "G55" : "G54", sys[k - 1]);
 }
 
-int nck_persist_save(struct nck_persist *p, const struct ncp_analyzer *interp, char *why,
-                     size_t len)
+int nck_persist_changes(struct nck_persist *p, const struct ncp_analyzer *interp, int again)
 {
-    int written = 0;
-    struct ncp_diag d;
-    memset(&d, 0, sizeof d);
+    int changed = 0;
     if (p->vf) {
-        int changed = 0;
         for (int k = 1; k < NCP_VAR_PARAMS; k++) {
             if (!p->vf->listed[k])
                 continue;
             double v = ncp_analyzer_param(interp, k);
-            changed |= v != p->vf->value[k];
+            if (v != p->vf->value[k])
+                changed |= NCK_PERSIST_VARS;
             p->vf->value[k] = v;
         }
-        if (changed && ncp_var_file_write(p->var_path, p->vf, &d) != NCP_OK) {
-            /* the next save tries again: nothing is taken as written */
-            p->vf->value[5220] = -1;
-            return snprintf(why, len, "%s", d.msg), -1;
-        }
-        written |= changed;
+        changed |= again & NCK_PERSIST_VARS;
     }
     if (p->tool_path) {
-        int w = 0;
-        if (ncp_analyzer_save_tool_table(interp, p->tools_base, p->tool_path, &w, &d) != NCP_OK)
-            return snprintf(why, len, "%s", d.msg), -1;
-        if (w)
-            ncp_analyzer_copy_tools(p->tools_base, interp);
-        written |= w ? 2 : 0;
+        if (!ncp_analyzer_same_tools(interp, p->tools_sent)) {
+            ncp_analyzer_copy_tools(p->tools_sent, interp);
+            changed |= NCK_PERSIST_TOOLS;
+        }
+        changed |= again & NCK_PERSIST_TOOLS;
     }
-    return written;
+    return changed;
+}
+
+int nck_persist_write_vars(const char *path, const struct ncp_var_file *vf, char *why,
+                           size_t len)
+{
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    if (ncp_var_file_write(path, vf, &d) != NCP_OK)
+        return snprintf(why, len, "%s", d.msg), -1;
+    return 1;
+}
+
+int nck_persist_write_tools(const char *path, const struct ncp_analyzer *tools,
+                            struct ncp_analyzer *base, char *why, size_t len)
+{
+    struct ncp_diag d;
+    memset(&d, 0, sizeof d);
+    int w = 0;
+    if (ncp_analyzer_save_tool_table(tools, base, path, &w, &d) != NCP_OK)
+        return snprintf(why, len, "%s", d.msg), -1;
+    if (w)
+        ncp_analyzer_copy_tools(base, tools);
+    return w;
 }

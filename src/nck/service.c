@@ -36,8 +36,10 @@ struct serve_channel {
     struct ncp_nck *nck;
     int num;                         /* the messages' channel field */
     int32_t jog_client;              /* whose keep-alives hold a continuous jog */
-    int pending;                     /* a command answered later (a load's check) */
+    int pending;                     /* a command answered later (a load's check, or one
+                                        that waits for the NCK's disk writer) */
     int32_t pending_client, pending_seq;
+    int pending_kind;                /* its enum ncp_nck_cmd_kind */
     int faulted;                     /* in fault when last polled */
 };
 
@@ -429,6 +431,7 @@ static void act(struct serve *sv, struct serve_channel *ch, struct client *cl,
         ch->pending = 1;
         ch->pending_client = c->client_id;
         ch->pending_seq = c->seq;
+        ch->pending_kind = c->kind;
         return;
     }
     cl->pending = 0;
@@ -469,7 +472,7 @@ static void answer_pending(struct serve *sv, struct serve_channel *ch)
     struct client *cl = client_of(sv, ch->pending_client, utime_now());
     const char *text;
     size_t len;
-    if (rc == 0 && sv->hook && sv->hook->loaded &&
+    if (rc == 0 && ch->pending_kind == NCP_CMD_LOAD && sv->hook && sv->hook->loaded &&
         ncp_nck_program_text(ch->nck, &text, &len) == 0) {
         struct ncp_nck_snapshot st;
         ncp_nck_get_status(ch->nck, &st);
@@ -477,7 +480,8 @@ static void answer_pending(struct serve *sv, struct serve_channel *ch)
     }
     ncp_ack_t a;
     memset(&a, 0, sizeof a);
-    answer(sv, ch, &a, ch->pending_client, ch->pending_seq, rc, why, 0);
+    answer(sv, ch, &a, ch->pending_client, ch->pending_seq, rc, why,
+           ch->pending_kind == NCP_CMD_FILES);
     if (cl != NULL && cl->seq == ch->pending_seq) {
         cl->ack = a;
         cl->pending = 0;

@@ -11,10 +11,13 @@
 
 #include "trace_rows.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -33,10 +36,11 @@ static void nap_ms(int ms)
     nanosleep(&ts, NULL);
 }
 
-static void start(struct svc *s, int with_trace)
+static void start_history(struct svc *s, int with_trace, const char *history)
 {
     memset(s, 0, sizeof *s);
     ncp_machine_cfg_default(&s->cfg);
+    snprintf(s->cfg.op.history_file, sizeof s->cfg.op.history_file, "%s", history);
     s->cfg.position.priority = 0;
     s->trace = with_trace ? tmpfile() : NULL;
     struct ncp_nck_setup setup = { .cfg = &s->cfg, .virtual_clock = 1, .trace = s->trace,
@@ -45,6 +49,11 @@ static void start(struct svc *s, int with_trace)
     memset(&d, 0, sizeof d);
     s->nck = ncp_nck_new(&setup, &d);
     assert_non_null(s->nck);
+}
+
+static void start(struct svc *s, int with_trace)
+{
+    start_history(s, with_trace, "");
 }
 
 static void stop(struct svc *s)
@@ -675,6 +684,90 @@ static void test_single_block_and_from_line(void **state_)
     stop(&s);
 }
 
+/* Polls until an event holds text (60 s of wall time at most). */
+static void wait_event(struct svc *s, const char *text)
+{
+    struct ncp_nck_event ev;
+    for (int i = 0; i < 60000; i++) {
+        ncp_nck_poll(s->nck);
+        while (ncp_nck_next_event(s->nck, &ev))
+            if (strstr(ev.text, text))
+                return;
+        nap_ms(1);
+    }
+    fail_msg("no event with '%s'", text);
+}
+
+/* One history line from the FIFO the writer appends to: opening its
+ * reading end lets the writer's open go on. */
+static void read_history_line(const char *fifo, char *line, size_t cap)
+{
+    int fd = open(fifo, O_RDONLY | O_NONBLOCK);
+    assert_true(fd >= 0);
+    size_t n = 0;
+    for (int i = 0; i < 60000 && (n == 0 || line[n - 1] != '\n') && n + 1 < cap; i++) {
+        ssize_t r = read(fd, line + n, cap - 1 - n);
+        if (r > 0)
+            n += (size_t)r;
+        else
+            nap_ms(1);
+    }
+    line[n] = 0;
+    close(fd);
+}
+
+/* A disk that does not answer (the history is a FIFO nobody reads yet: the
+ * writer's open waits): the job's state stays until its line is written,
+ * and meanwhile the NCK answers at once; what needs the disk waits for it
+ * (pending), what moves nothing is taken or refused, an E-stop acts, and a
+ * reset ends a wait for the disk. */
+static void test_slow_disk(void **state_)
+{
+    (void)state_;
+    char fifo[64], why[256], line[2048];
+    snprintf(fifo, sizeof fifo, "/tmp/ncp-svc-hist-%d", (int)getpid());
+    unlink(fifo);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    struct svc s;
+    start_history(&s, 0, fifo);
+    home_all(&s);
+    write_prog(&s, "G1 X5 F3000\nM2\n");
+    assert_int_equal(cmd(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), 0);
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, why), 0);
+    wait_event(&s, "program finished");
+    for (int i = 0; i < 20; i++) {
+        ncp_nck_poll(s.nck);
+        nap_ms(1);
+    }
+    assert_int_equal(state(&s), NCP_ST_RUNNING);
+    assert_int_equal(cmd_now(&s, NCP_CMD_PAUSE, NULL, 0, 0, why), -1);
+    assert_non_null(strstr(why, "has ended"));
+    assert_int_equal(cmd_now(&s, NCP_CMD_OVERRIDE, NULL, 50, 0, why), 0);
+    assert_int_equal(cmd_now(&s, NCP_CMD_FILES, "history", 0, 0, why), NCP_NCK_CMD_PENDING);
+    assert_int_equal(ncp_nck_pending(s.nck, why, sizeof why), NCP_NCK_CMD_PENDING);
+    assert_int_equal(cmd_now(&s, NCP_CMD_LOAD, s.prog, 0, 0, why), -1);
+    assert_non_null(strstr(why, "another command waits"));
+    read_history_line(fifo, line, sizeof line);
+    assert_non_null(strstr(line, "\"result\": \"done\""));
+    assert_int_equal(answer(&s, why), 0);
+    assert_string_equal(why, fifo);
+    wait_state(&s, NCP_ST_IDLE);
+
+    assert_int_equal(cmd(&s, NCP_CMD_RUN, NULL, 0, 0, why), 0);
+    wait_event(&s, "program finished");
+    assert_int_equal(cmd_now(&s, NCP_CMD_ESTOP, NULL, 0, 0, why), 0);
+    assert_int_equal(state(&s), NCP_ST_ESTOP);
+    assert_int_equal(cmd_now(&s, NCP_CMD_FILES, "history", 0, 0, why), NCP_NCK_CMD_PENDING);
+    assert_int_equal(cmd_now(&s, NCP_CMD_RESET, NULL, 0, 0, why), 0);
+    assert_int_equal(ncp_nck_pending(s.nck, why, sizeof why), -1);
+    assert_non_null(strstr(why, "reset came while it waited for the disk"));
+    read_history_line(fifo, line, sizeof line);
+    assert_non_null(strstr(line, "\"result\": \"done\""));
+    wait_state(&s, NCP_ST_IDLE);
+    stop(&s);
+    unlink(fifo);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1)
@@ -690,6 +783,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_jog_input),
         cmocka_unit_test(test_estop_reset),
         cmocka_unit_test(test_single_block_and_from_line),
+        cmocka_unit_test(test_slow_disk),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
