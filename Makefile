@@ -150,7 +150,7 @@ deps:
 	    liblcm-dev liblcm-bin \
 	    python3 python3-matplotlib python3-scipy valgrind cppcheck clang-tidy file podman \
 	    libwebsockets-dev chromium firefox-esr \
-	    debhelper lintian man-db curl debootstrap
+	    debhelper lintian man-db curl debootstrap strace
 	command -v npm >/dev/null || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
 	    --no-install-recommends nodejs npm
 	tools/rtvm/install-deps
