@@ -13,6 +13,9 @@ kinds: sharp   CAM-like 1 mm moves with small arcs and sharp turns (60-150 deg)
        stairs  steps along X and Y in turn, 0.5-5 mm, every corner 90 deg
                between axis-aligned lines (where tools/planner-bound.py's
                per-axis floor applies)
+       cam     a CAM contour: 1 mm lines turning up to 15 deg each, Z
+               following a surface, and a tangent G2/G3 (radius 2-10 mm)
+               every 10th block
 usage: gen-planner.py KIND [BLOCKS]"""
 import math
 import random
@@ -151,9 +154,34 @@ def stairs(r, n):
     return out
 
 
+def cam(r, n):
+    out, x, y, h = [], 0.0, 0.0, 0.0
+    for i in range(n):
+        if i % 10 == 9:
+            rad = r.uniform(2, 10)
+            turn = r.uniform(0.1, 0.6)
+            cw = r.random() < 0.5
+            nx, ny = (math.sin(h), -math.cos(h)) if cw else (-math.sin(h), math.cos(h))
+            cx, cy = x + rad * nx, y + rad * ny
+            a0 = math.atan2(y - cy, x - cx)
+            a1 = a0 - turn if cw else a0 + turn
+            sx, sy = x, y
+            x, y = cx + rad * math.cos(a1), cy + rad * math.sin(a1)
+            out.append("%s %s I%.4f J%.4f" % ("G2" if cw else "G3", fmt(x, y), cx - sx, cy - sy))
+            h += -turn if cw else turn
+        else:
+            h += math.radians(r.uniform(-15, 15))
+            if abs(x) > LIM or abs(y) > LIM:
+                h = math.atan2(-y, -x)
+            x += math.cos(h)
+            y += math.sin(h)
+            out.append("G1 " + fmt(x, y, -0.5 - 0.2 * math.sin(i * 0.05)))
+    return out
+
+
 KINDS = {"sharp": (sharp, 300), "arcs": (arcs, 100), "tiny": (tiny, 1000),
          "lines": (lines, 15), "helix": (helix, 12), "square": (square, 60),
-         "walk": (walk, 150), "stairs": (stairs, 100)}
+         "walk": (walk, 150), "stairs": (stairs, 100), "cam": (cam, 300)}
 
 
 def main():
