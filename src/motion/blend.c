@@ -241,6 +241,8 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
     ncp_seg_eval(prev, prev->length - arc_trim, q1, t1);
     direction(cur, t2);
     int skewed = fabs(dot3(t2, prev->normal)) > 1e-9;
+    if (skewed && prev->tolerance <= 0)
+        return 0;  /* off the plane only where P bounds the blend */
     cross3(t1, t2, n);
     double nn = dot3(n, n), c = dot3(t1, t2);
     if (nn < 1e-18 || c < -0.999)
