@@ -31,6 +31,18 @@ def fmt(x, y, z=None):
     return s + (" Z%.4f" % z if z is not None else "")
 
 
+def tangent_arc(x, y, h, rad, turn, cw):
+    """A G2 (cw) or G3 of radius rad leaving (x, y) along heading h and
+    turning by turn: its block, where it ends and its heading there."""
+    nx, ny = (math.sin(h), -math.cos(h)) if cw else (-math.sin(h), math.cos(h))
+    cx, cy = x + rad * nx, y + rad * ny
+    a0 = math.atan2(y - cy, x - cx)
+    a1 = a0 - turn if cw else a0 + turn
+    ex, ey = cx + rad * math.cos(a1), cy + rad * math.sin(a1)
+    block = "%s %s I%.4f J%.4f" % ("G2" if cw else "G3", fmt(ex, ey), cx - x, cy - y)
+    return block, ex, ey, h - turn if cw else h + turn
+
+
 def sharp(r, n):
     out, x, y, h = [], 0.0, 0.0, 0.0
     while len(out) < n:
@@ -38,15 +50,8 @@ def sharp(r, n):
             # a small arc leaving tangentially, turning by up to 90 deg
             rad = r.uniform(0.5, 2.0)
             cw = r.random() < 0.5
-            turn = r.uniform(0.3, 1.5)
-            nx, ny = (math.sin(h), -math.cos(h)) if cw else (-math.sin(h), math.cos(h))
-            cx, cy = x + rad * nx, y + rad * ny
-            a0 = math.atan2(y - cy, x - cx)
-            a1 = a0 - turn if cw else a0 + turn
-            sx, sy = x, y
-            x, y = cx + rad * math.cos(a1), cy + rad * math.sin(a1)
-            out.append("%s %s I%.4f J%.4f" % ("G2" if cw else "G3", fmt(x, y), cx - sx, cy - sy))
-            h += -turn if cw else turn
+            block, x, y, h = tangent_arc(x, y, h, rad, r.uniform(0.3, 1.5), cw)
+            out.append(block)
         else:
             h += r.choice([-1, 1]) * math.radians(r.uniform(60, 150))
             x += math.cos(h)
@@ -160,15 +165,8 @@ def cam(r, n):
         if i % 10 == 9:
             rad = r.uniform(2, 10)
             turn = r.uniform(0.1, 0.6)
-            cw = r.random() < 0.5
-            nx, ny = (math.sin(h), -math.cos(h)) if cw else (-math.sin(h), math.cos(h))
-            cx, cy = x + rad * nx, y + rad * ny
-            a0 = math.atan2(y - cy, x - cx)
-            a1 = a0 - turn if cw else a0 + turn
-            sx, sy = x, y
-            x, y = cx + rad * math.cos(a1), cy + rad * math.sin(a1)
-            out.append("%s %s I%.4f J%.4f" % ("G2" if cw else "G3", fmt(x, y), cx - sx, cy - sy))
-            h += -turn if cw else turn
+            block, x, y, h = tangent_arc(x, y, h, rad, turn, r.random() < 0.5)
+            out.append(block)
         else:
             h += math.radians(r.uniform(-15, 15))
             if abs(x) > LIM or abs(y) > LIM:

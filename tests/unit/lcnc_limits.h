@@ -21,6 +21,17 @@ static void lcnc_like_cfg(struct ncp_machine_cfg *c)
     }
 }
 
+/* The program text run on lcnc_like_cfg's machine (gcode_src.h's run_text,
+ * included before): its trace, n rows, the servo period in *T. */
+static inline struct row *run_lcnc_like(const char *prog, size_t *n, double *T)
+{
+    struct ncp_machine_cfg cfg;
+    struct ncp_nck_result res;
+    lcnc_like_cfg(&cfg);
+    *T = cfg.servo_period;
+    return run_text(prog, &cfg, n, &res);
+}
+
 /* Largest per-axis acceleration over the limit, from the commanded samples. */
 static double worst_acc(const struct row *r, size_t n, double T)
 {

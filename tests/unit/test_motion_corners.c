@@ -258,36 +258,60 @@ static void test_uneven_corner_loads_both_axes(void **state)
 
 /* An arc running into a line: a G2 of radius 10 ending along +Y at X10 Y10,
  * then a line along u2, phi_deg to the left of +Y (against the arc's
- * curvature for phi_deg > 0). The path is run and every axis must stay
- * within its limits and the corner within P; the slowest sample within
- * 0.1 mm of the corner is returned. */
-static double arc_line_corner(double phi_deg)
+ * curvature for phi_deg > 0), rising `slope` mm per mm (leaving the arc's
+ * plane, as a CAM contour's Z beside a G2 in XY), or the same path backwards
+ * (the line first, into a G3). Every axis within its limits, the corner
+ * point passed within P in X Y Z by the servo's chords; the slowest of those
+ * within 0.1 mm of it is returned. */
+static double arc_line_corner_z(double phi_deg, double slope, int line_first)
 {
     const double phi = phi_deg * M_PI / 180, u2[2] = { -sin(phi), cos(phi) };
-    char prog[200];
-    snprintf(prog, sizeof prog,
-             "G21 G90 G17 G64 P0.01 Q0\nG0 X20 Y0\nG2 X10 Y10 I0 J10 F3000\nG1 X%.9f Y%.9f\nM2\n",
-             10 + 5 * u2[0], 10 + 5 * u2[1]);
-    struct ncp_machine_cfg cfg;
-    lcnc_like_cfg(&cfg);
-    struct ncp_nck_result res;
+    const double far[3] = { 10 + 5 * u2[0], 10 + 5 * u2[1], 5 * slope };
+    char prog[240];
+    if (line_first)
+        snprintf(prog, sizeof prog,
+                 "G21 G90 G17 G64 P0.01 Q0\nG0 X%.9f Y%.9f Z%.9f\nG1 X10 Y10 Z0 F3000\n"
+                 "G3 X20 Y0 I10 J0\nM2\n", far[0], far[1], far[2]);
+    else
+        snprintf(prog, sizeof prog,
+                 "G21 G90 G17 G64 P0.01 Q0\nG0 X20 Y0 Z0\nG2 X10 Y10 I0 J10 F3000\n"
+                 "G1 X%.9f Y%.9f Z%.9f\nM2\n", far[0], far[1], far[2]);
     size_t n;
-    struct row *r = run_text(prog, &cfg, &n, &res);
-    const double T = cfg.servo_period;
+    double T;
+    struct row *r = run_lcnc_like(prog, &n, &T);
     double v_min = INFINITY, closest = INFINITY;
     for (size_t k = 1; k < n; k++) {
-        double d = hypot(r[k].cmd[0] - 10, r[k].cmd[1] - 10);
+        /* the servo's chord from sample k - 1 to k: at 30 mm/s the samples
+         * lie 0.03 mm apart, and the corner between two of them */
+        const double a[3] = { r[k - 1].cmd[0] - 10, r[k - 1].cmd[1] - 10, r[k - 1].cmd[2] };
+        double e[3], ee = 0, ae = 0;
+        for (int j = 0; j < 3; j++) {
+            e[j] = r[k].cmd[j] - r[k - 1].cmd[j];
+            ee += e[j] * e[j];
+            ae += a[j] * e[j];
+        }
+        double f = ee > 0 ? fmin(1, fmax(0, -ae / ee)) : 0, d = 0;
+        for (int j = 0; j < 3; j++)
+            d += (a[j] + f * e[j]) * (a[j] + f * e[j]);
+        d = sqrt(d);
         closest = fmin(closest, d);
         if (d < 0.1)
-            v_min = fmin(v_min, hypot(r[k].cmd[0] - r[k - 1].cmd[0], r[k].cmd[1] - r[k - 1].cmd[1]) / T);
+            v_min = fmin(v_min, sqrt(ee) / T);
     }
     double w = worst_acc(r, n, T);
     if (closest > 0.01 + 1e-6 || w > 1 + 1e-9)
-        fail_msg("arc into a line at %.0f deg: corner missed by %.5f mm (P 0.01), axis "
+        fail_msg("%s at %.0f deg, Z %g mm/mm: corner missed by %.5f mm (P 0.01), axis "
                  "acceleration %.4f of the limit",
-                 phi_deg, closest, w);
+                 line_first ? "a line into an arc" : "an arc into a line", phi_deg, slope,
+                 closest, w);
     free(r);
     return v_min;
+}
+
+/* The same in the arc's plane, arc first. */
+static double arc_line_corner(double phi_deg)
+{
+    return arc_line_corner_z(phi_deg, 0, 0);
 }
 
 /* The 90 degree turn to -X: the blend is the corner parabola through the
@@ -334,60 +358,6 @@ static void test_arc_line_corner_turning_with_the_arc(void **state)
         print_message("arc into a line turning %.0f deg with it: %.2f mm/s, parabola %.2f\n",
                       -turn[i], v_min, v_parab);
     }
-}
-
-/* A line leaving the arc's plane, as a CAM contour's Z beside a G2 in XY:
- * the arc of arc_line_corner_z into a line turning phi_deg to the left of +Y
- * and rising `slope` mm per mm, or the same path backwards (the line first,
- * falling into a G3). Every axis within its limits, the corner point passed
- * within P in X Y Z by the servo's chords; the slowest of those within 0.1
- * mm of it is returned. */
-static double arc_line_corner_z(double phi_deg, double slope, int line_first)
-{
-    const double phi = phi_deg * M_PI / 180, u2[2] = { -sin(phi), cos(phi) };
-    const double far[3] = { 10 + 5 * u2[0], 10 + 5 * u2[1], 5 * slope };
-    char prog[240];
-    if (line_first)
-        snprintf(prog, sizeof prog,
-                 "G21 G90 G17 G64 P0.01 Q0\nG0 X%.9f Y%.9f Z%.9f\nG1 X10 Y10 Z0 F3000\n"
-                 "G3 X20 Y0 I10 J0\nM2\n", far[0], far[1], far[2]);
-    else
-        snprintf(prog, sizeof prog,
-                 "G21 G90 G17 G64 P0.01 Q0\nG0 X20 Y0 Z0\nG2 X10 Y10 I0 J10 F3000\n"
-                 "G1 X%.9f Y%.9f Z%.9f\nM2\n", far[0], far[1], far[2]);
-    struct ncp_machine_cfg cfg;
-    lcnc_like_cfg(&cfg);
-    struct ncp_nck_result res;
-    size_t n;
-    struct row *r = run_text(prog, &cfg, &n, &res);
-    const double T = cfg.servo_period;
-    double v_min = INFINITY, closest = INFINITY;
-    for (size_t k = 1; k < n; k++) {
-        /* the servo's chord from sample k - 1 to k: at 30 mm/s the samples
-         * lie 0.03 mm apart, and the corner between two of them */
-        double a[3] = { r[k - 1].cmd[0] - 10, r[k - 1].cmd[1] - 10, r[k - 1].cmd[2] };
-        double e[3], ee = 0, ae = 0;
-        for (int j = 0; j < 3; j++) {
-            e[j] = r[k].cmd[j] - r[k - 1].cmd[j];
-            ee += e[j] * e[j];
-            ae += a[j] * e[j];
-        }
-        double f = ee > 0 ? fmin(1, fmax(0, -ae / ee)) : 0, d = 0;
-        for (int j = 0; j < 3; j++)
-            d += (a[j] + f * e[j]) * (a[j] + f * e[j]);
-        d = sqrt(d);
-        closest = fmin(closest, d);
-        if (d < 0.1)
-            v_min = fmin(v_min, sqrt(ee) / T);
-    }
-    double w = worst_acc(r, n, T);
-    if (closest > 0.01 + 1e-6 || w > 1 + 1e-9)
-        fail_msg("%s at %.0f deg, Z %g mm/mm: corner missed by %.5f mm (P 0.01), axis "
-                 "acceleration %.4f of the limit",
-                 line_first ? "a line into an arc" : "an arc into a line", phi_deg, slope,
-                 closest, w);
-    free(r);
-    return v_min;
 }
 
 /* The line's Z once kept the corner from being blended at all: the tangent
