@@ -205,6 +205,13 @@ static void reverse(const struct ncp_seg *s, struct ncp_seg *o)
     o->r1 = s->r0;
 }
 
+int ncp_blend_line_leaves(const struct ncp_seg *arc, const struct ncp_seg *line)
+{
+    double u[3];
+    direction(line, u);
+    return fabs(dot3(u, arc->normal)) > 1e-9;
+}
+
 static int plane_arc(const struct ncp_seg *s)
 {
     /* a programmed arc's radii differ by the rounding of its end and centre */
@@ -240,7 +247,7 @@ static int arc_line(const struct ncp_seg *prev, const struct ncp_seg *cur, doubl
         return 0;
     ncp_seg_eval(prev, prev->length - arc_trim, q1, t1);
     direction(cur, t2);
-    int skewed = fabs(dot3(t2, prev->normal)) > 1e-9;
+    int skewed = ncp_blend_line_leaves(prev, cur);
     if (skewed && prev->tolerance <= 0)
         return 0;  /* off the plane only where P bounds the blend */
     cross3(t1, t2, n);

@@ -37,10 +37,14 @@ int ncp_blend_fan_init(struct ncp_blend_fan *f, const struct ncp_seg *prev,
 double ncp_blend_fan_at(const struct ncp_blend_fan *f, double r0, double start[3], double end[3]);
 
 /* blend.c: the same where one side is an arc in a plane and the other a line
- * in it: the arc gives up arc_trim of its length, the line what the blend
- * needs; prev_out and cur_out are the trimmed segments. 0 when the cut gives
- * no blend or leaves prev's G64 P. */
+ * (in that plane, or leaving it under a G64 P: ncp_blend_line_leaves): the
+ * arc gives up arc_trim of its length, the line what the blend needs;
+ * prev_out and cur_out are the trimmed segments. 0 when the cut gives no
+ * blend or leaves prev's G64 P. */
 int ncp_blend_arc_corner(const struct ncp_seg *prev, const struct ncp_seg *cur, double arc_trim,
                          struct ncp_seg *arc, struct ncp_seg *prev_out, struct ncp_seg *cur_out);
+/* blend.c: 1 where line (of some length) leaves arc's plane; its blend with
+ * the arc then ends in a slight kink where the line takes over. */
+int ncp_blend_line_leaves(const struct ncp_seg *arc, const struct ncp_seg *line);
 
 #endif

@@ -1001,8 +1001,7 @@ static int size_arc_blend(const struct ncp_planner *p, const struct ncp_seg *tol
     double lo = 0, hi = 0.5 * a->length;
     /* a line leaving the arc's plane ends its blend with a slight kink
      * (blend.c), a velocity step that an S-curve would take as a jerk */
-    if (plan_scurve(p) && line->length > 0 &&
-        fabs(dot3(a->normal, line->end) - dot3(a->normal, line->start)) > 1e-9 * line->length)
+    if (plan_scurve(p) && line->length > 0 && ncp_blend_line_leaves(a, line))
         return 0;
     /* the largest cut within P: the deviation grows with the cut */
     if (!ncp_blend_arc_corner(tol, s, hi, arc, prev_out, cur_out)) {

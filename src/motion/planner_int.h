@@ -199,12 +199,6 @@ static inline double plan_reach(int scurve, double acc, double jerk, double v, d
     return sqrt(v * v + 2 * acc * len);
 }
 
-/* The path acceleration ps allows at speeds up to v: an arc's centripetal
- * acceleration v^2 kappa (a corner parabola's turn, parab_limits) takes less
- * of its bound a_eff below the cruise cap, so the tangent gets the rest,
- * scaled as a corner scaled acc. Never below acc, the value at the cruise cap.
- * A fitted arc's box (box_kappa) is read beside the disc: each is a bound on
- * what every axis allows, so the larger is too. */
 /* The tangent a fitted arc's box leaves at centripetal acceleration a_n. */
 static inline double plan_box_at(const struct plan_seg *ps, double a_n)
 {
@@ -214,6 +208,12 @@ static inline double plan_box_at(const struct plan_seg *ps, double a_n)
     return at;
 }
 
+/* The path acceleration ps allows at speeds up to v: an arc's centripetal
+ * acceleration v^2 kappa (a corner parabola's turn, parab_limits) takes less
+ * of its bound a_eff below the cruise cap, so the tangent gets the rest,
+ * scaled as a corner scaled acc. Never below acc, the value at the cruise cap.
+ * A fitted arc's box (box_kappa) is read beside the disc: each is a bound on
+ * what every axis allows, so the larger is too. */
 static inline double plan_acc_at(const struct plan_seg *ps, double v)
 {
     if (ps->kappa <= 0 || ps->acc_full <= 0)
