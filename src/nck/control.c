@@ -139,7 +139,7 @@ static void run_state_text(struct ncp_nck *s, const char *text, const char *name
 static void persist(struct ncp_nck *s)
 {
     int changed = nck_persist_changes(&s->persist, s->interp, nck_writer_again(&s->writer));
-    nck_writer_persist(&s->writer, &s->persist, changed);
+    nck_writer_persist(&s->writer, changed);
 }
 
 /* A program run's line in the job history, made here and appended by the
@@ -1188,7 +1188,7 @@ int ncp_nck_poll(struct ncp_nck *s)
     /* the writer caught up too: what it writes is said as events before
      * the service ends */
     if (s->shutdown_pending && s->drop == NCK_DROP_NONE && !moving_state(s->state) &&
-        !s->loading && !s->ended_answer && !s->deferred && !nck_writer_busy(&s->writer))
+        !s->loading && !s->ended_answer && !s->deferred && !disk_busy(s))
         s->shutdown = 1;
     int changed = s->changed;
     s->changed = 0;
@@ -1274,7 +1274,7 @@ void ncp_nck_free(struct ncp_nck *s)
     int changed = s->interp && s->writer.started
                       ? nck_persist_changes(&s->persist, s->interp, nck_writer_again(&s->writer))
                       : 0;
-    nck_writer_stop(&s->writer, &s->persist, changed);
+    nck_writer_stop(&s->writer, changed);
     nck_persist_free(&s->persist);
     nck_release(n);
     ncp_analyzer_free(s->interp);

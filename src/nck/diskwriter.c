@@ -153,8 +153,9 @@ int nck_writer_line(struct nck_writer *w, const char *line, size_t n)
 }
 
 /* under the lock */
-static void hand_over(struct nck_writer *w, const struct nck_persist *p, int changed)
+static void hand_over(struct nck_writer *w, int changed)
 {
+    const struct nck_persist *p = w->persist;
     int taken = 0;
     if ((changed & NCK_PERSIST_VARS) && p->vf) {
         memcpy(w->vars_next, p->vf, sizeof *w->vars_next);
@@ -170,12 +171,12 @@ static void hand_over(struct nck_writer *w, const struct nck_persist *p, int cha
     pthread_cond_signal(&w->wake);
 }
 
-void nck_writer_persist(struct nck_writer *w, const struct nck_persist *p, int changed)
+void nck_writer_persist(struct nck_writer *w, int changed)
 {
     if (!w->started)
         return;
     pthread_mutex_lock(&w->lock);
-    hand_over(w, p, changed);
+    hand_over(w, changed);
     pthread_mutex_unlock(&w->lock);
 }
 
@@ -194,13 +195,13 @@ int nck_writer_busy(struct nck_writer *w)
     return busy;
 }
 
-void nck_writer_stop(struct nck_writer *w, const struct nck_persist *p, int changed)
+void nck_writer_stop(struct nck_writer *w, int changed)
 {
     if (!w->started)
         return;
     pthread_mutex_lock(&w->lock);
     w->to_stderr = 1;
-    hand_over(w, p, changed);
+    hand_over(w, changed);
     w->quit = 1;
     pthread_cond_signal(&w->wake);
     pthread_mutex_unlock(&w->lock);

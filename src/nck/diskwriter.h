@@ -23,7 +23,8 @@ struct nck_core;
 struct nck_writer {
     struct nck_core *core;           /* its events */
     const char *hist_path;
-    struct nck_persist *persist;     /* the paths; its tools_base is the thread's */
+    struct nck_persist *persist;     /* the paths and what is handed over; its
+                                        tools_base is the thread's */
     pthread_t th;
     int started;
     pthread_mutex_t lock;            /* guards what follows, up to the thread's own */
@@ -51,18 +52,18 @@ int nck_writer_start(struct nck_writer *w, struct nck_core *core, const char *hi
 /* A history line to append after those handed over before: 0, or -1 when
  * NCK_WRITER_LINES wait already (the line is not kept). */
 int nck_writer_line(struct nck_writer *w, const char *line, size_t n);
-/* The files of changed (NCK_PERSIST_* bits) with p's values now
+/* The files of changed (NCK_PERSIST_* bits) with the persist's values now
  * (nck_persist_changes), over whatever of them still waits. */
-void nck_writer_persist(struct nck_writer *w, const struct nck_persist *p, int changed);
+void nck_writer_persist(struct nck_writer *w, int changed);
 /* The failed files' bits, cleared: nck_persist_changes's again. */
 int nck_writer_again(struct nck_writer *w);
 /* 1 while anything handed over waits or is being written; 0 once all of it
  * is written (or failed, said as an event). */
 int nck_writer_busy(struct nck_writer *w);
-/* The NCK's end: the files of changed with p's values handed over last,
- * everything that waits written, then the thread ends; what fails from
- * here on is said on stderr (no event is read after the service). Frees
- * the buffers. */
-void nck_writer_stop(struct nck_writer *w, const struct nck_persist *p, int changed);
+/* The NCK's end: the files of changed with the persist's values handed
+ * over last, everything that waits written, then the thread ends; what
+ * fails from here on is said on stderr (no event is read after the
+ * service). Frees the buffers. */
+void nck_writer_stop(struct nck_writer *w, int changed);
 
 #endif
